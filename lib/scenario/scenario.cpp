@@ -1,0 +1,534 @@
+/// @file Scenario parsing (toml++) and validation. See scenario.h and docs/scenarios.md.
+///
+/// Two passes, as the header promises: a reader maps tables and keys 1:1 onto the structs,
+/// rejecting unknown keys and wrong types; then one validator per struct checks ranges and
+/// cross-field limits. Every failure is an rths::Error(where = "<file>: <dotted.key>", what).
+#include "scenario/scenario.h"
+
+#include <openssl/evp.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <initializer_list>
+#include <iterator>
+#include <limits>
+#include <sstream>
+#include <string>
+#include <type_traits>
+#include <utility>
+#include <vector>
+
+#include <fmt/format.h>
+#include <toml++/toml.h>
+
+#include "core/error.h"
+
+namespace rths::scenario {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+/// The name used in messages for the scenario's source.
+std::string DisplayName(const std::string& path) { return path.empty() ? "<scenario text>" : path; }
+
+/// Comma-separated list, each item wrapped in `quote`.
+std::string JoinList(const std::vector<std::string_view>& items, std::string_view quote = "") {
+  std::string out;
+  for (std::size_t i = 0; i < items.size(); ++i) {
+    if (i > 0) out += ", ";
+    out += quote;
+    out += items[i];
+    out += quote;
+  }
+  return out;
+}
+
+std::size_t EditDistance(std::string_view a, std::string_view b) {
+  std::vector<std::size_t> row(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    std::size_t diagonal = row[0];
+    row[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const std::size_t above = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      diagonal = above;
+    }
+  }
+  return row[b.size()];
+}
+
+/// The allowed name closest to `name`, or "" if none is close (a typo or a missing/extra suffix).
+std::string_view ClosestName(std::string_view name, const std::vector<std::string_view>& allowed) {
+  std::string_view best;
+  std::size_t best_distance = std::numeric_limits<std::size_t>::max();
+  for (std::string_view candidate : allowed) {
+    std::size_t d = EditDistance(name, candidate);
+    const bool close = d <= std::max<std::size_t>(2, name.size() / 3);
+    const bool affix = name.size() >= 3 && (candidate.starts_with(name) || name.starts_with(candidate));
+    if (!close && !affix) continue;
+    if (affix) d = std::min<std::size_t>(d, 1);  // "noise_y_mm" -> "noise_y_mm_rms"
+    if (d < best_distance) {
+      best_distance = d;
+      best = candidate;
+    }
+  }
+  return best;
+}
+
+/// "string \"abc\"", "float 2.5", "table", ... for type errors.
+std::string DescribeNode(const toml::node& node) {
+  switch (node.type()) {
+    case toml::node_type::string:
+      return fmt::format("string \"{}\"", node.as_string()->get());
+    case toml::node_type::integer:
+      return fmt::format("integer {}", node.as_integer()->get());
+    case toml::node_type::floating_point:
+      return fmt::format("float {}", node.as_floating_point()->get());
+    case toml::node_type::boolean:
+      return fmt::format("boolean {}", node.as_boolean()->get());
+    case toml::node_type::table:
+      return "a table";
+    case toml::node_type::array:
+      return "an array";
+    case toml::node_type::date:
+      return "a date";
+    case toml::node_type::time:
+      return "a time";
+    case toml::node_type::date_time:
+      return "a date-time";
+    case toml::node_type::none:
+      break;
+  }
+  return "nothing";
+}
+
+// ---------------------------------------------------------------------------------------
+// Pass 1: TOML -> structs (keys and types).
+
+/// One TOML table mapped onto a struct. Each read declares its key; Finish() rejects the rest.
+class Section {
+ public:
+  Section(std::string file, const toml::table* table, std::string prefix)
+      : file_(std::move(file)), table_(table), prefix_(std::move(prefix)) {}
+
+  void Number(std::string_view key, double* out) {
+    const toml::node* node = Declare(key, false);
+    if (node == nullptr) return;
+    if (const auto* f = node->as_floating_point()) {
+      *out = f->get();
+    } else if (const auto* i = node->as_integer()) {
+      *out = static_cast<double>(i->get());
+    } else {
+      WrongType(key, "a number (float or integer)", *node);
+    }
+  }
+
+  template <typename Int>
+  void Integer(std::string_view key, Int* out) {
+    const toml::node* node = Declare(key, false);
+    if (node == nullptr) return;
+    const auto* i = node->as_integer();
+    if (i == nullptr) WrongType(key, "an integer", *node);
+    const std::int64_t v = i->get();
+    bool fits = true;
+    if constexpr (std::is_unsigned_v<Int>) {
+      fits = v >= 0 && static_cast<std::uint64_t>(v) <= std::numeric_limits<Int>::max();
+    } else {
+      fits = v >= std::numeric_limits<Int>::min() && v <= std::numeric_limits<Int>::max();
+    }
+    if (!fits) {
+      Fail(key, fmt::format("{} is out of range [{}, {}]", v, std::numeric_limits<Int>::min(),
+                            std::numeric_limits<Int>::max()));
+    }
+    *out = static_cast<Int>(v);
+  }
+
+  void String(std::string_view key, std::string* out) {
+    const toml::node* node = Declare(key, false);
+    if (node == nullptr) return;
+    const auto* s = node->as_string();
+    if (s == nullptr) WrongType(key, "a string", *node);
+    *out = s->get();
+  }
+
+  void Bool(std::string_view key, bool* out) {
+    const toml::node* node = Declare(key, false);
+    if (node == nullptr) return;
+    const auto* b = node->as_boolean();
+    if (b == nullptr) WrongType(key, "a boolean (true or false)", *node);
+    *out = b->get();
+  }
+
+  /// A ServoModel3: a preset name or an inline table {K, p, b, c} (all four required).
+  void Servo(std::string_view key, ServoModel3* out) {
+    const toml::node* node = Declare(key, false);
+    if (node == nullptr) return;
+    constexpr std::string_view kExpected =
+        "a preset name (\"0.0A\", \"2.5A\", \"avg\") or a table {K = ..., p = ..., b = ..., c = ...}";
+    if (const auto* s = node->as_string()) {
+      try {
+        *out = ServoPreset(s->get());
+      } catch (const Error&) {
+        Fail(key, fmt::format("unknown servo model preset \"{}\" (allowed: \"0.0A\", \"2.5A\", \"avg\", "
+                              "or a table {{K = ..., p = ..., b = ..., c = ...}})",
+                              s->get()));
+      }
+      return;
+    }
+    const auto* table = node->as_table();
+    if (table == nullptr) WrongType(key, kExpected, *node);
+    Section model(file_, table, Dotted(key) + ".");
+    ServoModel3 m;
+    m.name = "custom";
+    for (auto [name, field] : {std::pair{"K", &m.K}, {"p", &m.p}, {"b", &m.b}, {"c", &m.c}}) {
+      model.Number(name, field);
+    }
+    model.Finish();
+    for (std::string_view name : {"K", "p", "b", "c"}) {
+      if (table->get(name) == nullptr) {
+        model.Fail(name, "missing (a servo model table needs all of K, p, b, c, each > 0)");
+      }
+    }
+    *out = m;
+  }
+
+  /// A sub-table (absent -> an empty section, so every key keeps its default).
+  Section Sub(std::string_view key) {
+    const toml::node* node = Declare(key, true);
+    const toml::table* table = nullptr;
+    if (node != nullptr) {
+      table = node->as_table();
+      if (table == nullptr) WrongType(key, "a table", *node);
+    }
+    return Section(file_, table, Dotted(key) + ".");
+  }
+
+  /// Rejects every key that no read declared, suggesting the closest declared one.
+  void Finish() const {
+    if (table_ == nullptr) return;
+    for (auto&& [k, node] : *table_) {
+      const std::string_view name = k.str();
+      if (std::find(keys_.begin(), keys_.end(), name) != keys_.end() ||
+          std::find(tables_.begin(), tables_.end(), name) != tables_.end()) {
+        continue;
+      }
+      const bool is_table = node.is_table() || node.is_array_of_tables();
+      std::vector<std::string_view> allowed;
+      std::string list;
+      if (is_table) {
+        allowed = tables_;
+        list = tables_.empty() ? "no tables allowed here" : "allowed tables: " + JoinList(tables_);
+        if (!keys_.empty()) list += "; allowed keys: " + JoinList(keys_);
+      } else {
+        allowed = keys_;
+        allowed.insert(allowed.end(), tables_.begin(), tables_.end());
+        list = "allowed: " + JoinList(allowed);
+      }
+      std::string problem = fmt::format("unknown {} ({})", is_table ? "table" : "key", list);
+      if (std::string_view close = ClosestName(name, allowed); !close.empty()) {
+        problem += fmt::format("; did you mean \"{}{}\"?", prefix_, close);
+      }
+      Fail(name, problem);
+    }
+  }
+
+  [[noreturn]] void Fail(std::string_view key, std::string problem) const {
+    throw Error(fmt::format("{}: {}", file_, Dotted(key)), std::move(problem));
+  }
+
+ private:
+  std::string Dotted(std::string_view key) const { return prefix_ + std::string(key); }
+
+  const toml::node* Declare(std::string_view key, bool is_table) {
+    (is_table ? tables_ : keys_).push_back(key);
+    return table_ == nullptr ? nullptr : table_->get(key);
+  }
+
+  [[noreturn]] void WrongType(std::string_view key, std::string_view expected, const toml::node& found) const {
+    Fail(key, fmt::format("expected {}, found {}", expected, DescribeNode(found)));
+  }
+
+  std::string file_;
+  const toml::table* table_;
+  std::string prefix_;
+  std::vector<std::string_view> keys_;    // declared scalar keys (string literals: static storage)
+  std::vector<std::string_view> tables_;  // declared sub-tables
+};
+
+/// `rms_key` is the unit-bearing name of SignalSpec::rms in this table.
+void ReadSignal(Section& section, std::string_view rms_key, SignalSpec* s) {
+  section.String("kind", &s->kind);
+  section.Number("band_hz", &s->band_hz);
+  section.Number(rms_key, &s->rms);
+  section.Integer("seed", &s->seed);
+  section.Number("discard_s", &s->discard_s);
+  section.String("file", &s->file);
+  section.Number("file_dt_s", &s->file_dt_s);
+  section.Number("scale", &s->scale);
+  section.Finish();
+}
+
+void ReadScenario(const toml::table& root, const std::string& file, Scenario* s) {
+  Section top(file, &root, "");
+
+  Section run = top.Sub("run");
+  run.String("name", &s->run.name);
+  run.Number("dt_s", &s->run.dt_s);
+  run.Number("duration_s", &s->run.duration_s);
+  run.Finish();
+
+  Section structure = top.Sub("structure");
+  StructureConfig& st = s->structure;
+  structure.String("mode", &st.mode);
+  structure.Number("mass_kg", &st.mass_kg);
+  structure.Number("frequency_hz", &st.frequency_hz);
+  structure.Number("damping_ratio", &st.damping_ratio);
+  structure.Number("specimen_count", &st.specimen_count);
+  structure.String("derivatives", &st.derivatives);
+  Section ground = structure.Sub("ground");
+  ReadSignal(ground, "rms_mm_s2", &st.ground);
+  Section desired = structure.Sub("desired");
+  ReadSignal(desired, "rms_mm", &st.desired);
+  structure.Finish();
+
+  Section controller = top.Sub("controller");
+  controller.String("kind", &s->controller.kind);
+  controller.Servo("model", &s->controller.model);
+  controller.Bool("half_step_ahead", &s->controller.half_step_ahead);
+  controller.Finish();
+
+  Section plant = top.Sub("plant");
+  plant.Servo("actuator", &s->plant.actuator);
+  plant.String("specimen", &s->plant.specimen);
+  plant.Number("noise_y_mm_rms", &s->plant.noise_y_mm_rms);
+  plant.Number("noise_f_kN_rms", &s->plant.noise_f_kN_rms);
+  plant.Integer("noise_seed", &s->plant.noise_seed);
+  plant.Number("cvode_rtol", &s->plant.cvode_rtol);
+  plant.Finish();
+
+  Section semiactive = top.Sub("semiactive");
+  semiactive.String("mode", &s->semiactive.mode);
+  semiactive.Number("current_A", &s->semiactive.current_A);
+  semiactive.Number("max_current_A", &s->semiactive.max_current_A);
+  semiactive.Finish();
+
+  Section lockstep = top.Sub("lockstep");
+  lockstep.Number("timeout_ms", &s->lockstep.timeout_ms);
+  lockstep.Integer("max_attempts", &s->lockstep.max_attempts);
+  lockstep.Number("handshake_timeout_s", &s->lockstep.handshake_timeout_s);
+  lockstep.Finish();
+
+  top.Finish();
+}
+
+// ---------------------------------------------------------------------------------------
+// Pass 2: one validator per struct (ranges as documented in scenario.h).
+
+/// An interval of allowed values; `note` explains a computed bound.
+struct Range {
+  double lo;
+  double hi;
+  bool lo_open;
+  bool hi_open;
+  std::string note = {};
+};
+Range Closed(double lo, double hi) { return {lo, hi, false, false}; }
+Range OpenClosed(double lo, double hi) { return {lo, hi, true, false}; }
+Range ClosedOpen(double lo, double hi) { return {lo, hi, false, true}; }
+Range Open(double lo, double hi) { return {lo, hi, true, true}; }
+
+class Check {
+ public:
+  explicit Check(std::string file) : file_(std::move(file)) {}
+
+  [[noreturn]] void Fail(std::string_view key, std::string problem) const {
+    throw Error(fmt::format("{}: {}", file_, key), std::move(problem));
+  }
+
+  void InRange(std::string_view key, double v, const Range& r) const {
+    const bool above_lo = r.lo_open ? v > r.lo : v >= r.lo;
+    const bool below_hi = r.hi_open ? v < r.hi : v <= r.hi;
+    if (std::isfinite(v) && above_lo && below_hi) return;
+    std::string problem = fmt::format("{} is out of range {}{}, {}{}", v, r.lo_open ? '(' : '[', r.lo, r.hi,
+                                      r.hi_open ? ')' : ']');
+    if (!r.note.empty()) problem += " (" + r.note + ")";
+    Fail(key, problem);
+  }
+
+  void OneOf(std::string_view key, const std::string& v, std::initializer_list<std::string_view> allowed) const {
+    if (std::find(allowed.begin(), allowed.end(), v) != allowed.end()) return;
+    Fail(key, fmt::format("\"{}\" is not allowed (allowed: {})", v, JoinList(allowed, "\"")));
+  }
+
+ private:
+  std::string file_;
+};
+
+/// Where a `kind = "file"` path points: relative paths are relative to the scenario's folder.
+std::filesystem::path ResolveSignalFile(const std::string& scenario_path, const std::string& file) {
+  std::filesystem::path p(file);
+  if (p.is_relative()) p = std::filesystem::path(scenario_path).parent_path() / p;
+  return std::filesystem::absolute(p).lexically_normal();
+}
+
+void ValidateRun(const RunConfig& r, const Check& check) {
+  if (r.name.empty() || !std::all_of(r.name.begin(), r.name.end(), [](char c) {
+        return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' ||
+               c == '-' || c == '.';
+      })) {
+    check.Fail("run.name", fmt::format("\"{}\" is not a usable name (allowed: non-empty, letters, digits, "
+                                       "'_', '-', '.')",
+                                       r.name));
+  }
+  check.InRange("run.dt_s", r.dt_s, Closed(1e-5, 0.01));
+  check.InRange("run.duration_s", r.duration_s, OpenClosed(0.0, 36000.0));
+  if (r.duration_s < r.dt_s) {
+    check.Fail("run.duration_s", fmt::format("{} is shorter than one step (run.dt_s = {})", r.duration_s, r.dt_s));
+  }
+}
+
+void ValidateServo(const ServoModel3& m, std::string_view key, const Check& check) {
+  for (auto [name, v] : {std::pair{"K", m.K}, {"p", m.p}, {"b", m.b}, {"c", m.c}}) {
+    check.InRange(fmt::format("{}.{}", key, name), v,
+                  {0.0, kInf, true, true, "K, p, b, c must all be > 0: stable, minimum phase"});
+  }
+}
+
+void ValidateSignal(const SignalSpec& s, std::string_view prefix, std::string_view rms_key, double dt_s,
+                    const std::string& scenario_path, const Check& check) {
+  auto key = [&](std::string_view k) { return fmt::format("{}.{}", prefix, k); };
+  check.OneOf(key("kind"), s.kind, {"blwn", "file", "zero"});
+  const double nyquist = 0.5 / dt_s;
+  check.InRange(key("band_hz"), s.band_hz,
+                {0.0, nyquist, true, true, "below the Nyquist frequency 0.5/run.dt_s"});
+  check.InRange(key(rms_key), s.rms, Open(0.0, kInf));
+  check.InRange(key("discard_s"), s.discard_s, Closed(0.0, 60.0));
+  check.InRange(key("file_dt_s"), s.file_dt_s, Closed(0.0, 10.0));
+  if (!std::isfinite(s.scale) || s.scale == 0.0) {
+    check.Fail(key("scale"), fmt::format("{} is not allowed (allowed: any finite value other than 0)", s.scale));
+  }
+  if (s.kind == "file") {
+    if (s.file.empty()) check.Fail(key("file"), "missing: kind = \"file\" needs a file path");
+    const std::filesystem::path resolved = ResolveSignalFile(scenario_path, s.file);
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(resolved, ec)) {
+      check.Fail(key("file"), fmt::format("file not found: {} (paths are relative to the scenario file's folder)",
+                                          resolved.string()));
+    }
+  }
+}
+
+void ValidateStructure(const StructureConfig& st, double dt_s, const std::string& scenario_path,
+                       const Check& check) {
+  check.OneOf("structure.mode", st.mode, {"rths", "predefined"});
+  check.InRange("structure.mass_kg", st.mass_kg, OpenClosed(0.0, 1e9));
+  // Central difference is stable for omega dt < 2, i.e. f < 1 / (pi dt).
+  const double f_max = 1.0 / (kPi * dt_s);
+  check.InRange("structure.frequency_hz", st.frequency_hz,
+                {0.0, f_max, true, true, "central-difference stability limit 1/(pi run.dt_s)"});
+  check.InRange("structure.damping_ratio", st.damping_ratio, ClosedOpen(0.0, 1.0));
+  check.InRange("structure.specimen_count", st.specimen_count, OpenClosed(0.0, 1000.0));
+  check.OneOf("structure.derivatives", st.derivatives, {"extrapolated", "central"});
+  ValidateSignal(st.ground, "structure.ground", "rms_mm_s2", dt_s, scenario_path, check);
+  ValidateSignal(st.desired, "structure.desired", "rms_mm", dt_s, scenario_path, check);
+}
+
+void ValidateController(const ControllerConfig& c, const Check& check) {
+  check.OneOf("controller.kind", c.kind, {"none", "ff"});
+  ValidateServo(c.model, "controller.model", check);
+}
+
+void ValidatePlant(const PlantConfig& p, const Check& check) {
+  ValidateServo(p.actuator, "plant.actuator", check);
+  check.OneOf("plant.specimen", p.specimen, {"mr_damper", "none"});
+  check.InRange("plant.noise_y_mm_rms", p.noise_y_mm_rms, Closed(0.0, 10.0));
+  check.InRange("plant.noise_f_kN_rms", p.noise_f_kN_rms, Closed(0.0, 100.0));
+  check.InRange("plant.cvode_rtol", p.cvode_rtol, OpenClosed(0.0, 1e-2));
+}
+
+void ValidateSemiactive(const SemiactiveConfig& s, const Check& check) {
+  check.OneOf("semiactive.mode", s.mode, {"passive_off", "passive_on", "constant"});
+  check.InRange("semiactive.max_current_A", s.max_current_A, OpenClosed(0.0, 5.0));
+  check.InRange("semiactive.current_A", s.current_A,
+                {0.0, s.max_current_A, false, false, "at most semiactive.max_current_A"});
+}
+
+void ValidateLockstep(const LockstepConfig& l, const Check& check) {
+  check.InRange("lockstep.timeout_ms", l.timeout_ms, Closed(1.0, 60000.0));
+  check.InRange("lockstep.max_attempts", l.max_attempts, Closed(1, 1000));
+  check.InRange("lockstep.handshake_timeout_s", l.handshake_timeout_s, Closed(0.1, 600.0));
+}
+
+}  // namespace
+
+ServoModel3 ServoPreset(std::string_view name) {
+  if (name == "0.0A") return {1.730e7, 182.7, 225.3, 9.499e4, "0.0A"};  // Eq. 28
+  if (name == "2.5A") return {1.613e7, 134.2, 324.6, 1.211e5, "2.5A"};  // Eq. 29
+  if (name == "avg") return {1.600e7, 151.7, 250.4, 1.061e5, "avg"};    // Eq. 30
+  throw Error("ServoPreset", fmt::format("unknown servo model preset \"{}\" (allowed: \"0.0A\", \"2.5A\", \"avg\")",
+                                         name));
+}
+
+std::int64_t Scenario::steps() const { return std::llround(run.duration_s / run.dt_s); }
+
+std::string Sha256Hex(std::string_view bytes) {
+  unsigned char digest[EVP_MAX_MD_SIZE];
+  unsigned int length = 0;
+  if (EVP_Digest(bytes.data(), bytes.size(), digest, &length, EVP_sha256(), nullptr) != 1) {
+    throw Error("Sha256Hex", "OpenSSL EVP_Digest(sha256) failed");
+  }
+  static constexpr char kHex[] = "0123456789abcdef";
+  std::string hex;
+  hex.reserve(2 * length);
+  for (unsigned int i = 0; i < length; ++i) {
+    hex += kHex[digest[i] >> 4];
+    hex += kHex[digest[i] & 0x0f];
+  }
+  return hex;
+}
+
+void ValidateScenario(const Scenario& s) {
+  const Check check(DisplayName(s.path));
+  ValidateRun(s.run, check);
+  ValidateStructure(s.structure, s.run.dt_s, s.path, check);
+  ValidateController(s.controller, check);
+  ValidatePlant(s.plant, check);
+  ValidateSemiactive(s.semiactive, check);
+  ValidateLockstep(s.lockstep, check);
+}
+
+Scenario ParseScenario(std::string_view toml_text, const std::string& path) {
+  const std::string file = DisplayName(path);
+  toml::table root;
+  try {
+    root = toml::parse(toml_text, path);
+  } catch (const toml::parse_error& e) {
+    const toml::source_position& at = e.source().begin;
+    throw Error(fmt::format("{}:{}:{}", file, at.line, at.column),
+                fmt::format("TOML syntax error at line {}, column {}: {}", at.line, at.column, e.description()));
+  }
+  Scenario s;
+  s.path = path;
+  ReadScenario(root, file, &s);
+  ValidateScenario(s);
+  for (SignalSpec* signal : {&s.structure.ground, &s.structure.desired}) {
+    if (signal->kind == "file") signal->file = ResolveSignalFile(path, signal->file).string();
+  }
+  return s;
+}
+
+Scenario LoadScenario(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw Error(path, "cannot open scenario file");
+  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (in.bad()) throw Error(path, "cannot read scenario file");
+  Scenario s = ParseScenario(bytes, path);
+  s.sha256 = Sha256Hex(bytes);
+  return s;
+}
+
+}  // namespace rths::scenario

@@ -1,0 +1,298 @@
+// Tests for lib/scenario: the default file, defaults, hashing, and one case per class of bad input.
+#include "scenario/scenario.h"
+
+#include <doctest/doctest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <initializer_list>
+#include <string>
+#include <string_view>
+
+#include "core/error.h"
+
+namespace fs = std::filesystem;
+using rths::scenario::LoadScenario;
+using rths::scenario::ParseScenario;
+using rths::scenario::Scenario;
+
+namespace {
+
+const fs::path kSourceDir = RTHS_SOURCE_DIR;
+
+/// The message of the rths::Error that parsing `text` throws ("" and a failed check if none).
+std::string ErrorOf(std::string_view text, const std::string& path = "bad.toml") {
+  try {
+    ParseScenario(text, path);
+  } catch (const rths::Error& e) {
+    return e.what();
+  }
+  FAIL_CHECK("expected an rths::Error for:\n" << text);
+  return "";
+}
+
+/// Checks that `message` contains every one of `parts`.
+void CheckContains(const std::string& message, std::initializer_list<std::string_view> parts) {
+  for (std::string_view part : parts) {
+    CHECK_MESSAGE(message.find(part) != std::string::npos, "\"" << part << "\" not in: " << message);
+  }
+}
+
+/// A fresh empty folder under the system temp dir.
+fs::path TempDir(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / ("rths_scenario_test_" + name);
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+void WriteFile(const fs::path& path, std::string_view text) {
+  std::ofstream out(path, std::ios::binary);
+  out << text;
+}
+
+}  // namespace
+
+TEST_CASE("the default scenario file loads with the issue's values") {
+  const Scenario s = LoadScenario((kSourceDir / "scenarios/default.toml").string());
+  CHECK(s.run.dt_s == 0.0005);
+  CHECK(s.run.duration_s == 20.0);
+  CHECK(s.steps() == 40000);
+  CHECK(s.structure.mode == "rths");
+  CHECK(s.structure.mass_kg == 20000.0);
+  CHECK(s.structure.frequency_hz == 5.0);
+  CHECK(s.structure.damping_ratio == 0.02);
+  CHECK(s.structure.ground.kind == "blwn");
+  CHECK(s.structure.ground.band_hz == 30.0);
+  CHECK(s.structure.ground.rms == 1500.0);
+  CHECK(s.structure.ground.seed == 1);
+  CHECK(s.controller.kind == "ff");
+  CHECK(s.controller.model.name == "avg");
+  CHECK(s.controller.model.K == 1.600e7);
+  CHECK(s.plant.actuator.name == "avg");
+  CHECK(s.plant.actuator.p == 151.7);
+  CHECK(s.plant.specimen == "mr_damper");
+  CHECK(s.semiactive.mode == "passive_off");
+  CHECK(s.semiactive.current_A == 0.0);
+  CHECK(s.sha256.size() == 64);
+  CHECK(s.path.find("default.toml") != std::string::npos);
+}
+
+TEST_CASE("the tracking scenarios are predefined 0-5 Hz records") {
+  for (const char* kind : {"ff", "none"}) {
+    CAPTURE(kind);
+    const Scenario s = LoadScenario((kSourceDir / "scenarios" / (std::string("tracking_") + kind + "_0-5hz.toml")).string());
+    CHECK(s.structure.mode == "predefined");
+    CHECK(s.structure.desired.kind == "blwn");
+    CHECK(s.structure.desired.band_hz == 5.0);
+    CHECK(s.structure.desired.rms == 2.78);
+    CHECK(s.run.duration_s == 60.0);
+    CHECK(s.plant.actuator.name == "avg");
+    CHECK(s.plant.specimen == "none");
+    CHECK(s.controller.kind == kind);
+  }
+}
+
+TEST_CASE("every file in scenarios/ loads") {
+  int count = 0;
+  for (const auto& entry : fs::directory_iterator(kSourceDir / "scenarios")) {
+    if (entry.path().extension() != ".toml") continue;
+    CAPTURE(entry.path().string());
+    CHECK_NOTHROW(LoadScenario(entry.path().string()));
+    ++count;
+  }
+  CHECK(count >= 3);
+}
+
+TEST_CASE("omitted keys keep the struct defaults") {
+  const Scenario empty = ParseScenario("", "empty.toml");
+  const Scenario defaults;
+  CHECK(empty.run.name == defaults.run.name);
+  CHECK(empty.run.dt_s == defaults.run.dt_s);
+  CHECK(empty.structure.mass_kg == defaults.structure.mass_kg);
+  CHECK(empty.structure.desired.band_hz == 5.0);
+  CHECK(empty.structure.desired.rms == 2.78);
+  CHECK(empty.plant.noise_seed == 7);
+  CHECK(empty.plant.cvode_rtol == 1e-8);
+  CHECK(empty.lockstep.max_attempts == 8);
+  CHECK(empty.sha256.empty());
+
+  const Scenario partial = ParseScenario(R"(
+[run]
+dt_s = 0.001
+[structure.ground]
+rms_mm_s2 = 900
+)",
+                                         "partial.toml");
+  CHECK(partial.run.dt_s == 0.001);
+  CHECK(partial.run.duration_s == 20.0);
+  CHECK(partial.steps() == 20000);
+  CHECK(partial.structure.ground.rms == 900.0);  // integer accepted for a float
+  CHECK(partial.structure.ground.band_hz == 30.0);
+  CHECK(partial.structure.frequency_hz == 5.0);
+}
+
+TEST_CASE("servo models: presets and inline tables") {
+  const auto a = rths::scenario::ServoPreset("0.0A");
+  CHECK(a.K == 1.730e7);
+  CHECK(a.p == 182.7);
+  CHECK(a.b == 225.3);
+  CHECK(a.c == 9.499e4);
+  const auto b = rths::scenario::ServoPreset("2.5A");
+  CHECK(b.K == 1.613e7);
+  CHECK(b.p == 134.2);
+  CHECK(b.b == 324.6);
+  CHECK(b.c == 1.211e5);
+  CHECK_THROWS_AS(rths::scenario::ServoPreset("1.0A"), rths::Error);
+
+  const Scenario s = ParseScenario(R"(
+[controller]
+model = {K = 1.5e7, p = 150, b = 250.0, c = 1.0e5}
+[plant]
+actuator = "2.5A"
+)",
+                                   "servo.toml");
+  CHECK(s.controller.model.name == "custom");
+  CHECK(s.controller.model.K == 1.5e7);
+  CHECK(s.controller.model.p == 150.0);
+  CHECK(s.plant.actuator.name == "2.5A");
+  CHECK(s.plant.actuator.c == 1.211e5);
+}
+
+TEST_CASE("sha256 of known strings") {
+  using rths::scenario::Sha256Hex;
+  CHECK(Sha256Hex("abc") == "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad");
+  CHECK(Sha256Hex("") == "e3b0c44298fc1c149afbf4c8996fb92427ae41e4649b934ca495991b7852b855");
+}
+
+TEST_CASE("LoadScenario hashes exactly the file's bytes") {
+  const fs::path dir = TempDir("hash");
+  const std::string text = "[run]\r\nname = \"crlf\"\r\n";
+  WriteFile(dir / "crlf.toml", text);
+  const Scenario s = LoadScenario((dir / "crlf.toml").string());
+  CHECK(s.sha256 == rths::scenario::Sha256Hex(text));
+  CHECK(s.run.name == "crlf");
+  fs::remove_all(dir);
+}
+
+TEST_CASE("unknown keys and tables are named, with the allowed ones and a suggestion") {
+  CheckContains(ErrorOf("[plant]\nnoise_y_mm = 0.1\n"),
+                {"bad.toml: plant.noise_y_mm: unknown key", "actuator", "specimen", "noise_y_mm_rms",
+                 "did you mean \"plant.noise_y_mm_rms\""});
+  CheckContains(ErrorOf("[run]\ndt = 0.001\n"), {"bad.toml: run.dt: unknown key", "did you mean \"run.dt_s\""});
+  CheckContains(ErrorOf("[structure.ground]\nrms_mm = 3.0\n"),
+                {"structure.ground.rms_mm: unknown key", "did you mean \"structure.ground.rms_mm_s2\""});
+  CheckContains(ErrorOf("[structure.desired]\nrms_mm_s2 = 3.0\n"),
+                {"structure.desired.rms_mm_s2: unknown key", "rms_mm"});
+  CheckContains(ErrorOf("[controler]\nkind = \"ff\"\n"),
+                {"bad.toml: controler: unknown table", "run", "lockstep", "did you mean \"controller\""});
+  CheckContains(ErrorOf("[structure.grond]\nkind = \"zero\"\n"),
+                {"bad.toml: structure.grond: unknown table", "ground", "desired"});
+  CheckContains(ErrorOf("[plant]\nactuator = {K = 1.0e7, p = 150, b = 250, c = 1.0e5, d = 1}\n"),
+                {"bad.toml: plant.actuator.d: unknown key", "K, p, b, c"});
+  CheckContains(ErrorOf("name = \"x\"\n"), {"bad.toml: name: unknown key", "run, structure"});
+}
+
+TEST_CASE("wrong types name the key, the expected type and what was found") {
+  CheckContains(ErrorOf("[run]\ndt_s = \"0.001\"\n"),
+                {"bad.toml: run.dt_s: expected a number", "found string \"0.001\""});
+  CheckContains(ErrorOf("[lockstep]\nmax_attempts = 2.5\n"),
+                {"bad.toml: lockstep.max_attempts: expected an integer", "found float 2.5"});
+  CheckContains(ErrorOf("[controller]\nhalf_step_ahead = \"yes\"\n"),
+                {"controller.half_step_ahead: expected a boolean", "found string"});
+  CheckContains(ErrorOf("[structure]\nmode = 1\n"), {"structure.mode: expected a string", "found integer 1"});
+  CheckContains(ErrorOf("run = 3\n"), {"bad.toml: run: expected a table", "found integer 3"});
+  CheckContains(ErrorOf("[plant]\nactuator = 3.5\n"),
+                {"plant.actuator: expected a preset name", "found float 3.5"});
+  CheckContains(ErrorOf("[plant]\nnoise_seed = -1\n"), {"plant.noise_seed: -1 is out of range [0,"});
+}
+
+TEST_CASE("out-of-range values name the key, the value and the range") {
+  CheckContains(ErrorOf("[run]\ndt_s = 0.5\n"), {"bad.toml: run.dt_s: 0.5 is out of range [1e-05, 0.01]"});
+  CheckContains(ErrorOf("[run]\nduration_s = 0\n"), {"bad.toml: run.duration_s: 0 is out of range (0, 36000]"});
+  CheckContains(ErrorOf("[structure]\nmass_kg = -5\n"), {"structure.mass_kg: -5 is out of range (0, 1000000000]"});
+  CheckContains(ErrorOf("[structure]\ndamping_ratio = 1.0\n"), {"structure.damping_ratio: 1 is out of range [0, 1)"});
+  CheckContains(ErrorOf("[structure]\ndamping_ratio = nan\n"), {"structure.damping_ratio: nan is out of range"});
+  CheckContains(ErrorOf("[plant]\ncvode_rtol = 0.1\n"), {"plant.cvode_rtol: 0.1 is out of range (0, 0.01]"});
+  CheckContains(ErrorOf("[plant]\nnoise_f_kN_rms = 200\n"), {"plant.noise_f_kN_rms: 200 is out of range [0, 100]"});
+  CheckContains(ErrorOf("[lockstep]\nmax_attempts = 0\n"), {"lockstep.max_attempts: 0 is out of range [1, 1000]"});
+  CheckContains(ErrorOf("[lockstep]\nhandshake_timeout_s = 1000\n"),
+                {"lockstep.handshake_timeout_s: 1000 is out of range [0.1, 600]"});
+  CheckContains(ErrorOf("[semiactive]\nmode = \"constant\"\ncurrent_A = 3.0\n"),
+                {"semiactive.current_A: 3 is out of range [0, 2.5]", "max_current_A"});
+  CheckContains(ErrorOf("[semiactive]\nmax_current_A = 6\n"), {"semiactive.max_current_A: 6 is out of range (0, 5]"});
+  CheckContains(ErrorOf("[structure.desired]\ndiscard_s = 100\n"),
+                {"structure.desired.discard_s: 100 is out of range [0, 60]"});
+  CheckContains(ErrorOf("[structure.ground]\nrms_mm_s2 = 0\n"), {"structure.ground.rms_mm_s2: 0 is out of range (0,"});
+  CheckContains(ErrorOf("[controller]\nmodel = {K = 1.0e7, p = -150, b = 250, c = 1.0e5}\n"),
+                {"controller.model.p: -150 is out of range (0, inf)"});
+  CheckContains(ErrorOf("[controller]\nmodel = {K = 1.0e7, p = 150, b = 250}\n"),
+                {"controller.model.c: missing", "K, p, b, c"});
+}
+
+TEST_CASE("limits that depend on dt: central-difference stability and Nyquist") {
+  // dt = 0.01 s: 1/(pi dt) = 31.83 Hz, Nyquist 50 Hz.
+  CHECK_NOTHROW(ParseScenario("[run]\ndt_s = 0.01\n[structure]\nfrequency_hz = 31.8\n", "ok.toml"));
+  CheckContains(ErrorOf("[run]\ndt_s = 0.01\n[structure]\nfrequency_hz = 32.0\n"),
+                {"bad.toml: structure.frequency_hz: 32 is out of range (0, 31.83", "central-difference"});
+  CheckContains(ErrorOf("[run]\ndt_s = 0.01\n[structure.ground]\nband_hz = 50\n"),
+                {"bad.toml: structure.ground.band_hz: 50 is out of range (0, 50)", "Nyquist"});
+  CheckContains(ErrorOf("[structure.desired]\nband_hz = 1000\n"),
+                {"structure.desired.band_hz: 1000 is out of range (0, 1000)"});
+}
+
+TEST_CASE("enums and presets list the allowed values") {
+  CheckContains(ErrorOf("[structure]\nmode = \"hybrid\"\n"),
+                {"bad.toml: structure.mode: \"hybrid\" is not allowed", "\"rths\", \"predefined\""});
+  CheckContains(ErrorOf("[controller]\nkind = \"pid\"\n"), {"controller.kind", "\"none\", \"ff\""});
+  CheckContains(ErrorOf("[plant]\nspecimen = \"spring\"\n"), {"plant.specimen", "\"mr_damper\", \"none\""});
+  CheckContains(ErrorOf("[semiactive]\nmode = \"on\"\n"),
+                {"semiactive.mode", "\"passive_off\", \"passive_on\", \"constant\""});
+  CheckContains(ErrorOf("[structure.ground]\nkind = \"sine\"\n"),
+                {"structure.ground.kind", "\"blwn\", \"file\", \"zero\""});
+  CheckContains(ErrorOf("[structure]\nderivatives = \"backward\"\n"),
+                {"structure.derivatives", "\"extrapolated\", \"central\""});
+  CheckContains(ErrorOf("[controller]\nmodel = \"1.0A\"\n"),
+                {"bad.toml: controller.model: unknown servo model preset \"1.0A\"", "\"0.0A\", \"2.5A\", \"avg\""});
+  CheckContains(ErrorOf("[plant]\nactuator = \"average\"\n"), {"plant.actuator", "\"avg\""});
+}
+
+TEST_CASE("kind = \"file\" resolves the path against the scenario's folder") {
+  const fs::path dir = TempDir("file");
+  fs::create_directories(dir / "records");
+  WriteFile(dir / "records/elcentro.txt", "0.0\n0.1\n");
+  const std::string scenario = R"(
+[structure.ground]
+kind = "file"
+file = "records/elcentro.txt"
+file_dt_s = 0.02
+scale = 9810.0
+)";
+  WriteFile(dir / "quake.toml", scenario);
+  const Scenario s = LoadScenario((dir / "quake.toml").string());
+  CHECK(fs::equivalent(s.structure.ground.file, dir / "records/elcentro.txt"));
+  CHECK(fs::path(s.structure.ground.file).is_absolute());
+  CHECK(s.structure.ground.scale == 9810.0);
+
+  WriteFile(dir / "missing.toml", "[structure.ground]\nkind = \"file\"\nfile = \"nowhere.txt\"\n");
+  std::string message;
+  try {
+    LoadScenario((dir / "missing.toml").string());
+  } catch (const rths::Error& e) {
+    message = e.what();
+  }
+  CheckContains(message, {"missing.toml: structure.ground.file: file not found", (dir / "nowhere.txt").string()});
+  CheckContains(ErrorOf("[structure.desired]\nkind = \"file\"\n"), {"structure.desired.file: missing"});
+  fs::remove_all(dir);
+}
+
+TEST_CASE("syntax errors name the file, line and column") {
+  const std::string message = ErrorOf("[run]\nname = \"x\"\ndt_s = = 0.001\n", "broken.toml");
+  CheckContains(message, {"broken.toml:3:", "line 3", "TOML syntax error"});
+  CheckContains(ErrorOf("[run]\nname = \"x\"\n[run]\n", "dup.toml"), {"dup.toml:3:"});
+}
+
+TEST_CASE("unreadable files are errors naming the path") {
+  CHECK_THROWS_WITH_AS(LoadScenario("/nonexistent/rths.toml"), doctest::Contains("/nonexistent/rths.toml"),
+                       rths::Error);
+}
