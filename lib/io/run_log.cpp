@@ -1,0 +1,93 @@
+#include "io/run_log.h"
+
+#include <algorithm>
+#include <lcm/lcm-cpp.hpp>
+
+#include "core/error.h"
+#include "lockstep/runtime.h"
+#include "scenario/scenario.h"
+
+namespace rths::io {
+
+namespace {
+template <class Msg>
+void Store(const lcm::LogEvent* ev, const std::string& path, std::vector<Msg>* by_k, RunLog* log) {
+  Msg m;
+  if (m.decode(ev->data, 0, ev->datalen) < 0) {
+    throw Error(path, "event " + std::to_string(ev->eventnum) + " on " + ev->channel +
+                          " cannot be decoded");
+  }
+  if (m.k < 0) throw Error(path, "negative step index on " + ev->channel);
+  const auto k = static_cast<std::size_t>(m.k);
+  if (by_k->size() <= k) by_k->resize(k + 1, [] { Msg e{}; e.k = -1; return e; }());
+  auto& raw = log->payload[ev->channel];
+  if (raw.size() <= k) raw.resize(k + 1);
+  ++log->count[ev->channel];
+  if ((*by_k)[k].k == m.k) {
+    ++log->duplicates[ev->channel];
+    return;
+  }
+  (*by_k)[k] = m;
+  m.run_id = 0;  // differs between runs by design; everything else must not
+  lockstep::Encode(m, &raw[k]);
+}
+}  // namespace
+
+std::int64_t RunLog::CompleteSteps() const {
+  const std::size_t n = std::min({desired.size(), command.size(), measured.size(), current.size()});
+  std::size_t k = 0;
+  while (k < n && desired[k].k >= 0 && command[k].k >= 0 && measured[k].k >= 0 && current[k].k >= 0) {
+    ++k;
+  }
+  return static_cast<std::int64_t>(k);
+}
+
+std::string RunLog::AbortReason() const {
+  for (const auto& h : handshakes) {
+    if (h.phase == lockstep::kAbort) return h.participant + ": " + h.reason;
+  }
+  return "";
+}
+
+RunLog ReadRunLog(const std::string& path) {
+  lcm::LogFile file(path, "r");
+  if (!file.good()) throw Error(path, "cannot open the LCM event log");
+  RunLog log;
+  for (const lcm::LogEvent* ev = file.readNextEvent(); ev; ev = file.readNextEvent()) {
+    if (ev->channel == lockstep::kChDesired) {
+      Store(ev, path, &log.desired, &log);
+      if (log.first_desired_utime == 0) log.first_desired_utime = ev->timestamp;
+      log.last_desired_utime = ev->timestamp;
+    } else if (ev->channel == lockstep::kChCommand) {
+      Store(ev, path, &log.command, &log);
+    } else if (ev->channel == lockstep::kChMeasured) {
+      Store(ev, path, &log.measured, &log);
+    } else if (ev->channel == lockstep::kChCurrent) {
+      Store(ev, path, &log.current, &log);
+    } else if (ev->channel == lockstep::kChHandshake) {
+      rths::handshake_t h;
+      if (h.decode(ev->data, 0, ev->datalen) < 0) throw Error(path, "bad handshake event");
+      log.run_id = h.run_id;
+      log.handshakes.push_back(h);
+    } else {
+      ++log.unknown_events;
+    }
+  }
+  return log;
+}
+
+std::string PayloadDigest(const RunLog& log) {
+  std::string all;
+  for (const auto& [channel, per_k] : log.payload) {  // std::map: sorted by channel name
+    all += channel;
+    all.push_back('\0');
+    for (const auto& bytes : per_k) {
+      const std::uint64_t n = bytes.size();
+      all.append(reinterpret_cast<const char*>(&n), sizeof n);
+      all.append(bytes.begin(), bytes.end());
+    }
+  }
+  return scenario::Sha256Hex(all);
+}
+
+}  // namespace rths::io

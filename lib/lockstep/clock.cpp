@@ -1,0 +1,212 @@
+#include "lockstep/clock.h"
+
+#include <cstdio>
+#include <exception>
+
+#include <fmt/core.h>
+
+namespace rths::lockstep {
+
+namespace {
+constexpr double kHandshakeRepeatS = 0.1;
+
+double Seconds(SteadyClock::time_point a, SteadyClock::time_point b) {
+  return std::chrono::duration<double>(b - a).count();
+}
+
+int RosterIndex(const std::string& name) {
+  for (std::size_t i = 0; i < kRoster.size(); ++i) {
+    if (name == kRoster[i].name) return static_cast<int>(i);
+  }
+  return -1;
+}
+}  // namespace
+
+ClockParticipant::ClockParticipant(std::string name, RunIdentity id, Timing timing, lcm::LCM* lcm)
+    : Participant(std::move(name), std::move(id), timing, lcm) {
+  is_clock_ = true;
+  hello_.fill(false);
+  bye_.fill(false);
+  const int self = RosterIndex(name_);
+  if (self >= 0) {
+    hello_[self] = true;
+    bye_[self] = true;
+  }
+  start_ = SteadyClock::now();
+  last_send_ = start_ - std::chrono::seconds(1);
+  lcm_->subscribe(kChMeasured, &ClockParticipant::OnMeasured, this);
+  lcm_->subscribe(kChCommand, &ClockParticipant::OnCommand, this);
+  lcm_->subscribe(kChCurrent, &ClockParticipant::OnCurrent, this);
+  lcm_->subscribe(kChAck, &ClockParticipant::OnAck, this);
+}
+
+void ClockParticipant::OnHandshakeForClock(const rths::handshake_t& msg, SteadyClock::time_point) {
+  const int i = RosterIndex(msg.participant);
+  if (i < 0) {
+    std::fprintf(stderr, "%s: ignoring handshake from unknown participant '%s'\n", name_.c_str(),
+                 msg.participant.c_str());
+    return;
+  }
+  if (msg.phase == kHello && k_ < 0 && !hello_[i]) {
+    if (msg.scenario_sha256 != id_.scenario_sha256) {
+      Fail(kExitLockstep,
+           fmt::format("scenario mismatch: {} loaded a scenario with SHA-256 {}, {} loaded {}",
+                       msg.participant, msg.scenario_sha256, name_, id_.scenario_sha256),
+           true);
+      return;
+    }
+    if (msg.n_steps != id_.n_steps || msg.dt_s != id_.dt_s) {
+      Fail(kExitLockstep,
+           fmt::format("{} expects {} steps of {} s, {} expects {} steps of {} s", msg.participant,
+                       msg.n_steps, msg.dt_s, name_, id_.n_steps, id_.dt_s),
+           true);
+      return;
+    }
+    hello_[i] = true;
+    bool all = true;
+    for (bool h : hello_) all = all && h;
+    if (all) SendGo();
+  } else if (msg.phase == kBye) {
+    bye_[i] = true;
+    bool all = true;
+    for (bool b : bye_) all = all && b;
+    if (all && done_) Finish();
+  }
+}
+
+void ClockParticipant::SendGo() {
+  rths::handshake_t go{};
+  go.run_id = id_.run_id;
+  go.phase = kGo;
+  go.participant = name_;
+  go.scenario_sha256 = id_.scenario_sha256;
+  go.n_steps = id_.n_steps;
+  go.dt_s = id_.dt_s;
+  go.k = 0;
+  for (const auto& r : kRoster) {
+    go.roster_names.emplace_back(r.name);
+    go.roster_sha256.push_back(id_.scenario_sha256);  // every HELLO matched ours
+  }
+  go.n_roster = static_cast<int32_t>(go.roster_names.size());
+  Bytes bytes;
+  Encode(go, &bytes);
+  // GO is sent twice: a participant that missed it would otherwise wait for the watchdog.
+  PublishBytes(kChHandshake, bytes);
+  PublishBytes(kChHandshake, bytes);
+  OnGo();
+  try {
+    IssueStep(0);
+  } catch (const std::exception& e) {
+    Fail(kExitInternal, fmt::format("{}: step 0: {}", name_, e.what()), true, 0);
+  }
+}
+
+void ClockParticipant::IssueStep(std::int64_t k) {
+  const rths::measured_t* prev = k > 0 ? measured_.Get(k - 1) : nullptr;
+  ComputeDesired(k, prev, &desired_);
+  desired_.run_id = id_.run_id;
+  desired_.k = k;
+  k_ = k;
+  attempts_ = 1;
+  last_send_ = SteadyClock::now();
+  Answer(kChDesired, &desired_cache_, k, desired_);
+}
+
+void ClockParticipant::CheckBarrier() {
+  if (finished() || done_ || k_ < 0) return;
+  if (!measured_.Get(k_) || !command_.Get(k_) || !current_.Get(k_) || !ack_.Get(k_)) return;
+  if (k_ + 1 >= id_.n_steps) {
+    done_ = true;
+    done_sends_ = 1;
+    last_send_ = SteadyClock::now();
+    SendHandshake(kDone, id_.n_steps);
+    return;
+  }
+  try {
+    IssueStep(k_ + 1);
+  } catch (const std::exception& e) {
+    Fail(kExitInternal, fmt::format("{}: step {}: {}", name_, k_ + 1, e.what()), true, k_ + 1);
+  }
+}
+
+#define RTHS_CLOCK_HANDLER(Method, box)                                                   \
+  void ClockParticipant::Method(const lcm::ReceiveBuffer* rbuf, const std::string&) {     \
+    if (finished()) return;                                                               \
+    if (box.Add(rbuf, id_.run_id) == std::remove_reference_t<decltype(box)>::Put::kNew && \
+        box.last_k() == k_)                                                               \
+      CheckBarrier();                                                                     \
+  }
+RTHS_CLOCK_HANDLER(OnMeasured, measured_)
+RTHS_CLOCK_HANDLER(OnCommand, command_)
+RTHS_CLOCK_HANDLER(OnCurrent, current_)
+RTHS_CLOCK_HANDLER(OnAck, ack_)
+#undef RTHS_CLOCK_HANDLER
+
+std::string ClockParticipant::MissingAnswers(std::int64_t k) const {
+  std::string out;
+  auto add = [&](bool present, const char* who, const char* type) {
+    if (present) return;
+    if (!out.empty()) out += ", ";
+    out += fmt::format("{} ({})", who, type);
+  };
+  add(command_.Get(k) != nullptr, "controller", "command_t");
+  add(measured_.Get(k) != nullptr, "plant", "measured_t");
+  add(current_.Get(k) != nullptr, "semiactive", "current_t");
+  add(ack_.Get(k) != nullptr, "logger", "ack_t");
+  return out;
+}
+
+void ClockParticipant::Poll(SteadyClock::time_point now) {
+  if (finished()) return;
+  const double timeout_s = timing_.timeout_ms * 1e-3;
+  if (k_ < 0) {  // handshake
+    if (Seconds(start_, now) > timing_.handshake_timeout_s) {
+      std::string missing;
+      for (std::size_t i = 0; i < kRoster.size(); ++i) {
+        if (hello_[i]) continue;
+        if (!missing.empty()) missing += ", ";
+        missing += kRoster[i].name;
+      }
+      Fail(kExitLockstep,
+           fmt::format("no HELLO from {} within {:g} s: not started, crashed, or on another LCM "
+                       "URL / run id",
+                       missing, timing_.handshake_timeout_s),
+           true);
+      return;
+    }
+    if (Seconds(last_send_, now) >= kHandshakeRepeatS) {
+      SendHandshake(kRequest);
+      last_send_ = now;
+    }
+    return;
+  }
+  if (Seconds(last_send_, now) < timeout_s) return;
+  if (done_) {
+    if (done_sends_ >= timing_.max_attempts) {
+      std::string missing;
+      for (std::size_t i = 0; i < kRoster.size(); ++i) {
+        if (!bye_[i]) missing += std::string(missing.empty() ? "" : ", ") + kRoster[i].name;
+      }
+      std::fprintf(stderr, "%s: every step committed, but no BYE from %s\n", name_.c_str(),
+                   missing.c_str());
+      Finish();
+      return;
+    }
+    SendHandshake(kDone, id_.n_steps);
+    ++done_sends_;
+    last_send_ = now;
+    return;
+  }
+  if (attempts_ >= timing_.max_attempts) {
+    Fail(kExitLockstep,
+         fmt::format("step {}: no answer from {} after {} requests over {:.3g} s", k_,
+                     MissingAnswers(k_), attempts_, attempts_ * timeout_s),
+         true, k_);
+    return;
+  }
+  ++attempts_;
+  last_send_ = now;
+  Republish(kChDesired, desired_cache_, k_);
+}
+
+}  // namespace rths::lockstep

@@ -1,0 +1,22 @@
+#include "participants/controller.h"
+
+namespace rths::participants {
+
+Controller::Controller(const scenario::Scenario& s, lockstep::RunIdentity id, lcm::LCM* lcm)
+    : DesiredMeasuredParticipant("controller", std::move(id),
+                                 lockstep::Timing{s.lockstep.timeout_ms, s.lockstep.max_attempts,
+                                                  s.lockstep.handshake_timeout_s},
+                                 lcm, lockstep::kChCommand),
+      law_(control::MakeTrackingController(s.controller, s.run.dt_s)) {}
+
+void Controller::Compute(std::int64_t, const rths::desired_t& d, const rths::measured_t& m,
+                         rths::command_t* out) {
+  const control::Derivatives der{d.r_mm,           d.rd_mm_s,         d.rdd_mm_s2,
+                                 d.rddd_mm_s3,     d.acc_prev_mm_s2,  d.vel_prev_mm_s};
+  const control::Command c = law_->Step(der, m.y_mm);
+  out->u_mm = c.u_mm;
+  out->u_ff_mm = c.u_ff_mm;
+  out->u_fb_mm = c.u_fb_mm;
+}
+
+}  // namespace rths::participants

@@ -1,0 +1,33 @@
+#pragma once
+/// @file Builds any participant of a run by role name, for a process (udpm) or for the
+/// in-process group (memq), and the standard main() of a participant process.
+#include <memory>
+#include <string>
+#include <string_view>
+
+#include "lockstep/runtime.h"
+#include "scenario/scenario.h"
+
+namespace rths::participants {
+
+/// Role names in roster order: integrator (clock), controller, plant, semiactive, logger.
+inline constexpr std::string_view kRoles[] = {"integrator", "controller", "plant", "semiactive",
+                                              "logger"};
+
+/// What the handshake compares, from a loaded scenario.
+lockstep::RunIdentity IdentityOf(const scenario::Scenario& s, std::int64_t run_id);
+/// Lockstep knobs from the scenario's [lockstep] table.
+lockstep::Timing TimingOf(const scenario::Scenario& s);
+
+/// Builds the participant `role` on `lcm`. The logger writes `out_dir`/log.lcm and
+/// `out_dir`/signals.csv. Throws rths::Error (unknown role, bad model, unwritable output).
+std::unique_ptr<lockstep::Participant> MakeParticipant(std::string_view role,
+                                                       const scenario::Scenario& s,
+                                                       const lockstep::RunIdentity& id,
+                                                       lcm::LCM* lcm, const std::string& out_dir);
+
+/// main() of procs/<role>: `--scenario FILE --lcm-url URL --run-id N [--out DIR]`.
+/// Exit codes: lockstep::ExitCode.
+int RoleMain(std::string_view role, int argc, char** argv);
+
+}  // namespace rths::participants

@@ -1,0 +1,42 @@
+#pragma once
+/// @file procs/integrator's participant: the numerical substructure and the clock (owns k).
+///
+/// Step k (docs/lockstep.md): with measured_t k-1 in (the barrier of step k-1), it computes
+/// x_k by central difference (Eqs. 1-3) from x_{k-1}, x_{k-2}, the ground acceleration
+/// a_g,k-1 and the force f_{k-1} measured at sample k-1 — i.e. x_{k+1} comes from the force
+/// measured at step k — and publishes desired_t k: r_k = x_k at the actuator DOF, with
+/// r'_k, r''_k, r'''_k by Eqs. 20-22 from the r sequence (identical to the central-difference
+/// accelerations), the structure's displacements x_k and absolute accelerations at k-1.
+/// In "predefined" mode r_k is read from a history (BLWN or file); derivatives by Eqs. 20-22
+/// or, offline, by non-causal central differences of the known record.
+#include <optional>
+#include <vector>
+
+#include "control/feedforward.h"
+#include "lockstep/clock.h"
+#include "models/structure.h"
+#include "scenario/scenario.h"
+
+namespace rths::participants {
+
+class Integrator final : public lockstep::ClockParticipant {
+ public:
+  Integrator(const scenario::Scenario& s, lockstep::RunIdentity id, lcm::LCM* lcm);
+
+ protected:
+  void ComputeDesired(std::int64_t k, const rths::measured_t* measured_prev,
+                      rths::desired_t* out) override;
+
+ private:
+  const bool predefined_;
+  const double dt_s_;
+  std::optional<models::CentralDifference> cd_;
+  models::StructureState state_;
+  int dof_ = 0;
+  std::vector<double> ground_mm_s2_;  ///< a_g,k for every step (rths mode)
+  std::vector<double> r_mm_;          ///< r_k for every step (predefined mode)
+  std::optional<control::DerivativeRecords> central_;  ///< offline derivatives, if chosen
+  control::ExtrapolationState extrapolation_{};
+};
+
+}  // namespace rths::participants

@@ -1,0 +1,79 @@
+#include "participants/plant.h"
+
+#include "participants/factory.h"
+
+namespace rths::participants {
+
+using lockstep::StepMailbox;
+
+Plant::Plant(const scenario::Scenario& s, lockstep::RunIdentity id, lcm::LCM* lcm)
+    : Participant("plant", std::move(id), TimingOf(s), lcm),
+      rig_(models::LinearRig::Make(s.plant.actuator, s.run.dt_s, s.plant.specimen == "mr_damper",
+                                   models::MrDamperParams::Table3(), s.plant.cvode_rtol)),
+      stepper_(rig_),
+      noise_y_mm_(s.plant.noise_y_mm_rms),
+      noise_f_kN_(s.plant.noise_f_kN_rms),
+      noise_(signal::MakeGaussian(s.plant.noise_seed)) {
+  lcm_->subscribe(lockstep::kChDesired, &Plant::OnDesired, this);
+  lcm_->subscribe(lockstep::kChCommand, &Plant::OnCommand, this);
+  lcm_->subscribe(lockstep::kChCurrent, &Plant::OnCurrent, this);
+}
+
+void Plant::Publish(std::int64_t k, double current_A) {
+  // Noise is drawn once per sample, in step order, so a seed gives the same readings every run.
+  const double ny = noise_y_mm_ > 0.0 ? noise_y_mm_ * signal::NextGaussian(&noise_) : 0.0;
+  const double nf = noise_f_kN_ > 0.0 ? noise_f_kN_ * signal::NextGaussian(&noise_) : 0.0;
+  out_.run_id = id_.run_id;
+  out_.k = k;
+  out_.y_mm = models::MeasuredDisplacementMm(rig_, state_) + ny;
+  out_.f_kN = models::MeasuredForceKn(rig_, state_, current_A) + nf;
+  out_.current_A = current_A;
+  Answer(lockstep::kChMeasured, &cache_, k, out_);
+}
+
+void Plant::OnGo() {
+  Guarded(0, [&] {
+    Publish(0, 0.0);  // at rest; no current has been commanded yet
+    next_ = 1;
+  });
+}
+
+void Plant::OnDesired(const lcm::ReceiveBuffer* rbuf, const std::string&) {
+  if (finished()) return;
+  HeardClock(lockstep::SteadyClock::now());
+  const auto put = desired_.Add(rbuf, id_.run_id);
+  const std::int64_t k = desired_.last_k();
+  if (put == StepMailbox<rths::desired_t>::Put::kDuplicate && !Stalled(k)) {
+    Republish(lockstep::kChMeasured, cache_, k);  // re-request: cached bytes, never recomputed
+  }
+}
+
+void Plant::OnCommand(const lcm::ReceiveBuffer* rbuf, const std::string&) {
+  if (finished()) return;
+  if (command_.Add(rbuf, id_.run_id) == StepMailbox<rths::command_t>::Put::kNew) TryStep();
+}
+
+void Plant::OnCurrent(const lcm::ReceiveBuffer* rbuf, const std::string&) {
+  if (finished()) return;
+  if (current_.Add(rbuf, id_.run_id) == StepMailbox<rths::current_t>::Put::kNew) TryStep();
+}
+
+void Plant::TryStep() {
+  while (running() && next_ >= 1 && next_ < id_.n_steps && !Stalled(next_)) {
+    const std::int64_t k = next_;
+    const rths::command_t* u = command_.Get(k - 1);
+    const rths::current_t* i = current_.Get(k - 1);
+    if (!u || !i) return;
+    bool ok = false;
+    Guarded(k, [&] {
+      MaybeThrow(k);
+      stepper_.Step(&state_, u->u_mm, i->i_cmd_A);  // hold u_{k-1}, i_{k-1} over [t_{k-1}, t_k)
+      Publish(k, i->i_cmd_A);
+      ok = true;
+    });
+    if (!ok) return;
+    ++next_;
+  }
+}
+
+}  // namespace rths::participants

@@ -1,0 +1,49 @@
+#pragma once
+/// @file procs/plant's participant: the loading system and the "physical" specimen.
+/// Step k answer: measured_t k = sensor readings at t_k, computed from the state after holding
+/// command_t k-1 (u_{k-1}) and current_t k-1 (i_{k-1}) over [t_{k-1}, t_k) (zero-order hold,
+/// as the D/A converters do). measured_t 0 is the state at rest, sent at GO. The plant answers
+/// as soon as both inputs of the interval are in, so measured_t k+1 is usually ready before the
+/// clock requests step k+1. See docs/lockstep.md.
+#include <optional>
+
+#include "lockstep/runtime.h"
+#include "models/linear_rig.h"
+#include "rths/command_t.hpp"
+#include "rths/current_t.hpp"
+#include "rths/desired_t.hpp"
+#include "rths/measured_t.hpp"
+#include "scenario/scenario.h"
+#include "signal/random.h"
+
+namespace rths::participants {
+
+class Plant final : public lockstep::Participant {
+ public:
+  Plant(const scenario::Scenario& s, lockstep::RunIdentity id, lcm::LCM* lcm);
+
+ protected:
+  void OnGo() override;
+
+ private:
+  void OnDesired(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
+  void OnCommand(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
+  void OnCurrent(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
+  void TryStep();
+  void Publish(std::int64_t k, double current_A);
+
+  const models::LinearRig rig_;
+  models::LinearRigStepper stepper_;
+  models::LinearRigState state_{};
+  const double noise_y_mm_;
+  const double noise_f_kN_;
+  signal::GaussianState noise_;
+  lockstep::StepMailbox<rths::desired_t> desired_;
+  lockstep::StepMailbox<rths::command_t> command_;
+  lockstep::StepMailbox<rths::current_t> current_;
+  lockstep::AnswerCache cache_;
+  rths::measured_t out_{};
+  std::int64_t next_ = 0;  ///< next measured_t to produce
+};
+
+}  // namespace rths::participants
