@@ -239,11 +239,12 @@ std::vector<Outcome> RunUdpm(const rths::scenario::Scenario&, const std::string&
 int main(int argc, char** argv) {
   CLI::App app{"rths run: start a lockstep RTHS run (integrator, controller, plant, semiactive, "
                "logger), wait for it, and write its output folder"};
-  std::string scenario_path = "scenarios/default.toml";
+  std::string scenario_path, default_scenario = "scenarios/default.toml";
   std::string out_arg, transport = "udpm", bin_dir;
   std::vector<std::string> fault_args;
   bool quiet = false;
-  app.add_option("scenario", scenario_path, "scenario TOML file")->capture_default_str();
+  app.add_option("scenario", scenario_path, "scenario TOML file (default: scenarios/default.toml)");
+  app.add_option("--default-scenario", default_scenario, "used when no scenario is given")->group("");
   app.add_option("--out", out_arg, "output folder (default: a new folder under runs/)");
   app.add_option("--transport", transport, "udpm: one process per participant; memq: one process")
       ->check(CLI::IsMember({"udpm", "memq"}))
@@ -253,6 +254,7 @@ int main(int argc, char** argv) {
   app.add_flag("--quiet", quiet, "print only the output folder");
   CLI11_PARSE(app, argc, argv);
 
+  if (scenario_path.empty()) scenario_path = default_scenario;
   std::signal(SIGINT, OnSignal);
   std::signal(SIGTERM, OnSignal);
 
