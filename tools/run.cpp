@@ -125,7 +125,10 @@ std::vector<Outcome> RunMemq(const rths::scenario::Scenario& s,
     for (const auto& f : faults) {
       if (f.role != role) continue;
       auto& fl = owned.back()->faults;
-      (f.kind == "drop" ? fl.drop_first_request_at : f.kind == "stall" ? fl.stall_at : fl.throw_at) = f.k;
+      (f.kind == "drop"    ? fl.drop_first_request_at
+       : f.kind == "stall" ? fl.stall_at
+       : f.kind == "crash" ? fl.crash_at
+                           : fl.throw_at) = f.k;
     }
     ps.push_back(owned.back().get());
   }
@@ -250,7 +253,7 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"udpm", "memq"}))
       ->capture_default_str();
   app.add_option("--bin-dir", bin_dir, "where the rths-* programs are (default: next to this one)");
-  app.add_option("--fault", fault_args, "test only: ROLE:drop|stall|throw:K")->group("");
+  app.add_option("--fault", fault_args, "test only: ROLE:drop|stall|throw|crash:K")->group("");
   app.add_flag("--quiet", quiet, "print only the output folder");
   CLI11_PARSE(app, argc, argv);
 
@@ -266,8 +269,9 @@ int main(int argc, char** argv) {
     std::getline(ss, x.role, ':');
     std::getline(ss, x.kind, ':');
     std::getline(ss, k);
-    if ((x.kind != "drop" && x.kind != "stall" && x.kind != "throw") || k.empty()) {
-      std::fprintf(stderr, "rths run: --fault %s: expected ROLE:drop|stall|throw:K\n", f.c_str());
+    if ((x.kind != "drop" && x.kind != "stall" && x.kind != "throw" && x.kind != "crash") ||
+        k.empty()) {
+      std::fprintf(stderr, "rths run: --fault %s: expected ROLE:drop|stall|throw|crash:K\n", f.c_str());
       return rths::lockstep::kExitUsage;
     }
     x.k = std::stoll(k);
@@ -369,11 +373,13 @@ int main(int argc, char** argv) {
                   j["steps_per_s"].get<double>() * s.run.dt_s);
     }
   }
+  std::fflush(stdout);
   if (culprit) {
     const char* what = culprit->signal ? strsignal(culprit->signal) : nullptr;
-    std::fprintf(stderr, "rths run: FAILED: %s %s: %s\n", culprit->role.c_str(),
+    std::fprintf(stderr, "rths run: FAILED: %s %s%s%s\n", culprit->role.c_str(),
                  what ? fmt::format("was killed by signal {} ({})", culprit->signal, what).c_str()
                       : fmt::format("exited with code {}", culprit->exit_code).c_str(),
+                 culprit->message.empty() ? "" : ": ",
                  culprit->message.c_str());
     std::printf("output: %s (log valid up to step %lld)\n", out.string().c_str(),
                 static_cast<long long>(steps));

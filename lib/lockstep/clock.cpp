@@ -143,17 +143,20 @@ RTHS_CLOCK_HANDLER(OnAck, ack_)
 #undef RTHS_CLOCK_HANDLER
 
 std::string ClockParticipant::MissingAnswers(std::int64_t k) const {
-  std::string out;
-  auto add = [&](bool present, const char* who, const char* type) {
-    if (present) return;
-    if (!out.empty()) out += ", ";
-    out += fmt::format("{} ({})", who, type);
+  // Who is silent, and who only waits for them: the controller and the semiactive law need
+  // measured_t k; the logger needs everything; the plant's inputs (step k-1) are all in.
+  const bool m = measured_.Get(k) != nullptr, c = command_.Get(k) != nullptr,
+             i = current_.Get(k) != nullptr, a = ack_.Get(k) != nullptr;
+  std::string silent, waiting;
+  auto add = [](std::string* list, const char* text) {
+    if (!list->empty()) *list += ", ";
+    *list += text;
   };
-  add(command_.Get(k) != nullptr, "controller", "command_t");
-  add(measured_.Get(k) != nullptr, "plant", "measured_t");
-  add(current_.Get(k) != nullptr, "semiactive", "current_t");
-  add(ack_.Get(k) != nullptr, "logger", "ack_t");
-  return out;
+  if (!m) add(&silent, "plant (measured_t)");
+  if (!c) add(m ? &silent : &waiting, "controller (command_t)");
+  if (!i) add(m ? &silent : &waiting, "semiactive (current_t)");
+  if (!a) add(m && c && i ? &silent : &waiting, "logger (ack_t)");
+  return waiting.empty() ? silent : fmt::format("{} (also missing, waiting for it: {})", silent, waiting);
 }
 
 void ClockParticipant::Poll(SteadyClock::time_point now) {

@@ -1,6 +1,7 @@
 #include "lockstep/runtime.h"
 
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
@@ -126,6 +127,7 @@ void Participant::Fail(int exit_code, const std::string& reason, bool broadcast,
 
 void Participant::MaybeThrow(std::int64_t k) const {
   if (faults.throw_at == k) throw std::runtime_error("injected fault (test)");
+  if (faults.crash_at == k) std::abort();
 }
 
 void Participant::Finish() {

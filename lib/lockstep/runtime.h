@@ -60,6 +60,7 @@ struct Faults {
   std::int64_t drop_first_request_at = -1;  ///< behave as if the first copy of desired k was lost
   std::int64_t stall_at = -1;               ///< stop answering from step k on (a hung process)
   std::int64_t throw_at = -1;               ///< throw from the step computation at step k
+  std::int64_t crash_at = -1;               ///< die by SIGABRT at step k (a crashed process)
 };
 
 /// Encodes an lcm-gen message into `out` (reusing its capacity: no allocation once sized).
@@ -191,7 +192,7 @@ class Participant {
   }
   /// Fault injection (test-only): this participant no longer answers from step k on.
   bool Stalled(std::int64_t k) const { return faults.stall_at >= 0 && k >= faults.stall_at; }
-  /// Fault injection (test-only): throws from the step computation of step k.
+  /// Fault injection (test-only): throws from (or crashes in) the step computation of step k.
   void MaybeThrow(std::int64_t k) const;
   /// Runs a message handler body, turning an exception into a clean, broadcast failure.
   template <class F>

@@ -53,6 +53,7 @@ int RoleMain(std::string_view role, int argc, char** argv) {
       ->group("");
   app.add_option("--fault-stall", faults.stall_at, "test only: stop answering at step k")->group("");
   app.add_option("--fault-throw", faults.throw_at, "test only: throw at step k")->group("");
+  app.add_option("--fault-crash", faults.crash_at, "test only: abort() at step k")->group("");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

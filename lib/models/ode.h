@@ -1,0 +1,68 @@
+#pragma once
+/// @file A small CVODE (SUNDIALS 6) wrapper shared by the nonlinear models.
+///
+/// Integrates x' = f(t, x) over one step [t0, t1] with variable-order BDF and Newton iterations on
+/// a dense Jacobian, which is robust for the stiff Bouc-Wen states. The Jacobian comes from
+/// difference quotients computed here, with CVODE's own increments (cvLsDenseDQJac) but into
+/// preallocated storage: CVODE's built-in version allocates a vector header per evaluation.
+/// Inputs are piecewise constant per step, so every Advance() re-initialises CVODE at t0: the
+/// result depends only on (t0, t1, x), never on earlier calls, and re-answering a step from a
+/// committed state reproduces it bit for bit.
+#include <span>
+#include <string>
+
+// SUNDIALS handle types (sundials_nvector.h, sundials_matrix.h, ...), kept out of this header.
+struct _generic_N_Vector;
+struct _generic_SUNMatrix;
+struct _generic_SUNLinearSolver;
+struct _SUNContext;
+
+namespace rths::models {
+
+/// Right-hand side x' = f(t, x) with x and xdot of the stepper's size. Returns 0 on success,
+/// > 0 for a recoverable error (CVODE retries with a smaller step), < 0 to stop.
+using OdeRhs = int (*)(double t, const double* x, double* xdot, void* ctx);
+
+class OdeStepper {
+ public:
+  /// Allocates every CVODE object once. n > 0 states; rtol relative tolerance (> 0); atol the
+  /// absolute tolerance per state (size n, > 0, in each state's unit). ctx is passed to rhs and
+  /// must outlive the stepper. Throws rths::Error.
+  OdeStepper(int n, double rtol, std::span<const double> atol, OdeRhs rhs, void* ctx);
+  /// Same absolute tolerance for every state.
+  OdeStepper(int n, double rtol, double atol, OdeRhs rhs, void* ctx);
+  ~OdeStepper();
+  OdeStepper(const OdeStepper&) = delete;
+  OdeStepper& operator=(const OdeStepper&) = delete;
+
+  /// Integrates from x(t0) = x_inout to t1 > t0 (never past t1: stop time) and writes x(t1) to
+  /// x_inout (size n). Allocates nothing. Throws rths::Error with CVODE's flag on failure.
+  void Advance(double t0, double t1, double* x_inout);
+
+  int size() const { return n_; }
+  /// Internal steps taken by the last Advance() (diagnostics).
+  long last_steps() const;
+
+ private:
+  static int Rhs(double t, _generic_N_Vector* x, _generic_N_Vector* xdot, void* self);
+  static int Jac(double t, _generic_N_Vector* x, _generic_N_Vector* fx, _generic_SUNMatrix* jac,
+                 void* self, _generic_N_Vector* tmp1, _generic_N_Vector* tmp2,
+                 _generic_N_Vector* tmp3);
+  static void ErrHandler(int code, const char* module, const char* function, char* msg, void* self);
+  void Init(double rtol, std::span<const double> atol);
+  void Free();
+
+  int n_;
+  OdeRhs rhs_;
+  void* ctx_;
+  _SUNContext* sunctx_ = nullptr;
+  _generic_N_Vector* x_ = nullptr;
+  _generic_N_Vector* atol_ = nullptr;
+  _generic_N_Vector* ewt_ = nullptr;  // error weights, for the Jacobian increments
+  _generic_SUNMatrix* jac_ = nullptr;
+  _generic_SUNLinearSolver* ls_ = nullptr;
+  void* cvode_ = nullptr;
+  std::string last_message_;  // CVODE's last error text (written only on failure)
+};
+
+}  // namespace rths::models

@@ -1,0 +1,38 @@
+#pragma once
+/// @file Time histories read or generated at the edge: ground accelerations and desired
+/// displacements (scenario::SignalSpec).
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "scenario/scenario.h"
+
+namespace rths::signal {
+
+/// Reads a time history from a text file and resamples it to the run's step.
+///
+/// Format: one data row per line; fields separated by whitespace or by commas (with optional
+/// whitespace around them); '#' starts a comment to the end of the line; blank lines are
+/// skipped. Either
+///   - one column of values v_j at t_j = j file_dt_s (file_dt_s > 0), or
+///   - two columns t [s], value (file_dt_s == 0); t must start at >= 0, increase strictly, and
+///     have no gap: no step may exceed 1.5 x the median step (missing rows).
+/// Output: x_k = scale * v(k dt_s), k = 0 .. n - 1, with v linearly interpolated between rows;
+/// zero before the first row's time and after the last row's time (a record shorter than the
+/// run is padded with zeros). The unit of x is the file's unit times `scale`.
+/// Throws rths::Error("path:line", ...) for a non-numeric or empty field, a wrong number of
+/// columns, a non-increasing or negative time, a gap; rths::Error("path", ...) for a file that
+/// cannot be read or has no data rows; and for file_dt_s < 0, dt_s <= 0 or a non-finite scale.
+std::vector<double> LoadHistory(const std::string& path, double file_dt_s, double scale, double dt_s,
+                                std::size_t n);
+
+/// The n-sample record described by `spec` at step dt_s [s]:
+///   kind "blwn": Blwn(band_hz, rms, dt_s, n, seed, discard_s) (signal/blwn.h);
+///   kind "file": LoadHistory(file, file_dt_s, scale, dt_s, n), a relative `file` being taken
+///                relative to `scenario_dir` (the scenario file's folder);
+///   kind "zero": n zeros.
+/// Throws rths::Error for any other kind, and whatever the chosen generator throws.
+std::vector<double> MakeSignal(const scenario::SignalSpec& spec, double dt_s, std::size_t n,
+                               const std::string& scenario_dir);
+
+}  // namespace rths::signal
