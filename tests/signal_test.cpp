@@ -78,15 +78,19 @@ double Rms(const std::vector<double>& x) {
   return std::sqrt(s / static_cast<double>(x.size()));
 }
 
-// A scratch folder for history files, unique per test binary run.
+// A scratch folder for history files, unique per test binary run, removed at exit.
+struct Scratch {
+  std::filesystem::path dir = std::filesystem::temp_directory_path() /
+                              ("rths_signal_test_" + std::to_string(std::random_device{}()));
+  Scratch() { std::filesystem::create_directories(dir); }
+  ~Scratch() {
+    std::error_code ec;
+    std::filesystem::remove_all(dir, ec);
+  }
+};
 std::filesystem::path ScratchDir() {
-  static const std::filesystem::path dir = [] {
-    auto d = std::filesystem::temp_directory_path() /
-             ("rths_signal_test_" + std::to_string(std::random_device{}()));
-    std::filesystem::create_directories(d);
-    return d;
-  }();
-  return dir;
+  static const Scratch scratch;
+  return scratch.dir;
 }
 
 std::string WriteFile(const std::string& name, const std::string& text) {
