@@ -73,6 +73,19 @@ void OdeStepper::Init(double rtol, std::span<const double> atol) {
   Check(ls_ != nullptr, "SUNLinSol_Dense");
   Check(CVodeSetLinearSolver(cvode_, ls_, jac_) == CV_SUCCESS, "CVodeSetLinearSolver");
   Check(CVodeSetJacFn(cvode_, &OdeStepper::Jac) == CV_SUCCESS, "CVodeSetJacFn");
+
+  // CVODE allocates its saved Jacobian lazily, on the first step: take one step of x' = 0 now
+  // so that Advance() never allocates.
+  const OdeRhs user_rhs = rhs_;
+  rhs_ = [](double, const double*, double* xdot, void* ctx) {
+    for (int i = 0, n = *static_cast<const int*>(ctx); i < n; ++i) xdot[i] = 0.0;
+    return 0;
+  };
+  void* user_ctx = ctx_;
+  ctx_ = &n_;
+  std::vector<double> x0(n_, 0.0);
+  Advance(0.0, 1.0, x0.data());
+  rhs_ = user_rhs, ctx_ = user_ctx;
 }
 
 OdeStepper::~OdeStepper() { Free(); }

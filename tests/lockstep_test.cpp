@@ -1,0 +1,247 @@
+// Lockstep protocol: regression (bit-identical runs, per transport, golden digest), logger
+// completeness, re-requests after lost messages, silent/crashing participants, handshake.
+#include <doctest/doctest.h>
+
+#include <cstdio>
+#include <csignal>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "io/run_log.h"
+#include "lockstep/runtime.h"
+#include "participants/factory.h"
+#include "scenario/scenario.h"
+
+namespace fs = std::filesystem;
+using rths::io::PayloadDigest;
+using rths::io::ReadRunLog;
+
+namespace {
+
+fs::path TempDir(const std::string& name) {
+  const fs::path p = fs::temp_directory_path() / ("rths_lockstep_test_" + std::to_string(::getpid())) / name;
+  fs::remove_all(p);
+  fs::create_directories(p);
+  return p;
+}
+
+fs::path WriteScenario(const fs::path& dir, const std::string& text) {
+  const fs::path p = dir / "scenario.toml";
+  std::ofstream(p) << text;
+  return p;
+}
+
+const char* kShort = R"(
+[run]
+name = "lockstep_test"
+duration_s = 0.5
+[lockstep]
+timeout_ms = 50.0
+max_attempts = 5
+handshake_timeout_s = 5.0
+)";
+
+struct MemqRun {
+  int code = 0;
+  std::vector<std::pair<std::string, int>> exit_codes;
+  std::vector<std::string> errors;
+};
+
+/// Runs every participant in this process on memq://, like `rths run --transport memq`.
+MemqRun RunMemq(const std::vector<rths::scenario::Scenario>& per_role, const fs::path& out,
+                const std::string& fault_role = "", rths::lockstep::Faults faults = {}) {
+  lcm::LCM lcm("memq://");
+  REQUIRE(lcm.good());
+  std::vector<std::unique_ptr<rths::lockstep::Participant>> owned;
+  std::vector<rths::lockstep::Participant*> ps;
+  int i = 0;
+  for (std::string_view role : {"logger", "plant", "controller", "semiactive", "integrator"}) {
+    const auto& s = per_role[per_role.size() == 1 ? 0 : i++];
+    owned.push_back(rths::participants::MakeParticipant(
+        role, s, rths::participants::IdentityOf(s, 42), &lcm, out.string()));
+    if (role == fault_role) owned.back()->faults = faults;
+    ps.push_back(owned.back().get());
+  }
+  MemqRun r;
+  r.code = rths::lockstep::RunLoop(&lcm, ps);
+  for (auto* p : ps) {
+    r.exit_codes.emplace_back(p->name(), p->exit_code());
+    r.errors.push_back(p->error());
+  }
+  return r;
+}
+
+int RunCli(const std::string& args, std::string* output = nullptr) {
+  const std::string cmd = std::string(RTHS_BIN_DIR) + "/rths-run " + args + " > out.txt 2>&1";
+  const int status = std::system(cmd.c_str());
+  if (output) {
+    std::ifstream in("out.txt");
+    std::stringstream ss;
+    ss << in.rdbuf();
+    *output = ss.str();
+  }
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+bool UdpmAvailable() { return rths::lockstep::CheckMulticastRoute().empty(); }
+
+}  // namespace
+
+TEST_CASE("logger completeness: an N-step run logs exactly N messages per step channel") {
+  const auto dir = TempDir("complete");
+  const auto s = rths::scenario::LoadScenario(WriteScenario(dir, kShort).string());
+  const std::int64_t n = s.steps();
+  REQUIRE(n == 1000);
+  const auto r = RunMemq({s}, dir);
+  REQUIRE(r.code == 0);
+  const auto log = ReadRunLog((dir / "log.lcm").string());
+  CHECK(log.CompleteSteps() == n);
+  for (const char* ch : {"RTHS_DESIRED", "RTHS_COMMAND", "RTHS_MEASURED", "RTHS_CURRENT"}) {
+    CAPTURE(ch);
+    CHECK(log.count.at(ch) == n);
+    CHECK(log.duplicates.count(ch) == 0);
+  }
+  // The handshake is on its own channel: every HELLO, GO and DONE.
+  int hellos = 0, gos = 0, dones = 0;
+  for (const auto& h : log.handshakes) {
+    hellos += h.phase == rths::lockstep::kHello;
+    gos += h.phase == rths::lockstep::kGo;
+    dones += h.phase == rths::lockstep::kDone;
+  }
+  CHECK(hellos == 4);  // every participant but the clock
+  CHECK(gos == 1);
+  CHECK(dones == 1);
+  // signals.csv: a header and one row per step.
+  std::ifstream csv(dir / "signals.csv");
+  std::string line;
+  std::int64_t rows = -1;
+  while (std::getline(csv, line)) ++rows;
+  CHECK(rows == n);
+}
+
+TEST_CASE("lost requests are re-requested; answers come from the cache, the log is unchanged") {
+  const auto base = TempDir("nodrop");
+  const auto s = rths::scenario::LoadScenario(WriteScenario(base, kShort).string());
+  REQUIRE(RunMemq({s}, base).code == 0);
+  const std::string reference = PayloadDigest(ReadRunLog((base / "log.lcm").string()));
+  for (const char* role : {"controller", "plant", "semiactive", "logger"}) {
+    CAPTURE(role);
+    const auto dir = TempDir(std::string("drop_") + role);
+    rths::lockstep::Faults f;
+    f.drop_first_request_at = 123;
+    const auto r = RunMemq({s}, dir, role, f);
+    CHECK(r.code == 0);
+    const auto log = ReadRunLog((dir / "log.lcm").string());
+    CHECK(log.CompleteSteps() == s.steps());
+    for (const auto& [ch, d] : log.duplicates) CHECK(d == 0);  // re-sent copies are not logged
+    CHECK(PayloadDigest(log) == reference);
+  }
+}
+
+TEST_CASE("a silent participant stops the run, named, with the log valid up to the last step") {
+  const auto dir = TempDir("stall");
+  const auto s = rths::scenario::LoadScenario(WriteScenario(dir, kShort).string());
+  rths::lockstep::Faults f;
+  f.stall_at = 321;
+  const auto r = RunMemq({s}, dir, "plant", f);
+  CHECK(r.code == rths::lockstep::kExitLockstep);
+  const std::string& clock_error = r.errors.back();  // integrator is last
+  CHECK(clock_error.find("step 321") != std::string::npos);
+  CHECK(clock_error.find("no answer from plant") != std::string::npos);
+  const auto log = ReadRunLog((dir / "log.lcm").string());
+  CHECK(log.CompleteSteps() == 321);
+  CHECK(log.AbortReason().find("plant") != std::string::npos);
+}
+
+TEST_CASE("an exception in a participant aborts the run cleanly, named") {
+  const auto dir = TempDir("throw");
+  const auto s = rths::scenario::LoadScenario(WriteScenario(dir, kShort).string());
+  rths::lockstep::Faults f;
+  f.throw_at = 77;
+  const auto r = RunMemq({s}, dir, "controller", f);
+  CHECK(r.code == rths::lockstep::kExitInternal);
+  for (std::size_t i = 0; i < r.exit_codes.size(); ++i) {
+    if (r.exit_codes[i].first == "controller") {
+      CHECK(r.exit_codes[i].second == rths::lockstep::kExitInternal);
+      CHECK(r.errors[i].find("step 77") != std::string::npos);
+    } else {
+      CHECK(r.exit_codes[i].second == rths::lockstep::kExitPeerAbort);
+    }
+  }
+  CHECK(ReadRunLog((dir / "log.lcm").string()).CompleteSteps() == 77);
+}
+
+TEST_CASE("the handshake refuses participants that loaded a different scenario") {
+  const auto dir = TempDir("mismatch");
+  const auto a = rths::scenario::LoadScenario(WriteScenario(dir, kShort).string());
+  const auto other = TempDir("mismatch_other");
+  const auto b = rths::scenario::LoadScenario(
+      WriteScenario(other, std::string(kShort) + "\n[plant]\nnoise_y_mm_rms = 0.01\n").string());
+  REQUIRE(a.sha256 != b.sha256);
+  // logger, plant, controller, semiactive, integrator: the plant loaded b.
+  const auto r = RunMemq({a, b, a, a, a}, dir);
+  CHECK(r.code == rths::lockstep::kExitLockstep);
+  CHECK(r.errors.back().find("scenario mismatch: plant") != std::string::npos);
+  CHECK(ReadRunLog((dir / "log.lcm").string()).CompleteSteps() == 0);
+}
+
+TEST_CASE("regression: runs are bit-identical across repeats and transports; golden digest") {
+  const fs::path golden_scenario = fs::path(RTHS_SOURCE_DIR) / "tests/data/regression_short.toml";
+  const fs::path golden_digest = fs::path(RTHS_SOURCE_DIR) / "tests/data/regression_short.digest";
+  const auto s = rths::scenario::LoadScenario(golden_scenario.string());
+  const auto d1 = TempDir("repeat1"), d2 = TempDir("repeat2");
+  REQUIRE(RunMemq({s}, d1).code == 0);
+  REQUIRE(RunMemq({s}, d2).code == 0);
+  const std::string digest = PayloadDigest(ReadRunLog((d1 / "log.lcm").string()));
+  CHECK(digest == PayloadDigest(ReadRunLog((d2 / "log.lcm").string())));
+
+  std::ifstream in(golden_digest);
+  std::string golden;
+  in >> golden;
+  CHECK_MESSAGE(digest == golden, "payload digest changed: if the change is intended, update "
+                                      << golden_digest.string() << " to " << digest);
+
+  if (!UdpmAvailable()) {
+    FAIL("udpm cannot run on this host: " << rths::lockstep::CheckMulticastRoute());
+  }
+  const auto d3 = TempDir("udpm");
+  fs::remove_all(d3);
+  std::string output;
+  REQUIRE(RunCli(golden_scenario.string() + " --transport udpm --out " + d3.string(), &output) == 0);
+  CAPTURE(output);
+  CHECK(PayloadDigest(ReadRunLog((d3 / "log.lcm").string())) == digest);
+  const auto summary = nlohmann::json::parse(std::ifstream(d3 / "summary.json"));
+  CHECK(summary["steps"] == s.steps());
+  CHECK(summary["scenario_sha256"] == s.sha256);
+  CHECK(summary["stopped"] == "no");
+  CHECK(summary["tracking_nrmse_pct"].get<double>() > 0.0);
+  CHECK(fs::file_size(d3 / "scenario.toml") == fs::file_size(golden_scenario));
+}
+
+TEST_CASE("supervisor: a crashed process is named, the group torn down, the log kept") {
+  if (!UdpmAvailable()) FAIL("udpm cannot run on this host: " << rths::lockstep::CheckMulticastRoute());
+  const auto dir = TempDir("crash");
+  const auto scen = WriteScenario(dir, kShort);
+  const fs::path out = dir / "run";
+  std::string output;
+  const int code = RunCli(scen.string() + " --out " + out.string() + " --fault plant:crash:250", &output);
+  CAPTURE(output);
+  CHECK(code == 128 + SIGABRT);
+  CHECK(output.find("FAILED: plant was killed by signal 6") != std::string::npos);
+  CHECK(ReadRunLog((out / "log.lcm").string()).CompleteSteps() == 250);
+  const auto summary = nlohmann::json::parse(std::ifstream(out / "summary.json"));
+  CHECK(summary["steps"] == 250);
+  CHECK(summary["stopped"].get<std::string>().rfind("plant", 0) == 0);
+
+  // An existing run is never overwritten.
+  CHECK(RunCli(scen.string() + " --out " + out.string(), &output) == rths::lockstep::kExitUsage);
+  CHECK(output.find("refusing to overwrite") != std::string::npos);
+  CHECK(ReadRunLog((out / "log.lcm").string()).CompleteSteps() == 250);
+}
