@@ -18,6 +18,7 @@
 #include "lockstep/runtime.h"
 #include "participants/factory.h"
 #include "scenario/scenario.h"
+#include "test_support.h"
 
 namespace fs = std::filesystem;
 using rths::io::PayloadDigest;
@@ -25,18 +26,7 @@ using rths::io::ReadRunLog;
 
 namespace {
 
-fs::path TempDir(const std::string& name) {
-  const fs::path p = fs::temp_directory_path() / ("rths_lockstep_test_" + std::to_string(::getpid())) / name;
-  fs::remove_all(p);
-  fs::create_directories(p);
-  return p;
-}
-
-fs::path WriteScenario(const fs::path& dir, const std::string& text) {
-  const fs::path p = dir / "scenario.toml";
-  std::ofstream(p) << text;
-  return p;
-}
+using namespace rths_test;
 
 const char* kShort = R"(
 [run]
@@ -48,41 +38,12 @@ max_attempts = 5
 handshake_timeout_s = 5.0
 )";
 
-struct MemqRun {
-  int code = 0;
-  std::vector<std::pair<std::string, int>> exit_codes;
-  std::vector<std::string> errors;
-};
-
-/// Runs every participant in this process on memq://, like `rths run --transport memq`.
-MemqRun RunMemq(const std::vector<rths::scenario::Scenario>& per_role, const fs::path& out,
-                const std::string& fault_role = "", rths::lockstep::Faults faults = {}) {
-  lcm::LCM lcm("memq://");
-  REQUIRE(lcm.good());
-  std::vector<std::unique_ptr<rths::lockstep::Participant>> owned;
-  std::vector<rths::lockstep::Participant*> ps;
-  int i = 0;
-  for (std::string_view role : {"logger", "plant", "controller", "semiactive", "integrator"}) {
-    const auto& s = per_role[per_role.size() == 1 ? 0 : i++];
-    owned.push_back(rths::participants::MakeParticipant(
-        role, s, rths::participants::IdentityOf(s, 42), &lcm, out.string()));
-    if (role == fault_role) owned.back()->faults = faults;
-    ps.push_back(owned.back().get());
-  }
-  MemqRun r;
-  r.code = rths::lockstep::RunLoop(&lcm, ps);
-  for (auto* p : ps) {
-    r.exit_codes.emplace_back(p->name(), p->exit_code());
-    r.errors.push_back(p->error());
-  }
-  return r;
-}
-
 int RunCli(const std::string& args, std::string* output = nullptr) {
-  const std::string cmd = std::string(RTHS_BIN_DIR) + "/rths-run " + args + " > out.txt 2>&1";
+  const fs::path out_txt = fs::temp_directory_path() / ("rths_run_" + std::to_string(::getpid()) + ".txt");
+  const std::string cmd = std::string(RTHS_BIN_DIR) + "/rths-run " + args + " > " + out_txt.string() + " 2>&1";
   const int status = std::system(cmd.c_str());
   if (output) {
-    std::ifstream in("out.txt");
+    std::ifstream in(out_txt);
     std::stringstream ss;
     ss << in.rdbuf();
     *output = ss.str();

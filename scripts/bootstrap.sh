@@ -1,0 +1,41 @@
+#!/usr/bin/env bash
+# Installs rths's dependencies (Debian 12 packages only), makes sure LCM's udpm transport can
+# work on this host, and builds everything into build/. Run as root on a fresh Debian 12.
+# Idempotent: a second run only rebuilds what changed.
+set -euo pipefail
+cd "$(dirname "${BASH_SOURCE[0]}")/.."
+
+packages=(
+  cmake ninja-build g++ pkg-config
+  liblcm-dev liblcm-bin            # LCM 1.3.1: library, lcm-gen, lcm-logger/-logplayer/-spy
+  libeigen3-dev libsundials-dev    # linear algebra, CVODE
+  libfmt-dev doctest-dev libcli11-dev libtomlplusplus-dev nlohmann-json3-dev
+  libssl-dev                       # SHA-256 of scenario files (libcrypto)
+  iproute2                         # ip route, for the multicast route below
+)
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if ((${#missing[@]})); then
+  if [[ $(id -u) -ne 0 ]]; then
+    echo "bootstrap: missing packages: ${missing[*]} (run as root, or: sudo apt-get install ${missing[*]})" >&2
+    exit 1
+  fi
+  apt-get update
+  DEBIAN_FRONTEND=noninteractive apt-get install -y --no-install-recommends "${missing[@]}"
+fi
+
+# LCM's udpm needs a route for multicast; without one lcm_create fails or stalls 10 s.
+# Loopback keeps every run on this host.
+if ! ip route show 224.0.0.0/4 2>/dev/null | grep -q .; then
+  if [[ $(id -u) -eq 0 ]] && ip route add 224.0.0.0/4 dev lo; then
+    echo "bootstrap: added the multicast route: ip route add 224.0.0.0/4 dev lo"
+  else
+    echo "bootstrap: no multicast route; as root run: ip route add 224.0.0.0/4 dev lo" >&2
+    echo "           (until then use: ./rths run --transport memq)" >&2
+  fi
+fi
+
+cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo
+cmake --build build -j"$(nproc)"
