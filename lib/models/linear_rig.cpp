@@ -23,8 +23,8 @@ double MeasuredDisplacementMm(const LinearRig& rig, const LinearRigState& s) {
 
 double MeasuredForceKn(const LinearRig& rig, const LinearRigState& s, double current_A) {
   if (!rig.has_damper) return 0.0;
-  return DamperForceKn(CoefficientsAt(rig.damper, current_A), s.damper,
-                       Output(rig.servo, s.servo), OutputVelocity(rig.servo, s.servo));
+  return DamperForceKn(CoefficientsAt(rig.damper, current_A), s.damper, Output(rig.servo, s.servo),
+                       OutputVelocity(rig.servo, s.servo));
 }
 
 namespace {

@@ -20,10 +20,10 @@ namespace rths::models {
 
 /// Immutable description of the rig.
 struct LinearRig {
-  LinearServo servo;        ///< actuator model and its ZOH matrices (dt = servo.dt_s)
-  MrDamperParams damper;    ///< specimen (Table 3)
-  bool has_damper = true;   ///< false: no specimen, force is 0
-  double rtol = 1e-8;       ///< CVODE relative tolerance (0, 1e-2]
+  LinearServo servo;       ///< actuator model and its ZOH matrices (dt = servo.dt_s)
+  MrDamperParams damper;   ///< specimen (Table 3)
+  bool has_damper = true;  ///< false: no specimen, force is 0
+  double rtol = 1e-8;      ///< CVODE relative tolerance (0, 1e-2]
 
   /// Validates everything (rths::Error on a bad value).
   static LinearRig Make(const scenario::ServoModel3& actuator, double dt_s, bool has_damper,
@@ -33,8 +33,8 @@ struct LinearRig {
 
 /// Per-step state at sample k.
 struct LinearRigState {
-  LinearServoState servo;   ///< z_k = [x, x', x''] of the actuator [mm, mm/s, mm/s^2]
-  MrDamperState damper;     ///< y_d, z_bw at t_k [mm]
+  LinearServoState servo;  ///< z_k = [x, x', x''] of the actuator [mm, mm/s, mm/s^2]
+  MrDamperState damper;    ///< y_d, z_bw at t_k [mm]
 };
 
 /// Measured actuator displacement y_k = C z_k [mm].

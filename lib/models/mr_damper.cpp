@@ -21,6 +21,7 @@ void MrDamperParams::Validate() const {
     double min;
     bool strict;
   };
+  // clang-format off
   const Field fields[] = {
       {"alpha_a", alpha_a, 0, false}, {"alpha_b", alpha_b, 0, false}, {"alpha_c", alpha_c, 0, false},
       {"c0_a", c0_a, 0, true},        {"c0_b", c0_b, 0, true},        {"c0_c", c0_c, 0, false},
@@ -30,12 +31,13 @@ void MrDamperParams::Validate() const {
       {"A", A, 0, false},             {"n", n, 1, false},             {"k0", k0, 0, false},
       {"k1", k1, 0, false},
   };
+  // clang-format on
   for (const Field& f : fields) {
     const bool ok = std::isfinite(f.value) && (f.strict ? f.value > f.min : f.value >= f.min);
     if (!ok)
-      throw Error(fmt::format("MrDamperParams: {}", f.name),
-                  fmt::format("must be finite and {} {} (got {})", f.strict ? ">" : ">=", f.min,
-                              f.value));
+      throw Error(
+          fmt::format("MrDamperParams: {}", f.name),
+          fmt::format("must be finite and {} {} (got {})", f.strict ? ">" : ">=", f.min, f.value));
   }
   if (!std::isfinite(x0)) throw Error("MrDamperParams: x0", "must be finite");
 }

@@ -18,16 +18,16 @@ namespace rths::models {
 
 /// Table 3 of the paper (defaults). a: fitted at 0.0 A, b: at 2.5 A, c: exponential rate.
 struct MrDamperParams {
-  double alpha_a = 0.11, alpha_b = 0.55, alpha_c = 1.0;  ///< [kN/mm], [kN/mm], [1/A]
-  double c0_a = 0.080, c0_b = 0.32, c0_c = 1.5;          ///< [kN s/mm], [kN s/mm], [1/A]
-  double c1_a = 3.0, c1_b = 15.0, c1_c = 2.0;            ///< [kN s/mm], [kN s/mm], [1/A]
-  double beta_a = 0.050, beta_b = 0.0020, beta_c = 5.2;  ///< [1/mm^2], [1/mm^2], [1/A]
+  double alpha_a = 0.11, alpha_b = 0.55, alpha_c = 1.0;     ///< [kN/mm], [kN/mm], [1/A]
+  double c0_a = 0.080, c0_b = 0.32, c0_c = 1.5;             ///< [kN s/mm], [kN s/mm], [1/A]
+  double c1_a = 3.0, c1_b = 15.0, c1_c = 2.0;               ///< [kN s/mm], [kN s/mm], [1/A]
+  double beta_a = 0.050, beta_b = 0.0020, beta_c = 5.2;     ///< [1/mm^2], [1/mm^2], [1/A]
   double gamma_a = 0.050, gamma_b = 0.0020, gamma_c = 5.2;  ///< [1/mm^2], [1/mm^2], [1/A]
-  double A = 300.0;   ///< Bouc-Wen A [-]
-  double n = 2.0;     ///< Bouc-Wen exponent [-], >= 1
-  double k0 = 0.0;    ///< [kN/mm]
-  double k1 = 0.0;    ///< accumulator stiffness [kN/mm]
-  double x0 = 0.0;    ///< accumulator offset [mm]
+  double A = 300.0;                                         ///< Bouc-Wen A [-]
+  double n = 2.0;                                           ///< Bouc-Wen exponent [-], >= 1
+  double k0 = 0.0;                                          ///< [kN/mm]
+  double k1 = 0.0;                                          ///< accumulator stiffness [kN/mm]
+  double x0 = 0.0;                                          ///< accumulator offset [mm]
 
   /// The paper's identified 200-kN damper (same as the defaults).
   static MrDamperParams Table3() { return {}; }

@@ -117,8 +117,7 @@ int OdeStepper::Jac(double t, N_Vector x, N_Vector fx, SUNMatrix jac, void* self
   if (CVodeGetCurrentStep(me->cvode_, &h) != CV_SUCCESS) return -1;
   const double uround = SUN_UNIT_ROUNDOFF, srur = std::sqrt(uround);
   const double fnorm = N_VWrmsNorm(fx, me->ewt_);
-  const double min_inc =
-      fnorm != 0.0 ? 1000.0 * std::abs(h) * uround * me->n_ * fnorm : 1.0;
+  const double min_inc = fnorm != 0.0 ? 1000.0 * std::abs(h) * uround * me->n_ * fnorm : 1.0;
   double* xv = N_VGetArrayPointer(x);
   const double* f0 = N_VGetArrayPointer(fx);
   const double* f1 = N_VGetArrayPointer(tmp1);

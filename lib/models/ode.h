@@ -20,7 +20,8 @@ struct _SUNContext;
 namespace rths::models {
 
 /// Right-hand side x' = f(t, x) with x and xdot of the stepper's size. Returns 0 on success,
-/// > 0 for a recoverable error (CVODE retries with a smaller step), < 0 to stop.
+/// > 0 for a recoverable error (CVODE retries with a smaller step), < 0 to stop. It is called
+/// from C code: it must not throw, and it must allocate nothing for Advance() not to.
 using OdeRhs = int (*)(double t, const double* x, double* xdot, void* ctx);
 
 class OdeStepper {

@@ -15,16 +15,19 @@ LinearServo LinearServo::Make(const scenario::ServoModel3& m, double dt_s) {
   const auto positive = [](double v) { return std::isfinite(v) && v > 0.0; };
   if (!positive(m.K) || !positive(m.p) || !positive(m.b) || !positive(m.c))
     throw Error("LinearServo", fmt::format("K, p, b, c must be finite and > 0 (got K = {}, p = {}, "
-                                           "b = {}, c = {})", m.K, m.p, m.b, m.c));
+                                           "b = {}, c = {})",
+                                           m.K, m.p, m.b, m.c));
   if (!positive(dt_s))
     throw Error("LinearServo", fmt::format("dt_s must be finite and > 0 (got {})", dt_s));
 
   LinearServo s;
   s.K = m.K, s.p = m.p, s.b = m.b, s.c = m.c, s.dt_s = dt_s;
   const double d2 = m.p + m.b, d1 = m.p * m.b + m.c, d0 = m.p * m.c;
+  // clang-format off
   s.A << 0, 1, 0,
          0, 0, 1,
          -d0, -d1, -d2;
+  // clang-format on
   s.B << 0, 0, m.K;
   s.C << 1, 0, 0;
 

@@ -21,12 +21,12 @@ namespace rths::models {
 
 /// Immutable description of one linear servo (continuous and ZOH matrices).
 struct LinearServo {
-  Eigen::Matrix3d A;       ///< continuous state matrix [1/s^k]
-  Eigen::Vector3d B;       ///< continuous input vector, [0, 0, K]^T [1/s^3]
-  Eigen::RowVector3d C;    ///< output row [1, 0, 0]
-  Eigen::Matrix3d Phi;     ///< e^{A dt}
-  Eigen::Vector3d Gamma;   ///< int_0^dt e^{A s} ds B
-  double dt_s = 0.0;       ///< ZOH step [s]
+  Eigen::Matrix3d A;                  ///< continuous state matrix [1/s^k]
+  Eigen::Vector3d B;                  ///< continuous input vector, [0, 0, K]^T [1/s^3]
+  Eigen::RowVector3d C;               ///< output row [1, 0, 0]
+  Eigen::Matrix3d Phi;                ///< e^{A dt}
+  Eigen::Vector3d Gamma;              ///< int_0^dt e^{A s} ds B
+  double dt_s = 0.0;                  ///< ZOH step [s]
   double K = 0, p = 0, b = 0, c = 0;  ///< model coefficients (scenario::ServoModel3)
 
   /// Builds the realisation and its exact ZOH discretisation (augmented-matrix exponential,

@@ -23,8 +23,7 @@ LinearStructure LinearStructure::Sdof(double mass_kg, double frequency_hz, doubl
   const double m = mass_kg * 1e-6;  // kN s^2/mm
   const double w = 2.0 * std::numbers::pi * frequency_hz;
   const auto scalar = [](double v) { return Eigen::MatrixXd::Constant(1, 1, v); };
-  return Make(scalar(m), scalar(2.0 * damping_ratio * m * w), scalar(m * w * w), 0,
-              specimen_count);
+  return Make(scalar(m), scalar(2.0 * damping_ratio * m * w), scalar(m * w * w), 0, specimen_count);
 }
 
 LinearStructure LinearStructure::Make(const Eigen::MatrixXd& M, const Eigen::MatrixXd& C,
@@ -32,9 +31,10 @@ LinearStructure LinearStructure::Make(const Eigen::MatrixXd& M, const Eigen::Mat
                                       double specimen_count) {
   const Eigen::Index n = M.rows();
   if (n == 0 || M.cols() != n || C.rows() != n || C.cols() != n || K.rows() != n || K.cols() != n)
-    throw Error("LinearStructure", fmt::format("M, C, K must be square and of one size (got "
-                                               "{}x{}, {}x{}, {}x{})", M.rows(), M.cols(),
-                                               C.rows(), C.cols(), K.rows(), K.cols()));
+    throw Error("LinearStructure",
+                fmt::format("M, C, K must be square and of one size (got "
+                            "{}x{}, {}x{}, {}x{})",
+                            M.rows(), M.cols(), C.rows(), C.cols(), K.rows(), K.cols()));
   if (!M.allFinite() || !C.allFinite() || !K.allFinite())
     throw Error("LinearStructure", "M, C, K must be finite");
   const auto symmetric = [](const Eigen::MatrixXd& A) {
@@ -63,7 +63,7 @@ CentralDifference CentralDifference::Make(const LinearStructure& s, double dt,
   if (!(dt > 0.0) || !std::isfinite(dt))
     throw Error("CentralDifference", fmt::format("dt_s must be > 0 (got {})", dt));
   const Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> eig(s.K, s.M,
-                                                                       Eigen::EigenvaluesOnly);
+                                                                      Eigen::EigenvaluesOnly);
   const double w_max = std::sqrt(std::max(0.0, eig.eigenvalues().maxCoeff()));
   CentralDifference cd;
   cd.dt_s = dt;
@@ -72,8 +72,8 @@ CentralDifference CentralDifference::Make(const LinearStructure& s, double dt,
   if (enforce_stability_limit && dt >= cd.dt_limit_s)
     throw Error("CentralDifference",
                 fmt::format("dt = {} s is at or above the stability limit T_min/pi = {:.6g} s "
-                            "(highest natural frequency {:.6g} Hz)", dt, cd.dt_limit_s,
-                            cd.max_frequency_hz));
+                            "(highest natural frequency {:.6g} Hz)",
+                            dt, cd.dt_limit_s, cd.max_frequency_hz));
   const Eigen::MatrixXd m_dt2 = s.M / (dt * dt), c_2dt = s.C / (2.0 * dt);
   const Eigen::PartialPivLU<Eigen::MatrixXd> khat(m_dt2 + c_2dt);
   cd.P_x = khat.solve(2.0 * m_dt2 - s.K);
@@ -92,8 +92,8 @@ StructureState MakeState(const CentralDifference& cd) {
   return s;
 }
 
-void SetInitialConditions(const CentralDifference& cd, StructureState* s,
-                          const Eigen::VectorXd& x0, const Eigen::VectorXd& v0) {
+void SetInitialConditions(const CentralDifference& cd, StructureState* s, const Eigen::VectorXd& x0,
+                          const Eigen::VectorXd& v0) {
   if (x0.size() != cd.dofs() || v0.size() != cd.dofs())
     throw Error("SetInitialConditions", fmt::format("x0, v0 must have {} entries", cd.dofs()));
   const Eigen::VectorXd a0 = cd.M.llt().solve(-cd.C * v0 - cd.K * x0);
@@ -108,11 +108,11 @@ void Advance(const CentralDifference& cd, StructureState* s, double ground_acc_m
   s->x_next.noalias() = cd.P_x * s->x;
   s->x_next.noalias() += cd.P_xprev * s->x_prev;
   s->x_next += cd.p_ground * ground_acc_mm_s2 + cd.p_force * specimen_force_kN;
-  s->vel_prev = (s->x_next - s->x_prev) / (2.0 * dt);                 // Eq. 2 at k
-  s->acc_prev = (s->x_next - 2.0 * s->x + s->x_prev) / (dt * dt);     // Eq. 3 at k
+  s->vel_prev = (s->x_next - s->x_prev) / (2.0 * dt);              // Eq. 2 at k
+  s->acc_prev = (s->x_next - 2.0 * s->x + s->x_prev) / (dt * dt);  // Eq. 3 at k
   s->abs_acc_prev = s->acc_prev + cd.iota * ground_acc_mm_s2;
-  std::swap(s->x_prev, s->x);       // x_prev = x_k
-  std::swap(s->x, s->x_next);       // x = x_{k+1}
+  std::swap(s->x_prev, s->x);  // x_prev = x_k
+  std::swap(s->x, s->x_next);  // x = x_{k+1}
   ++s->k;
 }
 

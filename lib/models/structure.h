@@ -43,15 +43,15 @@ struct LinearStructure {
 
 /// Immutable central-difference integrator for one structure and step.
 struct CentralDifference {
-  double dt_s = 0.0;                ///< step [s]
-  double max_frequency_hz = 0.0;    ///< highest natural frequency of (M, K) [Hz]
-  double dt_limit_s = 0.0;          ///< stability limit T_min / pi [s]
-  Eigen::MatrixXd P_x;              ///< Khat^-1 (2M/dt^2 - K), multiplies x_k
-  Eigen::MatrixXd P_xprev;          ///< -Khat^-1 (M/dt^2 - C/(2dt)), multiplies x_{k-1}
-  Eigen::VectorXd p_ground;         ///< -Khat^-1 M iota [s^2], multiplies a_g,k [mm/s^2]
-  Eigen::VectorXd p_force;          ///< -Khat^-1 s [mm/kN], multiplies f_k [kN]
-  Eigen::VectorXd iota;             ///< ground influence (for absolute accelerations)
-  Eigen::MatrixXd M, C, K;          ///< the structure's matrices (initial conditions)
+  double dt_s = 0.0;              ///< step [s]
+  double max_frequency_hz = 0.0;  ///< highest natural frequency of (M, K) [Hz]
+  double dt_limit_s = 0.0;        ///< stability limit T_min / pi [s]
+  Eigen::MatrixXd P_x;            ///< Khat^-1 (2M/dt^2 - K), multiplies x_k
+  Eigen::MatrixXd P_xprev;        ///< -Khat^-1 (M/dt^2 - C/(2dt)), multiplies x_{k-1}
+  Eigen::VectorXd p_ground;       ///< -Khat^-1 M iota [s^2], multiplies a_g,k [mm/s^2]
+  Eigen::VectorXd p_force;        ///< -Khat^-1 s [mm/kN], multiplies f_k [kN]
+  Eigen::VectorXd iota;           ///< ground influence (for absolute accelerations)
+  Eigen::MatrixXd M, C, K;        ///< the structure's matrices (initial conditions)
 
   /// Precomputes the recurrence, with Khat = M/dt^2 + C/(2dt). Throws rths::Error for dt <= 0
   /// and, if enforce_stability_limit, for dt >= T_min / pi, naming the highest natural
@@ -78,8 +78,8 @@ StructureState MakeState(const CentralDifference& cd);
 /// Initial conditions x_0 [mm], x'_0 [mm/s] at k = 0 with the second-order start
 /// x_{-1} = x_0 - dt x'_0 + dt^2/2 x''_0, x''_0 = M^-1 (-M iota a_g0 - s f0 - C x'_0 - K x_0)
 /// (here with a_g0 = f0 = 0).
-void SetInitialConditions(const CentralDifference& cd, StructureState* s,
-                          const Eigen::VectorXd& x0, const Eigen::VectorXd& v0);
+void SetInitialConditions(const CentralDifference& cd, StructureState* s, const Eigen::VectorXd& x0,
+                          const Eigen::VectorXd& v0);
 
 /// Step k: from x_k, x_{k-1}, the ground acceleration a_g,k [mm/s^2] and the specimen force f_k
 /// [kN] measured at k, computes x_{k+1}; then exposes x = x_{k+1}, x_prev = x_k, and the
