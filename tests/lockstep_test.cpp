@@ -206,3 +206,16 @@ TEST_CASE("supervisor: a crashed process is named, the group torn down, the log 
   CHECK(output.find("refusing to overwrite") != std::string::npos);
   CHECK(ReadRunLog((out / "log.lcm").string()).CompleteSteps() == 250);
 }
+
+TEST_CASE("supervisor: a bad scenario is refused before anything runs, naming file and key") {
+  const auto dir = TempDir("bad_scenario");
+  const auto scen = WriteScenario(dir, "[run]\ndt_s = 0.5\n");
+  const fs::path out = dir / "run";
+  std::string output;
+  CHECK(RunCli(scen.string() + " --out " + out.string(), &output) == rths::lockstep::kExitUsage);
+  CAPTURE(output);
+  CHECK(output.find("scenario.toml") != std::string::npos);
+  CHECK(output.find("run.dt_s") != std::string::npos);
+  CHECK(output.find("[1e-05, 0.01]") != std::string::npos);
+  CHECK_FALSE(fs::exists(out));
+}
