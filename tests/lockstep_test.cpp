@@ -219,3 +219,23 @@ TEST_CASE("supervisor: a bad scenario is refused before anything runs, naming fi
   CHECK(output.find("[1e-05, 0.01]") != std::string::npos);
   CHECK_FALSE(fs::exists(out));
 }
+
+TEST_CASE("log.lcm is a standard LCM event log: lcm-logplayer replays it, lcm-logger records it") {
+  if (!UdpmAvailable()) FAIL("udpm cannot run on this host: " << rths::lockstep::CheckMulticastRoute());
+  const auto dir = TempDir("replay");
+  const auto s = rths::scenario::LoadScenario(WriteScenario(dir, kShort).string());
+  REQUIRE(RunMemq({s}, dir).code == 0);
+  const auto original = ReadRunLog((dir / "log.lcm").string());
+  // Replay on a port of its own, record with Debian's lcm-logger, read the recording back.
+  const std::string url = "udpm://239.255.76.67:" + std::to_string(20000 + ::getpid() % 20000) + "?ttl=0";
+  const fs::path replay = dir / "replay.lcm";
+  const std::string cmd =
+      "lcm-logger --lcm-url='" + url + "' -f " + replay.string() + " > /dev/null 2>&1 & pid=$!; " +
+      "sleep 0.5; lcm-logplayer --speed=0.05 --lcm-url='" + url + "' " + (dir / "log.lcm").string() +
+      " > /dev/null 2>&1; sleep 0.5; kill -INT $pid; wait $pid";
+  REQUIRE(std::system(cmd.c_str()) == 0);
+  const auto replayed = ReadRunLog(replay.string());
+  CHECK(replayed.CompleteSteps() == s.steps());
+  CHECK(PayloadDigest(replayed) == PayloadDigest(original));
+  CHECK(replayed.handshakes.size() == original.handshakes.size());
+}

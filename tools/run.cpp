@@ -358,7 +358,9 @@ int main(int argc, char** argv) {
     j["steps"] = 0;
     j["log_error"] = e.what();
   }
-  j["stopped"] = culprit ? fmt::format("{}: {}", culprit->role, culprit->message) : "no";
+  j["stopped"] = g_interrupted ? std::string("interrupted by the user")
+                 : culprit    ? fmt::format("{}: {}", culprit->role, culprit->message)
+                              : std::string("no");
   j["participants"] = nlohmann::json::object();
   for (const auto& o : outcomes) j["participants"][o.role] = {{"exit_code", o.exit_code}, {"message", o.message}};
   std::ofstream(out / "summary.json") << j.dump(2) << "\n";
@@ -374,6 +376,12 @@ int main(int argc, char** argv) {
     }
   }
   std::fflush(stdout);
+  if (g_interrupted) {
+    std::fprintf(stderr, "rths run: interrupted; the group was stopped\n");
+    std::printf("output: %s (log valid up to step %lld)\n", out.string().c_str(),
+                static_cast<long long>(steps));
+    return 130;
+  }
   if (culprit) {
     const char* what = culprit->signal ? strsignal(culprit->signal) : nullptr;
     std::fprintf(stderr, "rths run: FAILED: %s %s%s%s\n", culprit->role.c_str(),
