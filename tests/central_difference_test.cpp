@@ -12,28 +12,7 @@
 using namespace rths::models;
 
 // Count every heap allocation of the process (Eigen and new end in malloc).
-extern "C" {
-void* __libc_malloc(size_t);
-void* __libc_calloc(size_t, size_t);
-void* __libc_realloc(void*, size_t);
-void __libc_free(void*);
-}
-namespace {
-std::atomic<long> g_allocations{0};
-}
-extern "C" void* malloc(size_t n) noexcept {
-  g_allocations.fetch_add(1, std::memory_order_relaxed);
-  return __libc_malloc(n);
-}
-extern "C" void* calloc(size_t n, size_t m) noexcept {
-  g_allocations.fetch_add(1, std::memory_order_relaxed);
-  return __libc_calloc(n, m);
-}
-extern "C" void* realloc(void* p, size_t n) noexcept {
-  g_allocations.fetch_add(1, std::memory_order_relaxed);
-  return __libc_realloc(p, n);
-}
-extern "C" void free(void* p) noexcept { __libc_free(p); }
+#include "alloc_counter.h"
 
 namespace {
 
@@ -230,9 +209,9 @@ TEST_CASE("Advance allocates nothing") {
   const CentralDifference cd =
       CentralDifference::Make(LinearStructure::Make(M, 0.01 * K, K, 0, 18), 0.0005);
   StructureState s = MakeState(cd);
-  const long before = g_allocations.load();
+  const long before = rths_test::AllocationCount();
   for (int k = 0; k < 1000; ++k) Advance(cd, &s, 100.0 * std::sin(0.01 * k), 1.0);
-  CHECK(g_allocations.load() - before == 0);
+  CHECK(rths_test::AllocationCount() - before == 0);
   CHECK(s.k == 1000);
   CHECK(s.x.allFinite());
 }

@@ -18,17 +18,7 @@ namespace ctl = rths::control;
 using rths::scenario::ServoModel3;
 using std::numbers::pi;
 
-// Counting global allocator: the per-step functions must allocate nothing (style.md item 2).
-namespace {
-std::size_t g_allocations = 0;
-}
-void* operator new(std::size_t n) {
-  ++g_allocations;
-  if (void* p = std::malloc(n ? n : 1)) return p;
-  throw std::bad_alloc();
-}
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+#include "alloc_counter.h"
 
 namespace {
 
@@ -267,12 +257,12 @@ TEST_CASE("per-step functions allocate nothing") {
   const auto a = ctl::MakeFeedforwardCoefficients(kModelAvg);
   ctl::ExtrapolationState st;
   double sink = 0.0;
-  const std::size_t before = g_allocations;
+  const long before = rths_test::AllocationCount();
   for (int i = 0; i < 1000; ++i) {
     const auto d = ctl::StepDerivatives(&st, std::sin(0.01 * i), 0.0005);
     sink += ctl::FeedforwardCommand(a, d, false, 0.0005) + ctl::FeedforwardCommand(a, d, true, 0.0005);
   }
-  const std::size_t after = g_allocations;
+  const long after = rths_test::AllocationCount();
   CHECK(after == before);
   CHECK(std::isfinite(sink));
 }

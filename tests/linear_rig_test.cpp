@@ -17,28 +17,7 @@ using namespace rths::models;
 using rths::scenario::ServoModel3;
 
 // Count every heap allocation of the process (CVODE uses malloc, C++ new ends in malloc).
-extern "C" {
-void* __libc_malloc(size_t);
-void* __libc_calloc(size_t, size_t);
-void* __libc_realloc(void*, size_t);
-void __libc_free(void*);
-}
-namespace {
-std::atomic<long> g_allocations{0};
-}
-extern "C" void* malloc(size_t n) noexcept {
-  g_allocations.fetch_add(1, std::memory_order_relaxed);
-  return __libc_malloc(n);
-}
-extern "C" void* calloc(size_t n, size_t m) noexcept {
-  g_allocations.fetch_add(1, std::memory_order_relaxed);
-  return __libc_calloc(n, m);
-}
-extern "C" void* realloc(void* p, size_t n) noexcept {
-  g_allocations.fetch_add(1, std::memory_order_relaxed);
-  return __libc_realloc(p, n);
-}
-extern "C" void free(void* p) noexcept { __libc_free(p); }
+#include "alloc_counter.h"
 
 namespace {
 
@@ -154,7 +133,7 @@ TEST_CASE("Step allocates nothing; timing") {
   LinearRigStepper stepper(rig);
   LinearRigState s;
   const int steps = 4000;
-  const long before = g_allocations.load();
+  const long before = rths_test::AllocationCount();
   const auto t0 = std::chrono::steady_clock::now();
   double sum = 0.0;
   for (int k = 0; k < steps; ++k) {
@@ -163,7 +142,7 @@ TEST_CASE("Step allocates nothing; timing") {
     sum += MeasuredForceKn(rig, s, current);
   }
   const auto t1 = std::chrono::steady_clock::now();
-  const long allocations = g_allocations.load() - before;
+  const long allocations = rths_test::AllocationCount() - before;
   const double us = std::chrono::duration<double, std::micro>(t1 - t0).count() / steps;
   MESSAGE("LinearRig step with damper: " << us << " us (mean over " << steps << " steps)");
   CHECK(allocations == 0);

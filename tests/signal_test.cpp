@@ -26,17 +26,7 @@
 namespace sig = rths::signal;
 using std::numbers::pi;
 
-// Counting global allocator: the per-step functions must allocate nothing (style.md item 2).
-namespace {
-std::size_t g_allocations = 0;
-}
-void* operator new(std::size_t n) {
-  ++g_allocations;
-  if (void* p = std::malloc(n ? n : 1)) return p;
-  throw std::bad_alloc();
-}
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+#include "alloc_counter.h"
 
 namespace {
 
@@ -479,13 +469,13 @@ TEST_CASE("per-step functions allocate nothing") {
   sig::GaussianState g = sig::MakeGaussian(3);
   sig::RmsErrorAccumulator acc;
   double sink = 0.0;
-  const std::size_t before = g_allocations;
+  const long before = rths_test::AllocationCount();
   for (int i = 0; i < 1000; ++i) {
     const double x = sig::SosStep(sos, &st, sig::NextGaussian(&g));
     acc.Add(x, 0.5 * x);
     sink += x + sig::NextUniform(&g);
   }
-  const std::size_t after = g_allocations;
+  const long after = rths_test::AllocationCount();
   CHECK(after == before);
   CHECK(std::isfinite(sink));
   CHECK(acc.Percent() == doctest::Approx(50.0));

@@ -75,24 +75,11 @@ void ClockParticipant::OnHandshakeForClock(const rths::handshake_t& msg, SteadyC
 }
 
 void ClockParticipant::SendGo() {
-  rths::handshake_t go{};
-  go.run_id = id_.run_id;
-  go.phase = kGo;
-  go.participant = name_;
-  go.scenario_sha256 = id_.scenario_sha256;
-  go.n_steps = id_.n_steps;
-  go.dt_s = id_.dt_s;
-  go.k = 0;
-  for (const auto& r : kRoster) {
-    go.roster_names.emplace_back(r.name);
-    go.roster_sha256.push_back(id_.scenario_sha256);  // every HELLO matched ours
-  }
-  go.n_roster = static_cast<int32_t>(go.roster_names.size());
-  Bytes bytes;
-  Encode(go, &bytes);
+  std::vector<std::string> roster;
+  for (const auto& r : kRoster) roster.emplace_back(r.name);
   // GO is sent twice: a participant that missed it would otherwise wait for the watchdog.
-  PublishBytes(kChHandshake, bytes);
-  PublishBytes(kChHandshake, bytes);
+  SendHandshake(kGo, 0, "", &roster);
+  SendHandshake(kGo, 0, "", &roster);
   OnGo();
   try {
     IssueStep(0);

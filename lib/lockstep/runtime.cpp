@@ -35,7 +35,8 @@ void Participant::Republish(const char* channel, const AnswerCache& cache, std::
   }
 }
 
-void Participant::SendHandshake(Phase phase, std::int64_t k, const std::string& reason) {
+void Participant::SendHandshake(Phase phase, std::int64_t k, const std::string& reason,
+                                const std::vector<std::string>* roster) {
   hs_out_.run_id = id_.run_id;
   hs_out_.phase = phase;
   hs_out_.participant = name_;
@@ -43,9 +44,13 @@ void Participant::SendHandshake(Phase phase, std::int64_t k, const std::string& 
   hs_out_.n_steps = id_.n_steps;
   hs_out_.dt_s = id_.dt_s;
   hs_out_.k = k;
-  hs_out_.n_roster = 0;
   hs_out_.roster_names.clear();
   hs_out_.roster_sha256.clear();
+  if (roster) {
+    hs_out_.roster_names = *roster;
+    hs_out_.roster_sha256.assign(roster->size(), id_.scenario_sha256);
+  }
+  hs_out_.n_roster = static_cast<std::int32_t>(hs_out_.roster_names.size());
   hs_out_.reason = reason;
   Encode(hs_out_, &hs_bytes_);
   lcm_->publish(kChHandshake, hs_bytes_.data(), static_cast<unsigned int>(hs_bytes_.size()));

@@ -179,8 +179,10 @@ class Participant {
   void Fail(int exit_code, const std::string& reason, bool broadcast, std::int64_t k = -1);
   /// Stops cleanly.
   void Finish();
-  /// Sends a handshake message of this participant.
-  void SendHandshake(Phase phase, std::int64_t k = -1, const std::string& reason = "");
+  /// Sends a handshake message of this participant; `roster` (GO only) lists who takes part,
+  /// every one of them with this participant's scenario hash (the clock checked them).
+  void SendHandshake(Phase phase, std::int64_t k = -1, const std::string& reason = "",
+                     const std::vector<std::string>* roster = nullptr);
 
   bool running() const { return running_ && !finished_; }
 

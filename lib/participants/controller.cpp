@@ -1,12 +1,11 @@
 #include "participants/controller.h"
 
+#include "participants/factory.h"
+
 namespace rths::participants {
 
 Controller::Controller(const scenario::Scenario& s, lockstep::RunIdentity id, lcm::LCM* lcm)
-    : DesiredMeasuredParticipant("controller", std::move(id),
-                                 lockstep::Timing{s.lockstep.timeout_ms, s.lockstep.max_attempts,
-                                                  s.lockstep.handshake_timeout_s},
-                                 lcm, lockstep::kChCommand),
+    : DesiredMeasuredParticipant("controller", std::move(id), TimingOf(s), lcm, lockstep::kChCommand),
       law_(control::MakeTrackingController(s.controller, s.run.dt_s)) {}
 
 void Controller::Compute(std::int64_t, const rths::desired_t& d, const rths::measured_t& m,

@@ -1,6 +1,7 @@
 #include "participants/semiactive.h"
 
 #include "core/error.h"
+#include "participants/factory.h"
 
 namespace rths::participants {
 
@@ -13,10 +14,7 @@ double ConstantCurrentA(const scenario::SemiactiveConfig& cfg) {
 }
 
 Semiactive::Semiactive(const scenario::Scenario& s, lockstep::RunIdentity id, lcm::LCM* lcm)
-    : DesiredMeasuredParticipant("semiactive", std::move(id),
-                                 lockstep::Timing{s.lockstep.timeout_ms, s.lockstep.max_attempts,
-                                                  s.lockstep.handshake_timeout_s},
-                                 lcm, lockstep::kChCurrent),
+    : DesiredMeasuredParticipant("semiactive", std::move(id), TimingOf(s), lcm, lockstep::kChCurrent),
       current_A_(ConstantCurrentA(s.semiactive)) {}
 
 void Semiactive::Compute(std::int64_t, const rths::desired_t&, const rths::measured_t&,
