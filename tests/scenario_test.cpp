@@ -296,3 +296,49 @@ TEST_CASE("unreadable files are errors naming the path") {
   CHECK_THROWS_WITH_AS(LoadScenario("/nonexistent/rths.toml"), doctest::Contains("/nonexistent/rths.toml"),
                        rths::Error);
 }
+
+TEST_CASE("ToToml writes every key: parsing it gives back the same scenario") {
+  for (const auto& entry : fs::directory_iterator(kSourceDir / "scenarios")) {
+    if (entry.path().extension() != ".toml") continue;
+    CAPTURE(entry.path().string());
+    auto s = rths::scenario::LoadScenario(entry.path().string());
+    // Exercise non-default values of the newer tables too.
+    s.controller.kind = "bumpless_lp";
+    s.controller.model = {1.5e7, 150.0, 250.0, 1.0e5, "custom"};
+    s.controller.lqg.q = 12.5;
+    s.plant.kind = "physical";
+    s.plant.physical.valve_hz = 71.0;
+    s.semiactive.mode = "pulse";
+    s.semiactive.pulse_duty = 0.25;
+    const std::string text = rths::scenario::ToToml(s);
+    const auto back = rths::scenario::ParseScenario(text, (kSourceDir / "scenarios/x.toml").string());
+    CHECK(rths::scenario::ToToml(back) == text);
+    CHECK(back.controller.kind == "bumpless_lp");
+    CHECK(back.controller.model.K == 1.5e7);
+    CHECK(back.controller.model.name == "custom");
+    CHECK(back.controller.model_low.name == "0.0A");
+    CHECK(back.controller.lqg.q == 12.5);
+    CHECK(back.plant.kind == "physical");
+    CHECK(back.plant.physical.valve_hz == 71.0);
+    CHECK(back.semiactive.pulse_duty == 0.25);
+    CHECK(back.run.dt_s == s.run.dt_s);
+    CHECK(back.structure.ground.rms == s.structure.ground.rms);
+    CHECK(back.steps() == s.steps());
+  }
+}
+
+TEST_CASE("controller and plant options of Table 1 are validated") {
+  CheckContains(ErrorOf("[controller]\nkind = \"poly3\"\ndelay_ms = 20.0\n"),
+                {"bad.toml", "controller.delay_ms", "20 is out of range (0, 15]"});
+  CheckContains(ErrorOf("[controller]\nkind = \"smith\"\n"),
+                {"controller.kind", "\"none\", \"ff\", \"poly3\", \"lead\", \"ff_lp\", \"bumpless_lp\", \"ff_lqg\""});
+  CheckContains(ErrorOf("[controller]\nlp_order = 2\n"), {"controller.lp_order", "[3, 8]"});
+  CheckContains(ErrorOf("[controller.lqg]\nq = -1.0\n"), {"controller.lqg.q", "(0, 1000000000000]"});
+  CheckContains(ErrorOf("[plant.physical]\nvalve_hz = 0.0\n"),
+                {"plant.physical.valve_hz", "0 is out of range (0, 10000]"});
+  CheckContains(ErrorOf("[plant]\nkind = \"hydraulic\"\n"), {"plant.kind", "\"linear\", \"physical\""});
+  CheckContains(ErrorOf("[semiactive]\nmode = \"pulse\"\npulse_duty = 1.0\n"),
+                {"semiactive.pulse_duty", "(0, 1)"});
+  CheckContains(ErrorOf("[controller]\nmodel = {K = 1.6e7, p = -151.7, b = 250.4, c = 1.061e5}\n"),
+                {"controller.model.p", "stable"});
+}

@@ -259,6 +259,21 @@ class Section {
   std::vector<std::string_view> tables_;  // declared sub-tables
 };
 
+/// The physical actuator's keys, in file order, with where each goes (read, validate, write).
+std::vector<std::pair<const char*, double*>> PhysicalFields(PhysicalActuatorConfig* p) {
+  return {{"area_m2", &p->area_m2},
+          {"supply_pressure_Pa", &p->supply_pressure_Pa},
+          {"volume_m3", &p->volume_m3},
+          {"piston_mass_kg", &p->piston_mass_kg},
+          {"piston_damping_N_s_m", &p->piston_damping_N_s_m},
+          {"valve_hz", &p->valve_hz},
+          {"valve_zeta", &p->valve_zeta},
+          {"kq_m3_s", &p->kq_m3_s},
+          {"kp_per_m", &p->kp_per_m},
+          {"beta_Pa", &p->beta_Pa},
+          {"leakage_m3_s_Pa", &p->leakage_m3_s_Pa}};
+}
+
 /// `rms_key` is the unit-bearing name of SignalSpec::rms in this table.
 void ReadSignal(Section& section, std::string_view rms_key, SignalSpec* s) {
   section.String("kind", &s->kind);
@@ -295,14 +310,35 @@ void ReadScenario(const toml::table& root, const std::string& file, Scenario* s)
   ReadSignal(desired, "rms_mm", &st.desired);
   structure.Finish();
 
+  ControllerConfig& c = s->controller;
   Section controller = top.Sub("controller");
-  controller.String("kind", &s->controller.kind);
-  controller.Servo("model", &s->controller.model);
-  controller.Bool("half_step_ahead", &s->controller.half_step_ahead);
+  controller.String("kind", &c.kind);
+  controller.Servo("model", &c.model);
+  controller.Bool("half_step_ahead", &c.half_step_ahead);
+  controller.Number("delay_ms", &c.delay_ms);
+  controller.Number("max_delay_ms", &c.max_delay_ms);
+  controller.Number("lead_tp_ms", &c.lead_tp_ms);
+  controller.Number("lp_cutoff_hz", &c.lp_cutoff_hz);
+  controller.Integer("lp_order", &c.lp_order);
+  controller.Servo("model_low", &c.model_low);
+  controller.Servo("model_high", &c.model_high);
+  controller.Number("current_high_A", &c.current_high_A);
+  Section lqg = controller.Sub("lqg");
+  for (auto [key, field] : {std::pair{"q", &c.lqg.q}, {"w_f_hz", &c.lqg.w_f_hz}, {"xi_f", &c.lqg.xi_f},
+                            {"eta_f", &c.lqg.eta_f}, {"W", &c.lqg.W}, {"V", &c.lqg.V}}) {
+    lqg.Number(key, field);
+  }
+  lqg.Finish();
   controller.Finish();
 
+  PlantConfig& pl = s->plant;
   Section plant = top.Sub("plant");
+  plant.String("kind", &pl.kind);
   plant.Servo("actuator", &s->plant.actuator);
+  Section physical = plant.Sub("physical");
+  for (auto [key, field] : PhysicalFields(&pl.physical)) physical.Number(key, field);
+  physical.Finish();
+  plant.Bool("current_dynamics", &pl.current_dynamics);
   plant.String("specimen", &s->plant.specimen);
   plant.Number("noise_y_mm_rms", &s->plant.noise_y_mm_rms);
   plant.Number("noise_f_kN_rms", &s->plant.noise_f_kN_rms);
@@ -314,6 +350,8 @@ void ReadScenario(const toml::table& root, const std::string& file, Scenario* s)
   semiactive.String("mode", &s->semiactive.mode);
   semiactive.Number("current_A", &s->semiactive.current_A);
   semiactive.Number("max_current_A", &s->semiactive.max_current_A);
+  semiactive.Number("pulse_hz", &s->semiactive.pulse_hz);
+  semiactive.Number("pulse_duty", &s->semiactive.pulse_duty);
   semiactive.Finish();
 
   Section lockstep = top.Sub("lockstep");
@@ -437,13 +475,51 @@ void ValidateStructure(const StructureConfig& st, double dt_s, const std::string
   ValidateSignal(st.desired, "structure.desired", "rms_mm", dt_s, scenario_path, check);
 }
 
-void ValidateController(const ControllerConfig& c, const Check& check) {
-  check.OneOf("controller.kind", c.kind, {"none", "ff"});
+void ValidateController(const ControllerConfig& c, double dt_s, const Check& check) {
+  check.OneOf("controller.kind", c.kind, {"none", "ff", "poly3", "lead", "ff_lp", "bumpless_lp", "ff_lqg"});
   ValidateServo(c.model, "controller.model", check);
+  ValidateServo(c.model_low, "controller.model_low", check);
+  ValidateServo(c.model_high, "controller.model_high", check);
+  check.InRange("controller.max_delay_ms", c.max_delay_ms, OpenClosed(0.0, 100.0));
+  check.InRange("controller.delay_ms", c.delay_ms,
+                {0.0, c.max_delay_ms, true, false,
+                 "extrapolation beyond controller.max_delay_ms amplifies noise too much; raise that "
+                 "bound deliberately if you mean it"});
+  check.InRange("controller.lead_tp_ms", c.lead_tp_ms, OpenClosed(0.0, 100.0));
+  const bool uses_lp = c.kind == "ff_lp" || c.kind == "bumpless_lp";
+  check.InRange("controller.lp_cutoff_hz", c.lp_cutoff_hz,
+                {0.0, uses_lp ? 0.5 / dt_s : kInf, true, true,
+                 uses_lp ? "below the Nyquist frequency 0.5/run.dt_s" : ""});
+  check.InRange("controller.lp_order", c.lp_order,
+                {3, 8, false, false, "the three-pole inverse needs at least order 3 to be proper"});
+  check.InRange("controller.current_high_A", c.current_high_A, OpenClosed(0.0, 5.0));
+  check.InRange("controller.lqg.q", c.lqg.q, OpenClosed(0.0, 1e12));
+  check.InRange("controller.lqg.w_f_hz", c.lqg.w_f_hz, OpenClosed(0.0, 1000.0));
+  check.InRange("controller.lqg.xi_f", c.lqg.xi_f, OpenClosed(0.0, 10.0));
+  check.InRange("controller.lqg.eta_f", c.lqg.eta_f, Closed(0.0, 100.0));
+  check.InRange("controller.lqg.W", c.lqg.W, OpenClosed(0.0, 1e12));
+  check.InRange("controller.lqg.V", c.lqg.V, OpenClosed(0.0, 1e12));
+}
+
+void ValidatePhysical(const PhysicalActuatorConfig& p, const Check& check) {
+  const std::vector<std::pair<const char*, Range>> ranges = {
+      {"area_m2", OpenClosed(0, 1)},          {"supply_pressure_Pa", OpenClosed(0, 1e9)},
+      {"volume_m3", OpenClosed(0, 1)},        {"piston_mass_kg", OpenClosed(0, 1e5)},
+      {"piston_damping_N_s_m", Closed(0, 1e9)}, {"valve_hz", OpenClosed(0, 1e4)},
+      {"valve_zeta", OpenClosed(0, 10)},      {"kq_m3_s", OpenClosed(0, 10)},
+      {"kp_per_m", OpenClosed(0, 1e6)},       {"beta_Pa", OpenClosed(0, 1e12)},
+      {"leakage_m3_s_Pa", Closed(0, 1e-6)}};
+  PhysicalActuatorConfig copy = p;
+  const auto fields = PhysicalFields(&copy);
+  for (std::size_t i = 0; i < fields.size(); ++i) {
+    check.InRange(fmt::format("plant.physical.{}", fields[i].first), *fields[i].second, ranges[i].second);
+  }
 }
 
 void ValidatePlant(const PlantConfig& p, const Check& check) {
+  check.OneOf("plant.kind", p.kind, {"linear", "physical"});
   ValidateServo(p.actuator, "plant.actuator", check);
+  ValidatePhysical(p.physical, check);
   check.OneOf("plant.specimen", p.specimen, {"mr_damper", "none"});
   check.InRange("plant.noise_y_mm_rms", p.noise_y_mm_rms, Closed(0.0, 10.0));
   check.InRange("plant.noise_f_kN_rms", p.noise_f_kN_rms, Closed(0.0, 100.0));
@@ -451,7 +527,8 @@ void ValidatePlant(const PlantConfig& p, const Check& check) {
 }
 
 void ValidateSemiactive(const SemiactiveConfig& s, const Check& check) {
-  check.OneOf("semiactive.mode", s.mode, {"passive_off", "passive_on", "constant"});
+  check.OneOf("semiactive.mode", s.mode, {"passive_off", "passive_on", "constant", "pulse"});
+  check.InRange("semiactive.pulse_duty", s.pulse_duty, Open(0.0, 1.0));
   check.InRange("semiactive.max_current_A", s.max_current_A, OpenClosed(0.0, 5.0));
   check.InRange("semiactive.current_A", s.current_A,
                 {0.0, s.max_current_A, false, false, "at most semiactive.max_current_A"});
@@ -495,7 +572,9 @@ void ValidateScenario(const Scenario& s) {
   const Check check(DisplayName(s.path));
   ValidateRun(s.run, check);
   ValidateStructure(s.structure, s.run.dt_s, s.path, check);
-  ValidateController(s.controller, check);
+  ValidateController(s.controller, s.run.dt_s, check);
+  check.InRange("semiactive.pulse_hz", s.semiactive.pulse_hz,
+                {0.0, 0.25 / s.run.dt_s, true, true, "at least four steps per period: below 0.25/run.dt_s"});
   ValidatePlant(s.plant, check);
   ValidateSemiactive(s.semiactive, check);
   ValidateLockstep(s.lockstep, check);
@@ -519,6 +598,77 @@ Scenario ParseScenario(std::string_view toml_text, const std::string& path) {
     if (signal->kind == "file") signal->file = ResolveSignalFile(path, signal->file).string();
   }
   return s;
+}
+
+namespace {
+std::string TomlString(const std::string& v) {
+  std::string out = "\"";
+  for (char ch : v) {
+    if (ch == '"' || ch == '\\') out += '\\';
+    out += ch;
+  }
+  return out + "\"";
+}
+std::string TomlNumber(double v) { return fmt::format("{:.17g}", v); }
+std::string TomlServo(const ServoModel3& m) {
+  if (m.name != "custom") {
+    const ServoModel3 preset = ServoPreset(m.name);
+    if (preset.K == m.K && preset.p == m.p && preset.b == m.b && preset.c == m.c) return TomlString(m.name);
+  }
+  return fmt::format("{{ K = {}, p = {}, b = {}, c = {} }}", TomlNumber(m.K), TomlNumber(m.p), TomlNumber(m.b),
+                     TomlNumber(m.c));
+}
+void WriteSignal(std::string* out, const char* table, const char* rms_key, const SignalSpec& g) {
+  *out += fmt::format("\n[{}]\nkind = {}\nband_hz = {}\n{} = {}\nseed = {}\ndiscard_s = {}\n", table,
+                      TomlString(g.kind), TomlNumber(g.band_hz), rms_key, TomlNumber(g.rms), g.seed,
+                      TomlNumber(g.discard_s));
+  *out += fmt::format("file = {}\nfile_dt_s = {}\nscale = {}\n", TomlString(g.file), TomlNumber(g.file_dt_s),
+                      TomlNumber(g.scale));
+}
+}  // namespace
+
+std::string ToToml(const Scenario& s) {
+  std::string o = "# Written by rths (scenario::ToToml): every key, explicit.\n";
+  const auto& r = s.run;
+  o += fmt::format("\n[run]\nname = {}\ndt_s = {}\nduration_s = {}\n", TomlString(r.name), TomlNumber(r.dt_s),
+                   TomlNumber(r.duration_s));
+  const auto& st = s.structure;
+  o += fmt::format(
+      "\n[structure]\nmode = {}\nmass_kg = {}\nfrequency_hz = {}\ndamping_ratio = {}\nspecimen_count = "
+      "{}\nderivatives = {}\n",
+      TomlString(st.mode), TomlNumber(st.mass_kg), TomlNumber(st.frequency_hz), TomlNumber(st.damping_ratio),
+      TomlNumber(st.specimen_count), TomlString(st.derivatives));
+  WriteSignal(&o, "structure.ground", "rms_mm_s2", st.ground);
+  WriteSignal(&o, "structure.desired", "rms_mm", st.desired);
+  const auto& c = s.controller;
+  o += fmt::format(
+      "\n[controller]\nkind = {}\nmodel = {}\nhalf_step_ahead = {}\ndelay_ms = {}\nmax_delay_ms = {}\n"
+      "lead_tp_ms = {}\nlp_cutoff_hz = {}\nlp_order = {}\nmodel_low = {}\nmodel_high = {}\n"
+      "current_high_A = {}\n",
+      TomlString(c.kind), TomlServo(c.model), c.half_step_ahead, TomlNumber(c.delay_ms),
+      TomlNumber(c.max_delay_ms), TomlNumber(c.lead_tp_ms), TomlNumber(c.lp_cutoff_hz), c.lp_order,
+      TomlServo(c.model_low), TomlServo(c.model_high), TomlNumber(c.current_high_A));
+  o += fmt::format("\n[controller.lqg]\nq = {}\nw_f_hz = {}\nxi_f = {}\neta_f = {}\nW = {}\nV = {}\n",
+                   TomlNumber(c.lqg.q), TomlNumber(c.lqg.w_f_hz), TomlNumber(c.lqg.xi_f), TomlNumber(c.lqg.eta_f),
+                   TomlNumber(c.lqg.W), TomlNumber(c.lqg.V));
+  const auto& p = s.plant;
+  o += fmt::format(
+      "\n[plant]\nkind = {}\nactuator = {}\nspecimen = {}\ncurrent_dynamics = {}\nnoise_y_mm_rms = {}\n"
+      "noise_f_kN_rms = {}\nnoise_seed = {}\ncvode_rtol = {}\n",
+      TomlString(p.kind), TomlServo(p.actuator), TomlString(p.specimen), p.current_dynamics,
+      TomlNumber(p.noise_y_mm_rms), TomlNumber(p.noise_f_kN_rms), p.noise_seed, TomlNumber(p.cvode_rtol));
+  o += "\n[plant.physical]\n";
+  PhysicalActuatorConfig phys = p.physical;
+  for (auto [key, field] : PhysicalFields(&phys)) o += fmt::format("{} = {}\n", key, TomlNumber(*field));
+  const auto& sa = s.semiactive;
+  o += fmt::format(
+      "\n[semiactive]\nmode = {}\ncurrent_A = {}\nmax_current_A = {}\npulse_hz = {}\npulse_duty = {}\n",
+      TomlString(sa.mode), TomlNumber(sa.current_A), TomlNumber(sa.max_current_A), TomlNumber(sa.pulse_hz),
+      TomlNumber(sa.pulse_duty));
+  const auto& l = s.lockstep;
+  o += fmt::format("\n[lockstep]\ntimeout_ms = {}\nmax_attempts = {}\nhandshake_timeout_s = {}\n",
+                   TomlNumber(l.timeout_ms), l.max_attempts, TomlNumber(l.handshake_timeout_s));
+  return o;
 }
 
 Scenario LoadScenario(const std::string& path) {

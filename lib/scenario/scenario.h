@@ -57,30 +57,84 @@ struct StructureConfig {
   std::string derivatives = "extrapolated";
 };
 
-/// Outer-loop tracking controller (procs/controller).
+/// LQG feedback on the deviation system (Eqs. 23-27, models.md section 4). The cost is
+/// sum(q e_k^2 + u_FB,k^2); the disturbance is white noise of intensity W through the
+/// second-order shaping filter of Eq. 27; the measurement noise has intensity V.
+struct LqgConfig {
+  double q = 10.0;       ///< weight on the tracking error, (0, 1e12]
+  double w_f_hz = 3.0;   ///< shaping filter frequency omega_f / 2 pi [Hz], (0, 1000]
+  double xi_f = 0.7;     ///< shaping filter damping (peak), (0, 10]
+  double eta_f = 0.5;    ///< shaping filter zero (roll-off), [0, 100]
+  double W = 1.0;        ///< process-noise intensity, (0, 1e12]
+  double V = 1.0;        ///< measurement-noise intensity, (0, 1e12]
+};
+
+/// Outer-loop tracking controller (procs/controller); Table 1 of the paper.
 struct ControllerConfig {
-  std::string kind = "ff";     ///< "none" (u = r) | "ff" (model inverse, Eqs. 16-22)
-  ServoModel3 model{};         ///< design model for "ff"
+  /// "none" (u = r) | "ff" (model inverse, Eqs. 16-22) | "poly3" (third-order polynomial
+  /// extrapolation, Horiuchi 1996) | "lead" (single-pole single-zero lead compensator) |
+  /// "ff_lp" (model inverse with a Butterworth low-pass, Carrion & Spencer 2007) |
+  /// "bumpless_lp" (ff_lp for model_low and model_high blended by damper current) |
+  /// "ff_lqg" (ff with `model` plus LQG feedback designed on `model`, Eqs. 23-27).
+  std::string kind = "ff";
+  ServoModel3 model{};         ///< design model for "ff", "ff_lp", "ff_lqg"
   /// models.md section 2: evaluate the feedforward half a step ahead to cancel the ZOH's
   /// half-sample lag in simulation. false = the paper's Eq. 19.
   bool half_step_ahead = false;
+  double delay_ms = 9.0;        ///< "poly3", "lead": the delay compensated [ms], (0, max_delay_ms]
+  double max_delay_ms = 15.0;   ///< bound on delay_ms (extrapolation amplifies noise), (0, 100]
+  double lead_tp_ms = 0.5;      ///< "lead": pole time constant T_p [ms] (T_z = delay + T_p), (0, 100]
+  double lp_cutoff_hz = 318.0;  ///< "ff_lp", "bumpless_lp": Butterworth cutoff [Hz], (0, 0.5/dt)
+  int lp_order = 3;             ///< Butterworth order, [3, 8] (the inverse is improper by 3)
+  ServoModel3 model_low{1.730e7, 182.7, 225.3, 9.499e4, "0.0A"};   ///< "bumpless_lp": at 0 A (Eq. 28)
+  ServoModel3 model_high{1.613e7, 134.2, 324.6, 1.211e5, "2.5A"};  ///< at current_high_A (Eq. 29)
+  double current_high_A = 2.5;  ///< "bumpless_lp": lambda = i_eff / current_high_A, (0, 5]
+  LqgConfig lqg{};              ///< "ff_lqg"
+};
+
+/// The physics-based servohydraulic actuator (models.md section 5). SI units inside, as named.
+struct PhysicalActuatorConfig {
+  double area_m2 = 0.0271;             ///< piston area A, (0, 1]
+  double supply_pressure_Pa = 20.7e6;  ///< P_s, (0, 1e9]
+  double volume_m3 = 9.26e-3;          ///< total oil volume V_t, (0, 1]
+  double piston_mass_kg = 150.0;       ///< moving mass m, (0, 1e5]
+  double piston_damping_N_s_m = 0.0;   ///< c_p, [0, 1e9]
+  double valve_hz = 70.24;             ///< servovalve natural frequency w_v / 2 pi [Hz], (0, 1e4]
+  double valve_zeta = 0.583;           ///< servovalve damping zeta_v, (0, 10]
+  double kq_m3_s = 1.09e-2;            ///< flow gain K_q at full spool, (0, 10]
+  double kp_per_m = 331.0;             ///< inner-loop gain K_p [1/m] (i_c = K_p (u - x)), (0, 1e6]
+  double beta_Pa = 1.172e9;            ///< effective bulk modulus beta_e, (0, 1e12]
+  double leakage_m3_s_Pa = 2.693e-11;  ///< total leakage coefficient C_tot, [0, 1e-6]
 };
 
 /// "Physical" substructure and loading system (procs/plant).
 struct PlantConfig {
-  ServoModel3 actuator{};              ///< linear servohydraulic model, ZOH-discretised
+  /// "linear": the three-pole model `actuator` (Eqs. 28-30), ZOH-discretised, unaffected by the
+  /// specimen; "physical": the servovalve / oil column / piston model of models.md section 5
+  /// loaded by the damper force (control-structure interaction).
+  std::string kind = "linear";
+  ServoModel3 actuator{};              ///< "linear": servohydraulic model
+  PhysicalActuatorConfig physical{};   ///< "physical": its parameters
   std::string specimen = "mr_damper";  ///< "mr_damper" (Eqs. 32-39, Table 3) | "none"
+  /// Damper current dynamics: the driver lag of Eq. 40 and a 75 Hz second-order Butterworth
+  /// low-pass between the commanded and the effective current. false: effective = commanded.
+  bool current_dynamics = true;
   double noise_y_mm_rms = 0.0;         ///< Gaussian sensor noise on y [mm], [0, 10]
   double noise_f_kN_rms = 0.0;         ///< Gaussian sensor noise on f [kN], [0, 100]
   std::uint64_t noise_seed = 7;
   double cvode_rtol = 1e-8;            ///< CVODE relative tolerance, (0, 1e-2]
 };
 
-/// Semiactive current (procs/semiactive). For now a constant current; clipped-optimal later.
+/// Semiactive current (procs/semiactive). Constant modes, or the 0.5 Hz pulse of Table 2;
+/// clipped-optimal control later.
 struct SemiactiveConfig {
-  std::string mode = "passive_off";  ///< "passive_off" (0 A) | "passive_on" (max_current_A) | "constant"
+  /// "passive_off" (0 A) | "passive_on" (max_current_A) | "constant" (current_A) |
+  /// "pulse" (max_current_A for the first pulse_duty of every period 1/pulse_hz, then 0 A).
+  std::string mode = "passive_off";
   double current_A = 0.0;            ///< for "constant": [0, max_current_A]
   double max_current_A = 2.5;        ///< (0, 5]
+  double pulse_hz = 0.5;             ///< "pulse": frequency [Hz], (0, 0.25/dt)
+  double pulse_duty = 0.5;           ///< "pulse": fraction of the period at max current, (0, 1)
 };
 
 /// Lockstep runtime knobs (docs/lockstep.md).
@@ -117,6 +171,9 @@ Scenario ParseScenario(std::string_view toml_text, const std::string& path);
 /// Checks every range and cross-field limit (the second half of ParseScenario); for scenarios
 /// built or modified in code. Messages name s.path. Throws rths::Error.
 void ValidateScenario(const Scenario& s);
+/// The scenario as TOML text with every key written out (ParseScenario of it gives back the same
+/// scenario). Used to store programmatic variants as files, so every run has a real file and hash.
+std::string ToToml(const Scenario& s);
 /// Hex SHA-256 of a byte string.
 std::string Sha256Hex(std::string_view bytes);
 
