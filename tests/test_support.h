@@ -12,6 +12,7 @@
 
 #include "lockstep/runtime.h"
 #include "participants/factory.h"
+#include "participants/group.h"
 #include "scenario/scenario.h"
 
 namespace rths_test {
@@ -39,26 +40,18 @@ struct MemqRun {
 };
 
 /// Runs every participant in this process on memq://, like `rths run --transport memq`.
-/// `per_role` holds one scenario for all, or one per role in the order of the loop below.
+/// `per_role` holds one scenario for all, or one per role in participants::kGroupOrder.
 inline MemqRun RunMemq(const std::vector<rths::scenario::Scenario>& per_role, const fs::path& out,
-                const std::string& fault_role = "", rths::lockstep::Faults faults = {}) {
-  lcm::LCM lcm("memq://");
-  REQUIRE(lcm.good());
-  std::vector<std::unique_ptr<rths::lockstep::Participant>> owned;
-  std::vector<rths::lockstep::Participant*> ps;
-  int i = 0;
-  for (std::string_view role : {"logger", "plant", "controller", "semiactive", "integrator"}) {
-    const auto& s = per_role[per_role.size() == 1 ? 0 : i++];
-    owned.push_back(rths::participants::MakeParticipant(
-        role, s, rths::participants::IdentityOf(s, 42), &lcm, out.string()));
-    if (role == fault_role) owned.back()->faults = faults;
-    ps.push_back(owned.back().get());
-  }
+                       const std::string& fault_role = "", rths::lockstep::Faults faults = {}) {
+  std::vector<rths::participants::RoleFault> f;
+  if (!fault_role.empty()) f.push_back({fault_role, faults});
+  const auto outcomes = rths::participants::RunGroupInProcess(per_role, 42, out.string(), f);
   MemqRun r;
-  r.code = rths::lockstep::RunLoop(&lcm, ps);
-  for (auto* p : ps) {
-    r.exit_codes.emplace_back(p->name(), p->exit_code());
-    r.errors.push_back(p->error());
+  const auto* culprit = rths::participants::RootCause(outcomes);
+  r.code = culprit ? culprit->exit_code : 0;
+  for (const auto& o : outcomes) {
+    r.exit_codes.emplace_back(o.role, o.exit_code);
+    r.errors.push_back(o.message);
   }
   return r;
 }

@@ -35,6 +35,7 @@
 #include "io/run_log.h"
 #include "lockstep/runtime.h"
 #include "participants/factory.h"
+#include "participants/group.h"
 #include "scenario/scenario.h"
 #include "signal/metrics.h"
 
@@ -46,20 +47,7 @@ namespace {
 volatile std::sig_atomic_t g_interrupted = 0;
 void OnSignal(int) { g_interrupted = 1; }
 
-struct Fault {
-  std::string role;
-  std::string kind;  // drop | stall | throw
-  std::int64_t k = -1;
-};
-
-/// What happened to one participant.
-struct Outcome {
-  std::string role;
-  int exit_code = 0;  // ExitCode, or 128 + signal
-  int signal = 0;
-  std::string message;
-  bool exited = false;
-};
+using rths::participants::Outcome;
 
 std::string LastLine(const fs::path& file) {
   std::ifstream in(file);
@@ -99,50 +87,10 @@ fs::path DefaultOutDir(const std::string& name) {
   return p;
 }
 
-/// Priority of an outcome as the root cause: a participant that failed on its own beats one
-/// that detected a failure (lockstep), which beats one that was told to stop (peer abort).
-int Blame(const Outcome& o) {
-  if (o.signal != 0) return 4;
-  switch (o.exit_code) {
-    case 0: return 0;
-    case rths::lockstep::kExitPeerAbort: return 1;
-    case rths::lockstep::kExitLockstep: return 2;
-    default: return 3;
-  }
-}
-
-std::vector<Outcome> RunMemq(const rths::scenario::Scenario& s,
-                             std::int64_t run_id, const fs::path& out,
-                             const std::vector<Fault>& faults) {
-  lcm::LCM lcm("memq://");
-  if (!lcm.good()) throw rths::Error("rths run", "cannot create the memq:// LCM instance");
-  const auto id = rths::participants::IdentityOf(s, run_id);
-  std::vector<std::unique_ptr<rths::lockstep::Participant>> owned;
-  std::vector<rths::lockstep::Participant*> ps;
-  // The logger first: it subscribes before anyone publishes.
-  for (std::string_view role : {"logger", "plant", "controller", "semiactive", "integrator"}) {
-    owned.push_back(rths::participants::MakeParticipant(role, s, id, &lcm, out.string()));
-    for (const auto& f : faults) {
-      if (f.role != role) continue;
-      auto& fl = owned.back()->faults;
-      (f.kind == "drop"    ? fl.drop_first_request_at
-       : f.kind == "stall" ? fl.stall_at
-       : f.kind == "crash" ? fl.crash_at
-                           : fl.throw_at) = f.k;
-    }
-    ps.push_back(owned.back().get());
-  }
-  rths::lockstep::RunLoop(&lcm, ps);
-  std::vector<Outcome> outcomes;
-  for (auto* p : ps) {
-    outcomes.push_back({p->name(), p->exit_code(), 0, p->error(), true});
-  }
-  return outcomes;
-}
-
 std::vector<Outcome> RunUdpm(const rths::scenario::Scenario&, const std::string& scenario_path,
                              std::int64_t run_id, const fs::path& out, const fs::path& bin_dir,
-                             const std::vector<Fault>& faults, std::string* url_out) {
+                             const std::vector<rths::participants::RoleFault>& faults,
+                             std::string* url_out) {
   if (const std::string hint = rths::lockstep::CheckMulticastRoute(); !hint.empty()) {
     throw rths::Error("rths run", hint);
   }
@@ -151,6 +99,7 @@ std::vector<Outcome> RunUdpm(const rths::scenario::Scenario&, const std::string&
   *url_out = url;
   fs::create_directories(out / "logs");
   std::map<pid_t, Outcome> children;
+  std::map<pid_t, bool> exited;
   for (const char* role : {"logger", "plant", "controller", "semiactive", "integrator"}) {
     const fs::path exe = bin_dir / fmt::format("rths-{}", role);
     if (!fs::exists(exe)) {
@@ -160,9 +109,14 @@ std::vector<Outcome> RunUdpm(const rths::scenario::Scenario&, const std::string&
                                   "--run-id",       std::to_string(run_id),      "--out",
                                   out.string()};
     for (const auto& f : faults) {
-      if (f.role == role) {
-        args.push_back("--fault-" + f.kind);
-        args.push_back(std::to_string(f.k));
+      if (f.role != role) continue;
+      for (auto [flag, k] : {std::pair{"--fault-drop", f.faults.drop_first_request_at},
+                             {"--fault-stall", f.faults.stall_at},
+                             {"--fault-throw", f.faults.throw_at},
+                             {"--fault-crash", f.faults.crash_at}}) {
+        if (k < 0) continue;
+        args.push_back(flag);
+        args.push_back(std::to_string(k));
       }
     }
     const fs::path log = out / "logs" / fmt::format("{}.log", role);
@@ -183,7 +137,8 @@ std::vector<Outcome> RunUdpm(const rths::scenario::Scenario&, const std::string&
       std::fprintf(stderr, "exec %s failed: %s\n", argv[0], std::strerror(errno));
       ::_exit(127);
     }
-    children[pid] = Outcome{role, 0, 0, "", false};
+    children[pid] = Outcome{role, 0, 0, ""};
+    exited[pid] = false;
   }
 
   using Clock = std::chrono::steady_clock;
@@ -196,7 +151,7 @@ std::vector<Outcome> RunUdpm(const rths::scenario::Scenario&, const std::string&
     const pid_t pid = ::waitpid(-1, &status, WNOHANG);
     if (pid > 0 && children.count(pid)) {
       Outcome& o = children[pid];
-      o.exited = true;
+      exited[pid] = true;
       --running;
       if (WIFSIGNALED(status)) {
         o.signal = WTERMSIG(status);
@@ -219,14 +174,14 @@ std::vector<Outcome> RunUdpm(const rths::scenario::Scenario&, const std::string&
     const auto now = Clock::now();
     if (tearing_down && !termed && now >= term_at) {
       for (auto& [p, o] : children) {
-        if (!o.exited) ::kill(p, SIGTERM);
+        if (!exited[p]) ::kill(p, SIGTERM);
       }
       termed = true;
       kill_at = now + std::chrono::seconds(2);
     }
     if (termed && !killed && now >= kill_at) {
       for (auto& [p, o] : children) {
-        if (!o.exited) ::kill(p, SIGKILL);
+        if (!exited[p]) ::kill(p, SIGKILL);
       }
       killed = true;
     }
@@ -261,20 +216,24 @@ int main(int argc, char** argv) {
   std::signal(SIGINT, OnSignal);
   std::signal(SIGTERM, OnSignal);
 
-  std::vector<Fault> faults;
+  std::vector<rths::participants::RoleFault> faults;
   for (const auto& f : fault_args) {
-    Fault x;
+    rths::participants::RoleFault x;
     std::istringstream ss(f);
-    std::string k;
+    std::string kind, k;
     std::getline(ss, x.role, ':');
-    std::getline(ss, x.kind, ':');
+    std::getline(ss, kind, ':');
     std::getline(ss, k);
-    if ((x.kind != "drop" && x.kind != "stall" && x.kind != "throw" && x.kind != "crash") ||
-        k.empty()) {
+    std::int64_t* slot = kind == "drop"    ? &x.faults.drop_first_request_at
+                         : kind == "stall" ? &x.faults.stall_at
+                         : kind == "throw" ? &x.faults.throw_at
+                         : kind == "crash" ? &x.faults.crash_at
+                                           : nullptr;
+    if (!slot || k.empty()) {
       std::fprintf(stderr, "rths run: --fault %s: expected ROLE:drop|stall|throw|crash:K\n", f.c_str());
       return rths::lockstep::kExitUsage;
     }
-    x.k = std::stoll(k);
+    *slot = std::stoll(k);
     faults.push_back(x);
   }
 
@@ -310,7 +269,7 @@ int main(int argc, char** argv) {
                   static_cast<long long>(s.steps()), s.run.dt_s, transport.c_str());
       std::fflush(stdout);
     }
-    outcomes = transport == "memq" ? RunMemq(s, run_id, out, faults)
+    outcomes = transport == "memq" ? rths::participants::RunGroupInProcess({s}, run_id, out.string(), faults)
                                    : RunUdpm(s, scenario_path, run_id, out, bin_dir, faults, &url);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "rths run: %s\n", e.what());
@@ -318,11 +277,7 @@ int main(int argc, char** argv) {
   }
   const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
-  // Root cause: the worst outcome by Blame(), first in roster order on ties.
-  const Outcome* culprit = nullptr;
-  for (const auto& o : outcomes) {
-    if (Blame(o) > 0 && (!culprit || Blame(o) > Blame(*culprit))) culprit = &o;
-  }
+  const Outcome* culprit = rths::participants::RootCause(outcomes);
 
   // Summary from the log: whatever was committed, even after a failure.
   nlohmann::json j;

@@ -12,6 +12,13 @@
 
 namespace rths::control {
 
+/// What the plant reported at sample k (measured_t k).
+struct Measurement {
+  double y_mm = 0.0;       ///< measured displacement y_k [mm]
+  double f_kN = 0.0;       ///< measured force f_k [kN]
+  double current_A = 0.0;  ///< effective damper current at t_k [A] (after the driver dynamics)
+};
+
 /// One step's command, split into its parts [mm].
 struct Command {
   double u_mm = 0.0;
@@ -22,16 +29,16 @@ struct Command {
 class TrackingController {
  public:
   virtual ~TrackingController() = default;
-  /// Computes u_k. Allocates nothing.
-  /// @param d     r_k [mm] and r'_k, r''_k, r'''_k [mm/s^n] (Eqs. 20-22, from the integrator)
-  /// @param y_mm  measured displacement y_k [mm]
-  virtual Command Step(const Derivatives& d, double y_mm) = 0;
+  /// Computes u_k. Called exactly once per step, in order. Allocates nothing.
+  /// @param d  r_k [mm] and r'_k, r''_k, r'''_k [mm/s^n] (Eqs. 20-22, from the integrator)
+  /// @param m  the measurements of sample k
+  virtual Command Step(const Derivatives& d, const Measurement& m) = 0;
 };
 
 /// `none`: u_k = r_k (no compensation).
 class NoCompensation final : public TrackingController {
  public:
-  Command Step(const Derivatives& d, double) override { return {d.r, d.r, 0.0}; }
+  Command Step(const Derivatives& d, const Measurement&) override { return {d.r, d.r, 0.0}; }
 };
 
 /// `ff`: the proposed model-inverse feedforward G_FF(s) = (s+p)(s^2+bs+c)/K (Eqs. 16-19):
@@ -40,7 +47,7 @@ class ModelFeedforward final : public TrackingController {
  public:
   ModelFeedforward(const scenario::ServoModel3& model, bool half_step_ahead, double dt_s)
       : a_(MakeFeedforwardCoefficients(model)), half_step_ahead_(half_step_ahead), dt_s_(dt_s) {}
-  Command Step(const Derivatives& d, double) override {
+  Command Step(const Derivatives& d, const Measurement&) override {
     const double u = FeedforwardCommand(a_, d, half_step_ahead_, dt_s_);
     return {u, u, 0.0};
   }
