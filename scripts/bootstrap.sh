@@ -12,6 +12,7 @@ packages=(
   libfmt-dev doctest-dev libcli11-dev libtomlplusplus-dev nlohmann-json3-dev
   libssl-dev                       # SHA-256 of scenario files (libcrypto)
   iproute2                         # ip route, for the multicast route below
+  gnuplot-nox                      # figures (PNG via pngcairo)
 )
 missing=()
 for p in "${packages[@]}"; do
