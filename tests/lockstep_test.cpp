@@ -223,19 +223,32 @@ TEST_CASE("supervisor: a bad scenario is refused before anything runs, naming fi
 TEST_CASE("log.lcm is a standard LCM event log: lcm-logplayer replays it, lcm-logger records it") {
   if (!UdpmAvailable()) FAIL("udpm cannot run on this host: " << rths::lockstep::CheckMulticastRoute());
   const auto dir = TempDir("replay");
-  const auto s = rths::scenario::LoadScenario(WriteScenario(dir, kShort).string());
+  const auto s = rths::scenario::LoadScenario(
+      WriteScenario(dir, std::string(kShort) + "\n").string());
   REQUIRE(RunMemq({s}, dir).code == 0);
   const auto original = ReadRunLog((dir / "log.lcm").string());
   // Replay on a port of its own, record with Debian's lcm-logger, read the recording back.
-  const std::string url = "udpm://239.255.76.67:" + std::to_string(20000 + ::getpid() % 20000) + "?ttl=0";
-  const fs::path replay = dir / "replay.lcm";
-  const std::string cmd =
-      "lcm-logger --lcm-url='" + url + "' -f " + replay.string() + " > /dev/null 2>&1 & pid=$!; " +
-      "sleep 0.5; lcm-logplayer --speed=0.05 --lcm-url='" + url + "' " + (dir / "log.lcm").string() +
-      " > /dev/null 2>&1; sleep 0.5; kill -INT $pid; wait $pid";
-  REQUIRE(std::system(cmd.c_str()) == 0);
-  const auto replayed = ReadRunLog(replay.string());
-  CHECK(replayed.CompleteSteps() == s.steps());
-  CHECK(PayloadDigest(replayed) == PayloadDigest(original));
-  CHECK(replayed.handshakes.size() == original.handshakes.size());
+  // lcm-logplayer never waits for its listeners (an LCM property): on a loaded machine the
+  // listener can miss datagrams, so the replay is slowed down and retried a few times; every
+  // attempt must still deliver byte-identical payloads for what arrives.
+  bool complete = false;
+  for (int attempt = 0; attempt < 3 && !complete; ++attempt) {
+    const std::string url =
+        "udpm://239.255.76.67:" + std::to_string(20000 + (::getpid() * 3 + attempt) % 20000) + "?ttl=0";
+    const fs::path replay = dir / ("replay" + std::to_string(attempt) + ".lcm");
+    const std::string cmd =
+        "lcm-logger --lcm-url='" + url + "' -f " + replay.string() + " > /dev/null 2>&1 & pid=$!; " +
+        "sleep 1; lcm-logplayer --speed=0.02 --lcm-url='" + url + "' " + (dir / "log.lcm").string() +
+        " > /dev/null 2>&1; sleep 0.5; kill -INT $pid; wait $pid";
+    REQUIRE(std::system(cmd.c_str()) == 0);
+    const auto replayed = ReadRunLog(replay.string());
+    for (const auto& [ch, per_k] : replayed.payload) {
+      for (std::size_t k = 0; k < per_k.size(); ++k) {
+        if (!per_k[k].empty()) CHECK(per_k[k] == original.payload.at(ch).at(k));
+      }
+    }
+    complete = replayed.CompleteSteps() == s.steps() && PayloadDigest(replayed) == PayloadDigest(original) &&
+               replayed.handshakes.size() == original.handshakes.size();
+  }
+  CHECK(complete);
 }

@@ -337,6 +337,12 @@ int main(int argc, char** argv) {
                 static_cast<long long>(steps));
     return 130;
   }
+  if (culprit && culprit->exit_code == rths::lockstep::kExitSafety) {
+    std::fprintf(stderr, "rths run: STOPPED by the safety monitor: %s\n", culprit->message.c_str());
+    std::printf("output: %s (log valid up to step %lld)\n", out.string().c_str(),
+                static_cast<long long>(steps));
+    return rths::lockstep::kExitSafety;
+  }
   if (culprit) {
     const char* what = culprit->signal ? strsignal(culprit->signal) : nullptr;
     std::fprintf(stderr, "rths run: FAILED: %s %s%s%s\n", culprit->role.c_str(),

@@ -101,7 +101,13 @@ void ClockParticipant::IssueStep(std::int64_t k) {
 
 void ClockParticipant::CheckBarrier() {
   if (finished() || done_ || k_ < 0) return;
-  if (!measured_.Get(k_) || !command_.Get(k_) || !current_.Get(k_) || !ack_.Get(k_)) return;
+  const rths::measured_t* m = measured_.Get(k_);
+  const rths::command_t* c = command_.Get(k_);
+  if (!m || !c || !current_.Get(k_) || !ack_.Get(k_)) return;
+  if (const std::string_view stop = CheckCommitted(k_, desired_, *m, *c); !stop.empty()) {
+    Fail(kExitSafety, std::string(stop), true, k_);
+    return;
+  }
   if (k_ + 1 >= id_.n_steps) {
     done_ = true;
     done_sends_ = 1;

@@ -12,6 +12,7 @@
 /// skipped: step k+1 is issued only after the barrier of step k.
 #include <array>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "lockstep/runtime.h"
@@ -48,6 +49,15 @@ class ClockParticipant : public Participant {
   /// Must not allocate once warmed up (reuse `out`).
   virtual void ComputeDesired(std::int64_t k, const rths::measured_t* measured_prev,
                               rths::desired_t* out) = 0;
+
+  /// Called once per step when its barrier is complete (every message of step k is logged),
+  /// before step k+1 is requested. A non-empty return stops the run: ABORT with that reason,
+  /// exit code kExitSafety. `desired` is the clock's own desired_t k.
+  virtual std::string_view CheckCommitted(std::int64_t /*k*/, const rths::desired_t& /*desired*/,
+                                          const rths::measured_t& /*measured*/,
+                                          const rths::command_t& /*command*/) {
+    return {};
+  }
 
   void OnHandshakeForClock(const rths::handshake_t& msg, SteadyClock::time_point now) override;
 

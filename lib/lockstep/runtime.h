@@ -35,6 +35,7 @@ enum ExitCode : int {
   kExitLockstep = 3,       ///< this participant detected a protocol failure (silence, hash mismatch)
   kExitPeerAbort = 4,      ///< stopped because another participant broadcast ABORT
   kExitInternal = 5,       ///< an exception in this participant's own computation
+  kExitSafety = 6,         ///< the safety monitor stopped the run (a limit was left)
 };
 
 using SteadyClock = std::chrono::steady_clock;

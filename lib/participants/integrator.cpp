@@ -17,7 +17,8 @@ std::string FolderOf(const std::string& path) {
 Integrator::Integrator(const scenario::Scenario& s, lockstep::RunIdentity id, lcm::LCM* lcm)
     : ClockParticipant("integrator", id, TimingOf(s), lcm),
       predefined_(s.structure.mode == "predefined"),
-      dt_s_(s.run.dt_s) {
+      dt_s_(s.run.dt_s),
+      safety_(s.safety, s.run.dt_s) {
   const auto n = static_cast<std::size_t>(id.n_steps);
   const std::string dir = FolderOf(s.path);
   if (predefined_) {
@@ -71,6 +72,16 @@ void Integrator::ComputeDesired(std::int64_t k, const rths::measured_t* measured
     out->x_mm[j] = state_.x[j];
     out->abs_acc_mm_s2[j] = (predefined_ || k == 0) ? 0.0 : state_.abs_acc_prev[j];
   }
+}
+
+}  // namespace rths::participants
+
+namespace rths::participants {
+
+std::string_view Integrator::CheckCommitted(std::int64_t k, const rths::desired_t& desired,
+                                            const rths::measured_t& measured,
+                                            const rths::command_t& command) {
+  return safety_.Check(k, desired.r_mm, command.u_mm, measured.y_mm, measured.f_kN);
 }
 
 }  // namespace rths::participants

@@ -15,6 +15,7 @@
 #include "control/feedforward.h"
 #include "lockstep/clock.h"
 #include "models/structure.h"
+#include "safety/monitor.h"
 #include "scenario/scenario.h"
 
 namespace rths::participants {
@@ -26,6 +27,10 @@ class Integrator final : public lockstep::ClockParticipant {
  protected:
   void ComputeDesired(std::int64_t k, const rths::measured_t* measured_prev,
                       rths::desired_t* out) override;
+  /// The safety monitor (docs/safety.md) on every committed step.
+  std::string_view CheckCommitted(std::int64_t k, const rths::desired_t& desired,
+                                  const rths::measured_t& measured,
+                                  const rths::command_t& command) override;
 
  private:
   const bool predefined_;
@@ -37,6 +42,7 @@ class Integrator final : public lockstep::ClockParticipant {
   std::vector<double> r_mm_;          ///< r_k for every step (predefined mode)
   std::optional<control::DerivativeRecords> central_;  ///< offline derivatives, if chosen
   control::ExtrapolationState extrapolation_{};
+  safety::Monitor safety_;
 };
 
 }  // namespace rths::participants

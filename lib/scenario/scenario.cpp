@@ -284,6 +284,7 @@ void ReadSignal(Section& section, std::string_view rms_key, SignalSpec* s) {
   section.String("file", &s->file);
   section.Number("file_dt_s", &s->file_dt_s);
   section.Number("scale", &s->scale);
+  section.Number("taper_s", &s->taper_s);
   section.Finish();
 }
 
@@ -299,6 +300,9 @@ void ReadScenario(const toml::table& root, const std::string& file, Scenario* s)
   Section structure = top.Sub("structure");
   StructureConfig& st = s->structure;
   structure.String("mode", &st.mode);
+  structure.String("kind", &st.kind);
+  structure.String("file", &st.file);
+  structure.Integer("actuator_dof", &st.actuator_dof);
   structure.Number("mass_kg", &st.mass_kg);
   structure.Number("frequency_hz", &st.frequency_hz);
   structure.Number("damping_ratio", &st.damping_ratio);
@@ -353,6 +357,17 @@ void ReadScenario(const toml::table& root, const std::string& file, Scenario* s)
   semiactive.Number("pulse_hz", &s->semiactive.pulse_hz);
   semiactive.Number("pulse_duty", &s->semiactive.pulse_duty);
   semiactive.Finish();
+
+  SafetyConfig& sf = s->safety;
+  Section safety = top.Sub("safety");
+  safety.Bool("enabled", &sf.enabled);
+  for (auto [key, field] : {std::pair{"stroke_mm", &sf.stroke_mm}, {"force_kN", &sf.force_kN},
+                            {"max_error_mm", &sf.max_error_mm}, {"growth_window_s", &sf.growth_window_s},
+                            {"growth_factor", &sf.growth_factor}, {"growth_floor_mm", &sf.growth_floor_mm}}) {
+    safety.Number(key, field);
+  }
+  safety.Integer("growth_windows", &sf.growth_windows);
+  safety.Finish();
 
   Section lockstep = top.Sub("lockstep");
   lockstep.Number("timeout_ms", &s->lockstep.timeout_ms);
@@ -446,6 +461,7 @@ void ValidateSignal(const SignalSpec& s, std::string_view prefix, std::string_vi
   check.InRange(key(rms_key), s.rms, Open(0.0, kInf));
   check.InRange(key("discard_s"), s.discard_s, Closed(0.0, 60.0));
   check.InRange(key("file_dt_s"), s.file_dt_s, Closed(0.0, 10.0));
+  check.InRange(key("taper_s"), s.taper_s, Closed(0.0, 60.0));
   if (!std::isfinite(s.scale) || s.scale == 0.0) {
     check.Fail(key("scale"), fmt::format("{} is not allowed (allowed: any finite value other than 0)", s.scale));
   }
@@ -463,6 +479,19 @@ void ValidateSignal(const SignalSpec& s, std::string_view prefix, std::string_vi
 void ValidateStructure(const StructureConfig& st, double dt_s, const std::string& scenario_path,
                        const Check& check) {
   check.OneOf("structure.mode", st.mode, {"rths", "predefined"});
+  check.OneOf("structure.kind", st.kind, {"sdof", "file"});
+  if (st.mode == "rths" && st.kind == "file") {
+    if (st.file.empty()) check.Fail("structure.file", "missing: kind = \"file\" needs a structure file");
+    const std::filesystem::path resolved = ResolveSignalFile(scenario_path, st.file);
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(resolved, ec)) {
+      check.Fail("structure.file", fmt::format("file not found: {} (paths are relative to the scenario file's "
+                                               "folder)",
+                                               resolved.string()));
+    }
+    check.InRange("structure.actuator_dof", st.actuator_dof,
+                  {1, 10000, false, false, "1-based; at most the structure's number of DOFs"});
+  }
   check.InRange("structure.mass_kg", st.mass_kg, OpenClosed(0.0, 1e9));
   // Central difference is stable for omega dt < 2, i.e. f < 1 / (pi dt).
   const double f_max = 1.0 / (kPi * dt_s);
@@ -534,6 +563,16 @@ void ValidateSemiactive(const SemiactiveConfig& s, const Check& check) {
                 {0.0, s.max_current_A, false, false, "at most semiactive.max_current_A"});
 }
 
+void ValidateSafety(const SafetyConfig& f, const Check& check) {
+  check.InRange("safety.stroke_mm", f.stroke_mm, OpenClosed(0.0, 10000.0));
+  check.InRange("safety.force_kN", f.force_kN, OpenClosed(0.0, 1e6));
+  check.InRange("safety.max_error_mm", f.max_error_mm, OpenClosed(0.0, 10000.0));
+  check.InRange("safety.growth_window_s", f.growth_window_s, OpenClosed(0.0, 10.0));
+  check.InRange("safety.growth_factor", f.growth_factor, OpenClosed(1.0, 1000.0));
+  check.InRange("safety.growth_windows", f.growth_windows, Closed(2, 1000));
+  check.InRange("safety.growth_floor_mm", f.growth_floor_mm, OpenClosed(0.0, 10000.0));
+}
+
 void ValidateLockstep(const LockstepConfig& l, const Check& check) {
   check.InRange("lockstep.timeout_ms", l.timeout_ms, Closed(1.0, 60000.0));
   check.InRange("lockstep.max_attempts", l.max_attempts, Closed(1, 1000));
@@ -578,6 +617,7 @@ void ValidateScenario(const Scenario& s) {
   ValidatePlant(s.plant, check);
   ValidateSemiactive(s.semiactive, check);
   ValidateLockstep(s.lockstep, check);
+  ValidateSafety(s.safety, check);
 }
 
 Scenario ParseScenario(std::string_view toml_text, const std::string& path) {
@@ -597,6 +637,7 @@ Scenario ParseScenario(std::string_view toml_text, const std::string& path) {
   for (SignalSpec* signal : {&s.structure.ground, &s.structure.desired}) {
     if (signal->kind == "file") signal->file = ResolveSignalFile(path, signal->file).string();
   }
+  if (!s.structure.file.empty()) s.structure.file = ResolveSignalFile(path, s.structure.file).string();
   return s;
 }
 
@@ -622,8 +663,8 @@ void WriteSignal(std::string* out, const char* table, const char* rms_key, const
   *out += fmt::format("\n[{}]\nkind = {}\nband_hz = {}\n{} = {}\nseed = {}\ndiscard_s = {}\n", table,
                       TomlString(g.kind), TomlNumber(g.band_hz), rms_key, TomlNumber(g.rms), g.seed,
                       TomlNumber(g.discard_s));
-  *out += fmt::format("file = {}\nfile_dt_s = {}\nscale = {}\n", TomlString(g.file), TomlNumber(g.file_dt_s),
-                      TomlNumber(g.scale));
+  *out += fmt::format("file = {}\nfile_dt_s = {}\nscale = {}\ntaper_s = {}\n", TomlString(g.file),
+                      TomlNumber(g.file_dt_s), TomlNumber(g.scale), TomlNumber(g.taper_s));
 }
 }  // namespace
 
@@ -635,9 +676,10 @@ std::string ToToml(const Scenario& s) {
   const auto& st = s.structure;
   o += fmt::format(
       "\n[structure]\nmode = {}\nmass_kg = {}\nfrequency_hz = {}\ndamping_ratio = {}\nspecimen_count = "
-      "{}\nderivatives = {}\n",
+      "{}\nderivatives = {}\nkind = {}\nfile = {}\nactuator_dof = {}\n",
       TomlString(st.mode), TomlNumber(st.mass_kg), TomlNumber(st.frequency_hz), TomlNumber(st.damping_ratio),
-      TomlNumber(st.specimen_count), TomlString(st.derivatives));
+      TomlNumber(st.specimen_count), TomlString(st.derivatives), TomlString(st.kind), TomlString(st.file),
+      st.actuator_dof);
   WriteSignal(&o, "structure.ground", "rms_mm_s2", st.ground);
   WriteSignal(&o, "structure.desired", "rms_mm", st.desired);
   const auto& c = s.controller;
@@ -665,6 +707,12 @@ std::string ToToml(const Scenario& s) {
       "\n[semiactive]\nmode = {}\ncurrent_A = {}\nmax_current_A = {}\npulse_hz = {}\npulse_duty = {}\n",
       TomlString(sa.mode), TomlNumber(sa.current_A), TomlNumber(sa.max_current_A), TomlNumber(sa.pulse_hz),
       TomlNumber(sa.pulse_duty));
+  const auto& f = s.safety;
+  o += fmt::format(
+      "\n[safety]\nenabled = {}\nstroke_mm = {}\nforce_kN = {}\nmax_error_mm = {}\ngrowth_window_s = {}\n"
+      "growth_factor = {}\ngrowth_windows = {}\ngrowth_floor_mm = {}\n",
+      f.enabled, TomlNumber(f.stroke_mm), TomlNumber(f.force_kN), TomlNumber(f.max_error_mm),
+      TomlNumber(f.growth_window_s), TomlNumber(f.growth_factor), f.growth_windows, TomlNumber(f.growth_floor_mm));
   const auto& l = s.lockstep;
   o += fmt::format("\n[lockstep]\ntimeout_ms = {}\nmax_attempts = {}\nhandshake_timeout_s = {}\n",
                    TomlNumber(l.timeout_ms), l.max_attempts, TomlNumber(l.handshake_timeout_s));

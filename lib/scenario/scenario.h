@@ -39,19 +39,27 @@ struct SignalSpec {
   std::string file;           ///< path, relative to the scenario file's folder (after parsing: absolute)
   double file_dt_s = 0.0;     ///< step of a one-column file [s]; 0 = the file has a time column
   double scale = 1.0;         ///< multiply the file's values by this to get the signal's unit
+  /// Raised-cosine fade-in over the first taper_s seconds [s], [0, 60]: a BLWN record cut after
+  /// its discarded start begins mid-motion, which would ask the actuator for a step.
+  double taper_s = 0.0;
 };
 
 /// Numerical substructure (procs/integrator).
 struct StructureConfig {
   std::string mode = "rths";  ///< "rths" (central difference, Eqs. 1-3) | "predefined" (r from a history)
-  // mode = "rths": an SDOF structure.
+  /// mode = "rths": "sdof" (mass, frequency, damping below) | "file" (M, K, C from `file`, a
+  /// structure file: docs/structures.md; e.g. data/buildings/ohtori9_ns.txt).
+  std::string kind = "sdof";
+  std::string file;           ///< kind = "file": path, relative to the scenario file's folder
+  int actuator_dof = 1;       ///< kind = "file": DOF the specimen acts on, 1-based (1 = first story)
+  // kind = "sdof":
   double mass_kg = 20000.0;          ///< (0, 1e9]
   double frequency_hz = 5.0;         ///< natural frequency (0, 1/(pi dt)) -- central-difference limit omega dt < 2
   double damping_ratio = 0.02;       ///< [0, 1)
   double specimen_count = 1.0;       ///< measured force multiplier (18 dampers act as one) (0, 1000]
   SignalSpec ground{};               ///< ground acceleration [mm/s^2]
   // mode = "predefined": the desired displacement itself [mm].
-  SignalSpec desired{"blwn", 5.0, 2.78, 1, 2.0, "", 0.0, 1.0};
+  SignalSpec desired{"blwn", 5.0, 2.78, 1, 2.0, "", 0.0, 1.0, 0.5};
   /// How the integrator gets r', r'', r''' in predefined mode: "extrapolated" (Eqs. 20-22, the
   /// causal RTHS path) | "central" (offline, non-causal central differences of the known record).
   std::string derivatives = "extrapolated";
@@ -137,6 +145,21 @@ struct SemiactiveConfig {
   double pulse_duty = 0.5;           ///< "pulse": fraction of the period at max current, (0, 1)
 };
 
+/// Safety monitor (docs/safety.md): the clock stops the run, cleanly, when a limit is left.
+/// Defaults are the paper's actuator ratings (556 kN, +/-152.4 mm stroke).
+struct SafetyConfig {
+  bool enabled = true;
+  double stroke_mm = 152.4;        ///< |r|, |u|, |y| must stay within, (0, 10000]
+  double force_kN = 556.0;         ///< |f| must stay within, (0, 1e6]
+  double max_error_mm = 25.0;      ///< |r - y| must stay within, (0, 10000]
+  /// Divergence: the peak |r - y| over consecutive windows of growth_window_s grows by at least
+  /// growth_factor every window for growth_windows windows, above growth_floor_mm.
+  double growth_window_s = 0.05;   ///< (0, 10]
+  double growth_factor = 1.5;      ///< (1, 1000]
+  int growth_windows = 6;          ///< [2, 1000]
+  double growth_floor_mm = 0.5;    ///< (0, 10000]
+};
+
 /// Lockstep runtime knobs (docs/lockstep.md).
 struct LockstepConfig {
   double timeout_ms = 250.0;       ///< re-request step k after this silence [ms], [1, 60000]
@@ -159,6 +182,7 @@ struct Scenario {
   PlantConfig plant;
   SemiactiveConfig semiactive;
   LockstepConfig lockstep;
+  SafetyConfig safety;
 
   /// Number of lockstep steps: round(duration_s / dt_s).
   std::int64_t steps() const;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <numbers>
 #include <filesystem>
 #include <fstream>
 #include <string_view>
@@ -183,17 +184,29 @@ std::vector<double> LoadHistory(const std::string& path, double file_dt_s, doubl
 
 std::vector<double> MakeSignal(const scenario::SignalSpec& spec, double dt_s, std::size_t n,
                                const std::string& scenario_dir) {
+  std::vector<double> x;
   if (spec.kind == "blwn") {
-    return Blwn(spec.band_hz, spec.rms, dt_s, n, spec.seed, spec.discard_s);
-  }
-  if (spec.kind == "file") {
+    x = Blwn(spec.band_hz, spec.rms, dt_s, n, spec.seed, spec.discard_s);
+  } else if (spec.kind == "file") {
     if (spec.file.empty()) throw Error("signal.file", "empty path for kind = \"file\"");
     std::filesystem::path p(spec.file);
     if (p.is_relative() && !scenario_dir.empty()) p = std::filesystem::path(scenario_dir) / p;
-    return LoadHistory(p.string(), spec.file_dt_s, spec.scale, dt_s, n);
+    x = LoadHistory(p.string(), spec.file_dt_s, spec.scale, dt_s, n);
+  } else if (spec.kind == "zero") {
+    x.assign(n, 0.0);
+  } else {
+    throw Error("signal.kind", fmt::format("\"{}\": allowed \"blwn\", \"file\", \"zero\"", spec.kind));
   }
-  if (spec.kind == "zero") return std::vector<double>(n, 0.0);
-  throw Error("signal.kind", fmt::format("\"{}\": allowed \"blwn\", \"file\", \"zero\"", spec.kind));
+  ApplyTaper(spec.taper_s, dt_s, &x);
+  return x;
+}
+
+void ApplyTaper(double taper_s, double dt_s, std::vector<double>* x) {
+  const auto m = static_cast<std::size_t>(std::llround(taper_s / dt_s));
+  for (std::size_t i = 0; i < m && i < x->size(); ++i) {
+    const double w = 0.5 * (1.0 - std::cos(std::numbers::pi * static_cast<double>(i) / static_cast<double>(m)));
+    (*x)[i] *= w;
+  }
 }
 
 }  // namespace rths::signal

@@ -31,8 +31,14 @@ std::vector<double> LoadHistory(const std::string& path, double file_dt_s, doubl
 ///   kind "file": LoadHistory(file, file_dt_s, scale, dt_s, n), a relative `file` being taken
 ///                relative to `scenario_dir` (the scenario file's folder);
 ///   kind "zero": n zeros.
+/// Then the first spec.taper_s seconds are faded in (ApplyTaper).
 /// Throws rths::Error for any other kind, and whatever the chosen generator throws.
 std::vector<double> MakeSignal(const scenario::SignalSpec& spec, double dt_s, std::size_t n,
                                const std::string& scenario_dir);
+
+/// Fades a record in from zero over its first taper_s seconds with a raised cosine,
+/// w_i = (1 - cos(pi i / m)) / 2 for i < m = round(taper_s / dt_s): a record that starts
+/// mid-motion would otherwise ask the actuator for a step (and its derivatives for an impulse).
+void ApplyTaper(double taper_s, double dt_s, std::vector<double>* x);
 
 }  // namespace rths::signal
