@@ -1,0 +1,186 @@
+#include "report/batch.h"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <fstream>
+#include <mutex>
+#include <random>
+#include <thread>
+
+#include <fmt/format.h>
+#include <lcm/lcm-cpp.hpp>
+#include <nlohmann/json.hpp>
+
+#include "core/error.h"
+#include "io/run_log.h"
+#include "participants/factory.h"
+#include "participants/group.h"
+#include "signal/metrics.h"
+
+namespace rths::report {
+
+namespace fs = std::filesystem;
+
+std::string Slug(const std::string& label) {
+  std::string out;
+  bool dash = false;
+  for (char c : label) {
+    const bool keep = (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '.' || c == '_';
+    if (c >= 'A' && c <= 'Z') {
+      c = static_cast<char>(c - 'A' + 'a');
+    } else if (!keep) {
+      dash = !out.empty();
+      continue;
+    }
+    if (dash) out += '-';
+    dash = false;
+    out += c;
+  }
+  return out.empty() ? "run" : out;
+}
+
+Trace ReadTrace(const fs::path& run_dir) {
+  const auto log = io::ReadRunLog((run_dir / "log.lcm").string());
+  const std::int64_t n = log.CompleteSteps();
+  Trace t;
+  for (auto* v : {&t.r_mm, &t.u_mm, &t.y_mm, &t.f_kN, &t.current_A, &t.i_cmd_A}) v->reserve(n);
+  for (std::int64_t k = 0; k < n; ++k) {
+    t.r_mm.push_back(log.desired[k].r_mm);
+    t.u_mm.push_back(log.command[k].u_mm);
+    t.y_mm.push_back(log.measured[k].y_mm);
+    t.f_kN.push_back(log.measured[k].f_kN);
+    t.current_A.push_back(log.measured[k].current_A);
+    t.i_cmd_A.push_back(log.current[k].i_cmd_A);
+  }
+  return t;
+}
+
+scenario::Scenario WriteScenarioFile(const RunSpec& spec) {
+  fs::create_directories(spec.dir);
+  const fs::path file = spec.dir / "scenario.toml";
+  {
+    std::ofstream out(file, std::ios::binary);
+    if (!out) throw Error(file.string(), "cannot open for writing");
+    out << "# " << spec.label << " (written by rths reproduce; every key is written out)\n"
+        << scenario::ToToml(spec.scenario);
+    if (!out) throw Error(file.string(), "write failed");
+  }
+  return scenario::LoadScenario(file.string());
+}
+
+void Preflight(const std::vector<RunSpec>& specs) {
+  std::vector<std::string> problems;
+  lcm::LCM lcm("memq://");
+  if (!lcm.good()) throw Error("reproduce", "cannot create a memq:// LCM instance");
+  for (const auto& spec : specs) {
+    try {
+      scenario::ValidateScenario(spec.scenario);
+      const auto id = participants::IdentityOf(spec.scenario, 1);
+      for (const char* role : {"controller", "semiactive", "plant", "integrator"}) {
+        participants::MakeParticipant(role, spec.scenario, id, &lcm, "");
+      }
+    } catch (const std::exception& e) {
+      problems.push_back(fmt::format("  {}: {}", spec.label, e.what()));
+    }
+  }
+  if (problems.empty()) return;
+  std::string msg = fmt::format("{} of {} runs cannot be built with this build of rths:", problems.size(), specs.size());
+  for (const auto& p : problems) msg += "\n" + p;
+  throw Error("reproduce", msg);
+}
+
+namespace {
+
+std::int64_t NewRunId() {
+  static std::mutex m;
+  static std::mt19937_64 gen{std::random_device{}()};
+  std::lock_guard<std::mutex> lock(m);
+  return static_cast<std::int64_t>(gen() & 0x3fffffffffffffffULL) | 1;
+}
+
+RunResult RunOne(const RunSpec& spec) {
+  RunResult res;
+  res.label = spec.label;
+  res.dir = spec.dir;
+  nlohmann::json j;
+  const auto t0 = std::chrono::steady_clock::now();
+  scenario::Scenario s;
+  std::int64_t run_id = NewRunId();
+  try {
+    if (fs::exists(spec.dir / "log.lcm")) {
+      throw Error(spec.dir.string(), "holds a run already; refusing to overwrite it");
+    }
+    s = WriteScenarioFile(spec);
+    const auto outcomes = participants::RunGroupInProcess({s}, run_id, spec.dir.string());
+    if (const auto* culprit = participants::RootCause(outcomes)) {
+      res.error = fmt::format("{} exited with code {}: {}", culprit->role, culprit->exit_code, culprit->message);
+    }
+    j["participants"] = nlohmann::json::object();
+    for (const auto& o : outcomes) j["participants"][o.role] = {{"exit_code", o.exit_code}, {"message", o.message}};
+  } catch (const std::exception& e) {
+    res.error = e.what();
+  }
+  res.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  try {
+    if (fs::exists(spec.dir / "log.lcm")) {
+      const Trace t = ReadTrace(spec.dir);
+      res.steps = static_cast<std::int64_t>(t.r_mm.size());
+      if (res.steps > 0) res.tracking_pct = signal::RmsErrorPercent(t.r_mm, t.y_mm);
+      for (double f : t.f_kN) res.peak_force_kN = std::max(res.peak_force_kN, std::abs(f));
+      if (res.error.empty() && res.steps != s.steps()) {
+        res.error = fmt::format("the log holds {} of {} steps", res.steps, s.steps());
+      }
+    }
+  } catch (const std::exception& e) {
+    if (res.error.empty()) res.error = e.what();
+  }
+  res.ok = res.error.empty();
+  j["label"] = spec.label;
+  j["scenario"] = (spec.dir / "scenario.toml").string();
+  j["scenario_sha256"] = s.sha256;
+  j["run_id"] = run_id;
+  j["transport"] = "memq";
+  j["steps_expected"] = s.steps();
+  j["steps"] = res.steps;
+  j["wall_s"] = res.wall_s;
+  j["steps_per_s"] = res.wall_s > 0 ? res.steps / res.wall_s : 0.0;
+  j["tracking_nrmse_pct"] = res.tracking_pct;
+  j["peak_force_kN"] = res.peak_force_kN;
+  j["stopped"] = res.ok ? std::string("no") : res.error;
+  try {
+    fs::create_directories(spec.dir);
+    std::ofstream(spec.dir / "summary.json") << j.dump(2) << "\n";
+  } catch (const std::exception&) {
+  }
+  return res;
+}
+
+}  // namespace
+
+std::vector<RunResult> RunBatch(const std::vector<RunSpec>& specs, int jobs, const Progress& progress) {
+  if (jobs < 1) throw Error("reproduce", "--jobs must be >= 1");
+  std::vector<RunResult> results(specs.size());
+  std::atomic<std::size_t> next{0};
+  std::size_t done = 0;
+  std::mutex m;
+  auto worker = [&] {
+    for (;;) {
+      const std::size_t i = next.fetch_add(1);
+      if (i >= specs.size()) return;
+      RunResult r = RunOne(specs[i]);
+      std::lock_guard<std::mutex> lock(m);
+      results[i] = r;
+      ++done;
+      if (progress) progress(done, specs.size(), results[i]);
+    }
+  };
+  const int n = std::min<int>(jobs, static_cast<int>(std::max<std::size_t>(specs.size(), 1)));
+  std::vector<std::thread> threads;
+  for (int t = 0; t < n; ++t) threads.emplace_back(worker);
+  for (auto& t : threads) t.join();
+  return results;
+}
+
+}  // namespace rths::report

@@ -1,0 +1,67 @@
+#pragma once
+/// @file Many lockstep runs side by side: each run a whole participant group in this process on
+/// its own memq:// instance (participants/group.h), `jobs` groups at a time in threads. Every run
+/// gets a folder of its own with the exact scenario file that ran (scenario.toml, written by
+/// scenario::ToToml and loaded back, so its hash is that of the file), log.lcm, signals.csv and
+/// summary.json.
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "scenario/scenario.h"
+
+namespace rths::report {
+
+/// One run to make.
+struct RunSpec {
+  std::string label;                 ///< for progress lines and errors
+  scenario::Scenario scenario;       ///< built in code; written to dir/scenario.toml
+  std::filesystem::path dir;         ///< the run's folder (created; must not hold a run yet)
+};
+
+/// How one run went.
+struct RunResult {
+  std::string label;
+  std::filesystem::path dir;
+  bool ok = false;
+  std::string error;                 ///< why it failed ("" if ok)
+  std::int64_t steps = 0;            ///< complete steps in the log
+  double wall_s = 0.0;
+  double tracking_pct = 0.0;         ///< Eq. 31 over every logged step (r_k, y_k)
+  double peak_force_kN = 0.0;
+};
+
+/// A run's signals, read back from its log.lcm, per step k (docs/lockstep.md).
+struct Trace {
+  std::vector<double> r_mm;          ///< desired r_k
+  std::vector<double> u_mm;          ///< command u_k
+  std::vector<double> y_mm;          ///< measured y_k
+  std::vector<double> f_kN;          ///< measured force f_k
+  std::vector<double> current_A;     ///< effective current at t_k
+  std::vector<double> i_cmd_A;       ///< commanded current i_k
+};
+/// Reads the complete steps of dir/log.lcm. Throws rths::Error.
+Trace ReadTrace(const std::filesystem::path& run_dir);
+
+/// Writes spec.scenario into spec.dir/scenario.toml and loads it back (a real file and hash).
+scenario::Scenario WriteScenarioFile(const RunSpec& spec);
+
+/// Builds the controller, plant, semiactive and integrator of every scenario once, without
+/// running, and throws one rths::Error listing every run that cannot be built (e.g. a
+/// controller kind or plant that is not implemented yet) with the component's own message.
+void Preflight(const std::vector<RunSpec>& specs);
+
+/// Called after each run (from the worker threads, serialised): done so far, total, the result.
+using Progress = std::function<void(std::size_t done, std::size_t total, const RunResult&)>;
+
+/// Runs every spec, `jobs` at a time (>= 1), and returns the results in spec order. A failed
+/// run is reported in its RunResult (and its summary.json), not thrown.
+std::vector<RunResult> RunBatch(const std::vector<RunSpec>& specs, int jobs, const Progress& progress = {});
+
+/// A folder-name-safe form of a label: lower case, runs of other characters -> '-'
+/// ("G_FF,0.0A + LP" -> "g_ff-0.0a-lp").
+std::string Slug(const std::string& label);
+
+}  // namespace rths::report

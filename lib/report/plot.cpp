@@ -1,0 +1,237 @@
+#include "report/plot.h"
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+
+#include <fmt/format.h>
+
+#include "core/error.h"
+
+namespace rths::report {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+bool ValidName(const std::string& s) {
+  if (s.empty()) return false;
+  for (char c : s) {
+    const bool ok = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
+                    c == '_' || c == '-' || c == '.';
+    if (!ok) return false;
+  }
+  return true;
+}
+
+std::string FindOnPath(const std::string& program) {
+  if (program.find('/') != std::string::npos) {
+    return ::access(program.c_str(), X_OK) == 0 ? program : "";
+  }
+  const char* path = std::getenv("PATH");
+  std::stringstream ss(path ? path : "/usr/local/bin:/usr/bin:/bin");
+  std::string dir;
+  while (std::getline(ss, dir, ':')) {
+    if (dir.empty()) dir = ".";
+    const std::string candidate = dir + "/" + program;
+    if (::access(candidate.c_str(), X_OK) == 0 && fs::is_regular_file(candidate)) return candidate;
+  }
+  return "";
+}
+
+// Runs `exe script` in `dir`; returns the exit status and everything it printed.
+int RunIn(const fs::path& dir, const std::string& exe, const std::string& script, std::string* output) {
+  int pipefd[2];
+  if (::pipe(pipefd) != 0) throw Error("gnuplot", "pipe failed");
+  const pid_t pid = ::fork();
+  if (pid < 0) {
+    ::close(pipefd[0]);
+    ::close(pipefd[1]);
+    throw Error("gnuplot", "fork failed");
+  }
+  if (pid == 0) {
+    ::dup2(pipefd[1], 1);
+    ::dup2(pipefd[1], 2);
+    ::close(pipefd[0]);
+    ::close(pipefd[1]);
+    if (::chdir(dir.c_str()) != 0) ::_exit(126);
+    ::execl(exe.c_str(), exe.c_str(), script.c_str(), static_cast<char*>(nullptr));
+    ::_exit(127);
+  }
+  ::close(pipefd[1]);
+  char buf[4096];
+  for (;;) {
+    const ssize_t got = ::read(pipefd[0], buf, sizeof buf);
+    if (got > 0) {
+      output->append(buf, static_cast<std::size_t>(got));
+    } else if (got < 0 && errno == EINTR) {
+      continue;
+    } else {
+      break;
+    }
+  }
+  ::close(pipefd[0]);
+  int status = 0;
+  while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+  }
+  if (WIFEXITED(status)) return WEXITSTATUS(status);
+  return 128 + (WIFSIGNALED(status) ? WTERMSIG(status) : 0);
+}
+
+std::string Num(double v) { return fmt::format("{:.10g}", v); }
+
+}  // namespace
+
+std::string GnuplotQuote(const std::string& s) {
+  std::string out = "'";
+  for (char c : s) {
+    if (c == '\'') out += '\'';
+    if (c == '\n') {
+      out += "\\n";  // only meaningful in double quotes; keep labels on one line
+      continue;
+    }
+    out += c;
+  }
+  out += '\'';
+  return out;
+}
+
+bool GnuplotAvailable(const std::string& program) { return !FindOnPath(program).empty(); }
+
+PlotFiles Plot(const Figure& fig, const fs::path& dir) {
+  const std::string where = "plot " + fig.name;
+  if (!ValidName(fig.name)) {
+    throw Error(where, "figure name must be letters, digits, '_', '-' or '.'");
+  }
+  if (fig.panels.empty()) throw Error(where, "no panels");
+  if (fig.columns < 1) throw Error(where, "columns must be >= 1");
+  const std::string exe = FindOnPath(fig.gnuplot);
+  if (exe.empty()) {
+    throw Error(where, fmt::format("gnuplot is not installed (no '{}' on PATH): install it with "
+                                   "`apt-get install gnuplot-nox` (Debian) and run again",
+                                   fig.gnuplot));
+  }
+  fs::create_directories(dir);
+  PlotFiles files{dir / (fig.name + ".dat"), dir / (fig.name + ".gp"), dir / (fig.name + ".png")};
+
+  // Data: one block per curve with at least one finite point; `index` counts the blocks.
+  std::ofstream dat(files.dat);
+  if (!dat) throw Error(files.dat.string(), "cannot open for writing");
+  dat << "# " << fig.name << ": data of " << fig.name << ".png (whitespace-separated columns; "
+      << "one block per curve, blocks separated by two blank lines: gnuplot `index`)\n";
+  std::vector<std::vector<int>> index(fig.panels.size());
+  int next_index = 0;
+  for (std::size_t p = 0; p < fig.panels.size(); ++p) {
+    const Panel& panel = fig.panels[p];
+    for (std::size_t s = 0; s < panel.series.size(); ++s) {
+      const Series& ser = panel.series[s];
+      if (ser.x.size() != ser.y.size()) {
+        throw Error(where, fmt::format("panel {} curve '{}': {} x values but {} y values", p + 1,
+                                       ser.title, ser.x.size(), ser.y.size()));
+      }
+      bool any = false;
+      for (std::size_t i = 0; i < ser.x.size(); ++i) {
+        any = any || (std::isfinite(ser.x[i]) && std::isfinite(ser.y[i]));
+      }
+      if (!any) {
+        index[p].push_back(-1);
+        continue;
+      }
+      if (next_index > 0) dat << "\n\n";
+      dat << fmt::format("# index {}: panel {} curve \"{}\"\n# x: {}   y: {}\n", next_index, p + 1,
+                         ser.title, panel.xlabel, panel.ylabel);
+      for (std::size_t i = 0; i < ser.x.size(); ++i) {
+        if (std::isfinite(ser.x[i]) && std::isfinite(ser.y[i])) {
+          dat << Num(ser.x[i]) << ' ' << Num(ser.y[i]) << '\n';
+        } else {
+          dat << '\n';  // a blank line breaks the curve
+        }
+      }
+      index[p].push_back(next_index++);
+    }
+    bool has = false;
+    for (int i : index[p]) has = has || i >= 0;
+    if (!has) throw Error(where, fmt::format("panel {} ('{}') has no finite point to plot", p + 1, panel.ylabel));
+  }
+  dat.close();
+  if (!dat) throw Error(files.dat.string(), "write failed");
+
+  // Script.
+  const int rows = static_cast<int>((fig.panels.size() + fig.columns - 1) / fig.columns);
+  const int height = rows * fig.panel_height_px + (fig.title.empty() ? 0 : 40);
+  const std::string dat_name = GnuplotQuote(fig.name + ".dat");
+  std::ostringstream gp;
+  gp << "# " << fig.name << ".gp: written by rths (lib/report/plot.cpp). Run again with:\n"
+     << "#   cd <this folder> && gnuplot " << fig.name << ".gp\n"
+     << fmt::format("set terminal pngcairo noenhanced size {},{} font {}\n", fig.width_px, height,
+                    GnuplotQuote(fig.font))
+     << "set output " << GnuplotQuote(fig.name + ".png") << "\n"
+     << "set encoding utf8\n";
+  if (fig.panels.size() > 1 || !fig.title.empty()) {
+    gp << fmt::format("set multiplot layout {},{}", rows, fig.columns);
+    if (!fig.title.empty()) gp << " title " << GnuplotQuote(fig.title);
+    gp << "\n";
+  }
+  for (std::size_t p = 0; p < fig.panels.size(); ++p) {
+    const Panel& panel = fig.panels[p];
+    gp << "\n# panel " << p + 1 << "\n"
+       << "unset logscale\nset grid\nset autoscale\n"
+       << "set title " << GnuplotQuote(panel.title) << "\n"
+       << "set xlabel " << GnuplotQuote(panel.xlabel) << "\n"
+       << "set ylabel " << GnuplotQuote(panel.ylabel) << "\n";
+    if (panel.log_x) gp << "set logscale x\n";
+    if (panel.log_y) gp << "set logscale y\n";
+    gp << (panel.x_range ? fmt::format("set xrange [{}:{}]\n", Num(panel.x_range->first), Num(panel.x_range->second))
+                         : std::string("set xrange [*:*]\n"));
+    gp << (panel.y_range ? fmt::format("set yrange [{}:{}]\n", Num(panel.y_range->first), Num(panel.y_range->second))
+                         : std::string("set yrange [*:*]\n"));
+    if (panel.key == "off") {
+      gp << "set key off\n";
+    } else {
+      gp << "set key on " << panel.key << " box opaque\n";
+    }
+    gp << "plot ";
+    bool first = true;
+    for (std::size_t s = 0; s < panel.series.size(); ++s) {
+      if (index[p][s] < 0) continue;
+      const Series& ser = panel.series[s];
+      if (!first) gp << ", \\\n     ";
+      first = false;
+      gp << dat_name << " index " << index[p][s] << " using 1:2 with " << ser.with;
+      if (ser.with != "points") gp << " lw " << Num(ser.width) << " dt " << ser.dash;
+      if (!ser.color.empty()) gp << " lc rgb " << GnuplotQuote(ser.color);
+      gp << (ser.title.empty() ? std::string(" notitle") : " title " + GnuplotQuote(ser.title));
+    }
+    gp << "\n";
+  }
+  if (fig.panels.size() > 1 || !fig.title.empty()) gp << "\nunset multiplot\n";
+  gp << "set output\n";
+  {
+    std::ofstream out(files.gp);
+    if (!out) throw Error(files.gp.string(), "cannot open for writing");
+    out << gp.str();
+    if (!out) throw Error(files.gp.string(), "write failed");
+  }
+
+  std::error_code ec;
+  fs::remove(files.png, ec);
+  std::string output;
+  const int code = RunIn(dir, exe, fig.name + ".gp", &output);
+  if (code == 127) throw Error(where, fmt::format("cannot run {}: install gnuplot (apt-get install gnuplot-nox)", exe));
+  if (code != 0) {
+    throw Error(where, fmt::format("gnuplot failed (exit {}) on {}:\n{}", code, files.gp.string(), output));
+  }
+  if (!fs::exists(files.png) || fs::file_size(files.png) == 0) {
+    throw Error(where, fmt::format("gnuplot made no PNG from {}:\n{}", files.gp.string(), output));
+  }
+  return files;
+}
+
+}  // namespace rths::report

@@ -1,0 +1,99 @@
+// rths-reproduce: `rths reproduce NAME [--out DIR] [--quick] [--plant physical|linear] [--jobs N]`.
+//
+// Reproduces one figure or table of the paper (experiments.md) into a new folder: CSV tables,
+// Markdown, PNG figures and, for the lockstep studies, every run's folder. The work is done by
+// lib/report (report/reproduce.h); this file parses options and prints.
+#include <chrono>
+#include <cstdio>
+#include <ctime>
+#include <filesystem>
+#include <string>
+
+#include <CLI/CLI.hpp>
+#include <fmt/core.h>
+
+#include "core/error.h"
+#include "report/reproduce.h"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+fs::path DefaultOutDir(const std::string& name, bool quick) {
+  const std::time_t t = std::time(nullptr);
+  std::tm tm{};
+  gmtime_r(&t, &tm);
+  char stamp[32];
+  std::strftime(stamp, sizeof stamp, "%Y%m%d-%H%M%S", &tm);
+  const fs::path base = fs::path("runs") / fmt::format("{}-reproduce-{}{}", stamp, name, quick ? "-quick" : "");
+  fs::path p = base;
+  for (int i = 2; fs::exists(p); ++i) p = base.string() + "-" + std::to_string(i);
+  return p;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"rths reproduce: reproduce a figure or table of Phillips & Spencer (2013) into a new folder"};
+  std::string name, out_arg, plant = "physical";
+  bool quick = false;
+  int jobs = 2;
+  app.add_option("name", name, "what to reproduce")
+      ->required()
+      ->check(CLI::IsMember({"fig5", "fig6", "fig7", "fig8", "table2"}));
+  app.add_option("--out", out_arg, "output folder (default: a new folder under runs/); never overwritten");
+  app.add_flag("--quick", quick, "shorter records (for tests; numbers are noisier)");
+  app.add_option("--plant", plant, "plant for the lockstep runs")
+      ->check(CLI::IsMember({"physical", "linear"}))
+      ->capture_default_str();
+  app.add_option("--jobs", jobs, "lockstep groups run at the same time")->check(CLI::Range(1, 64))->capture_default_str();
+  CLI11_PARSE(app, argc, argv);
+
+  rths::report::ReproduceOptions opts;
+  opts.out_dir = out_arg.empty() ? DefaultOutDir(name, quick) : fs::path(out_arg);
+  opts.quick = quick;
+  opts.plant = plant;
+  opts.jobs = jobs;
+  opts.log = [](std::string_view line) {
+    std::printf("%.*s\n", static_cast<int>(line.size()), line.data());
+    std::fflush(stdout);
+  };
+  const auto t0 = std::chrono::steady_clock::now();
+  try {
+    std::printf("rths reproduce %s%s -> %s\n", name.c_str(), quick ? " (quick)" : "", opts.out_dir.string().c_str());
+    std::fflush(stdout);
+    if (name == "fig5") {
+      const auto r = rths::report::ReproduceFig5(opts);
+      double worst = 0.0;
+      for (std::size_t i = 0; i < r.current_A.size(); ++i) {
+        worst = std::max(worst, std::abs(r.ours_peak_kN[i] / r.paper_peak_kN[i] - 1.0));
+      }
+      std::printf("fig5: largest peak difference %.2f %% (E6 holds within 2 %%: %s)\n", 100 * worst,
+                  worst <= 0.02 ? "yes" : "NO");
+    } else if (name == "table2") {
+      const auto r = rths::report::ReproduceTable2(opts);
+      std::printf("\n%-6s %-18s %7s %9s %7s %9s\n", "cond", "controller", "paper5", "ours5", "paper15", "ours15");
+      for (std::size_t i = 0; i + 1 < r.rows.size(); i += 2) {
+        const auto& a = r.rows[i];
+        const auto& b = r.rows[i + 1];
+        std::printf("%-6s %-18s %7s %9.3f %7s %9.3f\n", a.condition.c_str(), a.controller.c_str(),
+                    a.paper_text.c_str(), a.ours_pct, b.paper_text.c_str(), b.ours_pct);
+      }
+      std::printf("\n");
+      for (const auto& c : r.claims) {
+        std::printf("%s %s\n    %s\n", c.holds ? "[holds]" : "[DOES NOT HOLD]", c.text.c_str(), c.detail.c_str());
+      }
+    } else {
+      throw rths::Error(name, "not available in this build yet");
+    }
+  } catch (const rths::Error& e) {
+    std::fprintf(stderr, "rths reproduce %s: %s\n", name.c_str(), e.what());
+    return 2;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "rths reproduce %s: internal error: %s\n", name.c_str(), e.what());
+    return 1;
+  }
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  std::printf("time: %.1f s\noutput: %s\n", wall, opts.out_dir.string().c_str());
+  return 0;
+}
