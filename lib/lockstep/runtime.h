@@ -62,6 +62,7 @@ struct Faults {
   std::int64_t stall_at = -1;               ///< stop answering from step k on (a hung process)
   std::int64_t throw_at = -1;               ///< throw from the step computation at step k
   std::int64_t crash_at = -1;               ///< die by SIGABRT at step k (a crashed process)
+  double command_gain = 1.0;                ///< controller: multiply u_k (-1: a sign error)
 };
 
 /// Encodes an lcm-gen message into `out` (reusing its capacity: no allocation once sized).

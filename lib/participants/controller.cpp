@@ -13,9 +13,10 @@ void Controller::Compute(std::int64_t, const rths::desired_t& d, const rths::mea
   const control::Derivatives der{d.r_mm,           d.rd_mm_s,         d.rdd_mm_s2,
                                  d.rddd_mm_s3,     d.acc_prev_mm_s2,  d.vel_prev_mm_s};
   const control::Command c = law_->Step(der, {m.y_mm, m.f_kN, m.current_A});
-  out->u_mm = c.u_mm;
-  out->u_ff_mm = c.u_ff_mm;
-  out->u_fb_mm = c.u_fb_mm;
+  const double g = faults.command_gain;  // 1 outside fault-injection tests
+  out->u_mm = g * c.u_mm;
+  out->u_ff_mm = g * c.u_ff_mm;
+  out->u_fb_mm = g * c.u_fb_mm;
 }
 
 }  // namespace rths::participants

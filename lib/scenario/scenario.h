@@ -154,9 +154,9 @@ struct SafetyConfig {
   double max_error_mm = 25.0;      ///< |r - y| must stay within, (0, 10000]
   /// Divergence: the peak |r - y| over consecutive windows of growth_window_s grows by at least
   /// growth_factor every window for growth_windows windows, above growth_floor_mm.
-  double growth_window_s = 0.05;   ///< (0, 10]
-  double growth_factor = 1.5;      ///< (1, 1000]
-  int growth_windows = 6;          ///< [2, 1000]
+  double growth_window_s = 0.25;   ///< (0, 10]; at least one period of the oscillation to watch
+  double growth_factor = 1.3;      ///< (1, 1000]
+  int growth_windows = 4;          ///< [2, 1000]
   double growth_floor_mm = 0.5;    ///< (0, 10000]
 };
 
