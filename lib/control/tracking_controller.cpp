@@ -1,14 +1,77 @@
 #include "control/tracking_controller.h"
 
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "control/baselines.h"
+#include "control/inverse_lowpass.h"
+#include "control/lqg.h"
 #include "core/error.h"
 
 namespace rths::control {
 
+void RequireServoModel(const scenario::ServoModel3& m, const std::string& key) {
+  for (double v : {m.K, m.p, m.b, m.c}) {
+    if (!(v > 0.0) || !std::isfinite(v)) {
+      throw Error(key, fmt::format("servo model \"{}\" (K = {}, p = {}, b = {}, c = {}): all must be finite "
+                                   "and > 0 (a stable, minimum-phase model)",
+                                   m.name, m.K, m.p, m.b, m.c));
+    }
+  }
+}
+
+FeedforwardCoefficients FeedforwardFor(const scenario::ServoModel3& m, const std::string& key) {
+  RequireServoModel(m, key);
+  return MakeFeedforwardCoefficients(m);
+}
+
+DiscreteSs FeedforwardFir(const FeedforwardCoefficients& a, bool half_step_ahead, double dt_s) {
+  // The map r -> u is linear in (r_k, r_{k-1}, r_{k-2}, r_{k-3}): its taps are the responses to
+  // unit vectors, through the same Eqs. 20-22 the integrator uses.
+  Eigen::Vector4d h;
+  for (int j = 0; j < 4; ++j) {
+    ExtrapolationState past;
+    past.r1 = j == 1, past.r2 = j == 2, past.r3 = j == 3;
+    h(j) = FeedforwardCommand(a, ExtrapolateDerivatives(past, j == 0, dt_s), half_step_ahead, dt_s);
+  }
+  return Fir(h, dt_s);
+}
+
 std::unique_ptr<TrackingController> MakeTrackingController(const scenario::ControllerConfig& cfg,
                                                            double dt_s) {
-  if (cfg.kind == "none") return std::make_unique<NoCompensation>();
-  if (cfg.kind == "ff") return std::make_unique<ModelFeedforward>(cfg.model, cfg.half_step_ahead, dt_s);
-  throw Error("controller.kind", "unknown controller '" + cfg.kind + "' (allowed: none, ff)");
+  if (!(dt_s > 0.0) || !std::isfinite(dt_s)) throw Error("run.dt_s", fmt::format("{}: allowed > 0", dt_s));
+  const std::string& k = cfg.kind;
+  if (k == "poly3" || k == "lead") {
+    if (!(cfg.delay_ms <= cfg.max_delay_ms)) {
+      throw Error("controller.delay_ms",
+                  fmt::format("{} ms: allowed (0, controller.max_delay_ms = {} ms] (extrapolation beyond it "
+                              "amplifies noise too much)",
+                              cfg.delay_ms, cfg.max_delay_ms));
+    }
+  }
+  if (k == "none") return std::make_unique<NoCompensation>(dt_s);
+  if (k == "ff") {
+    RequireServoModel(cfg.model, "controller.model");
+    return std::make_unique<ModelFeedforward>(cfg.model, cfg.half_step_ahead, dt_s);
+  }
+  if (k == "poly3") return std::make_unique<PolynomialExtrapolation>(MakePoly3(cfg.delay_ms * 1e-3, dt_s), dt_s);
+  if (k == "lead") {
+    return std::make_unique<LeadCompensator>(MakeLead(cfg.delay_ms * 1e-3, cfg.lead_tp_ms * 1e-3, dt_s), dt_s);
+  }
+  if (k == "ff_lp") {
+    return std::make_unique<InverseLowpass>(
+        MakeInverseLowpass(cfg.model, cfg.lp_order, cfg.lp_cutoff_hz, dt_s, "controller.model"));
+  }
+  if (k == "bumpless_lp") {
+    return std::make_unique<BumplessInverseLowpass>(
+        MakeInverseLowpass(cfg.model_low, cfg.lp_order, cfg.lp_cutoff_hz, dt_s, "controller.model_low"),
+        MakeInverseLowpass(cfg.model_high, cfg.lp_order, cfg.lp_cutoff_hz, dt_s, "controller.model_high"),
+        cfg.current_high_A);
+  }
+  if (k == "ff_lqg") return std::make_unique<FeedforwardLqg>(cfg.model, cfg.lqg, cfg.half_step_ahead, dt_s);
+  throw Error("controller.kind",
+              fmt::format("unknown controller '{}' (allowed: none, ff, poly3, lead, ff_lp, bumpless_lp, ff_lqg)", k));
 }
 
 }  // namespace rths::control
