@@ -241,6 +241,7 @@ int main(int argc, char** argv) {
   fs::path out;
   try {
     s = rths::scenario::LoadScenario(scenario_path);
+    rths::participants::CheckBuildable(s);
     out = out_arg.empty() ? DefaultOutDir(s.run.name) : fs::path(out_arg);
     if (fs::exists(out) && !fs::is_empty(out)) {
       throw rths::Error(out.string(), "output folder exists and is not empty; refusing to overwrite "

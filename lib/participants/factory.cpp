@@ -38,6 +38,13 @@ std::unique_ptr<lockstep::Participant> MakeParticipant(std::string_view role,
   throw Error("", fmt::format("unknown participant role '{}'", role));
 }
 
+void CheckBuildable(const scenario::Scenario& s) {
+  lcm::LCM lcm("memq://");
+  for (std::string_view role : {"integrator", "controller", "plant", "semiactive"}) {
+    MakeParticipant(role, s, IdentityOf(s, 1), &lcm, "");
+  }
+}
+
 int RoleMain(std::string_view role, int argc, char** argv) {
   const std::string name(role);
   CLI::App app{fmt::format("rths-{}: the {} participant of a lockstep run (started by `rths run`)",

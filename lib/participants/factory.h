@@ -26,6 +26,11 @@ std::unique_ptr<lockstep::Participant> MakeParticipant(std::string_view role,
                                                        const lockstep::RunIdentity& id,
                                                        lcm::LCM* lcm, const std::string& out_dir);
 
+/// Builds every participant but the logger once, off-line, and throws away: a scenario whose
+/// models cannot be built (a structure file with errors, a design that fails) is refused before
+/// any process starts. Throws rths::Error.
+void CheckBuildable(const scenario::Scenario& s);
+
 /// main() of procs/<role>: `--scenario FILE --lcm-url URL --run-id N [--out DIR]`.
 /// Exit codes: lockstep::ExitCode.
 int RoleMain(std::string_view role, int argc, char** argv);

@@ -2,16 +2,27 @@
 /// @file procs/semiactive's participant: the damper current command.
 /// Step k: desired_t k (structure state) + measured_t k (y_k, f_k)  ->  current_t k, held by the
 /// plant over [t_k, t_{k+1}): it first shows in measured_t k+1. See docs/lockstep.md.
-/// For now a constant current (passive-off 0 A, passive-on max current, or a given constant);
-/// clipped-optimal control (issue 4) implements the same Compute() from the same inputs.
+/// For now a scheduled current (passive-off 0 A, passive-on, a constant, or the pulse of
+/// Table 2); clipped-optimal control implements the same Compute() from the same inputs.
 #include "participants/step_participant.h"
 #include "rths/current_t.hpp"
 #include "scenario/scenario.h"
 
 namespace rths::participants {
 
-/// The current a constant-current mode commands [A] (passive_off: 0, passive_on: max, constant).
-double ConstantCurrentA(const scenario::SemiactiveConfig& cfg);
+/// The current command of a scheduled mode at step k [A]: passive_off 0; passive_on
+/// max_current_A; constant current_A; pulse max_current_A for the first round(duty N) steps of
+/// every period of N = round(1 / (pulse_hz dt)) steps, else 0 (Table 2's 0.5 Hz, 50 % pulse).
+/// Throws rths::Error for a mode that is not a schedule.
+class CurrentSchedule {
+ public:
+  CurrentSchedule(const scenario::SemiactiveConfig& cfg, double dt_s);
+  double At(std::int64_t k) const;
+
+ private:
+  double on_A_ = 0.0;
+  std::int64_t period_ = 1, on_steps_ = 1;
+};
 
 class Semiactive final : public DesiredMeasuredParticipant<rths::current_t> {
  public:
@@ -22,7 +33,7 @@ class Semiactive final : public DesiredMeasuredParticipant<rths::current_t> {
                rths::current_t* out) override;
 
  private:
-  const double current_A_;
+  const CurrentSchedule schedule_;
 };
 
 }  // namespace rths::participants

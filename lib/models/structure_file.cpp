@@ -1,0 +1,175 @@
+#include "models/structure_file.h"
+
+#include <cmath>
+#include <fstream>
+#include <numbers>
+#include <sstream>
+
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+#include <fmt/format.h>
+
+#include "core/error.h"
+
+namespace rths::models {
+
+namespace {
+constexpr double kKgToProject = 1e-6;  // kg -> kN s^2/mm
+
+/// Non-comment tokens with their line numbers.
+struct Tokens {
+  std::vector<std::string> words;
+  std::vector<int> lines;
+  std::size_t next = 0;
+};
+
+Tokens Tokenize(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw Error(path, "cannot open the structure file");
+  Tokens t;
+  std::string line;
+  for (int n = 1; std::getline(in, line); ++n) {
+    if (const auto hash = line.find('#'); hash != std::string::npos) line.erase(hash);
+    std::istringstream ss(line);
+    for (std::string w; ss >> w;) {
+      t.words.push_back(w);
+      t.lines.push_back(n);
+    }
+  }
+  return t;
+}
+
+std::string Where(const std::string& path, const Tokens& t) {
+  const int line = t.next < t.lines.size() ? t.lines[t.next] : (t.lines.empty() ? 0 : t.lines.back());
+  return fmt::format("{}:{}", path, line);
+}
+
+double Number(const std::string& path, Tokens* t, const char* what) {
+  if (t->next >= t->words.size()) throw Error(Where(path, *t), fmt::format("file ends inside {}", what));
+  const std::string& w = t->words[t->next];
+  std::size_t used = 0;
+  double v = 0;
+  try {
+    v = std::stod(w, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used != w.size() || !std::isfinite(v)) {
+    throw Error(Where(path, *t), fmt::format("\"{}\" is not a number (in {})", w, what));
+  }
+  ++t->next;
+  return v;
+}
+
+void Expect(const std::string& path, Tokens* t, const std::string& word, const std::string& unit) {
+  if (t->next >= t->words.size() || t->words[t->next] != word) {
+    throw Error(Where(path, *t), fmt::format("expected \"{} {}\"", word, unit));
+  }
+  ++t->next;
+  if (!unit.empty()) {
+    if (t->next >= t->words.size() || t->words[t->next] != unit) {
+      throw Error(Where(path, *t), fmt::format("matrix {} must be given in {}", word, unit));
+    }
+    ++t->next;
+  }
+}
+
+Eigen::MatrixXd Matrix(const std::string& path, Tokens* t, int n, const char* name) {
+  Eigen::MatrixXd m(n, n);
+  for (int i = 0; i < n; ++i) {
+    for (int j = 0; j < n; ++j) m(i, j) = Number(path, t, name);
+  }
+  return m;
+}
+
+void CheckSymmetric(const std::string& path, const Eigen::MatrixXd& a, const char* name) {
+  const double tol = 1e-9 * std::max(1.0, a.cwiseAbs().maxCoeff());
+  if ((a - a.transpose()).cwiseAbs().maxCoeff() > tol) throw Error(path, fmt::format("{} is not symmetric", name));
+}
+}  // namespace
+
+StructureMatrices LoadStructureFile(const std::string& path) {
+  Tokens t = Tokenize(path);
+  Expect(path, &t, "n", "");
+  const double nd = Number(path, &t, "n");
+  if (nd < 1 || nd > 10000 || nd != std::floor(nd)) {
+    throw Error(Where(path, t), fmt::format("n = {} is out of range [1, 10000] (whole number)", nd));
+  }
+  const int n = static_cast<int>(nd);
+  StructureMatrices m;
+  Expect(path, &t, "M", "kg");
+  m.M = Matrix(path, &t, n, "M") * kKgToProject;
+  Expect(path, &t, "K", "kN/mm");
+  m.K = Matrix(path, &t, n, "K");
+  Expect(path, &t, "C", "kN*s/mm");
+  m.C = Matrix(path, &t, n, "C");
+  if (t.next != t.words.size()) throw Error(Where(path, t), "unexpected text after the C matrix");
+  CheckSymmetric(path, m.M, "M");
+  CheckSymmetric(path, m.K, "K");
+  CheckSymmetric(path, m.C, "C");
+  if (Eigen::LLT<Eigen::MatrixXd>(m.M).info() != Eigen::Success) {
+    throw Error(path, "M is not positive definite");
+  }
+  return m;
+}
+
+void WriteStructureFile(const std::string& path, const StructureMatrices& m, const std::string& comment) {
+  std::ofstream out(path);
+  if (!out) throw Error(path, "cannot write the structure file");
+  out << "# rths structure v1\n";
+  std::istringstream c(comment);
+  for (std::string line; std::getline(c, line);) out << "# " << line << "\n";
+  const int n = static_cast<int>(m.M.rows());
+  out << "n " << n << "\n";
+  auto write = [&](const char* head, const Eigen::MatrixXd& a, double scale) {
+    out << head << "\n";
+    for (int i = 0; i < n; ++i) {
+      for (int j = 0; j < n; ++j) out << fmt::format("{}{:.17g}", j ? " " : "", a(i, j) * scale);
+      out << "\n";
+    }
+  };
+  write("M kg", m.M, 1.0 / kKgToProject);
+  write("K kN/mm", m.K, 1.0);
+  write("C kN*s/mm", m.C, 1.0);
+}
+
+StructureMatrices ShearBuilding(const std::vector<double>& floor_masses_kg,
+                                const std::vector<double>& story_stiffness_kN_per_mm, double zeta) {
+  const int n = static_cast<int>(floor_masses_kg.size());
+  if (n == 0 || story_stiffness_kN_per_mm.size() != floor_masses_kg.size()) {
+    throw Error("ShearBuilding", "one story stiffness per floor mass is needed");
+  }
+  StructureMatrices m;
+  m.M = Eigen::MatrixXd::Zero(n, n);
+  m.K = Eigen::MatrixXd::Zero(n, n);
+  for (int i = 0; i < n; ++i) {
+    m.M(i, i) = floor_masses_kg[i] * kKgToProject;
+    const double k = story_stiffness_kN_per_mm[i];  // story i+1, below floor i+1
+    m.K(i, i) += k;
+    if (i > 0) {
+      m.K(i - 1, i - 1) += k;
+      m.K(i - 1, i) -= k;
+      m.K(i, i - 1) -= k;
+    }
+  }
+  Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> eig(m.K, m.M);
+  const Eigen::MatrixXd& phi = eig.eigenvectors();  // mass-normalised: phi^T M phi = I
+  const Eigen::VectorXd w = eig.eigenvalues().cwiseSqrt();
+  m.C = m.M * phi * (2.0 * zeta * w).asDiagonal() * phi.transpose() * m.M;
+  m.C = 0.5 * (m.C + m.C.transpose()).eval();
+  return m;
+}
+
+Modes ModalAnalysis(const StructureMatrices& m) {
+  Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> eig(m.K, m.M);
+  Modes out;
+  for (int i = 0; i < eig.eigenvalues().size(); ++i) {
+    const double w = std::sqrt(std::max(0.0, eig.eigenvalues()[i]));
+    const Eigen::VectorXd phi = eig.eigenvectors().col(i);
+    out.frequency_hz.push_back(w / (2.0 * std::numbers::pi));
+    out.damping_ratio.push_back(w > 0 ? phi.dot(m.C * phi) / (2.0 * w) : 0.0);
+  }
+  return out;
+}
+
+}  // namespace rths::models

@@ -1,0 +1,44 @@
+#pragma once
+/// @file Structures as text files a user can replace (docs/structures.md), shear-building
+/// construction with modal damping, and modal analysis.
+///
+/// File format (whitespace separated; '#' starts a comment):
+///     # rths structure v1
+///     n 9
+///     M kg              then n rows of n values: mass matrix [kg]
+///     K kN/mm           then n rows of n values: stiffness [kN/mm]
+///     C kN*s/mm         then n rows of n values: damping [kN s/mm]
+/// The loader converts M to project units (kN s^2/mm = kg * 1e-6).
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+namespace rths::models {
+
+/// M [kN s^2/mm], K [kN/mm], C [kN s/mm].
+struct StructureMatrices {
+  Eigen::MatrixXd M, K, C;
+};
+
+/// Reads a structure file; throws rths::Error naming the file, line and problem (missing or
+/// malformed matrix, wrong size, non-symmetric M or K, M not positive definite).
+StructureMatrices LoadStructureFile(const std::string& path);
+/// Writes a structure file (masses back in kg), with `comment` lines after the header.
+void WriteStructureFile(const std::string& path, const StructureMatrices& m, const std::string& comment);
+
+/// A lumped-mass shear building: floor masses [kg] (floor 1 first), story stiffnesses [kN/mm]
+/// (story 1 between the ground and floor 1), and damping ratio zeta in every mode:
+/// C = M Phi diag(2 zeta w_i) Phi^T M with Phi mass-normalised (Phi^T M Phi = I).
+StructureMatrices ShearBuilding(const std::vector<double>& floor_masses_kg,
+                                const std::vector<double>& story_stiffness_kN_per_mm, double zeta);
+
+/// Undamped modes: natural frequencies [Hz], ascending, and the modal damping ratios
+/// zeta_i = (phi_i^T C phi_i) / (2 w_i) of mass-normalised modes.
+struct Modes {
+  std::vector<double> frequency_hz;
+  std::vector<double> damping_ratio;
+};
+Modes ModalAnalysis(const StructureMatrices& m);
+
+}  // namespace rths::models
