@@ -10,11 +10,18 @@
 namespace rths::models {
 
 LinearRig LinearRig::Make(const scenario::ServoModel3& actuator, double dt_s, bool has_damper,
-                          const MrDamperParams& damper, double rtol) {
+                          const MrDamperParams& damper, double rtol, bool current_dynamics) {
   if (!(rtol > 0.0 && rtol <= 1e-2))
     throw Error("LinearRig: rtol", fmt::format("must be in (0, 1e-2] (got {})", rtol));
   damper.Validate();
-  return {LinearServo::Make(actuator, dt_s), damper, has_damper, rtol};
+  LinearRig r;
+  r.servo = LinearServo::Make(actuator, dt_s);
+  r.damper = damper;
+  r.has_damper = has_damper;
+  r.rtol = rtol;
+  r.current_dynamics = current_dynamics;
+  r.driver = CurrentDriver::Make({}, dt_s);
+  return r;
 }
 
 double MeasuredDisplacementMm(const LinearRig& rig, const LinearRigState& s) {
@@ -25,6 +32,14 @@ double MeasuredForceKn(const LinearRig& rig, const LinearRigState& s, double cur
   if (!rig.has_damper) return 0.0;
   return DamperForceKn(CoefficientsAt(rig.damper, current_A), s.damper, Output(rig.servo, s.servo),
                        OutputVelocity(rig.servo, s.servo));
+}
+
+double EffectiveCurrentA(const LinearRig& rig, const LinearRigState& s) {
+  return EffectiveCurrentA(rig.driver, s.current);
+}
+
+double MeasuredForceKn(const LinearRig& rig, const LinearRigState& s) {
+  return MeasuredForceKn(rig, s, EffectiveCurrentA(rig, s));
 }
 
 namespace {
@@ -44,7 +59,7 @@ LinearRigStepper::LinearRigStepper(const LinearRig& rig)
   rig_.damper.Validate();
 }
 
-int LinearRigStepper::Rhs(double, const double* w, double* wdot, void* self) {
+int LinearRigStepper::Rhs(double t, const double* w, double* wdot, void* self) {
   const auto* me = static_cast<const LinearRigStepper*>(self);
   const LinearServo& servo = me->rig_.servo;
   const Eigen::Map<const Eigen::Vector3d> z(w);
@@ -52,21 +67,33 @@ int LinearRigStepper::Rhs(double, const double* w, double* wdot, void* self) {
   wdot[0] = zdot(0), wdot[1] = zdot(1), wdot[2] = zdot(2);
   const double x = (servo.C * z).value();
   const double xdot = (servo.C * zdot).value();  // C A z (C B = 0: strictly proper)
-  const MrDamperRates r = DamperRates(me->coef_, {w[3], w[4]}, x, xdot);
+  const MrDamperCoefficients coef =
+      me->constant_current_
+          ? me->coef_
+          : CoefficientsAt(me->rig_.damper, EffectiveCurrentAt(me->rig_.driver, me->current_, t));
+  const MrDamperRates r = DamperRates(coef, {w[3], w[4]}, x, xdot);
   wdot[3] = r.ydot_mm_s;
   wdot[4] = r.zdot_mm_s;
   return 0;
 }
 
 void LinearRigStepper::Step(LinearRigState* s, double u_mm, double current_A) {
+  if (rig_.current_dynamics) {
+    Hold(rig_.driver, &s->current, current_A);  // i_c(t) in closed form over the step
+  } else {
+    s->current = SteadyState(current_A);
+  }
+  current_ = s->current;
+  constant_current_ = AtSteadyState(current_);
   if (rig_.has_damper) {
     u_mm_ = u_mm;
-    coef_ = CoefficientsAt(rig_.damper, current_A);
+    if (constant_current_) coef_ = CoefficientsAt(rig_.damper, current_.held_A);
     double w[5] = {s->servo.z(0), s->servo.z(1), s->servo.z(2), s->damper.y_mm, s->damper.z_mm};
     ode_.Advance(0.0, rig_.servo.dt_s, w);
     s->damper = {w[3], w[4]};
   }
   models::Step(rig_.servo, &s->servo, u_mm);  // exact ZOH, authoritative for y
+  if (rig_.current_dynamics) Advance(rig_.driver, &s->current);
 }
 
 }  // namespace rths::models

@@ -8,9 +8,7 @@ using lockstep::StepMailbox;
 
 Plant::Plant(const scenario::Scenario& s, lockstep::RunIdentity id, lcm::LCM* lcm)
     : Participant("plant", std::move(id), TimingOf(s), lcm),
-      rig_(models::LinearRig::Make(s.plant.actuator, s.run.dt_s, s.plant.specimen == "mr_damper",
-                                   models::MrDamperParams::Table3(), s.plant.cvode_rtol)),
-      stepper_(rig_),
+      rig_(models::MakeRig(s.plant, s.run.dt_s)),
       noise_y_mm_(s.plant.noise_y_mm_rms),
       noise_f_kN_(s.plant.noise_f_kN_rms),
       noise_(signal::MakeGaussian(s.plant.noise_seed)) {
@@ -19,21 +17,21 @@ Plant::Plant(const scenario::Scenario& s, lockstep::RunIdentity id, lcm::LCM* lc
   lcm_->subscribe(lockstep::kChCurrent, &Plant::OnCurrent, this);
 }
 
-void Plant::Publish(std::int64_t k, double current_A) {
+void Plant::Publish(std::int64_t k) {
   // Noise is drawn once per sample, in step order, so a seed gives the same readings every run.
   const double ny = noise_y_mm_ > 0.0 ? noise_y_mm_ * signal::NextGaussian(&noise_) : 0.0;
   const double nf = noise_f_kN_ > 0.0 ? noise_f_kN_ * signal::NextGaussian(&noise_) : 0.0;
   out_.run_id = id_.run_id;
   out_.k = k;
-  out_.y_mm = models::MeasuredDisplacementMm(rig_, state_) + ny;
-  out_.f_kN = models::MeasuredForceKn(rig_, state_, current_A) + nf;
-  out_.current_A = current_A;
+  out_.y_mm = rig_->y_mm() + ny;
+  out_.f_kN = rig_->f_kN() + nf;
+  out_.current_A = rig_->current_A();  // effective current at t_k
   Answer(lockstep::kChMeasured, &cache_, k, out_);
 }
 
 void Plant::OnGo() {
   Guarded(0, [&] {
-    Publish(0, 0.0);  // at rest; no current has been commanded yet
+    Publish(0);  // at rest; no current has been commanded yet (0 A)
     next_ = 1;
   });
 }
@@ -67,8 +65,8 @@ void Plant::TryStep() {
     bool ok = false;
     Guarded(k, [&] {
       MaybeThrow(k);
-      stepper_.Step(&state_, u->u_mm, i->i_cmd_A);  // hold u_{k-1}, i_{k-1} over [t_{k-1}, t_k)
-      Publish(k, i->i_cmd_A);
+      rig_->Step(u->u_mm, i->i_cmd_A);  // hold u_{k-1}, i_{k-1} over [t_{k-1}, t_k)
+      Publish(k);
       ok = true;
     });
     if (!ok) return;

@@ -5,10 +5,16 @@
 /// as the D/A converters do). measured_t 0 is the state at rest, sent at GO. The plant answers
 /// as soon as both inputs of the interval are in, so measured_t k+1 is usually ready before the
 /// clock requests step k+1. See docs/lockstep.md.
+///
+/// The rig is plant.kind's (models::MakeRig: "linear", Eqs. 28-30; "physical", models.md
+/// section 5; docs/plant.md). measured_t k carries y_k [mm], f_k [kN] (plus the scenario's sensor
+/// noise) and current_A = the effective damper current i_c(t_k) [A] (after Eq. 40 and the 75 Hz
+/// low-pass when plant.current_dynamics; 0 at k = 0).
+#include <memory>
 #include <optional>
 
 #include "lockstep/runtime.h"
-#include "models/linear_rig.h"
+#include "models/rig.h"
 #include "rths/command_t.hpp"
 #include "rths/current_t.hpp"
 #include "rths/desired_t.hpp"
@@ -30,11 +36,9 @@ class Plant final : public lockstep::Participant {
   void OnCommand(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
   void OnCurrent(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
   void TryStep();
-  void Publish(std::int64_t k, double current_A);
+  void Publish(std::int64_t k);
 
-  const models::LinearRig rig_;
-  models::LinearRigStepper stepper_;
-  models::LinearRigState state_{};
+  const std::unique_ptr<models::Rig> rig_;
   const double noise_y_mm_;
   const double noise_f_kN_;
   signal::GaussianState noise_;

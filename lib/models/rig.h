@@ -1,0 +1,41 @@
+#pragma once
+/// @file One interface for the plant participant's loading system + specimen: the linear rig
+/// (Eqs. 28-30 with the MR damper, lib/models/linear_rig.h) or the physics-based rig (models.md
+/// section 5, lib/models/servo_physical.h), both with the optional current dynamics (Eq. 40 and
+/// the 75 Hz low-pass, lib/models/current_driver.h). Units: mm, kN, A, s (docs/units.md).
+///
+/// Step indices (docs/lockstep.md): after k calls of Step() the rig is at sample k; y_mm(),
+/// f_kN() and current_A() are the sensor readings at t_k, made from the state after holding
+/// u_{k-1} and i_{k-1} over [t_{k-1}, t_k). At k = 0 the rig is at rest and current_A() is 0.
+///
+/// Initial current: with current dynamics, the driver starts at the steady state of the first
+/// commanded current i_0 (the current is set before the test starts, as in the lab), so a
+/// constant current stays exactly constant and equals the commanded one from k = 1 on.
+#include <cstdint>
+#include <memory>
+
+#include "scenario/scenario.h"
+
+namespace rths::models {
+
+class Rig {
+ public:
+  virtual ~Rig() = default;
+  /// Sample k -> k+1: holds the command u_mm [mm] and the commanded damper current i_cmd_A [A]
+  /// over [t_k, t_{k+1}). Allocates nothing. Throws rths::Error if the integration fails.
+  virtual void Step(double u_mm, double i_cmd_A) = 0;
+  /// Measured actuator displacement y_k [mm].
+  virtual double y_mm() const = 0;
+  /// Measured specimen force f_k [kN] (0 without a specimen).
+  virtual double f_kN() const = 0;
+  /// Effective damper current i_c(t_k) [A] (after Eq. 40 and the low-pass if they are on).
+  virtual double current_A() const = 0;
+  /// Sample index k (number of Step() calls so far).
+  virtual std::int64_t k() const = 0;
+};
+
+/// The rig that `plant` describes ("linear" | "physical"; specimen "mr_damper" | "none";
+/// current_dynamics; cvode_rtol), stepping at dt_s [s]. Throws rths::Error for a bad kind or value.
+std::unique_ptr<Rig> MakeRig(const scenario::PlantConfig& plant, double dt_s);
+
+}  // namespace rths::models
