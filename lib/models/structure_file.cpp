@@ -172,4 +172,17 @@ Modes ModalAnalysis(const StructureMatrices& m) {
   return out;
 }
 
+LinearStructure StructureFromScenario(const scenario::StructureConfig& st, const std::string& scenario_path) {
+  if (st.kind != "file") {
+    return LinearStructure::Sdof(st.mass_kg, st.frequency_hz, st.damping_ratio, st.specimen_count);
+  }
+  const StructureMatrices m = LoadStructureFile(st.file);
+  if (st.actuator_dof > m.M.rows()) {
+    throw Error(scenario_path + ": structure.actuator_dof",
+                fmt::format("{} is out of range [1, {}] ({} has {} DOFs)", st.actuator_dof, m.M.rows(), st.file,
+                            m.M.rows()));
+  }
+  return LinearStructure::Make(m.M, m.C, m.K, st.actuator_dof - 1, st.specimen_count);
+}
+
 }  // namespace rths::models

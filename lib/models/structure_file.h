@@ -14,6 +14,9 @@
 
 #include <Eigen/Core>
 
+#include "models/structure.h"
+#include "scenario/scenario.h"
+
 namespace rths::models {
 
 /// M [kN s^2/mm], K [kN/mm], C [kN s/mm].
@@ -40,5 +43,10 @@ struct Modes {
   std::vector<double> damping_ratio;
 };
 Modes ModalAnalysis(const StructureMatrices& m);
+
+/// The numerical substructure a scenario describes: the SDOF of [structure], or the matrices of
+/// structure.file with the specimen on structure.actuator_dof (1-based). Throws rths::Error naming
+/// the scenario key or the structure file's line.
+LinearStructure StructureFromScenario(const scenario::StructureConfig& st, const std::string& scenario_path);
 
 }  // namespace rths::models

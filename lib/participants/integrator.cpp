@@ -30,20 +30,7 @@ Integrator::Integrator(const scenario::Scenario& s, lockstep::RunIdentity id, lc
     state_.x = Eigen::VectorXd::Zero(1);
     state_.abs_acc_prev = Eigen::VectorXd::Zero(1);
   } else {
-    const auto& st = s.structure;
-    models::LinearStructure structure;
-    if (st.kind == "file") {
-      const models::StructureMatrices m = models::LoadStructureFile(st.file);
-      if (st.actuator_dof > m.M.rows()) {
-        throw Error(s.path + ": structure.actuator_dof",
-                    fmt::format("{} is out of range [1, {}] ({} has {} DOFs)", st.actuator_dof, m.M.rows(),
-                                st.file, m.M.rows()));
-      }
-      structure = models::LinearStructure::Make(m.M, m.C, m.K, st.actuator_dof - 1, st.specimen_count);
-    } else {
-      structure = models::LinearStructure::Sdof(st.mass_kg, st.frequency_hz, st.damping_ratio,
-                                                st.specimen_count);
-    }
+    const models::LinearStructure structure = models::StructureFromScenario(s.structure, s.path);
     cd_ = models::CentralDifference::Make(structure, dt_s_);
     state_ = models::MakeState(*cd_);
     dof_ = structure.actuator_dof;

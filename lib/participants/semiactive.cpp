@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "core/error.h"
+#include "models/structure_file.h"
 #include "participants/factory.h"
 
 namespace rths::participants {
@@ -30,11 +31,28 @@ double CurrentSchedule::At(std::int64_t k) const { return k % period_ < on_steps
 
 Semiactive::Semiactive(const scenario::Scenario& s, lockstep::RunIdentity id, lcm::LCM* lcm)
     : DesiredMeasuredParticipant("semiactive", std::move(id), TimingOf(s), lcm, lockstep::kChCurrent),
-      schedule_(s.semiactive, s.run.dt_s) {}
+      f_prev_kN_(0.0) {
+  if (s.semiactive.mode == "clipped_optimal") {
+    const control::ClippedOptimalOptions o{s.semiactive.r_weight, s.semiactive.noise_ratio,
+                                           s.semiactive.capacity_kN, s.semiactive.max_current_A};
+    clipped_ = std::make_unique<control::ClippedOptimal>(control::DesignClippedOptimal(
+        models::StructureFromScenario(s.structure, s.path), s.run.dt_s, o));
+  } else {
+    schedule_.emplace(s.semiactive, s.run.dt_s);
+  }
+}
 
-void Semiactive::Compute(std::int64_t k, const rths::desired_t&, const rths::measured_t&,
+void Semiactive::Compute(std::int64_t k, const rths::desired_t& d, const rths::measured_t& m,
                          rths::current_t* out) {
-  out->i_cmd_A = schedule_.At(k);
+  if (clipped_) {
+    if (d.n_dof != clipped_->design().n) throw Error("semiactive", "desired_t carries the wrong number of DOFs");
+    out->i_cmd_A = clipped_->Step(k, d.abs_acc_mm_s2.data(), f_prev_kN_, m.f_kN);
+    out->f_desired_kN = clipped_->desired_force_kN();
+    f_prev_kN_ = m.f_kN;
+    return;
+  }
+  out->i_cmd_A = schedule_->At(k);
+  out->f_desired_kN = 0.0;
 }
 
 }  // namespace rths::participants

@@ -2,8 +2,13 @@
 /// @file procs/semiactive's participant: the damper current command.
 /// Step k: desired_t k (structure state) + measured_t k (y_k, f_k)  ->  current_t k, held by the
 /// plant over [t_k, t_{k+1}): it first shows in measured_t k+1. See docs/lockstep.md.
-/// For now a scheduled current (passive-off 0 A, passive-on, a constant, or the pulse of
-/// Table 2); clipped-optimal control implements the same Compute() from the same inputs.
+/// A scheduled current (passive-off 0 A, passive-on, a constant, or the pulse of Table 2), or
+/// clipped-optimal control (control/clipped_optimal.h: it uses the absolute accelerations of
+/// sample k-1 carried by desired_t k and the forces of samples k-1 and k).
+#include <memory>
+#include <optional>
+
+#include "control/clipped_optimal.h"
 #include "participants/step_participant.h"
 #include "rths/current_t.hpp"
 #include "scenario/scenario.h"
@@ -33,7 +38,9 @@ class Semiactive final : public DesiredMeasuredParticipant<rths::current_t> {
                rths::current_t* out) override;
 
  private:
-  const CurrentSchedule schedule_;
+  std::optional<CurrentSchedule> schedule_;           ///< scheduled modes
+  std::unique_ptr<control::ClippedOptimal> clipped_;  ///< "clipped_optimal"
+  double f_prev_kN_ = 0.0;                            ///< force of one damper at step k-1
 };
 
 }  // namespace rths::participants

@@ -356,6 +356,9 @@ void ReadScenario(const toml::table& root, const std::string& file, Scenario* s)
   semiactive.Number("max_current_A", &s->semiactive.max_current_A);
   semiactive.Number("pulse_hz", &s->semiactive.pulse_hz);
   semiactive.Number("pulse_duty", &s->semiactive.pulse_duty);
+  semiactive.Number("r_weight", &s->semiactive.r_weight);
+  semiactive.Number("noise_ratio", &s->semiactive.noise_ratio);
+  semiactive.Number("capacity_kN", &s->semiactive.capacity_kN);
   semiactive.Finish();
 
   SafetyConfig& sf = s->safety;
@@ -556,7 +559,10 @@ void ValidatePlant(const PlantConfig& p, const Check& check) {
 }
 
 void ValidateSemiactive(const SemiactiveConfig& s, const Check& check) {
-  check.OneOf("semiactive.mode", s.mode, {"passive_off", "passive_on", "constant", "pulse"});
+  check.OneOf("semiactive.mode", s.mode, {"passive_off", "passive_on", "constant", "pulse", "clipped_optimal"});
+  check.InRange("semiactive.r_weight", s.r_weight, OpenClosed(0.0, 1e6));
+  check.InRange("semiactive.noise_ratio", s.noise_ratio, OpenClosed(0.0, 1e6));
+  check.InRange("semiactive.capacity_kN", s.capacity_kN, OpenClosed(0.0, 1e6));
   check.InRange("semiactive.pulse_duty", s.pulse_duty, Open(0.0, 1.0));
   check.InRange("semiactive.max_current_A", s.max_current_A, OpenClosed(0.0, 5.0));
   check.InRange("semiactive.current_A", s.current_A,
@@ -612,6 +618,9 @@ void ValidateScenario(const Scenario& s) {
   ValidateRun(s.run, check);
   ValidateStructure(s.structure, s.run.dt_s, s.path, check);
   ValidateController(s.controller, s.run.dt_s, check);
+  if (s.semiactive.mode == "clipped_optimal" && s.structure.mode != "rths") {
+    check.Fail("semiactive.mode", "\"clipped_optimal\" needs a structure to control (structure.mode = \"rths\")");
+  }
   check.InRange("semiactive.pulse_hz", s.semiactive.pulse_hz,
                 {0.0, 0.25 / s.run.dt_s, true, true, "at least four steps per period: below 0.25/run.dt_s"});
   ValidatePlant(s.plant, check);
@@ -704,9 +713,10 @@ std::string ToToml(const Scenario& s) {
   for (auto [key, field] : PhysicalFields(&phys)) o += fmt::format("{} = {}\n", key, TomlNumber(*field));
   const auto& sa = s.semiactive;
   o += fmt::format(
-      "\n[semiactive]\nmode = {}\ncurrent_A = {}\nmax_current_A = {}\npulse_hz = {}\npulse_duty = {}\n",
+      "\n[semiactive]\nmode = {}\ncurrent_A = {}\nmax_current_A = {}\npulse_hz = {}\npulse_duty = {}\n"
+      "r_weight = {}\nnoise_ratio = {}\ncapacity_kN = {}\n",
       TomlString(sa.mode), TomlNumber(sa.current_A), TomlNumber(sa.max_current_A), TomlNumber(sa.pulse_hz),
-      TomlNumber(sa.pulse_duty));
+      TomlNumber(sa.pulse_duty), TomlNumber(sa.r_weight), TomlNumber(sa.noise_ratio), TomlNumber(sa.capacity_kN));
   const auto& f = s.safety;
   o += fmt::format(
       "\n[safety]\nenabled = {}\nstroke_mm = {}\nforce_kN = {}\nmax_error_mm = {}\ngrowth_window_s = {}\n"
