@@ -9,6 +9,7 @@ packages=(
   cmake ninja-build g++ pkg-config
   liblcm-dev liblcm-bin            # LCM 1.3.1: library, lcm-gen, lcm-logger/-logplayer/-spy
   libeigen3-dev libsundials-dev    # linear algebra, CVODE
+  libfftw3-dev                     # FFTs for spectral estimation (identification, Figs. 6-8)
   libfmt-dev doctest-dev libcli11-dev libtomlplusplus-dev nlohmann-json3-dev
   libssl-dev                       # SHA-256 of scenario files (libcrypto)
   iproute2                         # ip route, for the multicast route below

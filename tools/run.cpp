@@ -37,7 +37,6 @@
 #include "participants/factory.h"
 #include "participants/group.h"
 #include "scenario/scenario.h"
-#include "signal/metrics.h"
 
 namespace fs = std::filesystem;
 using rths::lockstep::ExitCode;
@@ -292,21 +291,15 @@ int main(int argc, char** argv) {
   std::int64_t steps = 0;
   try {
     const auto log = rths::io::ReadRunLog((out / "log.lcm").string());
-    steps = log.CompleteSteps();
-    std::vector<double> r(steps), y(steps);
-    double peak_f = 0.0, peak_y = 0.0;
-    for (std::int64_t k = 0; k < steps; ++k) {
-      r[k] = log.desired[k].r_mm;
-      y[k] = log.measured[k].y_mm;
-      peak_f = std::max(peak_f, std::abs(log.measured[k].f_kN));
-      peak_y = std::max(peak_y, std::abs(y[k]));
-    }
-    const double span_s = (log.last_desired_utime - log.first_desired_utime) * 1e-6;
+    const auto m = rths::io::ComputeMetrics(log);
+    steps = m.steps;
     j["steps"] = steps;
-    j["steps_per_s"] = (steps > 1 && span_s > 0) ? (steps - 1) / span_s : 0.0;
-    j["tracking_nrmse_pct"] = steps > 0 ? rths::signal::RmsErrorPercent(r, y) : 0.0;
-    j["peak_force_kN"] = peak_f;
-    j["peak_displacement_mm"] = peak_y;
+    j["steps_per_s"] = m.steps_per_s;
+    j["tracking_nrmse_pct"] = m.tracking_nrmse_pct;
+    j["peak_force_kN"] = m.peak_force_kN;
+    j["peak_displacement_mm"] = m.peak_displacement_mm;
+    j["accel_extrapolation_rms_err_pct"] = m.accel_extrapolation_rms_err_pct;
+    j["velocity_prediction_rms_err_pct"] = m.velocity_prediction_rms_err_pct;
     std::int64_t dups = 0;
     for (const auto& [ch, n] : log.duplicates) dups += n;
     j["duplicates_logged"] = dups;

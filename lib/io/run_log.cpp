@@ -1,6 +1,7 @@
 #include "io/run_log.h"
 
 #include <algorithm>
+#include <cmath>
 #include <lcm/lcm-cpp.hpp>
 
 #include "core/error.h"
@@ -74,6 +75,39 @@ RunLog ReadRunLog(const std::string& path) {
     }
   }
   return log;
+}
+
+RunMetrics ComputeMetrics(const RunLog& log) {
+  RunMetrics m;
+  m.steps = log.CompleteSteps();
+  const auto n = static_cast<std::size_t>(m.steps);
+  std::vector<double> r(n), y(n), acc_pred, acc_true, vel_pred, vel_true;
+  for (std::size_t k = 0; k < n; ++k) {
+    r[k] = log.desired[k].r_mm;
+    y[k] = log.measured[k].y_mm;
+    m.peak_force_kN = std::max(m.peak_force_kN, std::abs(log.measured[k].f_kN));
+    m.peak_displacement_mm = std::max(m.peak_displacement_mm, std::abs(y[k]));
+    if (k >= 2 && k + 1 < n) {  // from k = 2 the extrapolation has a real history
+      acc_pred.push_back(log.desired[k].rdd_mm_s2);
+      acc_true.push_back(log.desired[k + 1].acc_prev_mm_s2);
+      vel_pred.push_back(log.desired[k].rd_mm_s);
+      vel_true.push_back(log.desired[k + 1].vel_prev_mm_s);
+    }
+  }
+  auto pct = [](const std::vector<double>& truth, const std::vector<double>& est) {
+    double num = 0, den = 0;
+    for (std::size_t i = 0; i < truth.size(); ++i) {
+      num += (truth[i] - est[i]) * (truth[i] - est[i]);
+      den += truth[i] * truth[i];
+    }
+    return den > 0 ? 100.0 * std::sqrt(num / den) : 0.0;
+  };
+  m.tracking_nrmse_pct = pct(r, y);
+  m.accel_extrapolation_rms_err_pct = pct(acc_true, acc_pred);
+  m.velocity_prediction_rms_err_pct = pct(vel_true, vel_pred);
+  const double span_s = (log.last_desired_utime - log.first_desired_utime) * 1e-6;
+  m.steps_per_s = (m.steps > 1 && span_s > 0) ? (m.steps - 1) / span_s : 0.0;
+  return m;
 }
 
 std::string PayloadDigest(const RunLog& log) {

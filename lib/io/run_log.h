@@ -40,6 +40,21 @@ struct RunLog {
   std::string AbortReason() const;
 };
 
+/// What a run achieved, computed from its log over its complete steps.
+struct RunMetrics {
+  std::int64_t steps = 0;                  ///< complete steps
+  double tracking_nrmse_pct = 0.0;         ///< Eq. 31 between r_k and y_k
+  double peak_force_kN = 0.0;              ///< max |f_k|
+  double peak_displacement_mm = 0.0;       ///< max |y_k|
+  /// Eq. 20's extrapolated acceleration r''_k against the acceleration of sample k known one
+  /// step later (a_{k} = acc_prev of desired_t k+1), as Eq. 31's norm [%] (paper: 1.81 %).
+  double accel_extrapolation_rms_err_pct = 0.0;
+  /// Eq. 21's predicted velocity r'_k against v_k one step later [%] (paper: 0.0061 %).
+  double velocity_prediction_rms_err_pct = 0.0;
+  double steps_per_s = 0.0;                ///< from the wall-clock log timestamps
+};
+RunMetrics ComputeMetrics(const RunLog& log);
+
 /// Reads `path`; throws rths::Error if it cannot be opened or an event cannot be decoded.
 RunLog ReadRunLog(const std::string& path);
 

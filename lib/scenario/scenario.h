@@ -110,7 +110,7 @@ struct PhysicalActuatorConfig {
   double valve_hz = 70.24;             ///< servovalve natural frequency w_v / 2 pi [Hz], (0, 1e4]
   double valve_zeta = 0.583;           ///< servovalve damping zeta_v, (0, 10]
   double kq_m3_s = 1.09e-2;            ///< flow gain K_q at full spool, (0, 10]
-  double kp_per_m = 331.0;             ///< inner-loop gain K_p [1/m] (i_c = K_p (u - x)), (0, 1e6]
+  double kp_per_m = 331.4;             ///< inner-loop gain K_p [1/m] (K_p K_q / A = 133.3 1/s), (0, 1e6]
   double beta_Pa = 1.172e9;            ///< effective bulk modulus beta_e, (0, 1e12]
   double leakage_m3_s_Pa = 2.693e-11;  ///< total leakage coefficient C_tot, [0, 1e-6]
 };
