@@ -54,7 +54,8 @@ const Table2Row* Find(const std::vector<Table2Row>& rows, const std::string& con
   return nullptr;
 }
 
-std::string Pct(double v) { return FormatSig(v, 3); }
+// Three significant digits, trailing zeros kept ("12.0", "0.340"), as the paper prints them.
+std::string Pct(double v) { return std::isfinite(v) ? fmt::format("{:#.3g}", v) : FormatSig(v); }
 
 }  // namespace
 
