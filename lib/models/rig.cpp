@@ -5,6 +5,9 @@
 #include "core/error.h"
 #include "models/linear_rig.h"
 #include "models/servo_physical.h"
+#include "models/current_driver.h"
+#include "models/mr_damper.h"
+#include "models/ode.h"
 
 namespace rths::models {
 namespace {
@@ -51,6 +54,78 @@ class PhysicalRigAdapter final : public Rig {
   std::int64_t k_ = 0;
 };
 
+// The ideal loading system (plant.kind = "ideal"): the MR damper driven by the desired motion
+// itself, x(t) linear between samples; y_k = r_k bit for bit.
+class IdealRig final : public Rig {
+ public:
+  IdealRig(const MrDamperParams& params, bool damper, bool current_dynamics, double dt_s, double rtol)
+      : params_(params),
+        damper_(damper),
+        current_dynamics_(current_dynamics),
+        dt_(dt_s),
+        driver_(CurrentDriver::Make({}, dt_s)),
+        ode_(2, rtol, rtol * 0.01, &IdealRig::Rhs, this) {
+    params_.Validate();
+  }
+  void StartAt(double x_mm) override {
+    x_ = x_mm;
+    v_ = 0.0;
+  }
+  void Step(double r_mm, double i_cmd_A) override {
+    if (k_ == 0) state_ = SteadyState(i_cmd_A);  // current set before the test
+    if (current_dynamics_) {
+      Hold(driver_, &state_, i_cmd_A);
+    } else {
+      state_ = SteadyState(i_cmd_A);
+    }
+    constant_ = AtSteadyState(state_);
+    x0_ = x_;
+    v_ = (r_mm - x_) / dt_;
+    if (damper_) {
+      if (constant_) coef_ = CoefficientsAt(params_, state_.held_A);
+      double w[2] = {d_.y_mm, d_.z_mm};
+      ode_.Advance(0.0, dt_, w);
+      d_ = {w[0], w[1]};
+    }
+    if (current_dynamics_) Advance(driver_, &state_);
+    x_ = r_mm;  // exactly r_k: no arithmetic between the request and the measurement
+    ++k_;
+  }
+  double y_mm() const override { return x_; }
+  double f_kN() const override {
+    if (!damper_) return 0.0;
+    return DamperForceKn(CoefficientsAt(params_, current_A()), d_, x_, v_);
+  }
+  double current_A() const override { return k_ == 0 ? 0.0 : EffectiveCurrentA(driver_, state_); }
+  std::int64_t k() const override { return k_; }
+  bool TracksDesired() const override { return true; }
+
+ private:
+  static int Rhs(double t, const double* w, double* wdot, void* self) {
+    const auto* me = static_cast<const IdealRig*>(self);
+    const double x = me->x0_ + me->v_ * t;
+    const MrDamperCoefficients coef =
+        me->constant_ ? me->coef_
+                      : CoefficientsAt(me->params_, EffectiveCurrentAt(me->driver_, me->state_, t));
+    const MrDamperRates r = DamperRates(coef, {w[0], w[1]}, x, me->v_);
+    wdot[0] = r.ydot_mm_s;
+    wdot[1] = r.zdot_mm_s;
+    return 0;
+  }
+
+  MrDamperParams params_;
+  bool damper_, current_dynamics_;
+  double dt_;
+  CurrentDriver driver_;
+  CurrentDriverState state_{};
+  MrDamperState d_{};
+  MrDamperCoefficients coef_{};
+  bool constant_ = true;
+  double x_ = 0.0, x0_ = 0.0, v_ = 0.0;
+  std::int64_t k_ = 0;
+  OdeStepper ode_;
+};
+
 }  // namespace
 
 std::unique_ptr<Rig> MakeRig(const scenario::PlantConfig& plant, double dt_s) {
@@ -73,8 +148,14 @@ std::unique_ptr<Rig> MakeRig(const scenario::PlantConfig& plant, double dt_s) {
                           plant.current_dynamics, MrDamperParams::Table3(), {},
                           plant.cvode_rtol));
   }
+  if (plant.kind == "ideal") {
+    if (!(plant.cvode_rtol > 0.0 && plant.cvode_rtol <= 1e-2))
+      throw Error("plant.cvode_rtol", fmt::format("must be in (0, 1e-2] (got {})", plant.cvode_rtol));
+    return std::make_unique<IdealRig>(MrDamperParams::Table3(), damper, plant.current_dynamics, dt_s,
+                                      plant.cvode_rtol);
+  }
   throw Error("plant.kind",
-              fmt::format("\"{}\" is not one of \"linear\", \"physical\"", plant.kind));
+              fmt::format("\"{}\" is not one of \"linear\", \"physical\", \"ideal\"", plant.kind));
 }
 
 }  // namespace rths::models

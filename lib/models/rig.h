@@ -32,9 +32,21 @@ class Rig {
   virtual double current_A() const = 0;
   /// Sample index k (number of Step() calls so far).
   virtual std::int64_t k() const = 0;
+  /// true for the "ideal" loading system (plant.kind = "ideal"): Step()'s first argument is then
+  /// the desired displacement r_k of the step's *end* (not a command held from its start), and
+  /// the plant answers measured_t k from desired_t k (docs/lockstep.md, footnote).
+  virtual bool TracksDesired() const { return false; }
+  /// "ideal" only: the position at k = 0 (r_0, at rest). Others ignore it (they start at rest at 0).
+  virtual void StartAt(double /*x_mm*/) {}
 };
 
-/// The rig that `plant` describes ("linear" | "physical"; specimen "mr_damper" | "none";
+/// "ideal" (the pure numerical simulation: the damper model in place of the physical plant): a
+/// loading system that tracks perfectly. Step(r_k, i_{k-1}) drives the damper with x(t) linear from
+/// r_{k-1} to r_k over [t_{k-1}, t_k] (velocity (r_k - r_{k-1}) / dt) at the current i_{k-1}
+/// (through the current dynamics if on), so y_k = r_k exactly and f_k is the damper force at t_k
+/// (x = r_k, x' = that velocity).
+///
+/// The rig that `plant` describes ("linear" | "physical" | "ideal"; specimen "mr_damper" | "none";
 /// current_dynamics; cvode_rtol), stepping at dt_s [s]. Throws rths::Error for a bad kind or value.
 std::unique_ptr<Rig> MakeRig(const scenario::PlantConfig& plant, double dt_s);
 

@@ -30,6 +30,10 @@ void Plant::Publish(std::int64_t k) {
 }
 
 void Plant::OnGo() {
+  if (rig_->TracksDesired()) {  // "ideal": measured_t 0 waits for desired_t 0 (y_0 = r_0)
+    TryStep();
+    return;
+  }
   Guarded(0, [&] {
     Publish(0);  // at rest; no current has been commanded yet (0 A)
     next_ = 1;
@@ -43,6 +47,8 @@ void Plant::OnDesired(const lcm::ReceiveBuffer* rbuf, const std::string&) {
   const std::int64_t k = desired_.last_k();
   if (put == StepMailbox<rths::desired_t>::Put::kDuplicate && !Stalled(k)) {
     Republish(lockstep::kChMeasured, cache_, k);  // re-request: cached bytes, never recomputed
+  } else if (put == StepMailbox<rths::desired_t>::Put::kNew && rig_->TracksDesired()) {
+    TryStep();
   }
 }
 
@@ -57,6 +63,10 @@ void Plant::OnCurrent(const lcm::ReceiveBuffer* rbuf, const std::string&) {
 }
 
 void Plant::TryStep() {
+  if (rig_->TracksDesired()) {
+    TryStepIdeal();
+    return;
+  }
   while (running() && next_ >= 1 && next_ < id_.n_steps && !Stalled(next_)) {
     const std::int64_t k = next_;
     const rths::command_t* u = command_.Get(k - 1);
@@ -66,6 +76,34 @@ void Plant::TryStep() {
     Guarded(k, [&] {
       MaybeThrow(k);
       rig_->Step(u->u_mm, i->i_cmd_A);  // hold u_{k-1}, i_{k-1} over [t_{k-1}, t_k)
+      Publish(k);
+      ok = true;
+    });
+    if (!ok) return;
+    ++next_;
+  }
+}
+
+// plant.kind = "ideal" (docs/lockstep.md, footnote): measured_t k from desired_t k (r_k) and
+// current_t k-1; the command is logged but not used. Order per step: desired -> plant -> controller.
+void Plant::TryStepIdeal() {
+  while (running() && next_ < id_.n_steps && !Stalled(next_)) {
+    const std::int64_t k = next_;
+    const rths::desired_t* r = desired_.Get(k);
+    if (!r) return;
+    const rths::current_t* i = nullptr;
+    if (k >= 1) {
+      i = current_.Get(k - 1);
+      if (!i) return;
+    }
+    bool ok = false;
+    Guarded(k, [&] {
+      MaybeThrow(k);
+      if (k == 0) {
+        rig_->StartAt(r->r_mm);  // at rest at r_0 (0 A)
+      } else {
+        rig_->Step(r->r_mm, i->i_cmd_A);  // x(t) from r_{k-1} to r_k over [t_{k-1}, t_k], i_{k-1}
+      }
       Publish(k);
       ok = true;
     });

@@ -6,6 +6,10 @@
 /// as soon as both inputs of the interval are in, so measured_t k+1 is usually ready before the
 /// clock requests step k+1. See docs/lockstep.md.
 ///
+/// plant.kind = "ideal" (the pure numerical simulation): measured_t k is answered from desired_t k
+/// (y_k = r_k) and current_t k-1 instead; measured_t 0 waits for desired_t 0 (docs/lockstep.md,
+/// footnote).
+///
 /// The rig is plant.kind's (models::MakeRig: "linear", Eqs. 28-30; "physical", models.md
 /// section 5; docs/plant.md). measured_t k carries y_k [mm], f_k [kN] (plus the scenario's sensor
 /// noise) and current_A = the effective damper current i_c(t_k) [A] (after Eq. 40 and the 75 Hz
@@ -36,6 +40,7 @@ class Plant final : public lockstep::Participant {
   void OnCommand(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
   void OnCurrent(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
   void TryStep();
+  void TryStepIdeal();
   void Publish(std::int64_t k);
 
   const std::unique_ptr<models::Rig> rig_;

@@ -549,7 +549,7 @@ void ValidatePhysical(const PhysicalActuatorConfig& p, const Check& check) {
 }
 
 void ValidatePlant(const PlantConfig& p, const Check& check) {
-  check.OneOf("plant.kind", p.kind, {"linear", "physical"});
+  check.OneOf("plant.kind", p.kind, {"linear", "physical", "ideal"});
   ValidateServo(p.actuator, "plant.actuator", check);
   ValidatePhysical(p.physical, check);
   check.OneOf("plant.specimen", p.specimen, {"mr_damper", "none"});

@@ -119,7 +119,9 @@ struct PhysicalActuatorConfig {
 struct PlantConfig {
   /// "linear": the three-pole model `actuator` (Eqs. 28-30), ZOH-discretised, unaffected by the
   /// specimen; "physical": the servovalve / oil column / piston model of models.md section 5
-  /// loaded by the damper force (control-structure interaction).
+  /// loaded by the damper force (control-structure interaction); "ideal": the pure numerical
+  /// simulation, a loading system that tracks perfectly (y_k = r_k, the damper driven by the
+  /// desired motion; answers measured_t k from desired_t k: docs/lockstep.md, footnote).
   std::string kind = "linear";
   ServoModel3 actuator{};              ///< "linear": servohydraulic model
   PhysicalActuatorConfig physical{};   ///< "physical": its parameters

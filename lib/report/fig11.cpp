@@ -1,0 +1,307 @@
+// Fig. 11 (experiments.md E5): the 9-story building (one NS frame, half the seismic mass, shear
+// model of models.md section 8) with 18 MR dampers at the first story under El Centro NS x 0.5;
+// 3 controllers x 3 semiactive modes of RTHS, plus the pure numerical simulation (plant.kind =
+// "ideal": the damper model driven by the desired motion) for each semiactive mode.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <fstream>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "core/error.h"
+#include "io/run_log.h"
+#include "report/csv.h"
+#include "report/plot.h"
+#include "report/studies.h"
+#include "signal/metrics.h"
+
+namespace rths::report {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+scenario::ControllerConfig Fig11Kind(const std::string& kind) {
+  scenario::ControllerConfig c;
+  c.kind = kind;
+  return c;
+}
+
+constexpr const char* kNumerical = "Numerical";
+
+// Per-run signals for the figures and the summary.
+struct Fig11Trace {
+  std::vector<double> t, y_mm, v_mm_s, f_kN;
+};
+
+Fig11Run Summarise(const fs::path& dir, const std::string& controller, const std::string& mode,
+                   const RunResult& rr, double dt, Fig11Trace* tr) {
+  Fig11Run run;
+  run.controller = controller;
+  run.semiactive = mode;
+  run.stopped = StoppedText(rr);
+  run.wall_s = rr.wall_s;
+  run.run_dir = dir;
+  const io::RunLog log = io::ReadRunLog((dir / "log.lcm").string());
+  const io::RunMetrics m = io::ComputeMetrics(log);
+  run.accel_extrapolation_rms_err_pct = m.accel_extrapolation_rms_err_pct;
+  run.velocity_prediction_rms_err_pct = m.velocity_prediction_rms_err_pct;
+  const std::int64_t n = log.CompleteSteps();
+  run.peak_drift_mm.assign(9, 0.0);
+  run.peak_abs_accel_mps2.assign(9, 0.0);
+  for (std::int64_t k = 0; k < n; ++k) {
+    const auto& d = log.desired[k];
+    const int nd = std::min<int>(d.n_dof, 9);
+    for (int i = 0; i < nd; ++i) {
+      const double drift = d.x_mm[i] - (i > 0 ? d.x_mm[i - 1] : 0.0);
+      run.peak_drift_mm[i] = std::max(run.peak_drift_mm[i], std::abs(drift));
+      run.peak_abs_accel_mps2[i] = std::max(run.peak_abs_accel_mps2[i], std::abs(d.abs_acc_mm_s2[i]) / 1000.0);
+    }
+    run.damper_peak_force_kN = std::max(run.damper_peak_force_kN, std::abs(log.measured[k].f_kN));
+    run.damper_peak_disp_mm = std::max(run.damper_peak_disp_mm, std::abs(log.measured[k].y_mm));
+  }
+  tr->t.resize(n);
+  tr->y_mm.resize(n);
+  tr->v_mm_s.resize(n);
+  tr->f_kN.resize(n);
+  for (std::int64_t k = 0; k < n; ++k) {
+    tr->t[k] = k * dt;
+    tr->y_mm[k] = log.measured[k].y_mm;
+    tr->f_kN[k] = log.measured[k].f_kN;
+  }
+  for (std::int64_t k = 0; k < n; ++k) {  // damper velocity: central difference of y (one-sided at the ends)
+    const std::int64_t a = std::max<std::int64_t>(k - 1, 0), b = std::min<std::int64_t>(k + 1, n - 1);
+    tr->v_mm_s[k] = b > a ? (tr->y_mm[b] - tr->y_mm[a]) / ((b - a) * dt) : 0.0;
+  }
+  return run;
+}
+
+nlohmann::json ToJson(const Fig11Run& r) {
+  nlohmann::json j;
+  j["controller"] = r.controller;
+  j["semiactive"] = r.semiactive;
+  j["stopped"] = r.stopped;
+  j["peak_drift_mm"] = r.peak_drift_mm;
+  j["peak_abs_accel_mps2"] = r.peak_abs_accel_mps2;
+  j["damper_peak_force_kN"] = r.damper_peak_force_kN;
+  j["damper_peak_disp_mm"] = r.damper_peak_disp_mm;
+  j["force_rths_vs_numerical_nrmse_pct"] = r.force_rths_vs_numerical_nrmse_pct;
+  j["accel_extrapolation_rms_err_pct"] = r.accel_extrapolation_rms_err_pct;
+  j["velocity_prediction_rms_err_pct"] = r.velocity_prediction_rms_err_pct;
+  return j;
+}
+
+// Every `stride`-th point (the time histories hold 2000 points per second).
+Series Thin(Series s, const std::vector<double>& x, const std::vector<double>& y, std::size_t stride) {
+  for (std::size_t i = 0; i < x.size(); i += stride) {
+    s.x.push_back(x[i]);
+    s.y.push_back(y[i]);
+  }
+  return s;
+}
+
+}  // namespace
+
+std::vector<Fig11Controller> Fig11Controllers() {
+  scenario::ControllerConfig poly = Fig11Kind("poly3");
+  poly.delay_ms = 9.0;
+  scenario::ControllerConfig lqg = Fig11Kind("ff_lqg");
+  lqg.model = scenario::ServoPreset("avg");
+  return {{"3rd Poly 9ms", poly}, {"Bumpless + LP", Fig11Kind("bumpless_lp")}, {"G_FF,avgA + LQG", lqg}};
+}
+
+std::vector<std::string> Fig11SemiactiveModes() { return {"passive_off", "passive_on", "clipped_optimal"}; }
+
+scenario::Scenario Fig11Scenario(const scenario::Scenario& base, const Fig11Controller& c,
+                                 const std::string& semiactive, const std::string& plant, double duration_s) {
+  scenario::Scenario s = base;
+  s.path.clear();
+  s.sha256.clear();
+  s.run.name = Slug(fmt::format("fig11 {} {} {}", plant == "ideal" ? kNumerical : c.name, semiactive, plant));
+  s.run.duration_s = duration_s;
+  s.controller = c.controller;
+  s.plant.kind = plant;
+  s.semiactive.mode = semiactive;
+  return s;
+}
+
+Fig11Result ReproduceFig11(const ReproduceOptions& opts) {
+  const auto t0 = std::chrono::steady_clock::now();
+  PrepareOutDir(opts.out_dir);
+  if (opts.plant != "ideal") RequirePlant(opts.plant, opts.out_dir);
+  const fs::path base_file = FindSourceFile("scenarios/fig11_base.toml");
+  const scenario::Scenario base = scenario::LoadScenario(base_file.string());
+  const double duration = opts.quick ? kFig11QuickS : kFig11FullS;
+  const auto controllers = Fig11Controllers();
+  const auto modes = Fig11SemiactiveModes();
+
+  struct Item {
+    std::string controller, mode;
+  };
+  std::vector<RunSpec> specs;
+  std::vector<Item> items;
+  // The numerical simulations first (they are the references), then the RTHS runs.
+  for (const auto& mode : modes) {
+    Fig11Controller none{kNumerical, Fig11Kind("none")};
+    const fs::path dir = opts.out_dir / "runs" / Slug(fmt::format("numerical {}", mode));
+    specs.push_back({fmt::format("Numerical / {}", mode), Fig11Scenario(base, none, mode, "ideal", duration), dir});
+    items.push_back({kNumerical, mode});
+  }
+  for (const auto& c : controllers) {
+    for (const auto& mode : modes) {
+      const fs::path dir = opts.out_dir / "runs" / Slug(fmt::format("{} {}", c.name, mode));
+      specs.push_back({fmt::format("{} / {}", c.name, mode), Fig11Scenario(base, c, mode, opts.plant, duration), dir});
+      items.push_back({c.name, mode});
+    }
+  }
+  Preflight(specs);
+  if (opts.log) {
+    opts.log(fmt::format("fig11: {} lockstep runs of {:g} s (9 RTHS on the {} plant + 3 numerical), {} at a time "
+                         "(base {})",
+                         specs.size(), duration, opts.plant, opts.jobs, base_file.string()));
+  }
+  const auto results = RunBatch(specs, opts.jobs, [&](std::size_t done, std::size_t total, const RunResult& r) {
+    if (!opts.log) return;
+    opts.log(fmt::format("  [{:2}/{}] {:<36} peak f {:7.2f} kN ({:.1f} s){}", done, total, r.label, r.peak_force_kN,
+                         r.wall_s, r.ok ? "" : "  STOPPED: " + StoppedText(r)));
+  });
+
+  Fig11Result res;
+  std::vector<Fig11Trace> traces(specs.size());
+  std::vector<Fig11Run> all;
+  for (std::size_t j = 0; j < specs.size(); ++j) {
+    if (results[j].steps == 0) {
+      throw Error("fig11", fmt::format("{} did not run: {}", results[j].label, results[j].error));
+    }
+    all.push_back(Summarise(specs[j].dir, items[j].controller, items[j].mode, results[j], base.run.dt_s, &traces[j]));
+  }
+  auto numerical_index = [&](const std::string& mode) {
+    for (std::size_t j = 0; j < items.size(); ++j) {
+      if (items[j].controller == kNumerical && items[j].mode == mode) return j;
+    }
+    return items.size();
+  };
+  for (std::size_t j = 0; j < all.size(); ++j) {
+    const std::size_t ni = numerical_index(items[j].mode);
+    const auto& ref = traces[ni].f_kN;
+    const auto& f = traces[j].f_kN;
+    const std::size_t n = std::min(ref.size(), f.size());
+    all[j].force_rths_vs_numerical_nrmse_pct =
+        n > 0 ? signal::RmsErrorPercent(std::span(ref.data(), n), std::span(f.data(), n)) : 0.0;
+    (items[j].controller == kNumerical ? res.numerical : res.runs).push_back(all[j]);
+  }
+
+  auto write_json = [&](const fs::path& file, const std::vector<Fig11Run>& runs) {
+    nlohmann::json j;
+    j["runs"] = nlohmann::json::array();
+    for (const auto& r : runs) j["runs"].push_back(ToJson(r));
+    std::ofstream out(file);
+    if (!out) throw Error(file.string(), "cannot open for writing");
+    out << j.dump(2) << "\n";
+  };
+  write_json(opts.out_dir / "fig11_summary.json", res.runs);
+  write_json(opts.out_dir / "fig11_numerical.json", res.numerical);
+
+  // Figures.
+  if (GnuplotAvailable(opts.gnuplot)) {
+    const std::vector<std::string> colors = {"black", "#1f77b4", "#2ca02c", "#d62728"};
+    const std::size_t stride = opts.quick ? 2 : 4;
+    for (const auto& mode : modes) {
+      Figure fig;
+      fig.name = "fig11_damper_" + mode;
+      fig.gnuplot = opts.gnuplot;
+      fig.title = fmt::format("Fig. 11: damper at the first story, semiactive {} (RTHS on the {} plant vs numerical)",
+                              mode, opts.plant);
+      fig.columns = 2;
+      fig.width_px = 1400;
+      fig.panel_height_px = 420;
+      Panel disp = MakePanel("Damper displacement", "Time [s]", "Displacement [mm]");
+      Panel force = MakePanel("Damper force (one of 18)", "Time [s]", "Force [kN]");
+      Panel fd = MakePanel("Force-displacement", "Displacement [mm]", "Force [kN]");
+      Panel fv = MakePanel("Force-velocity", "Velocity [mm/s]", "Force [kN]");
+      for (Panel* p : {&disp, &force, &fd, &fv}) p->key = "top left";
+      int ci = 0;
+      for (std::size_t j = 0; j < items.size(); ++j) {
+        if (items[j].mode != mode) continue;
+        const bool num = items[j].controller == kNumerical;
+        const std::string title = num ? "Numerical (ideal tracking)" : "RTHS " + items[j].controller;
+        const std::string color = colors[ci++ % colors.size()];
+        const int dash = num ? 2 : 1;
+        const auto& tr = traces[j];
+        disp.series.push_back(Thin(MakeSeries(title, color, dash), tr.t, tr.y_mm, stride));
+        force.series.push_back(Thin(MakeSeries(title, color, dash), tr.t, tr.f_kN, stride));
+        fd.series.push_back(Thin(MakeSeries(title, color, dash), tr.y_mm, tr.f_kN, stride));
+        fv.series.push_back(Thin(MakeSeries(title, color, dash), tr.v_mm_s, tr.f_kN, stride));
+      }
+      fig.panels = {disp, force, fd, fv};
+      Plot(fig, opts.out_dir);
+    }
+    {
+      Figure fig;
+      fig.name = "fig11_stories";
+      fig.gnuplot = opts.gnuplot;
+      fig.title = "Fig. 11: peak story drifts and absolute floor accelerations (El Centro NS x 0.5)";
+      fig.columns = 2;
+      fig.width_px = 1400;
+      fig.panel_height_px = 600;
+      Panel drift = MakePanel("Peak story drift", "Peak drift [mm]", "Story");
+      Panel acc = MakePanel("Peak absolute acceleration", "Peak acceleration [m/s^2]", "Floor");
+      drift.key = acc.key = "bottom right";
+      drift.y_range = acc.y_range = std::make_pair(0.5, 9.5);
+      const std::vector<std::string> mode_colors = {"#1f77b4", "#d62728", "#2ca02c"};
+      std::vector<double> story(9);
+      for (int i = 0; i < 9; ++i) story[i] = i + 1;
+      for (std::size_t m = 0; m < modes.size(); ++m) {
+        for (const auto* set : {&res.numerical, &res.runs}) {
+          for (const auto& r : *set) {
+            if (r.semiactive != modes[m]) continue;
+            const bool num = r.controller == kNumerical;
+            if (!num && r.controller != "G_FF,avgA + LQG") continue;
+            const std::string title = fmt::format("{} {}", modes[m], num ? "numerical" : "RTHS FF avg + LQG");
+            Series sd = MakeSeries(title, mode_colors[m], num ? 2 : 1);
+            sd.with = "linespoints";
+            sd.x = r.peak_drift_mm;
+            sd.y = story;
+            drift.series.push_back(sd);
+            Series sa = sd;
+            sa.x = r.peak_abs_accel_mps2;
+            acc.series.push_back(sa);
+          }
+        }
+      }
+      fig.panels = {drift, acc};
+      Plot(fig, opts.out_dir);
+    }
+  } else if (opts.log) {
+    opts.log("fig11: gnuplot not found, no PNGs (apt-get install gnuplot-nox)");
+  }
+
+  res.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  {
+    std::ofstream md(opts.out_dir / "fig11.md");
+    md << "# Fig. 11: 9-story building, El Centro NS x 0.5, semiactive MR dampers\n\n"
+       << fmt::format("Made by `rths reproduce fig11{} --plant {}`: {} runs of {:g} s in {:.0f} s wall time.\n\n",
+                      opts.quick ? " --quick" : "", opts.plant, specs.size(), duration, res.wall_s)
+       << "| controller | semiactive | stopped | peak drift story 1 [mm] | max peak drift [mm] | max peak abs. "
+          "acc. [m/s^2] | damper peak force [kN] | damper peak disp. [mm] | force vs numerical [%] | "
+          "accel. extrapolation err. [%] | velocity prediction err. [%] |\n"
+       << "|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+    for (const auto* set : {&res.numerical, &res.runs}) {
+      for (const auto& r : *set) {
+        md << fmt::format("| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |\n", r.controller, r.semiactive,
+                          r.stopped, FormatSig(r.peak_drift_mm[0], 4),
+                          FormatSig(*std::max_element(r.peak_drift_mm.begin(), r.peak_drift_mm.end()), 4),
+                          FormatSig(*std::max_element(r.peak_abs_accel_mps2.begin(), r.peak_abs_accel_mps2.end()), 4),
+                          FormatSig(r.damper_peak_force_kN, 4), FormatSig(r.damper_peak_disp_mm, 4),
+                          FormatSig(r.force_rths_vs_numerical_nrmse_pct, 3),
+                          FormatSig(r.accel_extrapolation_rms_err_pct, 3),
+                          FormatSig(r.velocity_prediction_rms_err_pct, 3));
+      }
+    }
+  }
+  return res;
+}
+
+}  // namespace rths::report

@@ -1,0 +1,247 @@
+// Fig. 9 (experiments.md E4): SDOF RTHS parametric study. 6 natural frequencies x 6 controllers,
+// each pair one lockstep group (in-process, memq://), `jobs` at a time; Eq. 31 on r_k, y_k.
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+
+#include <fmt/format.h>
+
+#include "core/error.h"
+#include "io/run_log.h"
+#include "report/csv.h"
+#include "report/plot.h"
+#include "report/studies.h"
+
+namespace rths::report {
+
+namespace fs = std::filesystem;
+
+fs::path FindSourceFile(const std::string& rel) {
+  std::vector<fs::path> roots;
+  if (const char* env = std::getenv("RTHS_SOURCE_DIR"); env && *env) roots.emplace_back(env);
+  std::error_code ec;
+  for (fs::path p = fs::current_path(ec); !ec && !p.empty(); p = p.parent_path()) {
+    roots.push_back(p);
+    if (p == p.root_path()) break;
+  }
+  char exe[4096];
+  const ssize_t n = ::readlink("/proc/self/exe", exe, sizeof exe - 1);
+  if (n > 0) {
+    exe[n] = '\0';
+    for (fs::path p = fs::path(exe).parent_path(); !p.empty(); p = p.parent_path()) {
+      roots.push_back(p);
+      if (p == p.root_path()) break;
+    }
+  }
+  roots.push_back(fs::path(__FILE__).parent_path().parent_path().parent_path());  // lib/report/..
+  for (const auto& r : roots) {
+    if (fs::exists(r / rel, ec)) return fs::weakly_canonical(r / rel);
+  }
+  throw Error(rel, "not found in the source tree (set RTHS_SOURCE_DIR to the rths checkout, or run "
+                   "from inside it)");
+}
+
+std::string StoppedText(const RunResult& r) {
+  if (r.ok) return "no";
+  std::string s = r.error;
+  // "integrator exited with code 6: <the monitor's reason>" -> the reason
+  if (const auto p = s.find("exited with code"); p != std::string::npos) {
+    if (const auto c = s.find(": ", p); c != std::string::npos) s = s.substr(c + 2);
+  }
+  for (char& ch : s) {
+    if (ch == '\n' || ch == '\r') ch = ' ';
+  }
+  return s.empty() ? "stopped" : s;
+}
+
+namespace {
+
+scenario::ControllerConfig Kind(const std::string& kind) {
+  scenario::ControllerConfig c;
+  c.kind = kind;
+  return c;
+}
+scenario::ControllerConfig Delay(const std::string& kind, double ms) {
+  auto c = Kind(kind);
+  c.delay_ms = ms;
+  return c;
+}
+scenario::ControllerConfig Model(const std::string& kind, const std::string& model) {
+  auto c = Kind(kind);
+  c.model = scenario::ServoPreset(model);
+  return c;
+}
+
+std::string FreqText(double f) { return FormatSig(f, 3); }
+
+}  // namespace
+
+std::vector<Fig9Controller> Fig9Controllers() {
+  return {
+      {"None", Kind("none")},
+      {"3rd Poly 8ms", Delay("poly3", 8.0)},
+      {"Lead Comp 8ms", Delay("lead", 8.0)},
+      {"G_FF,0.0A + LP", Model("ff_lp", "0.0A")},
+      {"G_FF,0.0A", Model("ff", "0.0A")},
+      {"G_FF,avgA + LQG", Model("ff_lqg", "avg")},
+  };
+}
+
+std::vector<double> Fig9FrequenciesHz() { return {0.5, 1.0, 5.0, 10.0, 20.0, 30.0}; }
+
+double Fig9GroundRms(double f_hz) { return f_hz < 2.0 ? 1000.0 : f_hz < 7.0 ? 1500.0 : 2000.0; }
+
+scenario::Scenario Fig9Scenario(const scenario::Scenario& base, double f_hz, const Fig9Controller& c,
+                                const std::string& plant, double duration_s) {
+  scenario::Scenario s = base;
+  s.path.clear();
+  s.sha256.clear();
+  s.run.name = Slug(fmt::format("fig9 {}hz {}", FreqText(f_hz), c.name));
+  s.run.duration_s = duration_s;
+  s.structure.mode = "rths";
+  s.structure.kind = "sdof";
+  s.structure.frequency_hz = f_hz;
+  s.structure.ground.rms = Fig9GroundRms(f_hz);
+  s.controller = c.controller;
+  s.plant.kind = plant;
+  s.plant.actuator = scenario::ServoPreset("0.0A");
+  s.semiactive.mode = "passive_off";
+  return s;
+}
+
+Fig9Result ReproduceFig9(const ReproduceOptions& opts) {
+  const auto t0 = std::chrono::steady_clock::now();
+  PrepareOutDir(opts.out_dir);
+  if (opts.plant != "ideal") RequirePlant(opts.plant, opts.out_dir);
+  const fs::path base_file = FindSourceFile("scenarios/fig9_base.toml");
+  const scenario::Scenario base = scenario::LoadScenario(base_file.string());
+  const double duration = opts.quick ? kFig9QuickS : kFig9FullS;
+
+  std::vector<RunSpec> specs;
+  Fig9Result res;
+  for (double f : Fig9FrequenciesHz()) {
+    for (const auto& c : Fig9Controllers()) {
+      Fig9Row row;
+      row.f_hz = f;
+      row.controller = c.name;
+      row.run_dir = opts.out_dir / "runs" / Slug(fmt::format("{}hz {}", FreqText(f), c.name));
+      specs.push_back({fmt::format("{:>4} Hz {}", FreqText(f), c.name), Fig9Scenario(base, f, c, opts.plant, duration),
+                       row.run_dir});
+      res.rows.push_back(row);
+    }
+  }
+  Preflight(specs);
+  if (opts.log) {
+    opts.log(fmt::format("fig9: {} lockstep runs of {:g} s on the {} plant, {} at a time (base {})", specs.size(),
+                         duration, opts.plant, opts.jobs, base_file.string()));
+  }
+  const auto results = RunBatch(specs, opts.jobs, [&](std::size_t done, std::size_t total, const RunResult& r) {
+    if (!opts.log) return;
+    opts.log(fmt::format("  [{:2}/{}] {:<28} {:9.3f} %  ({:.1f} s){}", done, total, r.label, r.tracking_pct, r.wall_s,
+                         r.ok ? "" : "  STOPPED: " + StoppedText(r)));
+  });
+  for (std::size_t j = 0; j < results.size(); ++j) {
+    Fig9Row& row = res.rows[j];
+    row.rms_pct = results[j].tracking_pct;
+    row.stopped = StoppedText(results[j]);
+    if (results[j].steps == 0 && !results[j].ok) {
+      throw Error("fig9", fmt::format("{} did not run: {}", results[j].label, results[j].error));
+    }
+    const Trace t = ReadTrace(row.run_dir);
+    for (std::size_t k = 0; k < t.r_mm.size(); ++k) {
+      row.peak_error_mm = std::max(row.peak_error_mm, std::abs(t.r_mm[k] - t.y_mm[k]));
+      row.peak_u_mm = std::max(row.peak_u_mm, std::abs(t.u_mm[k]));
+      row.peak_y_mm = std::max(row.peak_y_mm, std::abs(t.y_mm[k]));
+      row.peak_f_kN = std::max(row.peak_f_kN, std::abs(t.f_kN[k]));
+    }
+  }
+
+  {
+    CsvWriter csv(opts.out_dir / "fig9.csv", {"f_hz", "controller", "rms_pct", "stopped"});
+    for (const auto& r : res.rows) csv.Row({FreqText(r.f_hz), r.controller, FormatSig(r.rms_pct, 4), r.stopped});
+    csv.Close();
+  }
+
+  // Figure: one curve per controller, stopped pairs marked.
+  {
+    Figure fig;
+    fig.name = "fig9";
+    fig.gnuplot = opts.gnuplot;
+    fig.panel_height_px = 600;
+    Panel p = MakePanel(fmt::format("Fig. 9: RTHS tracking error, SDOF with the MR damper at 0.0 A ({} plant{})",
+                                    opts.plant, opts.quick ? ", --quick" : ""),
+                        "Natural frequency [Hz]", "RMS error, Eq. 31 [%]");
+    p.log_x = true;
+    p.log_y = true;
+    p.key = "top left";
+    p.x_range = std::make_pair(0.4, 40.0);
+    Series stopped;
+    stopped.title = "stopped by the safety monitor";
+    stopped.with = "points pt 6 ps 3";
+    stopped.color = "red";
+    for (const auto& c : Fig9Controllers()) {
+      Series s;
+      s.title = c.name;
+      s.with = "linespoints";
+      for (const auto& r : res.rows) {
+        if (r.controller != c.name) continue;
+        s.x.push_back(r.f_hz);
+        s.y.push_back(r.rms_pct > 0 ? r.rms_pct : std::nan(""));
+        if (r.stopped != "no") {
+          stopped.x.push_back(r.f_hz);
+          stopped.y.push_back(r.rms_pct > 0 ? r.rms_pct : std::nan(""));
+        }
+      }
+      p.series.push_back(s);
+    }
+    if (!stopped.x.empty()) p.series.push_back(stopped);
+    fig.panels.push_back(p);
+    if (GnuplotAvailable(opts.gnuplot)) {
+      Plot(fig, opts.out_dir);
+    } else if (opts.log) {
+      opts.log("fig9: gnuplot not found, no fig9.png (apt-get install gnuplot-nox)");
+    }
+  }
+
+  res.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  {
+    const scenario::SafetyConfig lim = base.safety;
+    std::ofstream md(opts.out_dir / "fig9.md");
+    md << "# Fig. 9: SDOF RTHS parametric study\n\n"
+       << fmt::format("Made by `rths reproduce fig9{} --plant {}`: {} runs of {:g} s in {:.0f} s wall time "
+                      "({} at a time).\n\n",
+                      opts.quick ? " --quick" : "", opts.plant, res.rows.size(), duration, res.wall_s, opts.jobs)
+       << "RMS tracking error (Eq. 31) [%]; * = stopped by the safety monitor (its error is over the "
+          "steps before the stop).\n\n| f_n [Hz] |";
+    for (const auto& c : Fig9Controllers()) md << " " << c.name << " |";
+    md << "\n|---:|";
+    for (std::size_t i = 0; i < Fig9Controllers().size(); ++i) md << "---:|";
+    md << "\n";
+    for (double f : Fig9FrequenciesHz()) {
+      md << "| " << FreqText(f) << " |";
+      for (const auto& r : res.rows) {
+        if (r.f_hz == f) md << " " << FormatSig(r.rms_pct, 3) << (r.stopped == "no" ? "" : "*") << " |";
+      }
+      md << "\n";
+    }
+    md << "\n## Peaks against the safety limits\n\n"
+       << fmt::format("Limits: stroke {} mm (|r|, |u|, |y|), force {} kN, |r - y| {} mm, divergence of the "
+                      "error peak ({}x per {} s window, {} windows, above {} mm).\n\n",
+                      lim.stroke_mm, lim.force_kN, lim.max_error_mm, lim.growth_factor, lim.growth_window_s,
+                      lim.growth_windows, lim.growth_floor_mm)
+       << "| f_n [Hz] | controller | RMS [%] | max abs(r - y) [mm] | max abs(u) [mm] | max abs(y) [mm] | max abs(f) [kN] | stopped |\n"
+       << "|---:|---|---:|---:|---:|---:|---:|---|\n";
+    for (const auto& r : res.rows) {
+      md << fmt::format("| {} | {} | {} | {} | {} | {} | {} | {} |\n", FreqText(r.f_hz), r.controller,
+                        FormatSig(r.rms_pct, 3), FormatSig(r.peak_error_mm, 3), FormatSig(r.peak_u_mm, 3),
+                        FormatSig(r.peak_y_mm, 3), FormatSig(r.peak_f_kN, 3), r.stopped);
+    }
+  }
+  return res;
+}
+
+}  // namespace rths::report
