@@ -14,6 +14,7 @@
 
 #include "core/error.h"
 #include "report/reproduce.h"
+#include "report/studies.h"
 
 namespace fs = std::filesystem;
 
@@ -40,7 +41,7 @@ int main(int argc, char** argv) {
   int jobs = 2;
   app.add_option("name", name, "what to reproduce")
       ->required()
-      ->check(CLI::IsMember({"fig5", "fig6", "fig7", "fig8", "table2"}));
+      ->check(CLI::IsMember({"fig5", "fig6", "fig7", "fig8", "fig9", "fig11", "table2"}));
   app.add_option("--out", out_arg, "output folder (default: a new folder under runs/); never overwritten");
   app.add_flag("--quick", quick, "shorter records (for tests; numbers are noisier)");
   app.add_option("--plant", plant, "plant for the lockstep runs")
@@ -83,6 +84,13 @@ int main(int argc, char** argv) {
       for (const auto& c : r.claims) {
         std::printf("%s %s\n    %s\n", c.holds ? "[holds]" : "[DOES NOT HOLD]", c.text.c_str(), c.detail.c_str());
       }
+    } else if (name == "fig9") {
+      const auto r = rths::report::ReproduceFig9(opts);  // report/studies.h; table in fig9.md
+      std::printf("fig9: %zu runs in %.1f s; fig9.csv, fig9.md, fig9.png\n", r.rows.size(), r.wall_s);
+    } else if (name == "fig11") {
+      const auto r = rths::report::ReproduceFig11(opts);  // report/studies.h; table in fig11.md
+      std::printf("fig11: %zu RTHS + %zu numerical runs in %.1f s; fig11_summary.json, fig11.md, PNGs\n",
+                  r.runs.size(), r.numerical.size(), r.wall_s);
     } else {
       throw rths::Error(name, "not available in this build yet");
     }
