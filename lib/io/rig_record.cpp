@@ -1,0 +1,253 @@
+#include "io/rig_record.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <map>
+
+#include <fmt/format.h>
+
+#include "core/error.h"
+
+namespace rths::io {
+
+namespace {
+
+constexpr const char* kMagic = "# rths rig record v1";
+
+std::string Trim(std::string s) {
+  const auto b = s.find_first_not_of(" \t\r\n");
+  if (b == std::string::npos) return "";
+  const auto e = s.find_last_not_of(" \t\r\n");
+  return s.substr(b, e - b + 1);
+}
+
+std::vector<std::string> SplitCsv(const std::string& line) {
+  std::vector<std::string> out;
+  std::size_t start = 0;
+  while (true) {
+    const auto comma = line.find(',', start);
+    out.push_back(Trim(line.substr(start, comma == std::string::npos ? std::string::npos : comma - start)));
+    if (comma == std::string::npos) break;
+    start = comma + 1;
+  }
+  return out;
+}
+
+/// Parses a finite double from the whole of `s`; false otherwise (text, NaN, inf, empty).
+bool ParseFinite(const std::string& s, double* v) {
+  if (s.empty()) return false;
+  char* end = nullptr;
+  *v = std::strtod(s.c_str(), &end);
+  return end == s.c_str() + s.size() && std::isfinite(*v);
+}
+
+std::string Where(const std::string& path, std::size_t line) { return fmt::format("{}:{}", path, line); }
+
+double Median(std::vector<double> v) {
+  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
+  return v[v.size() / 2];
+}
+
+/// Time-axis checks shared by the CSV reader and ValidateRigRecord. `line_of(k)` names sample k.
+template <class LineOf>
+void CheckTime(const std::vector<double>& t, double dt_header, const std::string& dt_where, LineOf line_of) {
+  if (t.size() < 2) return;  // too short: reported by the duration check
+  std::vector<double> steps(t.size() - 1);
+  for (std::size_t k = 1; k < t.size(); ++k) steps[k - 1] = t[k] - t[k - 1];
+  const double med = Median(steps);
+  for (std::size_t k = 1; k < t.size(); ++k) {
+    const double d = steps[k - 1];
+    if (!(d > 0.0)) {
+      throw Error(line_of(k), fmt::format("time t_s = {} does not increase (previous {})", t[k], t[k - 1]));
+    }
+    if (med > 0.0 && std::abs(d - med) > 0.01 * med) {
+      if (d > 1.5 * med) {
+        throw Error(line_of(k), fmt::format("gap in time: t_s jumps from {} to {} ({:.6g} s, {:.3g} steps of {:.6g} s; "
+                                            "missing rows?)",
+                                            t[k - 1], t[k], d, d / med, med));
+      }
+      throw Error(line_of(k), fmt::format("non-uniform time: step {:.6g} s from t_s = {} differs from the record's "
+                                          "step {:.6g} s by more than 1 %",
+                                          d, t[k - 1], med));
+    }
+  }
+  if (std::abs(med - dt_header) > 0.01 * dt_header) {
+    throw Error(dt_where, fmt::format("dt_s = {} disagrees with the time column's step {:.6g} s", dt_header, med));
+  }
+}
+
+void CheckDuration(std::size_t n, double dt, const std::string& where) {
+  const double dur = static_cast<double>(n) * dt;
+  if (dur < kMinRecordS - 1e-9) {
+    throw Error(where, fmt::format("only {:.4g} s of data ({} rows at dt_s = {}); a record needs at least {} s", dur,
+                                   n, dt, kMinRecordS));
+  }
+}
+
+}  // namespace
+
+std::string RigRecord::Meta(const std::string& key) const {
+  for (const auto& [k, v] : metadata)
+    if (k == key) return v;
+  return "";
+}
+
+RigRecord ReadRigRecord(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw Error(path, "cannot open the rig record");
+  RigRecord rec;
+  rec.source = path;
+  std::string line;
+  std::size_t ln = 0;
+
+  if (!std::getline(in, line) || Trim(line) != kMagic) {
+    throw Error(Where(path, 1), fmt::format("not a rig record: the first line must be \"{}\"", kMagic));
+  }
+  ln = 1;
+  std::size_t dt_line = 0;
+  std::vector<std::string> cols;
+  std::size_t header_line = 0;
+  while (std::getline(in, line)) {
+    ++ln;
+    const std::string s = Trim(line);
+    if (s.empty()) continue;
+    if (s[0] == '#') {
+      const auto colon = s.find(':');
+      if (colon == std::string::npos) continue;  // a plain comment
+      const std::string key = Trim(s.substr(1, colon - 1)), value = Trim(s.substr(colon + 1));
+      if (key == "dt_s") {
+        if (!ParseFinite(value, &rec.dt_s) || !(rec.dt_s > 0.0))
+          throw Error(Where(path, ln), fmt::format("dt_s must be a number > 0 (got \"{}\")", value));
+        dt_line = ln;
+      } else {
+        rec.metadata.emplace_back(key, value);
+      }
+      continue;
+    }
+    cols = SplitCsv(s);
+    header_line = ln;
+    break;
+  }
+  if (header_line == 0) throw Error(Where(path, ln), "no column header line (t_s,u_mm,y_mm,f_kN,i_A)");
+  if (dt_line == 0) throw Error(Where(path, header_line), "missing the '# dt_s: <step in s>' line before the columns");
+
+  // Column map.
+  static const std::vector<std::string> kRequired{"t_s", "u_mm", "y_mm", "f_kN", "i_A"};
+  std::map<std::string, std::size_t> index;
+  for (std::size_t c = 0; c < cols.size(); ++c) {
+    if (index.count(cols[c]))
+      throw Error(Where(path, header_line), fmt::format("column \"{}\" appears twice", cols[c]));
+    index[cols[c]] = c;
+    const bool known = cols[c] == "r_mm" || std::find(kRequired.begin(), kRequired.end(), cols[c]) != kRequired.end();
+    if (!known)
+      rec.warnings.push_back(fmt::format("{}: unknown column \"{}\" ignored", Where(path, header_line), cols[c]));
+  }
+  for (const auto& name : kRequired) {
+    if (!index.count(name)) {
+      throw Error(Where(path, header_line),
+                  fmt::format("missing column \"{}\" (required: t_s,u_mm,y_mm,f_kN,i_A; optional r_mm)", name));
+    }
+  }
+  const bool has_r = index.count("r_mm") > 0;
+  std::vector<std::pair<std::vector<double>*, std::size_t>> targets{
+      {&rec.t_s, index["t_s"]}, {&rec.u_mm, index["u_mm"]}, {&rec.y_mm, index["y_mm"]},
+      {&rec.f_kN, index["f_kN"]}, {&rec.i_A, index["i_A"]}};
+  if (has_r) targets.emplace_back(&rec.r_mm, index["r_mm"]);
+
+  std::vector<std::size_t> row_line;
+  while (std::getline(in, line)) {
+    ++ln;
+    const std::string s = Trim(line);
+    if (s.empty() || s[0] == '#') continue;
+    const auto f = SplitCsv(s);
+    if (f.size() != cols.size()) {
+      throw Error(Where(path, ln), fmt::format("{} fields, expected {} (one per column of line {})", f.size(),
+                                               cols.size(), header_line));
+    }
+    for (auto& [vec, c] : targets) {
+      double v = 0.0;
+      if (!ParseFinite(f[c], &v)) {
+        throw Error(Where(path, ln), fmt::format("column {}: \"{}\" is not a finite number", cols[c], f[c]));
+      }
+      vec->push_back(v);
+    }
+    row_line.push_back(ln);
+  }
+  CheckTime(rec.t_s, rec.dt_s, Where(path, dt_line), [&](std::size_t k) { return Where(path, row_line[k]); });
+  CheckDuration(rec.size(), rec.dt_s, Where(path, row_line.empty() ? ln : row_line.back()));
+  return rec;
+}
+
+void ValidateRigRecord(const RigRecord& rec, const std::string& where) {
+  const std::size_t n = rec.t_s.size();
+  if (rec.u_mm.size() != n || rec.y_mm.size() != n || rec.f_kN.size() != n || rec.i_A.size() != n ||
+      (rec.has_r() && rec.r_mm.size() != n))
+    throw Error(where, "the record's columns differ in length");
+  if (!(rec.dt_s > 0.0) || !std::isfinite(rec.dt_s))
+    throw Error(where, fmt::format("dt_s must be > 0 (got {})", rec.dt_s));
+  const std::vector<std::pair<const char*, const std::vector<double>*>> cols{
+      {"t_s", &rec.t_s}, {"u_mm", &rec.u_mm}, {"y_mm", &rec.y_mm}, {"f_kN", &rec.f_kN}, {"i_A", &rec.i_A},
+      {"r_mm", &rec.r_mm}};
+  for (const auto& [name, v] : cols)
+    for (std::size_t k = 0; k < v->size(); ++k)
+      if (!std::isfinite((*v)[k])) throw Error(fmt::format("{}: sample {}", where, k), fmt::format("{} is not finite", name));
+  CheckTime(rec.t_s, rec.dt_s, where, [&](std::size_t k) { return fmt::format("{}: sample {}", where, k); });
+  CheckDuration(n, rec.dt_s, where);
+}
+
+void WriteRigRecord(const RigRecord& rec, const std::string& path) {
+  const std::size_t n = rec.size();
+  if (rec.u_mm.size() != n || rec.y_mm.size() != n || rec.f_kN.size() != n || rec.i_A.size() != n ||
+      (rec.has_r() && rec.r_mm.size() != n))
+    throw Error(path, "the record's columns differ in length");
+  std::FILE* f = std::fopen(path.c_str(), "w");
+  if (!f) throw Error(path, "cannot write the rig record");
+  std::string out = fmt::format("{}\n# dt_s: {}\n", kMagic, rec.dt_s);
+  for (const auto& [k, v] : rec.metadata) out += fmt::format("# {}: {}\n", k, v);
+  out += rec.has_r() ? "t_s,u_mm,y_mm,f_kN,i_A,r_mm\n" : "t_s,u_mm,y_mm,f_kN,i_A\n";
+  for (std::size_t k = 0; k < n; ++k) {
+    out += fmt::format("{:.10g},{:.10g},{:.10g},{:.10g},{:.10g}", rec.t_s[k], rec.u_mm[k], rec.y_mm[k], rec.f_kN[k],
+                       rec.i_A[k]);
+    if (rec.has_r()) out += fmt::format(",{:.10g}", rec.r_mm[k]);
+    out += '\n';
+  }
+  const bool ok = std::fwrite(out.data(), 1, out.size(), f) == out.size();
+  if (std::fclose(f) != 0 || !ok) throw Error(path, "cannot write the rig record");
+}
+
+RigRecord RigRecordFromRunLog(const RunLog& log, const std::string& source) {
+  RigRecord rec;
+  rec.source = source;
+  for (const auto& h : log.handshakes)
+    if (h.dt_s > 0.0) rec.dt_s = h.dt_s;
+  if (!(rec.dt_s > 0.0)) throw Error(source, "the run log has no handshake with the step dt_s");
+  const auto n = static_cast<std::size_t>(log.CompleteSteps());
+  rec.metadata = {{"source", source + " (LCM run log)"}, {"run_id", std::to_string(log.run_id)}};
+  for (std::size_t k = 0; k < n; ++k) {
+    rec.t_s.push_back(static_cast<double>(k) * rec.dt_s);
+    rec.u_mm.push_back(log.command[k].u_mm);
+    rec.y_mm.push_back(log.measured[k].y_mm);
+    rec.f_kN.push_back(log.measured[k].f_kN);
+    rec.i_A.push_back(log.current[k].i_cmd_A);
+    rec.r_mm.push_back(log.desired[k].r_mm);
+  }
+  ValidateRigRecord(rec, source);
+  return rec;
+}
+
+bool IsLcmLog(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  unsigned char b[4] = {0, 0, 0, 0};
+  if (!in.read(reinterpret_cast<char*>(b), 4)) return false;
+  return b[0] == 0xED && b[1] == 0xA1 && b[2] == 0xDA && b[3] == 0x01;
+}
+
+RigRecord ReadRecordAny(const std::string& path) {
+  if (IsLcmLog(path)) return RigRecordFromRunLog(ReadRunLog(path), path);
+  return ReadRigRecord(path);
+}
+
+}  // namespace rths::io

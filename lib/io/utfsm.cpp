@@ -1,0 +1,202 @@
+#include "io/utfsm.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <fmt/format.h>
+
+#include "core/error.h"
+
+namespace rths::io {
+
+namespace {
+
+std::string Trim(const std::string& s) {
+  const auto b = s.find_first_not_of(" \t\r\n");
+  if (b == std::string::npos) return "";
+  const auto e = s.find_last_not_of(" \t\r\n");
+  return s.substr(b, e - b + 1);
+}
+
+bool ParseFinite(const std::string& s, double* v) {
+  const std::string t = Trim(s);
+  if (t.empty()) return false;
+  char* end = nullptr;
+  *v = std::strtod(t.c_str(), &end);
+  return end == t.c_str() + t.size() && std::isfinite(*v);
+}
+
+std::string Where(const std::string& path, std::size_t line) { return fmt::format("{}:{}", path, line); }
+
+double Mean(const std::vector<double>& v, std::size_t a, std::size_t b) {
+  double s = 0.0;
+  for (std::size_t k = a; k < b; ++k) s += v[k];
+  return s / static_cast<double>(b - a);
+}
+
+}  // namespace
+
+RigRecord ReadUtfsmActuator(const std::string& path, const UtfsmActuatorOptions& o) {
+  if (!(o.start_threshold_mm > 0.0)) throw Error(path, "start_threshold_mm must be > 0");
+  std::ifstream in(path);
+  if (!in) throw Error(path, "cannot open the DAQ export");
+  std::string line;
+  std::size_t ln = 0;
+  // Header block: "Header Size: H" first, H lines in all, then the column line.
+  if (!std::getline(in, line)) throw Error(Where(path, 1), "empty file");
+  ++ln;
+  const auto colon = line.find(':');
+  double hsize = 0.0;
+  if (Trim(line.substr(0, colon)) != "Header Size" || colon == std::string::npos ||
+      !ParseFinite(line.substr(colon + 1), &hsize) || hsize < 1)
+    throw Error(Where(path, 1), "not a DAQ export: the first line must be 'Header Size: <lines>'");
+  double dt = 0.0;
+  std::string columns;
+  while (ln < static_cast<std::size_t>(hsize) && std::getline(in, line)) {
+    ++ln;
+    const auto c = line.find(':');
+    if (c != std::string::npos && Trim(line.substr(0, c)) == "Sampling Interval" &&
+        (!ParseFinite(line.substr(c + 1), &dt) || !(dt > 0.0)))
+      throw Error(Where(path, ln), "bad Sampling Interval");
+    columns = line;
+  }
+  if (!(dt > 0.0)) throw Error(Where(path, ln), "no 'Sampling Interval' in the header");
+  if (columns.find("CHANNEL0") == std::string::npos || columns.find("CHANNEL2") == std::string::npos) {
+    throw Error(Where(path, ln), "expected the header's last line to name the columns 'Sample Number, Date/Time, "
+                                 "CHANNEL0, CHANNEL1, CHANNEL2'");
+  }
+  std::vector<double> y, f, u;
+  while (std::getline(in, line)) {
+    ++ln;
+    if (Trim(line).empty()) continue;
+    std::vector<std::string> fields;
+    std::stringstream ss(line);
+    std::string field;
+    while (std::getline(ss, field, ',')) fields.push_back(field);
+    double c0 = 0, c1 = 0, c2 = 0;
+    if (fields.size() < 5 || !ParseFinite(fields[2], &c0) || !ParseFinite(fields[3], &c1) ||
+        !ParseFinite(fields[4], &c2))
+      throw Error(Where(path, ln), "expected 'sample, date/time, CHANNEL0, CHANNEL1, CHANNEL2' with numbers");
+    y.push_back(10.0 * c0);      // mm
+    f.push_back(9.80665 * c1);   // kN (9806.65 N/V)
+    u.push_back(10.0 * c2);      // mm
+  }
+  if (u.empty()) throw Error(path, "no data rows");
+
+  // Chirp start/end on u relative to a first idle estimate (the first 0.5 s), then the idle
+  // stretch proper and its means.
+  const auto n0 = std::min<std::size_t>(u.size(), std::max<std::size_t>(1, static_cast<std::size_t>(0.5 / dt)));
+  const double u0 = Mean(u, 0, n0);
+  std::size_t start = u.size(), end = 0;
+  for (std::size_t k = 0; k < u.size(); ++k) {
+    if (std::abs(u[k] - u0) > o.start_threshold_mm) {
+      start = std::min(start, k);
+      end = k + 1;
+    }
+  }
+  if (start == u.size()) throw Error(path, fmt::format("|u| never exceeds {} mm: no chirp found", o.start_threshold_mm));
+  const auto one_s = static_cast<std::size_t>(std::lround(1.0 / dt));
+  std::size_t idle_end = start > one_s ? start - one_s : 0;
+  if (static_cast<double>(idle_end) * dt < 0.5) idle_end = start / 2;
+  if (idle_end == 0) throw Error(path, "no idle stretch before the chirp to take the offsets from");
+  const double mu = Mean(u, 0, idle_end), my = Mean(y, 0, idle_end), mf = Mean(f, 0, idle_end);
+  // Re-detect start and end with the final offset.
+  start = u.size(), end = 0;
+  for (std::size_t k = 0; k < u.size(); ++k) {
+    if (std::abs(u[k] - mu) > o.start_threshold_mm) {
+      start = std::min(start, k);
+      end = k + 1;
+    }
+  }
+
+  RigRecord rec;
+  rec.source = path;
+  rec.dt_s = dt;
+  for (std::size_t k = start; k < end; ++k) {
+    rec.t_s.push_back(static_cast<double>(k - start) * dt);
+    rec.u_mm.push_back(u[k] - mu);
+    rec.y_mm.push_back(y[k] - my);
+    rec.f_kN.push_back(f[k] - mf);
+    rec.i_A.push_back(o.current_A);
+  }
+  rec.metadata = {
+      {"source", std::filesystem::path(path).filename().string() + " (UTFSM DAQ export, data/utfsm/)"},
+      {"conversion", "y_mm = 10 CHANNEL0, f_kN = 9.80665 CHANNEL1, u_mm = 10 CHANNEL2"},
+      {"offsets_subtracted", fmt::format("u_mm {:.6g}, y_mm {:.6g}, f_kN {:.6g} (mean of samples 1..{})", mu, my, mf,
+                                         idle_end)},
+      {"kept_samples", fmt::format("{}..{} of {} (|u| > {} mm from the first to the last crossing)", start + 1, end,
+                                   u.size(), o.start_threshold_mm)},
+      {"current_A", fmt::format("{}", o.current_A)},
+  };
+  ValidateRigRecord(rec, path);
+  return rec;
+}
+
+double UtfsmCurrentFromName(const std::string& path) {
+  const std::string stem = std::filesystem::path(path).stem().string();
+  const auto hz = stem.rfind("Hz");
+  if (hz == std::string::npos || stem.empty() || stem.back() != 'A')
+    throw Error(path, "file name does not end in '<current>A' after '<frequency>Hz' (e.g. 25mm0x5Hz0x75A.txt)");
+  std::string cur = stem.substr(hz + 2, stem.size() - hz - 3);
+  std::replace(cur.begin(), cur.end(), 'x', '.');
+  double v = 0.0;
+  if (!ParseFinite(cur, &v) || v < 0.0)
+    throw Error(path, fmt::format("cannot read the current '{}' from the file name", cur));
+  return v;
+}
+
+RigRecord ReadUtfsmDamper(const std::string& path) {
+  const double current = UtfsmCurrentFromName(path);
+  std::ifstream in(path);
+  if (!in) throw Error(path, "cannot open the damper record");
+  RigRecord rec;
+  rec.source = path;
+  std::string line;
+  std::size_t ln = 0;
+  while (std::getline(in, line)) {
+    ++ln;
+    if (Trim(line).empty()) continue;
+    std::stringstream ss(line);
+    std::vector<std::string> fields;
+    std::string field;
+    while (ss >> field) fields.push_back(field);
+    double v[4];
+    if (fields.size() != 4 || !ParseFinite(fields[0], &v[0]) || !ParseFinite(fields[1], &v[1]) ||
+        !ParseFinite(fields[2], &v[2]) || !ParseFinite(fields[3], &v[3]))
+      throw Error(Where(path, ln), "expected four numbers: t [s], x [mm], xdot [mm/s], F [N]");
+    rec.t_s.push_back(v[0]);
+    rec.u_mm.push_back(v[1]);
+    rec.y_mm.push_back(v[1]);
+    rec.f_kN.push_back(v[3] / 1000.0);
+    rec.i_A.push_back(current);
+  }
+  if (rec.size() < 2) throw Error(path, "fewer than two data rows");
+  std::vector<double> steps;
+  for (std::size_t k = 1; k < rec.size(); ++k) steps.push_back(rec.t_s[k] - rec.t_s[k - 1]);
+  std::nth_element(steps.begin(), steps.begin() + static_cast<std::ptrdiff_t>(steps.size() / 2), steps.end());
+  rec.dt_s = steps[steps.size() / 2];
+  // The files print t with 7 significant digits: round the step to a microsecond.
+  rec.dt_s = std::round(rec.dt_s * 1e6) / 1e6;
+  rec.metadata = {
+      {"source", std::filesystem::path(path).filename().string() + " (UTFSM MR damper test, data/utfsm/)"},
+      {"conversion", "u_mm = y_mm = x [mm], f_kN = F [N] / 1000, i_A from the file name"},
+      {"current_A", fmt::format("{}", current)},
+  };
+  ValidateRigRecord(rec, path);
+  return rec;
+}
+
+RigRecord ReadUtfsm(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw Error(path, "cannot open");
+  std::string first;
+  std::getline(in, first);
+  if (Trim(first).rfind("Header Size", 0) == 0) return ReadUtfsmActuator(path);
+  return ReadUtfsmDamper(path);
+}
+
+}  // namespace rths::io
