@@ -15,6 +15,7 @@
 #include "models/servo_linear.h"
 #include "scenario/scenario.h"
 #include "signal/blwn.h"
+#include "test_support.h"
 
 namespace {
 
@@ -202,6 +203,17 @@ TEST_CASE("E1 on the linear plants: BLWN 0-50 Hz, 0.254 mm RMS, 60 s through the
       CHECK(rc.fit.rms_rel_error < 0.01);
       CHECK(rc.fit.model.DcGain() == doctest::Approx(m.K / (m.p * m.c)).epsilon(0.015));
       CHECK((rc.fit.model.DcLagS() - m.b / m.c - 1.0 / m.p) == doctest::Approx(dt / 2).epsilon(0.25));
+
+      // The printed fragment is a valid scenario part: plant.actuator = the ZOH-consistent fit,
+      // controller.model = the continuous fit.
+      const auto dir = rths_test::TempDir("identify_fragment");
+      const auto sc = rths::scenario::LoadScenario(
+          rths_test::WriteScenario(dir, "[run]\nduration_s = 0.5\n" + rths::ident::ScenarioFragment(rc, rz, "E1"))
+              .string());
+      CHECK(sc.plant.actuator.K == doctest::Approx(z.K).epsilon(1e-9));
+      CHECK(sc.plant.actuator.c == doctest::Approx(z.c).epsilon(1e-9));
+      CHECK(sc.controller.model.p == doctest::Approx(c.p).epsilon(1e-9));
+      CHECK(sc.controller.model.b == doctest::Approx(c.b).epsilon(1e-9));
     }
   }
 }

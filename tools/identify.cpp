@@ -6,6 +6,7 @@
 // paper's Fig. 6 with gnuplot. docs/identification.md. Exit 0 ok, 2 bad input.
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -62,6 +63,7 @@ void PlotBode(const std::string& png, const std::string& title, const rths::iden
   const fs::path dir = fs::temp_directory_path() / fmt::format("rths_identify_{}", ::getpid());
   fs::create_directories(dir);
   const fs::path meas = dir / "measured.dat", model = dir / "model.dat", script = dir / "plot.gp";
+  double lag_lo = 1e300, lag_hi = -1e300;  // the models' time-lag range [ms], for the lag axis
   {
     // Measured: the excited band points (those fitted or not), phase unwrapped over them.
     std::ofstream o(meas);
@@ -90,6 +92,8 @@ void PlotBode(const std::string& png, const std::string& title, const rths::iden
     for (int i = 1; i <= 500; ++i) {
       const double f = fmax * i / 500.0, w = 2.0 * std::numbers::pi * f;
       const double pc = ModelPhase(gc, f), pz = ModelPhase(gz, f);
+      lag_lo = std::min({lag_lo, -pc / w * 1e3, -pz / w * 1e3});
+      lag_hi = std::max({lag_hi, -pc / w * 1e3, -pz / w * 1e3});
       o << fmt::format("{:.6g} {:.6g} {:.6g} {:.6g} {:.6g} {:.6g} {:.6g}\n", f, std::abs(gc(f)),
                        pc * 180.0 / std::numbers::pi, -pc / w * 1e3, std::abs(gz(f)), pz * 180.0 / std::numbers::pi,
                        -pz / w * 1e3);
@@ -106,17 +110,17 @@ void PlotBode(const std::string& png, const std::string& title, const rths::iden
     o << band;
     o << "set ylabel 'magnitude |G_{yu}| [mm/mm]'\n";
     o << "plot '" << meas.string() << "' u 1:2 w l lw 2 lc rgb '#1f77b4' t 'measured (H1)', '" << model.string()
-      << "' u 1:2 w l dt 2 lw 2 lc rgb 'black' t 'fitted model (Eq. 15)', '' u 1:5 w l dt 3 lw 2 lc rgb '#d62728' t "
+      << "' u 1:2 w l dt 2 lw 2 lc rgb 'black' t 'fitted model (Eq. 15)', '' u 1:5 w l dt (3,5) lw 3 lc rgb '#d62728' t "
          "'ZOH-consistent fit, discretised'\n";
     o << "set ylabel 'phase [deg]'\n";
     o << "plot '" << meas.string() << "' u 1:3 w l lw 2 lc rgb '#1f77b4' t 'measured (H1)', '" << model.string()
-      << "' u 1:3 w l dt 2 lw 2 lc rgb 'black' t 'fitted model', '' u 1:6 w l dt 3 lw 2 lc rgb '#d62728' t "
+      << "' u 1:3 w l dt 2 lw 2 lc rgb 'black' t 'fitted model', '' u 1:6 w l dt (3,5) lw 3 lc rgb '#d62728' t "
          "'ZOH-consistent fit'\n";
-    o << "set ylabel 'time lag -phase/{/Symbol w} [ms]'\n";
+    o << fmt::format("set ylabel 'time lag -phase/{{/Symbol w}} [ms]'\nset yrange [{}:{}]\n", 0.7 * lag_lo, 1.3 * lag_hi);
     o << "plot '" << meas.string() << "' u 1:4 w l lw 2 lc rgb '#1f77b4' t 'measured (H1)', '" << model.string()
-      << "' u 1:4 w l dt 2 lw 2 lc rgb 'black' t 'fitted model', '' u 1:7 w l dt 3 lw 2 lc rgb '#d62728' t "
+      << "' u 1:4 w l dt 2 lw 2 lc rgb 'black' t 'fitted model', '' u 1:7 w l dt (3,5) lw 3 lc rgb '#d62728' t "
          "'ZOH-consistent fit'\n";
-    o << "set ylabel 'coherence {/Symbol g}^2'\nset yrange [0:1.05]\nset xlabel 'frequency [Hz]'\n";
+    o << "set ylabel 'coherence {/Symbol g}^2'\nset yrange [0:1.05]\nset key bottom right\nset xlabel 'frequency [Hz]'\n";
     o << "plot '" << meas.string() << "' u 1:5 w l lw 2 lc rgb '#1f77b4' t 'measured; shaded: fitted band'\n";
     o << "unset multiplot\n";
   }
@@ -187,28 +191,10 @@ int main(int argc, char** argv) {
                 rec.dt_s, rz.fit.Report().c_str());
     std::printf("time domain: Eq. 31 error of the predicted y %.3f %%\n", rz.prediction.model_error_pct);
 
-    std::string toml;
-    toml += fmt::format("# rths identify {} (band {}-{} Hz, {} poles, {} weights)\n", fs::path(record).filename().string(),
-                        o.fit.band_lo_hz, o.fit.band_hi_hz, poles, weights);
-    if (rc.fit.model.Order() == 3 && rz.fit.model.Order() == 3 && rc.fit.model.b.size() == 1 &&
-        rz.fit.model.b.size() == 1) {
-      const auto table = [](const rths::ident::PoleModel& m) {
-        return fmt::format("{{ K = {:.10g}, p = {:.10g}, b = {:.10g}, c = {:.10g} }}", m.K, m.p, m.b[0], m.c[0]);
-      };
-      toml += fmt::format(
-          "\n[plant]\n# ZOH-consistent fit: simulated with a zero-order hold at dt = {} s it reproduces the record\n"
-          "# (Eq. 31 error {:.3g} %; fit error {:.3g} %; DC gain {:.5g}, DC lag {:.4g} ms)\nactuator = {}\n",
-          rec.dt_s, rz.prediction.model_error_pct, 100.0 * rz.fit.rms_rel_error, rz.fit.model.DcGain(),
-          1e3 * rz.fit.model.DcLagS(), table(rz.fit.model));
-      toml += fmt::format(
-          "\n[controller]\n# Eq. 15 fitted to the measured G_yu as the paper does (it holds the D/A hold's half-sample\n"
-          "# lag, as the lab's Eqs. 28-30 hold their converters'; fit error {:.3g} %; DC gain {:.5g}, DC lag {:.4g} ms)\n"
-          "model = {}\n",
-          100.0 * rc.fit.rms_rel_error, rc.fit.model.DcGain(), 1e3 * rc.fit.model.DcLagS(), table(rc.fit.model));
-    } else {
-      toml += rths::ident::ModelToml(rc.fit.model, "Eq. 15 fitted to the measured G_yu (continuous)");
-      toml += rths::ident::ModelToml(rz.fit.model, "ZOH-consistent fit");
-    }
+    const std::string toml = rths::ident::ScenarioFragment(
+        rc, rz,
+        fmt::format("rths identify {} (band {}-{} Hz, {} poles, {} weights)", fs::path(record).filename().string(),
+                    o.fit.band_lo_hz, o.fit.band_hi_hz, poles, weights));
     std::printf("\n%s", toml.c_str());
     if (!out.empty()) {
       std::ofstream f(out);
@@ -217,7 +203,11 @@ int main(int argc, char** argv) {
     }
     if (plot.empty()) plot = out.empty() ? "identify.png" : fs::path(out).replace_extension(".png").string();
     std::string name;  // enhanced-text safe
-    for (char ch : fs::path(record).filename().string()) {
+    const fs::path rp(record);
+    const std::string shown = rp.filename() == "log.lcm" && !rp.parent_path().filename().empty()
+                                  ? (rp.parent_path().filename() / rp.filename()).string()
+                                  : rp.filename().string();
+    for (char ch : shown) {
       if (ch == '_' || ch == '^' || ch == '{' || ch == '}' || ch == '@' || ch == '&') name += '\\';
       if (ch != '\'') name += ch;
     }

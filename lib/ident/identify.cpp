@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <sstream>
 
 #include <fmt/format.h>
 
@@ -107,19 +106,38 @@ std::string IdentifyResult::Report() const {
   return s;
 }
 
-std::string ModelToml(const PoleModel& model, const std::string& comment) {
-  std::string s;
-  std::istringstream in(comment);
-  for (std::string line; std::getline(in, line);) s += "# " + line + "\n";
-  if (model.Order() != 3 || model.b.size() != 1) {
-    s += fmt::format("# {} poles: a scenario holds 3-pole models only. K = {:.10g}; factors:", model.Order(), model.K);
-    if (model.p > 0) s += fmt::format(" (s + {:.10g})", model.p);
-    for (std::size_t j = 0; j < model.b.size(); ++j) s += fmt::format(" (s^2 + {:.10g} s + {:.10g})", model.b[j], model.c[j]);
-    return s + "\n";
+namespace {
+std::string Table(const PoleModel& m) {
+  return fmt::format("{{ K = {:.10g}, p = {:.10g}, b = {:.10g}, c = {:.10g} }}", m.K, m.p, m.b[0], m.c[0]);
+}
+std::string Factors(const PoleModel& m) {
+  std::string s = fmt::format("K = {:.10g}; denominator", m.K);
+  if (m.p > 0) s += fmt::format(" (s + {:.10g})", m.p);
+  for (std::size_t j = 0; j < m.b.size(); ++j) s += fmt::format(" (s^2 + {:.10g} s + {:.10g})", m.b[j], m.c[j]);
+  return s;
+}
+}  // namespace
+
+std::string ScenarioFragment(const IdentifyResult& continuous, const IdentifyResult& zoh, const std::string& title) {
+  const auto& mc = continuous.fit.model;
+  const auto& mz = zoh.fit.model;
+  std::string s = "# " + title + "\n";
+  const std::string zoh_note = fmt::format(
+      "# ZOH-consistent fit: simulated with a zero-order hold at dt = {} s it reproduces the record\n"
+      "# (Eq. 31 error {:.3g} %; fit error {:.3g} %; DC gain {:.5g}, DC lag {:.4g} ms)\n",
+      zoh.dt_s, zoh.prediction.model_error_pct, 100.0 * zoh.fit.rms_rel_error, mz.DcGain(), 1e3 * mz.DcLagS());
+  const std::string cont_note = fmt::format(
+      "# Eq. 15 fitted to the measured G_yu as the paper does (it holds the D/A hold's half-sample\n"
+      "# lag, as the lab's Eqs. 28-30 hold their converters'; fit error {:.3g} %; DC gain {:.5g}, DC lag {:.4g} ms)\n",
+      100.0 * continuous.fit.rms_rel_error, mc.DcGain(), 1e3 * mc.DcLagS());
+  const bool three = mc.Order() == 3 && mc.b.size() == 1 && mz.Order() == 3 && mz.b.size() == 1;
+  if (!three) {
+    s += fmt::format("# {} poles: a scenario holds 3-pole models only.\n", mc.Order());
+    s += zoh_note + "# " + Factors(mz) + "\n" + cont_note + "# " + Factors(mc) + "\n";
+    return s;
   }
-  const std::string table = fmt::format("{{ K = {:.10g}, p = {:.10g}, b = {:.10g}, c = {:.10g} }}", model.K, model.p,
-                                        model.b[0], model.c[0]);
-  s += "[plant]\nactuator = " + table + "\n\n[controller]\nmodel = " + table + "\n";
+  s += "\n[plant]\n" + zoh_note + "actuator = " + Table(mz) + "\n";
+  s += "\n[controller]\n" + cont_note + "model = " + Table(mc) + "\n";
   return s;
 }
 

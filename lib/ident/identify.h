@@ -64,10 +64,15 @@ struct IdentifyResult {
 IdentifyResult Identify(std::span<const double> u_mm, std::span<const double> y_mm, double dt_s,
                         const IdentifyOptions& options);
 
-/// The scenario fragment for a 3-pole model: "[plant]\nactuator = { K = .., p = .., b = .., c = .. }"
-/// and "[controller]\nmodel = { ... }" (scenario keys plant.actuator and controller.model),
-/// preceded by '#' lines holding `comment`. Models of another order come out as comments only
-/// (a scenario holds 3-pole models).
-std::string ModelToml(const PoleModel& model, const std::string& comment);
+/// The scenario fragment `rths identify` prints and writes, from the two fits of one record:
+///     [plant]
+///     actuator = { K = .., p = .., b = .., c = .. }   <- `zoh`: its ZOH simulation at the record's
+///                                                       dt reproduces the record (a plant to simulate)
+///     [controller]
+///     model = { K = .., p = .., b = .., c = .. }      <- `continuous`: Eq. 15 fitted to the measured
+///                                                       G_yu, hold lag included (a design model)
+/// with '#' comments giving each fit's errors, DC gain and lag; `title` is the first comment line.
+/// Models of another order than 3 come out as comments only (scenarios hold 3-pole models).
+std::string ScenarioFragment(const IdentifyResult& continuous, const IdentifyResult& zoh, const std::string& title);
 
 }  // namespace rths::ident
