@@ -8,6 +8,7 @@
 #include <ctime>
 #include <filesystem>
 #include <string>
+#include <tuple>
 
 #include <CLI/CLI.hpp>
 #include <fmt/core.h>
@@ -91,8 +92,24 @@ int main(int argc, char** argv) {
       const auto r = rths::report::ReproduceFig11(opts);  // report/studies.h; table in fig11.md
       std::printf("fig11: %zu RTHS + %zu numerical runs in %.1f s; fig11_summary.json, fig11.md, PNGs\n",
                   r.runs.size(), r.numerical.size(), r.wall_s);
+    } else if (name == "fig6") {
+      const auto r = rths::report::ReproduceFig6(opts);
+      std::printf("\n%-5s %-3s %12s %12s %8s\n", "cond", "", "paper", "ours", "diff");
+      for (const auto& m : r.models) {
+        const auto o = m.fit.model.ToServoModel3();
+        for (auto [n, p, q] : {std::tuple{"K", m.paper.K, o.K}, {"p", m.paper.p, o.p}, {"b", m.paper.b, o.b},
+                               {"c", m.paper.c, o.c}}) {
+          std::printf("%-5s %-3s %12.5g %12.5g %+7.2f%%\n", m.condition.c_str(), n, p, q, 100 * (q / p - 1));
+        }
+      }
+      std::printf("\n%s %s\n    %s\n", r.verdict.holds ? "[holds]" : "[DOES NOT HOLD]", r.verdict.text.c_str(),
+                  r.verdict.detail.c_str());
     } else {
-      throw rths::Error(name, "not available in this build yet");
+      const auto r = rths::report::ReproduceFig78(opts, name);
+      std::printf("\n");
+      for (const auto& c : r.checks) {
+        std::printf("%s %s\n    %s\n", c.holds ? "[holds]" : "[does not hold]", c.text.c_str(), c.detail.c_str());
+      }
     }
   } catch (const rths::Error& e) {
     std::fprintf(stderr, "rths reproduce %s: %s\n", name.c_str(), e.what());

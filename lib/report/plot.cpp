@@ -195,7 +195,7 @@ PlotFiles Plot(const Figure& fig, const fs::path& dir) {
     if (panel.key == "off") {
       gp << "set key off\n";
     } else {
-      gp << "set key on " << panel.key << " box opaque\n";
+      gp << "set key on " << panel.key << " box opaque spacing 1.2\n";
     }
     gp << "plot ";
     bool first = true;

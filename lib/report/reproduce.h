@@ -13,8 +13,10 @@
 #include <string_view>
 #include <vector>
 
+#include "ident/fit.h"
 #include "report/batch.h"
 #include "scenario/scenario.h"
+#include "signal/spectral.h"
 
 namespace rths::report {
 
@@ -97,5 +99,61 @@ struct Table2Result {
 Table2Result ReproduceTable2(const ReproduceOptions& opts);
 /// The claims of E3 on a finished table (rows as ReproduceTable2 returns them).
 std::vector<Claim> CheckTable2Claims(const std::vector<Table2Row>& rows);
+
+// --- Frequency-domain studies: Fig. 6 (E1) and Figs. 7-8 (E2) ------------------------------
+
+/// A measured or modelled frequency response on a grid, as the paper plots it.
+struct BodeCurve {
+  std::string name;                 ///< legend entry
+  std::vector<double> f_hz;         ///< frequencies [Hz], > 0
+  std::vector<double> magnitude;    ///< |G| [mm/mm]
+  std::vector<double> phase_deg;    ///< unwrapped phase [deg]
+  std::vector<double> lag_ms;       ///< time lag -phase / (2 pi f) [ms] (> 0: the output lags)
+  std::vector<double> coherence;    ///< gamma^2 (1 for a model)
+};
+/// The H1 estimate on (0, f_max_hz], phase unwrapped from the lowest frequency up.
+BodeCurve BodeFromEstimate(const std::string& name, const signal::FrequencyResponseEstimate& est,
+                           double f_max_hz);
+/// A model's response on the grid f_hz: continuous if zoh_dt_s = 0, else that of its
+/// zero-order-hold discretisation at zoh_dt_s (what a ZOH plant sampled at the same rate shows).
+BodeCurve BodeFromModel(const std::string& name, const ident::PoleModel& model, const std::vector<double>& f_hz,
+                        double zoh_dt_s);
+
+/// The scenario of one frequency-domain run (E1, E2): desired r = BLWN 0-50 Hz, RMS 0.254 mm,
+/// seed 1, faded in over 0.5 s; the damper attached at the condition's constant current
+/// ("0.0A" or "2.5A"); the plant ("linear": Eq. 28 or 29).
+scenario::Scenario FrequencyScenario(const std::string& condition, const scenario::ControllerConfig& controller,
+                                     const std::string& plant, double duration_s);
+
+struct Fig6Model {
+  std::string condition;            ///< "0.0A", "2.5A", "avg" (the fit of the averaged response)
+  scenario::ServoModel3 paper;      ///< Eq. 28, 29, 30
+  ident::FitSummary fit;            ///< our 3-pole fit (ZOH-aware)
+  double max_diff_pct = 0.0;        ///< largest |ours / paper - 1| over K, p, b, c [%]
+};
+struct Fig6Result {
+  std::vector<BodeCurve> measured;  ///< H1 of G_yu at 0.0 A and 2.5 A
+  std::vector<Fig6Model> models;    ///< 0.0A, 2.5A, avg
+  double tolerance_pct = 0.0;       ///< E1: 3 % on the linear plant, 8 % on the physical one
+  Claim verdict;                    ///< E1 on the 0.0 A and 2.5 A fits
+};
+/// E1: BLWN 0-50 Hz, RMS 0.254 mm commanded with no controller at 0.0 A and 2.5 A (60 s;
+/// --quick 16 s); H1 with coherence; 3-pole fits over 0.5-40 Hz. Writes fig6.png (magnitude,
+/// phase, time lag with the fitted models overlaid), fig6.csv (the measured curves),
+/// fig6_models.csv (condition,parameter,paper,ours,diff_pct), fig6.md and runs/.
+Fig6Result ReproduceFig6(const ReproduceOptions& opts);
+
+struct Fig78Result {
+  std::string condition;            ///< "0.0A" (Fig. 7) or "2.5A" (Fig. 8)
+  std::vector<BodeCurve> curves;    ///< G_yr per controller, in Table 1's order
+  std::vector<Claim> checks;        ///< E2's statements, measured on the curves
+};
+/// The Table 2 controllers of one condition, in order ("0.0A" or "2.5A").
+std::vector<Table2Controller> ControllersOf(const std::string& condition);
+/// E2: the same BLWN as the desired displacement through each controller of the condition
+/// (figure "fig7": 0.0 A, "fig8": 2.5 A); G_yr by H1. Writes <figure>.png (magnitude, phase and
+/// time lag, 0-50 Hz, one curve per controller), <figure>.csv
+/// (controller,f_hz,magnitude,phase_deg,time_lag_ms,coherence), <figure>.md and runs/.
+Fig78Result ReproduceFig78(const ReproduceOptions& opts, const std::string& figure);
 
 }  // namespace rths::report
