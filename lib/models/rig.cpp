@@ -12,10 +12,11 @@
 namespace rths::models {
 namespace {
 
-// Rig over LinearRig (+ LinearRigStepper).
-class LinearRigAdapter final : public Rig {
+// Rig over a model with its stepper and state (LinearRig or PhysicalRig).
+template <class Model, class Stepper, class State>
+class RigAdapter final : public Rig {
  public:
-  explicit LinearRigAdapter(const LinearRig& rig) : rig_(rig), stepper_(rig_) {}
+  explicit RigAdapter(const Model& rig) : rig_(rig), stepper_(rig_) {}
   void Step(double u_mm, double i_cmd_A) override {
     if (k_ == 0) state_.current = SteadyState(i_cmd_A);  // current set before the test
     stepper_.Step(&state_, u_mm, i_cmd_A);
@@ -27,32 +28,13 @@ class LinearRigAdapter final : public Rig {
   std::int64_t k() const override { return k_; }
 
  private:
-  const LinearRig rig_;
-  LinearRigStepper stepper_;
-  LinearRigState state_{};
+  const Model rig_;
+  Stepper stepper_;
+  State state_{};
   std::int64_t k_ = 0;
 };
-
-// Rig over PhysicalRig (+ PhysicalRigStepper).
-class PhysicalRigAdapter final : public Rig {
- public:
-  explicit PhysicalRigAdapter(const PhysicalRig& rig) : rig_(rig), stepper_(rig_) {}
-  void Step(double u_mm, double i_cmd_A) override {
-    if (k_ == 0) state_.current = SteadyState(i_cmd_A);  // current set before the test
-    stepper_.Step(&state_, u_mm, i_cmd_A);
-    ++k_;
-  }
-  double y_mm() const override { return MeasuredDisplacementMm(rig_, state_); }
-  double f_kN() const override { return MeasuredForceKn(rig_, state_); }
-  double current_A() const override { return EffectiveCurrentA(rig_, state_); }
-  std::int64_t k() const override { return k_; }
-
- private:
-  const PhysicalRig rig_;
-  PhysicalRigStepper stepper_;
-  PhysicalRigState state_{};
-  std::int64_t k_ = 0;
-};
+using LinearRigAdapter = RigAdapter<LinearRig, LinearRigStepper, LinearRigState>;
+using PhysicalRigAdapter = RigAdapter<PhysicalRig, PhysicalRigStepper, PhysicalRigState>;
 
 // The ideal loading system (plant.kind = "ideal"): the MR damper driven by the desired motion
 // itself, x(t) linear between samples; y_k = r_k bit for bit.

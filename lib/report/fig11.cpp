@@ -23,11 +23,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-scenario::ControllerConfig Fig11Kind(const std::string& kind) {
-  scenario::ControllerConfig c;
-  c.kind = kind;
-  return c;
-}
 
 constexpr const char* kNumerical = "Numerical";
 
@@ -105,11 +100,11 @@ Series Thin(Series s, const std::vector<double>& x, const std::vector<double>& y
 }  // namespace
 
 std::vector<Fig11Controller> Fig11Controllers() {
-  scenario::ControllerConfig poly = Fig11Kind("poly3");
+  scenario::ControllerConfig poly = ControllerKind("poly3");
   poly.delay_ms = 9.0;
-  scenario::ControllerConfig lqg = Fig11Kind("ff_lqg");
+  scenario::ControllerConfig lqg = ControllerKind("ff_lqg");
   lqg.model = scenario::ServoPreset("avg");
-  return {{"3rd Poly 9ms", poly}, {"Bumpless + LP", Fig11Kind("bumpless_lp")}, {"G_FF,avgA + LQG", lqg}};
+  return {{"3rd Poly 9ms", poly}, {"Bumpless + LP", ControllerKind("bumpless_lp")}, {"G_FF,avgA + LQG", lqg}};
 }
 
 std::vector<std::string> Fig11SemiactiveModes() { return {"passive_off", "passive_on", "clipped_optimal"}; }
@@ -144,7 +139,7 @@ Fig11Result ReproduceFig11(const ReproduceOptions& opts) {
   std::vector<Item> items;
   // The numerical simulations first (they are the references), then the RTHS runs.
   for (const auto& mode : modes) {
-    Fig11Controller none{kNumerical, Fig11Kind("none")};
+    Fig11Controller none{kNumerical, ControllerKind("none")};
     const fs::path dir = opts.out_dir / "runs" / Slug(fmt::format("numerical {}", mode));
     specs.push_back({fmt::format("Numerical / {}", mode), Fig11Scenario(base, none, mode, "ideal", duration), dir});
     items.push_back({kNumerical, mode});

@@ -60,21 +60,6 @@ std::string StoppedText(const RunResult& r) {
 
 namespace {
 
-scenario::ControllerConfig Kind(const std::string& kind) {
-  scenario::ControllerConfig c;
-  c.kind = kind;
-  return c;
-}
-scenario::ControllerConfig Delay(const std::string& kind, double ms) {
-  auto c = Kind(kind);
-  c.delay_ms = ms;
-  return c;
-}
-scenario::ControllerConfig Model(const std::string& kind, const std::string& model) {
-  auto c = Kind(kind);
-  c.model = scenario::ServoPreset(model);
-  return c;
-}
 
 std::string FreqText(double f) { return FormatSig(f, 3); }
 
@@ -82,12 +67,12 @@ std::string FreqText(double f) { return FormatSig(f, 3); }
 
 std::vector<Fig9Controller> Fig9Controllers() {
   return {
-      {"None", Kind("none")},
-      {"3rd Poly 8ms", Delay("poly3", 8.0)},
-      {"Lead Comp 8ms", Delay("lead", 8.0)},
-      {"G_FF,0.0A + LP", Model("ff_lp", "0.0A")},
-      {"G_FF,0.0A", Model("ff", "0.0A")},
-      {"G_FF,avgA + LQG", Model("ff_lqg", "avg")},
+      {"None", ControllerKind("none")},
+      {"3rd Poly 8ms", ControllerDelay("poly3", 8.0)},
+      {"Lead Comp 8ms", ControllerDelay("lead", 8.0)},
+      {"G_FF,0.0A + LP", ControllerModel("ff_lp", "0.0A")},
+      {"G_FF,0.0A", ControllerModel("ff", "0.0A")},
+      {"G_FF,avgA + LQG", ControllerModel("ff_lqg", "avg")},
   };
 }
 

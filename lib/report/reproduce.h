@@ -100,6 +100,12 @@ Table2Result ReproduceTable2(const ReproduceOptions& opts);
 /// The claims of E3 on a finished table (rows as ReproduceTable2 returns them).
 std::vector<Claim> CheckTable2Claims(const std::vector<Table2Row>& rows);
 
+/// Controller settings of a Table 1 row: the kind alone; with the delay it compensates (poly3,
+/// lead) [ms]; or with its design model (a preset: "0.0A", "2.5A", "avg").
+scenario::ControllerConfig ControllerKind(const std::string& kind);
+scenario::ControllerConfig ControllerDelay(const std::string& kind, double delay_ms);
+scenario::ControllerConfig ControllerModel(const std::string& kind, const std::string& preset);
+
 // --- Frequency-domain studies: Fig. 6 (E1) and Figs. 7-8 (E2) ------------------------------
 
 /// A measured or modelled frequency response on a grid, as the paper plots it.

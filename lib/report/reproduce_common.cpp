@@ -77,4 +77,22 @@ void RequirePlant(const std::string& plant, const fs::path& scratch_parent) {
   }
 }
 
+scenario::ControllerConfig ControllerKind(const std::string& kind) {
+  scenario::ControllerConfig c;
+  c.kind = kind;
+  return c;
+}
+
+scenario::ControllerConfig ControllerDelay(const std::string& kind, double delay_ms) {
+  auto c = ControllerKind(kind);
+  c.delay_ms = delay_ms;
+  return c;
+}
+
+scenario::ControllerConfig ControllerModel(const std::string& kind, const std::string& preset) {
+  auto c = ControllerKind(kind);
+  c.model = scenario::ServoPreset(preset);
+  return c;
+}
+
 }  // namespace rths::report

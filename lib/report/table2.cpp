@@ -28,21 +28,6 @@ constexpr double kQuickDurationS = 6.0;
 constexpr double kQuickNoneDurationS = 20.0;
 constexpr double kTaperS = 0.5;           // raised-cosine fade-in of the desired record
 
-scenario::ControllerConfig Kind(const std::string& kind) {
-  scenario::ControllerConfig c;
-  c.kind = kind;
-  return c;
-}
-scenario::ControllerConfig Delay(const std::string& kind, double ms) {
-  auto c = Kind(kind);
-  c.delay_ms = ms;
-  return c;
-}
-scenario::ControllerConfig Model(const std::string& kind, const std::string& model) {
-  auto c = Kind(kind);
-  c.model = scenario::ServoPreset(model);
-  return c;
-}
 
 std::string BandText(double band_hz) { return band_hz < 10 ? "0-5" : "0-15"; }
 
@@ -62,24 +47,24 @@ std::string Pct(double v) { return std::isfinite(v) ? fmt::format("{:#.3g}", v) 
 std::vector<Table2Controller> Table2Controllers() {
   // Table 2 of the paper, in its order; names as in Table 1 (short names).
   return {
-      {"0.0A", "None", 16.0, 42.9, "16.0", "42.9", Kind("none")},
-      {"0.0A", "3rd Poly 8ms", 1.22, 12.8, "1.22", "12.8", Delay("poly3", 8.0)},
-      {"0.0A", "Lead Comp 8ms", 1.95, 13.3, "1.95", "13.3", Delay("lead", 8.0)},
-      {"0.0A", "G_FF,0.0A + LP", 1.01, 4.27, "1.01", "4.27", Model("ff_lp", "0.0A")},
-      {"0.0A", "G_FF,0.0A", 0.942, 3.45, "0.942", "3.45", Model("ff", "0.0A")},
-      {"0.0A", "G_FF,avgA + LQG", 1.16, 3.89, "1.16", "3.89", Model("ff_lqg", "avg")},
-      {"2.5A", "None", 20.1, 51.7, "20.1", "51.7", Kind("none")},
-      {"2.5A", "3rd Poly 10ms", 2.04, 25.9, "2.04", "25.9", Delay("poly3", 10.0)},
-      {"2.5A", "Lead Comp 10ms", 3.34, 15.1, "3.34", "15.1", Delay("lead", 10.0)},
-      {"2.5A", "G_FF,2.5A + LP", 2.55, 9.40, "2.55", "9.40", Model("ff_lp", "2.5A")},
-      {"2.5A", "G_FF,2.5A", 2.27, 4.68, "2.27", "4.68", Model("ff", "2.5A")},
-      {"2.5A", "G_FF,avgA + LQG", 1.41, 5.57, "1.41", "5.57", Model("ff_lqg", "avg")},
-      {"pulse", "None", 18.1, 49.2, "18.1", "49.2", Kind("none")},
-      {"pulse", "3rd Poly 9ms", 1.80, 18.3, "1.80", "18.3", Delay("poly3", 9.0)},
-      {"pulse", "Lead Comp 9ms", 2.97, 16.0, "2.97", "16.0", Delay("lead", 9.0)},
-      {"pulse", "Bumpless + LP", 2.04, 8.45, "2.04", "8.45", Kind("bumpless_lp")},
-      {"pulse", "G_FF,avgA", 1.93, 6.35, "1.93", "6.35", Model("ff", "avg")},
-      {"pulse", "G_FF,avgA + LQG", 1.09, 4.72, "1.09", "4.72", Model("ff_lqg", "avg")},
+      {"0.0A", "None", 16.0, 42.9, "16.0", "42.9", ControllerKind("none")},
+      {"0.0A", "3rd Poly 8ms", 1.22, 12.8, "1.22", "12.8", ControllerDelay("poly3", 8.0)},
+      {"0.0A", "Lead Comp 8ms", 1.95, 13.3, "1.95", "13.3", ControllerDelay("lead", 8.0)},
+      {"0.0A", "G_FF,0.0A + LP", 1.01, 4.27, "1.01", "4.27", ControllerModel("ff_lp", "0.0A")},
+      {"0.0A", "G_FF,0.0A", 0.942, 3.45, "0.942", "3.45", ControllerModel("ff", "0.0A")},
+      {"0.0A", "G_FF,avgA + LQG", 1.16, 3.89, "1.16", "3.89", ControllerModel("ff_lqg", "avg")},
+      {"2.5A", "None", 20.1, 51.7, "20.1", "51.7", ControllerKind("none")},
+      {"2.5A", "3rd Poly 10ms", 2.04, 25.9, "2.04", "25.9", ControllerDelay("poly3", 10.0)},
+      {"2.5A", "Lead Comp 10ms", 3.34, 15.1, "3.34", "15.1", ControllerDelay("lead", 10.0)},
+      {"2.5A", "G_FF,2.5A + LP", 2.55, 9.40, "2.55", "9.40", ControllerModel("ff_lp", "2.5A")},
+      {"2.5A", "G_FF,2.5A", 2.27, 4.68, "2.27", "4.68", ControllerModel("ff", "2.5A")},
+      {"2.5A", "G_FF,avgA + LQG", 1.41, 5.57, "1.41", "5.57", ControllerModel("ff_lqg", "avg")},
+      {"pulse", "None", 18.1, 49.2, "18.1", "49.2", ControllerKind("none")},
+      {"pulse", "3rd Poly 9ms", 1.80, 18.3, "1.80", "18.3", ControllerDelay("poly3", 9.0)},
+      {"pulse", "Lead Comp 9ms", 2.97, 16.0, "2.97", "16.0", ControllerDelay("lead", 9.0)},
+      {"pulse", "Bumpless + LP", 2.04, 8.45, "2.04", "8.45", ControllerKind("bumpless_lp")},
+      {"pulse", "G_FF,avgA", 1.93, 6.35, "1.93", "6.35", ControllerModel("ff", "avg")},
+      {"pulse", "G_FF,avgA + LQG", 1.09, 4.72, "1.09", "4.72", ControllerModel("ff_lqg", "avg")},
   };
 }
 
