@@ -7,6 +7,7 @@
 #include "core/error.h"
 #include "lockstep/runtime.h"
 #include "scenario/scenario.h"
+#include "signal/metrics.h"
 
 namespace rths::io {
 
@@ -94,13 +95,10 @@ RunMetrics ComputeMetrics(const RunLog& log) {
       vel_true.push_back(log.desired[k + 1].vel_prev_mm_s);
     }
   }
-  auto pct = [](const std::vector<double>& truth, const std::vector<double>& est) {
-    double num = 0, den = 0;
-    for (std::size_t i = 0; i < truth.size(); ++i) {
-      num += (truth[i] - est[i]) * (truth[i] - est[i]);
-      den += truth[i] * truth[i];
-    }
-    return den > 0 ? 100.0 * std::sqrt(num / den) : 0.0;
+  // Eq. 31's norm; 0 where the reference is all zeros (nothing to compare).
+  auto pct = [](const std::vector<double>& reference, const std::vector<double>& estimate) {
+    const double p = signal::RmsErrorPercent(reference, estimate);
+    return std::isfinite(p) ? p : 0.0;
   };
   m.tracking_nrmse_pct = pct(r, y);
   m.accel_extrapolation_rms_err_pct = pct(acc_true, acc_pred);

@@ -17,7 +17,6 @@
 #include "io/run_log.h"
 #include "participants/factory.h"
 #include "participants/group.h"
-#include "signal/metrics.h"
 
 namespace rths::report {
 
@@ -125,10 +124,10 @@ RunResult RunOne(const RunSpec& spec) {
   res.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   try {
     if (fs::exists(spec.dir / "log.lcm")) {
-      const Trace t = ReadTrace(spec.dir);
-      res.steps = static_cast<std::int64_t>(t.r_mm.size());
-      if (res.steps > 0) res.tracking_pct = signal::RmsErrorPercent(t.r_mm, t.y_mm);
-      for (double f : t.f_kN) res.peak_force_kN = std::max(res.peak_force_kN, std::abs(f));
+      const io::RunMetrics m = io::ComputeMetrics(io::ReadRunLog((spec.dir / "log.lcm").string()));
+      res.steps = m.steps;
+      res.tracking_pct = m.tracking_nrmse_pct;
+      res.peak_force_kN = m.peak_force_kN;
       if (res.error.empty() && res.steps != s.steps()) {
         res.error = fmt::format("the log holds {} of {} steps", res.steps, s.steps());
       }
