@@ -1,0 +1,130 @@
+#pragma once
+/// @file The effect library of the sim-to-real diagnosis (../shared/spec/diagnosis.md, "The
+/// effect library"): unmodelled effects of a real rig, as small per-sample blocks shared by the
+/// plant's rig mode (procs/plant, which switches them on to rehearse a real rig) and by the
+/// diagnosis (lib/diagnosis, which adds them to the nominal model to explain a residual).
+/// Units: mm, kN, A, s (docs/units.md); parameters carry their unit in their name.
+///
+/// Where each effect acts (one order, documented in docs/diagnosis.md):
+///
+///   displacement path   u_k --[pure_delay]--[gain_error]--> actuator model --> x_k
+///                       x_k --[oil_column_resonance]--[servovalve_saturation]
+///                           --[load_coupling (- c f)]--[coulomb_friction]--[backlash]--> y_k
+///   force path          i_k --[current_lag]--> model's current dynamics (Eq. 40 + 75 Hz) --> i_c
+///                       damper model (Eqs. 32-39) at (y, y', i_c) --[damper_scale]--> f_k
+///   both channels       + sensor_noise (rig mode only: the diagnosis never adds noise)
+///
+/// Every block is an immutable description (the parameters and dt) plus a per-step state; the
+/// per-step calls allocate nothing (the delay line is sized once, at construction).
+#include <array>
+#include <optional>
+#include <string_view>
+#include <vector>
+
+namespace rths::models {
+
+/// The library's effect names, exactly as in the contract (the JSON and the scenario use them).
+inline constexpr std::array<std::string_view, 10> kEffectNames = {
+    "pure_delay",        "gain_error", "load_coupling",         "oil_column_resonance",
+    "coulomb_friction",  "backlash",   "servovalve_saturation", "sensor_noise",
+    "current_lag",       "damper_scale"};
+
+/// Transport delay of the command: u_d(t) = u(t - tau), linear interpolation between samples.
+struct PureDelay { double tau_ms = 0.0; };                          ///< [0, 100] ms
+/// Static gain mismatch of the displacement path: the actuator model sees gain * u.
+struct GainError { double gain = 1.0; };                            ///< [0.5, 2]
+/// The actuator yields under the specimen force: y = x - compliance * f_{k-1}.
+struct LoadCoupling { double compliance_mm_per_kN = 0.0; };         ///< [-1, 1] mm/kN
+/// An extra, lightly damped mode in series: w^2 / (s^2 + 2 zeta w s + w^2), w = 2 pi f_hz
+/// (unity at DC), discretised exactly with a zero-order hold on its input.
+struct OilColumnResonance { double f_hz = 60.0; double zeta = 0.05; };  ///< f in (0, 0.45/dt), zeta (0, 2]
+/// Seal friction: displacement lost against the direction of motion,
+/// y = x - loss * tanh(x' / v_smooth), x' = (x_k - x_{k-1}) / dt of the block's input.
+struct CoulombFriction { double loss_mm = 0.0; double v_smooth_mm_s = 0.5; };  ///< loss [0, 10] mm
+/// Dead band (play operator): y holds until its input has moved gap/2 past it, then follows.
+struct Backlash { double gap_mm = 0.0; };                           ///< [0, 10] mm
+/// Flow limit: the output moves at most vmax * dt per step towards its input (rate limiter).
+struct ServovalveSaturation { double vmax_mm_per_s = 1e9; };        ///< > 0
+/// Gaussian measurement noise added to a channel (rig mode only); rms in the channel's unit.
+struct SensorNoise { double rms_y_mm = 0.0; double rms_f_kN = 0.0; };  ///< >= 0
+/// Extra first-order lag of the damper current, 1 / (tau s + 1), exact ZOH, in series with the
+/// model's own current dynamics.
+struct CurrentLag { double tau_ms = 0.0; };                         ///< [0, 1000] ms
+/// Damper force level drift: f = scale * f_model.
+struct DamperScale { double scale = 1.0; };                         ///< [0.1, 10]
+
+/// Which effects are on, with their parameters. Default: none (the nominal model).
+struct EffectSet {
+  std::optional<PureDelay> pure_delay;
+  std::optional<GainError> gain_error;
+  std::optional<LoadCoupling> load_coupling;
+  std::optional<OilColumnResonance> oil_column_resonance;
+  std::optional<CoulombFriction> coulomb_friction;
+  std::optional<Backlash> backlash;
+  std::optional<ServovalveSaturation> servovalve_saturation;
+  std::optional<SensorNoise> sensor_noise;
+  std::optional<CurrentLag> current_lag;
+  std::optional<DamperScale> damper_scale;
+
+  bool Empty() const;
+  /// Throws rths::Error naming the effect and parameter out of its range (ranges above) for a
+  /// time step dt_s [s]; `where` prefixes the message (e.g. the scenario file and table).
+  void Validate(double dt_s, std::string_view where) const;
+};
+
+/// The displacement path's effects around an actuator model (order in the file comment).
+/// Use: per step k, u_act = Pre(u_k) goes into the actuator model, whose output x at t_k goes
+/// through Post(x, f_prev) to give the displacement y_k (before any noise).
+class DisplacementEffects {
+ public:
+  /// Sizes the delay line for tau (allocates here only). Throws rths::Error for bad parameters.
+  DisplacementEffects(const EffectSet& effects, double dt_s);
+  /// Back to rest (all inputs and outputs 0).
+  void Reset();
+  /// Command u_k [mm] -> the command the actuator model holds over [t_k, t_{k+1}) [mm]
+  /// (pure_delay, then gain_error). Call once per step, in order.
+  double Pre(double u_mm);
+  /// Actuator model output x_k [mm] at t_k and the specimen force of the previous sample
+  /// f_prev_kN [kN] -> the specimen / measured displacement y_k [mm] (oil_column_resonance,
+  /// servovalve_saturation, load_coupling, coulomb_friction, backlash). Call once per step.
+  double Post(double x_mm, double f_prev_kN);
+  /// true if Pre() is the identity (no delay, gain 1).
+  bool PreIsIdentity() const;
+
+ private:
+  EffectSet e_;
+  double dt_s_ = 0.0;
+  // pure delay: ring buffer of past commands
+  std::vector<double> ring_;
+  std::size_t head_ = 0;
+  std::size_t count_ = 0;
+  // oil column: ZOH 2x2 state-space [q, q'] with input x
+  double a11_ = 1, a12_ = 0, a21_ = 0, a22_ = 1, b1_ = 0, b2_ = 0;
+  double q1_ = 0, q2_ = 0;
+  double prev_in_ = 0.0;       // previous input of the oil-column block (ZOH)
+  double rate_out_ = 0.0;      // servovalve saturation output
+  double fric_prev_in_ = 0.0;  // friction block's previous input
+  double play_out_ = 0.0;      // backlash output
+};
+
+/// The force path's effects: current_lag before the model's current dynamics, damper_scale
+/// on the model's force.
+class ForceEffects {
+ public:
+  ForceEffects(const EffectSet& effects, double dt_s);
+  /// Back to rest at the constant current i0_A (the lag's state at steady state).
+  void Reset(double i0_A = 0.0);
+  /// Commanded current i_k [A] -> the current the model's current dynamics receive over
+  /// [t_k, t_{k+1}) [A]: the lag's output, exact ZOH: l_{k+1} = a l_k + (1 - a) i_k,
+  /// a = exp(-dt / tau); returns l_k (the value held over the step).
+  double Current(double i_A);
+  /// Model force [kN] -> scale * force [kN].
+  double Force(double f_kN) const;
+
+ private:
+  EffectSet e_;
+  double a_ = 0.0;
+  double lag_ = 0.0;
+};
+
+}  // namespace rths::models
