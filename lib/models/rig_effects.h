@@ -101,7 +101,6 @@ class DisplacementEffects {
   // oil column: ZOH 2x2 state-space [q, q'] with input x
   double a11_ = 1, a12_ = 0, a21_ = 0, a22_ = 1, b1_ = 0, b2_ = 0;
   double q1_ = 0, q2_ = 0;
-  double prev_in_ = 0.0;       // previous input of the oil-column block (ZOH)
   double rate_out_ = 0.0;      // servovalve saturation output
   double fric_prev_in_ = 0.0;  // friction block's previous input
   double play_out_ = 0.0;      // backlash output
@@ -116,7 +115,7 @@ class ForceEffects {
   void Reset(double i0_A = 0.0);
   /// Commanded current i_k [A] -> the current the model's current dynamics receive over
   /// [t_k, t_{k+1}) [A]: the lag's output, exact ZOH: l_{k+1} = a l_k + (1 - a) i_k,
-  /// a = exp(-dt / tau); returns l_k (the value held over the step).
+  /// a = exp(-dt / tau); returns l_{k+1} (no extra sample of delay: tau -> 0 gives i_k).
   double Current(double i_A);
   /// Model force [kN] -> scale * force [kN].
   double Force(double f_kN) const;

@@ -1,0 +1,168 @@
+// The effect library's blocks (lib/models/rig_effects.h): each one's signature on simple inputs.
+#include <cmath>
+#include <string>
+
+#include <doctest/doctest.h>
+
+#include "alloc_counter.h"
+#include "core/error.h"
+#include "models/rig_effects.h"
+
+using namespace rths;
+using namespace rths::models;
+
+namespace {
+constexpr double kDt = 0.0005;
+}
+
+TEST_CASE("an empty effect set is the identity") {
+  EffectSet e;
+  CHECK(e.Empty());
+  DisplacementEffects d(e, kDt);
+  ForceEffects f(e, kDt);
+  CHECK(d.PreIsIdentity());
+  for (int k = 0; k < 100; ++k) {
+    const double u = std::sin(0.1 * k);
+    CHECK(d.Pre(u) == u);
+    CHECK(d.Post(u, 3.0) == u);
+    CHECK(f.Current(u) == u);
+    CHECK(f.Force(u) == u);
+  }
+}
+
+TEST_CASE("pure_delay shifts the command by tau, with linear interpolation") {
+  EffectSet e;
+  e.pure_delay = PureDelay{1.25};  // 2.5 samples
+  DisplacementEffects d(e, kDt);
+  CHECK_FALSE(d.PreIsIdentity());
+  // A ramp u_k = k: delayed by 2.5 samples -> k - 2.5 once the line is full.
+  for (int k = 0; k < 20; ++k) {
+    const double out = d.Pre(k);
+    if (k >= 3) CHECK(out == doctest::Approx(k - 2.5).epsilon(1e-12));
+    if (k < 2) CHECK(out == 0.0);
+  }
+}
+
+TEST_CASE("gain_error scales the command") {
+  EffectSet e;
+  e.gain_error = GainError{1.1};
+  DisplacementEffects d(e, kDt);
+  CHECK(d.Pre(2.0) == doctest::Approx(2.2));
+}
+
+TEST_CASE("oil_column_resonance: unity at DC, rings at f_hz") {
+  EffectSet e;
+  e.oil_column_resonance = OilColumnResonance{50.0, 0.05};
+  DisplacementEffects d(e, kDt);
+  // Step response: overshoot ~ exp(-pi zeta / sqrt(1 - zeta^2)) = 0.855, settles at 1.
+  double peak = 0.0, last = 0.0;
+  int first_peak = -1;
+  double prev = 0.0;
+  for (int k = 0; k < 20000; ++k) {
+    last = d.Post(1.0, 0.0);
+    if (first_peak < 0 && k > 0 && last < prev) first_peak = k - 1;
+    prev = last;
+    peak = std::max(peak, last);
+  }
+  CHECK(last == doctest::Approx(1.0).epsilon(1e-9));
+  CHECK(peak - 1.0 == doctest::Approx(0.855).epsilon(0.01));
+  // First peak at half the damped period: 1 / (2 f_d) = 10.0 ms = 20 samples (+-1, ZOH).
+  CHECK(first_peak >= 19);
+  CHECK(first_peak <= 21);
+}
+
+TEST_CASE("servovalve_saturation bounds the output's rate") {
+  EffectSet e;
+  e.servovalve_saturation = ServovalveSaturation{100.0};  // 0.05 mm per step
+  DisplacementEffects d(e, kDt);
+  double prev = 0.0;
+  for (int k = 0; k < 400; ++k) {
+    const double y = d.Post(5.0 * std::sin(2 * M_PI * 10 * k * kDt), 0.0);  // 314 mm/s peak
+    CHECK(std::abs(y - prev) <= 0.05 + 1e-12);
+    prev = y;
+  }
+}
+
+TEST_CASE("load_coupling: y = x - c f") {
+  EffectSet e;
+  e.load_coupling = LoadCoupling{0.01};
+  DisplacementEffects d(e, kDt);
+  CHECK(d.Post(1.0, 20.0) == doctest::Approx(0.8));
+}
+
+TEST_CASE("coulomb_friction loses displacement against the motion") {
+  EffectSet e;
+  e.coulomb_friction = CoulombFriction{0.1, 0.5};
+  DisplacementEffects d(e, kDt);
+  double y = 0.0;
+  for (int k = 1; k <= 100; ++k) y = d.Post(0.01 * k, 0.0);  // 20 mm/s upwards
+  CHECK(y == doctest::Approx(1.0 - 0.1).epsilon(1e-6));
+  for (int k = 99; k >= 50; --k) y = d.Post(0.01 * k, 0.0);  // downwards
+  CHECK(y == doctest::Approx(0.5 + 0.1).epsilon(1e-6));
+}
+
+TEST_CASE("backlash: lost motion of the gap at a reversal") {
+  EffectSet e;
+  e.backlash = Backlash{0.2};
+  DisplacementEffects d(e, kDt);
+  double y = 0.0;
+  for (int k = 1; k <= 100; ++k) y = d.Post(0.01 * k, 0.0);
+  CHECK(y == doctest::Approx(0.9));  // trails by gap / 2
+  // Reverse by 0.15 mm (< gap): the output does not move.
+  for (int k = 99; k >= 85; --k) CHECK(d.Post(0.01 * k, 0.0) == doctest::Approx(0.9));
+  y = d.Post(0.5, 0.0);
+  CHECK(y == doctest::Approx(0.6));
+}
+
+TEST_CASE("current_lag is a first-order lag; damper_scale scales") {
+  EffectSet e;
+  e.current_lag = CurrentLag{10.0};
+  e.damper_scale = DamperScale{0.8};
+  ForceEffects f(e, kDt);
+  double i = 0.0;
+  for (int k = 0; k < 20; ++k) i = f.Current(2.5);  // 10 ms = tau
+  CHECK(i == doctest::Approx(2.5 * (1 - std::exp(-1.0))).epsilon(1e-9));
+  CHECK(f.Force(10.0) == doctest::Approx(8.0));
+  f.Reset(1.0);
+  CHECK(f.Current(1.0) == doctest::Approx(1.0));
+}
+
+TEST_CASE("bad parameters name the effect, the key and the range") {
+  EffectSet e;
+  e.backlash = Backlash{-1.0};
+  try {
+    e.Validate(kDt, "s.toml");
+    FAIL("no error");
+  } catch (const Error& err) {
+    const std::string msg = err.what();
+    CHECK(msg.find("s.toml") != std::string::npos);
+    CHECK(msg.find("backlash.gap_mm") != std::string::npos);
+    CHECK(msg.find("[0, 10]") != std::string::npos);
+  }
+  EffectSet o;
+  o.oil_column_resonance = OilColumnResonance{1000.0, 0.1};  // above 0.45 / dt = 900 Hz
+  CHECK_THROWS_AS(DisplacementEffects(o, kDt), Error);
+}
+
+TEST_CASE("the per-step calls allocate nothing") {
+  EffectSet e;
+  e.pure_delay = PureDelay{3.3};
+  e.gain_error = GainError{1.05};
+  e.oil_column_resonance = OilColumnResonance{40.0, 0.1};
+  e.servovalve_saturation = ServovalveSaturation{200.0};
+  e.load_coupling = LoadCoupling{0.001};
+  e.coulomb_friction = CoulombFriction{0.02, 0.5};
+  e.backlash = Backlash{0.05};
+  e.current_lag = CurrentLag{5.0};
+  e.damper_scale = DamperScale{1.2};
+  DisplacementEffects d(e, kDt);
+  ForceEffects f(e, kDt);
+  double acc = 0.0;
+  const long before = rths_test::AllocationCount();
+  for (int k = 0; k < 1000; ++k) {
+    const double u = d.Pre(std::sin(0.01 * k));
+    acc += d.Post(u, 1.0) + f.Force(f.Current(1.0));
+  }
+  CHECK(rths_test::AllocationCount() == before);
+  CHECK(std::isfinite(acc));
+}
