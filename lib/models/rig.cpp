@@ -120,20 +120,20 @@ std::unique_ptr<Rig> MakeRig(const scenario::PlantConfig& plant, double dt_s) {
   }
   if (plant.kind == "linear") {
     return std::make_unique<LinearRigAdapter>(LinearRig::Make(plant.actuator, dt_s, damper,
-                                                              MrDamperParams::Table3(),
+                                                              plant.damper,
                                                               plant.cvode_rtol,
                                                               plant.current_dynamics));
   }
   if (plant.kind == "physical") {
     return std::make_unique<PhysicalRigAdapter>(
         PhysicalRig::Make(plant.physical, dt_s, damper ? RigLoad::kMrDamper : RigLoad::kNone,
-                          plant.current_dynamics, MrDamperParams::Table3(), {},
+                          plant.current_dynamics, plant.damper, {},
                           plant.cvode_rtol));
   }
   if (plant.kind == "ideal") {
     if (!(plant.cvode_rtol > 0.0 && plant.cvode_rtol <= 1e-2))
       throw Error("plant.cvode_rtol", fmt::format("must be in (0, 1e-2] (got {})", plant.cvode_rtol));
-    return std::make_unique<IdealRig>(MrDamperParams::Table3(), damper, plant.current_dynamics, dt_s,
+    return std::make_unique<IdealRig>(plant.damper, damper, plant.current_dynamics, dt_s,
                                       plant.cvode_rtol);
   }
   throw Error("plant.kind",

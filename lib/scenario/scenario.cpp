@@ -207,6 +207,11 @@ class Section {
     return Section(file_, table, Dotted(key) + ".");
   }
 
+  /// true if the table exists in the file (a Sub() of an absent table is empty).
+  bool Present() const { return table_ != nullptr; }
+  /// true if the table has `key` (declared or not).
+  bool Has(std::string_view key) const { return table_ != nullptr && table_->get(key) != nullptr; }
+
   /// Rejects every key that no read declared, suggesting the closest declared one.
   void Finish() const {
     if (table_ == nullptr) return;
@@ -272,6 +277,97 @@ std::vector<std::pair<const char*, double*>> PhysicalFields(PhysicalActuatorConf
           {"kp_per_m", &p->kp_per_m},
           {"beta_Pa", &p->beta_Pa},
           {"leakage_m3_s_Pa", &p->leakage_m3_s_Pa}};
+}
+
+/// The Spencer damper's keys ([plant.damper]), in file order: every MrDamperParams field.
+std::vector<std::pair<const char*, double*>> DamperFields(models::MrDamperParams* d) {
+  return {{"alpha_a", &d->alpha_a}, {"alpha_b", &d->alpha_b}, {"alpha_c", &d->alpha_c},
+          {"c0_a", &d->c0_a},       {"c0_b", &d->c0_b},       {"c0_c", &d->c0_c},
+          {"c1_a", &d->c1_a},       {"c1_b", &d->c1_b},       {"c1_c", &d->c1_c},
+          {"beta_a", &d->beta_a},   {"beta_b", &d->beta_b},   {"beta_c", &d->beta_c},
+          {"gamma_a", &d->gamma_a}, {"gamma_b", &d->gamma_b}, {"gamma_c", &d->gamma_c},
+          {"A", &d->A},             {"n", &d->n},             {"k0", &d->k0},
+          {"k1", &d->k1},           {"x0", &d->x0}};
+}
+
+/// One parameter of an effect of the library: its key, where it goes, whether the table must
+/// give it.
+struct EffectKey {
+  const char* key;
+  double* field;
+  bool required;
+};
+
+/// The keys of each effect present in `e` (the contract's parameter names, models/rig_effects.h),
+/// in file order; effects that are off have no keys. `e` must outlive the result.
+std::vector<std::pair<const char*, std::vector<EffectKey>>> EffectKeys(models::EffectSet* e) {
+  std::vector<std::pair<const char*, std::vector<EffectKey>>> out;
+  if (e->pure_delay) out.push_back({"pure_delay", {{"tau_ms", &e->pure_delay->tau_ms, true}}});
+  if (e->gain_error) out.push_back({"gain_error", {{"gain", &e->gain_error->gain, true}}});
+  if (e->load_coupling)
+    out.push_back({"load_coupling", {{"compliance_mm_per_kN", &e->load_coupling->compliance_mm_per_kN, true}}});
+  if (e->oil_column_resonance)
+    out.push_back({"oil_column_resonance",
+                   {{"f_hz", &e->oil_column_resonance->f_hz, true}, {"zeta", &e->oil_column_resonance->zeta, false}}});
+  if (e->coulomb_friction)
+    out.push_back({"coulomb_friction",
+                   {{"loss_mm", &e->coulomb_friction->loss_mm, true},
+                    {"v_smooth_mm_s", &e->coulomb_friction->v_smooth_mm_s, false}}});
+  if (e->backlash) out.push_back({"backlash", {{"gap_mm", &e->backlash->gap_mm, true}}});
+  if (e->servovalve_saturation)
+    out.push_back({"servovalve_saturation", {{"vmax_mm_per_s", &e->servovalve_saturation->vmax_mm_per_s, true}}});
+  if (e->sensor_noise)
+    out.push_back({"sensor_noise",
+                   {{"rms_y_mm", &e->sensor_noise->rms_y_mm, false}, {"rms_f_kN", &e->sensor_noise->rms_f_kN, false}}});
+  if (e->current_lag) out.push_back({"current_lag", {{"tau_ms", &e->current_lag->tau_ms, true}}});
+  if (e->damper_scale) out.push_back({"damper_scale", {{"scale", &e->damper_scale->scale, true}}});
+  return out;
+}
+
+/// Switches on, with its defaults, the effect called `name` (one of models::kEffectNames).
+void TurnOn(models::EffectSet* e, std::string_view name) {
+  if (name == "pure_delay") e->pure_delay.emplace();
+  if (name == "gain_error") e->gain_error.emplace();
+  if (name == "load_coupling") e->load_coupling.emplace();
+  if (name == "oil_column_resonance") e->oil_column_resonance.emplace();
+  if (name == "coulomb_friction") e->coulomb_friction.emplace();
+  if (name == "backlash") e->backlash.emplace();
+  if (name == "servovalve_saturation") e->servovalve_saturation.emplace();
+  if (name == "sensor_noise") e->sensor_noise.emplace();
+  if (name == "current_lag") e->current_lag.emplace();
+  if (name == "damper_scale") e->damper_scale.emplace();
+}
+
+/// [plant.effects]: one sub-table per effect that is on; an unknown name is refused by Finish()
+/// with the list of the library's names.
+void ReadEffects(Section& effects, models::EffectSet* out) {
+  models::EffectSet e;
+  std::vector<Section> tables;
+  tables.reserve(models::kEffectNames.size());
+  for (std::string_view name : models::kEffectNames) {
+    tables.push_back(effects.Sub(name));
+    if (tables.back().Present()) TurnOn(&e, name);
+  }
+  effects.Finish();
+  for (auto& [name, keys] : EffectKeys(&e)) {
+    Section* table = nullptr;
+    for (std::size_t i = 0; i < models::kEffectNames.size(); ++i) {
+      if (models::kEffectNames[i] == name) table = &tables[i];
+    }
+    for (const EffectKey& k : keys) table->Number(k.key, k.field);
+    table->Finish();
+    for (const EffectKey& k : keys) {
+      if (k.required && !table->Has(k.key)) {
+        table->Fail(k.key, fmt::format("missing (the effect \"{}\" needs it; remove the table to switch the "
+                                       "effect off)",
+                                       name));
+      }
+    }
+    if (std::string_view(name) == "sensor_noise" && !table->Has("rms_y_mm") && !table->Has("rms_f_kN")) {
+      table->Fail("rms_y_mm", "missing (sensor_noise needs rms_y_mm, rms_f_kN or both)");
+    }
+  }
+  *out = e;
 }
 
 /// `rms_key` is the unit-bearing name of SignalSpec::rms in this table.
@@ -348,6 +444,16 @@ void ReadScenario(const toml::table& root, const std::string& file, Scenario* s)
   plant.Number("noise_f_kN_rms", &s->plant.noise_f_kN_rms);
   plant.Integer("noise_seed", &s->plant.noise_seed);
   plant.Number("cvode_rtol", &s->plant.cvode_rtol);
+  Section damper = plant.Sub("damper");
+  for (auto [key, field] : DamperFields(&pl.damper)) damper.Number(key, field);
+  damper.Finish();
+  Section effects = plant.Sub("effects");
+  ReadEffects(effects, &pl.effects);
+  Section unmodelled = plant.Sub("unmodelled");
+  unmodelled.Number("ripple_mm", &pl.unmodelled.ripple_mm);
+  unmodelled.Number("ripple_hz", &pl.unmodelled.ripple_hz);
+  unmodelled.Number("stiffness_kN_per_mm", &pl.unmodelled.stiffness_kN_per_mm);
+  unmodelled.Finish();
   plant.Finish();
 
   Section semiactive = top.Sub("semiactive");
@@ -404,6 +510,8 @@ class Check {
   [[noreturn]] void Fail(std::string_view key, std::string problem) const {
     throw Error(fmt::format("{}: {}", file_, key), std::move(problem));
   }
+
+  const std::string& file() const { return file_; }
 
   void InRange(std::string_view key, double v, const Range& r) const {
     const bool above_lo = r.lo_open ? v > r.lo : v >= r.lo;
@@ -548,7 +656,58 @@ void ValidatePhysical(const PhysicalActuatorConfig& p, const Check& check) {
   }
 }
 
-void ValidatePlant(const PlantConfig& p, const Check& check) {
+/// The allowed range of each effect parameter (models/rig_effects.h), for the scenario's messages.
+Range EffectRange(std::string_view effect, std::string_view key, double dt_s) {
+  if (effect == "pure_delay") return Closed(0.0, 100.0);
+  if (effect == "gain_error") return Closed(0.5, 2.0);
+  if (effect == "load_coupling") return Closed(-1.0, 1.0);
+  if (effect == "oil_column_resonance") {
+    if (key == "f_hz") return {0.0, 0.45 / dt_s, true, true, "below 0.45/run.dt_s"};
+    return OpenClosed(0.0, 2.0);
+  }
+  if (effect == "coulomb_friction") return key == "loss_mm" ? Closed(0.0, 10.0) : OpenClosed(0.0, 1000.0);
+  if (effect == "backlash") return Closed(0.0, 10.0);
+  if (effect == "servovalve_saturation") return OpenClosed(0.0, 1e9);
+  if (effect == "sensor_noise") return key == "rms_y_mm" ? Closed(0.0, 10.0) : Closed(0.0, 100.0);
+  if (effect == "current_lag") return Closed(0.0, 1000.0);
+  return Closed(0.1, 10.0);  // damper_scale
+}
+
+void ValidateEffects(const PlantConfig& p, double dt_s, const Check& check) {
+  models::EffectSet e = p.effects;
+  for (auto& [name, keys] : EffectKeys(&e)) {
+    for (const EffectKey& k : keys) {
+      check.InRange(fmt::format("plant.effects.{}.{}", name, k.key), *k.field, EffectRange(name, k.key, dt_s));
+    }
+  }
+  p.effects.Validate(dt_s, check.file() + ": plant.effects");  // the library's own ranges
+  const UnmodelledConfig& u = p.unmodelled;
+  check.InRange("plant.unmodelled.ripple_mm", u.ripple_mm, Closed(0.0, 10.0));
+  check.InRange("plant.unmodelled.ripple_hz", u.ripple_hz,
+                {0.0, 0.5 / dt_s, u.ripple_mm > 0.0, true,
+                 u.ripple_mm > 0.0 ? "a ripple needs a frequency below the Nyquist frequency 0.5/run.dt_s"
+                                   : "below the Nyquist frequency 0.5/run.dt_s"});
+  check.InRange("plant.unmodelled.stiffness_kN_per_mm", u.stiffness_kN_per_mm, Closed(-100.0, 100.0));
+  if (p.RigMode() && p.kind != "linear") {
+    check.Fail(p.effects.Empty() ? "plant.unmodelled" : "plant.effects",
+               fmt::format("rig mode needs plant.kind = \"linear\" (got \"{}\"): the effects act around the "
+                           "linear actuator model",
+                           p.kind));
+  }
+}
+
+void ValidateDamper(const models::MrDamperParams& d, const Check& check) {
+  try {
+    d.Validate();
+  } catch (const Error& e) {
+    // "MrDamperParams: alpha_a" -> plant.damper.alpha_a
+    const std::string& w = e.where();
+    const std::size_t colon = w.rfind(": ");
+    check.Fail(fmt::format("plant.damper.{}", colon == std::string::npos ? w : w.substr(colon + 2)), e.problem());
+  }
+}
+
+void ValidatePlant(const PlantConfig& p, double dt_s, const Check& check) {
   check.OneOf("plant.kind", p.kind, {"linear", "physical", "ideal"});
   ValidateServo(p.actuator, "plant.actuator", check);
   ValidatePhysical(p.physical, check);
@@ -556,6 +715,8 @@ void ValidatePlant(const PlantConfig& p, const Check& check) {
   check.InRange("plant.noise_y_mm_rms", p.noise_y_mm_rms, Closed(0.0, 10.0));
   check.InRange("plant.noise_f_kN_rms", p.noise_f_kN_rms, Closed(0.0, 100.0));
   check.InRange("plant.cvode_rtol", p.cvode_rtol, OpenClosed(0.0, 1e-2));
+  ValidateDamper(p.damper, check);
+  ValidateEffects(p, dt_s, check);
 }
 
 void ValidateSemiactive(const SemiactiveConfig& s, const Check& check) {
@@ -623,7 +784,7 @@ void ValidateScenario(const Scenario& s) {
   }
   check.InRange("semiactive.pulse_hz", s.semiactive.pulse_hz,
                 {0.0, 0.25 / s.run.dt_s, true, true, "at least four steps per period: below 0.25/run.dt_s"});
-  ValidatePlant(s.plant, check);
+  ValidatePlant(s.plant, s.run.dt_s, check);
   ValidateSemiactive(s.semiactive, check);
   ValidateLockstep(s.lockstep, check);
   ValidateSafety(s.safety, check);
@@ -711,6 +872,17 @@ std::string ToToml(const Scenario& s) {
   o += "\n[plant.physical]\n";
   PhysicalActuatorConfig phys = p.physical;
   for (auto [key, field] : PhysicalFields(&phys)) o += fmt::format("{} = {}\n", key, TomlNumber(*field));
+  o += "\n[plant.damper]\n";
+  models::MrDamperParams damper = p.damper;
+  for (auto [key, field] : DamperFields(&damper)) o += fmt::format("{} = {}\n", key, TomlNumber(*field));
+  o += fmt::format("\n[plant.unmodelled]\nripple_mm = {}\nripple_hz = {}\nstiffness_kN_per_mm = {}\n",
+                   TomlNumber(p.unmodelled.ripple_mm), TomlNumber(p.unmodelled.ripple_hz),
+                   TomlNumber(p.unmodelled.stiffness_kN_per_mm));
+  models::EffectSet effects = p.effects;
+  for (auto& [name, keys] : EffectKeys(&effects)) {
+    o += fmt::format("\n[plant.effects.{}]\n", name);
+    for (const EffectKey& k : keys) o += fmt::format("{} = {}\n", k.key, TomlNumber(*k.field));
+  }
   const auto& sa = s.semiactive;
   o += fmt::format(
       "\n[semiactive]\nmode = {}\ncurrent_A = {}\nmax_current_A = {}\npulse_hz = {}\npulse_duty = {}\n"

@@ -10,6 +10,9 @@
 #include <string_view>
 #include <vector>
 
+#include "models/mr_damper.h"
+#include "models/rig_effects.h"
+
 namespace rths::scenario {
 
 /// A three-pole servohydraulic model G(s) = K / ((s + p)(s^2 + b s + c)) (Eq. 15 with N = 3;
@@ -115,6 +118,21 @@ struct PhysicalActuatorConfig {
   double leakage_m3_s_Pa = 2.693e-11;  ///< total leakage coefficient C_tot, [0, 1e-6]
 };
 
+/// Disturbances of the rig mode that are deliberately NOT in the effect library
+/// (models/rig_effects.h), so that the diagnosis can be tested on its "unknown" verdict
+/// (docs/rig_mode.md). All off (0) by default.
+struct UnmodelledConfig {
+  /// Periodic disturbance on the measured displacement (e.g. supply-pressure ripple):
+  /// y_meas += ripple_mm sin(2 pi ripple_hz t_k). Amplitude [mm], [0, 10].
+  double ripple_mm = 0.0;
+  double ripple_hz = 0.0;            ///< [Hz], (0, 0.5/run.dt_s) when ripple_mm > 0, else [0, ...)
+  /// Extra spring force on the measured force (e.g. an accumulator): f += k y, y the specimen
+  /// displacement before noise [kN/mm], [-100, 100].
+  double stiffness_kN_per_mm = 0.0;
+  /// true if every disturbance is off.
+  bool Empty() const { return ripple_mm == 0.0 && stiffness_kN_per_mm == 0.0; }
+};
+
 /// "Physical" substructure and loading system (procs/plant).
 struct PlantConfig {
   /// "linear": the three-pole model `actuator` (Eqs. 28-30), ZOH-discretised, unaffected by the
@@ -133,6 +151,15 @@ struct PlantConfig {
   double noise_f_kN_rms = 0.0;         ///< Gaussian sensor noise on f [kN], [0, 100]
   std::uint64_t noise_seed = 7;
   double cvode_rtol = 1e-8;            ///< CVODE relative tolerance, (0, 1e-2]
+  /// The Spencer MR damper of every rig (`[plant.damper]`, Eqs. 32-39; default Table 3).
+  models::MrDamperParams damper{};
+  /// Rig mode (docs/rig_mode.md): effects of the library switched on, `[plant.effects.<name>]`
+  /// (kind = "linear" only). Empty: the nominal plant.
+  models::EffectSet effects{};
+  /// Rig mode: disturbances outside the library, `[plant.unmodelled]` (kind = "linear" only).
+  UnmodelledConfig unmodelled{};
+  /// true if the plant runs in rig mode (effects or unmodelled disturbances on).
+  bool RigMode() const { return !effects.Empty() || !unmodelled.Empty(); }
 };
 
 /// Semiactive current (procs/semiactive). Constant modes, or the 0.5 Hz pulse of Table 2;
