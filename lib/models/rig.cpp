@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include "core/error.h"
+#include "models/effect_rig.h"
 #include "models/linear_rig.h"
 #include "models/servo_physical.h"
 #include "models/current_driver.h"
@@ -118,7 +119,16 @@ std::unique_ptr<Rig> MakeRig(const scenario::PlantConfig& plant, double dt_s) {
     throw Error("plant.specimen",
                 fmt::format("\"{}\" is not one of \"mr_damper\", \"none\"", plant.specimen));
   }
-  if (plant.kind == "linear") {
+  if (plant.RigMode()) {  // effects or unmodelled disturbances on: docs/rig_mode.md
+    if (plant.kind != "linear") {
+      throw Error(plant.effects.Empty() ? "plant.unmodelled" : "plant.effects",
+                  fmt::format("rig mode needs plant.kind = \"linear\" (got \"{}\"): the effects act around "
+                              "the linear actuator model",
+                              plant.kind));
+    }
+    return MakeEffectRig(plant, dt_s);
+  }
+  if (plant.kind == "linear") {  // the nominal linear rig, unchanged
     return std::make_unique<LinearRigAdapter>(LinearRig::Make(plant.actuator, dt_s, damper,
                                                               plant.damper,
                                                               plant.cvode_rtol,

@@ -47,7 +47,10 @@ class Rig {
 /// (x = r_k, x' = that velocity).
 ///
 /// The rig that `plant` describes ("linear" | "physical" | "ideal"; specimen "mr_damper" | "none";
-/// current_dynamics; cvode_rtol), stepping at dt_s [s]. Throws rths::Error for a bad kind or value.
+/// current_dynamics; cvode_rtol; the damper parameters plant.damper), stepping at dt_s [s].
+/// With effects or unmodelled disturbances on (plant.RigMode()), the rig mode of
+/// lib/models/effect_rig.h, which needs kind "linear"; otherwise the nominal rigs, unchanged.
+/// Throws rths::Error for a bad kind or value.
 std::unique_ptr<Rig> MakeRig(const scenario::PlantConfig& plant, double dt_s);
 
 }  // namespace rths::models
