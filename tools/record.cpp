@@ -1,0 +1,63 @@
+// rths-record RUN_DIR [--out FILE.csv]
+// Writes a run's plant-side signals as a CSV rig record (../shared/spec/diagnosis.md "Rig record,
+// CSV"; io/rig_record.h): t_s, u_mm (command_t), y_mm and f_kN (measured_t, as the plant published
+// them: with its sensor noise), i_A (current_t, the commanded current), r_mm (desired_t), over the
+// run's complete steps. So a run of ours (e.g. the rig mode: docs/rig_mode.md) can go to
+// `rths diagnose` or to another lab. Default output: RUN_DIR/record.csv.
+// Exit 0 ok, 2 bad input (no such run folder, no log.lcm, a log that is not a usable record).
+#include <cstdio>
+#include <filesystem>
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+#include "io/rig_record.h"
+#include "io/run_log.h"
+
+namespace fs = std::filesystem;
+
+int main(int argc, char** argv) {
+  CLI::App app{"rths-record: a run's plant-side signals (u, y, f, i, r) as a CSV rig record"};
+  std::string run_dir, out;
+  app.add_option("run_dir", run_dir, "run folder written by `rths run` (holds log.lcm)")->required();
+  app.add_option("--out", out, "output CSV (default: RUN_DIR/record.csv)");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e);
+    return code == 0 ? 0 : 2;
+  }
+  std::error_code ec;
+  if (!fs::is_directory(run_dir, ec)) {
+    std::fprintf(stderr, "rths-record: %s: no such run folder (give the folder `rths run` printed, e.g. "
+                         "runs/<time>-<name>)\n", run_dir.c_str());
+    return 2;
+  }
+  const fs::path log_path = fs::path(run_dir) / "log.lcm";
+  if (!fs::is_regular_file(log_path, ec)) {
+    std::fprintf(stderr, "rths-record: %s: no log.lcm in this folder (not a run folder of `rths run`?)\n",
+                 run_dir.c_str());
+    return 2;
+  }
+  try {
+    const rths::io::RunLog log = rths::io::ReadRunLog(log_path.string());
+    rths::io::RigRecord rec = rths::io::RigRecordFromRunLog(log, log_path.string());
+    rec.metadata.emplace_back("producer", "rths record");
+    std::string reason = log.AbortReason();
+    for (char& c : reason) {
+      if (c == '\n' || c == '\r') c = ' ';  // one metadata line
+    }
+    if (!reason.empty()) rec.metadata.emplace_back("run_stopped", reason);
+    if (out.empty()) out = (fs::path(run_dir) / "record.csv").string();
+    rths::io::WriteRigRecord(rec, out);
+    std::printf("%s: %zu samples at dt = %g s (%.3f s) -> %s\n", run_dir.c_str(), rec.size(), rec.dt_s,
+                rec.DurationS(), out.c_str());
+    if (!reason.empty()) {
+      std::printf("  note: the run stopped early (%s); the record holds its complete steps\n", reason.c_str());
+    }
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "rths-record: %s\n", e.what());
+    return 2;
+  }
+  return 0;
+}
