@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <initializer_list>
 #include <memory>
@@ -558,4 +559,107 @@ TEST_CASE("rig mode: MakeRig refuses effects on a physical or ideal plant") {
       CheckContains(e.what(), {"plant.effects", "rig mode needs plant.kind = \"linear\""});
     }
   }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Through the lockstep, and out as a rig record
+
+TEST_CASE("rig mode: a lockstep run (memq) with effects on, then its rig record (rths record's path)") {
+  const fs::path dir = rths_test::TempDir("rig_mode_run");
+  // The example scenario, shortened to 2.5 s (a record needs at least 2 s).
+  const fs::path example = fs::path(RTHS_SOURCE_DIR) / "scenarios/rig_mode_example.toml";
+  Scenario s = rths::scenario::LoadScenario(example.string());
+  REQUIRE(s.plant.effects.pure_delay);
+  REQUIRE(s.plant.effects.damper_scale);
+  s.run.duration_s = 2.5;
+  const fs::path file = rths_test::WriteScenario(dir, rths::scenario::ToToml(s));
+  s = rths::scenario::LoadScenario(file.string());
+  const fs::path out = dir / "run";
+  fs::create_directories(out);
+  const auto r = rths_test::RunMemq({s}, out);
+  for (const auto& e : r.errors) CAPTURE(e);
+  REQUIRE(r.code == 0);
+
+  const rths::io::RunLog log = rths::io::ReadRunLog((out / "log.lcm").string());
+  REQUIRE(log.CompleteSteps() == s.steps());
+  rths::io::RigRecord rec = rths::io::RigRecordFromRunLog(log, (out / "log.lcm").string());
+  rec.metadata.emplace_back("producer", "rths record");
+  const fs::path csv = dir / "record.csv";
+  rths::io::WriteRigRecord(rec, csv.string());
+  const rths::io::RigRecord back = rths::io::ReadRigRecord(csv.string());
+  CHECK(back.size() == static_cast<std::size_t>(s.steps()));
+  CHECK(back.dt_s == s.run.dt_s);
+  CHECK(back.has_r());
+  CHECK(back.Meta("producer") == "rths record");
+  CHECK(back.warnings.empty());
+  // Written with 10 significant digits: the values come back to that precision.
+  for (std::size_t k = 0; k < back.size(); k += 331) {
+    CHECK(back.u_mm[k] == doctest::Approx(log.command[k].u_mm).epsilon(1e-9).scale(1e-6));
+    CHECK(back.y_mm[k] == doctest::Approx(log.measured[k].y_mm).epsilon(1e-9).scale(1e-6));
+    CHECK(back.f_kN[k] == doctest::Approx(log.measured[k].f_kN).epsilon(1e-9).scale(1e-6));
+    CHECK(back.i_A[k] == log.current[k].i_cmd_A);
+  }
+  // The pulse current reaches the record, and the damper answers with force.
+  CHECK(*std::max_element(back.i_A.begin(), back.i_A.end()) == 2.5);
+  CHECK(Rms(back.f_kN) > 5.0);
+
+  // The effects are in the loop: replaying the record's command through the rig model reproduces
+  // the measured y and f to the sensor noise, and the nominal linear rig does not.
+  auto replay = [&](const PlantConfig& plant) {
+    auto rig = rths::models::MakeRig(plant, s.run.dt_s);
+    double ey = 0.0, ef = 0.0;
+    for (std::size_t k = 1; k < back.size(); ++k) {
+      rig->Step(log.command[k - 1].u_mm, log.current[k - 1].i_cmd_A);
+      ey += std::pow(rig->y_mm() - log.measured[k].y_mm, 2);
+      ef += std::pow(rig->f_kN() - log.measured[k].f_kN, 2);
+    }
+    const double n = static_cast<double>(back.size() - 1);
+    return std::pair{std::sqrt(ey / n), std::sqrt(ef / n)};
+  };
+  PlantConfig quiet = s.plant;  // the same rig, without the baseline noise (the participant adds it)
+  const auto [ey, ef] = replay(quiet);
+  CHECK(ey == doctest::Approx(s.plant.noise_y_mm_rms).epsilon(0.1));
+  CHECK(ef == doctest::Approx(s.plant.noise_f_kN_rms).epsilon(0.1));
+  PlantConfig nominal = s.plant;
+  nominal.effects = {};
+  const auto [ny, nf] = replay(nominal);
+  CHECK(ny > 5 * ey);
+  CHECK(nf > 5 * ef);
+}
+
+TEST_CASE("rths record: writes RUN_DIR/record.csv; a missing run folder or log exits 2") {
+  const std::string bin = std::string(RTHS_BIN_DIR) + "/rths-record";
+  if (!fs::exists(bin)) {
+    MESSAGE("rths-record is not built in " << RTHS_BIN_DIR << ": skipped");
+    return;
+  }
+  const fs::path dir = rths_test::TempDir("record_cli");
+  CHECK(std::system((bin + " " + (dir / "nothing").string() + " > /dev/null 2>&1").c_str()) == 2 * 256);
+  CHECK(std::system((bin + " " + dir.string() + " > /dev/null 2>&1").c_str()) == 2 * 256);  // no log.lcm
+  const fs::path file = rths_test::WriteScenario(dir, R"(
+[run]
+dt_s = 0.0005
+duration_s = 2.0
+[structure]
+mode = "predefined"
+[structure.desired]
+band_hz = 5.0
+rms_mm = 1.0
+[plant]
+specimen = "none"
+[plant.effects.gain_error]
+gain = 0.9
+)");
+  const Scenario s = rths::scenario::LoadScenario(file.string());
+  const fs::path out = dir / "run";
+  fs::create_directories(out);
+  REQUIRE(rths_test::RunMemq({s}, out).code == 0);
+  REQUIRE(std::system((bin + " " + out.string() + " > /dev/null 2>&1").c_str()) == 0);
+  const rths::io::RigRecord rec = rths::io::ReadRigRecord((out / "record.csv").string());
+  CHECK(rec.size() == 4000);
+  CHECK(rec.Meta("producer") == "rths record");
+  CHECK(Rms(rec.y_mm) == doctest::Approx(0.9 * Rms(rec.u_mm)).epsilon(0.05));  // the gain error shows
+  const fs::path other = dir / "elsewhere.csv";
+  REQUIRE(std::system((bin + " " + out.string() + " --out " + other.string() + " > /dev/null 2>&1").c_str()) == 0);
+  CHECK(rths::io::ReadRigRecord(other.string()).size() == 4000);
 }
