@@ -1,0 +1,245 @@
+#include "diagnosis/channel_models.h"
+
+#include <algorithm>
+#include <cmath>
+#include <complex>
+
+#include <fmt/format.h>
+#include <toml++/toml.h>
+
+#include "core/error.h"
+#include "signal/butterworth.h"
+
+namespace rths::diagnosis {
+
+NominalModel PaperModel() { return NominalModel{}; }
+
+NominalModel LoadModel(const std::string& path) {
+  toml::table tbl;
+  try {
+    tbl = toml::parse_file(path);
+  } catch (const toml::parse_error& e) {
+    const auto& b = e.source().begin;
+    throw Error(fmt::format("{}:{}", path, b.line), fmt::format("not a TOML file: {}", e.description()));
+  }
+  const auto* plant = tbl["plant"].as_table();
+  const bool actuator_only = !tbl.contains("run") && !tbl.contains("structure") &&
+                             (plant == nullptr || (!plant->contains("specimen") && !plant->contains("damper")));
+  const scenario::Scenario s = scenario::LoadScenario(path);
+  NominalModel m;
+  m.actuator = s.plant.actuator;
+  m.damper = s.plant.damper;
+  m.current_dynamics = s.plant.current_dynamics;
+  m.has_damper = !actuator_only && s.plant.specimen == "mr_damper";
+  m.source = fmt::format("{}: [plant] actuator K={:.6g} p={:.6g} b={:.6g} c={:.6g}", path, m.actuator.K,
+                         m.actuator.p, m.actuator.b, m.actuator.c);
+  if (actuator_only) {
+    m.notes.push_back(fmt::format("{}: an actuator model only (no [run], [structure], plant.specimen or "
+                                  "plant.damper): the force channel is not diagnosed",
+                                  path));
+  } else if (!m.has_damper) {
+    m.notes.push_back(fmt::format("{}: plant.specimen = \"{}\": the force channel is not diagnosed", path,
+                                  s.plant.specimen));
+  } else {
+    m.source += fmt::format("; Spencer damper from [plant.damper]; current dynamics {}",
+                            m.current_dynamics ? "Eq. 40 + 75 Hz" : "off");
+  }
+  if (s.plant.kind != "linear")
+    m.notes.push_back(fmt::format("{}: plant.kind = \"{}\": the diagnosis uses the 3-pole [plant] actuator "
+                                  "as the displacement model",
+                                  path, s.plant.kind));
+  if (s.plant.RigMode())
+    m.notes.push_back(fmt::format("{}: the file switches rig-mode effects on; the nominal model ignores them", path));
+  return m;
+}
+
+namespace {
+
+/// Runs the cascade over x in place (causal), from rest.
+void FilterInPlace(const signal::Sos& sos, std::vector<double>* x) {
+  auto st = signal::SosAtRest(sos);
+  for (double& v : *x) v = signal::SosStep(sos, &st, v);
+}
+
+}  // namespace
+
+SmoothedMotion SmoothMotion(std::span<const double> y_mm, double dt_s, double smooth_hz) {
+  const std::size_t n = y_mm.size();
+  if (n < 4) throw Error("SmoothMotion", "need at least 4 samples");
+  if (!(dt_s > 0.0) || !(smooth_hz > 0.0) || !(smooth_hz < 0.5 / dt_s))
+    throw Error("SmoothMotion", fmt::format("smooth_hz {} must be in (0, {}) Hz", smooth_hz, 0.5 / dt_s));
+  const auto sos = signal::ButterworthLowpass(2, smooth_hz, 1.0 / dt_s);
+  // Odd reflection about both ends: 6 time constants of the filter, at most n - 1 samples.
+  const std::size_t pad = std::min<std::size_t>(n - 1, static_cast<std::size_t>(std::ceil(6.0 / (smooth_hz * dt_s))) + 8);
+  std::vector<double> w;
+  w.reserve(n + 2 * pad);
+  for (std::size_t j = pad; j >= 1; --j) w.push_back(2.0 * y_mm[0] - y_mm[j]);
+  for (double v : y_mm) w.push_back(v);
+  for (std::size_t j = 1; j <= pad; ++j) w.push_back(2.0 * y_mm[n - 1] - y_mm[n - 1 - j]);
+  FilterInPlace(sos, &w);
+  std::reverse(w.begin(), w.end());
+  FilterInPlace(sos, &w);
+  std::reverse(w.begin(), w.end());
+  SmoothedMotion m;
+  m.x_mm.assign(w.begin() + static_cast<std::ptrdiff_t>(pad), w.begin() + static_cast<std::ptrdiff_t>(pad + n));
+  m.v_mm_s.resize(n);
+  for (std::size_t k = 1; k + 1 < n; ++k) m.v_mm_s[k] = (m.x_mm[k + 1] - m.x_mm[k - 1]) / (2.0 * dt_s);
+  m.v_mm_s[0] = (m.x_mm[1] - m.x_mm[0]) / dt_s;
+  m.v_mm_s[n - 1] = (m.x_mm[n - 1] - m.x_mm[n - 2]) / dt_s;
+  return m;
+}
+
+std::vector<double> PredictDisplacement(const models::LinearServo& servo, const models::EffectSet& effects,
+                                        std::span<const double> u_mm, std::span<const double> f_kN) {
+  const std::size_t n = u_mm.size();
+  std::vector<double> y(n);
+  models::DisplacementEffects fx(effects, servo.dt_s);
+  // Plain 3x3 arithmetic (this is the inner loop of every fit).
+  const Eigen::Matrix3d& P = servo.Phi;
+  const Eigen::Vector3d& G = servo.Gamma;
+  double z0 = 0, z1 = 0, z2 = 0;
+  for (std::size_t k = 0; k < n; ++k) {
+    const double fprev = (k > 0 && k - 1 < f_kN.size()) ? f_kN[k - 1] : 0.0;
+    y[k] = fx.Post(z0, fprev);
+    const double ua = fx.Pre(u_mm[k]);
+    const double n0 = P(0, 0) * z0 + P(0, 1) * z1 + P(0, 2) * z2 + G(0) * ua;
+    const double n1 = P(1, 0) * z0 + P(1, 1) * z1 + P(1, 2) * z2 + G(1) * ua;
+    const double n2 = P(2, 0) * z0 + P(2, 1) * z1 + P(2, 2) * z2 + G(2) * ua;
+    z0 = n0, z1 = n1, z2 = n2;
+  }
+  return y;
+}
+
+ForcePredictor::ForcePredictor(const models::MrDamperParams& damper, bool current_dynamics, double dt_s)
+    : damper_(damper), current_dynamics_(current_dynamics), dt_s_(dt_s),
+      driver_(models::CurrentDriver::Make({}, dt_s)) {
+  damper_.Validate();
+}
+
+std::vector<double> ForcePredictor::Predict(const SmoothedMotion& motion, std::span<const double> i_A,
+                                            const models::EffectSet& effects) const {
+  auto f = PredictUnscaled(motion, i_A, effects);
+  if (effects.damper_scale)
+    for (double& v : f) v *= effects.damper_scale->scale;
+  return f;
+}
+
+std::vector<double> ForcePredictor::PredictUnscaled(const SmoothedMotion& motion, std::span<const double> i_A,
+                                                    const models::EffectSet& effects) const {
+  const std::size_t n = motion.x_mm.size();
+  if (i_A.size() != n || motion.v_mm_s.size() != n) throw Error("ForcePredictor", "lengths differ");
+  std::vector<double> f(n, 0.0);
+  if (n == 0) return f;
+  models::EffectSet fe_set;  // force effects only (current_lag); damper_scale is applied outside
+  fe_set.current_lag = effects.current_lag;
+  models::ForceEffects fe(fe_set, dt_s_);
+  fe.Reset(i_A[0]);
+  models::CurrentDriverState cs = models::SteadyState(i_A[0]);
+  models::MrDamperState s{};
+  const double dt = dt_s_;
+  // Eqs. 35-39 tabulated on a 1 mA grid over the currents this record can reach (the effective
+  // current overshoots a step of the command by a few per cent), linear interpolation between
+  // (relative error below 1e-5 for Table 3's rates); exact outside the table.
+  double imin = i_A[0], imax = i_A[0];
+  for (double v : i_A) imin = std::min(imin, v), imax = std::max(imax, v);
+  const double span = imax - imin;
+  const double tlo = imin - 0.25 * span - 0.01, thi = imax + 0.25 * span + 0.01;
+  const double di = 1e-3;
+  const auto nt = static_cast<std::size_t>(std::ceil((thi - tlo) / di)) + 2;
+  std::vector<models::MrDamperCoefficients> table(nt);
+  for (std::size_t j = 0; j < nt; ++j) table[j] = models::CoefficientsAt(damper_, tlo + di * static_cast<double>(j));
+  auto coef_at = [&](double i) {
+    const double x = (i - tlo) / di;
+    if (!(x >= 0.0) || x >= static_cast<double>(nt - 1)) return models::CoefficientsAt(damper_, i);
+    const auto j = static_cast<std::size_t>(x);
+    const double w = x - static_cast<double>(j);
+    const auto& a = table[j];
+    const auto& b = table[j + 1];
+    models::MrDamperCoefficients c = a;
+    c.alpha += w * (b.alpha - a.alpha);
+    c.c0 += w * (b.c0 - a.c0);
+    c.c1 += w * (b.c1 - a.c1);
+    c.beta += w * (b.beta - a.beta);
+    c.gamma += w * (b.gamma - a.gamma);
+    return c;
+  };
+  // The effective current inside a step at tau = j h / 2 from the closed form of
+  // models/current_driver.h, i_c = i_h + r_1 e_1 e^{lambda_1 tau} + 2 Re(r e_q e^{lambda tau}),
+  // with the exponentials advanced by multiplication (cached per substep count).
+  int cached_m = -1;
+  double half1 = 1.0;
+  std::complex<double> half{1.0, 0.0};
+  std::vector<double> ic(2 * 256 + 1);
+  for (std::size_t k = 0; k < n; ++k) {
+    const double ic_k = current_dynamics_ ? models::EffectiveCurrentA(driver_, cs) : cs.held_A;
+    f[k] = models::DamperForceKn(coef_at(ic_k), s, motion.x_mm[k], motion.v_mm_s[k]);
+    if (k + 1 == n) break;
+    const double il = fe.Current(i_A[k]);
+    if (current_dynamics_) {
+      models::Hold(driver_, &cs, il);
+    } else {
+      cs = models::SteadyState(il);
+    }
+    const bool constant = !current_dynamics_ || models::AtSteadyState(cs);
+    const double x0 = motion.x_mm[k], x1 = motion.x_mm[k + 1];
+    const double v0 = motion.v_mm_s[k], v1 = motion.v_mm_s[k + 1];
+    // Substeps from the size of the local Jacobian at the start of the step (file comment).
+    const models::MrDamperCoefficients c0 = coef_at(constant ? cs.held_A : models::EffectiveCurrentAt(driver_, cs, 0.0));
+    const double vmax = std::max(std::abs(v0), std::abs(v1));
+    const double zabs = std::abs(s.z_mm);
+    const double zpow = c0.n == 2.0 ? zabs : std::pow(zabs, c0.n - 1.0);
+    const double lam = (c0.beta + c0.gamma) * c0.n * zpow * vmax + c0.A * c0.alpha / (c0.c0 + c0.c1) +
+                       c0.k0 / (c0.c0 + c0.c1);
+    const int m = std::clamp(static_cast<int>(std::ceil(dt * lam / kRk4StepLambda)), 1, 256);
+    const double h = dt / m;
+    if (!constant) {
+      if (m != cached_m) {
+        cached_m = m;
+        half1 = std::exp(driver_.pole1 * 0.5 * h);
+        half = std::exp(driver_.pole * 0.5 * h);
+      }
+      double e1 = cs.e1_A_s;
+      std::complex<double> eq = cs.eq_A_s;
+      for (int j = 0; j <= 2 * m; ++j) {
+        ic[static_cast<std::size_t>(j)] = cs.held_A + driver_.residue1 * e1 + 2.0 * (driver_.residue * eq).real();
+        e1 *= half1;
+        eq *= half;
+      }
+    }
+    auto motion_at = [&](double tau, double* x, double* xd) {
+      const double t = tau / dt;
+      const double t2 = t * t, t3 = t2 * t;
+      *x = (2 * t3 - 3 * t2 + 1) * x0 + (t3 - 2 * t2 + t) * dt * v0 + (-2 * t3 + 3 * t2) * x1 + (t3 - t2) * dt * v1;
+      *xd = ((6 * t2 - 6 * t) * x0 + (3 * t2 - 4 * t + 1) * dt * v0 + (-6 * t2 + 6 * t) * x1 + (3 * t2 - 2 * t) * dt * v1) / dt;
+    };
+    models::MrDamperCoefficients cmid = c0, cend = c0, cstart = c0;
+    double xa, va;
+    motion_at(0.0, &xa, &va);
+    for (int j = 0; j < m; ++j) {
+      const double ta = j * h, tb = ta + 0.5 * h, tc = ta + h;
+      if (!constant) {
+        cstart = j == 0 ? c0 : cend;
+        cmid = coef_at(ic[static_cast<std::size_t>(2 * j + 1)]);
+        cend = coef_at(ic[static_cast<std::size_t>(2 * j + 2)]);
+      }
+      (void)ta;
+      double xb, vb, xc, vc;
+      motion_at(tb, &xb, &vb);
+      motion_at(tc, &xc, &vc);
+      const models::MrDamperRates r1 = models::DamperRates(cstart, s, xa, va);
+      const models::MrDamperState s2{s.y_mm + 0.5 * h * r1.ydot_mm_s, s.z_mm + 0.5 * h * r1.zdot_mm_s};
+      const models::MrDamperRates r2 = models::DamperRates(cmid, s2, xb, vb);
+      const models::MrDamperState s3{s.y_mm + 0.5 * h * r2.ydot_mm_s, s.z_mm + 0.5 * h * r2.zdot_mm_s};
+      const models::MrDamperRates r3 = models::DamperRates(cmid, s3, xb, vb);
+      const models::MrDamperState s4{s.y_mm + h * r3.ydot_mm_s, s.z_mm + h * r3.zdot_mm_s};
+      const models::MrDamperRates r4 = models::DamperRates(cend, s4, xc, vc);
+      s.y_mm += h / 6.0 * (r1.ydot_mm_s + 2 * r2.ydot_mm_s + 2 * r3.ydot_mm_s + r4.ydot_mm_s);
+      s.z_mm += h / 6.0 * (r1.zdot_mm_s + 2 * r2.zdot_mm_s + 2 * r3.zdot_mm_s + r4.zdot_mm_s);
+      xa = xc, va = vc;
+    }
+    if (current_dynamics_) models::Advance(driver_, &cs);
+  }
+  return f;
+}
+
+}  // namespace rths::diagnosis

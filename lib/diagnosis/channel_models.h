@@ -1,0 +1,103 @@
+#pragma once
+/// @file The nominal model of the sim-to-real diagnosis (../shared/spec/diagnosis.md "Model",
+/// docs/diagnosis.md) and its two channel predictors, with effects of the library
+/// (models/rig_effects.h) inserted. Units: mm, kN, A, s. Offline analysis: these functions
+/// allocate.
+///
+/// Displacement channel (from the command u and, for load_coupling, the measured force):
+///     x_{k+1} = Phi x_k + Gamma Pre(u_k)        (Eq. 30 or the model file's actuator, exact ZOH)
+///     yhat_k  = Post(C x_k, f_{k-1})            (DisplacementEffects; f_{-1} = 0)
+/// from rest at k = 0 (y_k depends on u_0 .. u_{k-1}: the record's sample pairing).
+///
+/// Force channel (from the MEASURED displacement y and the current command i):
+///   1. y is smoothed without phase: a Butterworth low-pass of order 2 at smooth_hz run forward
+///      and backward (|H|^2: a 4th-order magnitude, zero phase), the ends padded by odd
+///      reflection; the velocity is the central difference of the smoothed y,
+///      v_k = (ys_{k+1} - ys_{k-1}) / (2 dt) (one-sided at the ends). This keeps the noise of
+///      y from being amplified (white noise sigma gives a velocity noise of about
+///      2 pi sigma sqrt(smooth_hz^3 dt / 3) rms) while the motion below ~0.6 smooth_hz passes
+///      unchanged in amplitude and phase.
+///   2. Within a step the motion is the cubic Hermite interpolant of (ys_k, v_k), (ys_{k+1},
+///      v_{k+1}); the current command i_k, through ForceEffects::Current (current_lag), is held
+///      over [t_k, t_{k+1}) by Eq. 40 and the 75 Hz low-pass (models/current_driver.h, whose
+///      closed form gives i_c(t) inside the step), starting at the steady state of i_0.
+///   3. The Spencer damper (Eqs. 32-33) is integrated by classical Runge-Kutta (RK4) with
+///      m substeps per sample, m = ceil(dt lambda / kRk4StepLambda), lambda the size of the local
+///      Jacobian, (beta + gamma) n |z|^(n-1) max(|v_k|, |v_{k+1}|) + A alpha / (c0 + c1) +
+///      k0 / (c0 + c1) (so h lambda <= 0.8, inside RK4's stability interval [-2.78, 0] and
+///      accurate: R(-0.8) = 0.4493 vs e^-0.8 = 0.4493; checked against CVODE at 1e-8 in
+///      tests/diagnosis_test.cpp). Eqs. 35-39 come from a 1 mA table (linear interpolation) and
+///      i_c at the substep times from the driver's closed form advanced by multiplication.
+///      Deterministic, about a microsecond per sample.
+///   4. fhat_k = Force(Eq. 34 at (ys_k, v_k), i_c(t_k)) (damper_scale).
+#include <span>
+#include <string>
+#include <vector>
+
+#include "io/rig_record.h"
+#include "models/current_driver.h"
+#include "models/mr_damper.h"
+#include "models/rig_effects.h"
+#include "models/servo_linear.h"
+#include "scenario/scenario.h"
+
+namespace rths::diagnosis {
+
+/// RK4 step size bound h lambda of the force predictor (file comment, step 3).
+inline constexpr double kRk4StepLambda = 0.8;
+
+/// The nominal model: what the lab believes its rig is.
+struct NominalModel {
+  scenario::ServoModel3 actuator{};        ///< displacement path (default Eq. 30, "avg")
+  bool has_damper = true;                  ///< false: the force channel is not diagnosed
+  models::MrDamperParams damper{};         ///< Spencer model (default Table 3)
+  bool current_dynamics = true;            ///< Eq. 40 + 75 Hz low-pass on the current
+  std::string source = "paper: Eq. 30 (ZOH), Spencer damper with Table 3, Eq. 40 + 75 Hz low-pass";
+  std::vector<std::string> notes;          ///< what was read and how (for the report)
+};
+
+/// The paper's nominal model (the defaults above).
+NominalModel PaperModel();
+
+/// Reads --model FILE.toml: a scenario (its [plant] is the nominal model: actuator, specimen,
+/// [plant.damper], current_dynamics) or a file written by `rths identify` (an actuator only).
+/// A file is taken as actuator-only when it has no [run] and no [structure] table and its
+/// [plant] table has neither `specimen` nor `damper`: then has_damper = false (the force channel
+/// is not diagnosed) and the rest is read with the scenario parser. Throws rths::Error naming the
+/// file and key.
+NominalModel LoadModel(const std::string& path);
+
+/// Zero-phase smoothing of y and its velocity (file comment, step 1).
+struct SmoothedMotion {
+  std::vector<double> x_mm;     ///< smoothed displacement [mm]
+  std::vector<double> v_mm_s;   ///< velocity [mm/s]
+};
+/// Throws rths::Error unless smooth_hz is in (0, 0.5/dt_s) and y has at least 4 samples.
+SmoothedMotion SmoothMotion(std::span<const double> y_mm, double dt_s, double smooth_hz);
+
+/// Displacement channel prediction yhat_k for one record (file comment). `effects` may hold
+/// any effects; only the displacement ones act. f_kN: the measured force (load_coupling).
+std::vector<double> PredictDisplacement(const models::LinearServo& servo,
+                                        const models::EffectSet& effects,
+                                        std::span<const double> u_mm, std::span<const double> f_kN);
+
+/// Force channel predictor: an immutable description (damper, current dynamics, dt).
+class ForcePredictor {
+ public:
+  ForcePredictor(const models::MrDamperParams& damper, bool current_dynamics, double dt_s);
+  /// fhat_k for one record (file comment, steps 2-4): the smoothed motion and the current
+  /// commands i_A (same length). Only the force effects of `effects` act.
+  std::vector<double> Predict(const SmoothedMotion& motion, std::span<const double> i_A,
+                              const models::EffectSet& effects) const;
+  /// The same without damper_scale applied (Predict = scale x this).
+  std::vector<double> PredictUnscaled(const SmoothedMotion& motion, std::span<const double> i_A,
+                                      const models::EffectSet& effects) const;
+
+ private:
+  models::MrDamperParams damper_;
+  bool current_dynamics_;
+  double dt_s_;
+  models::CurrentDriver driver_;
+};
+
+}  // namespace rths::diagnosis

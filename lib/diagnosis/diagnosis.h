@@ -1,0 +1,153 @@
+#pragma once
+/// @file The sim-to-real gap diagnosis (`rths diagnose`; contract ../shared/spec/diagnosis.md,
+/// method docs/diagnosis.md): where the nominal model is wrong, which effect of the library
+/// (models/rig_effects.h) explains it, and how far the held-out gap shrinks once it is added.
+///
+/// Numbers, per channel c in {y, f} (f only with a damper model):
+///   residual     e_k = meas_k - pred_k, over the samples k >= warmup_s / dt of every record;
+///   NRMSE        100 sqrt( sum e_k^2 / sum meas_k^2 ), sums over all records of a set (Eq. 31);
+///   shrink       100 (1 - NRMSE_after / NRMSE_before) on the test records;
+///   noise floor  sigma_c^2 = median over f in [0.5, 0.95] f_Nyquist of the residual's Welch PSD,
+///                times f_Nyquist (white noise of variance sigma^2 has PSD sigma^2 / f_Nyq);
+///   floor ratio  rho_c = mean e_k^2 / sigma_c^2 (1 for a residual that is only white noise).
+/// Selection (training records only), greedy: a candidate is fitted with the channel's selected
+/// effects held, then all of the channel's effects are refitted coordinate-wise; it is added if
+///   (a) BIC falls: n_eff ln(SSE_new / SSE_old) + p ln(n_eff) < 0, with n_eff = n / tau_int,
+///       tau_int = 1 + 2 sum_{l>=1} r_l (the residual's autocorrelation summed up to its first
+///       non-positive value): correlated samples count once per correlation time; and
+///   (b) it removes at least min_excess_reduction of the channel's excess SSE over its noise
+///       floor, (SSE_old - SSE_new) >= min_excess_reduction (SSE_old - n sigma^2): a tiny
+///       improvement on 100k samples is not an effect.
+/// The candidate with the largest (b) fraction goes first; the loop stops when none passes.
+/// Verdict: "none" if rho_c <= none_ratio on every diagnosed channel (train and test pooled);
+/// a channel whose test residual is structured (rho > none_ratio) keeps its selected effects
+/// only if they shrink its test NRMSE by >= min_test_shrink_pct; no effect left and some channel
+/// structured: "unknown"; else the selected effects in the order they were added.
+#include <chrono>
+#include <map>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "diagnosis/channel_models.h"
+#include "io/rig_record.h"
+#include "models/rig_effects.h"
+
+namespace rths::diagnosis {
+
+/// Knobs of the method (defaults: those of `rths diagnose`, documented in docs/diagnosis.md).
+struct Options {
+  double warmup_s = 0.1;               ///< start of every record left out of all sums [s]
+  double smooth_hz = 80.0;             ///< zero-phase smoothing of y for the force channel [Hz]
+  double none_ratio = 1.6;             ///< rho_c at or below this: the channel is at its noise floor
+  double min_excess_reduction = 0.25;  ///< rule (b) above, in (0, 1)
+  double min_test_shrink_pct = 30.0;   ///< the contract's 30 % on the test records
+  bool detrend = false;                ///< remove each record's mean of u, y, f first (--detrend)
+  int max_effects_per_channel = 3;     ///< greedy stops after this many on one channel
+};
+
+/// A residual localised in frequency.
+struct Band {
+  std::string channel;       ///< "y" or "f"
+  double lo_hz = 0, hi_hz = 0;
+  double share_pct = 0;      ///< share of the channel's residual energy in the band
+  double signal_share_pct = 0;  ///< share of the measured channel's energy in the band
+  double rel_residual_pct = 0;  ///< 100 sqrt(residual energy / measured energy) in the band
+  double coherence = -1;     ///< y only: mean coherence of u -> measured y in the band (-1: n/a)
+  double gain_ratio = -1;    ///< y only: mean |H_meas / H_model| in the band (-1: n/a)
+  double phase_diff_deg = 0; ///< y only: mean phase of H_meas / H_model in the band [deg]
+};
+/// A residual localised in a state condition.
+struct Condition {
+  std::string channel;
+  std::string name;          ///< velocity_reversal | high_velocity | high_force | current_switching
+  double share_pct = 0;      ///< share of the channel's residual energy in the condition's samples
+  double samples_pct = 0;    ///< share of the samples in the condition
+};
+/// A residual localised in time.
+struct TimeWindow {
+  std::string channel;
+  std::string record;        ///< source of the record
+  double t0_s = 0, t1_s = 0;
+  double share_pct = 0;      ///< share of the channel's residual energy (all test records)
+};
+
+/// One candidate effect as fitted and scored.
+struct EffectResult {
+  std::string name;                       ///< a library name (models::kEffectNames)
+  std::string channel;                    ///< "y" or "f"
+  std::map<std::string, double> params;   ///< the contract's keys (plus documented extras)
+  double train_nrmse_after = 0;           ///< training NRMSE of the channel with it [%]
+  double test_nrmse_after = 0;            ///< test NRMSE of the channel with it [%]
+  double shrink_pct = 0;                  ///< test shrink against the nominal model [%]
+  double excess_reduction = 0;            ///< rule (b)'s fraction when it was last tried
+  double delta_bic = 0;                   ///< rule (a)'s value when it was last tried
+  bool selected = false;
+  int order = -1;                         ///< position in the verdict (selected only)
+};
+
+/// Per-channel numbers.
+struct ChannelSummary {
+  std::string channel;
+  bool diagnosed = false;
+  double gap_test_pct = 0;                ///< nominal test NRMSE [%]
+  double gap_train_pct = 0;               ///< nominal training NRMSE [%]
+  double after_test_pct = 0;              ///< test NRMSE with the channel's selected effects [%]
+  double noise_rms = 0;                   ///< sigma_c (mm or kN)
+  double floor_ratio = 0;                 ///< rho_c, train and test pooled
+  double floor_ratio_test = 0;            ///< rho_c on the test records
+  double whiteness = 0;                   ///< Ljung-Box-like: n sum_{l=1..20} r_l^2 (test); ~20 if white
+  std::string status;                     ///< "noise" | "explained" | "unexplained" | "not diagnosed"
+};
+
+struct Result {
+  std::vector<std::string> train, test;   ///< record sources
+  std::string model_source;
+  std::vector<ChannelSummary> channels;   ///< y, then f
+  std::vector<Band> bands;
+  std::vector<Condition> conditions;
+  std::vector<TimeWindow> time;
+  std::vector<EffectResult> effects;      ///< ranked: selected in order, then by shrink
+  std::vector<std::string> verdict;
+  std::vector<std::string> warnings;
+  double runtime_s = 0;
+  double dt_s = 0;
+  std::size_t samples = 0;                ///< all samples, train + test
+  Options options;
+
+  const ChannelSummary* Channel(const std::string& c) const;
+};
+
+/// Traces kept for the report's plots (test records, nominal and final models).
+struct Traces {
+  struct Record {
+    std::string source;
+    double dt_s = 0;
+    std::vector<double> u, y_meas, y_nom, y_fin, f_meas, f_nom, f_fin, i, v;  // f_*: empty if no damper
+  };
+  std::vector<Record> test;
+};
+
+/// Runs the whole diagnosis. Records must already be valid (io::ReadRecordAny /
+/// ValidateRigRecord) and share one dt (else rths::Error naming the record). `traces`, if not
+/// null, receives the test records' traces for plots. Throws rths::Error.
+Result Diagnose(const std::vector<io::RigRecord>& train, const std::vector<io::RigRecord>& test,
+                const NominalModel& model, const Options& options, Traces* traces = nullptr);
+
+/// The contract's JSON (diagnosis.md "Output") with our extra fields.
+nlohmann::json ToJson(const Result& r);
+
+/// The terminal summary.
+std::string Summary(const Result& r);
+
+/// The effect set for one effect name and its parameters (contract keys); throws rths::Error for
+/// an unknown name or a missing key.
+void SetEffect(models::EffectSet* set, const std::string& name, const std::map<std::string, double>& params);
+
+/// NRMSE of a residual [%]: 100 sqrt(sum (m - p)^2 / sum m^2) over k >= first of each pair.
+double Nrmse(std::span<const double> meas, std::span<const double> pred, std::size_t first = 0);
+/// 100 (1 - after / before).
+double ShrinkPct(double before_pct, double after_pct);
+
+}  // namespace rths::diagnosis

@@ -1,0 +1,214 @@
+#include "diagnosis/harness.h"
+
+#include <algorithm>
+#include <chrono>
+#include <map>
+#include <set>
+
+#include <fmt/format.h>
+
+#include "core/error.h"
+#include "signal/random.h"
+
+namespace rths::diagnosis {
+
+namespace {
+
+const std::vector<std::string> kSingles = {"pure_delay",       "gain_error", "load_coupling",         "oil_column_resonance",
+                                           "coulomb_friction", "backlash",   "servovalve_saturation", "current_lag",
+                                           "damper_scale"};
+const std::vector<std::string> kPairs = {"pure_delay+damper_scale", "gain_error+current_lag", "pure_delay+gain_error",
+                                         "backlash+damper_scale", "load_coupling+current_lag",
+                                         "oil_column_resonance+coulomb_friction"};
+
+std::vector<std::string> Split(const std::string& s) {
+  std::vector<std::string> out;
+  std::size_t a = 0;
+  for (;;) {
+    const auto b = s.find('+', a);
+    out.push_back(s.substr(a, b == std::string::npos ? std::string::npos : b - a));
+    if (b == std::string::npos) break;
+    a = b + 1;
+  }
+  return out;
+}
+
+}  // namespace
+
+std::vector<std::string> HarnessCaseKinds(bool pairs) {
+  std::vector<std::string> k = kSingles;
+  if (pairs) k.insert(k.end(), kPairs.begin(), kPairs.end());
+  k.push_back("none");
+  k.push_back("unknown_ripple");
+  k.push_back("unknown_stiffness");
+  return k;
+}
+
+Truth HarnessTruth(const std::string& kind, std::uint64_t seed, double noise_y_mm, double noise_f_kN,
+                   std::string* params_text) {
+  Truth t;
+  t.noise_seed = seed * 131 + 7;
+  t.effects.sensor_noise = models::SensorNoise{noise_y_mm, noise_f_kN};
+  auto g = signal::MakeGaussian(seed * 2654435761ULL + std::hash<std::string>{}(kind) % 100000);
+  auto U = [&](double a, double b) { return a + (b - a) * signal::NextUniform(&g); };
+  auto side = [&](double a, double b, double c, double d) { return signal::NextUniform(&g) < 0.5 ? U(a, b) : U(c, d); };
+  std::string txt;
+  for (const auto& e : Split(kind)) {
+    if (e == "pure_delay") {
+      t.effects.pure_delay = models::PureDelay{U(1.0, 8.0)};
+      txt += fmt::format("tau_ms={:.3g} ", t.effects.pure_delay->tau_ms);
+    } else if (e == "gain_error") {
+      t.effects.gain_error = models::GainError{side(0.85, 0.95, 1.05, 1.2)};
+      txt += fmt::format("gain={:.3g} ", t.effects.gain_error->gain);
+    } else if (e == "load_coupling") {
+      t.effects.load_coupling = models::LoadCoupling{U(0.0001, 0.0004)};
+      txt += fmt::format("compliance_mm_per_kN={:.3g} ", t.effects.load_coupling->compliance_mm_per_kN);
+    } else if (e == "oil_column_resonance") {
+      t.effects.oil_column_resonance = models::OilColumnResonance{U(15.0, 40.0), U(0.05, 0.3)};
+      txt += fmt::format("f_hz={:.3g} zeta={:.3g} ", t.effects.oil_column_resonance->f_hz, t.effects.oil_column_resonance->zeta);
+    } else if (e == "coulomb_friction") {
+      models::CoulombFriction c;
+      c.loss_mm = U(0.05, 0.3);
+      t.effects.coulomb_friction = c;
+      txt += fmt::format("loss_mm={:.3g} ", c.loss_mm);
+    } else if (e == "backlash") {
+      t.effects.backlash = models::Backlash{U(0.1, 0.6)};
+      txt += fmt::format("gap_mm={:.3g} ", t.effects.backlash->gap_mm);
+    } else if (e == "servovalve_saturation") {
+      t.effects.servovalve_saturation = models::ServovalveSaturation{U(150.0, 300.0)};
+      txt += fmt::format("vmax_mm_per_s={:.4g} ", t.effects.servovalve_saturation->vmax_mm_per_s);
+    } else if (e == "current_lag") {
+      t.effects.current_lag = models::CurrentLag{U(20.0, 150.0)};
+      txt += fmt::format("tau_ms={:.3g} ", t.effects.current_lag->tau_ms);
+    } else if (e == "damper_scale") {
+      t.effects.damper_scale = models::DamperScale{side(0.75, 0.9, 1.1, 1.3)};
+      txt += fmt::format("scale={:.3g} ", t.effects.damper_scale->scale);
+    } else if (e == "none") {
+    } else if (e == "unknown_ripple") {
+      t.ripple_mm = U(0.05, 0.2);
+      t.ripple_hz = U(5.0, 9.0);
+      txt += fmt::format("ripple_mm={:.3g} ripple_hz={:.3g} ", t.ripple_mm, t.ripple_hz);
+    } else if (e == "unknown_stiffness") {
+      t.stiffness_kN_per_mm = U(0.5, 2.0);
+      txt += fmt::format("stiffness_kN_per_mm={:.3g} ", t.stiffness_kN_per_mm);
+    } else {
+      throw Error("harness", "unknown case kind " + kind);
+    }
+  }
+  if (params_text) *params_text = txt;
+  return t;
+}
+
+HarnessCase RunHarnessCase(const std::string& kind, std::uint64_t seed, const HarnessOptions& o) {
+  HarnessCase c;
+  c.kind = kind;
+  c.seed = seed;
+  const Truth truth = HarnessTruth(kind, seed, o.noise_y_mm, o.noise_f_kN, &c.params);
+  if (kind == "none") c.truth = {"none"};
+  else if (kind.rfind("unknown", 0) == 0) c.truth = {"unknown"};
+  else c.truth = Split(kind);
+  std::sort(c.truth.begin(), c.truth.end());
+  Excitation tr;
+  tr.duration_s = o.duration_s;
+  tr.band_hz = 25.0;
+  tr.rms_mm = 4.0;
+  tr.seed = seed * 2 + 1;
+  Excitation te = tr;
+  te.band_hz = 8.0;
+  te.rms_mm = 5.0;
+  te.seed = seed * 2 + 1000003;
+  te.hold_min_s = 0.3;
+  te.hold_max_s = 1.5;
+  Truth ttr = truth, tte = truth;
+  tte.noise_seed = truth.noise_seed + 99991;
+  const auto make = o.use_rig ? &MakeRecordRig : &MakeRecordBlocks;
+  const auto rtr = make(tr, ttr, fmt::format("{}-s{}-train", kind, seed));
+  const auto rte = make(te, tte, fmt::format("{}-s{}-test", kind, seed));
+  const auto t0 = std::chrono::steady_clock::now();
+  const Result r = Diagnose({rtr}, {rte}, PaperModel(), Options{});
+  c.runtime_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  c.verdict = r.verdict;
+  auto v = r.verdict;
+  std::sort(v.begin(), v.end());
+  c.right = v == c.truth;
+  if (c.right && c.truth[0] != "none" && c.truth[0] != "unknown") {
+    std::set<std::string> chans;
+    for (const auto& e : r.effects)
+      if (e.selected) chans.insert(e.channel);
+    double s = 0;
+    for (const auto& ch : chans) {
+      const auto* cs = r.Channel(ch);
+      s += ShrinkPct(cs->gap_test_pct, cs->after_test_pct);
+    }
+    c.shrink_pct = chans.empty() ? 0 : s / static_cast<double>(chans.size());
+  }
+  return c;
+}
+
+std::vector<HarnessCase> RunHarness(const HarnessOptions& o, const std::function<void(const HarnessCase&)>& progress) {
+  std::vector<HarnessCase> out;
+  for (const auto& kind : HarnessCaseKinds(o.pairs)) {
+    if (!o.only.empty() && std::find(o.only.begin(), o.only.end(), kind) == o.only.end()) continue;
+    for (int s = 1; s <= o.seeds; ++s) {
+      out.push_back(RunHarnessCase(kind, static_cast<std::uint64_t>(s), o));
+      if (progress) progress(out.back());
+    }
+  }
+  return out;
+}
+
+HarnessScore ScoreHarness(const std::vector<HarnessCase>& cases) {
+  HarnessScore sc;
+  std::map<std::string, std::map<std::string, int>> conf;  // kind -> verdict -> count
+  std::map<std::string, std::pair<double, int>> shrink;     // kind -> (sum, n) over right cases
+  std::vector<std::string> kinds;
+  double ssum = 0;
+  int sn = 0;
+  for (const auto& c : cases) {
+    if (std::find(kinds.begin(), kinds.end(), c.kind) == kinds.end()) kinds.push_back(c.kind);
+    conf[c.kind][fmt::format("{}", fmt::join(c.verdict, "+"))]++;
+    const bool is_none = c.truth[0] == "none", is_unk = c.truth[0] == "unknown";
+    const bool named_effect = c.verdict[0] != "none" && c.verdict[0] != "unknown";
+    if (is_none) {
+      ++sc.none_n;
+      sc.none_right += c.right;
+      sc.none_as_effect += named_effect;
+    } else if (is_unk) {
+      ++sc.unknown_n;
+      sc.unknown_right += c.right;
+      sc.unknown_as_effect += named_effect;
+    } else if (c.truth.size() == 1) {
+      ++sc.single_n;
+      sc.single_right += c.right;
+      if (c.right) ssum += c.shrink_pct, ++sn;
+    } else {
+      ++sc.pair_n;
+      sc.pair_right += c.right;
+    }
+    if (c.right && !is_none && !is_unk) {
+      shrink[c.kind].first += c.shrink_pct;
+      shrink[c.kind].second++;
+    }
+  }
+  sc.single_shrink_mean = sn ? ssum / sn : 0.0;
+  std::string t = fmt::format("{:<40} {:>5} {:>5} {:>10}  verdicts (count)\n", "true effect(s)", "right", "of", "shrink %");
+  for (const auto& k : kinds) {
+    int n = 0, right = 0;
+    for (const auto& c : cases)
+      if (c.kind == k) ++n, right += c.right;
+    std::string vs;
+    for (const auto& [v, cnt] : conf[k]) vs += fmt::format("{}({}) ", v, cnt);
+    const auto& sh = shrink[k];
+    t += fmt::format("{:<40} {:>5} {:>5} {:>10}  {}\n", k, right, n, sh.second ? fmt::format("{:.1f}", sh.first / sh.second) : "-", vs);
+  }
+  t += fmt::format("single effects: {}/{} right ({:.0f} %), mean held-out shrink when right {:.1f} %\n", sc.single_right,
+                   sc.single_n, sc.single_n ? 100.0 * sc.single_right / sc.single_n : 0.0, sc.single_shrink_mean);
+  t += fmt::format("two effects:    {}/{} right ({:.0f} %)\n", sc.pair_right, sc.pair_n,
+                   sc.pair_n ? 100.0 * sc.pair_right / sc.pair_n : 0.0);
+  t += fmt::format("none:           {}/{} right, {} named an effect\n", sc.none_right, sc.none_n, sc.none_as_effect);
+  t += fmt::format("unknown:        {}/{} right, {} named an effect\n", sc.unknown_right, sc.unknown_n, sc.unknown_as_effect);
+  sc.table = t;
+  return sc;
+}
+
+}  // namespace rths::diagnosis

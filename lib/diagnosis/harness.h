@@ -1,0 +1,66 @@
+#pragma once
+/// @file The diagnosis's validation harness (issue 5 "Done means"; bench/diagnosis.cpp and
+/// tests/diagnosis_harness_test.cpp): records with known effects, diagnosed without the truth,
+/// scored as a confusion table and held-out shrink.
+///
+/// Each case: a truth (one effect, two effects, none = sensor noise only, or a disturbance
+/// outside the library) with parameters drawn from the seed in the ranges of
+/// HarnessCaseKinds() (docs/diagnosis.md "Harness"), one training record (BLWN 0-25 Hz command,
+/// 4 mm rms, a random current staircase) and one test record (BLWN 0-8 Hz, 5 mm rms, another
+/// seed and staircase); sensor noise 0.01 mm and 0.2 kN rms on every record.
+/// Right verdict: the set of effects named equals the truth (order free); none -> ["none"];
+/// outside the library -> ["unknown"].
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "diagnosis/diagnosis.h"
+#include "diagnosis/synthetic.h"
+
+namespace rths::diagnosis {
+
+struct HarnessOptions {
+  int seeds = 5;                 ///< seeds per case kind
+  double duration_s = 20.0;      ///< each record's length [s]
+  bool use_rig = false;          ///< records from the plant's rig mode (MakeRecordRig), else the blocks
+  std::vector<std::string> only; ///< case kinds to run (empty: all)
+  bool pairs = true;             ///< include the two-effect cases
+  double noise_y_mm = 0.01, noise_f_kN = 0.2;
+};
+
+struct HarnessCase {
+  std::string kind;                    ///< e.g. "pure_delay", "pure_delay+damper_scale", "none", "unknown_ripple"
+  std::vector<std::string> truth;      ///< expected verdict, sorted (["none"] / ["unknown"] for those)
+  std::string params;                  ///< the true parameters, as text
+  std::uint64_t seed = 0;
+  std::vector<std::string> verdict;    ///< the diagnosis's verdict, as returned
+  bool right = false;
+  double shrink_pct = 0;               ///< held-out shrink of the verdict's channel(s) (mean over the truth's channels)
+  double runtime_s = 0;
+};
+
+/// The case kinds: 9 single effects, pairs, "none", "unknown_ripple", "unknown_stiffness".
+std::vector<std::string> HarnessCaseKinds(bool pairs);
+
+/// Draws the truth of a case kind for a seed (parameters in documented ranges).
+Truth HarnessTruth(const std::string& kind, std::uint64_t seed, double noise_y_mm, double noise_f_kN,
+                   std::string* params_text);
+
+/// Runs one case. progress (may be empty) is called after it.
+HarnessCase RunHarnessCase(const std::string& kind, std::uint64_t seed, const HarnessOptions& o);
+
+/// Runs every case of o; calls progress after each.
+std::vector<HarnessCase> RunHarness(const HarnessOptions& o, const std::function<void(const HarnessCase&)>& progress = {});
+
+/// Scores: fractions right per class and the mean held-out shrink of correctly identified singles.
+struct HarnessScore {
+  int single_n = 0, single_right = 0;
+  int pair_n = 0, pair_right = 0;
+  int none_n = 0, none_right = 0, none_as_effect = 0;
+  int unknown_n = 0, unknown_right = 0, unknown_as_effect = 0;
+  double single_shrink_mean = 0;   ///< over correctly identified single-effect cases
+  std::string table;               ///< confusion table and shrink per effect, as text
+};
+HarnessScore ScoreHarness(const std::vector<HarnessCase>& cases);
+
+}  // namespace rths::diagnosis

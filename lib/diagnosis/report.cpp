@@ -1,0 +1,269 @@
+#include "diagnosis/report.h"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+
+#include <fmt/format.h>
+
+#include "core/error.h"
+#include "diagnosis/localise.h"
+#include "report/plot.h"
+#include "signal/spectral.h"
+
+namespace rths::diagnosis {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string Esc(const std::string& s) {
+  std::string o;
+  for (char c : s) {
+    if (c == '<') o += "&lt;";
+    else if (c == '>') o += "&gt;";
+    else if (c == '&') o += "&amp;";
+    else o += c;
+  }
+  return o;
+}
+
+std::vector<double> Residual(const std::vector<double>& m, const std::vector<double>& p, std::size_t first) {
+  std::vector<double> e;
+  for (std::size_t k = first; k < m.size(); ++k) e.push_back(m[k] - p[k]);
+  return e;
+}
+
+/// Spectra of one channel (first test record): measured, nominal residual, final residual.
+report::Figure SpectrumFigure(const Traces::Record& t, const std::string& ch, std::size_t first) {
+  const auto& m = ch == "y" ? t.y_meas : t.f_meas;
+  const auto& pn = ch == "y" ? t.y_nom : t.f_nom;
+  const auto& pf = ch == "y" ? t.y_fin : t.f_fin;
+  std::vector<double> meas(m.begin() + static_cast<std::ptrdiff_t>(first), m.end());
+  const std::size_t L = std::max<std::size_t>(64, std::min<std::size_t>(static_cast<std::size_t>(std::lround(1.0 / t.dt_s)), meas.size() / 8));
+  const auto sm = signal::WelchPsd(meas, t.dt_s, L);
+  const auto sn = signal::WelchPsd(Residual(m, pn, first), t.dt_s, L);
+  const auto sf = signal::WelchPsd(Residual(m, pf, first), t.dt_s, L);
+  const std::string unit = ch == "y" ? "mm^2/Hz" : "kN^2/Hz";
+  report::Figure fig;
+  fig.name = "spectrum_" + ch;
+  auto p = report::MakePanel(fmt::format("channel {}: spectra (test record {})", ch, fs::path(t.source).filename().string()),
+                             "frequency [Hz]", "PSD [" + unit + "]");
+  p.log_x = p.log_y = true;
+  auto s1 = report::MakeSeries("measured", "#1f77b4");
+  auto s2 = report::MakeSeries("residual, nominal model", "#d62728");
+  auto s3 = report::MakeSeries("residual, with the verdict's effects", "#2ca02c");
+  for (std::size_t j = 1; j < sm.size(); ++j) {
+    const double f = static_cast<double>(j) / (t.dt_s * static_cast<double>(L));
+    s1.x.push_back(f), s1.y.push_back(sm[j] > 0 ? sm[j] : NAN);
+    s2.x.push_back(f), s2.y.push_back(sn[j] > 0 ? sn[j] : NAN);
+    s3.x.push_back(f), s3.y.push_back(sf[j] > 0 ? sf[j] : NAN);
+  }
+  p.series = {s1, s2, s3};
+  fig.panels.push_back(p);
+  return fig;
+}
+
+report::Figure FrfFigure(const Traces::Record& t, std::size_t first) {
+  std::vector<double> u(t.u.begin() + static_cast<std::ptrdiff_t>(first), t.u.end());
+  std::vector<double> ym(t.y_meas.begin() + static_cast<std::ptrdiff_t>(first), t.y_meas.end());
+  std::vector<double> yn(t.y_nom.begin() + static_cast<std::ptrdiff_t>(first), t.y_nom.end());
+  std::vector<double> yf(t.y_fin.begin() + static_cast<std::ptrdiff_t>(first), t.y_fin.end());
+  const std::size_t L = std::max<std::size_t>(64, std::min<std::size_t>(static_cast<std::size_t>(std::lround(2.0 / t.dt_s)), u.size() / 8));
+  const auto hm = signal::H1Estimate(u, ym, t.dt_s, L);
+  const auto hn = signal::H1Estimate(u, yn, t.dt_s, L);
+  const auto hf = signal::H1Estimate(u, yf, t.dt_s, L);
+  const auto phm = signal::UnwrapPhase(hm.h), phn = signal::UnwrapPhase(hn.h), phf = signal::UnwrapPhase(hf.h);
+  report::Figure fig;
+  fig.name = "frf_y";
+  fig.title = "u -> y: measured vs model (H1, test record)";
+  auto pm = report::MakePanel("", "frequency [Hz]", "|G_yu| [mm/mm]");
+  auto pp = report::MakePanel("", "frequency [Hz]", "phase [deg]");
+  auto pc = report::MakePanel("", "frequency [Hz]", "coherence u -> y_meas");
+  const double fmax = std::min(60.0, 0.5 / t.dt_s);
+  for (auto* p : {&pm, &pp, &pc}) p->x_range = std::make_pair(0.0, fmax);
+  auto a1 = report::MakeSeries("measured", "#1f77b4"), a2 = report::MakeSeries("nominal model", "#d62728", 2),
+       a3 = report::MakeSeries("with the verdict's effects", "#2ca02c", 3);
+  auto b1 = a1, b2 = a2, b3 = a3;
+  auto c1 = report::MakeSeries("", "#1f77b4");
+  for (std::size_t j = 1; j < hm.f_hz.size() && hm.f_hz[j] <= fmax; ++j) {
+    const double f = hm.f_hz[j];
+    a1.x.push_back(f), a1.y.push_back(std::abs(hm.h[j]));
+    a2.x.push_back(f), a2.y.push_back(std::abs(hn.h[j]));
+    a3.x.push_back(f), a3.y.push_back(std::abs(hf.h[j]));
+    b1.x.push_back(f), b1.y.push_back(phm[j] * 180 / M_PI);
+    b2.x.push_back(f), b2.y.push_back(phn[j] * 180 / M_PI);
+    b3.x.push_back(f), b3.y.push_back(phf[j] * 180 / M_PI);
+    c1.x.push_back(f), c1.y.push_back(hm.coherence[j]);
+  }
+  pm.series = {a1, a2, a3};
+  pp.series = {b1, b2, b3};
+  pc.series = {c1};
+  pc.key = "off";
+  pc.y_range = std::make_pair(0.0, 1.05);
+  fig.panels = {pm, pp, pc};
+  fig.panel_height_px = 260;
+  return fig;
+}
+
+/// RMS residual (nominal) inside vs outside each condition, as bars drawn with boxes-like lines.
+report::Figure ConditionFigure(const Result& r) {
+  report::Figure fig;
+  fig.name = "conditions";
+  for (const std::string ch : {"y", "f"}) {
+    auto p = report::MakePanel(fmt::format("channel {}: share of residual energy vs share of samples", ch), "condition #",
+                               "[%]");
+    auto s1 = report::MakeSeries("share of residual energy", "#d62728");
+    auto s2 = report::MakeSeries("share of samples", "#1f77b4");
+    s1.with = s2.with = "linespoints";
+    std::string names;
+    int j = 0;
+    for (const auto& c : r.conditions) {
+      if (c.channel != ch) continue;
+      ++j;
+      s1.x.push_back(j), s1.y.push_back(c.share_pct);
+      s2.x.push_back(j), s2.y.push_back(c.samples_pct);
+      names += fmt::format("{}{}={}", names.empty() ? "" : ", ", j, c.name);
+    }
+    if (j == 0) continue;
+    p.xlabel = names;
+    p.x_range = std::make_pair(0.5, j + 0.5);
+    p.series = {s1, s2};
+    fig.panels.push_back(p);
+  }
+  return fig;
+}
+
+report::Figure TraceFigure(const Traces::Record& t, const std::string& ch) {
+  const auto& m = ch == "y" ? t.y_meas : t.f_meas;
+  const auto& pn = ch == "y" ? t.y_nom : t.f_nom;
+  const auto& pf = ch == "y" ? t.y_fin : t.f_fin;
+  report::Figure fig;
+  fig.name = "trace_" + ch;
+  // The 2 s window with the largest nominal residual energy.
+  const auto w = static_cast<std::size_t>(std::lround(2.0 / t.dt_s));
+  std::size_t best = 0;
+  double be = -1;
+  for (std::size_t a = 0; a + w <= m.size(); a += w / 4) {
+    double e = 0;
+    for (std::size_t k = a; k < a + w; ++k) e += (m[k] - pn[k]) * (m[k] - pn[k]);
+    if (e > be) be = e, best = a;
+  }
+  const std::size_t b = std::min(m.size(), best + w);
+  const std::string unit = ch == "y" ? "mm" : "kN";
+  auto p1 = report::MakePanel(fmt::format("channel {}: measured and predicted", ch), "t [s]", ch + " [" + unit + "]");
+  auto p2 = report::MakePanel("residual", "t [s]", "[" + unit + "]");
+  auto s1 = report::MakeSeries("measured", "#1f77b4"), s2 = report::MakeSeries("nominal", "#d62728", 2),
+       s3 = report::MakeSeries("with the verdict's effects", "#2ca02c", 3);
+  auto r1 = report::MakeSeries("nominal", "#d62728"), r2 = report::MakeSeries("with the verdict's effects", "#2ca02c");
+  for (std::size_t k = best; k < b; ++k) {
+    const double tt = static_cast<double>(k) * t.dt_s;
+    s1.x.push_back(tt), s1.y.push_back(m[k]);
+    s2.x.push_back(tt), s2.y.push_back(pn[k]);
+    s3.x.push_back(tt), s3.y.push_back(pf[k]);
+    r1.x.push_back(tt), r1.y.push_back(m[k] - pn[k]);
+    r2.x.push_back(tt), r2.y.push_back(m[k] - pf[k]);
+  }
+  p1.series = {s1, s2, s3};
+  p2.series = {r1, r2};
+  fig.panels = {p1, p2};
+  fig.panel_height_px = 280;
+  return fig;
+}
+
+}  // namespace
+
+void WriteReport(const Result& r, const Traces& traces, const fs::path& dir) {
+  std::vector<std::string> pngs;
+  std::string plot_note;
+  if (!traces.test.empty() && report::GnuplotAvailable()) {
+    const auto& t = traces.test[0];
+    const auto first = static_cast<std::size_t>(std::lround(r.options.warmup_s / t.dt_s));
+    std::vector<report::Figure> figs = {SpectrumFigure(t, "y", first), FrfFigure(t, first)};
+    if (!t.f_nom.empty()) figs.push_back(SpectrumFigure(t, "f", first));
+    figs.push_back(ConditionFigure(r));
+    figs.push_back(TraceFigure(t, "y"));
+    if (!t.f_nom.empty()) figs.push_back(TraceFigure(t, "f"));
+    for (const auto& f : figs) {
+      if (f.panels.empty()) continue;
+      try {
+        report::Plot(f, dir);
+        pngs.push_back(f.name + ".png");
+      } catch (const std::exception& e) {
+        plot_note += fmt::format("<p>plot {} failed: {}</p>\n", f.name, Esc(e.what()));
+      }
+    }
+  } else if (traces.test.empty()) {
+    plot_note = "<p>No traces: no plots.</p>\n";
+  } else {
+    plot_note = "<p>gnuplot is not installed (apt-get install gnuplot-nox): no plots.</p>\n";
+  }
+  std::string h;
+  h += "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>rths diagnose</title>\n<style>"
+       "body{font-family:sans-serif;max-width:1100px;margin:1em auto}table{border-collapse:collapse;margin:.5em 0}"
+       "td,th{border:1px solid #bbb;padding:2px 8px;text-align:right}th{background:#eee}td.l{text-align:left}"
+       ".sel{background:#dfd}</style></head><body>\n";
+  h += "<h1>Sim-to-real gap diagnosis</h1>\n";
+  h += fmt::format("<p><b>Verdict: {}</b></p>\n", Esc(fmt::format("{}", fmt::join(r.verdict, ", "))));
+  h += fmt::format("<p>Model: {}<br>Training records: {}<br>Test records: {}<br>dt = {} s, {} samples, runtime {:.2f} s</p>\n",
+                   Esc(r.model_source), Esc(fmt::format("{}", fmt::join(r.train, ", "))),
+                   Esc(fmt::format("{}", fmt::join(r.test, ", "))), r.dt_s, r.samples, r.runtime_s);
+  h += "<h2>Gap per channel (test records)</h2>\n<table><tr><th>channel</th><th>NRMSE nominal [%]</th><th>train [%]</th>"
+       "<th>after [%]</th><th>noise floor rms</th><th>residual / floor</th><th>whiteness Q20</th><th>status</th></tr>\n";
+  for (const auto& c : r.channels) {
+    if (!c.diagnosed) {
+      h += fmt::format("<tr><td class=l>{}</td><td colspan=7 class=l>not diagnosed</td></tr>\n", c.channel);
+      continue;
+    }
+    h += fmt::format("<tr><td class=l>{}</td><td>{:.3f}</td><td>{:.3f}</td><td>{:.3f}</td><td>{:.4g} {}</td><td>{:.2f}</td>"
+                     "<td>{:.0f}</td><td class=l>{}</td></tr>\n",
+                     c.channel, c.gap_test_pct, c.gap_train_pct, c.after_test_pct, c.noise_rms, c.channel == "y" ? "mm" : "kN",
+                     c.floor_ratio, c.whiteness, c.status);
+  }
+  h += "</table>\n<h2>Effects (fitted on the training records, scored on the test records)</h2>\n"
+       "<table><tr><th>effect</th><th>channel</th><th>parameters</th><th>test NRMSE after [%]</th><th>shrink [%]</th>"
+       "<th>train NRMSE after [%]</th><th>selected</th></tr>\n";
+  for (const auto& e : r.effects) {
+    std::string ps;
+    for (const auto& [k, v] : e.params) ps += fmt::format("{} = {:.4g}<br>", k, v);
+    h += fmt::format("<tr{}><td class=l>{}</td><td>{}</td><td class=l>{}</td><td>{:.3f}</td><td>{:.1f}</td><td>{:.3f}</td>"
+                     "<td>{}</td></tr>\n",
+                     e.selected ? " class=sel" : "", e.name, e.channel, ps, e.test_nrmse_after, e.shrink_pct, e.train_nrmse_after,
+                     e.selected ? fmt::format("yes ({})", e.order + 1) : "no");
+  }
+  h += "</table>\n<h2>Where: frequency bands (nominal residual, test records)</h2>\n<table><tr><th>channel</th><th>band [Hz]</th>"
+       "<th>residual share [%]</th><th>signal share [%]</th><th>residual / signal in band [%]</th><th>coherence</th>"
+       "<th>|H_meas / H_model|</th><th>phase diff [deg]</th></tr>\n";
+  for (const auto& b : r.bands) {
+    if (b.share_pct < 0.05 && b.signal_share_pct < 0.05) continue;
+    h += fmt::format("<tr><td class=l>{}</td><td>{:g}-{:g}</td><td>{:.1f}</td><td>{:.1f}</td><td>{:.2f}</td><td>{}</td><td>{}</td>"
+                     "<td>{}</td></tr>\n",
+                     b.channel, b.lo_hz, b.hi_hz, b.share_pct, b.signal_share_pct, b.rel_residual_pct,
+                     b.coherence >= 0 ? fmt::format("{:.3f}", b.coherence) : "",
+                     b.coherence >= 0 ? fmt::format("{:.3f}", b.gain_ratio) : "",
+                     b.coherence >= 0 ? fmt::format("{:.2f}", b.phase_diff_deg) : "");
+  }
+  h += "</table>\n<h2>Where: state conditions</h2>\n<table><tr><th>channel</th><th>condition</th><th>residual share [%]</th>"
+       "<th>sample share [%]</th><th>ratio</th></tr>\n";
+  for (const auto& c : r.conditions)
+    h += fmt::format("<tr><td class=l>{}</td><td class=l>{}</td><td>{:.1f}</td><td>{:.1f}</td><td>{:.2f}</td></tr>\n", c.channel,
+                     c.name, c.share_pct, c.samples_pct, c.samples_pct > 0 ? c.share_pct / c.samples_pct : 0.0);
+  h += "</table>\n<h2>Where: time windows (largest shares)</h2>\n<table><tr><th>channel</th><th>record</th><th>t0 [s]</th>"
+       "<th>t1 [s]</th><th>share [%]</th></tr>\n";
+  for (const auto& t : r.time)
+    h += fmt::format("<tr><td class=l>{}</td><td class=l>{}</td><td>{:.2f}</td><td>{:.2f}</td><td>{:.1f}</td></tr>\n", t.channel,
+                     Esc(t.record), t.t0_s, t.t1_s, t.share_pct);
+  h += "</table>\n";
+  if (!r.warnings.empty()) {
+    h += "<h2>Warnings</h2>\n<ul>\n";
+    for (const auto& w : r.warnings) h += "<li>" + Esc(w) + "</li>\n";
+    h += "</ul>\n";
+  }
+  h += "<h2>Plots</h2>\n" + plot_note;
+  for (const auto& p : pngs) h += fmt::format("<p><img src=\"{}\" alt=\"{}\" style=\"max-width:100%\"></p>\n", p, p);
+  h += "<p>Method: docs/diagnosis.md. JSON: diagnosis.json.</p>\n</body></html>\n";
+  std::ofstream f(dir / "report.html");
+  if (!(f << h)) throw Error((dir / "report.html").string(), "cannot write");
+}
+
+}  // namespace rths::diagnosis

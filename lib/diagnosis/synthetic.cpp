@@ -1,0 +1,141 @@
+#include "diagnosis/synthetic.h"
+
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "core/error.h"
+#include "models/current_driver.h"
+#include "models/mr_damper.h"
+#include "models/rig.h"
+#include "models/servo_linear.h"
+#include "signal/blwn.h"
+#include "signal/random.h"
+
+namespace rths::diagnosis {
+
+void MakeInputs(const Excitation& ex, std::vector<double>* u_mm, std::vector<double>* i_A) {
+  const auto n = static_cast<std::size_t>(std::lround(ex.duration_s / ex.dt_s));
+  *u_mm = signal::Blwn(ex.band_hz, ex.rms_mm, ex.dt_s, n, ex.seed, 2.0);
+  // Fade in over 0.25 s so that the record starts at rest.
+  const auto nf = static_cast<std::size_t>(std::lround(0.25 / ex.dt_s));
+  for (std::size_t k = 0; k < std::min(n, nf); ++k) (*u_mm)[k] *= 0.5 * (1.0 - std::cos(M_PI * k / nf));
+  i_A->assign(n, ex.current_max_A);
+  if (ex.current_constant) return;
+  auto g = signal::MakeGaussian(ex.seed * 7919 + 17);
+  std::size_t k = 0;
+  while (k < n) {
+    const int level = static_cast<int>(std::floor(6.0 * signal::NextUniform(&g)));
+    const double hold = ex.hold_min_s + (ex.hold_max_s - ex.hold_min_s) * signal::NextUniform(&g);
+    const std::size_t m = std::max<std::size_t>(1, static_cast<std::size_t>(std::lround(hold / ex.dt_s)));
+    for (std::size_t j = k; j < std::min(n, k + m); ++j) (*i_A)[j] = ex.current_max_A * std::min(level, 5) / 5.0;
+    k += m;
+  }
+}
+
+namespace {
+
+io::RigRecord Empty(const Excitation& ex, const std::string& name, std::size_t n) {
+  io::RigRecord r;
+  r.dt_s = ex.dt_s;
+  r.source = name;
+  r.t_s.resize(n);
+  for (std::size_t k = 0; k < n; ++k) r.t_s[k] = static_cast<double>(k) * ex.dt_s;
+  r.y_mm.resize(n);
+  r.f_kN.resize(n);
+  return r;
+}
+
+}  // namespace
+
+io::RigRecord MakeRecordBlocks(const Excitation& ex, const Truth& truth, const std::string& name) {
+  std::vector<double> u, i;
+  MakeInputs(ex, &u, &i);
+  const std::size_t n = u.size();
+  io::RigRecord r = Empty(ex, name, n);
+  r.u_mm = u;
+  r.i_A = i;
+  const double dt = ex.dt_s;
+  const auto servo = models::LinearServo::Make(scenario::ServoPreset("avg"), dt);
+  models::LinearServoState xs;
+  models::DisplacementEffects dfx(truth.effects, dt);
+  models::ForceEffects ffx(truth.effects, dt);
+  ffx.Reset(i[0]);
+  const auto driver = models::CurrentDriver::Make({}, dt);
+  models::CurrentDriverState cs = models::SteadyState(i[0]);
+  const auto damper = models::MrDamperParams::Table3();
+  models::MrDamperState ds{};
+  auto g = signal::MakeGaussian(truth.noise_seed);
+  const double sy = truth.effects.sensor_noise ? truth.effects.sensor_noise->rms_y_mm : 0.0;
+  const double sf = truth.effects.sensor_noise ? truth.effects.sensor_noise->rms_f_kN : 0.0;
+  double y_prev = 0.0, f_prev = 0.0;
+  for (std::size_t k = 0; k < n; ++k) {
+    const double y = dfx.Post(models::Output(servo, xs), f_prev);
+    // The damper over [t_{k-1}, t_k]: linear motion y_{k-1} -> y_k, current held from k-1.
+    const double v = k > 0 ? (y - y_prev) / dt : 0.0;
+    if (k > 0) {
+      const int m = 8;
+      const double h = dt / m;
+      for (int j = 0; j < m; ++j) {
+        const double ta = j * h;
+        auto coef = [&](double tau) { return models::CoefficientsAt(damper, models::EffectiveCurrentAt(driver, cs, tau)); };
+        const auto ca = coef(ta), cb = coef(ta + 0.5 * h), cc = coef(ta + h);
+        auto xat = [&](double tau) { return y_prev + v * tau; };
+        const auto r1 = models::DamperRates(ca, ds, xat(ta), v);
+        const models::MrDamperState s2{ds.y_mm + 0.5 * h * r1.ydot_mm_s, ds.z_mm + 0.5 * h * r1.zdot_mm_s};
+        const auto r2 = models::DamperRates(cb, s2, xat(ta + 0.5 * h), v);
+        const models::MrDamperState s3{ds.y_mm + 0.5 * h * r2.ydot_mm_s, ds.z_mm + 0.5 * h * r2.zdot_mm_s};
+        const auto r3 = models::DamperRates(cb, s3, xat(ta + 0.5 * h), v);
+        const models::MrDamperState s4{ds.y_mm + h * r3.ydot_mm_s, ds.z_mm + h * r3.zdot_mm_s};
+        const auto r4 = models::DamperRates(cc, s4, xat(ta + h), v);
+        ds.y_mm += h / 6.0 * (r1.ydot_mm_s + 2 * r2.ydot_mm_s + 2 * r3.ydot_mm_s + r4.ydot_mm_s);
+        ds.z_mm += h / 6.0 * (r1.zdot_mm_s + 2 * r2.zdot_mm_s + 2 * r3.zdot_mm_s + r4.zdot_mm_s);
+      }
+      models::Advance(driver, &cs);
+    }
+    const double ic = models::EffectiveCurrentA(driver, cs);
+    double f = ffx.Force(models::DamperForceKn(models::CoefficientsAt(damper, ic), ds, y, v));
+    f += truth.stiffness_kN_per_mm * y;
+    const double t = static_cast<double>(k) * dt;
+    r.y_mm[k] = y + truth.ripple_mm * std::sin(2.0 * M_PI * truth.ripple_hz * t) + sy * signal::NextGaussian(&g);
+    r.f_kN[k] = f + sf * signal::NextGaussian(&g);
+    // Step k -> k+1.
+    models::Hold(driver, &cs, ffx.Current(i[k]));
+    models::Step(servo, &xs, dfx.Pre(u[k]));
+    y_prev = y;
+    f_prev = f;
+  }
+  r.metadata.push_back({"generator", "diagnosis::MakeRecordBlocks"});
+  io::ValidateRigRecord(r, name);
+  return r;
+}
+
+io::RigRecord MakeRecordRig(const Excitation& ex, const Truth& truth, const std::string& name) {
+  std::vector<double> u, i;
+  MakeInputs(ex, &u, &i);
+  const std::size_t n = u.size();
+  scenario::PlantConfig plant;
+  plant.kind = "linear";
+  plant.actuator = scenario::ServoPreset("avg");
+  plant.specimen = "mr_damper";
+  plant.current_dynamics = true;
+  plant.effects = truth.effects;
+  plant.noise_seed = truth.noise_seed;
+  plant.unmodelled.ripple_mm = truth.ripple_mm;
+  plant.unmodelled.ripple_hz = truth.ripple_mm > 0 ? truth.ripple_hz : 0.0;
+  plant.unmodelled.stiffness_kN_per_mm = truth.stiffness_kN_per_mm;
+  auto rig = models::MakeRig(plant, ex.dt_s);
+  io::RigRecord r = Empty(ex, name, n);
+  r.u_mm = u;
+  r.i_A = i;
+  for (std::size_t k = 0; k < n; ++k) {
+    r.y_mm[k] = rig->y_mm();
+    r.f_kN[k] = rig->f_kN();
+    rig->Step(u[k], i[k]);
+  }
+  r.metadata.push_back({"generator", "models::MakeRig (rig mode)"});
+  io::ValidateRigRecord(r, name);
+  return r;
+}
+
+}  // namespace rths::diagnosis
