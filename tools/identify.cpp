@@ -3,7 +3,14 @@
 // Fits the servohydraulic model of Eq. 15 to a record of command u and measured y (a CSV rig
 // record or an LCM run log of ours): H1 estimate with coherence, least-squares fit over a band,
 // time-domain check. Prints the model as a scenario fragment; writes a Bode plot like the
-// paper's Fig. 6 with gnuplot. docs/identification.md. Exit 0 ok, 2 bad input.
+// paper's Fig. 6 with gnuplot.
+// rths identify --damper RECORD... --current A [--check RECORD...] [--A A] [--velocity-cutoff-hz F]
+//                        [--out FILE.toml]
+// Fits the Spencer MR damper model (Eqs. 32-34) at one current to damper tests (rig records, LCM
+// logs, or UTFSM damper files: x = y_mm, F = f_kN) by least squares on the force
+// (ident/damper_fit.h); prints the parameters, the force error per record (and per held-out
+// --check record) and the model as a [plant.damper] TOML fragment.
+// docs/identification.md. Exit 0 ok, 2 bad input.
 #include <unistd.h>
 
 #include <algorithm>
@@ -20,8 +27,10 @@
 #include <fmt/format.h>
 
 #include "core/error.h"
+#include "ident/damper_fit.h"
 #include "ident/identify.h"
 #include "io/rig_record.h"
+#include "io/utfsm.h"
 #include "signal/spectral.h"
 
 namespace {
@@ -136,20 +145,130 @@ void PlotBode(const std::string& png, const std::string& title, const rths::iden
     throw Error(png, fmt::format("gnuplot failed ({}); is gnuplot-nox installed? {}", rc_sys, err));
 }
 
+/// Text safe for gnuplot's enhanced mode.
+std::string GnuplotSafe(const std::string& s) {
+  std::string o;
+  for (char ch : s) {
+    if (ch == '_' || ch == '^' || ch == '{' || ch == '}' || ch == '@' || ch == '&') o += '\\';
+    if (ch != '\'') o += ch;
+  }
+  return o;
+}
+
+/// --damper plot: per record (training, then held-out), force against velocity and against
+/// displacement, measured and model, over the record's last 60 % (the steady cycles).
+void PlotDamper(const std::string& png, const std::vector<std::pair<const rths::io::RigRecord*, bool>>& recs,
+                const rths::models::MrDamperCoefficients& coef, double cutoff_hz, double current_A) {
+  const fs::path dir = fs::temp_directory_path() / fmt::format("rths_identify_damper_{}", ::getpid());
+  fs::create_directories(dir);
+  const fs::path script = dir / "plot.gp";
+  std::ofstream o(script);
+  const std::size_t rows = recs.size();
+  o << fmt::format("set terminal pngcairo size 1000,{} font 'Sans,9'\n", 60 + 260 * rows);
+  o << "set output '" << png << "'\n";
+  o << fmt::format("set multiplot layout {},2 title 'MR damper at {} A: measured (blue) and fitted model (red)'\n", rows,
+                   current_A);
+  o << "set grid\nset key top left\n";
+  for (std::size_t i = 0; i < rows; ++i) {
+    const auto& rec = *recs[i].first;
+    const auto v = rths::ident::SmoothVelocity(rec.y_mm, rec.dt_s, cutoff_hz);
+    const auto F = rths::ident::SimulateDamperForce(coef, rec.y_mm, v, rec.dt_s);
+    const auto score = rths::ident::ScoreDamper(coef, rec, cutoff_hz);
+    const fs::path dat = dir / fmt::format("r{}.dat", i);
+    std::ofstream d(dat);
+    for (std::size_t k = rec.size() * 2 / 5; k < rec.size(); ++k)
+      d << fmt::format("{:.6g} {:.6g} {:.6g} {:.6g}\n", rec.y_mm[k], v[k], rec.f_kN[k], F[k]);
+    const std::string name = GnuplotSafe(fs::path(rec.source).filename().string());
+    const std::string title = fmt::format("{} ({}, Eq. 31 on f {:.1f} %)", name, recs[i].second ? "fitted" : "held out",
+                                          score.nrmse_f_pct);
+    o << fmt::format("set title '{}'\nset xlabel 'velocity [mm/s]'\nset ylabel 'force [kN]'\n", title);
+    o << "plot '" << dat.string() << "' u 2:3 w l lw 1.5 lc rgb '#1f77b4' t 'measured', '' u 2:4 w l lw 1.5 lc rgb '#d62728' t 'model'\n";
+    o << "set xlabel 'displacement [mm]'\n";
+    o << "plot '" << dat.string() << "' u 1:3 w l lw 1.5 lc rgb '#1f77b4' t 'measured', '' u 1:4 w l lw 1.5 lc rgb '#d62728' t 'model'\n";
+  }
+  o << "unset multiplot\n";
+  o.close();
+  const std::string cmd = fmt::format("gnuplot '{}' 2>'{}'", script.string(), (dir / "gnuplot.err").string());
+  const int rc = std::system(cmd.c_str());
+  std::string err;
+  if (rc != 0) {
+    std::ifstream e(dir / "gnuplot.err");
+    std::getline(e, err);
+  }
+  fs::remove_all(dir);
+  if (rc != 0) throw Error(png, fmt::format("gnuplot failed ({}); is gnuplot-nox installed? {}", rc, err));
+}
+
+/// The --damper mode (file comment).
+int RunDamper(const std::vector<std::string>& records, double current_A, const std::vector<std::string>& checks,
+              const rths::ident::DamperFitOptions& o, const std::string& out, const std::string& plot) {
+  std::vector<rths::io::RigRecord> recs;
+  for (const auto& path : records) {
+    recs.push_back(rths::io::ReadRecordOrUtfsm(path));
+    for (const auto& w : recs.back().warnings) std::fprintf(stderr, "rths identify: warning: %s\n", w.c_str());
+  }
+  std::vector<rths::io::RigRecord> held;
+  for (const auto& path : checks) held.push_back(rths::io::ReadRecordOrUtfsm(path));
+  const auto fit = rths::ident::FitDamper(recs, current_A, o);
+  std::printf("rths identify --damper: %zu record(s) at %g A\n%s", recs.size(), current_A, fit.Report().c_str());
+  std::string names;
+  for (const auto& r : records) names += (names.empty() ? "" : " ") + fs::path(r).filename().string();
+  std::string title = fmt::format("rths identify --damper {} --current {}", names, current_A);
+  auto fit_out = fit;
+  if (!held.empty()) {
+    std::printf("  held-out force error (Eq. 31 on f), same model:\n");
+    for (const auto& h : held) {
+      const auto sc = rths::ident::ScoreDamper(fit.coef, h, o.velocity_cutoff_hz);
+      std::printf("    %-40s %6zu samples at %g s, peak %.4g kN: %.3f %%\n", sc.source.c_str(), sc.samples, sc.dt_s,
+                  sc.peak_force_kN, sc.nrmse_f_pct);
+    }
+  }
+  const std::string toml = rths::ident::DamperTomlFragment(fit_out, title);
+  std::printf("\n%s", toml.c_str());
+  if (!out.empty()) {
+    std::ofstream f(out);
+    if (!(f << toml)) throw Error(out, "cannot write the model file");
+    std::printf("\nwrote %s\n", out.c_str());
+  }
+  if (!plot.empty()) {
+    std::vector<std::pair<const rths::io::RigRecord*, bool>> all;
+    for (const auto& r : recs) all.emplace_back(&r, true);
+    for (const auto& r : held) all.emplace_back(&r, false);
+    PlotDamper(plot, all, fit.coef, o.velocity_cutoff_hz, current_A);
+    std::printf("wrote %s\n", plot.c_str());
+  }
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{"rths identify: fit the servohydraulic model of Eq. 15 to a record of command u and measured y"};
   std::string record, band = "0.5-40", out, plot, weights = "inverse-variance";
+  std::vector<std::string> records, checks;
   int poles = 3;
   double segment_s = 0.0;
-  app.add_option("record", record, "CSV rig record or LCM run log (log.lcm) of ours")->required();
+  bool damper = false;
+  double current_A = -1.0;
+  rths::ident::DamperFitOptions damper_options;
+  app.add_option("record", records,
+                 "CSV rig record or LCM run log (log.lcm) of ours; with --damper one or more damper tests (also UTFSM "
+                 "damper files)")
+      ->required();
+  app.add_flag("--damper", damper, "fit the Spencer MR damper model (Eqs. 32-34) at one current instead");
+  app.add_option("--current", current_A, "--damper: the current of the records [A] (required)");
+  app.add_option("--check", checks, "--damper: held-out records to score the fitted model on");
+  app.add_option("--A", damper_options.A, "--damper: Bouc-Wen A, held fixed (default 300, Table 3)");
+  app.add_option("--velocity-cutoff-hz", damper_options.velocity_cutoff_hz,
+                 "--damper: cutoff of the zero-phase smoothing differentiator [Hz] (default 50)");
   app.add_option("--band", band, "frequency band fitted, LO-HI [Hz] (default 0.5-40, the paper's range)");
   app.add_option("--poles", poles, "number of poles N of Eq. 15 (default 3)");
   app.add_option("--segment-s", segment_s, "Welch segment length [s] (default min(4 s, 2/9 of the record))");
   app.add_option("--weights", weights, "frequency weights: inverse-variance (default), coherence, uniform");
   app.add_option("--out", out, "write the scenario fragment ([plant] actuator, [controller] model) here");
-  app.add_option("--plot", plot, "Bode plot PNG (default: beside --out, else identify.png)");
+  app.add_option("--plot", plot,
+                 "Bode plot PNG (default: beside --out, else identify.png); with --damper: force against velocity and "
+                 "displacement per record (only if given)");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -158,6 +277,14 @@ int main(int argc, char** argv) {
   }
 
   try {
+    if (damper) {
+      if (current_A < 0.0) throw Error("--current", "--damper needs --current A (>= 0), the current of the records");
+      return RunDamper(records, current_A, checks, damper_options, out, plot);
+    }
+    if (current_A >= 0.0 || !checks.empty()) throw Error("--current/--check", "only with --damper");
+    if (records.size() != 1)
+      throw Error("record", fmt::format("{} records given: the actuator fit takes one (or use --damper)", records.size()));
+    record = records[0];
     rths::ident::IdentifyOptions o;
     std::tie(o.fit.band_lo_hz, o.fit.band_hi_hz) = ParseBand(band);
     o.fit.poles = poles;

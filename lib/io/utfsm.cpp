@@ -199,4 +199,50 @@ RigRecord ReadUtfsm(const std::string& path) {
   return ReadUtfsmDamper(path);
 }
 
+RigRecord ReadRecordOrUtfsm(const std::string& path) {
+  if (IsLcmLog(path)) return ReadRecordAny(path);
+  std::ifstream in(path);
+  if (!in) throw Error(path, "cannot open");
+  std::string first;
+  std::getline(in, first);
+  if (Trim(first).rfind("# rths rig record", 0) == 0) return ReadRecordAny(path);
+  return ReadUtfsm(path);
+}
+
+RigRecord CutRigRecord(const RigRecord& rec, double from_s, double to_s) {
+  const std::string where = rec.source.empty() ? "record" : rec.source;
+  if (!(from_s >= 0.0) || std::isnan(to_s) || !(to_s > from_s))
+    throw Error(where, fmt::format("cut window [{}, {}) s: need 0 <= from < to", from_s, to_s));
+  RigRecord out;
+  out.dt_s = rec.dt_s;
+  out.source = rec.source;
+  out.metadata = rec.metadata;
+  const double t0 = rec.size() > 0 ? rec.t_s[0] : 0.0;
+  // Sample k is kept if from <= t_k - t0 < to, with half a step of slack against rounding.
+  const double eps = 0.5 * rec.dt_s;
+  std::size_t first = rec.size(), last = 0;
+  for (std::size_t k = 0; k < rec.size(); ++k) {
+    const double t = rec.t_s[k] - t0;
+    if (t >= from_s - eps && t < to_s - eps) {
+      if (first == rec.size()) first = k;
+      last = k + 1;
+      out.t_s.push_back(static_cast<double>(out.t_s.size()) * rec.dt_s);
+      out.u_mm.push_back(rec.u_mm[k]);
+      out.y_mm.push_back(rec.y_mm[k]);
+      out.f_kN.push_back(rec.f_kN[k]);
+      out.i_A.push_back(rec.i_A[k]);
+      if (rec.has_r()) out.r_mm.push_back(rec.r_mm[k]);
+    }
+  }
+  if (out.size() == 0)
+    throw Error(where, fmt::format("cut window [{}, {}) s holds no sample (the record lasts {:.6g} s)", from_s, to_s,
+                                   rec.DurationS()));
+  out.metadata.emplace_back("cut_from_record", std::filesystem::path(rec.source).filename().string());
+  out.metadata.emplace_back("cut_window_s", fmt::format("[{}, {}) s of the record: samples {}..{} of {}", from_s,
+                                                        std::isinf(to_s) ? std::string("end") : fmt::format("{}", to_s),
+                                                        first + 1, last, rec.size()));
+  ValidateRigRecord(out, fmt::format("{} cut to [{}, {}) s", where, from_s, to_s));
+  return out;
+}
+
 }  // namespace rths::io

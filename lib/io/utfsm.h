@@ -47,4 +47,16 @@ RigRecord ReadUtfsmDamper(const std::string& path);
 /// export, anything else a damper file.
 RigRecord ReadUtfsm(const std::string& path);
 
+/// Any record a tool takes, by content: an LCM run log of ours (IsLcmLog) or a CSV rig record
+/// (first line "# rths rig record ...") through ReadRecordAny, anything else through ReadUtfsm.
+RigRecord ReadRecordOrUtfsm(const std::string& path);
+
+/// The samples of `rec` with from_s <= t_k - t_0 < to_s (times relative to the record's first
+/// sample, so the second half of a record starts at its own t = 0 as well), time restarted at 0
+/// (t_k = k dt), everything else copied; metadata gain "cut_from_record" (the source) and
+/// "cut_window_s" (the window and the samples kept). to_s = infinity keeps the rest.
+/// Throws rths::Error (where = rec.source) if from_s < 0, to_s <= from_s, or the window keeps
+/// under 2 s (kMinRecordS; ValidateRigRecord).
+RigRecord CutRigRecord(const RigRecord& rec, double from_s, double to_s);
+
 }  // namespace rths::io

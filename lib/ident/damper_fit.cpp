@@ -1,0 +1,442 @@
+#include "ident/damper_fit.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+
+#include <Eigen/Dense>
+#include <fmt/format.h>
+
+#include "core/error.h"
+#include "signal/butterworth.h"
+
+namespace rths::ident {
+
+namespace {
+
+constexpr int kNonlinear = 6;  // ln alpha, ln c0, ln c1, ln k0, ln beta, ln gamma
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// Bounds of the nonlinear parameters (natural units: kN/mm, kN s/mm, kN s/mm, kN/mm, 1/mm^2,
+// 1/mm^2), in the order of theta.
+constexpr std::array<double, kNonlinear> kLo = {1e-7, 1e-7, 1e-7, 1e-8, 1e-9, 1e-9};
+constexpr std::array<double, kNonlinear> kHi = {1e2, 1e2, 1e3, 1e2, 1e4, 1e4};
+
+using Theta = Eigen::Matrix<double, kNonlinear, 1>;
+
+// One record prepared for the fit: x, v, f and its weight 1 / sum f^2.
+struct Prepared {
+  const io::RigRecord* rec;
+  std::vector<double> v;
+  double weight;
+  double vmax;
+};
+
+models::MrDamperCoefficients FromTheta(const Theta& th, double A, double k1, double x0) {
+  models::MrDamperCoefficients k{};
+  k.alpha = std::exp(th[0]);
+  k.c0 = std::exp(th[1]);
+  k.c1 = std::exp(th[2]);
+  k.k0 = std::exp(th[3]);
+  k.beta = std::exp(th[4]);
+  k.gamma = std::exp(th[5]);
+  k.A = A;
+  k.n = 2.0;
+  k.k1 = k1;
+  k.x0 = x0;
+  return k;
+}
+
+Theta Clamp(Theta th) {
+  for (int i = 0; i < kNonlinear; ++i) th[i] = std::clamp(th[i], std::log(kLo[i]), std::log(kHi[i]));
+  return th;
+}
+
+// The model at theta on every record: residuals r = sqrt(w_r) (f - F) stacked, with k1 and
+// b = -k1 x0 solved by weighted linear least squares (file comment of damper_fit.h).
+struct Evaluation {
+  Eigen::VectorXd r;
+  double cost = kInf;
+  double k1 = 0.0, x0 = 0.0;
+};
+
+Evaluation Evaluate(const Theta& th, const std::vector<Prepared>& data, double A, int substeps_fixed) {
+  Evaluation ev;
+  std::size_t total = 0;
+  for (const auto& p : data) total += p.rec->size();
+  const auto k = FromTheta(th, A, 0.0, 0.0);
+  std::vector<std::vector<double>> fnl(data.size());
+  for (std::size_t i = 0; i < data.size(); ++i) {
+    const auto& d = data[i];
+    const int m = substeps_fixed > 0 ? substeps_fixed : DamperSubsteps(k, d.rec->dt_s, d.vmax);
+    fnl[i] = SimulateDamperForce(k, d.rec->y_mm, d.v, d.rec->dt_s, m);
+    for (double f : fnl[i])
+      if (!std::isfinite(f)) return ev;  // cost = inf
+  }
+  // Weighted normal equations for e = f - F_nl - k1 x - b.
+  double sxx = 0, sx = 0, s1 = 0, sxe = 0, se = 0;
+  for (std::size_t i = 0; i < data.size(); ++i) {
+    const auto& d = data[i];
+    for (std::size_t j = 0; j < d.rec->size(); ++j) {
+      const double x = d.rec->y_mm[j], e = d.rec->f_kN[j] - fnl[i][j];
+      sxx += d.weight * x * x;
+      sx += d.weight * x;
+      s1 += d.weight;
+      sxe += d.weight * x * e;
+      se += d.weight * e;
+    }
+  }
+  const double det = sxx * s1 - sx * sx;
+  double k1 = 0.0, b = 0.0;
+  if (det > 1e-12 * sxx * s1) {
+    k1 = (sxe * s1 - sx * se) / det;
+    b = (sxx * se - sx * sxe) / det;
+  }
+  if (!(k1 > 0.0)) k1 = b = 0.0;
+  ev.k1 = k1;
+  ev.x0 = k1 > 0.0 ? -b / k1 : 0.0;
+  ev.r.resize(static_cast<Eigen::Index>(total));
+  Eigen::Index row = 0;
+  for (std::size_t i = 0; i < data.size(); ++i) {
+    const auto& d = data[i];
+    const double sw = std::sqrt(d.weight);
+    for (std::size_t j = 0; j < d.rec->size(); ++j)
+      ev.r[row++] = sw * (d.rec->f_kN[j] - fnl[i][j] - k1 * d.rec->y_mm[j] - b);
+  }
+  ev.cost = ev.r.squaredNorm();
+  if (!std::isfinite(ev.cost)) ev.cost = kInf;
+  return ev;
+}
+
+// Substeps of every record at theta (the Jacobian keeps them fixed so that the finite
+// differences see a smooth function).
+int MaxSubsteps(const Theta& th, const std::vector<Prepared>& data, double A) {
+  const auto k = FromTheta(th, A, 0.0, 0.0);
+  int m = 1;
+  for (const auto& d : data) m = std::max(m, DamperSubsteps(k, d.rec->dt_s, d.vmax));
+  return m;
+}
+
+struct LmState {
+  Theta theta;
+  Evaluation ev;
+  double mu = 1e-3;
+  int iterations = 0;
+  bool converged = false;
+};
+
+// Levenberg-Marquardt iterations on theta, the step projected on the box.
+void Iterate(LmState* s, const std::vector<Prepared>& data, double A, int iterations) {
+  for (int it = 0; it < iterations && !s->converged; ++it) {
+    const int m = MaxSubsteps(s->theta, data, A);
+    const Evaluation base = Evaluate(s->theta, data, A, m);
+    if (!std::isfinite(base.cost)) {
+      s->converged = true;
+      return;
+    }
+    Eigen::MatrixXd J(base.r.size(), kNonlinear);
+    for (int i = 0; i < kNonlinear; ++i) {
+      Theta t = s->theta;
+      double h = 1e-5;
+      if (t[i] + h > std::log(kHi[i])) h = -h;
+      t[i] += h;
+      const Evaluation e = Evaluate(t, data, A, m);
+      if (!std::isfinite(e.cost)) {
+        J.col(i).setZero();
+      } else {
+        J.col(i) = (e.r - base.r) / h;
+      }
+    }
+    const Eigen::MatrixXd H = J.transpose() * J;
+    const Eigen::VectorXd g = J.transpose() * base.r;
+    ++s->iterations;
+    bool accepted = false;
+    while (s->mu < 1e12) {
+      Eigen::MatrixXd Hd = H;
+      for (int i = 0; i < kNonlinear; ++i) Hd(i, i) += s->mu * std::max(H(i, i), 1e-12);
+      const Theta step = Hd.ldlt().solve(-g);
+      const Theta trial = Clamp(s->theta + step);
+      const Evaluation e = Evaluate(trial, data, A, 0);
+      if (std::isfinite(e.cost) && e.cost < s->ev.cost) {
+        const double rel = (s->ev.cost - e.cost) / std::max(s->ev.cost, 1e-300);
+        const double dstep = (trial - s->theta).norm();
+        s->theta = trial;
+        s->ev = e;
+        s->mu = std::max(s->mu / 3.0, 1e-9);
+        accepted = true;
+        if (rel < 1e-7 || dstep < 1e-6) s->converged = true;
+        break;
+      }
+      s->mu *= 4.0;
+    }
+    if (!accepted) s->converged = true;
+  }
+}
+
+}  // namespace
+
+bool DamperFitOptions::IsValid(std::string* error) const {
+  auto fail = [&](const std::string& m) {
+    if (error) *error = m;
+    return false;
+  };
+  if (!(A > 0.0) || !std::isfinite(A)) return fail(fmt::format("A = {}: must be > 0", A));
+  if (!(velocity_cutoff_hz > 0.0) || !std::isfinite(velocity_cutoff_hz))
+    return fail(fmt::format("velocity_cutoff_hz = {}: must be > 0", velocity_cutoff_hz));
+  if (start_iterations < 1) return fail(fmt::format("start_iterations = {}: must be >= 1", start_iterations));
+  if (max_iterations < 1) return fail(fmt::format("max_iterations = {}: must be >= 1", max_iterations));
+  if (!(current_tolerance_A >= 0.0))
+    return fail(fmt::format("current_tolerance_A = {}: must be >= 0", current_tolerance_A));
+  return true;
+}
+
+std::vector<double> SmoothVelocity(std::span<const double> x, double dt, double cutoff_hz) {
+  const std::size_t n = x.size();
+  if (n < 3) throw Error("SmoothVelocity", fmt::format("{} samples: need at least 3", n));
+  if (!(dt > 0.0)) throw Error("SmoothVelocity", fmt::format("dt_s = {}: must be > 0", dt));
+  if (!(cutoff_hz > 0.0)) throw Error("SmoothVelocity", fmt::format("cutoff_hz = {}: must be > 0", cutoff_hz));
+  std::vector<double> d(n);
+  d[0] = (x[1] - x[0]) / dt;
+  d[n - 1] = (x[n - 1] - x[n - 2]) / dt;
+  for (std::size_t k = 1; k + 1 < n; ++k) d[k] = (x[k + 1] - x[k - 1]) / (2.0 * dt);
+  const double fs = 1.0 / dt;
+  const double fc = std::min(cutoff_hz, 0.45 * fs);
+  const auto sos = signal::ButterworthLowpass(4, fc, fs);
+  // Odd reflection about both ends, about 3 time constants of the filter (at least 12 samples).
+  const std::size_t pad = std::min<std::size_t>(n - 1, std::max<std::size_t>(12, static_cast<std::size_t>(3.0 * fs / fc)));
+  std::vector<double> ext;
+  ext.reserve(n + 2 * pad);
+  for (std::size_t i = pad; i >= 1; --i) ext.push_back(2.0 * d[0] - d[i]);
+  ext.insert(ext.end(), d.begin(), d.end());
+  for (std::size_t i = 1; i <= pad; ++i) ext.push_back(2.0 * d[n - 1] - d[n - 1 - i]);
+  auto run = [&](auto begin, auto end) {
+    auto st = signal::SosAtRest(sos);
+    // Start at the first value's steady state: run the filter on a constant first.
+    for (int i = 0; i < 400; ++i) signal::SosStep(sos, &st, *begin);
+    for (auto it = begin; it != end; ++it) *it = signal::SosStep(sos, &st, *it);
+  };
+  run(ext.begin(), ext.end());
+  run(ext.rbegin(), ext.rend());
+  return {ext.begin() + static_cast<std::ptrdiff_t>(pad), ext.begin() + static_cast<std::ptrdiff_t>(pad + n)};
+}
+
+int DamperSubsteps(const models::MrDamperCoefficients& k, double dt, double vmax) {
+  const double lambda = 2.0 * std::sqrt(k.A * std::max(k.beta + k.gamma, 0.0)) * std::abs(vmax) +
+                        (k.A * k.alpha + k.k0) / (k.c0 + k.c1);
+  if (!std::isfinite(lambda)) return 4000;
+  const double m = std::ceil(dt * lambda / 0.5);
+  return static_cast<int>(std::clamp(m, 1.0, 4000.0));
+}
+
+std::vector<double> SimulateDamperForce(const models::MrDamperCoefficients& k, std::span<const double> x,
+                                        std::span<const double> v, double dt, int substeps) {
+  if (x.size() != v.size())
+    throw Error("SimulateDamperForce", fmt::format("x has {} samples, v {}", x.size(), v.size()));
+  const std::size_t n = x.size();
+  std::vector<double> f(n, std::numeric_limits<double>::quiet_NaN());
+  if (n == 0) return f;
+  if (substeps <= 0) {
+    double vmax = 0.0;
+    for (double vi : v) vmax = std::max(vmax, std::abs(vi));
+    substeps = DamperSubsteps(k, dt, vmax);
+  }
+  const double h = dt / substeps;
+  models::MrDamperState s{x[0], 0.0};
+  auto rates = [&](const models::MrDamperState& st, double xm, double vm) {
+    return models::DamperRates(k, st, xm, vm);
+  };
+  for (std::size_t j = 0; j < n; ++j) {
+    f[j] = models::DamperForceKn(k, s, x[j], v[j]);
+    if (!std::isfinite(f[j]) || !std::isfinite(s.y_mm) || !std::isfinite(s.z_mm)) {
+      f[j] = std::numeric_limits<double>::quiet_NaN();
+      return f;
+    }
+    if (j + 1 == n) break;
+    const double dx = x[j + 1] - x[j], dv = v[j + 1] - v[j];
+    for (int i = 0; i < substeps; ++i) {
+      const double a0 = static_cast<double>(i) / substeps, a1 = (i + 0.5) / substeps,
+                   a2 = static_cast<double>(i + 1) / substeps;
+      const double xa = x[j] + a0 * dx, va = v[j] + a0 * dv;
+      const double xb = x[j] + a1 * dx, vb = v[j] + a1 * dv;
+      const double xc = x[j] + a2 * dx, vc = v[j] + a2 * dv;
+      const auto r1 = rates(s, xa, va);
+      const auto r2 = rates({s.y_mm + 0.5 * h * r1.ydot_mm_s, s.z_mm + 0.5 * h * r1.zdot_mm_s}, xb, vb);
+      const auto r3 = rates({s.y_mm + 0.5 * h * r2.ydot_mm_s, s.z_mm + 0.5 * h * r2.zdot_mm_s}, xb, vb);
+      const auto r4 = rates({s.y_mm + h * r3.ydot_mm_s, s.z_mm + h * r3.zdot_mm_s}, xc, vc);
+      s.y_mm += h / 6.0 * (r1.ydot_mm_s + 2.0 * r2.ydot_mm_s + 2.0 * r3.ydot_mm_s + r4.ydot_mm_s);
+      s.z_mm += h / 6.0 * (r1.zdot_mm_s + 2.0 * r2.zdot_mm_s + 2.0 * r3.zdot_mm_s + r4.zdot_mm_s);
+    }
+  }
+  return f;
+}
+
+DamperRecordScore ScoreDamper(const models::MrDamperCoefficients& coef, const io::RigRecord& rec,
+                              double velocity_cutoff_hz) {
+  DamperRecordScore s;
+  s.source = rec.source;
+  s.samples = rec.size();
+  s.dt_s = rec.dt_s;
+  const auto v = SmoothVelocity(rec.y_mm, rec.dt_s, velocity_cutoff_hz);
+  const auto F = SimulateDamperForce(coef, rec.y_mm, v, rec.dt_s);
+  double se = 0.0, sf = 0.0;
+  for (std::size_t k = 0; k < rec.size(); ++k) {
+    se += (rec.f_kN[k] - F[k]) * (rec.f_kN[k] - F[k]);
+    sf += rec.f_kN[k] * rec.f_kN[k];
+    s.peak_force_kN = std::max(s.peak_force_kN, std::abs(rec.f_kN[k]));
+  }
+  s.nrmse_f_pct = sf > 0.0 ? std::sqrt(se / sf) * 100.0 : std::numeric_limits<double>::quiet_NaN();
+  if (!std::isfinite(se)) s.nrmse_f_pct = std::numeric_limits<double>::infinity();
+  return s;
+}
+
+DamperFitResult FitDamper(const std::vector<io::RigRecord>& records, double current_A,
+                          const DamperFitOptions& o) {
+  std::string why;
+  if (!o.IsValid(&why)) throw Error("DamperFitOptions", why);
+  if (records.empty()) throw Error("FitDamper", "no records");
+  if (!(current_A >= 0.0) || !std::isfinite(current_A))
+    throw Error("FitDamper", fmt::format("current {} A: must be >= 0", current_A));
+  std::vector<Prepared> data;
+  // Rough yield-force / viscous fit f ~ F_y sgn(v) + c v over every record, for the starts.
+  double a11 = 0, a12 = 0, a22 = 0, b1 = 0, b2 = 0, xmax = 0, vmax_all = 0;
+  for (const auto& rec : records) {
+    const std::string where = rec.source.empty() ? "record" : rec.source;
+    if (rec.size() < 3 || rec.f_kN.size() != rec.size() || rec.y_mm.size() != rec.size())
+      throw Error(where, "too few samples or columns of different lengths");
+    for (std::size_t k = 0; k < rec.i_A.size(); ++k) {
+      if (std::abs(rec.i_A[k] - current_A) > o.current_tolerance_A)
+        throw Error(fmt::format("{}:{}", where, k + 1),
+                    fmt::format("current i_A = {} A differs from --current {} A by more than {} A: the fit is at "
+                                "one current",
+                                rec.i_A[k], current_A, o.current_tolerance_A));
+    }
+    Prepared p{&rec, SmoothVelocity(rec.y_mm, rec.dt_s, o.velocity_cutoff_hz), 0.0, 0.0};
+    double sf = 0.0;
+    for (std::size_t k = 0; k < rec.size(); ++k) {
+      sf += rec.f_kN[k] * rec.f_kN[k];
+      p.vmax = std::max(p.vmax, std::abs(p.v[k]));
+      xmax = std::max(xmax, std::abs(rec.y_mm[k]));
+    }
+    if (!(sf > 0.0)) throw Error(where, "the force f_kN is zero throughout: nothing to fit");
+    p.weight = 1.0 / sf;
+    for (std::size_t k = 0; k < rec.size(); ++k) {
+      const double s = p.v[k] > 0.0 ? 1.0 : (p.v[k] < 0.0 ? -1.0 : 0.0), v = p.v[k], f = rec.f_kN[k];
+      a11 += p.weight * s * s;
+      a12 += p.weight * s * v;
+      a22 += p.weight * v * v;
+      b1 += p.weight * s * f;
+      b2 += p.weight * v * f;
+    }
+    vmax_all = std::max(vmax_all, p.vmax);
+    data.push_back(std::move(p));
+  }
+  if (!(vmax_all > 0.0)) throw Error("FitDamper", "the displacement never moves: nothing to fit");
+  const double det = a11 * a22 - a12 * a12;
+  double Fy = det > 0.0 ? (b1 * a22 - b2 * a12) / det : 0.0;
+  double c = det > 0.0 ? (a11 * b2 - a12 * b1) / det : 0.0;
+  double fpeak = 0.0;
+  for (const auto& rec : records)
+    for (double f : rec.f_kN) fpeak = std::max(fpeak, std::abs(f));
+  if (!(Fy > 0.0)) Fy = 0.5 * fpeak;
+  if (!(c > 0.0)) c = 0.1 * fpeak / vmax_all;
+
+  // Starts: pre-yield travel delta [mm] x c1/c0 (file comment of damper_fit.h).
+  std::vector<LmState> starts;
+  for (double delta : {0.1, 0.5, 2.0}) {
+    for (double ratio : {1.0, 10.0}) {
+      const double c0 = c * (1.0 + ratio) / ratio, c1 = ratio * c0;
+      const double zmax = o.A * delta;                 // z_max = A delta
+      const double bg = 1.0 / (o.A * delta * delta);   // beta + gamma
+      const double alpha = Fy / zmax * (c0 + c1) / c1;  // alpha z_max c1 / (c0 + c1) = F_y
+      const double k0 = 0.01 * Fy / std::max(xmax, 1e-3);
+      LmState s;
+      s.theta << std::log(alpha), std::log(c0), std::log(c1), std::log(k0), std::log(0.5 * bg), std::log(0.5 * bg);
+      s.theta = Clamp(s.theta);
+      s.ev = Evaluate(s.theta, data, o.A, 0);
+      starts.push_back(std::move(s));
+    }
+  }
+  DamperFitResult res;
+  res.current_A = current_A;
+  int best = -1;
+  for (std::size_t i = 0; i < starts.size(); ++i) {
+    if (std::isfinite(starts[i].ev.cost)) Iterate(&starts[i], data, o.A, o.start_iterations);
+    res.start_costs.push_back(starts[i].ev.cost);
+    if (std::isfinite(starts[i].ev.cost) && (best < 0 || starts[i].ev.cost < starts[static_cast<std::size_t>(best)].ev.cost))
+      best = static_cast<int>(i);
+  }
+  if (best < 0) throw Error("FitDamper", "no start gives a finite force prediction");
+  LmState& s = starts[static_cast<std::size_t>(best)];
+  s.converged = false;
+  Iterate(&s, data, o.A, o.max_iterations);
+  res.best_start = best;
+  res.iterations = s.iterations;
+  res.converged = s.converged;
+  res.cost = s.ev.cost;
+  res.coef = FromTheta(s.theta, o.A, s.ev.k1, s.ev.x0);
+  for (const auto& rec : records) res.records.push_back(ScoreDamper(res.coef, rec, o.velocity_cutoff_hz));
+  return res;
+}
+
+std::string DamperFitResult::Report() const {
+  const auto& k = coef;
+  const double bg = k.beta + k.gamma;
+  const double zmax = bg > 0.0 ? std::sqrt(k.A / bg) : kInf;
+  std::string o = fmt::format("Spencer MR damper model at {} A (Eqs. 32-34, n = 2, A held at {}):\n", current_A, k.A);
+  o += fmt::format("  alpha = {:.6g} kN/mm   c0 = {:.6g} kN s/mm   c1 = {:.6g} kN s/mm\n", k.alpha, k.c0, k.c1);
+  o += fmt::format("  k0 = {:.6g} kN/mm   k1 = {:.6g} kN/mm   x0 = {:.6g} mm\n", k.k0, k.k1, k.x0);
+  o += fmt::format("  beta = {:.6g} 1/mm^2   gamma = {:.6g} 1/mm^2   A = {:.6g}   n = 2\n", k.beta, k.gamma, k.A);
+  o += fmt::format(
+      "  derived: z_max = sqrt(A/(beta+gamma)) = {:.4g} mm, Bouc-Wen force alpha z_max = {:.4g} kN,\n"
+      "           pre-yield travel 1/sqrt(A (beta+gamma)) = {:.4g} mm, post-yield damping c0 c1/(c0+c1) = {:.4g} kN s/mm\n",
+      zmax, k.alpha * zmax, 1.0 / std::sqrt(k.A * bg), k.c0 * k.c1 / (k.c0 + k.c1));
+  o += fmt::format("  Levenberg-Marquardt: start {} of {} won, {} iterations, {}; cost J = {:.6g}\n", best_start + 1,
+                   start_costs.size(), iterations, converged ? "converged" : "not converged (iteration limit)", cost);
+  o += "  force error per record (Eq. 31 on f):\n";
+  for (const auto& r : records)
+    o += fmt::format("    {:<40} {:6d} samples at {:g} s, peak {:.4g} kN: {:.3f} %\n", r.source, r.samples, r.dt_s,
+                     r.peak_force_kN, r.nrmse_f_pct);
+  return o;
+}
+
+models::MrDamperParams ParamsAtOneCurrent(const models::MrDamperCoefficients& k) {
+  models::MrDamperParams p;
+  p.alpha_a = p.alpha_b = k.alpha;
+  p.c0_a = p.c0_b = k.c0;
+  p.c1_a = p.c1_b = k.c1;
+  p.beta_a = p.beta_b = k.beta;
+  p.gamma_a = p.gamma_b = k.gamma;
+  p.alpha_c = p.c0_c = p.c1_c = p.beta_c = p.gamma_c = 0.0;
+  p.A = k.A;
+  p.n = k.n;
+  p.k0 = k.k0;
+  p.k1 = k.k1;
+  p.x0 = k.x0;
+  return p;
+}
+
+std::string DamperTomlFragment(const DamperFitResult& fit, const std::string& title) {
+  const auto p = ParamsAtOneCurrent(fit.coef);
+  std::string o = fmt::format("# {}\n", title);
+  o += fmt::format(
+      "# Spencer MR damper (Eqs. 32-34, n = 2) fitted at {} A; current-independent here (p_a = p_b, rate 0),\n"
+      "# so it holds at {} A only. Force error (Eq. 31 on f) per training record:\n",
+      fit.current_A, fit.current_A);
+  for (const auto& r : fit.records) o += fmt::format("#   {}: {:.3f} %\n", r.source, r.nrmse_f_pct);
+  o += "\n[plant.damper]\n";
+  const std::pair<const char*, double> fields[] = {
+      {"alpha_a", p.alpha_a}, {"alpha_b", p.alpha_b}, {"alpha_c", p.alpha_c}, {"c0_a", p.c0_a},
+      {"c0_b", p.c0_b},       {"c0_c", p.c0_c},       {"c1_a", p.c1_a},       {"c1_b", p.c1_b},
+      {"c1_c", p.c1_c},       {"beta_a", p.beta_a},   {"beta_b", p.beta_b},   {"beta_c", p.beta_c},
+      {"gamma_a", p.gamma_a}, {"gamma_b", p.gamma_b}, {"gamma_c", p.gamma_c}, {"A", p.A},
+      {"n", p.n},             {"k0", p.k0},           {"k1", p.k1},           {"x0", p.x0}};
+  for (const auto& [key, v] : fields) {
+    std::string num = fmt::format("{:.10g}", v);  // a TOML float: keep a '.' or an exponent
+    if (num.find_first_of(".e") == std::string::npos) num += ".0";
+    o += fmt::format("{} = {}\n", key, num);
+  }
+  return o;
+}
+
+}  // namespace rths::ident

@@ -1,0 +1,119 @@
+#pragma once
+/// @file Least-squares fit of the Spencer MR damper model at one current to damper tests
+/// (`rths identify --damper`, docs/identification.md "The MR damper"). Units: mm, kN, s, A.
+///
+/// Model (models/mr_damper.h, Eqs. 32-34 at one current, n = 2):
+///     c1 y' = alpha z + k0 (x - y) + c0 (x' - y')                                  (Eq. 32)
+///     z'    = -gamma |x' - y'| z |z| - beta (x' - y') z^2 + A (x' - y')           (Eq. 33)
+///     F     = alpha z + c0 (x' - y') + k0 (x - y) + k1 (x - x0)                    (Eq. 34)
+/// driven by the measured displacement x_k = y_mm of the record and a velocity v_k estimated
+/// from it offline by SmoothVelocity (a zero-phase smoothing differentiator), from rest
+/// (y = x_0, z = 0) at the record's first sample.
+///
+/// Scale redundancy: z -> z / s with alpha -> s alpha, beta -> s beta, gamma -> s gamma,
+/// A -> A / s leaves F unchanged for n = 2, so A is not identifiable apart from the others; it
+/// is held at DamperFitOptions::A (default the paper's 300) and alpha, beta, gamma carry the
+/// scale. The physical quantities are invariant: the yield force level alpha z_max with
+/// z_max = sqrt(A / (beta + gamma)), and the pre-yield travel delta = 1 / sqrt(A (beta + gamma)).
+///
+/// Fit: minimise over records r and samples k
+///     J = sum_r  sum_k (f_rk - F_rk)^2 / sum_k f_rk^2                         (sum of Eq. 31^2)
+/// (each record weighs the same whatever its length and force level):
+///   - theta = ln [alpha, c0, c1, k0, beta, gamma], bounded box (DamperFitBounds), by
+///     Levenberg-Marquardt with a forward-difference Jacobian, the step projected on the box;
+///   - k1 and the offset b = -k1 x0 enter F linearly and are solved by weighted linear least
+///     squares at every theta (variable projection); if k1 <= 0 comes out, k1 = x0 = 0;
+///   - several starts from a rough yield-force / viscous fit of the data (f ~ F_y sgn(v) + c v)
+///     with pre-yield travels delta in {0.1, 0.5, 2} mm and c1 / c0 in {1, 10}; each start runs a
+///     few iterations, the best continues to convergence.
+/// Integration: classical Runge-Kutta (RK4) on (y, z) with x and x' interpolated linearly
+/// between samples, m substeps per sample with h = dt / m <= 0.5 / lambda, lambda =
+/// 2 sqrt(A (beta + gamma)) max|v| + (A alpha + k0) / (c0 + c1) a bound on the Jacobian's
+/// spectral radius (the stiffest rate: saturation of z over the pre-yield travel).
+#include <span>
+#include <string>
+#include <vector>
+
+#include "io/rig_record.h"
+#include "models/mr_damper.h"
+
+namespace rths::ident {
+
+/// Velocity of a sampled displacement x [mm] at step dt_s [s] -> [mm/s]: central differences
+/// (one-sided at the ends), then a 4th-order Butterworth low-pass at cutoff_hz run forward and
+/// backward (zero phase; |H|^2 = 1 / (1 + (f / fc)^8) overall, -6 dB at fc) over the series
+/// extended at both ends by odd reflection (no start-up transient). cutoff_hz is clipped to
+/// 0.45 / dt_s. Throws rths::Error for fewer than 3 samples, dt_s <= 0 or cutoff_hz <= 0.
+std::vector<double> SmoothVelocity(std::span<const double> x_mm, double dt_s, double cutoff_hz);
+
+/// Substeps per sample of SimulateDamperForce for these coefficients (file comment), given the
+/// largest |v| [mm/s] of the motion; at least 1, at most 4000.
+int DamperSubsteps(const models::MrDamperCoefficients& k, double dt_s, double vmax_mm_s);
+
+/// Force F_k [kN] (Eq. 34) at every sample of the motion x_k [mm], v_k [mm/s] at step dt_s,
+/// from rest (y = x_0, z = 0), RK4 with `substeps` per sample (0 = DamperSubsteps). Returns NaN
+/// from the first sample where the state stops being finite. Throws rths::Error if x and v
+/// differ in length.
+std::vector<double> SimulateDamperForce(const models::MrDamperCoefficients& k, std::span<const double> x_mm,
+                                        std::span<const double> v_mm_s, double dt_s, int substeps = 0);
+
+/// Options of FitDamper; defaults are those of `rths identify --damper`.
+struct DamperFitOptions {
+  double A = 300.0;                  ///< Bouc-Wen A, held fixed (file comment), > 0
+  double velocity_cutoff_hz = 50.0;  ///< SmoothVelocity cutoff [Hz], > 0
+  int start_iterations = 12;         ///< Levenberg-Marquardt iterations per start, >= 1
+  int max_iterations = 200;          ///< for the best start, >= 1
+  /// Largest |i_k - current| [A] accepted in a record (the fit is at one current), >= 0.
+  double current_tolerance_A = 0.05;
+  /// True if every field is in range; else false and a message naming the field.
+  bool IsValid(std::string* error) const;
+};
+
+/// One record's score: Eq. 31 on force, sqrt(sum (f - F)^2 / sum f^2) x 100 %.
+struct DamperRecordScore {
+  std::string source;     ///< the record's path
+  std::size_t samples = 0;
+  double dt_s = 0.0;
+  double peak_force_kN = 0.0;   ///< max |f|
+  double nrmse_f_pct = 0.0;     ///< of the fitted (or given) model
+};
+
+/// The fitted model at one current and how well it fits.
+struct DamperFitResult {
+  double current_A = 0.0;                  ///< the current of the records [A]
+  models::MrDamperCoefficients coef{};     ///< alpha, c0, c1, beta, gamma, A, n = 2, k0, k1, x0
+  std::vector<DamperRecordScore> records;  ///< per training record
+  double cost = 0.0;                       ///< J at the optimum (file comment)
+  int best_start = 0;                      ///< index of the start that won
+  int iterations = 0;                      ///< LM iterations of the winning start, all phases
+  bool converged = false;                  ///< relative cost change or step below tolerance
+  std::vector<double> start_costs;         ///< J of every start after its first iterations
+  /// Multi-line text: the coefficients, the derived yield force and pre-yield travel, the errors.
+  std::string Report() const;
+};
+
+/// Fits the model at current_A to the records (their y_mm as x, f_kN as F; see the file
+/// comment). Throws rths::Error (where = the record's source) if a record's current differs from
+/// current_A by more than the tolerance or its force is all zero; (where = "DamperFitOptions")
+/// for invalid options; if no start gives a finite cost.
+DamperFitResult FitDamper(const std::vector<io::RigRecord>& records, double current_A,
+                          const DamperFitOptions& options = {});
+
+/// Eq. 31 on force of `coef` on a record (held-out check), with the velocity of
+/// SmoothVelocity(y_mm, dt_s, velocity_cutoff_hz).
+DamperRecordScore ScoreDamper(const models::MrDamperCoefficients& coef, const io::RigRecord& record,
+                              double velocity_cutoff_hz = 50.0);
+
+/// The coefficients as current-independent MrDamperParams: p_a = p_b = the value, p_c = 0
+/// (Eqs. 35-39 then give the value at every current).
+models::MrDamperParams ParamsAtOneCurrent(const models::MrDamperCoefficients& k);
+
+/// The model as a TOML fragment a scenario (and `rths diagnose --model`) reads:
+///     [plant.damper]
+///     alpha_a = ..  alpha_b = ..  alpha_c = 0  ...  A = ..  n = 2  k0 = ..  k1 = ..  x0 = ..
+/// every MrDamperParams field (one per line), with '#' comments: `title`, the current, each
+/// record's error. Only the [plant.damper] table, so it can follow an actuator fragment of
+/// `rths identify` (which has [plant] and [controller]) in one file.
+std::string DamperTomlFragment(const DamperFitResult& fit, const std::string& title);
+
+}  // namespace rths::ident
