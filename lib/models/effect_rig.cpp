@@ -1,5 +1,6 @@
 #include "models/effect_rig.h"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 
@@ -64,6 +65,7 @@ EffectRig::EffectRig(const EffectRigModel& model)
     : m_(model),
       disp_(model.effects, model.rig.servo.dt_s),
       force_(model.effects, model.rig.servo.dt_s),
+      scratch_(disp_),
       noise_(signal::MakeGaussian(EffectNoiseSeed(model.noise_seed))),
       ode_(5, model.rig.rtol, AbsTol(model.rig), &EffectRig::Rhs, this) {
   m_.rig.damper.Validate();
@@ -92,9 +94,25 @@ int EffectRig::Rhs(double t, const double* w, double* wdot, void* self) {
   return 0;
 }
 
+double EffectRig::Trial(double x0, double x1, const LinearServoState& next, double y1, double i_end_A,
+                       MrDamperState* damper) {
+  const LinearRig& rig = m_.rig;
+  d0_ = y_ - x0;
+  dv_ = ((y1 - x1) - d0_) / rig.servo.dt_s;
+  *damper = damper_;
+  double force = 0.0;
+  if (rig.has_damper) {
+    double w[5] = {servo_.z(0), servo_.z(1), servo_.z(2), damper_.y_mm, damper_.z_mm};
+    ode_.Advance(0.0, rig.servo.dt_s, w);
+    *damper = {w[3], w[4]};
+    const double ydot = OutputVelocity(rig.servo, next) + dv_;
+    force = DamperForceKn(CoefficientsAt(rig.damper, i_end_A), *damper, y1, ydot);
+  }
+  return force_.Force(force) + m_.unmodelled.stiffness_kN_per_mm * y1;
+}
+
 void EffectRig::Step(double u_mm, double i_cmd_A) {
   const LinearRig& rig = m_.rig;
-  const double dt = rig.servo.dt_s;
   if (k_ == 0) {  // the current is set before the test starts: every lag at its steady state
     force_.Reset(i_cmd_A);
     current_ = SteadyState(i_cmd_A);
@@ -107,6 +125,10 @@ void EffectRig::Step(double u_mm, double i_cmd_A) {
     current_ = SteadyState(i_lag);
   }
   constant_current_ = AtSteadyState(current_);
+  if (rig.has_damper && constant_current_) coef_ = CoefficientsAt(rig.damper, current_.held_A);
+  CurrentDriverState end = current_;
+  if (rig.current_dynamics) Advance(rig.driver, &end);
+  const double i_end = EffectiveCurrentA(rig.driver, end);
 
   // Displacement path: command effects, the servo (exact ZOH), output effects.
   u_act_ = disp_.Pre(u_mm);
@@ -114,28 +136,68 @@ void EffectRig::Step(double u_mm, double i_cmd_A) {
   LinearServoState next = servo_;
   models::Step(rig.servo, &next, u_act_);
   const double x1 = Output(rig.servo, next);
-  const double y1 = disp_.Post(x1, f_);
 
-  // The damper, driven by the specimen's motion over the step.
-  const double d0 = y_ - x0;
-  const double d1 = y1 - x1;
-  d0_ = d0;
-  dv_ = (d1 - d0) / dt;
-  double force = 0.0;
-  if (rig.has_damper) {
-    if (constant_current_) coef_ = CoefficientsAt(rig.damper, current_.held_A);
-    double w[5] = {servo_.z(0), servo_.z(1), servo_.z(2), damper_.y_mm, damper_.z_mm};
-    ode_.Advance(0.0, dt, w);
-    damper_ = {w[3], w[4]};
+  double y1 = 0.0, f1 = 0.0;
+  MrDamperState damper{};
+  if (!m_.effects.load_coupling) {
+    y1 = disp_.Post(x1, f_);
+    f1 = Trial(x0, x1, next, y1, i_end, &damper);
+  } else {
+    // Load coupling: y_{k+1} = Post(x_{k+1}, f_{k+1}) with the force of the same sample. Root of
+    // h(f) = Phi(f) - f, Phi(f) = the force at the end of the step when the coupling sees f (each
+    // evaluation re-integrates the step from the saved state). For c > 0, Phi does not increase
+    // with f (more force, less displacement, less force), so h decreases strictly and f_k and
+    // Phi(f_k) bracket the root: the Illinois variant of regula falsi then converges. Without a
+    // bracket (c < 0) it takes secant steps.
+    auto eval = [&](double f_in) {
+      scratch_ = disp_;  // same sizes: no allocation
+      y1 = scratch_.Post(x1, f_in);
+      f1 = Trial(x0, x1, next, y1, i_end, &damper);
+      return f1 - f_in;
+    };
+    // Tolerance: y_{k+1} is off by c h, so |h| <= 1e-9 mm / |c| (or 1e-8 relative, CVODE's level).
+    const double c = std::abs(m_.effects.load_coupling->compliance_mm_per_kN);
+    const auto tol = [c](double f) { return std::max(1e-8 * (1.0 + std::abs(f)), c > 0.0 ? 1e-9 / c : 0.0); };
+    double fa = k_ >= 1 ? 2.0 * f_ - f_prev_ : f_;  // linear extrapolation of the force
+    f_prev_ = f_;
+    double ha = eval(fa);
+    double fb = fa + ha;
+    double hb = ha == 0.0 ? 0.0 : eval(fb);
+    if (ha == 0.0) fb = fa;
+    double f_best = fb, h_best = hb;
+    int it = 0;
+    while (std::abs(hb) > tol(fb) && std::abs(fb - fa) > 1e-12 * (1.0 + std::abs(fb)) &&
+           it < kMaxCouplingIterations) {
+      const bool bracket = (ha < 0.0) != (hb < 0.0);
+      const double fc = hb != ha ? fb - hb * (fb - fa) / (hb - ha) : 0.5 * (fa + fb);
+      const double hc = eval(fc);
+      if (!bracket || (hc < 0.0) != (hb < 0.0)) {
+        fa = fb;
+        ha = hb;
+      } else {
+        ha *= 0.5;  // Illinois: the stale end's value halved
+      }
+      fb = fc;
+      hb = hc;
+      if (std::abs(hb) < std::abs(h_best)) f_best = fb, h_best = hb;
+      ++it;
+    }
+    if (!std::isfinite(hb)) {
+      throw Error("EffectRig: load_coupling", fmt::format("the force of step {} is not finite", k_ + 1));
+    }
+    if (std::abs(hb) > 1e-6 * (1.0 + std::abs(fb))) {
+      // No root to the tolerance: Phi jumps across f = Phi(f) (coulomb_friction's steep sign near
+      // zero velocity makes Phi non-monotone: a sticking seal). Take the closest trial.
+      ++unconverged_steps_;
+      if (fb != f_best) hb = eval(f_best);
+    }
+    std::swap(disp_, scratch_);  // the state of the accepted evaluation (swap: no allocation)
   }
+  damper_ = damper;
   servo_ = next;  // authoritative for x (exact ZOH)
-  if (rig.current_dynamics) Advance(rig.driver, &current_);
-  if (rig.has_damper) {
-    const double ydot = OutputVelocity(rig.servo, servo_) + dv_;
-    force = DamperForceKn(CoefficientsAt(rig.damper, EffectiveCurrentA(rig.driver, current_)), damper_, y1, ydot);
-  }
+  current_ = end;
   y_ = y1;
-  f_ = force_.Force(force) + m_.unmodelled.stiffness_kN_per_mm * y1;
+  f_ = f1;
   ++k_;
   Measure();
 }

@@ -11,8 +11,8 @@
 ///             or i_l itself without them (plant.current_dynamics)
 ///     v_k   = DisplacementEffects::Pre(u_k)                    pure_delay, gain_error
 ///     z_{k+1} = Phi z_k + Gamma v_k,   x_{k+1} = C z_{k+1}     linear servo, exact ZOH
-///     y_{k+1} = DisplacementEffects::Post(x_{k+1}, f_k)        oil column, saturation, load
-///                                                              coupling, friction, backlash
+///     y_{k+1} = DisplacementEffects::Post(x_{k+1}, f_{k+1})    oil column, saturation, load
+///                                                              coupling, friction, backlash (**)
 ///     damper  Eqs. 32-33 integrated by CVODE over the step, driven by the specimen motion
 ///             y(t) = x(t) + d_k + (d_{k+1} - d_k) (t - t_k) / dt,   d = y - x      (*)
 ///             y'(t) = x'(t) + (d_{k+1} - d_k) / dt
@@ -28,8 +28,17 @@
 /// through every sample y_k and its velocity is the effects' mean rate over the step (a backlash
 /// that holds gives y' = x' - (x_{k+1} - x_k)/dt, close to 0; a rate limit gives y' ~ vmax).
 ///
-/// f_k, the load-coupling input, is the specimen's true force of the previous sample (before
-/// noise), including the unmodelled spring. Noise: effects.sensor_noise is drawn here, from a
+/// (**) The load-coupling input is the specimen's true force (before noise, with the unmodelled
+/// spring) of the SAME sample, f_{k+1}, which depends on y_{k+1}: the step is solved for it by the
+/// secant method (each trial re-integrates the step from the saved state; 2-4 trials). The
+/// library's explicit form y_{k+1} = x_{k+1} - c f_k (what the diagnosis fits, from the measured
+/// force) closes a one-sample loop with the stiff damper that diverges once c (K + 2 B / dt) > 1
+/// (K = alpha A, B = c0 c1 / (c0 + c1): at 2.5 A and dt = 0.5 ms already for c > 7e-4 mm/kN);
+/// the series compliance of a real rig is passive and stable at any c >= 0, and so is this
+/// implicit form. The two differ by c (f_{k+1} - f_k), far below the effect itself. Without
+/// load_coupling the input is f_k (unused) and the step is integrated once.
+///
+/// Noise: effects.sensor_noise is drawn here, from a
 /// Gaussian stream seeded with a value derived from plant.noise_seed (SplitMix64 of it), one
 /// deviate per channel whose rms is > 0, y first, once per sample (sample 0 at construction);
 /// the plant participant still adds the baseline plant.noise_* from its own stream on top, so
@@ -84,14 +93,25 @@ class EffectRig final : public Rig {
   /// The actuator model's output x_k [mm] (before the displacement effects).
   double actuator_x_mm() const { return Output(m_.rig.servo, servo_); }
   const EffectRigModel& model() const { return m_; }
+  /// load_coupling: steps whose same-sample force had no root to the tolerance (the closest
+  /// trial was taken; happens at reversals with coulomb_friction, whose steep sign makes the
+  /// force jump).
+  std::int64_t unconverged_steps() const { return unconverged_steps_; }
 
  private:
   static int Rhs(double t, const double* w, double* wdot, void* self);
+  /// One integration of the step for a candidate specimen displacement y1 at its end: sets the
+  /// motion (d0_, dv_), integrates the damper from the saved state into *damper, returns the total
+  /// force f_{k+1} [kN] (damper_scale, unmodelled spring) at the effective current i_end_A.
+  double Trial(double x0, double x1, const LinearServoState& next, double y1, double i_end_A,
+               MrDamperState* damper);
   void Measure();  // noise and ripple for the current sample
+  static constexpr int kMaxCouplingIterations = 20;
 
   const EffectRigModel m_;
   DisplacementEffects disp_;
   ForceEffects force_;
+  DisplacementEffects scratch_;   // load_coupling: trial copy of disp_ (same sizes)
   signal::GaussianState noise_;
   LinearServoState servo_{};
   MrDamperState damper_{};
@@ -105,7 +125,9 @@ class EffectRig final : public Rig {
   // sample k
   double y_ = 0.0, f_ = 0.0;      // true specimen displacement and force
   double y_meas_ = 0.0, f_meas_ = 0.0;
+  double f_prev_ = 0.0;           // load_coupling: f_{k-1}, for the first trial
   std::int64_t k_ = 0;
+  std::int64_t unconverged_steps_ = 0;
   OdeStepper ode_;
 };
 
