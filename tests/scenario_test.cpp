@@ -307,6 +307,8 @@ TEST_CASE("ToToml writes every key: parsing it gives back the same scenario") {
     s.controller.model = {1.5e7, 150.0, 250.0, 1.0e5, "custom"};
     s.controller.lqg.q = 12.5;
     s.plant.kind = "physical";
+    s.plant.effects = {};     // the rig mode (scenarios/rig_mode_example.toml) needs kind "linear"
+    s.plant.unmodelled = {};
     s.plant.physical.valve_hz = 71.0;
     s.semiactive.mode = "pulse";
     s.semiactive.pulse_duty = 0.25;
