@@ -117,6 +117,7 @@ tau_ms = 2.5
 gain = 0.95
 [plant.effects.load_coupling]
 compliance_mm_per_kN = 0.004
+same_sample = true
 [plant.effects.oil_column_resonance]
 f_hz = 55.0
 zeta = 0.08
@@ -184,6 +185,11 @@ k1 = 0.01
   CHECK(rths::scenario::ToToml(back) == written);
   REQUIRE(back.plant.effects.coulomb_friction);
   CHECK(back.plant.effects.coulomb_friction->v_smooth_mm_s == 2.0);
+  CHECK(s.plant.load_coupling_same_sample);
+  CHECK(back.plant.load_coupling_same_sample);
+  CHECK(written.find("same_sample = true") != std::string::npos);
+  CHECK_FALSE(ParseScenario(std::string(kBase) + "[plant.effects.load_coupling]\ncompliance_mm_per_kN = 0.001\n", "d.toml")
+                  .plant.load_coupling_same_sample);
   CHECK(back.plant.damper.k1 == 0.01);
   CHECK(back.plant.unmodelled.ripple_hz == 37.0);
 }
@@ -434,13 +440,30 @@ TEST_CASE("rig mode: current_lag delays the force response to a current step by 
 }
 
 TEST_CASE("rig mode: load_coupling makes y lower by c f, coulomb_friction by loss against the motion") {
-  // y_k = x_k - c f_k with the specimen force of the same sample (solved in the step), stable even
-  // for a compliance at which the explicit y_k = x_k - c f_{k-1} would diverge with the stiff
-  // damper at 2.5 A (c (alpha A + 2 B / dt) = 0.005 x 1420 > 1).
+  // Default: the library's form with the previous sample's force, y_k = x_k - c f_{k-1}, exactly.
+  // Stable while c (alpha A + 2 B / dt) < 1: at 2.5 A, 0.0004 x 1420 = 0.57.
+  {
+    const double c = 0.0004;
+    PlantConfig p = LinearPlant();
+    p.effects.load_coupling = rths::models::LoadCoupling{c};
+    auto rig = rths::models::MakeRig(p, kDt);
+    auto* e = AsEffectRig(rig.get());
+    double f_prev = e->true_f_kN(), peak_shift = 0.0;
+    for (int k = 0; k < 3000; ++k) {
+      rig->Step(Sine(10.0, 1.0)(k), 2.5);
+      CHECK(rig->y_mm() == doctest::Approx(e->actuator_x_mm() - c * f_prev).epsilon(0).scale(1).epsilon(1e-12));
+      peak_shift = std::max(peak_shift, std::abs(rig->y_mm() - e->actuator_x_mm()));
+      f_prev = e->true_f_kN();
+    }
+    CHECK(peak_shift > 0.04);  // 2.5 A: forces above 100 kN
+  }
+  // same_sample: y_k = x_k - c f_k with the force of the same sample (solved in the step), stable
+  // even where the explicit form diverges (c (alpha A + 2 B / dt) = 0.005 x 1420 > 1 at 2.5 A).
   for (double c : {0.0004, 0.005}) {
     CAPTURE(c);
     PlantConfig p = LinearPlant();
     p.effects.load_coupling = rths::models::LoadCoupling{c};
+    p.load_coupling_same_sample = true;
     auto rig = rths::models::MakeRig(p, kDt);
     auto* e = AsEffectRig(rig.get());
     double peak_shift = 0.0, peak_f = 0.0;
@@ -452,6 +475,22 @@ TEST_CASE("rig mode: load_coupling makes y lower by c f, coulomb_friction by los
     }
     CHECK(peak_f > 100.0);  // 2.5 A
     CHECK(peak_shift == doctest::Approx(c * peak_f).epsilon(0.05));
+    CHECK(e->unconverged_steps() == 0);
+  }
+  {  // the explicit form at c = 0.005 does diverge (the reason for same_sample)
+    PlantConfig p = LinearPlant();
+    p.effects.load_coupling = rths::models::LoadCoupling{0.005};
+    auto rig = rths::models::MakeRig(p, kDt);
+    bool diverged = false;
+    try {
+      for (int k = 0; k < 3000 && !diverged; ++k) {
+        rig->Step(Sine(10.0, 1.0)(k), 2.5);
+        diverged = !(std::abs(rig->f_kN()) < 1e4);
+      }
+    } catch (const rths::Error&) {
+      diverged = true;  // CVODE gives up
+    }
+    CHECK(diverged);
   }
 
   PlantConfig fr = LinearPlant();
@@ -529,7 +568,7 @@ TEST_CASE("rig mode: Step allocates nothing, with every effect on") {
   PlantConfig p = LinearPlant();
   p.effects.pure_delay = rths::models::PureDelay{3.7};
   p.effects.gain_error = rths::models::GainError{1.05};
-  p.effects.load_coupling = rths::models::LoadCoupling{0.002};
+  p.effects.load_coupling = rths::models::LoadCoupling{0.0004};
   p.effects.oil_column_resonance = rths::models::OilColumnResonance{70.0, 0.1};
   p.effects.coulomb_friction = rths::models::CoulombFriction{0.05, 0.5};
   p.effects.backlash = rths::models::Backlash{0.05};
@@ -540,13 +579,17 @@ TEST_CASE("rig mode: Step allocates nothing, with every effect on") {
   p.unmodelled.ripple_mm = 0.02;
   p.unmodelled.ripple_hz = 45.0;
   p.unmodelled.stiffness_kN_per_mm = 0.3;
-  auto rig = rths::models::MakeRig(p, kDt);
-  rig->Step(0.0, 0.0);  // first step outside the count
-  const long before = rths_test::AllocationCount();
-  for (int k = 1; k < 500; ++k) rig->Step(Sine(5.0, 3.0)(k), (k / 100) % 2 ? 2.5 : 0.0);
-  CHECK(rths_test::AllocationCount() == before);
-  CHECK(std::isfinite(rig->y_mm()));
-  CHECK(std::abs(rig->f_kN()) > 0.0);
+  for (bool same_sample : {false, true}) {
+    CAPTURE(same_sample);
+    p.load_coupling_same_sample = same_sample;
+    auto rig = rths::models::MakeRig(p, kDt);
+    rig->Step(0.0, 0.0);  // first step outside the count
+    const long before = rths_test::AllocationCount();
+    for (int k = 1; k < 500; ++k) rig->Step(Sine(5.0, 3.0)(k), (k / 100) % 2 ? 2.5 : 0.0);
+    CHECK(rths_test::AllocationCount() == before);
+    CHECK(std::isfinite(rig->y_mm()));
+    CHECK(std::abs(rig->f_kN()) > 0.0);
+  }
 }
 
 TEST_CASE("rig mode: MakeRig refuses effects on a physical or ideal plant") {

@@ -58,6 +58,7 @@ EffectRigModel EffectRigModel::Make(const scenario::PlantConfig& plant, double d
   m.effects = plant.effects;
   m.unmodelled = plant.unmodelled;
   m.noise_seed = plant.noise_seed;
+  m.coupling_same_sample = plant.load_coupling_same_sample;
   return m;
 }
 
@@ -139,7 +140,7 @@ void EffectRig::Step(double u_mm, double i_cmd_A) {
 
   double y1 = 0.0, f1 = 0.0;
   MrDamperState damper{};
-  if (!m_.effects.load_coupling) {
+  if (!m_.effects.load_coupling || !m_.coupling_same_sample) {
     y1 = disp_.Post(x1, f_);
     f1 = Trial(x0, x1, next, y1, i_end, &damper);
   } else {

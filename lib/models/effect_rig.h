@@ -11,7 +11,7 @@
 ///             or i_l itself without them (plant.current_dynamics)
 ///     v_k   = DisplacementEffects::Pre(u_k)                    pure_delay, gain_error
 ///     z_{k+1} = Phi z_k + Gamma v_k,   x_{k+1} = C z_{k+1}     linear servo, exact ZOH
-///     y_{k+1} = DisplacementEffects::Post(x_{k+1}, f_{k+1})    oil column, saturation, load
+///     y_{k+1} = DisplacementEffects::Post(x_{k+1}, f_k)        oil column, saturation, load
 ///                                                              coupling, friction, backlash (**)
 ///     damper  Eqs. 32-33 integrated by CVODE over the step, driven by the specimen motion
 ///             y(t) = x(t) + d_k + (d_{k+1} - d_k) (t - t_k) / dt,   d = y - x      (*)
@@ -29,14 +29,14 @@
 /// that holds gives y' = x' - (x_{k+1} - x_k)/dt, close to 0; a rate limit gives y' ~ vmax).
 ///
 /// (**) The load-coupling input is the specimen's true force (before noise, with the unmodelled
-/// spring) of the SAME sample, f_{k+1}, which depends on y_{k+1}: the step is solved for it by the
-/// secant method (each trial re-integrates the step from the saved state; 2-4 trials). The
-/// library's explicit form y_{k+1} = x_{k+1} - c f_k (what the diagnosis fits, from the measured
-/// force) closes a one-sample loop with the stiff damper that diverges once c (K + 2 B / dt) > 1
-/// (K = alpha A, B = c0 c1 / (c0 + c1): at 2.5 A and dt = 0.5 ms already for c > 7e-4 mm/kN);
-/// the series compliance of a real rig is passive and stable at any c >= 0, and so is this
-/// implicit form. The two differ by c (f_{k+1} - f_k), far below the effect itself. Without
-/// load_coupling the input is f_k (unused) and the step is integrated once.
+/// spring) of the previous sample, f_k: y_{k+1} = x_{k+1} - c f_k, the library's form, which the
+/// diagnosis fits from the measured force. Closed around the stiff damper this one-sample loop
+/// diverges once c (K + 2 B / dt) > 1 (K = alpha A, B = c0 c1 / (c0 + c1): at 2.5 A and
+/// dt = 0.5 ms for c > 7e-4 mm/kN, at 0 A for c > 2.9e-3 mm/kN). With coupling_same_sample
+/// (`same_sample = true`) the input is f_{k+1} of the same sample, which depends on y_{k+1}: the
+/// step is solved for it (Illinois regula falsi, each trial re-integrating the step from the
+/// saved state; 2-4 trials). A real series compliance is passive, and so is this form: stable at
+/// any c >= 0. The two differ by c (f_{k+1} - f_k).
 ///
 /// Noise: effects.sensor_noise is drawn here, from a
 /// Gaussian stream seeded with a value derived from plant.noise_seed (SplitMix64 of it), one
@@ -64,6 +64,8 @@ struct EffectRigModel {
   EffectSet effects;                       ///< library effects that are on
   scenario::UnmodelledConfig unmodelled;   ///< ripple on y, extra spring on f
   std::uint64_t noise_seed = 7;            ///< plant.noise_seed (the stream is derived from it)
+  /// load_coupling with the same-sample force f_{k+1} (solved per step) instead of f_k (**).
+  bool coupling_same_sample = false;
 
   /// From the scenario's plant (kind must be "linear"; specimen "mr_damper" | "none") at the step
   /// dt_s [s]. Validates everything; throws rths::Error naming the bad key.

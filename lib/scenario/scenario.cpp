@@ -340,7 +340,7 @@ void TurnOn(models::EffectSet* e, std::string_view name) {
 
 /// [plant.effects]: one sub-table per effect that is on; an unknown name is refused by Finish()
 /// with the list of the library's names.
-void ReadEffects(Section& effects, models::EffectSet* out) {
+void ReadEffects(Section& effects, models::EffectSet* out, bool* same_sample) {
   models::EffectSet e;
   std::vector<Section> tables;
   tables.reserve(models::kEffectNames.size());
@@ -355,6 +355,7 @@ void ReadEffects(Section& effects, models::EffectSet* out) {
       if (models::kEffectNames[i] == name) table = &tables[i];
     }
     for (const EffectKey& k : keys) table->Number(k.key, k.field);
+    if (std::string_view(name) == "load_coupling") table->Bool("same_sample", same_sample);  // rig only
     table->Finish();
     for (const EffectKey& k : keys) {
       if (k.required && !table->Has(k.key)) {
@@ -448,7 +449,7 @@ void ReadScenario(const toml::table& root, const std::string& file, Scenario* s)
   for (auto [key, field] : DamperFields(&pl.damper)) damper.Number(key, field);
   damper.Finish();
   Section effects = plant.Sub("effects");
-  ReadEffects(effects, &pl.effects);
+  ReadEffects(effects, &pl.effects, &pl.load_coupling_same_sample);
   Section unmodelled = plant.Sub("unmodelled");
   unmodelled.Number("ripple_mm", &pl.unmodelled.ripple_mm);
   unmodelled.Number("ripple_hz", &pl.unmodelled.ripple_hz);
@@ -882,6 +883,7 @@ std::string ToToml(const Scenario& s) {
   for (auto& [name, keys] : EffectKeys(&effects)) {
     o += fmt::format("\n[plant.effects.{}]\n", name);
     for (const EffectKey& k : keys) o += fmt::format("{} = {}\n", k.key, TomlNumber(*k.field));
+    if (std::string_view(name) == "load_coupling") o += fmt::format("same_sample = {}\n", p.load_coupling_same_sample);
   }
   const auto& sa = s.semiactive;
   o += fmt::format(
