@@ -225,7 +225,7 @@ int DamperSubsteps(const models::MrDamperCoefficients& k, double dt, double vmax
   const double lambda = 2.0 * std::sqrt(k.A * std::max(k.beta + k.gamma, 0.0)) * std::abs(vmax) +
                         (k.A * k.alpha + k.k0) / (k.c0 + k.c1);
   if (!std::isfinite(lambda)) return 4000;
-  const double m = std::ceil(dt * lambda / 0.5);
+  const double m = std::ceil(dt * lambda / 0.8);
   return static_cast<int>(std::clamp(m, 1.0, 4000.0));
 }
 

@@ -27,7 +27,7 @@
 ///     with pre-yield travels delta in {0.1, 0.5, 2} mm and c1 / c0 in {1, 10}; each start runs a
 ///     few iterations, the best continues to convergence.
 /// Integration: classical Runge-Kutta (RK4) on (y, z) with x and x' interpolated linearly
-/// between samples, m substeps per sample with h = dt / m <= 0.5 / lambda, lambda =
+/// between samples, m substeps per sample with h = dt / m <= 0.8 / lambda, lambda =
 /// 2 sqrt(A (beta + gamma)) max|v| + (A alpha + k0) / (c0 + c1) a bound on the Jacobian's
 /// spectral radius (the stiffest rate: saturation of z over the pre-yield travel).
 #include <span>
@@ -61,7 +61,7 @@ std::vector<double> SimulateDamperForce(const models::MrDamperCoefficients& k, s
 struct DamperFitOptions {
   double A = 300.0;                  ///< Bouc-Wen A, held fixed (file comment), > 0
   double velocity_cutoff_hz = 50.0;  ///< SmoothVelocity cutoff [Hz], > 0
-  int start_iterations = 12;         ///< Levenberg-Marquardt iterations per start, >= 1
+  int start_iterations = 6;          ///< Levenberg-Marquardt iterations per start, >= 1
   int max_iterations = 200;          ///< for the best start, >= 1
   /// Largest |i_k - current| [A] accepted in a record (the fit is at one current), >= 0.
   double current_tolerance_A = 0.05;
