@@ -16,9 +16,11 @@
 #include <unsupported/Eigen/MatrixFunctions>
 
 #include "core/error.h"
+#include "ident/identify.h"
 #include "io/run_log.h"
 #include "models/rig.h"
 #include "models/servo_physical.h"
+#include "signal/history.h"
 #include "test_support.h"
 
 // Count every heap allocation of the process.
@@ -220,6 +222,81 @@ TEST_CASE("(a) simulated small sines (CVODE, u held per step) give the linearisa
     CHECK(std::abs(g) == doctest::Approx(std::abs(gd)).epsilon(2e-3));
     CHECK(std::abs(PhaseDeg(g / gd)) < 0.1);
   }
+}
+
+TEST_CASE("(a) E1 on the damper-loaded rig (16 s records): how close the identified models come to Eqs. 28-29") {
+  // E1 as `rths reproduce fig6 --quick` runs it (lib/report/frequency.cpp), without the lockstep:
+  // BLWN 0-50 Hz, 0.254 mm RMS, seed 1, 2 s discarded, 0.5 s fade-in; u_k held over each step,
+  // y_k read at t_k; the MR damper (Table 3) at a constant current; H1 and the ZOH-consistent
+  // 3-pole fit over 0.5-40 Hz.
+  rths::scenario::SignalSpec spec;
+  spec.kind = "blwn";
+  spec.band_hz = 50.0;
+  spec.rms = 0.254;
+  spec.seed = 1;
+  spec.discard_s = 2.0;
+  spec.taper_s = 0.5;
+  const std::vector<double> u = rths::signal::MakeSignal(spec, kDt, 32000, "");
+  rths::ident::IdentifyOptions io;
+  io.fit.poles = 3;
+  io.fit.band_lo_hz = 0.5;
+  io.fit.band_hi_hz = 40.0;
+  io.fit.zoh_dt_s = kDt;
+  const double current[2] = {0.0, 2.5};
+  const char* cond[2] = {"0.0A", "2.5A"};
+  rths::scenario::ServoModel3 fit[2];
+  double lag_ms[2];
+  for (int j = 0; j < 2; ++j) {
+    const std::string name = cond[j];
+    CAPTURE(name);
+    const PhysicalRig rig = PhysicalRig::Make(PhysicalActuatorConfig{}, kDt, RigLoad::kMrDamper, true);
+    PhysicalRigStepper stepper(rig);
+    PhysicalRigState s;
+    s.current = SteadyState(current[j]);
+    std::vector<double> y(u.size());
+    for (std::size_t k = 0; k < u.size(); ++k) {
+      y[k] = MeasuredDisplacementMm(rig, s);
+      stepper.Step(&s, u[k], current[j]);
+    }
+    const auto id = rths::ident::Identify(u, y, kDt, io);
+    const auto ref = rths::scenario::ServoPreset(cond[j]);
+    fit[j] = id.fit.model.ToServoModel3();
+    lag_ms[j] = 1e3 * id.fit.model.DcLagS();
+    const double ref_lag_ms = 1e3 * rths::ident::PoleModel::FromServoModel3(ref).DcLagS();
+    // The measured response against the Eq.'s own (ZOH at dt, as the data are).
+    const auto zoh = rths::ident::Discretise(rths::ident::PoleModel::FromServoModel3(ref), kDt);
+    double mag = 0, phase = 0;
+    for (std::size_t i = 0; i < id.frf.f_hz.size(); ++i) {
+      if (id.frf.f_hz[i] < 0.5 || id.frf.f_hz[i] > 40.0) continue;
+      const cd q = id.frf.h[i] / rths::ident::ZohResponse(zoh, id.frf.f_hz[i]);
+      mag = std::max(mag, std::abs(std::abs(q) - 1.0));
+      phase = std::max(phase, std::abs(PhaseDeg(q)));
+    }
+    MESSAGE(cond[j] << ": fitted K " << fit[j].K << " (" << 100 * (fit[j].K / ref.K - 1) << " %), p " << fit[j].p
+                    << " (" << 100 * (fit[j].p / ref.p - 1) << " %), b " << fit[j].b << " ("
+                    << 100 * (fit[j].b / ref.b - 1) << " %), c " << fit[j].c << " (" << 100 * (fit[j].c / ref.c - 1)
+                    << " %); fit error: magnitude " << id.fit.max_mag_error_pct << " %, phase "
+                    << id.fit.max_phase_error_deg << " deg; DC lag " << lag_ms[j] << " ms (Eq.: " << ref_lag_ms
+                    << "); measured vs the Eq.: magnitude " << 100 * mag << " %, phase " << phase << " deg");
+    // What holds: a 3-pole model describes the loaded rig well, its real pole and its
+    // low-frequency lag are the Eq.'s, and the measured response is within 10 % / 8 deg of it.
+    CHECK(id.fit.max_mag_error_pct < 2.0);
+    CHECK(id.fit.max_phase_error_deg < 2.0);
+    CHECK(fit[j].p == doctest::Approx(ref.p).epsilon(0.05));
+    CHECK(lag_ms[j] == doctest::Approx(ref_lag_ms).epsilon(0.06));
+    CHECK(mag < 0.10);
+    CHECK(phase < 8.0);
+  }
+  // Control-structure interaction: 2.5 A lags more, as Eq. 29 does.
+  CHECK(lag_ms[1] > lag_ms[0] + 2.0);
+  // What does not hold (docs/plant.md, "E1 on the damper-loaded rig"): E1's 8 % on K, b, c
+  // (0.0 A: K +27 %, b +32 %, c +21 %; 2.5 A: K -17 %, c -14 %). From Eq. 28 to Eq. 29 the
+  // complex pair moves up and is damped more (b x 1.44, c x 1.27); the loaded rig's pair barely
+  // moves with the current (ratios about 1.03 and 0.91). bench/tune_physical.cpp searched the
+  // valve and oil-column parameters of models.md section 5 for both conditions at once: the best
+  // balance is about 17 % (K, b, c split +/-), so no retuning of those parameters meets 8 %.
+  MESSAGE("b 2.5A/0.0A " << fit[1].b / fit[0].b << " (Eqs.: 1.441), c 2.5A/0.0A " << fit[1].c / fit[0].c
+                         << " (Eqs.: 1.275)");
 }
 
 TEST_CASE("(b) limits: velocity K_q / A, valve saturation beyond 1 / K_p, flow factor at 190 kN") {
