@@ -6,7 +6,8 @@
 #   2. MR damper, at 0, 0.5 and 1 A: rths identify --damper on the 25 mm tests at 0.1, 0.25 and
 #      0.5 Hz, held-out scores on 10 mm / 1 Hz, 5 mm / 3 Hz, 2 mm / 5 Hz; rths diagnose with the
 #      fitted model (one dt per diagnosis: 5 ms: train the 25 mm tests, test 2 mm / 5 Hz; 1 ms:
-#      train 10 mm / 1 Hz, test 5 mm / 3 Hz), and with the paper's Table 3 damper at 1 A.
+#      train 10 mm / 1 Hz, test 5 mm / 3 Hz), and with the paper's Table 3 damper at 1 A;
+#      each 1 A test fitted alone.
 # Usage: scripts/real_data_study.sh [OUT]     (binaries: build/bin, or set RTHS_BIN_DIR)
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -72,5 +73,9 @@ for cur in 0 0x5 1; do
     "$rths" diagnose --train "${train[@]}" --test "2mm5Hz${cur}A.csv" --model model_table3.toml \
       --out diag_damper_1A_5ms_table3
   fi
+done
+log "damper at 1 A, each test fitted alone (the pre-yield travel against the stroke)"
+for t in $train_tests $held_tests; do
+  "$rths" identify --damper "${t}1A.csv" --current 1 | grep -E "pre-yield|^    .*%$"
 done
 log "done: $out"

@@ -306,10 +306,10 @@ DamperFitResult FitDamper(const std::vector<io::RigRecord>& records, double curr
       throw Error(where, "too few samples or columns of different lengths");
     for (std::size_t k = 0; k < rec.i_A.size(); ++k) {
       if (std::abs(rec.i_A[k] - current_A) > o.current_tolerance_A)
-        throw Error(fmt::format("{}:{}", where, k + 1),
-                    fmt::format("current i_A = {} A differs from --current {} A by more than {} A: the fit is at "
-                                "one current",
-                                rec.i_A[k], current_A, o.current_tolerance_A));
+        throw Error(where, fmt::format("sample {} (t = {} s): current i_A = {} A differs from --current {} A by "
+                                       "more than {} A: the fit is at one current",
+                                       k + 1, k < rec.t_s.size() ? rec.t_s[k] : 0.0, rec.i_A[k], current_A,
+                                       o.current_tolerance_A));
     }
     Prepared p{&rec, SmoothVelocity(rec.y_mm, rec.dt_s, o.velocity_cutoff_hz), 0.0, 0.0};
     double sf = 0.0;
