@@ -7,7 +7,8 @@
 #      0.5 Hz, held-out scores on 10 mm / 1 Hz, 5 mm / 3 Hz, 2 mm / 5 Hz; rths diagnose with the
 #      fitted model (one dt per diagnosis: 5 ms: train the 25 mm tests, test 2 mm / 5 Hz; 1 ms:
 #      train 10 mm / 1 Hz, test 5 mm / 3 Hz), and with the paper's Table 3 damper at 1 A;
-#      each 1 A test fitted alone.
+#      each 1 A test fitted alone;
+#   3. the chirp's force with the first-half actuator and the 0 A damper model (diagnose both channels).
 # Usage: scripts/real_data_study.sh [OUT]     (binaries: build/bin, or set RTHS_BIN_DIR)
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -74,6 +75,17 @@ for cur in 0 0x5 1; do
       --out diag_damper_1A_5ms_table3
   fi
 done
+# The chirp's force (0 A) with the actuator of the first half and the damper fitted at 0 A on the
+# 25 mm tests: a held-out test of the damper model on another excitation (2 mm, up to 20 Hz).
+grep -v '^\[controller\]\|^model = ' act_first.toml > act_damper_0A.toml
+cat damper_0A.toml >> act_damper_0A.toml
+log "damper at 0 A on the chirp's force (held out)"
+"$rths" identify --damper 25mm0x1Hz0A.csv 25mm0x25Hz0A.csv 25mm0x5Hz0A.csv --current 0 \
+  --check chirp_first.csv chirp_second.csv | grep -A3 "held-out"
+rm -rf diag_chirp_force
+log "diagnose: chirp halves with the identified actuator and the damper fitted at 0 A"
+"$rths" diagnose --train chirp_first.csv --test chirp_second.csv --model act_damper_0A.toml --out diag_chirp_force
+
 log "damper at 1 A, each test fitted alone (the pre-yield travel against the stroke)"
 for t in $train_tests $held_tests; do
   "$rths" identify --damper "${t}1A.csv" --current 1 | grep -E "pre-yield|^    .*%$"
