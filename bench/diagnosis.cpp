@@ -22,6 +22,7 @@ int main(int argc, char** argv) {
   app.add_flag("--rig", o.use_rig, "make the records with the plant's rig mode (models::MakeRig) instead of the blocks");
   app.add_flag("--no-pairs", no_pairs, "leave out the two-effect cases");
   app.add_option("--only", o.only, "case kinds to run");
+  app.add_flag("--verbose", o.verbose, "print every diagnosis summary");
   app.add_flag("--runtime-only", runtime_only, "only the 60 s runtime measurement");
   CLI11_PARSE(app, argc, argv);
   o.pairs = !no_pairs;

@@ -89,6 +89,20 @@ SmoothedMotion SmoothMotion(std::span<const double> y_mm, double dt_s, double sm
   return m;
 }
 
+SmoothedMotion ModelAidedMotion(std::span<const double> y_mm, std::span<const double> yhat_mm, double dt_s,
+                                double smooth_hz) {
+  const std::size_t n = y_mm.size();
+  if (yhat_mm.size() != n) throw Error("ModelAidedMotion", "lengths differ");
+  std::vector<double> res(n);
+  for (std::size_t k = 0; k < n; ++k) res[k] = y_mm[k] - yhat_mm[k];
+  SmoothedMotion m = SmoothMotion(res, dt_s, smooth_hz);
+  for (std::size_t k = 0; k < n; ++k) m.x_mm[k] += yhat_mm[k];
+  for (std::size_t k = 1; k + 1 < n; ++k) m.v_mm_s[k] = (m.x_mm[k + 1] - m.x_mm[k - 1]) / (2.0 * dt_s);
+  m.v_mm_s[0] = (m.x_mm[1] - m.x_mm[0]) / dt_s;
+  m.v_mm_s[n - 1] = (m.x_mm[n - 1] - m.x_mm[n - 2]) / dt_s;
+  return m;
+}
+
 std::vector<double> PredictDisplacement(const models::LinearServo& servo, const models::EffectSet& effects,
                                         std::span<const double> u_mm, std::span<const double> f_kN) {
   const std::size_t n = u_mm.size();

@@ -75,6 +75,14 @@ struct SmoothedMotion {
 /// Throws rths::Error unless smooth_hz is in (0, 0.5/dt_s) and y has at least 4 samples.
 SmoothedMotion SmoothMotion(std::span<const double> y_mm, double dt_s, double smooth_hz);
 
+/// The damper motion from the measured y and a model prediction yhat of it (the displacement
+/// channel's final model): x = yhat + S(y - yhat), v = central difference of x (one-sided at the
+/// ends), S the zero-phase smoother of SmoothMotion at smooth_hz. Only the residual is smoothed,
+/// so the motion keeps the model's content above smooth_hz (noise-free) and the measured content
+/// below it; with yhat = 0 it is SmoothMotion(y).
+SmoothedMotion ModelAidedMotion(std::span<const double> y_mm, std::span<const double> yhat_mm, double dt_s,
+                                double smooth_hz);
+
 /// Displacement channel prediction yhat_k for one record (file comment). `effects` may hold
 /// any effects; only the displacement ones act. f_kN: the measured force (load_coupling).
 std::vector<double> PredictDisplacement(const models::LinearServo& servo,

@@ -1,8 +1,12 @@
 #include "diagnosis/diagnosis.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <functional>
+#include <memory>
 #include <numeric>
 #include <optional>
 #include <set>
@@ -149,7 +153,7 @@ Data Prepare(const io::RigRecord& r, const Options& o, bool need_motion) {
     }
   }
   d.first = std::min<std::size_t>(d.size() / 2, static_cast<std::size_t>(std::lround(o.warmup_s / r.dt_s)));
-  if (need_motion) d.motion = SmoothMotion(d.y, d.dt, std::min(o.smooth_hz, 0.45 / d.dt));
+  (void)need_motion;  // the force channel's motion is made once y is diagnosed (ModelAidedMotion)
   return d;
 }
 
@@ -266,7 +270,8 @@ double Minimise1D(const std::function<double(double)>& f, const ParamSpec& s, in
   for (double x : extra)
     if (x >= s.lo && x <= s.hi) ts.push_back(to(x));
   std::sort(ts.begin(), ts.end());
-  ts.erase(std::unique(ts.begin(), ts.end()), ts.end());
+  const double tol = 1e-6 * (b - a);
+  ts.erase(std::unique(ts.begin(), ts.end(), [&](double x, double y) { return std::abs(x - y) <= tol; }), ts.end());
   std::vector<double> fs(ts.size());
   std::size_t best = 0;
   for (std::size_t j = 0; j < ts.size(); ++j) {
@@ -285,12 +290,62 @@ double Minimise1D(const std::function<double(double)>& f, const ParamSpec& s, in
   return from(tg);
 }
 
+/// Nelder-Mead on two variables (the simplex from x0 with steps dx), `evals` function evaluations
+/// at most. Returns the best point; *fbest its value.
+std::vector<double> NelderMead2(const std::function<double(const std::vector<double>&)>& f, std::vector<double> x0,
+                                const std::vector<double>& dx, int evals, double* fbest) {
+  std::vector<std::vector<double>> p = {x0, {x0[0] + dx[0], x0[1]}, {x0[0], x0[1] + dx[1]}};
+  std::vector<double> fv = {f(p[0]), f(p[1]), f(p[2])};
+  int n = 3;
+  while (n < evals) {
+    std::array<int, 3> idx = {0, 1, 2};
+    std::sort(idx.begin(), idx.end(), [&](int a, int b) { return fv[a] < fv[b]; });
+    const auto& b = p[idx[0]];
+    const auto& m = p[idx[1]];
+    const auto& w = p[idx[2]];
+    const std::vector<double> c = {0.5 * (b[0] + m[0]), 0.5 * (b[1] + m[1])};
+    auto at = [&](double t) { return std::vector<double>{c[0] + t * (w[0] - c[0]), c[1] + t * (w[1] - c[1])}; };
+    const auto r = at(-1.0);
+    const double fr = f(r);
+    ++n;
+    if (fr < fv[idx[0]]) {
+      const auto e = at(-2.0);
+      const double fe = f(e);
+      ++n;
+      if (fe < fr) p[idx[2]] = e, fv[idx[2]] = fe;
+      else p[idx[2]] = r, fv[idx[2]] = fr;
+    } else if (fr < fv[idx[1]]) {
+      p[idx[2]] = r, fv[idx[2]] = fr;
+    } else {
+      const auto k = at(0.5);
+      const double fk = f(k);
+      ++n;
+      if (fk < fv[idx[2]]) {
+        p[idx[2]] = k, fv[idx[2]] = fk;
+      } else {  // shrink towards the best
+        for (int j : {idx[1], idx[2]}) {
+          p[j] = {0.5 * (p[j][0] + b[0]), 0.5 * (p[j][1] + b[1])};
+          fv[j] = f(p[j]);
+          ++n;
+        }
+      }
+    }
+  }
+  int best = 0;
+  for (int j = 1; j < 3; ++j)
+    if (fv[j] < fv[best]) best = j;
+  *fbest = fv[best];
+  return p[best];
+}
+
 /// Fits the parameters of `name` (others in p held) on the channel; returns the SSE and updates
-/// p[name]. init: start from p[name] if present (a refit), else a full grid.
+/// p[name]. If p already holds `name` (a refit), the search is local around its value: a bracket
+/// of a factor 1.3 (log parameters) or +-5 % of the range (linear ones), 5 points and golden
+/// section (2 parameters: Nelder-Mead in log coordinates from the current point); else the whole
+/// range: the grid and golden section (2 parameters: the 2-D grid, then Nelder-Mead).
 double FitEffect(const Channel& ch, const std::vector<CandidateSpec>& specs, Params* p, const std::string& name) {
   const auto& spec = SpecOf(specs, name);
   const bool is_f = spec.channel == 'f';
-  const int giters = is_f ? 12 : 24;
   if (name == "damper_scale") {
     (*p)[name] = {1.0};
     double s = 1.0;
@@ -307,17 +362,28 @@ double FitEffect(const Channel& ch, const std::vector<CandidateSpec>& specs, Par
   };
   double best = 0;
   if (spec.params.size() == 1) {
-    const double x = Minimise1D([&](double x) { return eval({x}); }, spec.params[0], giters, &best,
-                                refit ? cur : std::vector<double>{});
+    ParamSpec ps = spec.params[0];
+    int giters = is_f ? 12 : 24;
+    if (refit) {
+      const double v = cur[0];
+      if (ps.log) {
+        ps.lo = std::max(spec.params[0].lo, v / 1.3), ps.hi = std::min(spec.params[0].hi, v * 1.3);
+      } else {
+        const double w = 0.05 * (spec.params[0].hi - spec.params[0].lo);
+        ps.lo = std::max(spec.params[0].lo, v - w), ps.hi = std::min(spec.params[0].hi, v + w);
+      }
+      ps.grid = 5;
+      giters = is_f ? 8 : 14;
+    }
+    const double x = Minimise1D([&](double x) { return eval({x}); }, ps, giters, &best, refit ? cur : std::vector<double>{});
     (*p)[name] = {x};
     return best;
   }
-  // Two parameters (oil_column_resonance): a coarse 2-D grid unless refitting, then coordinate
-  // refinement (each coordinate: its grid plus golden section), two rounds.
+  // Two parameters (oil_column_resonance), in log coordinates.
+  const auto& a = spec.params[0];
+  const auto& b = spec.params[1];
   std::vector<double> v = cur;
   if (!refit) {
-    const auto& a = spec.params[0];
-    const auto& b = spec.params[1];
     double fb = std::numeric_limits<double>::infinity();
     for (int i = 0; i < a.grid; ++i) {
       const double xa = std::clamp(std::exp(std::log(a.lo) + (std::log(a.hi) - std::log(a.lo)) * i / (a.grid - 1)), a.lo, a.hi);
@@ -328,25 +394,39 @@ double FitEffect(const Channel& ch, const std::vector<CandidateSpec>& specs, Par
       }
     }
   }
-  for (int round = 0; round < 2; ++round) {
-    for (std::size_t c = 0; c < 2; ++c) {
-      ParamSpec s = spec.params[c];
-      // Refine locally: a bracket of a factor 1.5 around the current value.
-      s.lo = std::max(spec.params[c].lo, v[c] / 1.5);
-      s.hi = std::min(spec.params[c].hi, v[c] * 1.5);
-      s.grid = 5;
-      const double x = Minimise1D(
-          [&](double x) {
-            auto w = v;
-            w[c] = x;
-            return eval(w);
-          },
-          s, 16, &best, {v[c]});
-      v[c] = x;
-    }
-  }
-  (*p)[name] = v;
+  auto flog = [&](const std::vector<double>& t) {
+    const double xa = std::exp(t[0]), xb = std::exp(t[1]);
+    if (xa < a.lo || xa > a.hi || xb < b.lo || xb > b.hi) return std::numeric_limits<double>::infinity();
+    return eval({xa, xb});
+  };
+  const double step_a = refit ? 0.05 : 0.5 * (std::log(a.hi) - std::log(a.lo)) / (a.grid - 1);
+  const double step_b = refit ? 0.1 : 0.5 * (std::log(b.hi) - std::log(b.lo)) / (b.grid - 1);
+  const auto t = NelderMead2(flog, {std::log(v[0]), std::log(v[1])}, {step_a, step_b}, refit ? 24 : 48, &best);
+  (*p)[name] = {std::exp(t[0]), std::exp(t[1])};
   return best;
+}
+
+/// Refits every effect of p, coordinate-wise (each with the others held), until a round
+/// improves the SSE by less than 1e-4 of it (at most `rounds` rounds). Returns the SSE.
+double RefitAll(const Channel& ch, const std::vector<CandidateSpec>& specs, Params* p, double sse, int rounds = 3) {
+  if (p->empty()) return sse;
+  for (int r = 0; r < rounds; ++r) {
+    double s = sse;
+    for (const auto& name : [&] {
+           std::vector<std::string> v;
+           for (const auto& kv : *p) v.push_back(kv.first);
+           return v;
+         }()) {
+      Params q = *p;
+      const double sn = FitEffect(ch, specs, &q, name);
+      if (std::getenv("RTHS_DIAG_DEBUG")) std::fprintf(stderr, "  refit %s: %g -> %g (%g)\n", name.c_str(), s, sn, q[name][0]);
+      if (sn < s) s = sn, *p = q;
+    }
+    const bool done = sse - s < 1e-4 * sse;
+    sse = s;
+    if (done) break;
+  }
+  return sse;
 }
 
 /// Integrated autocorrelation time of the channel's residual (all records concatenated per
@@ -511,6 +591,8 @@ Result Diagnose(const std::vector<io::RigRecord>& train_in, const std::vector<io
     for (std::size_t k = 1; k < d.size(); ++k) vmax_meas = std::max(vmax_meas, std::abs(d.y[k] - d.y[k - 1]) / dt);
   const auto specs = Candidates(dt, 2.0 * vmax_meas);
 
+  // The channels are diagnosed one after the other: y first, then f, whose motion input is the
+  // measured y seen through y's final model (ModelAidedMotion).
   std::vector<char> chans = {'y'};
   if (force_ok) chans.push_back('f');
   struct ChState {
@@ -524,16 +606,26 @@ Result Diagnose(const std::vector<io::RigRecord>& train_in, const std::vector<io
     bool structured = false;
     std::vector<std::vector<double>> pred_train;  // with sel
     std::vector<std::vector<double>> nom_test;    // nominal, test
-    bool dirty = true;                // candidates need re-evaluation
+    std::vector<std::vector<double>> fin_test;    // final (retained effects), test
+    std::vector<std::vector<double>> pred_train_fin;  // final (retained effects), training
+    Params keep;                      // retained effects
   };
-  std::vector<ChState> st;
-  for (char c : chans) {
-    const ForcePredictor* f = fp ? &*fp : nullptr;
-    st.push_back(ChState{c, Channel(c, &train, &servo, f), Channel(c, &test, &servo, f)});
-  }
-
-  // --- nominal residuals, noise floors, gap
-  for (auto& s : st) {
+  std::vector<std::unique_ptr<ChState>> st;
+  std::map<std::string, EffectResult> er;
+  std::vector<std::string> verdict;
+  const ForcePredictor* fpp = fp ? &*fp : nullptr;
+  for (char chan : chans) {
+    if (chan == 'f') {
+      // The motion of the damper: y's final model plus the zero-phase-smoothed residual.
+      const auto& ys = *st[0];
+      for (std::size_t r = 0; r < train.size(); ++r)
+        train[r].motion = ModelAidedMotion(train[r].y, ys.pred_train_fin[r], dt, std::min(o.smooth_hz, 0.45 / dt));
+      for (std::size_t r = 0; r < test.size(); ++r)
+        test[r].motion = ModelAidedMotion(test[r].y, ys.fin_test[r], dt, std::min(o.smooth_hz, 0.45 / dt));
+    }
+    st.push_back(std::make_unique<ChState>(ChState{chan, Channel(chan, &train, &servo, fpp), Channel(chan, &test, &servo, fpp)}));
+    auto& s = *st.back();
+    // --- nominal residuals, noise floor, gap
     ChannelSummary cs;
     cs.channel = std::string(1, s.ch);
     cs.diagnosed = true;
@@ -544,7 +636,6 @@ Result Diagnose(const std::vector<io::RigRecord>& train_in, const std::vector<io
     const double sse_test = s.test.Sse(s.nom_test);
     cs.gap_train_pct = s.train.NrmsePct(s.sse);
     cs.gap_test_pct = s.test.NrmsePct(sse_test);
-    // Floor from all records (train + test) pooled.
     const double v_tr = NoiseFloorVar(s.train, s.pred_train), v_te = NoiseFloorVar(s.test, s.nom_test);
     const double n_tr = static_cast<double>(Count(train)), n_te = static_cast<double>(Count(test));
     s.var_floor = (v_tr * n_tr + v_te * n_te) / (n_tr + n_te);
@@ -554,91 +645,116 @@ Result Diagnose(const std::vector<io::RigRecord>& train_in, const std::vector<io
     cs.floor_ratio_test = s.var_floor > 0 ? (sse_test / n_te) / s.var_floor : std::numeric_limits<double>::infinity();
     cs.whiteness = Whiteness(s.test, s.nom_test);
     s.structured = cs.floor_ratio > o.none_ratio;
-    res.channels.push_back(cs);
-  }
-  if (!force_ok) {
-    ChannelSummary cs;
-    cs.channel = "f";
-    cs.diagnosed = false;
-    cs.status = "not diagnosed";
-    res.channels.push_back(cs);
-  }
 
-  // --- greedy selection on the training records
-  struct Trial {
-    std::string name;
-    std::size_t chan;
-    Params params;  // the channel's whole set with this candidate
-    double sse = 0, excess_red = 0, dbic = 0;
-    bool pass = false;
-  };
-  std::map<std::string, Trial> last_trial;  // latest trial of every candidate
-  int added = 0;
-  for (;;) {
-    std::optional<Trial> best;
-    for (std::size_t c = 0; c < st.size(); ++c) {
-      auto& s = st[c];
-      if (!s.dirty) {
-        for (const auto& [name, t] : last_trial)
-          if (t.chan == c && t.pass && !s.sel.count(name) && (!best || t.excess_red > best->excess_red)) best = t;
-        continue;
-      }
-      s.dirty = false;
+    // --- greedy selection on the training records
+    struct Trial {
+      std::string name;
+      Params params;  // the channel's whole set with this candidate
+      double sse = 0, excess_red = 0, dbic = 0, marginal_red = 0;
+      bool pass = false;
+    };
+    std::map<std::string, Trial> last_trial;  // latest trial of every candidate
+    std::map<std::string, std::pair<double, double>> sel_stats;  // selected: (excess reduction, dBIC) when added
+    for (;;) {
+      std::optional<Trial> best;
       const double tau = IntegratedCorrelationTime(s.train, s.pred_train);
       const double n_eff = std::max(1.0, static_cast<double>(s.n_train) / tau);
       const double excess = s.sse - static_cast<double>(s.n_train) * s.var_floor;
+      // Only a channel whose current residual is still above its floor gets another effect.
+      const bool still_structured = s.sse > o.none_ratio * static_cast<double>(s.n_train) * s.var_floor;
       for (const auto& spec : specs) {
         if (spec.channel != s.ch || s.sel.count(spec.name)) continue;
         Trial t;
         t.name = spec.name;
-        t.chan = c;
         t.params = s.sel;
         double sse = FitEffect(s.train, specs, &t.params, spec.name);
-        if (!s.sel.empty()) {  // joint refit of the channel's effects, one coordinate round
-          for (const auto& [name, v] : s.sel) sse = FitEffect(s.train, specs, &t.params, name);
-          sse = FitEffect(s.train, specs, &t.params, spec.name);
-        }
+        sse = RefitAll(s.train, specs, &t.params, sse, 2);  // joint refit, two coordinate rounds
         t.sse = sse;
         const int p = static_cast<int>(spec.params.size());
         t.dbic = n_eff * std::log(std::max(sse, 1e-300) / std::max(s.sse, 1e-300)) + p * std::log(n_eff);
         t.excess_red = excess > 0 ? (s.sse - sse) / excess : 0.0;
-        t.pass = s.structured && t.dbic < 0 && t.excess_red >= o.min_excess_reduction &&
+        // The candidate's own share: the trial's set without it (the others as refitted).
+        Params without = t.params;
+        without.erase(spec.name);
+        const double sse_wo = s.train.Sse(s.train.Predict(ToSet(specs, without)));
+        const double excess_wo = sse_wo - static_cast<double>(s.n_train) * s.var_floor;
+        t.marginal_red = excess_wo > 0 ? (sse_wo - sse) / excess_wo : 0.0;
+        t.pass = s.structured && still_structured && t.dbic < 0 && t.excess_red >= o.min_excess_reduction &&
+                 t.marginal_red >= o.min_excess_reduction &&
                  static_cast<int>(s.order.size()) < o.max_effects_per_channel;
         last_trial[spec.name] = t;
         if (t.pass && (!best || t.excess_red > best->excess_red)) best = t;
       }
+      if (!best) break;
+      s.sel = best->params;
+      s.order.push_back(best->name);
+      sel_stats[best->name] = {best->excess_red, best->dbic};
+      s.sse = RefitAll(s.train, specs, &s.sel, best->sse, 6);
+      s.pred_train = s.train.Predict(ToSet(specs, s.sel));
+      s.sse = s.train.Sse(s.pred_train);
+      last_trial.erase(best->name);
     }
-    if (!best) break;
-    auto& s = st[best->chan];
-    s.sel = best->params;
-    s.order.push_back(best->name);
-    s.sse = best->sse;
+    // Swaps: an effect of the set replaced by another candidate (fitted, then the set refitted)
+    // when that lowers the training SSE by more than 0.1 % (e.g. a fast oil-column mode
+    // standing in for a delay); then pruning: an effect whose own share of the set's excess
+    // (the set refitted without it) is below min_excess_reduction is removed.
+    for (int sw = 0; sw < 2 && !s.order.empty(); ++sw) {
+      double best_sse = s.sse * (1.0 - 1e-3);
+      std::optional<std::pair<std::size_t, Params>> swap;
+      std::string swap_in;
+      for (std::size_t j = 0; j < s.order.size(); ++j) {
+        for (const auto& spec : specs) {
+          if (spec.channel != s.ch || s.sel.count(spec.name)) continue;
+          Params q = s.sel;
+          q.erase(s.order[j]);
+          double sq = FitEffect(s.train, specs, &q, spec.name);
+          sq = RefitAll(s.train, specs, &q, sq, 6);
+          if (std::getenv("RTHS_DIAG_DEBUG")) std::fprintf(stderr, "swap %s -> %s: %g (now %g)\n", s.order[j].c_str(), spec.name, sq, s.sse);
+          if (sq < best_sse) best_sse = sq, swap = std::make_pair(j, q), swap_in = spec.name;
+        }
+      }
+      if (!swap) break;
+      res.warnings.push_back(fmt::format("channel {}: {} replaced by {} (training SSE {:.4g} -> {:.4g})", cs.channel,
+                                         s.order[swap->first], swap_in, s.sse, best_sse));
+      sel_stats[swap_in] = sel_stats[s.order[swap->first]];
+      s.order[swap->first] = swap_in;
+      s.sel = swap->second;
+      s.sse = best_sse;
+    }
+    for (bool pruned = true; pruned && s.order.size() > 1;) {
+      pruned = false;
+      double least = o.min_excess_reduction;
+      std::optional<std::pair<std::size_t, Params>> drop;
+      double drop_sse = 0;
+      for (std::size_t j = 0; j < s.order.size(); ++j) {
+        Params q = s.sel;
+        q.erase(s.order[j]);
+        const double sq = RefitAll(s.train, specs, &q, s.train.Sse(s.train.Predict(ToSet(specs, q))), 2);
+        const double ex = sq - static_cast<double>(s.n_train) * s.var_floor;
+        const double share = ex > 0 ? (sq - s.sse) / ex : 0.0;
+        if (share < least) least = share, drop = std::make_pair(j, q), drop_sse = sq;
+      }
+      if (drop) {
+        res.warnings.push_back(fmt::format("channel {}: {} pruned (its own share of the excess {:.0f} % < {:.0f} %)", cs.channel,
+                                           s.order[drop->first], 100.0 * least, 100.0 * o.min_excess_reduction));
+        s.order.erase(s.order.begin() + static_cast<std::ptrdiff_t>(drop->first));
+        s.sel = drop->second;
+        s.sse = drop_sse;
+        pruned = true;
+      }
+    }
     s.pred_train = s.train.Predict(ToSet(specs, s.sel));
     s.sse = s.train.Sse(s.pred_train);
-    s.dirty = true;
-    last_trial.erase(best->name);
-    ++added;
-    res.verdict.push_back(best->name);  // provisional order of addition
-    if (added > 8) break;
-  }
 
-  // --- test scores; the 30 % rule per channel
-  std::map<std::string, EffectResult> er;
-  std::set<std::string> dropped;
-  for (std::size_t c = 0; c < st.size(); ++c) {
-    auto& s = st[c];
-    auto& cs = res.channels[c];
+    // --- test scores; the 30 % rule
     const double before = cs.gap_test_pct;
-    // Cumulative sets in order of addition.
     Params cum;
-    for (std::size_t j = 0; j < s.order.size(); ++j) {
-      const auto& name = s.order[j];
+    for (const auto& name : s.order) {
       cum[name] = s.sel.at(name);
-      double scale = 1;
       const auto sset = ToSet(specs, cum);
       std::optional<double> fixed;
       if (cum.count("damper_scale")) fixed = cum.at("damper_scale")[0];
-      const auto pt = s.test.Predict(sset, &scale, fixed);
+      const auto pt = s.test.Predict(sset, nullptr, fixed);
       const auto ptr = s.train.Predict(sset, nullptr, fixed);
       EffectResult e;
       e.name = name;
@@ -648,35 +764,44 @@ Result Diagnose(const std::vector<io::RigRecord>& train_in, const std::vector<io
       e.train_nrmse_after = s.train.NrmsePct(s.train.Sse(ptr));
       e.shrink_pct = ShrinkPct(before, e.test_nrmse_after);
       e.selected = true;
+      e.excess_reduction = sel_stats[name].first;
+      e.delta_bic = sel_stats[name].second;
       er[name] = e;
     }
-    // Final model of the channel.
     std::optional<double> fixed;
     if (s.sel.count("damper_scale")) fixed = s.sel.at("damper_scale")[0];
-    const auto fin = s.test.Predict(ToSet(specs, s.sel), nullptr, fixed);
+    auto fin = s.test.Predict(ToSet(specs, s.sel), nullptr, fixed);
     cs.after_test_pct = s.test.NrmsePct(s.test.Sse(fin));
     const bool test_structured = cs.floor_ratio_test > o.none_ratio;
-    if (!s.order.empty() && test_structured && ShrinkPct(before, cs.after_test_pct) < o.min_test_shrink_pct) {
+    bool retained = !s.order.empty();
+    if (retained && test_structured && ShrinkPct(before, cs.after_test_pct) < o.min_test_shrink_pct) {
       res.warnings.push_back(fmt::format(
           "channel {}: the effects selected on the training records ({}) shrink the test gap by only {:.1f} % "
           "(< {:.0f} %): not retained",
           cs.channel, fmt::join(s.order, ", "), ShrinkPct(before, cs.after_test_pct), o.min_test_shrink_pct));
-      for (const auto& n : s.order) {
-        dropped.insert(n);
-        er[n].selected = false;
-      }
+      for (const auto& n : s.order) er[n].selected = false;
       cs.after_test_pct = before;
-    } else if (!s.order.empty() && !test_structured) {
+      retained = false;
+    } else if (retained && !test_structured) {
       res.warnings.push_back(fmt::format("channel {}: the test records' residual is at the noise floor; the effects "
                                          "were found on the training records only",
                                          cs.channel));
     }
+    if (retained) {
+      s.keep = s.sel;
+      s.fin_test = std::move(fin);
+      s.pred_train_fin = s.pred_train;
+      for (const auto& n : s.order) verdict.push_back(n);
+    } else {
+      s.fin_test = s.nom_test;
+      s.pred_train_fin = s.train.Predict({});
+    }
     if (!s.structured) cs.status = "noise";
-    else if (!s.order.empty() && !dropped.count(s.order[0])) cs.status = "explained";
+    else if (retained) cs.status = "explained";
     else cs.status = "unexplained";
     // Candidates not selected: their latest trial (fitted on top of the selected ones).
     for (const auto& [name, t] : last_trial) {
-      if (t.chan != c || er.count(name)) continue;
+      if (er.count(name)) continue;
       std::optional<double> fx;
       if (t.params.count("damper_scale")) fx = t.params.at("damper_scale")[0];
       const auto pt = s.test.Predict(ToSet(specs, t.params), nullptr, fx);
@@ -691,11 +816,17 @@ Result Diagnose(const std::vector<io::RigRecord>& train_in, const std::vector<io
       e.delta_bic = t.dbic;
       er[name] = e;
     }
+    res.channels.push_back(cs);
   }
+  if (!force_ok) {
+    ChannelSummary cs;
+    cs.channel = "f";
+    cs.diagnosed = false;
+    cs.status = "not diagnosed";
+    res.channels.push_back(cs);
+  }
+
   // Verdict and ranking.
-  std::vector<std::string> verdict;
-  for (const auto& n : res.verdict)
-    if (!dropped.count(n)) verdict.push_back(n);
   int pos = 0;
   for (const auto& n : verdict) {
     er[n].order = pos++;
@@ -718,7 +849,7 @@ Result Diagnose(const std::vector<io::RigRecord>& train_in, const std::vector<io
     res.effects.push_back(e);
   }
   bool any_structured = false;
-  for (const auto& s : st) any_structured |= s.structured;
+  for (const auto& s : st) any_structured |= s->structured;
   if (!verdict.empty()) {
     res.verdict = verdict;
     for (const auto& cs : res.channels)
@@ -729,21 +860,15 @@ Result Diagnose(const std::vector<io::RigRecord>& train_in, const std::vector<io
   }
 
   // --- where (test records, nominal model)
-  std::vector<std::vector<double>> fin_pred[2];
   for (std::size_t c = 0; c < st.size(); ++c) {
-    auto& s = st[c];
-    Params keep;
-    for (const auto& n : s.order)
-      if (!dropped.count(n)) keep[n] = s.sel.at(n);
-    std::optional<double> fx;
-    if (keep.count("damper_scale")) fx = keep.at("damper_scale")[0];
-    fin_pred[c] = s.test.Predict(ToSet(specs, keep), nullptr, fx);
+    auto& s = *st[c];
     std::vector<LocaliseInput> li;
     std::vector<SmoothedMotion> motions;
     motions.reserve(test.size());
     for (std::size_t r = 0; r < test.size(); ++r) {
       const auto& d = test[r];
-      motions.push_back(d.motion.v_mm_s.empty() ? SmoothMotion(d.y, d.dt, std::min(o.smooth_hz, 0.45 / d.dt)) : d.motion);
+      motions.push_back(d.motion.v_mm_s.empty() ? ModelAidedMotion(d.y, st[0]->fin_test[r], dt, std::min(o.smooth_hz, 0.45 / dt))
+                                                : d.motion);
       LocaliseInput in;
       in.source = d.source;
       in.dt_s = d.dt;
@@ -757,26 +882,26 @@ Result Diagnose(const std::vector<io::RigRecord>& train_in, const std::vector<io
       li.push_back(in);
     }
     Localise(std::string(1, s.ch), li, &res.bands, &res.conditions, &res.time);
-  }
-  if (traces) {
-    traces->test.clear();
-    for (std::size_t r = 0; r < test.size(); ++r) {
-      const auto& d = test[r];
-      Traces::Record tr;
-      tr.source = d.source;
-      tr.dt_s = d.dt;
-      tr.u = d.u;
-      tr.y_meas = d.y;
-      tr.i = d.i;
-      tr.v = d.motion.v_mm_s.empty() ? SmoothMotion(d.y, d.dt, std::min(o.smooth_hz, 0.45 / d.dt)).v_mm_s : d.motion.v_mm_s;
-      tr.y_nom = st[0].nom_test[r];
-      tr.y_fin = fin_pred[0][r];
-      tr.f_meas = d.f;
-      if (st.size() > 1) {
-        tr.f_nom = st[1].nom_test[r];
-        tr.f_fin = fin_pred[1][r];
+    if (traces && c == 0) {
+      traces->test.clear();
+      for (std::size_t r = 0; r < test.size(); ++r) {
+        const auto& d = test[r];
+        Traces::Record tr;
+        tr.source = d.source;
+        tr.dt_s = d.dt;
+        tr.u = d.u;
+        tr.y_meas = d.y;
+        tr.i = d.i;
+        tr.v = motions[r].v_mm_s;
+        tr.y_nom = s.nom_test[r];
+        tr.y_fin = s.fin_test[r];
+        tr.f_meas = d.f;
+        if (st.size() > 1) {
+          tr.f_nom = st[1]->nom_test[r];
+          tr.f_fin = st[1]->fin_test[r];
+        }
+        traces->test.push_back(std::move(tr));
       }
-      traces->test.push_back(std::move(tr));
     }
   }
   res.runtime_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
@@ -826,7 +951,7 @@ nlohmann::json ToJson(const Result& r) {
     o["shrink_pct"] = num(e.shrink_pct);
     o["selected"] = e.selected;
     o["train_nrmse_" + e.channel + "_pct_after"] = num(e.train_nrmse_after);
-    if (e.name != "sensor_noise" && !e.selected) {
+    if (e.name != "sensor_noise") {
       o["excess_reduction_pct"] = num(100.0 * e.excess_reduction);
       o["delta_bic"] = num(e.delta_bic);
     }
@@ -896,8 +1021,8 @@ std::string Summary(const Result& r) {
   for (const auto& e : r.effects) {
     std::string ps;
     for (const auto& [k, v] : e.params) ps += fmt::format(" {}={:.4g}", k, v);
-    s += fmt::format("  {} {:<22} [{}]{}: {:.3f} %, shrink {:.1f} %\n", e.selected ? "*" : " ", e.name, e.channel, ps,
-                     e.test_nrmse_after, e.shrink_pct);
+    s += fmt::format("  {} {:<22} [{}]{}: {:.3f} %, shrink {:.1f} % (train: excess -{:.0f} %)\n", e.selected ? "*" : " ", e.name,
+                     e.channel, ps, e.test_nrmse_after, e.shrink_pct, 100.0 * e.excess_reduction);
   }
   s += fmt::format("verdict: {}\n", fmt::join(r.verdict, ", "));
   for (const auto& w : r.warnings) s += "warning: " + w + "\n";

@@ -39,7 +39,7 @@ namespace rths::diagnosis {
 /// Knobs of the method (defaults: those of `rths diagnose`, documented in docs/diagnosis.md).
 struct Options {
   double warmup_s = 0.1;               ///< start of every record left out of all sums [s]
-  double smooth_hz = 80.0;             ///< zero-phase smoothing of y for the force channel [Hz]
+  double smooth_hz = 20.0;             ///< zero-phase smoothing of the y residual for the force channel [Hz]
   double none_ratio = 1.6;             ///< rho_c at or below this: the channel is at its noise floor
   double min_excess_reduction = 0.25;  ///< rule (b) above, in (0, 1)
   double min_test_shrink_pct = 30.0;   ///< the contract's 30 % on the test records

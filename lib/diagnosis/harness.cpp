@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
 #include <map>
 #include <set>
 
@@ -128,6 +129,7 @@ HarnessCase RunHarnessCase(const std::string& kind, std::uint64_t seed, const Ha
   const Result r = Diagnose({rtr}, {rte}, PaperModel(), Options{});
   c.runtime_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   c.verdict = r.verdict;
+  if (o.verbose) std::printf("--- %s seed %llu\n%s", kind.c_str(), static_cast<unsigned long long>(seed), Summary(r).c_str());
   auto v = r.verdict;
   std::sort(v.begin(), v.end());
   c.right = v == c.truth;

@@ -26,6 +26,7 @@ struct HarnessOptions {
   std::vector<std::string> only; ///< case kinds to run (empty: all)
   bool pairs = true;             ///< include the two-effect cases
   double noise_y_mm = 0.01, noise_f_kN = 0.2;
+  bool verbose = false;          ///< print each diagnosis's Summary() to stdout
 };
 
 struct HarnessCase {
