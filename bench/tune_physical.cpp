@@ -320,7 +320,7 @@ int main(int argc, char** argv) {
   }
   std::vector<int> idx;
   for (int i = 0; i < static_cast<int>(ps.size()); ++i)
-    if (ps[i].free && ps[i].value > 0) idx.push_back(i);
+    if (ps[i].free && ps[i].value != 0) idx.push_back(i);
   const int n = static_cast<int>(idx.size());
 
   int evals = 0;
