@@ -18,7 +18,11 @@
 //     J = ( sum_j |e_j|^6 / 8 )^(1/6)
 // (a smooth stand-in for max_j |e_j|, which is what E1's 8 % bounds).
 // --free takes a comma-separated subset of: hz, zeta, gain (K_p K_q / A via K_p), beta, leak,
-// volume, mass, cp. --iters 0 only evaluates the given point.
+// volume, mass, cp, and dp, dphz (an experiment not in the library: a high-passed load-pressure
+// feedback in the inner loop, see SimulateDp). A free parameter keeps the sign of its start value.
+// --iters 0 only evaluates the given point (and prints the damper's equivalent spring-dashpot on
+// the record); --objective frf minimises the RMS complex error of H1 against the Eqs. instead;
+// --sample N evaluates N random points of a plausible box. Results: docs/plant.md.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
