@@ -3,6 +3,7 @@
 // generated, the real UTFSM damper tests (fit on one, predict held-out ones), the TOML fragment
 // read back by the scenario parser, record cutting (io::CutRigRecord), and bad input.
 #include <cmath>
+#include <fstream>
 #include <numbers>
 #include <string>
 #include <vector>
@@ -11,6 +12,7 @@
 #include <fmt/format.h>
 
 #include "core/error.h"
+#include "diagnosis/channel_models.h"
 #include "ident/damper_fit.h"
 #include "io/rig_record.h"
 #include "io/utfsm.h"
@@ -210,6 +212,25 @@ TEST_CASE("the TOML fragment is a [plant.damper] table the scenario parser reads
   const auto at0 = rths::models::CoefficientsAt(d, 0.0), at2 = rths::models::CoefficientsAt(d, 2.5);
   CHECK(at0.c0 == doctest::Approx(at2.c0).epsilon(1e-12));
   CHECK(at0.beta == doctest::Approx(at2.beta).epsilon(1e-12));
+}
+
+TEST_CASE("the fragment alone, and after an actuator fragment, is a damper model for rths diagnose --model") {
+  rths::ident::DamperFitResult fit;
+  fit.current_A = 1.0;
+  fit.coef = Truth();
+  const std::string damper = rths::ident::DamperTomlFragment(fit, "test");
+  const auto dir = rths_test::TempDir("damper_fit_model");
+  const auto alone = (dir / "damper.toml").string(), both = (dir / "act_damper.toml").string();
+  { std::ofstream(alone) << damper; }
+  { std::ofstream(both) << "[plant]\nactuator = { K = 2125494.5, p = 43.2, b = 161.15, c = 49022.3 }\n\n" << damper; }
+  for (const auto& path : {alone, both}) {
+    CAPTURE(path);
+    const auto m = rths::diagnosis::LoadModel(path);
+    CHECK(m.has_damper);
+    CHECK(m.damper.c1_a == doctest::Approx(Truth().c1).epsilon(1e-9));
+    CHECK(m.damper.gamma_c == 0.0);
+  }
+  CHECK(rths::diagnosis::LoadModel(both).actuator.p == doctest::Approx(43.2));
 }
 
 TEST_CASE("CutRigRecord: two halves of chirp_0A; windows too short or empty are refused") {
