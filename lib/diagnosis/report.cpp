@@ -80,7 +80,11 @@ report::Figure FrfFigure(const Traces::Record& t, std::size_t first) {
   auto pm = report::MakePanel("", "frequency [Hz]", "|G_yu| [mm/mm]");
   auto pp = report::MakePanel("", "frequency [Hz]", "phase [deg]");
   auto pc = report::MakePanel("", "frequency [Hz]", "coherence u -> y_meas");
-  const double fmax = std::min(60.0, 0.5 / t.dt_s);
+  // Up to twice the highest frequency where the test excitation is coherent (gamma^2 > 0.5).
+  double fcoh = 5.0;
+  for (std::size_t j = 1; j < hm.f_hz.size(); ++j)
+    if (hm.coherence[j] > 0.5) fcoh = std::max(fcoh, hm.f_hz[j]);
+  const double fmax = std::min({2.0 * fcoh, 100.0, 0.5 / t.dt_s});
   for (auto* p : {&pm, &pp, &pc}) p->x_range = std::make_pair(0.0, fmax);
   auto a1 = report::MakeSeries("measured", "#1f77b4"), a2 = report::MakeSeries("nominal model", "#d62728", 2),
        a3 = report::MakeSeries("with the verdict's effects", "#2ca02c", 3);

@@ -68,26 +68,42 @@ io::RigRecord MakeRecordBlocks(const Excitation& ex, const Truth& truth, const s
   auto g = signal::MakeGaussian(truth.noise_seed);
   const double sy = truth.effects.sensor_noise ? truth.effects.sensor_noise->rms_y_mm : 0.0;
   const double sf = truth.effects.sensor_noise ? truth.effects.sensor_noise->rms_f_kN : 0.0;
-  double y_prev = 0.0, f_prev = 0.0;
+  // The damper's motion inside a step, as in the rig mode (models/effect_rig.h): the servo's
+  // continuous motion (cubic Hermite through its samples x_k with its velocities C A z_k, exact
+  // for a cubic, close for the servo) plus a linear interpolation of what the effects add,
+  // d_k = y_k - x_k.
+  double x_prev = 0.0, xd_prev = 0.0, d_prev = 0.0, f_prev = 0.0;
   for (std::size_t k = 0; k < n; ++k) {
-    const double y = dfx.Post(models::Output(servo, xs), f_prev);
-    // The damper over [t_{k-1}, t_k]: linear motion y_{k-1} -> y_k, current held from k-1.
-    const double v = k > 0 ? (y - y_prev) / dt : 0.0;
+    const double x = models::Output(servo, xs), xd = models::OutputVelocity(servo, xs);
+    const double y = dfx.Post(x, f_prev);
+    const double d = y - x;
+    const double dd = k > 0 ? (d - d_prev) / dt : 0.0;
+    const double v = xd + dd;
     if (k > 0) {
       const int m = 8;
       const double h = dt / m;
+      auto at = [&](double tau, double* pos, double* vel) {
+        const double t = tau / dt, t2 = t * t, t3 = t2 * t;
+        *pos = (2 * t3 - 3 * t2 + 1) * x_prev + (t3 - 2 * t2 + t) * dt * xd_prev + (-2 * t3 + 3 * t2) * x + (t3 - t2) * dt * xd +
+               d_prev + dd * tau;
+        *vel = ((6 * t2 - 6 * t) * x_prev + (3 * t2 - 4 * t + 1) * dt * xd_prev + (-6 * t2 + 6 * t) * x + (3 * t2 - 2 * t) * dt * xd) / dt +
+               dd;
+      };
       for (int j = 0; j < m; ++j) {
         const double ta = j * h;
         auto coef = [&](double tau) { return models::CoefficientsAt(damper, models::EffectiveCurrentAt(driver, cs, tau)); };
         const auto ca = coef(ta), cb = coef(ta + 0.5 * h), cc = coef(ta + h);
-        auto xat = [&](double tau) { return y_prev + v * tau; };
-        const auto r1 = models::DamperRates(ca, ds, xat(ta), v);
+        double pa, va, pb, vb, pc, vc;
+        at(ta, &pa, &va);
+        at(ta + 0.5 * h, &pb, &vb);
+        at(ta + h, &pc, &vc);
+        const auto r1 = models::DamperRates(ca, ds, pa, va);
         const models::MrDamperState s2{ds.y_mm + 0.5 * h * r1.ydot_mm_s, ds.z_mm + 0.5 * h * r1.zdot_mm_s};
-        const auto r2 = models::DamperRates(cb, s2, xat(ta + 0.5 * h), v);
+        const auto r2 = models::DamperRates(cb, s2, pb, vb);
         const models::MrDamperState s3{ds.y_mm + 0.5 * h * r2.ydot_mm_s, ds.z_mm + 0.5 * h * r2.zdot_mm_s};
-        const auto r3 = models::DamperRates(cb, s3, xat(ta + 0.5 * h), v);
+        const auto r3 = models::DamperRates(cb, s3, pb, vb);
         const models::MrDamperState s4{ds.y_mm + h * r3.ydot_mm_s, ds.z_mm + h * r3.zdot_mm_s};
-        const auto r4 = models::DamperRates(cc, s4, xat(ta + h), v);
+        const auto r4 = models::DamperRates(cc, s4, pc, vc);
         ds.y_mm += h / 6.0 * (r1.ydot_mm_s + 2 * r2.ydot_mm_s + 2 * r3.ydot_mm_s + r4.ydot_mm_s);
         ds.z_mm += h / 6.0 * (r1.zdot_mm_s + 2 * r2.zdot_mm_s + 2 * r3.zdot_mm_s + r4.zdot_mm_s);
       }
@@ -102,8 +118,7 @@ io::RigRecord MakeRecordBlocks(const Excitation& ex, const Truth& truth, const s
     // Step k -> k+1.
     models::Hold(driver, &cs, ffx.Current(i[k]));
     models::Step(servo, &xs, dfx.Pre(u[k]));
-    y_prev = y;
-    f_prev = f;
+    x_prev = x, xd_prev = xd, d_prev = d, f_prev = f;
   }
   r.metadata.push_back({"generator", "diagnosis::MakeRecordBlocks"});
   io::ValidateRigRecord(r, name);

@@ -2,9 +2,10 @@
 /// @file Rig records with known effects made in-process, for the diagnosis's tests and its
 /// validation harness (tests/diagnosis_*_test.cpp, bench/diagnosis.cpp). Two generators:
 ///   - MakeRecordBlocks: the effect blocks of models/rig_effects.h around the Eq. 30 actuator
-///     (exact ZOH) and a Spencer damper stepped sample by sample (RK4, 8 substeps, linear motion
-///     between samples, the current through Eq. 40 + 75 Hz), independent of the diagnosis's own
-///     force predictor (which smooths the measured y instead);
+///     (exact ZOH) and a Spencer damper stepped sample by sample (RK4, 8 substeps; inside a step
+///     the servo's Hermite motion plus the effects' offset interpolated linearly, as the rig mode
+///     does; the current through Eq. 40 + 75 Hz), independent of the diagnosis's own force
+///     predictor (which works from the noisy measured y);
 ///   - MakeRecordRig: the plant's rig mode (models::MakeRig with plant.effects and
 ///     plant.unmodelled), the same code that procs/plant runs.
 /// Both: u from a band-limited white noise (signal::Blwn), the current command a random

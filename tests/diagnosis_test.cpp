@@ -1,0 +1,352 @@
+// The sim-to-real gap diagnosis (lib/diagnosis, ../shared/spec/diagnosis.md, docs/diagnosis.md):
+// arithmetic, the force predictor against CVODE, each effect recovered from a synthetic record,
+// none / unknown, the JSON of the contract, the model file, bad input.
+#include <unistd.h>
+#include <sys/wait.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <numbers>
+#include <set>
+#include <string>
+
+#include <doctest/doctest.h>
+
+#include "core/error.h"
+#include "diagnosis/diagnosis.h"
+#include "diagnosis/synthetic.h"
+#include "io/rig_record.h"
+#include "models/mr_damper.h"
+
+namespace fs = std::filesystem;
+using namespace rths::diagnosis;
+namespace m = rths::models;
+
+namespace {
+
+fs::path TempDir(const std::string& name) {
+  const fs::path p = fs::temp_directory_path() / ("rths_diag_test_" + std::to_string(::getpid())) / name;
+  fs::remove_all(p);
+  fs::create_directories(p);
+  return p;
+}
+
+/// Short training (BLWN 0-25 Hz) and test (BLWN 0-8 Hz) records from the effect blocks.
+std::pair<rths::io::RigRecord, rths::io::RigRecord> Records(const Truth& truth, double duration_s = 6.0,
+                                                             std::uint64_t seed = 3) {
+  Excitation tr;
+  tr.duration_s = duration_s;
+  tr.band_hz = 25.0;
+  tr.rms_mm = 4.0;
+  tr.seed = seed;
+  Excitation te = tr;
+  te.band_hz = 8.0;
+  te.rms_mm = 5.0;
+  te.seed = seed + 1000;
+  Truth t2 = truth;
+  t2.noise_seed += 17;
+  return {MakeRecordBlocks(tr, truth, "train"), MakeRecordBlocks(te, t2, "test")};
+}
+
+Truth Noisy() {
+  Truth t;
+  t.effects.sensor_noise = m::SensorNoise{0.01, 0.2};
+  return t;
+}
+
+const EffectResult* Find(const Result& r, const std::string& name) {
+  for (const auto& e : r.effects)
+    if (e.name == name) return &e;
+  return nullptr;
+}
+
+}  // namespace
+
+TEST_CASE("NRMSE (Eq. 31 on the residual) and shrink arithmetic") {
+  const std::vector<double> meas = {1, -2, 2, 0};
+  const std::vector<double> pred = {1, -1, 2, 1};
+  // sum e^2 = 0 + 1 + 0 + 1 = 2, sum m^2 = 9: 100 sqrt(2/9)
+  CHECK(Nrmse(meas, pred) == doctest::Approx(100.0 * std::sqrt(2.0 / 9.0)));
+  // from sample 2 on: e^2 = 0 + 1, m^2 = 4 + 0
+  CHECK(Nrmse(meas, pred, 2) == doctest::Approx(50.0));
+  CHECK(ShrinkPct(10.0, 2.0) == doctest::Approx(80.0));
+  CHECK(ShrinkPct(4.0, 5.0) == doctest::Approx(-25.0));
+  CHECK_THROWS_AS(Nrmse(meas, std::vector<double>{1.0}), rths::Error);
+}
+
+TEST_CASE("force predictor (RK4, model-aided motion) agrees with the CVODE damper at 1e-8") {
+  // A prescribed sinusoid x = 10 sin(2 pi 2 t) at constant currents, no current dynamics.
+  const double dt = 0.0005;
+  const std::size_t n = 4000;
+  SmoothedMotion mo;
+  for (std::size_t k = 0; k < n; ++k) {
+    const double t = k * dt, w = 2 * std::numbers::pi * 2.0;
+    mo.x_mm.push_back(10.0 * std::sin(w * t));
+    mo.v_mm_s.push_back(10.0 * w * std::cos(w * t));
+  }
+  for (double i : {0.0, 1.0, 2.5}) {
+    ForcePredictor fp(m::MrDamperParams::Table3(), false, dt);
+    const std::vector<double> cur(n, i);
+    const auto f = fp.Predict(mo, cur, {});
+    struct Ctx {
+      double w;
+    } ctx{2 * std::numbers::pi * 2.0};
+    m::MrDamperStepper st(
+        m::MrDamperParams::Table3(),
+        [](double t, void* c, double* x, double* xd) {
+          const double w = static_cast<Ctx*>(c)->w;
+          *x = 10.0 * std::sin(w * t);
+          *xd = 10.0 * w * std::cos(w * t);
+        },
+        &ctx, 1e-8);
+    m::MrDamperState s{};
+    double se = 0, sf = 0;
+    for (std::size_t k = 0; k < n; ++k) {
+      const double fr = st.ForceKn(k * dt, i, s);
+      se += (f[k] - fr) * (f[k] - fr);
+      sf += fr * fr;
+      if (k + 1 < n) st.Advance(k * dt, (k + 1) * dt, i, &s);
+    }
+    INFO("current " << i << " A");
+    CHECK(std::sqrt(se / sf) < 2e-3);  // (the Hermite motion differs from the sinusoid by O(dt^4))
+  }
+}
+
+TEST_CASE("model-aided motion keeps the model's content and smooths only the residual") {
+  const double dt = 0.0005;
+  std::vector<double> yhat, y;
+  for (int k = 0; k < 4000; ++k) {
+    const double t = k * dt;
+    yhat.push_back(std::sin(2 * std::numbers::pi * 50 * t));  // 50 Hz, above the 20 Hz smoother
+    y.push_back(yhat.back() + 0.1);                            // + an offset (passes the smoother)
+  }
+  const auto mo = ModelAidedMotion(y, yhat, dt, 20.0);
+  for (int k = 100; k < 3900; k += 37) CHECK(mo.x_mm[k] == doctest::Approx(y[k]).epsilon(1e-6));
+  const auto plain = SmoothMotion(y, dt, 20.0);
+  double d = 0;
+  for (int k = 100; k < 3900; ++k) d = std::max(d, std::abs(plain.x_mm[k] - y[k]));
+  CHECK(d > 0.5);  // the plain smoother removes the 50 Hz content the model-aided motion keeps
+}
+
+TEST_CASE("each effect of the library is named and its parameter recovered (synthetic records)") {
+  struct Case {
+    std::string name;
+    std::function<void(m::EffectSet*)> set;
+    std::string key;
+    double value, rel_tol;
+  };
+  const std::vector<Case> cases = {
+      {"pure_delay", [](m::EffectSet* e) { e->pure_delay = m::PureDelay{4.0}; }, "tau_ms", 4.0, 0.05},
+      {"gain_error", [](m::EffectSet* e) { e->gain_error = m::GainError{1.1}; }, "gain", 1.1, 0.01},
+      {"load_coupling", [](m::EffectSet* e) { e->load_coupling = m::LoadCoupling{3e-4}; }, "compliance_mm_per_kN", 3e-4, 0.15},
+      {"oil_column_resonance", [](m::EffectSet* e) { e->oil_column_resonance = m::OilColumnResonance{30.0, 0.1}; }, "f_hz", 30.0, 0.03},
+      {"coulomb_friction",
+       [](m::EffectSet* e) {
+         m::CoulombFriction c;
+         c.loss_mm = 0.2;
+         e->coulomb_friction = c;
+       },
+       "loss_mm", 0.2, 0.1},
+      {"backlash", [](m::EffectSet* e) { e->backlash = m::Backlash{0.4}; }, "gap_mm", 0.4, 0.1},
+      {"servovalve_saturation", [](m::EffectSet* e) { e->servovalve_saturation = m::ServovalveSaturation{200.0}; },
+       "vmax_mm_per_s", 200.0, 0.05},
+      {"current_lag", [](m::EffectSet* e) { e->current_lag = m::CurrentLag{80.0}; }, "tau_ms", 80.0, 0.15},
+      {"damper_scale", [](m::EffectSet* e) { e->damper_scale = m::DamperScale{1.2}; }, "scale", 1.2, 0.02},
+  };
+  for (const auto& c : cases) {
+    SUBCASE(c.name.c_str()) {
+      Truth t = Noisy();
+      c.set(&t.effects);
+      const auto [tr, te] = Records(t);
+      const auto r = Diagnose({tr}, {te}, PaperModel(), Options{});
+      INFO(Summary(r));
+      REQUIRE(r.verdict == std::vector<std::string>{c.name});
+      const auto* e = Find(r, c.name);
+      REQUIRE(e != nullptr);
+      CHECK(e->selected);
+      CHECK(e->params.at(c.key) == doctest::Approx(c.value).epsilon(c.rel_tol));
+      CHECK(e->shrink_pct > 50.0);
+      CHECK(e->shrink_pct == doctest::Approx(ShrinkPct(r.Channel(e->channel)->gap_test_pct, e->test_nrmse_after)));
+    }
+  }
+}
+
+TEST_CASE("a record with sensor noise only: verdict none, noise floors measured") {
+  const auto [tr, te] = Records(Noisy());
+  const auto r = Diagnose({tr}, {te}, PaperModel(), Options{});
+  INFO(Summary(r));
+  CHECK(r.verdict == std::vector<std::string>{"none"});
+  CHECK(r.Channel("y")->noise_rms == doctest::Approx(0.01).epsilon(0.15));
+  CHECK(r.Channel("f")->noise_rms == doctest::Approx(0.2).epsilon(0.15));
+  for (const auto& e : r.effects) CHECK_FALSE(e.selected);
+  const auto* sn = Find(r, "sensor_noise");
+  REQUIRE(sn != nullptr);
+  CHECK(sn->params.count("rms") == 1);
+}
+
+TEST_CASE("a structured disturbance outside the library (7 Hz ripple on y): verdict unknown") {
+  Truth t = Noisy();
+  t.ripple_mm = 0.1;
+  t.ripple_hz = 7.0;
+  const auto [tr, te] = Records(t);
+  const auto r = Diagnose({tr}, {te}, PaperModel(), Options{});
+  INFO(Summary(r));
+  CHECK(r.verdict == std::vector<std::string>{"unknown"});
+  CHECK(r.Channel("y")->status == "unexplained");
+  // Localised: the 5-10 Hz band holds most of y's residual.
+  double share = 0;
+  for (const auto& b : r.bands)
+    if (b.channel == "y" && b.lo_hz == 5.0) share = b.share_pct;
+  CHECK(share > 50.0);
+}
+
+TEST_CASE("JSON: the contract's fields and keys") {
+  Truth t = Noisy();
+  t.effects.pure_delay = m::PureDelay{3.0};
+  t.effects.damper_scale = m::DamperScale{0.8};
+  const auto [tr, te] = Records(t);
+  const auto r = Diagnose({tr}, {te}, PaperModel(), Options{});
+  const auto j = ToJson(r);
+  REQUIRE(j.contains("gap"));
+  CHECK(j["gap"]["nrmse_y_pct"].is_number());
+  CHECK(j["gap"]["nrmse_f_pct"].is_number());
+  for (const char* k : {"bands", "conditions", "time"}) CHECK(j["where"][k].is_array());
+  for (const auto& b : j["where"]["bands"]) {
+    CHECK(b["lo_hz"].is_number());
+    CHECK(b["hi_hz"].is_number());
+    CHECK(b["share_pct"].is_number());
+  }
+  std::set<std::string> conds;
+  for (const auto& c : j["where"]["conditions"]) {
+    CHECK(c["share_pct"].is_number());
+    conds.insert(c["name"].get<std::string>());
+  }
+  CHECK(conds == std::set<std::string>{"velocity_reversal", "high_velocity", "high_force", "current_switching"});
+  for (const auto& w : j["where"]["time"]) {
+    CHECK(w["t0_s"].is_number());
+    CHECK(w["t1_s"].is_number());
+    CHECK(w["share_pct"].is_number());
+  }
+  // Every candidate, with the contract's parameter keys.
+  const std::map<std::string, std::vector<std::string>> keys = {
+      {"pure_delay", {"tau_ms"}},        {"gain_error", {"gain"}},
+      {"load_coupling", {"compliance_mm_per_kN"}}, {"oil_column_resonance", {"f_hz", "zeta"}},
+      {"coulomb_friction", {"loss_mm"}}, {"backlash", {"gap_mm"}},
+      {"servovalve_saturation", {"vmax_mm_per_s"}}, {"sensor_noise", {"rms"}},
+      {"current_lag", {"tau_ms"}},       {"damper_scale", {"scale"}}};
+  std::set<std::string> names;
+  for (const auto& e : j["effects"]) {
+    const std::string name = e["name"];
+    names.insert(name);
+    const std::string ch = e["channel"];
+    CHECK((ch == "y" || ch == "f"));
+    CHECK(e["nrmse_" + ch + "_pct_after"].is_number());
+    CHECK(e["shrink_pct"].is_number());
+    CHECK(e["selected"].is_boolean());
+    REQUIRE(keys.count(name) == 1);
+    for (const auto& k : keys.at(name)) CHECK(e["params"].contains(k));
+    if (name == "sensor_noise") CHECK_FALSE(e["selected"].get<bool>());
+  }
+  CHECK(names.size() == rths::models::kEffectNames.size());
+  REQUIRE(j["verdict"].is_array());
+  CHECK(j["verdict"] == nlohmann::json({"pure_delay", "damper_scale"}));
+  // The selected effects come first, in the order of the verdict.
+  CHECK(j["effects"][0]["name"] == "pure_delay");
+  CHECK(j["effects"][1]["name"] == "damper_scale");
+  CHECK(j["runtime_s"].is_number());
+  CHECK(j["noise_floor"]["y_mm_rms"].is_number());
+}
+
+TEST_CASE("model files: a scenario's plant, an actuator-only file from rths identify") {
+  const auto dir = TempDir("models");
+  {
+    std::ofstream f(dir / "ident.toml");
+    f << "# rths identify x.csv\n\n[plant]\nactuator = { K = 1.6e7, p = 151.7, b = 250.4, c = 1.061e5 }\n\n"
+         "[controller]\nmodel = { K = 1.6e7, p = 151.7, b = 250.4, c = 1.061e5 }\n";
+  }
+  const auto mi = LoadModel((dir / "ident.toml").string());
+  CHECK_FALSE(mi.has_damper);
+  CHECK(mi.actuator.K == doctest::Approx(1.6e7));
+  {
+    std::ofstream f(dir / "scen.toml");
+    f << "[run]\nname = \"x\"\n\n[plant]\nactuator = \"2.5A\"\nspecimen = \"mr_damper\"\n";
+  }
+  const auto ms = LoadModel((dir / "scen.toml").string());
+  CHECK(ms.has_damper);
+  CHECK(ms.actuator.p == doctest::Approx(134.2));
+  {
+    std::ofstream f(dir / "bad.toml");
+    f << "[plant\nactuator = 3\n";
+  }
+  try {
+    LoadModel((dir / "bad.toml").string());
+    FAIL("a bad TOML file must be refused");
+  } catch (const rths::Error& e) {
+    CHECK(std::string(e.what()).find("bad.toml") != std::string::npos);
+  }
+  // Actuator only: the force channel is not diagnosed, and the result says so.
+  const auto [tr, te] = Records(Noisy(), 4.0);
+  const auto r = Diagnose({tr}, {te}, mi, Options{});
+  CHECK_FALSE(r.Channel("f")->diagnosed);
+  bool said = false;
+  for (const auto& w : r.warnings) said |= w.find("force channel is not diagnosed") != std::string::npos;
+  CHECK(said);
+  CHECK(ToJson(r)["gap"]["nrmse_f_pct"].is_null());
+}
+
+TEST_CASE("bad input: records with different dt, and the command's exit code 2 naming file and line") {
+  const auto [tr, te] = Records(Noisy(), 3.0);
+  auto te2 = te;
+  te2.dt_s = 0.001;
+  CHECK_THROWS_AS(Diagnose({tr}, {te2}, PaperModel(), Options{}), rths::Error);
+  CHECK_THROWS_AS(Diagnose({}, {te}, PaperModel(), Options{}), rths::Error);
+
+  const std::string bin = std::string(RTHS_BIN_DIR) + "/rths-diagnose";
+  if (::access(bin.c_str(), X_OK) != 0) {
+    MESSAGE("rths-diagnose is not built in " << RTHS_BIN_DIR << ": command checks skipped");
+    return;
+  }
+  const auto dir = TempDir("bad");
+  rths::io::WriteRigRecord(tr, (dir / "good.csv").string());
+  {  // a missing column
+    std::ofstream f(dir / "nocol.csv");
+    f << "# rths rig record v1\n# dt_s: 0.0005\nt_s,u_mm,y_mm,i_A\n";
+    for (int k = 0; k < 5000; ++k) f << k * 0.0005 << ",0,0,0\n";
+  }
+  {  // a gap in time at line 1004
+    std::ofstream f(dir / "gap.csv");
+    f << "# rths rig record v1\n# dt_s: 0.0005\nt_s,u_mm,y_mm,f_kN,i_A\n";
+    for (int k = 0; k < 5000; ++k) f << (k < 1000 ? k : k + 3) * 0.0005 << ",0,0,0,0\n";
+  }
+  auto run = [&](const std::string& args) {
+    const std::string out = (dir / "out.txt").string();
+    const std::string cmd = bin + " " + args + " > " + out + " 2>&1";
+    const int st = std::system(cmd.c_str());
+    std::ifstream f(out);
+    std::string text((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+    return std::make_pair(WIFEXITED(st) ? WEXITSTATUS(st) : -1, text);
+  };
+  {
+    const auto [code, text] = run("--train " + (dir / "nocol.csv").string() + " --test " + (dir / "good.csv").string() +
+                                  " --out " + (dir / "o1").string());
+    CHECK(code == 2);
+    CHECK(text.find("nocol.csv") != std::string::npos);
+    CHECK(text.find("f_kN") != std::string::npos);
+  }
+  {
+    const auto [code, text] = run("--train " + (dir / "good.csv").string() + " --test " + (dir / "gap.csv").string() +
+                                  " --out " + (dir / "o2").string());
+    CHECK(code == 2);
+    CHECK(text.find("gap.csv:1004") != std::string::npos);
+  }
+  {
+    const auto [code, text] = run("--train " + (dir / "good.csv").string() + " --test " + (dir / "good.csv").string() +
+                                  " --out " + (dir / "o3").string());
+    CHECK(code == 0);
+    CHECK(fs::exists(dir / "o3" / "diagnosis.json"));
+    CHECK(fs::exists(dir / "o3" / "report.html"));
+    CHECK(text.find("verdict:") != std::string::npos);
+  }
+}
