@@ -1,4 +1,4 @@
-// bench-diagnosis [--seeds N] [--duration S] [--rig] [--no-pairs] [--only KIND ...] [--runtime-only]
+// bench-diagnosis [--seeds N] [--duration S] [--blocks] [--no-pairs] [--only KIND ...] [--runtime-only]
 // The diagnosis's validation harness (lib/diagnosis/harness.h, docs/diagnosis.md "Harness"):
 // records with known effects, diagnosed without the truth; prints one line per case, the
 // confusion table (true effect vs verdict), the held-out shrink per effect and the scores against
@@ -19,13 +19,16 @@ int main(int argc, char** argv) {
   bool no_pairs = false, runtime_only = false;
   app.add_option("--seeds", o.seeds, "seeds per case kind (default 5)");
   app.add_option("--duration", o.duration_s, "record length [s] (default 20)");
-  app.add_flag("--rig", o.use_rig, "make the records with the plant's rig mode (models::MakeRig) instead of the blocks");
+  bool blocks = false;
+  app.add_flag("--blocks", blocks, "make the records with the effect blocks (diagnosis::MakeRecordBlocks) instead of the "
+                                   "plant's rig mode (models::MakeRig, the default)");
   app.add_flag("--no-pairs", no_pairs, "leave out the two-effect cases");
   app.add_option("--only", o.only, "case kinds to run");
   app.add_flag("--verbose", o.verbose, "print every diagnosis summary");
   app.add_flag("--runtime-only", runtime_only, "only the 60 s runtime measurement");
   CLI11_PARSE(app, argc, argv);
   o.pairs = !no_pairs;
+  o.use_rig = !blocks;
   try {
     if (!runtime_only) {
       std::printf("harness: %d seeds per case, %.0f s records, generator %s\n", o.seeds, o.duration_s,

@@ -113,8 +113,9 @@ std::vector<double> PredictDisplacement(const models::LinearServo& servo, const 
   const Eigen::Vector3d& G = servo.Gamma;
   double z0 = 0, z1 = 0, z2 = 0;
   for (std::size_t k = 0; k < n; ++k) {
-    const double fprev = (k > 0 && k - 1 < f_kN.size()) ? f_kN[k - 1] : 0.0;
-    y[k] = fx.Post(z0, fprev);
+    // load_coupling acts on the measured force of the same sample (see the header).
+    const double fk = k < f_kN.size() ? f_kN[k] : 0.0;
+    y[k] = fx.Post(z0, fk);
     const double ua = fx.Pre(u_mm[k]);
     const double n0 = P(0, 0) * z0 + P(0, 1) * z1 + P(0, 2) * z2 + G(0) * ua;
     const double n1 = P(1, 0) * z0 + P(1, 1) * z1 + P(1, 2) * z2 + G(1) * ua;

@@ -6,8 +6,12 @@
 ///
 /// Displacement channel (from the command u and, for load_coupling, the measured force):
 ///     x_{k+1} = Phi x_k + Gamma Pre(u_k)        (Eq. 30 or the model file's actuator, exact ZOH)
-///     yhat_k  = Post(C x_k, f_{k-1})            (DisplacementEffects; f_{-1} = 0)
-/// from rest at k = 0 (y_k depends on u_0 .. u_{k-1}: the record's sample pairing).
+///     yhat_k  = Post(C x_k, f_k)                (DisplacementEffects)
+/// from rest at k = 0 (y_k depends on u_0 .. u_{k-1}: the record's sample pairing). The
+/// load_coupling input is the MEASURED force of the same sample, f_k, not f_{k-1}: offline the
+/// diagnosis has it, and a series compliance yields under the present force (the rig mode solves
+/// its step for the same-sample force too, models/effect_rig.h); with f_{k-1} the residual keeps
+/// c (f_k - f_{k-1}), which with a stiff damper is a fifth of the effect.
 ///
 /// Force channel (from the MEASURED displacement y and the current command i):
 ///   1. y is smoothed without phase: a Butterworth low-pass of order 2 at smooth_hz run forward
@@ -84,7 +88,7 @@ SmoothedMotion ModelAidedMotion(std::span<const double> y_mm, std::span<const do
                                 double smooth_hz);
 
 /// Displacement channel prediction yhat_k for one record (file comment). `effects` may hold
-/// any effects; only the displacement ones act. f_kN: the measured force (load_coupling).
+/// any effects; only the displacement ones act. f_kN: the measured force f_k (load_coupling).
 std::vector<double> PredictDisplacement(const models::LinearServo& servo,
                                         const models::EffectSet& effects,
                                         std::span<const double> u_mm, std::span<const double> f_kN);

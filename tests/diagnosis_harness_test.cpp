@@ -1,0 +1,38 @@
+// The diagnosis's validation harness, CI size (lib/diagnosis/harness.h; the full one is
+// bench/diagnosis.cpp): records with known effects made by the plant's RIG MODE
+// (models::MakeRig with plant.effects / plant.unmodelled), diagnosed without the truth, scored
+// against issue 5's targets. Fewer and shorter records than the bench (2 seeds, 6 s), the same
+// targets on what it runs.
+#include <cstdio>
+
+#include <doctest/doctest.h>
+#include <fmt/format.h>
+
+#include "diagnosis/harness.h"
+
+using namespace rths::diagnosis;
+
+TEST_CASE("harness (rig mode): confusion table and held-out shrink meet issue 5's targets") {
+  HarnessOptions o;
+  o.seeds = 2;
+  o.duration_s = 6.0;
+  o.use_rig = true;
+  o.pairs = true;
+  std::string lines;
+  const auto cases = RunHarness(o, [&](const HarnessCase& c) {
+    lines += fmt::format("{:<40} seed {} {:<5} verdict {:<40} shrink {:5.1f} %  [{}]\n", c.kind, c.seed,
+                         c.right ? "RIGHT" : "wrong", fmt::format("{}", fmt::join(c.verdict, ",")), c.shrink_pct, c.params);
+  });
+  const auto sc = ScoreHarness(cases);
+  const std::string report = lines + sc.table;
+  MESSAGE(report);
+  REQUIRE(sc.single_n == 9 * o.seeds);
+  REQUIRE(sc.pair_n > 0);
+  REQUIRE(sc.none_n == o.seeds);
+  REQUIRE(sc.unknown_n == 2 * o.seeds);
+  CHECK(sc.single_right >= 0.9 * sc.single_n);
+  CHECK(sc.pair_right >= 0.75 * sc.pair_n);
+  CHECK(sc.none_as_effect == 0);
+  CHECK(sc.unknown_as_effect == 0);
+  CHECK(sc.single_shrink_mean >= 70.0);
+}
