@@ -681,6 +681,7 @@ Result Diagnose(const std::vector<io::RigRecord>& train_in, const std::vector<io
         t.marginal_red = excess_wo > 0 ? (sse_wo - sse) / excess_wo : 0.0;
         t.pass = s.structured && still_structured && t.dbic < 0 && t.excess_red >= o.min_excess_reduction &&
                  t.marginal_red >= o.min_excess_reduction &&
+                 (sse_wo - sse) >= o.min_floor_gain * static_cast<double>(s.n_train) * s.var_floor &&
                  static_cast<int>(s.order.size()) < o.max_effects_per_channel;
         last_trial[spec.name] = t;
         if (t.pass && (!best || t.excess_red > best->excess_red)) best = t;
@@ -987,6 +988,7 @@ nlohmann::json ToJson(const Result& r) {
                   {"smooth_hz", r.options.smooth_hz},
                   {"none_ratio", r.options.none_ratio},
                   {"min_excess_reduction", r.options.min_excess_reduction},
+                  {"min_floor_gain", r.options.min_floor_gain},
                   {"min_test_shrink_pct", r.options.min_test_shrink_pct},
                   {"detrend", r.options.detrend}};
   return j;

@@ -17,8 +17,16 @@
 ///       non-positive value): correlated samples count once per correlation time; and
 ///   (b) it removes at least min_excess_reduction of the channel's excess SSE over its noise
 ///       floor, (SSE_old - SSE_new) >= min_excess_reduction (SSE_old - n sigma^2): a tiny
-///       improvement on 100k samples is not an effect.
-/// The candidate with the largest (b) fraction goes first; the loop stops when none passes.
+///       improvement on 100k samples is not an effect; and the same fraction of the excess that
+///       would remain without it, the others as refitted (its own share: a candidate that only
+///       lets the others refit better is not an effect); and
+///   (c) the SSE it removes is at least min_floor_gain n sigma^2: an effect weaker than the
+///       noise floor is not diagnosable.
+/// and while the channel's residual is above none_ratio x its floor. The candidate with the
+/// largest (b) fraction goes first; after each addition the channel's effects are refitted
+/// jointly (coordinate-wise until the SSE settles); the loop stops when none passes. Then swaps
+/// (an effect replaced by another candidate if the refitted set has a lower training SSE) and
+/// pruning (an effect whose own share of the excess falls below min_excess_reduction).
 /// Verdict: "none" if rho_c <= none_ratio on every diagnosed channel (train and test pooled);
 /// a channel whose test residual is structured (rho > none_ratio) keeps its selected effects
 /// only if they shrink its test NRMSE by >= min_test_shrink_pct; no effect left and some channel
@@ -42,6 +50,7 @@ struct Options {
   double smooth_hz = 20.0;             ///< zero-phase smoothing of the y residual for the force channel [Hz]
   double none_ratio = 1.6;             ///< rho_c at or below this: the channel is at its noise floor
   double min_excess_reduction = 0.25;  ///< rule (b) above, in (0, 1)
+  double min_floor_gain = 0.5;         ///< rule (c) above: the SSE removed, in units of n sigma^2
   double min_test_shrink_pct = 30.0;   ///< the contract's 30 % on the test records
   bool detrend = false;                ///< remove each record's mean of u, y, f first (--detrend)
   int max_effects_per_channel = 3;     ///< greedy stops after this many on one channel
