@@ -645,6 +645,8 @@ Result Diagnose(const std::vector<io::RigRecord>& train_in, const std::vector<io
     cs.floor_ratio_test = s.var_floor > 0 ? (sse_test / n_te) / s.var_floor : std::numeric_limits<double>::infinity();
     cs.whiteness = Whiteness(s.test, s.nom_test);
     s.structured = cs.floor_ratio > o.none_ratio;
+    const double sse_nom = s.sse;
+    const double excess_nom = sse_nom - static_cast<double>(s.n_train) * s.var_floor;
 
     // --- greedy selection on the training records
     struct Trial {
@@ -800,7 +802,27 @@ Result Diagnose(const std::vector<io::RigRecord>& train_in, const std::vector<io
     if (!s.structured) cs.status = "noise";
     else if (retained) cs.status = "explained";
     else cs.status = "unexplained";
-    // Candidates not selected: their latest trial (fitted on top of the selected ones).
+    // Candidates not selected: their latest trial (fitted on top of the selected ones). If the
+    // selection was not retained, every candidate is refitted alone on the nominal model so that
+    // its numbers stand on their own.
+    if (!retained && !s.order.empty()) {
+      for (auto& [name, t] : last_trial) {
+        Params q;
+        t.sse = FitEffect(s.train, specs, &q, name);
+        t.params = q;
+        t.excess_red = excess_nom > 0 ? (sse_nom - t.sse) / excess_nom : 0.0;
+        t.dbic = std::nan("");
+      }
+      for (const auto& name : s.order) {
+        Trial t;
+        t.name = name;
+        t.sse = FitEffect(s.train, specs, &t.params, name);
+        t.excess_red = excess_nom > 0 ? (sse_nom - t.sse) / excess_nom : 0.0;
+        t.dbic = std::nan("");
+        last_trial[name] = t;
+        er.erase(name);
+      }
+    }
     for (const auto& [name, t] : last_trial) {
       if (er.count(name)) continue;
       std::optional<double> fx;
