@@ -751,6 +751,37 @@ Result Diagnose(const std::vector<io::RigRecord>& train_in, const std::vector<io
 
     // --- test scores; the 30 % rule
     const double before = cs.gap_test_pct;
+    // An effect whose addition (in the order of selection) makes the test NRMSE worse by more
+    // than max_test_worsening is not retained (a fit of training misfit that does not carry
+    // over); the rest are refitted on the training records without it.
+    {
+      Params cum;
+      double prev = before;
+      std::vector<std::string> kept;
+      for (const auto& name : s.order) {
+        cum[name] = s.sel.at(name);
+        std::optional<double> fixed;
+        if (cum.count("damper_scale")) fixed = cum.at("damper_scale")[0];
+        const double after = s.test.NrmsePct(s.test.Sse(s.test.Predict(ToSet(specs, cum), nullptr, fixed)));
+        if (after > prev * (1.0 + o.max_test_worsening)) {
+          res.warnings.push_back(fmt::format("channel {}: {} (selected on the training records) raises the test NRMSE "
+                                             "from {:.4g} % to {:.4g} %: not retained",
+                                             cs.channel, name, prev, after));
+          cum.erase(name);
+        } else {
+          kept.push_back(name);
+          prev = after;
+        }
+      }
+      if (kept.size() != s.order.size()) {
+        Params q;
+        for (const auto& n : kept) q[n] = s.sel.at(n);
+        s.order = kept;
+        s.sel = q;
+        s.sse = RefitAll(s.train, specs, &s.sel, s.train.Sse(s.train.Predict(ToSet(specs, s.sel))), 6);
+        s.pred_train = s.train.Predict(ToSet(specs, s.sel));
+      }
+    }
     Params cum;
     for (const auto& name : s.order) {
       cum[name] = s.sel.at(name);
@@ -1011,6 +1042,7 @@ nlohmann::json ToJson(const Result& r) {
                   {"none_ratio", r.options.none_ratio},
                   {"min_excess_reduction", r.options.min_excess_reduction},
                   {"min_floor_gain", r.options.min_floor_gain},
+                  {"max_test_worsening", r.options.max_test_worsening},
                   {"min_test_shrink_pct", r.options.min_test_shrink_pct},
                   {"detrend", r.options.detrend}};
   return j;

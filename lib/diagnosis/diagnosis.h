@@ -27,6 +27,8 @@
 /// jointly (coordinate-wise until the SSE settles); the loop stops when none passes. Then swaps
 /// (an effect replaced by another candidate if the refitted set has a lower training SSE) and
 /// pruning (an effect whose own share of the excess falls below min_excess_reduction).
+/// Held-out checks: an effect whose addition (in selection order) raises the channel's test
+/// NRMSE by more than max_test_worsening (relative) is dropped and the rest refitted.
 /// Verdict: "none" if rho_c <= none_ratio on every diagnosed channel (train and test pooled);
 /// a channel whose test residual is structured (rho > none_ratio) keeps its selected effects
 /// only if they shrink its test NRMSE by >= min_test_shrink_pct; no effect left and some channel
@@ -52,6 +54,7 @@ struct Options {
   double min_excess_reduction = 0.25;  ///< rule (b) above, in (0, 1)
   double min_floor_gain = 0.5;         ///< rule (c) above: the SSE removed, in units of n sigma^2
   double min_test_shrink_pct = 30.0;   ///< the contract's 30 % on the test records
+  double max_test_worsening = 0.02;    ///< an effect raising the test NRMSE by more than this is dropped
   bool detrend = false;                ///< remove each record's mean of u, y, f first (--detrend)
   int max_effects_per_channel = 3;     ///< greedy stops after this many on one channel
 };
