@@ -231,13 +231,12 @@ std::vector<double> ForcePredictor::PredictUnscaled(const SmoothedMotion& motion
     double xa, va;
     motion_at(0.0, &xa, &va);
     for (int j = 0; j < m; ++j) {
-      const double ta = j * h, tb = ta + 0.5 * h, tc = ta + h;
+      const double tb = j * h + 0.5 * h, tc = j * h + h;
       if (!constant) {
         cstart = j == 0 ? c0 : cend;
         cmid = coef_at(ic[static_cast<std::size_t>(2 * j + 1)]);
         cend = coef_at(ic[static_cast<std::size_t>(2 * j + 2)]);
       }
-      (void)ta;
       double xb, vb, xc, vc;
       motion_at(tb, &xb, &vb);
       motion_at(tc, &xc, &vc);

@@ -138,7 +138,7 @@ struct Data {
   std::size_t size() const { return u.size(); }
 };
 
-Data Prepare(const io::RigRecord& r, const Options& o, bool need_motion) {
+Data Prepare(const io::RigRecord& r, const Options& o) {
   Data d;
   d.source = r.source;
   d.dt = r.dt_s;
@@ -153,7 +153,7 @@ Data Prepare(const io::RigRecord& r, const Options& o, bool need_motion) {
     }
   }
   d.first = std::min<std::size_t>(d.size() / 2, static_cast<std::size_t>(std::lround(o.warmup_s / r.dt_s)));
-  (void)need_motion;  // the force channel's motion is made once y is diagnosed (ModelAidedMotion)
+  // The force channel's motion is made once y is diagnosed (ModelAidedMotion).
   return d;
 }
 
@@ -433,7 +433,6 @@ double RefitAll(const Channel& ch, const std::vector<CandidateSpec>& specs, Para
 /// record, summed): tau = 1 + 2 sum_{l>=1} r_l up to the first r_l <= 0, at most 2000 lags.
 double IntegratedCorrelationTime(const Channel& ch, const std::vector<std::vector<double>>& pred) {
   std::vector<double> acc;
-  double r0 = 0;
   for (std::size_t r = 0; r < ch.recs().size(); ++r) {
     const auto& d = ch.recs()[r];
     const auto meas = ch.Meas(r);
@@ -458,7 +457,6 @@ double IntegratedCorrelationTime(const Channel& ch, const std::vector<std::vecto
     const std::size_t L = std::min<std::size_t>(2001, n / 4);
     if (acc.size() < L) acc.resize(L, 0.0);
     for (std::size_t l = 0; l < L; ++l) acc[l] += R[l].real() / static_cast<double>(N);
-    (void)r0;
   }
   if (acc.empty() || acc[0] <= 0) return 1.0;
   double tau = 1.0;
@@ -527,9 +525,6 @@ double Whiteness(const Channel& ch, const std::vector<std::vector<double>>& pred
   return n_tot * q;
 }
 
-double MeanSq(const Channel& ch, const std::vector<std::vector<double>>& pred, std::size_t n) {
-  return ch.Sse(pred) / static_cast<double>(n);
-}
 
 std::map<std::string, double> ParamMap(const std::vector<CandidateSpec>& specs, const std::string& name,
                                        const std::vector<double>& v) {
@@ -565,8 +560,8 @@ Result Diagnose(const std::vector<io::RigRecord>& train_in, const std::vector<io
       for (const auto& w : r.warnings) res.warnings.push_back(w);
 
   std::vector<Data> train, test;
-  for (const auto& r : train_in) train.push_back(Prepare(r, o, model.has_damper));
-  for (const auto& r : test_in) test.push_back(Prepare(r, o, model.has_damper));
+  for (const auto& r : train_in) train.push_back(Prepare(r, o));
+  for (const auto& r : test_in) test.push_back(Prepare(r, o));
   for (const auto& d : train) res.train.push_back(d.source);
   for (const auto& d : test) res.test.push_back(d.source);
   res.samples = Count(train) + Count(test);
@@ -596,6 +591,7 @@ Result Diagnose(const std::vector<io::RigRecord>& train_in, const std::vector<io
   std::vector<char> chans = {'y'};
   if (force_ok) chans.push_back('f');
   struct ChState {
+    ChState(char c, Channel tr, Channel te) : ch(c), train(std::move(tr)), test(std::move(te)) {}
     char ch;
     Channel train, test;
     Params sel;                       // selected effects and their parameters
@@ -623,7 +619,7 @@ Result Diagnose(const std::vector<io::RigRecord>& train_in, const std::vector<io
       for (std::size_t r = 0; r < test.size(); ++r)
         test[r].motion = ModelAidedMotion(test[r].y, ys.fin_test[r], dt, std::min(o.smooth_hz, 0.45 / dt));
     }
-    st.push_back(std::make_unique<ChState>(ChState{chan, Channel(chan, &train, &servo, fpp), Channel(chan, &test, &servo, fpp)}));
+    st.push_back(std::make_unique<ChState>(chan, Channel(chan, &train, &servo, fpp), Channel(chan, &test, &servo, fpp)));
     auto& s = *st.back();
     // --- nominal residuals, noise floor, gap
     ChannelSummary cs;
