@@ -47,7 +47,11 @@ report::Figure SpectrumFigure(const Traces::Record& t, const std::string& ch, st
   const std::string unit = ch == "y" ? "mm^2/Hz" : "kN^2/Hz";
   report::Figure fig;
   fig.name = "spectrum_" + ch;
-  auto p = report::MakePanel(fmt::format("channel {}: spectra (test record {})", ch, fs::path(t.source).filename().string()),
+  const fs::path src(t.source);
+  const std::string shown = src.filename() == "log.lcm" && !src.parent_path().filename().empty()
+                                ? (src.parent_path().filename() / src.filename()).string()
+                                : src.filename().string();
+  auto p = report::MakePanel(fmt::format("channel {}: spectra (test record {})", ch, shown),
                              "frequency [Hz]", "PSD [" + unit + "]");
   p.log_x = p.log_y = true;
   auto s1 = report::MakeSeries("measured", "#1f77b4");
