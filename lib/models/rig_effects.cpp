@@ -135,7 +135,7 @@ double DisplacementEffects::Pre(double u_mm) {
   return u;
 }
 
-double DisplacementEffects::Post(double x_mm, double f_prev_kN) {
+double DisplacementEffects::Post(double x_mm, double f_kN) {
   double y = x_mm;
   if (e_.oil_column_resonance) {
     // The input x_k is held over the step that ends at t_k (a half-sample advance against a
@@ -151,7 +151,7 @@ double DisplacementEffects::Post(double x_mm, double f_prev_kN) {
     rate_out_ += std::clamp(y - rate_out_, -dmax, dmax);
     y = rate_out_;
   }
-  if (e_.load_coupling) y -= e_.load_coupling->compliance_mm_per_kN * f_prev_kN;
+  if (e_.load_coupling) y -= e_.load_coupling->compliance_mm_per_kN * f_kN;
   if (e_.coulomb_friction) {
     const double v = (y - fric_prev_in_) / dt_s_;
     fric_prev_in_ = y;

@@ -33,7 +33,9 @@ inline constexpr std::array<std::string_view, 10> kEffectNames = {
 struct PureDelay { double tau_ms = 0.0; };                          ///< [0, 100] ms
 /// Static gain mismatch of the displacement path: the actuator model sees gain * u.
 struct GainError { double gain = 1.0; };                            ///< [0.5, 2]
-/// The actuator yields under the specimen force: y = x - compliance * f_{k-1}.
+/// The actuator yields under the specimen force: y_k = x_k - compliance * f, with f the force
+/// the caller couples with (Post's f_kN: the diagnosis passes the measured f_k; the rig mode the
+/// true f_k of the same sample, solved per step, or f_{k-1} on request: docs/rig_mode.md).
 struct LoadCoupling { double compliance_mm_per_kN = 0.0; };         ///< [-1, 1] mm/kN
 /// An extra, lightly damped mode in series: w^2 / (s^2 + 2 zeta w s + w^2), w = 2 pi f_hz
 /// (unity at DC), discretised exactly with a zero-order hold on its input.
@@ -74,7 +76,7 @@ struct EffectSet {
 
 /// The displacement path's effects around an actuator model (order in the file comment).
 /// Use: per step k, u_act = Pre(u_k) goes into the actuator model, whose output x at t_k goes
-/// through Post(x, f_prev) to give the displacement y_k (before any noise).
+/// through Post(x, f) to give the displacement y_k (before any noise).
 class DisplacementEffects {
  public:
   /// Sizes the delay line for tau (allocates here only). Throws rths::Error for bad parameters.
@@ -84,10 +86,10 @@ class DisplacementEffects {
   /// Command u_k [mm] -> the command the actuator model holds over [t_k, t_{k+1}) [mm]
   /// (pure_delay, then gain_error). Call once per step, in order.
   double Pre(double u_mm);
-  /// Actuator model output x_k [mm] at t_k and the specimen force of the previous sample
-  /// f_prev_kN [kN] -> the specimen / measured displacement y_k [mm] (oil_column_resonance,
+  /// Actuator model output x_k [mm] at t_k and the specimen force f_kN [kN] to couple with
+  /// (LoadCoupling) -> the specimen / measured displacement y_k [mm] (oil_column_resonance,
   /// servovalve_saturation, load_coupling, coulomb_friction, backlash). Call once per step.
-  double Post(double x_mm, double f_prev_kN);
+  double Post(double x_mm, double f_kN);
   /// true if Pre() is the identity (no delay, gain 1).
   bool PreIsIdentity() const;
 
