@@ -1,4 +1,4 @@
-// bench-diagnosis [--seeds N] [--duration S] [--blocks] [--no-pairs] [--only KIND ...] [--runtime-only]
+// bench-diagnosis [--seeds N] [--duration S] [--blocks] [--noise-y MM] [--noise-f KN] [--verbose] [--no-pairs] [--only KIND ...] [--runtime-only]
 // The diagnosis's validation harness (lib/diagnosis/harness.h, docs/diagnosis.md "Harness"):
 // records with known effects, diagnosed without the truth; prints one line per case, the
 // confusion table (true effect vs verdict), the held-out shrink per effect and the scores against
@@ -24,6 +24,8 @@ int main(int argc, char** argv) {
                                    "plant's rig mode (models::MakeRig, the default)");
   app.add_flag("--no-pairs", no_pairs, "leave out the two-effect cases");
   app.add_option("--only", o.only, "case kinds to run");
+  app.add_option("--noise-y", o.noise_y_mm, "sensor noise rms on y [mm] (default 0.01)");
+  app.add_option("--noise-f", o.noise_f_kN, "sensor noise rms on f [kN] (default 0.2)");
   app.add_flag("--verbose", o.verbose, "print every diagnosis summary");
   app.add_flag("--runtime-only", runtime_only, "only the 60 s runtime measurement");
   CLI11_PARSE(app, argc, argv);
