@@ -50,7 +50,7 @@ int main(int argc, char** argv) {
   app.add_option("--out", out, "output folder (default: a new folder under runs/)");
   app.add_flag("--detrend", o.detrend, "remove each record's mean of u, y and f first");
   app.add_option("--none-ratio", o.none_ratio, "residual/noise-floor power ratio at or below which a channel is noise");
-  app.add_option("--smooth-hz", o.smooth_hz, "zero-phase smoothing of y for the force channel [Hz]");
+  app.add_option("--smooth-hz", o.smooth_hz, "zero-phase smoothing of the y residual for the force channel's motion [Hz] (default 20)");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
