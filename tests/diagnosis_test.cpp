@@ -350,3 +350,32 @@ TEST_CASE("bad input: records with different dt, and the command's exit code 2 n
     CHECK(text.find("verdict:") != std::string::npos);
   }
 }
+
+TEST_CASE("a displacement-only test (u = y): y is not diagnosed, the force channel still is") {
+  Truth t = Noisy();
+  t.effects.damper_scale = m::DamperScale{1.2};
+  auto [tr, te] = Records(t);
+  tr.u_mm = tr.y_mm;  // the damper tests of a lab: only the displacement was recorded
+  te.u_mm = te.y_mm;
+  const auto r = Diagnose({tr}, {te}, PaperModel(), Options{});
+  INFO(Summary(r));
+  CHECK_FALSE(r.Channel("y")->diagnosed);
+  CHECK(r.Channel("f")->diagnosed);
+  CHECK(r.verdict == std::vector<std::string>{"damper_scale"});
+  for (const auto& e : r.effects) CHECK(e.channel == "f");
+  CHECK(ToJson(r)["gap"]["nrmse_y_pct"].is_null());
+}
+
+TEST_CASE("a fit on an end of its range is not an explanation: a force 20 x off is unknown") {
+  Truth t = Noisy();
+  t.effects.damper_scale = m::DamperScale{10.0};  // the range's end; the data want 20
+  auto [tr, te] = Records(t);
+  for (auto* rec : {&tr, &te})
+    for (auto& f : rec->f_kN) f *= 2.0;
+  const auto r = Diagnose({tr}, {te}, PaperModel(), Options{});
+  INFO(Summary(r));
+  CHECK(r.verdict == std::vector<std::string>{"unknown"});
+  const auto* ds = Find(r, "damper_scale");
+  REQUIRE(ds != nullptr);
+  CHECK_FALSE(ds->selected);
+}

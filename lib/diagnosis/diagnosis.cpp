@@ -64,7 +64,7 @@ std::vector<CandidateSpec> Candidates(double dt_s, double vmax_hi) {
   return {
       {"pure_delay", 'y', {{"tau_ms", 0.0, 40.0, false, 81}}},
       {"gain_error", 'y', {{"gain", 0.5, 2.0, true, 41}}},
-      {"load_coupling", 'y', {{"compliance_mm_per_kN", -0.2, 0.2, false, 81}}},
+      {"load_coupling", 'y', {{"compliance_mm_per_kN", 0.0, 0.2, false, 81}}},  // yields: c >= 0
       {"oil_column_resonance", 'y', {{"f_hz", 2.0, 0.4 / dt_s, true, 40}, {"zeta", 0.02, 1.5, true, 10}}},
       {"coulomb_friction", 'y', {{"loss_mm", 1e-3, 10.0, true, 31}}},
       {"backlash", 'y', {{"gap_mm", 1e-3, 10.0, true, 31}}},
@@ -75,6 +75,20 @@ std::vector<CandidateSpec> Candidates(double dt_s, double vmax_hi) {
 }
 
 using Params = std::map<std::string, std::vector<double>>;  // effect name -> values (spec order)
+
+/// true if a fitted parameter sits on an end of its search range (within 0.1 % of the range, in
+/// log space for log parameters; a closed-form fit is clipped to its range): the effect's model does not describe the residual there, so it
+/// is not selected (e.g. a "resonance" pushed to the highest frequency, a lag at its floor).
+bool AtBound(const CandidateSpec& spec, const std::vector<double>& v) {
+  for (std::size_t j = 0; j < spec.params.size() && j < v.size(); ++j) {
+    const auto& p = spec.params[j];
+    const double lo = p.log ? std::log(p.lo) : p.lo, hi = p.log ? std::log(p.hi) : p.hi;
+    const double x = p.log ? std::log(std::max(v[j], 1e-300)) : v[j];
+    const double tol = 1e-3 * (hi - lo);
+    if (x <= lo + tol || x >= hi - tol) return true;
+  }
+  return false;
+}
 
 const CandidateSpec& SpecOf(const std::vector<CandidateSpec>& c, const std::string& name) {
   for (const auto& s : c)
@@ -585,6 +599,13 @@ Result Diagnose(const std::vector<io::RigRecord>& train_in, const std::vector<io
   for (const auto& d : train)
     for (std::size_t k = 1; k < d.size(); ++k) vmax_meas = std::max(vmax_meas, std::abs(d.y[k] - d.y[k - 1]) / dt);
   const auto specs = Candidates(dt, 2.0 * vmax_meas);
+  // A displacement-only test (u = y in every record, e.g. the UTFSM damper tests) has no
+  // displacement channel to diagnose: predicting y from u would only show the model's own lag.
+  bool y_ok = false;
+  for (const auto* set : {&train, &test})
+    for (const auto& d : *set) y_ok |= d.u != d.y;
+  if (!y_ok)
+    res.warnings.push_back("u = y in every record (a displacement-only test): the displacement channel is not diagnosed");
 
   // The channels are diagnosed one after the other: y first, then f, whose motion input is the
   // measured y seen through y's final model (ModelAidedMotion).
@@ -614,10 +635,18 @@ Result Diagnose(const std::vector<io::RigRecord>& train_in, const std::vector<io
     if (chan == 'f') {
       // The motion of the damper: y's final model plus the zero-phase-smoothed residual.
       const auto& ys = *st[0];
-      for (std::size_t r = 0; r < train.size(); ++r)
-        train[r].motion = ModelAidedMotion(train[r].y, ys.pred_train_fin[r], dt, std::min(o.smooth_hz, 0.45 / dt));
-      for (std::size_t r = 0; r < test.size(); ++r)
-        test[r].motion = ModelAidedMotion(test[r].y, ys.fin_test[r], dt, std::min(o.smooth_hz, 0.45 / dt));
+      if (!y_ok) {
+        // No displacement model to lean on (u = y): the measured y, zero-phase smoothed at a
+        // cutoff above the excitation (4 x smooth_hz, at most 0.45 / dt).
+        const double fc = std::min(4.0 * o.smooth_hz, 0.45 / dt);
+        for (auto& d : train) d.motion = SmoothMotion(d.y, dt, fc);
+        for (auto& d : test) d.motion = SmoothMotion(d.y, dt, fc);
+      } else {
+        for (std::size_t r = 0; r < train.size(); ++r)
+          train[r].motion = ModelAidedMotion(train[r].y, ys.pred_train_fin[r], dt, std::min(o.smooth_hz, 0.45 / dt));
+        for (std::size_t r = 0; r < test.size(); ++r)
+          test[r].motion = ModelAidedMotion(test[r].y, ys.fin_test[r], dt, std::min(o.smooth_hz, 0.45 / dt));
+      }
     }
     st.push_back(std::make_unique<ChState>(chan, Channel(chan, &train, &servo, fpp), Channel(chan, &test, &servo, fpp)));
     auto& s = *st.back();
@@ -641,6 +670,15 @@ Result Diagnose(const std::vector<io::RigRecord>& train_in, const std::vector<io
     cs.floor_ratio_test = s.var_floor > 0 ? (sse_test / n_te) / s.var_floor : std::numeric_limits<double>::infinity();
     cs.whiteness = Whiteness(s.test, s.nom_test);
     s.structured = cs.floor_ratio > o.none_ratio;
+    if (s.ch == 'y' && !y_ok) {
+      cs.diagnosed = false;
+      cs.status = "not diagnosed";
+      s.structured = false;
+      s.fin_test = s.nom_test;
+      s.pred_train_fin = s.pred_train;
+      res.channels.push_back(cs);
+      continue;
+    }
     const double sse_nom = s.sse;
     const double excess_nom = sse_nom - static_cast<double>(s.n_train) * s.var_floor;
 
@@ -680,7 +718,8 @@ Result Diagnose(const std::vector<io::RigRecord>& train_in, const std::vector<io
         t.pass = s.structured && still_structured && t.dbic < 0 && t.excess_red >= o.min_excess_reduction &&
                  t.marginal_red >= o.min_excess_reduction &&
                  (sse_wo - sse) >= o.min_floor_gain * static_cast<double>(s.n_train) * s.var_floor &&
-                 static_cast<int>(s.order.size()) < o.max_effects_per_channel;
+                 static_cast<int>(s.order.size()) < o.max_effects_per_channel &&
+                 !AtBound(spec, t.params.at(spec.name));
         last_trial[spec.name] = t;
         if (t.pass && (!best || t.excess_red > best->excess_red)) best = t;
       }
@@ -708,6 +747,7 @@ Result Diagnose(const std::vector<io::RigRecord>& train_in, const std::vector<io
           q.erase(s.order[j]);
           double sq = FitEffect(s.train, specs, &q, spec.name);
           sq = RefitAll(s.train, specs, &q, sq, 6);
+          if (AtBound(spec, q.at(spec.name))) continue;  // not an explanation (AtBound)
           if (std::getenv("RTHS_DIAG_DEBUG")) std::fprintf(stderr, "swap %s -> %s: %g (now %g)\n", s.order[j].c_str(), spec.name, sq, s.sse);
           if (sq < best_sse) best_sse = sq, swap = std::make_pair(j, q), swap_in = spec.name;
         }
@@ -889,6 +929,7 @@ Result Diagnose(const std::vector<io::RigRecord>& train_in, const std::vector<io
   for (auto& e : rest) res.effects.push_back(e);
   // sensor_noise: the noise floor of each diagnosed channel, never selected.
   for (std::size_t c = 0; c < st.size(); ++c) {
+    if (!res.channels[c].diagnosed) continue;
     EffectResult e;
     e.name = "sensor_noise";
     e.channel = res.channels[c].channel;
@@ -931,7 +972,7 @@ Result Diagnose(const std::vector<io::RigRecord>& train_in, const std::vector<io
       in.i = d.i;
       li.push_back(in);
     }
-    Localise(std::string(1, s.ch), li, &res.bands, &res.conditions, &res.time);
+    if (res.channels[c].diagnosed) Localise(std::string(1, s.ch), li, &res.bands, &res.conditions, &res.time);
     if (traces && c == 0) {
       traces->test.clear();
       for (std::size_t r = 0; r < test.size(); ++r) {
@@ -966,7 +1007,7 @@ nlohmann::json ToJson(const Result& r) {
   json j;
   const auto* y = r.Channel("y");
   const auto* f = r.Channel("f");
-  j["gap"] = {{"nrmse_y_pct", y ? num(y->gap_test_pct) : json(nullptr)},
+  j["gap"] = {{"nrmse_y_pct", y && y->diagnosed ? num(y->gap_test_pct) : json(nullptr)},
               {"nrmse_f_pct", f && f->diagnosed ? num(f->gap_test_pct) : json(nullptr)}};
   json where;
   where["bands"] = json::array();
@@ -1025,7 +1066,7 @@ nlohmann::json ToJson(const Result& r) {
                      {"whiteness_q20", num(c.whiteness)}};
   }
   j["channels"] = ch;
-  j["noise_floor"] = {{"y_mm_rms", y ? num(y->noise_rms) : json(nullptr)},
+  j["noise_floor"] = {{"y_mm_rms", y && y->diagnosed ? num(y->noise_rms) : json(nullptr)},
                       {"f_kN_rms", f && f->diagnosed ? num(f->noise_rms) : json(nullptr)}};
   j["records"] = {{"train", r.train}, {"test", r.test}};
   j["model"] = r.model_source;
