@@ -188,7 +188,11 @@ k1 = 0.01
   CHECK(s.plant.load_coupling_same_sample);
   CHECK(back.plant.load_coupling_same_sample);
   CHECK(written.find("same_sample = true") != std::string::npos);
-  CHECK_FALSE(ParseScenario(std::string(kBase) + "[plant.effects.load_coupling]\ncompliance_mm_per_kN = 0.001\n", "d.toml")
+  CHECK(ParseScenario(std::string(kBase) + "[plant.effects.load_coupling]\ncompliance_mm_per_kN = 0.001\n", "d.toml")
+            .plant.load_coupling_same_sample);  // the default: stable at any compliance
+  CHECK_FALSE(ParseScenario(std::string(kBase) +
+                                "[plant.effects.load_coupling]\ncompliance_mm_per_kN = 0.001\nsame_sample = false\n",
+                            "d.toml")
                   .plant.load_coupling_same_sample);
   CHECK(back.plant.damper.k1 == 0.01);
   CHECK(back.plant.unmodelled.ripple_hz == 37.0);
@@ -440,12 +444,13 @@ TEST_CASE("rig mode: current_lag delays the force response to a current step by 
 }
 
 TEST_CASE("rig mode: load_coupling makes y lower by c f, coulomb_friction by loss against the motion") {
-  // Default: the library's form with the previous sample's force, y_k = x_k - c f_{k-1}, exactly.
+  // same_sample = false: the previous sample's force, y_k = x_k - c f_{k-1}, exactly.
   // Stable while c (alpha A + 2 B / dt) < 1: at 2.5 A, 0.0004 x 1420 = 0.57.
   {
     const double c = 0.0004;
     PlantConfig p = LinearPlant();
     p.effects.load_coupling = rths::models::LoadCoupling{c};
+    p.load_coupling_same_sample = false;
     auto rig = rths::models::MakeRig(p, kDt);
     auto* e = AsEffectRig(rig.get());
     double f_prev = e->true_f_kN(), peak_shift = 0.0;
@@ -480,6 +485,7 @@ TEST_CASE("rig mode: load_coupling makes y lower by c f, coulomb_friction by los
   {  // the explicit form at c = 0.005 does diverge (the reason for same_sample)
     PlantConfig p = LinearPlant();
     p.effects.load_coupling = rths::models::LoadCoupling{0.005};
+    p.load_coupling_same_sample = false;
     auto rig = rths::models::MakeRig(p, kDt);
     bool diverged = false;
     try {

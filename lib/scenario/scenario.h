@@ -156,11 +156,12 @@ struct PlantConfig {
   /// Rig mode (docs/rig_mode.md): effects of the library switched on, `[plant.effects.<name>]`
   /// (kind = "linear" only). Empty: the nominal plant.
   models::EffectSet effects{};
-  /// Rig mode, `[plant.effects.load_coupling] same_sample`: false (default) couples with the force
-  /// of the previous sample, y_k = x_k - c f_{k-1}, the library's form (what the diagnosis fits);
-  /// true with the force of the same sample, solved per step: stable for any compliance (the
-  /// explicit form diverges with the stiff damper once c (alpha A + 2 B / dt) > 1; docs/rig_mode.md).
-  bool load_coupling_same_sample = false;
+  /// Rig mode, `[plant.effects.load_coupling] same_sample`: true (default) couples with the force
+  /// of the same sample, y_k = x_k - c f_k, solved per step, as a real series compliance does:
+  /// stable for any compliance (what the diagnosis fits, from the measured f_k); false with the
+  /// force of the previous sample, y_k = x_k - c f_{k-1}, cheaper, but the one-sample loop diverges
+  /// with the stiff damper once c (alpha A + 2 B / dt) > 1 (c > 7e-4 mm/kN at 2.5 A; docs/rig_mode.md).
+  bool load_coupling_same_sample = true;
   /// Rig mode: disturbances outside the library, `[plant.unmodelled]` (kind = "linear" only).
   UnmodelledConfig unmodelled{};
   /// true if the plant runs in rig mode (effects or unmodelled disturbances on).
