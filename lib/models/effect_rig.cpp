@@ -36,13 +36,7 @@ EffectRigModel EffectRigModel::Make(const scenario::PlantConfig& plant, double d
                                           "around the linear actuator model",
                                           plant.kind));
   }
-  bool damper = false;
-  if (plant.specimen == "mr_damper") {
-    damper = true;
-  } else if (plant.specimen != "none") {
-    throw Error("plant.specimen",
-                fmt::format("\"{}\" is not one of \"mr_damper\", \"none\"", plant.specimen));
-  }
+  const bool damper = HasDamper(plant);
   plant.effects.Validate(dt_s, "plant");
   const auto& u = plant.unmodelled;
   if (!(std::isfinite(u.ripple_mm) && u.ripple_mm >= 0.0 && u.ripple_mm <= 10.0))

@@ -111,14 +111,14 @@ class IdealRig final : public Rig {
 
 }  // namespace
 
+bool HasDamper(const scenario::PlantConfig& plant) {
+  if (plant.specimen == "mr_damper") return true;
+  if (plant.specimen == "none") return false;
+  throw Error("plant.specimen", fmt::format("\"{}\" is not one of \"mr_damper\", \"none\"", plant.specimen));
+}
+
 std::unique_ptr<Rig> MakeRig(const scenario::PlantConfig& plant, double dt_s) {
-  bool damper = false;
-  if (plant.specimen == "mr_damper") {
-    damper = true;
-  } else if (plant.specimen != "none") {
-    throw Error("plant.specimen",
-                fmt::format("\"{}\" is not one of \"mr_damper\", \"none\"", plant.specimen));
-  }
+  const bool damper = HasDamper(plant);
   if (plant.RigMode()) {  // effects or unmodelled disturbances on: docs/rig_mode.md
     if (plant.kind != "linear") {
       throw Error(plant.effects.Empty() ? "plant.unmodelled" : "plant.effects",

@@ -53,4 +53,7 @@ class Rig {
 /// Throws rths::Error for a bad kind or value.
 std::unique_ptr<Rig> MakeRig(const scenario::PlantConfig& plant, double dt_s);
 
+/// plant.specimen: true for "mr_damper", false for "none"; throws rths::Error otherwise.
+bool HasDamper(const scenario::PlantConfig& plant);
+
 }  // namespace rths::models
