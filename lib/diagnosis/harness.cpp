@@ -62,7 +62,7 @@ Truth HarnessTruth(const std::string& kind, std::uint64_t seed, double noise_y_m
       t.effects.gain_error = models::GainError{side(0.85, 0.95, 1.05, 1.2)};
       txt += fmt::format("gain={:.3g} ", t.effects.gain_error->gain);
     } else if (e == "load_coupling") {
-      t.effects.load_coupling = models::LoadCoupling{U(0.0003, 0.0008)};
+      t.effects.load_coupling = models::LoadCoupling{U(0.0003, 0.003)};
       txt += fmt::format("compliance_mm_per_kN={:.3g} ", t.effects.load_coupling->compliance_mm_per_kN);
     } else if (e == "oil_column_resonance") {
       t.effects.oil_column_resonance = models::OilColumnResonance{U(15.0, 40.0), U(0.05, 0.3)};
