@@ -38,6 +38,7 @@
 
 #include "ident/identify.h"
 #include "models/servo_physical.h"
+#include "report/reproduce.h"
 #include "scenario/scenario.h"
 #include "signal/history.h"
 
@@ -58,14 +59,7 @@ struct Eval {
 };
 
 std::vector<double> Command(double seconds) {
-  scenario::SignalSpec spec;
-  spec.kind = "blwn";
-  spec.band_hz = 50.0;
-  spec.rms = 0.254;
-  spec.seed = 1;
-  spec.discard_s = 2.0;
-  spec.taper_s = 0.5;
-  return signal::MakeSignal(spec, kDt, static_cast<std::size_t>(std::lround(seconds / kDt)), "");
+  return signal::MakeSignal(report::FrequencyExcitation(), kDt, static_cast<std::size_t>(std::lround(seconds / kDt)), "");
 }
 
 // Experimental, not in the library: a high-passed load-pressure ("delta-P") feedback in the

@@ -20,6 +20,7 @@
 #include "io/run_log.h"
 #include "models/rig.h"
 #include "models/servo_physical.h"
+#include "report/reproduce.h"
 #include "signal/history.h"
 #include "test_support.h"
 
@@ -229,14 +230,7 @@ TEST_CASE("(a) E1 on the damper-loaded rig (16 s records): how close the identif
   // BLWN 0-50 Hz, 0.254 mm RMS, seed 1, 2 s discarded, 0.5 s fade-in; u_k held over each step,
   // y_k read at t_k; the MR damper (Table 3) at a constant current; H1 and the ZOH-consistent
   // 3-pole fit over 0.5-40 Hz.
-  rths::scenario::SignalSpec spec;
-  spec.kind = "blwn";
-  spec.band_hz = 50.0;
-  spec.rms = 0.254;
-  spec.seed = 1;
-  spec.discard_s = 2.0;
-  spec.taper_s = 0.5;
-  const std::vector<double> u = rths::signal::MakeSignal(spec, kDt, 32000, "");
+  const std::vector<double> u = rths::signal::MakeSignal(rths::report::FrequencyExcitation(), kDt, 32000, "");
   rths::ident::IdentifyOptions io;
   io.fit.poles = 3;
   io.fit.band_lo_hz = 0.5;

@@ -166,6 +166,17 @@ BodeCurve BodeFromModel(const std::string& name, const ident::PoleModel& model, 
   return c;
 }
 
+scenario::SignalSpec FrequencyExcitation() {
+  scenario::SignalSpec spec;
+  spec.kind = "blwn";
+  spec.band_hz = kBandHz;
+  spec.rms = kRmsMm;
+  spec.seed = 1;
+  spec.discard_s = 2.0;
+  spec.taper_s = kTaperS;
+  return spec;
+}
+
 scenario::Scenario FrequencyScenario(const std::string& condition, const scenario::ControllerConfig& controller,
                                      const std::string& plant, double duration_s) {
   if (condition != "0.0A" && condition != "2.5A") {
@@ -177,13 +188,7 @@ scenario::Scenario FrequencyScenario(const std::string& condition, const scenari
   s.run.duration_s = duration_s;
   s.structure.mode = "predefined";
   s.structure.derivatives = "extrapolated";
-  s.structure.desired = scenario::SignalSpec{};
-  s.structure.desired.kind = "blwn";
-  s.structure.desired.band_hz = kBandHz;
-  s.structure.desired.rms = kRmsMm;
-  s.structure.desired.seed = 1;
-  s.structure.desired.discard_s = 2.0;
-  s.structure.desired.taper_s = kTaperS;
+  s.structure.desired = FrequencyExcitation();
   s.controller = controller;
   s.plant.kind = plant;
   s.plant.actuator = scenario::ServoPreset(condition);

@@ -125,6 +125,10 @@ BodeCurve BodeFromEstimate(const std::string& name, const signal::FrequencyRespo
 BodeCurve BodeFromModel(const std::string& name, const ident::PoleModel& model, const std::vector<double>& f_hz,
                         double zoh_dt_s);
 
+/// The excitation of E1 and E2: BLWN 0-50 Hz, RMS 0.254 mm, seed 1, 2 s discarded, faded in over
+/// 0.5 s (the command of E1; the desired displacement of E2).
+scenario::SignalSpec FrequencyExcitation();
+
 /// The scenario of one frequency-domain run (E1, E2): desired r = BLWN 0-50 Hz, RMS 0.254 mm,
 /// seed 1, faded in over 0.5 s; the damper attached at the condition's constant current
 /// ("0.0A" or "2.5A"); the plant ("linear": Eq. 28 or 29).
