@@ -90,6 +90,13 @@ bool AtBound(const CandidateSpec& spec, const std::vector<double>& v) {
   return false;
 }
 
+/// The damper scale fitted on the training records, if the set has one: on the test records it is
+/// held at that value (not refitted in closed form).
+std::optional<double> FittedScale(const Params& p) {
+  const auto it = p.find("damper_scale");
+  return it == p.end() ? std::nullopt : std::optional<double>(it->second[0]);
+}
+
 const CandidateSpec& SpecOf(const std::vector<CandidateSpec>& c, const std::string& name) {
   for (const auto& s : c)
     if (name == s.name) return s;
@@ -796,9 +803,7 @@ Result Diagnose(const std::vector<io::RigRecord>& train_in, const std::vector<io
       std::vector<std::string> kept;
       for (const auto& name : s.order) {
         cum[name] = s.sel.at(name);
-        std::optional<double> fixed;
-        if (cum.count("damper_scale")) fixed = cum.at("damper_scale")[0];
-        const double after = s.test.NrmsePct(s.test.Sse(s.test.Predict(ToSet(specs, cum), nullptr, fixed)));
+        const double after = s.test.NrmsePct(s.test.Sse(s.test.Predict(ToSet(specs, cum), nullptr, FittedScale(cum))));
         if (after > prev * (1.0 + o.max_test_worsening)) {
           res.warnings.push_back(fmt::format("channel {}: {} (selected on the training records) raises the test NRMSE "
                                              "from {:.4g} % to {:.4g} %: not retained",
@@ -822,8 +827,7 @@ Result Diagnose(const std::vector<io::RigRecord>& train_in, const std::vector<io
     for (const auto& name : s.order) {
       cum[name] = s.sel.at(name);
       const auto sset = ToSet(specs, cum);
-      std::optional<double> fixed;
-      if (cum.count("damper_scale")) fixed = cum.at("damper_scale")[0];
+      const std::optional<double> fixed = FittedScale(cum);
       const auto pt = s.test.Predict(sset, nullptr, fixed);
       const auto ptr = s.train.Predict(sset, nullptr, fixed);
       EffectResult e;
@@ -838,9 +842,7 @@ Result Diagnose(const std::vector<io::RigRecord>& train_in, const std::vector<io
       e.delta_bic = sel_stats[name].second;
       er[name] = e;
     }
-    std::optional<double> fixed;
-    if (s.sel.count("damper_scale")) fixed = s.sel.at("damper_scale")[0];
-    auto fin = s.test.Predict(ToSet(specs, s.sel), nullptr, fixed);
+    auto fin = s.test.Predict(ToSet(specs, s.sel), nullptr, FittedScale(s.sel));
     cs.after_test_pct = s.test.NrmsePct(s.test.Sse(fin));
     const bool test_structured = cs.floor_ratio_test > o.none_ratio;
     bool retained = !s.order.empty();
@@ -892,9 +894,7 @@ Result Diagnose(const std::vector<io::RigRecord>& train_in, const std::vector<io
     }
     for (const auto& [name, t] : last_trial) {
       if (er.count(name)) continue;
-      std::optional<double> fx;
-      if (t.params.count("damper_scale")) fx = t.params.at("damper_scale")[0];
-      const auto pt = s.test.Predict(ToSet(specs, t.params), nullptr, fx);
+      const auto pt = s.test.Predict(ToSet(specs, t.params), nullptr, FittedScale(t.params));
       EffectResult e;
       e.name = name;
       e.channel = cs.channel;
