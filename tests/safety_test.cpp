@@ -115,7 +115,7 @@ rms_mm_s2 = 1500.0
 [semiactive]
 mode = "passive_off"
 [lockstep]
-timeout_ms = 200.0
+rerequest_ms = 200.0
 [safety]
 )" + safety).string());
   rths::lockstep::Faults f;

@@ -114,7 +114,7 @@ TEST_CASE("omitted keys keep the struct defaults") {
   CHECK(empty.structure.desired.rms == 2.78);
   CHECK(empty.plant.noise_seed == 7);
   CHECK(empty.plant.cvode_rtol == 1e-8);
-  CHECK(empty.lockstep.max_attempts == 8);
+  CHECK(empty.lockstep.stall_budget_s == 10.0);
   CHECK(empty.sha256.empty());
 
   const Scenario partial = ParseScenario(R"(
@@ -196,8 +196,7 @@ TEST_CASE("unknown keys and tables are named, with the allowed ones and a sugges
 TEST_CASE("wrong types name the key, the expected type and what was found") {
   CheckContains(ErrorOf("[run]\ndt_s = \"0.001\"\n"),
                 {"bad.toml: run.dt_s: expected a number", "found string \"0.001\""});
-  CheckContains(ErrorOf("[lockstep]\nmax_attempts = 2.5\n"),
-                {"bad.toml: lockstep.max_attempts: expected an integer", "found float 2.5"});
+  CheckContains(ErrorOf("[faults]\nseed = 2.5\n"), {"bad.toml: faults.seed: expected an integer", "found float 2.5"});
   CheckContains(ErrorOf("[controller]\nhalf_step_ahead = \"yes\"\n"),
                 {"controller.half_step_ahead: expected a boolean", "found string"});
   CheckContains(ErrorOf("[structure]\nmode = 1\n"), {"structure.mode: expected a string", "found integer 1"});
@@ -215,7 +214,21 @@ TEST_CASE("out-of-range values name the key, the value and the range") {
   CheckContains(ErrorOf("[structure]\ndamping_ratio = nan\n"), {"structure.damping_ratio: nan is out of range"});
   CheckContains(ErrorOf("[plant]\ncvode_rtol = 0.1\n"), {"plant.cvode_rtol: 0.1 is out of range (0, 0.01]"});
   CheckContains(ErrorOf("[plant]\nnoise_f_kN_rms = 200\n"), {"plant.noise_f_kN_rms: 200 is out of range [0, 100]"});
-  CheckContains(ErrorOf("[lockstep]\nmax_attempts = 0\n"), {"lockstep.max_attempts: 0 is out of range [1, 1000]"});
+  CheckContains(ErrorOf("[lockstep]\nrerequest_ms = 1\n"), {"lockstep.rerequest_ms: 1 is out of range [5, 10000]"});
+  CheckContains(ErrorOf("[lockstep]\nstall_budget_s = 0.5\n"),
+                {"lockstep.stall_budget_s: 0.5 is out of range [1, 3600]", "at least 1 s and 4 lockstep.rerequest_ms"});
+  CheckContains(ErrorOf("[lockstep]\nrerequest_ms = 2000\nstall_budget_s = 5\n"),
+                {"lockstep.stall_budget_s: 5 is out of range [8, 3600]"});
+  CheckContains(ErrorOf("[lockstep]\ntimeout_ms = 250\n"), {"lockstep.timeout_ms: was renamed lockstep.rerequest_ms"});
+  CheckContains(ErrorOf("[lockstep]\nmax_attempts = 8\n"), {"lockstep.max_attempts: was replaced by lockstep.stall_budget_s"});
+  CheckContains(ErrorOf("[faults]\ndrop = 0.6\n"), {"faults.drop: 0.6 is out of range [0, 0.5]"});
+  CheckContains(ErrorOf("[faults]\ndrop = 0.3\ndelay = 0.3\n"), {"faults.drop: 0.6 is out of range", "must not exceed 0.5"});
+  CheckContains(ErrorOf("[faults]\nrecv_buf_bytes = 100\n"), {"faults.recv_buf_bytes: 100 is out of range [1024, 1.34218e+08]"});
+  CheckContains(ErrorOf("[faults.process]\nrole = \"plant\"\nkind = \"explode\"\n"),
+                {"faults.process.kind: \"explode\" is not allowed", "\"stop\""});
+  CheckContains(ErrorOf("[faults.process]\nrole = \"plan\"\nkind = \"kill\"\n"), {"faults.process.role: \"plan\" is not allowed"});
+  CheckContains(ErrorOf("[run]\nduration_s = 1\n[faults.process]\nrole = \"plant\"\nkind = \"kill\"\nat_step = 2000\n"),
+                {"faults.process.at_step: 2000 is out of range [0, 2000)"});
   CheckContains(ErrorOf("[lockstep]\nhandshake_timeout_s = 1000\n"),
                 {"lockstep.handshake_timeout_s: 1000 is out of range [0.1, 600]"});
   CheckContains(ErrorOf("[semiactive]\nmode = \"constant\"\ncurrent_A = 3.0\n"),

@@ -1,14 +1,20 @@
 // rths-run: the supervisor behind `rths run` (docs/lockstep.md).
 //
-// Validates the scenario, makes the output folder, starts the five participants — as
-// separate processes on udpm:// (one UDP port per run, ttl=0) or in this process on
-// memq:// — waits for them, tears the group down when one fails, and writes summary.json
-// from the event log. Exits non-zero naming the participant that failed.
+// Validates the scenario, checks the host (multicast route, free disk space), makes the output
+// folder, starts the five participants — as separate processes on udpm:// (one UDP port per
+// run, ttl=0) or in this process on memq:// — and waits for them. A participant that dies is
+// noticed at once (SIGCHLD through a signalfd): the supervisor broadcasts ABORT so the others
+// stop cleanly, then terminates and kills whoever does not. At the end it writes summary.json
+// (reserved before the run, so a full disk cannot take it) and exits non-zero naming the
+// participant to blame.
 #include <fcntl.h>
 #include <netinet/in.h>
+#include <poll.h>
 #include <signal.h>
 #include <sys/prctl.h>
+#include <sys/signalfd.h>
 #include <sys/socket.h>
+#include <sys/statvfs.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -24,7 +30,6 @@
 #include <random>
 #include <sstream>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include <CLI/CLI.hpp>
@@ -34,19 +39,28 @@
 #include "core/error.h"
 #include "io/run_log.h"
 #include "lockstep/runtime.h"
+#include "models/structure_file.h"
 #include "participants/factory.h"
 #include "participants/group.h"
+#include "participants/logger.h"
 #include "scenario/scenario.h"
 
 namespace fs = std::filesystem;
-using rths::lockstep::ExitCode;
+using rths::participants::Outcome;
+using Clock = std::chrono::steady_clock;
 
 namespace {
 
 volatile std::sig_atomic_t g_interrupted = 0;
 void OnSignal(int) { g_interrupted = 1; }
 
-using rths::participants::Outcome;
+/// Bytes reserved for summary.json before the run (written in place at the end).
+constexpr std::size_t kSummaryReserve = 64 * 1024;
+/// Runs that will write more than this get a warning first.
+constexpr double kWarnBytes = 2e9;
+/// After a failure: time the others get to stop by themselves after ABORT, then after SIGTERM.
+constexpr auto kGraceAbort = std::chrono::milliseconds(1000);
+constexpr auto kGraceTerm = std::chrono::milliseconds(1000);
 
 std::string LastLine(const fs::path& file) {
   std::ifstream in(file);
@@ -59,7 +73,7 @@ std::string LastLine(const fs::path& file) {
 
 int FreeUdpPort() {
   const int fd = ::socket(AF_INET, SOCK_DGRAM, 0);
-  if (fd < 0) throw rths::Error("rths run", "cannot create a UDP socket to pick a port");
+  if (fd < 0) throw rths::Error("", "cannot create a UDP socket to pick a port");
   sockaddr_in a{};
   a.sin_family = AF_INET;
   a.sin_addr.s_addr = htonl(INADDR_ANY);
@@ -68,7 +82,7 @@ int FreeUdpPort() {
   if (::bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof a) != 0 ||
       ::getsockname(fd, reinterpret_cast<sockaddr*>(&a), &len) != 0) {
     ::close(fd);
-    throw rths::Error("rths run", "cannot pick a free UDP port");
+    throw rths::Error("", "cannot pick a free UDP port");
   }
   ::close(fd);
   return ntohs(a.sin_port);
@@ -86,42 +100,104 @@ fs::path DefaultOutDir(const std::string& name) {
   return p;
 }
 
-std::vector<Outcome> RunUdpm(const rths::scenario::Scenario&, const std::string& scenario_path,
-                             std::int64_t run_id, const fs::path& out, const fs::path& bin_dir,
-                             const std::vector<rths::participants::RoleFault>& faults,
-                             std::string* url_out) {
-  if (const std::string hint = rths::lockstep::CheckMulticastRoute(); !hint.empty()) {
-    throw rths::Error("rths run", hint);
+std::string Megabytes(double bytes) { return fmt::format("{:.1f} MB", bytes / 1e6); }
+
+/// Output the run will write [bytes]: its steps, the reserved summary and some slack for the
+/// copied scenario and the participants' own logs.
+double EstimateOutputBytes(const rths::scenario::Scenario& s) {
+  int n_dof = 1;
+  if (s.structure.mode != "predefined") {
+    n_dof = static_cast<int>(rths::models::StructureFromScenario(s.structure, s.path).M.rows());
   }
-  const int port = FreeUdpPort();
-  const std::string url = fmt::format("udpm://239.255.76.67:{}?ttl=0", port);
-  *url_out = url;
+  return static_cast<double>(s.steps()) * static_cast<double>(rths::participants::StoredBytesPerStep(n_dof)) +
+         static_cast<double>(kSummaryReserve) + 256.0 * 1024.0;
+}
+
+/// Free bytes for an unprivileged writer on the file system that will hold `dir`.
+double FreeBytes(fs::path dir) {
+  dir = fs::absolute(dir);
+  while (!fs::exists(dir) && dir.has_parent_path() && dir != dir.parent_path()) dir = dir.parent_path();
+  struct statvfs st {};
+  if (::statvfs(dir.c_str(), &st) != 0) return -1.0;
+  return static_cast<double>(st.f_bavail) * static_cast<double>(st.f_frsize);
+}
+
+/// Writes `text` over the reserved summary.json, in place (no new blocks needed), then cuts it
+/// to length. Falls back to a plain write if the reservation is missing or too small.
+bool WriteSummary(const fs::path& path, const std::string& text) {
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_CLOEXEC, 0644);
+  if (fd < 0) return false;
+  std::size_t done = 0;
+  bool ok = true;
+  while (done < text.size()) {
+    const ssize_t n = ::pwrite(fd, text.data() + done, text.size() - done, static_cast<off_t>(done));
+    if (n <= 0) {
+      if (n < 0 && errno == EINTR) continue;
+      ok = false;
+      break;
+    }
+    done += static_cast<std::size_t>(n);
+  }
+  ok = ok && ::ftruncate(fd, static_cast<off_t>(text.size())) == 0;
+  ok = (::close(fd) == 0) && ok;
+  return ok;
+}
+
+/// The state letter of /proc/PID/stat ('T': stopped), or 0.
+char ProcessState(pid_t pid) {
+  std::ifstream in(fmt::format("/proc/{}/stat", pid));
+  std::string all((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const auto close = all.rfind(')');
+  return close != std::string::npos && close + 2 < all.size() ? all[close + 2] : 0;
+}
+
+/// Tells every participant of the run to stop: ABORT on the run's URL, from "supervisor".
+void BroadcastAbort(const std::string& url, std::int64_t run_id, const std::string& reason) {
+  lcm::LCM lcm(url);
+  if (!lcm.good()) return;
+  rths::handshake_t h{};
+  h.run_id = run_id;
+  h.phase = rths::lockstep::kAbort;
+  h.participant = "supervisor";
+  h.k = -1;
+  h.n_roster = 0;
+  h.reason = reason;
+  rths::lockstep::Bytes bytes;
+  rths::lockstep::Encode(h, &bytes);
+  for (int i = 0; i < 3; ++i) lcm.publish(rths::lockstep::kChHandshake, bytes.data(), bytes.size());
+}
+
+struct Child {
+  Outcome outcome;
+  bool exited = false;
+  bool signalled_by_us = false;
+};
+
+std::vector<Outcome> RunUdpm(const std::string& scenario_path, const rths::scenario::Scenario& s,
+                             std::int64_t run_id, const fs::path& out, const fs::path& bin_dir,
+                             const std::string& url, Clock::time_point* noticed) {
   fs::create_directories(out / "logs");
-  std::map<pid_t, Outcome> children;
-  std::map<pid_t, bool> exited;
+  // SIGCHLD, SIGINT and SIGTERM arrive through a signalfd: a dead participant is noticed at once.
+  sigset_t mask, old_mask;
+  sigemptyset(&mask);
+  sigaddset(&mask, SIGCHLD);
+  sigaddset(&mask, SIGINT);
+  sigaddset(&mask, SIGTERM);
+  if (::sigprocmask(SIG_BLOCK, &mask, &old_mask) != 0) throw rths::Error("", "cannot block signals");
+  const int sfd = ::signalfd(-1, &mask, SFD_CLOEXEC | SFD_NONBLOCK);
+  if (sfd < 0) throw rths::Error("", "cannot create a signalfd");
+
+  std::map<pid_t, Child> children;
   for (const char* role : {"logger", "plant", "controller", "semiactive", "integrator"}) {
     const fs::path exe = bin_dir / fmt::format("rths-{}", role);
-    if (!fs::exists(exe)) {
-      throw rths::Error("rths run", fmt::format("{} is missing: build first (see README)", exe.string()));
-    }
-    std::vector<std::string> args{exe.string(),     "--scenario", scenario_path, "--lcm-url", url,
-                                  "--run-id",       std::to_string(run_id),      "--out",
-                                  out.string()};
-    for (const auto& f : faults) {
-      if (f.role != role) continue;
-      for (auto [flag, k] : {std::pair{"--fault-drop", f.faults.drop_first_request_at},
-                             {"--fault-stall", f.faults.stall_at},
-                             {"--fault-throw", f.faults.throw_at},
-                             {"--fault-crash", f.faults.crash_at}}) {
-        if (k < 0) continue;
-        args.push_back(flag);
-        args.push_back(std::to_string(k));
-      }
-    }
+    if (!fs::exists(exe)) throw rths::Error("", fmt::format("{} is missing: build first (see README)", exe.string()));
+    std::vector<std::string> args{exe.string(), "--scenario", scenario_path,        "--lcm-url", url,
+                                  "--run-id",   std::to_string(run_id), "--out", out.string()};
     const fs::path log = out / "logs" / fmt::format("{}.log", role);
     const pid_t pid = ::fork();
-    if (pid < 0) throw rths::Error("rths run", "fork failed");
+    if (pid < 0) throw rths::Error("", "fork failed");
     if (pid == 0) {
+      ::sigprocmask(SIG_SETMASK, &old_mask, nullptr);
       ::prctl(PR_SET_PDEATHSIG, SIGTERM);  // never outlive the supervisor
       const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
       if (fd >= 0) {
@@ -136,59 +212,124 @@ std::vector<Outcome> RunUdpm(const rths::scenario::Scenario&, const std::string&
       std::fprintf(stderr, "exec %s failed: %s\n", argv[0], std::strerror(errno));
       ::_exit(127);
     }
-    children[pid] = Outcome{role, 0, 0, ""};
-    exited[pid] = false;
+    children[pid].outcome.role = role;
   }
 
-  using Clock = std::chrono::steady_clock;
   std::size_t running = children.size();
-  bool tearing_down = false;
+  bool tearing_down = false, termed = false, killed = false;
   Clock::time_point term_at{}, kill_at{};
-  bool termed = false, killed = false;
+  auto start_teardown = [&](const std::string& reason) {
+    if (tearing_down) return;
+    tearing_down = true;
+    *noticed = Clock::now();
+    BroadcastAbort(url, run_id, reason);
+    term_at = *noticed + kGraceAbort;
+  };
+  auto signal_survivors = [&](int sig) {
+    for (auto& [pid, c] : children) {
+      if (c.exited) continue;
+      if (ProcessState(pid) == 'T') c.outcome.was_stopped = true;
+      c.signalled_by_us = true;
+      ::kill(pid, sig);
+    }
+  };
   while (running > 0) {
-    int status = 0;
-    const pid_t pid = ::waitpid(-1, &status, WNOHANG);
-    if (pid > 0 && children.count(pid)) {
-      Outcome& o = children[pid];
-      exited[pid] = true;
-      --running;
-      if (WIFSIGNALED(status)) {
-        o.signal = WTERMSIG(status);
-        o.exit_code = 128 + o.signal;
-      } else {
-        o.exit_code = WEXITSTATUS(status);
-      }
-      o.message = LastLine(out / "logs" / fmt::format("{}.log", o.role));
-      if (o.exit_code != 0 && !tearing_down) {
-        // Let the others notice the ABORT (or the silence) and stop by themselves first.
-        tearing_down = true;
-        term_at = Clock::now() + std::chrono::seconds(3);
-      }
-      continue;
-    }
-    if (g_interrupted && !tearing_down) {
-      tearing_down = true;
-      term_at = Clock::now();
-    }
+    int timeout_ms = 200;
     const auto now = Clock::now();
-    if (tearing_down && !termed && now >= term_at) {
-      for (auto& [p, o] : children) {
-        if (!exited[p]) ::kill(p, SIGTERM);
+    if (tearing_down && !termed) timeout_ms = static_cast<int>(std::chrono::ceil<std::chrono::milliseconds>(term_at - now).count());
+    if (termed && !killed) timeout_ms = static_cast<int>(std::chrono::ceil<std::chrono::milliseconds>(kill_at - now).count());
+    pollfd p{sfd, POLLIN, 0};
+    const int r = ::poll(&p, 1, std::max(timeout_ms, 0));
+    if (r > 0) {
+      signalfd_siginfo si{};
+      while (::read(sfd, &si, sizeof si) == sizeof si) {
+        if (si.ssi_signo == SIGINT || si.ssi_signo == SIGTERM) {
+          g_interrupted = 1;
+          start_teardown("interrupted by the user");
+        }
       }
-      termed = true;
-      kill_at = now + std::chrono::seconds(2);
+      // Reap everyone who has exited (one SIGCHLD may stand for several).
+      for (;;) {
+        int status = 0;
+        const pid_t pid = ::waitpid(-1, &status, WNOHANG);
+        if (pid <= 0) break;
+        auto it = children.find(pid);
+        if (it == children.end()) continue;
+        Child& c = it->second;
+        c.exited = true;
+        --running;
+        Outcome& o = c.outcome;
+        if (WIFSIGNALED(status)) {
+          o.signal = WTERMSIG(status);
+          o.exit_code = 128 + o.signal;
+          o.killed_by_supervisor = c.signalled_by_us;
+        } else {
+          o.exit_code = WEXITSTATUS(status);
+        }
+        if (o.exit_code != 0) {
+          const std::string what =
+              o.signal ? fmt::format("{} was killed by signal {} ({})", o.role, o.signal, strsignal(o.signal))
+                       : fmt::format("{} exited with code {}", o.role, o.exit_code);
+          start_teardown(what);
+        }
+      }
     }
-    if (termed && !killed && now >= kill_at) {
-      for (auto& [p, o] : children) {
-        if (!exited[p]) ::kill(p, SIGKILL);
-      }
+    const auto t = Clock::now();
+    if (tearing_down && !termed && t >= term_at) {
+      signal_survivors(SIGTERM);
+      termed = true;
+      kill_at = t + kGraceTerm;
+    }
+    if (termed && !killed && t >= kill_at) {
+      signal_survivors(SIGKILL);
       killed = true;
     }
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }
+  ::close(sfd);
+  ::sigprocmask(SIG_SETMASK, &old_mask, nullptr);
+
+  // What each participant wrote about itself (its message, whom it blames, its link counters).
   std::vector<Outcome> outcomes;
-  for (auto& [p, o] : children) outcomes.push_back(o);
+  for (auto& [pid, c] : children) {
+    Outcome o = c.outcome;
+    try {
+      std::ifstream in(out / "logs" / (o.role + ".json"));
+      if (in) {
+        Outcome self = rths::participants::OutcomeFromJson(nlohmann::json::parse(in));
+        o.message = self.message;
+        o.culprit = self.culprit;
+        o.step = self.step;
+        o.stats = self.stats;
+        o.stats_known = self.stats_known;
+      }
+    } catch (const std::exception&) {
+      // a partial file (the disk filled up): keep what the exit status says
+    }
+    if (o.exit_code != 0 && o.message.empty() && !o.signal) o.message = LastLine(out / "logs" / (o.role + ".log"));
+    outcomes.push_back(std::move(o));
+  }
   return outcomes;
+}
+
+nlohmann::json LinkTotals(const std::vector<Outcome>& outcomes) {
+  rths::lockstep::LinkStats t;
+  for (const auto& o : outcomes) {
+    if (!o.stats_known) continue;
+    const auto& s = o.stats;
+    t.rerequests += s.rerequests;
+    t.steps_rerequested += s.steps_rerequested;
+    t.repair_requests += s.repair_requests;
+    t.resent += s.resent;
+    t.repaired += s.repaired;
+    t.duplicates += s.duplicates;
+    t.stale += s.stale;
+    t.foreign += s.foreign;
+    t.injected.dropped += s.injected.dropped;
+    t.injected.duplicated += s.injected.duplicated;
+    t.injected.delayed += s.injected.delayed;
+    t.injected.reordered += s.injected.reordered;
+  }
+  return rths::participants::StatsToJson(t);
 }
 
 }  // namespace
@@ -198,7 +339,6 @@ int main(int argc, char** argv) {
                "logger), wait for it, and write its output folder"};
   std::string scenario_path, default_scenario = "scenarios/default.toml";
   std::string out_arg, transport = "udpm", bin_dir;
-  std::vector<std::string> fault_args;
   bool quiet = false;
   app.add_option("scenario", scenario_path, "scenario TOML file (default: scenarios/default.toml)");
   app.add_option("--default-scenario", default_scenario, "used when no scenario is given")->group("");
@@ -207,51 +347,75 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"udpm", "memq"}))
       ->capture_default_str();
   app.add_option("--bin-dir", bin_dir, "where the rths-* programs are (default: next to this one)");
-  app.add_option("--fault", fault_args, "test only: ROLE:drop|stall|throw|crash:K")->group("");
   app.add_flag("--quiet", quiet, "print only the output folder");
+  app.footer("Exit codes: 0 ok; 2 bad input or not enough disk (nothing ran); 3 a participant stopped "
+             "answering (named); 4 stopped by an abort; 5 a participant's computation failed; 6 stopped "
+             "by the safety monitor; 7 the output could not be written (disk full); 128+N a participant "
+             "was killed by signal N; 130 interrupted.");
   CLI11_PARSE(app, argc, argv);
 
   if (scenario_path.empty()) scenario_path = default_scenario;
   std::signal(SIGINT, OnSignal);
   std::signal(SIGTERM, OnSignal);
 
-  std::vector<rths::participants::RoleFault> faults;
-  for (const auto& f : fault_args) {
-    rths::participants::RoleFault x;
-    std::istringstream ss(f);
-    std::string kind, k;
-    std::getline(ss, x.role, ':');
-    std::getline(ss, kind, ':');
-    std::getline(ss, k);
-    std::int64_t* slot = kind == "drop"    ? &x.faults.drop_first_request_at
-                         : kind == "stall" ? &x.faults.stall_at
-                         : kind == "throw" ? &x.faults.throw_at
-                         : kind == "crash" ? &x.faults.crash_at
-                                           : nullptr;
-    if (!slot || k.empty()) {
-      std::fprintf(stderr, "rths run: --fault %s: expected ROLE:drop|stall|throw|crash:K\n", f.c_str());
-      return rths::lockstep::kExitUsage;
-    }
-    *slot = std::stoll(k);
-    faults.push_back(x);
-  }
-
+  // Everything that can be checked before a byte is written.
   rths::scenario::Scenario s;
   fs::path out;
+  double estimate = 0.0;
+  std::string url = "memq://";
   try {
     s = rths::scenario::LoadScenario(scenario_path);
     rths::participants::CheckBuildable(s);
+    const std::string& kind = s.faults.process_kind;
+    if (transport == "memq" && (kind == "crash" || kind == "kill" || kind == "stop")) {
+      throw rths::Error(scenario_path + ": faults.process.kind",
+                        fmt::format("\"{}\" would take every participant down with the one memq process: "
+                                    "use --transport udpm",
+                                    kind));
+    }
+    if (transport == "udpm") {
+      if (const std::string hint = rths::lockstep::CheckMulticastRoute(); !hint.empty()) {
+        throw rths::Error("", hint);
+      }
+      url = fmt::format("udpm://239.255.76.67:{}?ttl=0", FreeUdpPort());
+      if (s.faults.recv_buf_bytes > 0) url += fmt::format("&recv_buf_size={}", s.faults.recv_buf_bytes);
+    }
     out = out_arg.empty() ? DefaultOutDir(s.run.name) : fs::path(out_arg);
     if (fs::exists(out) && !fs::is_empty(out)) {
       throw rths::Error(out.string(), "output folder exists and is not empty; refusing to overwrite "
                                       "a previous run (choose another --out)");
     }
-    fs::create_directories(out);
-    fs::copy_file(scenario_path, out / "scenario.toml");
-  } catch (const rths::Error& e) {
+    estimate = EstimateOutputBytes(s);
+    const double free_bytes = FreeBytes(out);
+    if (free_bytes >= 0 && estimate > free_bytes) {
+      throw rths::Error(out.string(),
+                        fmt::format("not enough free disk space: this run writes about {} ({} steps), and "
+                                    "the file system has {} free; free some space, shorten run.duration_s "
+                                    "or choose another --out",
+                                    Megabytes(estimate), s.steps(), Megabytes(free_bytes)));
+    }
+    if (estimate > kWarnBytes) {
+      std::fprintf(stderr, "rths run: warning: this run will write about %s to %s\n", Megabytes(estimate).c_str(),
+                   out.string().c_str());
+    }
+  } catch (const std::exception& e) {
     std::fprintf(stderr, "rths run: %s\n", e.what());
     return rths::lockstep::kExitUsage;
+  }
+
+  // The output folder; if nothing could start, remove what was made here so a retry with the
+  // same --out works.
+  const bool created_out = !fs::exists(out);
+  try {
+    fs::create_directories(out);
+    fs::copy_file(scenario_path, out / "scenario.toml");
+    std::ofstream reserve(out / "summary.json", std::ios::binary);
+    const std::string placeholder = "{\"status\": \"running\"}\n";
+    reserve << placeholder << std::string(kSummaryReserve - placeholder.size(), ' ');
+    if (!reserve.good()) throw rths::Error((out / "summary.json").string(), "cannot reserve the summary");
   } catch (const std::exception& e) {
+    std::error_code ec;
+    if (created_out) fs::remove_all(out, ec);
     std::fprintf(stderr, "rths run: %s\n", e.what());
     return rths::lockstep::kExitUsage;
   }
@@ -260,24 +424,26 @@ int main(int argc, char** argv) {
   std::random_device rd;
   const std::int64_t run_id =
       static_cast<std::int64_t>(((std::uint64_t{rd()} << 32) ^ rd()) & 0x3fffffffffffffffULL) | 1;
-  std::string url = "memq://";
   std::vector<Outcome> outcomes;
-  const auto t0 = std::chrono::steady_clock::now();
+  const auto t0 = Clock::now();
+  Clock::time_point noticed{};
   try {
     if (!quiet) {
       std::printf("rths run: %s (%lld steps of %g s), transport %s\n", scenario_path.c_str(),
                   static_cast<long long>(s.steps()), s.run.dt_s, transport.c_str());
       std::fflush(stdout);
     }
-    outcomes = transport == "memq" ? rths::participants::RunGroupInProcess({s}, run_id, out.string(), faults)
-                                   : RunUdpm(s, scenario_path, run_id, out, bin_dir, faults, &url);
+    outcomes = transport == "memq"
+                   ? rths::participants::RunGroupInProcess({s}, run_id, out.string(), {}, &g_interrupted)
+                   : RunUdpm(scenario_path, s, run_id, out, bin_dir, url, &noticed);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "rths run: %s\n", e.what());
+    std::error_code ec;
+    if (created_out && !fs::exists(out / "log.lcm")) fs::remove_all(out, ec);
     return rths::lockstep::kExitLockstep;
   }
-  const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-
-  const Outcome* culprit = rths::participants::RootCause(outcomes);
+  const double wall_s = std::chrono::duration<double>(Clock::now() - t0).count();
+  const rths::participants::Verdict verdict = rths::participants::Judge(outcomes);
 
   // Summary from the log: whatever was committed, even after a failure.
   nlohmann::json j;
@@ -288,6 +454,7 @@ int main(int argc, char** argv) {
   j["lcm_url"] = url;
   j["steps_expected"] = s.steps();
   j["wall_s"] = wall_s;
+  j["output_estimate_bytes"] = estimate;
   std::int64_t steps = 0;
   try {
     const auto log = rths::io::ReadRunLog((out / "log.lcm").string());
@@ -307,12 +474,33 @@ int main(int argc, char** argv) {
     j["steps"] = 0;
     j["log_error"] = e.what();
   }
-  j["stopped"] = g_interrupted ? std::string("interrupted by the user")
-                 : culprit    ? fmt::format("{}: {}", culprit->role, culprit->message)
-                              : std::string("no");
+  int code = 0;
+  std::string status = "completed";
+  if (g_interrupted) {
+    status = "interrupted";
+    code = 130;
+  } else if (verdict.failed) {
+    code = verdict.exit_code != 0 ? verdict.exit_code : rths::lockstep::kExitLockstep;
+    status = code == rths::lockstep::kExitSafety ? "stopped by the safety monitor" : "failed";
+  }
+  j["status"] = status;
+  j["exit_code"] = code;
+  j["stopped"] = g_interrupted ? std::string("interrupted by the user") : verdict.failed ? verdict.what : "no";
+  if (verdict.failed) {
+    j["failure"] = {{"participant", verdict.role}, {"step", verdict.step}, {"what", verdict.what},
+                    {"exit_code", verdict.exit_code}};
+    if (noticed != Clock::time_point{}) {
+      j["failure"]["teardown_s"] = std::chrono::duration<double>(Clock::now() - noticed).count();
+    }
+  }
+  j["link"] = LinkTotals(outcomes);
   j["participants"] = nlohmann::json::object();
-  for (const auto& o : outcomes) j["participants"][o.role] = {{"exit_code", o.exit_code}, {"message", o.message}};
-  std::ofstream(out / "summary.json") << j.dump(2) << "\n";
+  for (const auto& o : outcomes) {
+    nlohmann::json p = rths::participants::OutcomeToJson(o);
+    p.erase("role");
+    j["participants"][o.role] = p;
+  }
+  const bool summary_ok = WriteSummary(out / "summary.json", j.dump(2) + "\n");
 
   if (!quiet) {
     std::printf("  steps              %lld of %lld\n", static_cast<long long>(steps),
@@ -323,31 +511,29 @@ int main(int argc, char** argv) {
       std::printf("  rate               %.0f steps/s (%.2fx real time)\n", j["steps_per_s"].get<double>(),
                   j["steps_per_s"].get<double>() * s.run.dt_s);
     }
+    const auto rerequests = j["link"]["rerequests"].get<std::int64_t>();
+    if (rerequests > 0) {
+      std::printf("  link               %lld re-requests, %lld messages repaired\n",
+                  static_cast<long long>(rerequests), static_cast<long long>(j["link"]["repaired"].get<std::int64_t>()));
+    }
   }
   std::fflush(stdout);
+  if (!summary_ok) std::fprintf(stderr, "rths run: could not write %s\n", (out / "summary.json").c_str());
+  if (code == 0) {
+    std::printf("output: %s\n", out.string().c_str());
+    return 0;
+  }
   if (g_interrupted) {
     std::fprintf(stderr, "rths run: interrupted; the group was stopped\n");
-    std::printf("output: %s (log valid up to step %lld)\n", out.string().c_str(),
-                static_cast<long long>(steps));
-    return 130;
+  } else if (code == rths::lockstep::kExitSafety) {
+    std::fprintf(stderr, "rths run: STOPPED by the safety monitor: %s\n", verdict.what.c_str());
+  } else {
+    std::fprintf(stderr, "rths run: FAILED: %s\n", verdict.what.c_str());
   }
-  if (culprit && culprit->exit_code == rths::lockstep::kExitSafety) {
-    std::fprintf(stderr, "rths run: STOPPED by the safety monitor: %s\n", culprit->message.c_str());
-    std::printf("output: %s (log valid up to step %lld)\n", out.string().c_str(),
-                static_cast<long long>(steps));
-    return rths::lockstep::kExitSafety;
+  if (steps > 0) {
+    std::printf("output: %s (log complete up to step %lld)\n", out.string().c_str(), static_cast<long long>(steps) - 1);
+  } else {
+    std::printf("output: %s (no step completed)\n", out.string().c_str());
   }
-  if (culprit) {
-    const char* what = culprit->signal ? strsignal(culprit->signal) : nullptr;
-    std::fprintf(stderr, "rths run: FAILED: %s %s%s%s\n", culprit->role.c_str(),
-                 what ? fmt::format("was killed by signal {} ({})", culprit->signal, what).c_str()
-                      : fmt::format("exited with code {}", culprit->exit_code).c_str(),
-                 culprit->message.empty() ? "" : ": ",
-                 culprit->message.c_str());
-    std::printf("output: %s (log valid up to step %lld)\n", out.string().c_str(),
-                static_cast<long long>(steps));
-    return culprit->exit_code != 0 ? culprit->exit_code : rths::lockstep::kExitLockstep;
-  }
-  std::printf("output: %s\n", out.string().c_str());
-  return 0;
+  return code;
 }

@@ -20,13 +20,24 @@ int RosterIndex(const std::string& name) {
   }
   return -1;
 }
+
+std::string JoinNames(const std::vector<std::string>& names) {
+  std::string out;
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    if (i > 0) out += i + 1 == names.size() ? " and " : ", ";
+    out += names[i];
+  }
+  return out;
+}
 }  // namespace
 
-ClockParticipant::ClockParticipant(std::string name, RunIdentity id, Timing timing, lcm::LCM* lcm)
-    : Participant(std::move(name), std::move(id), timing, lcm) {
+ClockParticipant::ClockParticipant(std::string name, RunIdentity id, Timing timing, lcm::LCM* lcm,
+                                   Faults faults)
+    : Participant(std::move(name), std::move(id), timing, lcm, std::move(faults)) {
   is_clock_ = true;
   hello_.fill(false);
   bye_.fill(false);
+  reported_.fill(false);
   const int self = RosterIndex(name_);
   if (self >= 0) {
     hello_[self] = true;
@@ -34,13 +45,20 @@ ClockParticipant::ClockParticipant(std::string name, RunIdentity id, Timing timi
   }
   start_ = SteadyClock::now();
   last_send_ = start_ - std::chrono::seconds(1);
-  lcm_->subscribe(kChMeasured, &ClockParticipant::OnMeasured, this);
-  lcm_->subscribe(kChCommand, &ClockParticipant::OnCommand, this);
-  lcm_->subscribe(kChCurrent, &ClockParticipant::OnCurrent, this);
-  lcm_->subscribe(kChAck, &ClockParticipant::OnAck, this);
+  SetAnswerChannel(kDesired, &desired_cache_);
+  auto on_answer = [this](auto* box, Channel ch) {
+    return [this, box, ch](const lcm::ReceiveBuffer* rbuf) {
+      if (finished()) return;
+      if (Receive(box, ch, rbuf) == Put::kNew && box->last_k() == k_) CheckBarrier();
+    };
+  };
+  Subscribe(kChMeasured, on_answer(&measured_, kMeasured));
+  Subscribe(kChCommand, on_answer(&command_, kCommand));
+  Subscribe(kChCurrent, on_answer(&current_, kCurrent));
+  Subscribe(kChAck, on_answer(&ack_, kAck));
 }
 
-void ClockParticipant::OnHandshakeForClock(const rths::handshake_t& msg, SteadyClock::time_point) {
+void ClockParticipant::OnHandshakeForClock(const rths::handshake_t& msg, SteadyClock::time_point now) {
   const int i = RosterIndex(msg.participant);
   if (i < 0) {
     std::fprintf(stderr, "%s: ignoring handshake from unknown participant '%s'\n", name_.c_str(),
@@ -52,34 +70,48 @@ void ClockParticipant::OnHandshakeForClock(const rths::handshake_t& msg, SteadyC
       Fail(kExitLockstep,
            fmt::format("scenario mismatch: {} loaded a scenario with SHA-256 {}, {} loaded {}",
                        msg.participant, msg.scenario_sha256, name_, id_.scenario_sha256),
-           true);
+           true, -1, msg.participant);
       return;
     }
     if (msg.n_steps != id_.n_steps || msg.dt_s != id_.dt_s) {
       Fail(kExitLockstep,
            fmt::format("{} expects {} steps of {} s, {} expects {} steps of {} s", msg.participant,
                        msg.n_steps, msg.dt_s, name_, id_.n_steps, id_.dt_s),
-           true);
+           true, -1, msg.participant);
       return;
     }
     hello_[i] = true;
     bool all = true;
     for (bool h : hello_) all = all && h;
     if (all) SendGo();
-  } else if (msg.phase == kBye) {
+  } else if (msg.phase == kBye && done_) {
     bye_[i] = true;
     bool all = true;
     for (bool b : bye_) all = all && b;
-    if (all && done_) Finish();
+    if (all) {
+      SendHandshake(kClose, id_.n_steps);
+      Finish();
+    }
   }
+  (void)now;
+}
+
+void ClockParticipant::OnRepairForClock(const rths::repair_t& msg) {
+  const int i = RosterIndex(msg.participant);
+  if (i >= 0 && msg.k == k_) reported_[i] = true;
+}
+
+void ClockParticipant::ListMissing(std::int64_t k, WantList* out) const {
+  if (!measured_.Get(k)) out->Add(kMeasured, k);
+  if (!command_.Get(k)) out->Add(kCommand, k);
+  if (!current_.Get(k)) out->Add(kCurrent, k);
+  if (!ack_.Get(k)) out->Add(kAck, k);
 }
 
 void ClockParticipant::SendGo() {
   std::vector<std::string> roster;
   for (const auto& r : kRoster) roster.emplace_back(r.name);
-  // GO is sent twice: a participant that missed it would otherwise wait for the watchdog.
-  SendHandshake(kGo, 0, "", &roster);
-  SendHandshake(kGo, 0, "", &roster);
+  SendHandshake(kGo, 0, "", &roster);  // several copies; a lost GO is also repaired by step 0
   OnGo();
   try {
     IssueStep(0);
@@ -89,18 +121,20 @@ void ClockParticipant::SendGo() {
 }
 
 void ClockParticipant::IssueStep(std::int64_t k) {
+  MaybeFault(k);
   const rths::measured_t* prev = k > 0 ? measured_.Get(k - 1) : nullptr;
   ComputeDesired(k, prev, &desired_);
   desired_.run_id = id_.run_id;
   desired_.k = k;
   k_ = k;
-  attempts_ = 1;
-  last_send_ = SteadyClock::now();
+  rerequests_ = 0;
+  reported_.fill(false);
+  step_since_ = last_send_ = SteadyClock::now();
   Answer(kChDesired, &desired_cache_, k, desired_);
 }
 
 void ClockParticipant::CheckBarrier() {
-  if (finished() || done_ || k_ < 0) return;
+  if (finished() || done_ || k_ < 0 || Stalled(k_)) return;
   const rths::measured_t* m = measured_.Get(k_);
   const rths::command_t* c = command_.Get(k_);
   if (!m || !c || !current_.Get(k_) || !ack_.Get(k_)) return;
@@ -110,8 +144,8 @@ void ClockParticipant::CheckBarrier() {
   }
   if (k_ + 1 >= id_.n_steps) {
     done_ = true;
-    done_sends_ = 1;
-    last_send_ = SteadyClock::now();
+    rerequests_ = 0;
+    step_since_ = last_send_ = SteadyClock::now();
     SendHandshake(kDone, id_.n_steps);
     return;
   }
@@ -122,52 +156,47 @@ void ClockParticipant::CheckBarrier() {
   }
 }
 
-#define RTHS_CLOCK_HANDLER(Method, box)                                                   \
-  void ClockParticipant::Method(const lcm::ReceiveBuffer* rbuf, const std::string&) {     \
-    if (finished()) return;                                                               \
-    if (box.Add(rbuf, id_.run_id) == std::remove_reference_t<decltype(box)>::Put::kNew && \
-        box.last_k() == k_)                                                               \
-      CheckBarrier();                                                                     \
+void ClockParticipant::FailStalled(SteadyClock::time_point now) {
+  // Silent: its answer of step k is missing and it never said what it lacked. Waiting: its
+  // answer is missing but it asked for inputs (alive; it waits for a silent one).
+  const bool answered[kRoster.size()] = {true, command_.Get(k_) != nullptr, measured_.Get(k_) != nullptr,
+                                         current_.Get(k_) != nullptr, ack_.Get(k_) != nullptr};
+  std::vector<std::string> silent, waiting;
+  for (std::size_t i = 1; i < kRoster.size(); ++i) {
+    if (answered[i]) continue;
+    (reported_[i] ? waiting : silent).push_back(kRoster[i].name);
   }
-RTHS_CLOCK_HANDLER(OnMeasured, measured_)
-RTHS_CLOCK_HANDLER(OnCommand, command_)
-RTHS_CLOCK_HANDLER(OnCurrent, current_)
-RTHS_CLOCK_HANDLER(OnAck, ack_)
-#undef RTHS_CLOCK_HANDLER
-
-std::string ClockParticipant::MissingAnswers(std::int64_t k) const {
-  // Who is silent, and who only waits for them: the controller and the semiactive law need
-  // measured_t k; the logger needs everything; the plant's inputs (step k-1) are all in.
-  const bool m = measured_.Get(k) != nullptr, c = command_.Get(k) != nullptr,
-             i = current_.Get(k) != nullptr, a = ack_.Get(k) != nullptr;
-  std::string silent, waiting;
-  auto add = [](std::string* list, const char* text) {
-    if (!list->empty()) *list += ", ";
-    *list += text;
-  };
-  if (!m) add(&silent, "plant (measured_t)");
-  if (!c) add(m ? &silent : &waiting, "controller (command_t)");
-  if (!i) add(m ? &silent : &waiting, "semiactive (current_t)");
-  if (!a) add(m && c && i ? &silent : &waiting, "logger (ack_t)");
-  return waiting.empty() ? silent : fmt::format("{} (also missing, waiting for it: {})", silent, waiting);
+  if (silent.empty()) {
+    // Every one that lacks its answer says it is waiting: blame the first in the step's order
+    // (the plant's measurement feeds everyone, then the controller and semiactive, then the logger).
+    for (const char* role : {"plant", "controller", "semiactive", "logger"}) {
+      const int i = RosterIndex(role);
+      if (!answered[i]) {
+        silent.push_back(role);
+        break;
+      }
+    }
+    std::erase(waiting, silent.front());
+  }
+  std::string reason = fmt::format("step {}: {} stopped answering: no answer after {:.3g} s and {} re-requests",
+                                   k_, JoinNames(silent), Seconds(step_since_, now), rerequests_);
+  if (!waiting.empty()) reason += fmt::format(" ({} only waited for it)", JoinNames(waiting));
+  Fail(kExitLockstep, reason, true, k_, silent.size() == 1 ? silent.front() : JoinNames(silent));
 }
 
-void ClockParticipant::Poll(SteadyClock::time_point now) {
+void ClockParticipant::Poll(SteadyClock::time_point now, bool idle) {
   if (finished()) return;
-  const double timeout_s = timing_.timeout_ms * 1e-3;
   if (k_ < 0) {  // handshake
-    if (Seconds(start_, now) > timing_.handshake_timeout_s) {
-      std::string missing;
+    if (idle && Seconds(start_, now) > timing_.handshake_timeout_s) {
+      std::vector<std::string> missing;
       for (std::size_t i = 0; i < kRoster.size(); ++i) {
-        if (hello_[i]) continue;
-        if (!missing.empty()) missing += ", ";
-        missing += kRoster[i].name;
+        if (!hello_[i]) missing.emplace_back(kRoster[i].name);
       }
       Fail(kExitLockstep,
            fmt::format("no HELLO from {} within {:g} s: not started, crashed, or on another LCM "
                        "URL / run id",
-                       missing, timing_.handshake_timeout_s),
-           true);
+                       JoinNames(missing), timing_.handshake_timeout_s),
+           true, -1, missing.size() == 1 ? missing.front() : JoinNames(missing));
       return;
     }
     if (Seconds(last_send_, now) >= kHandshakeRepeatS) {
@@ -176,33 +205,37 @@ void ClockParticipant::Poll(SteadyClock::time_point now) {
     }
     return;
   }
-  if (Seconds(last_send_, now) < timeout_s) return;
+  if (Stalled(k_)) return;
   if (done_) {
-    if (done_sends_ >= timing_.max_attempts) {
-      std::string missing;
+    if (idle && Seconds(step_since_, now) > timing_.stall_budget_s) {
+      std::vector<std::string> missing;
       for (std::size_t i = 0; i < kRoster.size(); ++i) {
-        if (!bye_[i]) missing += std::string(missing.empty() ? "" : ", ") + kRoster[i].name;
+        if (!bye_[i]) missing.emplace_back(kRoster[i].name);
       }
-      std::fprintf(stderr, "%s: every step committed, but no BYE from %s\n", name_.c_str(),
-                   missing.c_str());
+      std::fprintf(stderr, "%s: every step committed, but no BYE from %s within %g s\n", name_.c_str(),
+                   JoinNames(missing).c_str(), timing_.stall_budget_s);
+      SendHandshake(kClose, id_.n_steps);
       Finish();
       return;
     }
-    SendHandshake(kDone, id_.n_steps);
-    ++done_sends_;
-    last_send_ = now;
+    if (Seconds(last_send_, now) >= timing_.RerequestAfterS(rerequests_ + 1)) {
+      ++rerequests_;
+      last_send_ = now;
+      SendHandshake(kDone, id_.n_steps);
+    }
     return;
   }
-  if (attempts_ >= timing_.max_attempts) {
-    Fail(kExitLockstep,
-         fmt::format("step {}: no answer from {} after {} requests over {:.3g} s", k_,
-                     MissingAnswers(k_), attempts_, attempts_ * timeout_s),
-         true, k_);
+  if (idle && Seconds(step_since_, now) > timing_.stall_budget_s) {
+    FailStalled(now);
     return;
   }
-  ++attempts_;
+  if (Seconds(last_send_, now) < timing_.RerequestAfterS(rerequests_ + 1)) return;
+  if (rerequests_ == 0) ++stats_.steps_rerequested;
+  ++rerequests_;
   last_send_ = now;
-  Republish(kChDesired, desired_cache_, k_);
+  WantList wants;
+  ListMissing(k_, &wants);
+  SendRepair(k_, wants);
 }
 
 }  // namespace rths::lockstep

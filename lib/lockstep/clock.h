@@ -6,10 +6,13 @@
 /// Step k: the clock publishes desired_t k (its own answer, and the request of step k), then
 /// waits for the barrier of step k: measured_t k (plant), command_t k (controller),
 /// current_t k (semiactive) and ack_t k (logger: every message of step k is on disk).
-/// Silence for `timeout_ms` re-publishes the cached desired_t k (byte-identical: the re-request);
-/// participants answer a repeated request from their cache. After `max_attempts` requests the
-/// run aborts, naming every participant whose answer of step k is missing. Steps are never
-/// skipped: step k+1 is issued only after the barrier of step k.
+/// Silence for `rerequest_ms` (then twice as long each time, up to 1 s) re-requests step k: a
+/// repair_t listing the answers it lacks; their owners re-send them from their caches, and
+/// whoever lacks an input says so in a repair_t of its own (docs/lockstep.md, "Repair").
+/// A step still incomplete after `stall_budget_s` stops the run, naming the participants that
+/// neither answered nor said what they lacked (the silent ones) apart from those that only
+/// waited. Steps are never skipped: step k+1 is issued only after the barrier of step k.
+/// After the last step: DONE until every BYE is in, then CLOSE.
 #include <array>
 #include <string>
 #include <string_view>
@@ -37,9 +40,9 @@ inline constexpr std::array<RosterEntry, 5> kRoster{{{"integrator", kChDesired},
 
 class ClockParticipant : public Participant {
  public:
-  ClockParticipant(std::string name, RunIdentity id, Timing timing, lcm::LCM* lcm);
+  ClockParticipant(std::string name, RunIdentity id, Timing timing, lcm::LCM* lcm, Faults faults = {});
 
-  void Poll(SteadyClock::time_point now) override;
+  void Poll(SteadyClock::time_point now, bool idle) override;
 
   /// Step currently requested (-1 before GO).
   std::int64_t current_step() const { return k_; }
@@ -60,16 +63,16 @@ class ClockParticipant : public Participant {
   }
 
   void OnHandshakeForClock(const rths::handshake_t& msg, SteadyClock::time_point now) override;
+  void OnRepairForClock(const rths::repair_t& msg) override;
+  /// The answers of step k the barrier lacks.
+  void ListMissing(std::int64_t k, WantList* out) const override;
 
  private:
-  void OnMeasured(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
-  void OnCommand(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
-  void OnCurrent(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
-  void OnAck(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
   void CheckBarrier();
   void IssueStep(std::int64_t k);
   void SendGo();
-  std::string MissingAnswers(std::int64_t k) const;
+  /// Fails the run: step k_ has been incomplete for the whole stall budget.
+  void FailStalled(SteadyClock::time_point now);
 
   StepMailbox<rths::measured_t> measured_;
   StepMailbox<rths::command_t> command_;
@@ -80,10 +83,12 @@ class ClockParticipant : public Participant {
 
   std::array<bool, kRoster.size()> hello_{};
   std::array<bool, kRoster.size()> bye_{};
+  /// Who sent a repair_t for the current step (alive, but lacking inputs).
+  std::array<bool, kRoster.size()> reported_{};
   std::int64_t k_ = -1;
-  int attempts_ = 0;
+  int rerequests_ = 0;  ///< re-requests of the current step (or DONEs after the first)
   bool done_ = false;
-  int done_sends_ = 0;
+  SteadyClock::time_point step_since_;  ///< when step k_ (or DONE) was first sent
   SteadyClock::time_point last_send_;
   SteadyClock::time_point start_;
 };

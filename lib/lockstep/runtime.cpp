@@ -1,5 +1,10 @@
 #include "lockstep/runtime.h"
 
+#include <signal.h>
+#include <sys/types.h>
+#include <unistd.h>
+
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
@@ -14,13 +19,139 @@ namespace {
 double SecondsBetween(SteadyClock::time_point a, SteadyClock::time_point b) {
   return std::chrono::duration<double>(b - a).count();
 }
+
+/// The clock's role name (it owns k; see clock.h).
+constexpr const char* kClockName = "integrator";
+/// Copies of ABORT, GO and CLOSE sent at once (each is also recovered otherwise; see
+/// docs/lockstep.md): a single loss then costs nothing.
+constexpr int kControlCopies = 3;
 }  // namespace
 
-Participant::Participant(std::string name, RunIdentity id, Timing timing, lcm::LCM* lcm)
-    : name_(std::move(name)), id_(std::move(id)), timing_(timing), lcm_(lcm) {
+const char* ChannelName(std::int8_t code) {
+  switch (code) {
+    case kDesired: return kChDesired;
+    case kCommand: return kChCommand;
+    case kMeasured: return kChMeasured;
+    case kCurrent: return kChCurrent;
+    case kAck: return kChAck;
+    default: return "";
+  }
+}
+
+double Timing::RerequestAfterS(int n) const {
+  const double first = rerequest_ms * 1e-3;
+  const double cap = std::max(first, 1.0);
+  double wait = first;
+  for (int i = 1; i < n && wait < cap; ++i) wait *= 2.0;
+  return std::min(wait, cap);
+}
+
+double Timing::LingerS() const { return std::min(stall_budget_s, std::max(0.5, 10.0 * rerequest_ms * 1e-3)); }
+
+bool PeekRunAndStep(const std::uint8_t* data, std::size_t size, std::int64_t* run_id, std::int64_t* k) {
+  if (size < 24) return false;
+  auto be64 = [](const std::uint8_t* p) {
+    std::uint64_t v = 0;
+    for (int i = 0; i < 8; ++i) v = (v << 8) | p[i];
+    return static_cast<std::int64_t>(v);
+  };
+  *run_id = be64(data + 8);
+  *k = be64(data + 16);
+  return true;
+}
+
+/// One subscription of one participant: LCM calls OnMessage, which passes the fault injector.
+struct Participant::Route {
+  Participant* self;
+  std::string channel;
+  Handler handler;
+  void OnMessage(const lcm::ReceiveBuffer* rbuf, const std::string&) { self->Deliver(this, rbuf); }
+};
+
+Participant::Participant(std::string name, RunIdentity id, Timing timing, lcm::LCM* lcm, Faults faults)
+    : name_(std::move(name)),
+      id_(std::move(id)),
+      timing_(timing),
+      lcm_(lcm),
+      faults_(std::move(faults)),
+      injector_(faults_, std::hash<std::string>{}(name_)) {
   created_ = SteadyClock::now();
   last_clock_ = created_;
-  lcm_->subscribe(kChHandshake, &Participant::OnHandshake, this);
+  for (auto& a : asked_) a = {kNoChannel, -1};
+  Subscribe(kChHandshake, [this](const lcm::ReceiveBuffer* rbuf) { OnHandshake(rbuf); });
+  Subscribe(kChRepair, [this](const lcm::ReceiveBuffer* rbuf) { OnRepair(rbuf); });
+}
+
+Participant::~Participant() = default;
+
+void Participant::Subscribe(const char* channel, Handler handler) {
+  routes_.push_back(std::make_unique<Route>(Route{this, channel, std::move(handler)}));
+  lcm_->subscribe(channel, &Route::OnMessage, routes_.back().get());
+}
+
+void Participant::SetAnswerChannel(Channel channel, const AnswerCache* cache) {
+  answer_channel_ = channel;
+  answer_cache_ = cache;
+}
+
+void Participant::Deliver(Route* route, const lcm::ReceiveBuffer* rbuf) {
+  if (finished_) return;
+  const auto* data = static_cast<const std::uint8_t*>(rbuf->data);
+  const auto fate = injector_.Decide(route->channel, data, rbuf->data_size, &stats_.injected);
+  const auto now = SteadyClock::now();
+  switch (fate) {
+    case FaultInjector::Fate::kDrop:
+      return;
+    case FaultInjector::Fate::kDelay:
+    case FaultInjector::Fate::kReorder:
+      // A reordered message waits for the next one (or, if none comes, a random delay).
+      if (injector_.Hold(route, data, rbuf->data_size, rbuf->recv_utime, injector_.DelayedDue(now),
+                         fate == FaultInjector::Fate::kReorder)) {
+        return;
+      }
+      break;
+    case FaultInjector::Fate::kDuplicate:
+      injector_.Hold(route, data, rbuf->data_size, rbuf->recv_utime, injector_.DelayedDue(now), false);
+      break;
+    case FaultInjector::Fate::kDeliver:
+      break;
+  }
+  DeliverNow(route, rbuf);
+  // A reordered message goes in right after the next one.
+  if (injector_.active()) {
+    injector_.Release(now, true, [](void* r, const std::uint8_t* d, std::size_t n, std::int64_t utime) {
+      lcm::ReceiveBuffer b{const_cast<std::uint8_t*>(d), static_cast<std::uint32_t>(n), utime};
+      auto* held_route = static_cast<Route*>(r);
+      held_route->self->DeliverNow(held_route, &b);
+    });
+  }
+}
+
+void Participant::DeliverNow(Route* route, const lcm::ReceiveBuffer* rbuf) {
+  if (finished_) return;
+  if (!is_clock_ && route->channel == kChDesired) {
+    // Only the clock publishes desired_t: it is alive, and it has sent GO (a lost GO is
+    // repaired here: the first message of a step of our run starts us).
+    std::int64_t run_id = 0, k = 0;
+    if (PeekRunAndStep(static_cast<const std::uint8_t*>(rbuf->data), rbuf->data_size, &run_id, &k) &&
+        run_id == id_.run_id) {
+      HeardClock(SteadyClock::now());
+      if (!lingering_) StartRunning();
+    }
+  }
+  route->handler(rbuf);
+}
+
+void Participant::Tick(SteadyClock::time_point now, bool idle) {
+  if (finished_) return;
+  if (injector_.active()) {
+    injector_.Release(now, false, [](void* r, const std::uint8_t* d, std::size_t n, std::int64_t utime) {
+      lcm::ReceiveBuffer b{const_cast<std::uint8_t*>(d), static_cast<std::uint32_t>(n), utime};
+      auto* held_route = static_cast<Route*>(r);
+      held_route->self->DeliverNow(held_route, &b);
+    });
+  }
+  if (!finished_) Poll(now, idle);
 }
 
 void Participant::PublishBytes(const char* channel, const Bytes& bytes) {
@@ -29,10 +160,42 @@ void Participant::PublishBytes(const char* channel, const Bytes& bytes) {
   }
 }
 
-void Participant::Republish(const char* channel, const AnswerCache& cache, std::int64_t k) {
-  for (std::int64_t j = k; j <= k + 1; ++j) {
-    if (const Bytes* b = cache.Get(j)) PublishBytes(channel, *b);
+void Participant::Count(Channel channel, Put put, std::int64_t k) {
+  switch (put) {
+    case Put::kDuplicate: ++stats_.duplicates; return;
+    case Put::kStale: ++stats_.stale; return;
+    case Put::kForeign: ++stats_.foreign; return;
+    case Put::kBad: return;
+    case Put::kNew: break;
   }
+  for (auto& a : asked_) {
+    if (a.first == channel && a.second == k) {
+      ++stats_.repaired;
+      a = {kNoChannel, -1};
+    }
+  }
+}
+
+void Participant::SendRepair(std::int64_t k, const WantList& wants) {
+  repair_out_.run_id = id_.run_id;
+  repair_out_.k = k;
+  repair_out_.participant = name_;
+  repair_out_.n_want = wants.size();
+  repair_out_.want_channel.resize(wants.size());
+  repair_out_.want_k.resize(wants.size());
+  for (int i = 0; i < wants.size(); ++i) {
+    repair_out_.want_channel[i] = wants.channel(i);
+    repair_out_.want_k[i] = wants.k(i);
+    bool known = false;
+    for (const auto& a : asked_) known = known || (a.first == wants.channel(i) && a.second == wants.k(i));
+    if (!known) {
+      asked_[asked_next_] = {wants.channel(i), wants.k(i)};
+      asked_next_ = (asked_next_ + 1) % static_cast<int>(asked_.size());
+    }
+  }
+  Encode(repair_out_, &repair_bytes_);
+  ++(is_clock_ ? stats_.rerequests : stats_.repair_requests);
+  PublishBytes(kChRepair, repair_bytes_);
 }
 
 void Participant::SendHandshake(Phase phase, std::int64_t k, const std::string& reason,
@@ -53,86 +216,166 @@ void Participant::SendHandshake(Phase phase, std::int64_t k, const std::string& 
   hs_out_.n_roster = static_cast<std::int32_t>(hs_out_.roster_names.size());
   hs_out_.reason = reason;
   Encode(hs_out_, &hs_bytes_);
-  lcm_->publish(kChHandshake, hs_bytes_.data(), static_cast<unsigned int>(hs_bytes_.size()));
+  const int copies = (phase == kAbort || phase == kGo || phase == kClose) ? kControlCopies : 1;
+  for (int i = 0; i < copies; ++i) {
+    lcm_->publish(kChHandshake, hs_bytes_.data(), static_cast<unsigned int>(hs_bytes_.size()));
+  }
 }
 
-void Participant::OnHandshake(const lcm::ReceiveBuffer* rbuf, const std::string&) {
+void Participant::StartRunning() {
+  if (running_ || finished_) return;
+  running_ = true;
+  OnGo();
+}
+
+void Participant::OnHandshake(const lcm::ReceiveBuffer* rbuf) {
   if (finished_) return;
   if (hs_in_.decode(rbuf->data, 0, rbuf->data_size) < 0) return;
   if (hs_in_.run_id != id_.run_id) {
-    ++foreign_messages_;
+    ++stats_.foreign;
     return;
   }
+  OnHandshakeSeen(rbuf, hs_in_);
+  if (finished_) return;
   if (hs_in_.participant == name_) return;  // our own message, looped back
   const auto now = SteadyClock::now();
+  if (hs_in_.phase == kAbort) {
+    OnStop();
+    Fail(kExitPeerAbort, fmt::format("{} aborted the run: {}", hs_in_.participant, hs_in_.reason), false,
+         hs_in_.k);
+    return;
+  }
   if (is_clock_) {
-    if (hs_in_.phase == kAbort) {
-      OnStop();
-      Fail(kExitPeerAbort, fmt::format("{} aborted the run: {}", hs_in_.participant, hs_in_.reason),
-           false);
-      return;
-    }
     OnHandshakeForClock(hs_in_, now);
     return;
   }
+  if (hs_in_.participant != kClockName) return;
   HeardClock(now);
   switch (hs_in_.phase) {
     case kRequest:
       if (!running_) SendHandshake(kHello);
       break;
     case kGo:
-      if (!running_) {
-        running_ = true;
-        OnGo();
-      }
-      break;
-    case kAbort:
-      OnStop();
-      Fail(kExitPeerAbort, fmt::format("{} aborted the run: {}", hs_in_.participant, hs_in_.reason),
-           false);
+      StartRunning();
       break;
     case kDone:
-      OnDone();
-      SendHandshake(kBye, hs_in_.k);
-      Finish();
+      if (!lingering_) {
+        if (const std::string why = OnDone(); !why.empty()) {
+          Fail(kExitOutput, why, true, hs_in_.k);
+          return;
+        }
+        lingering_ = true;
+        linger_since_ = now;
+        running_ = false;
+      }
+      SendHandshake(kBye, hs_in_.k);  // again for every repeated DONE: our BYE may have been lost
+      break;
+    case kClose:
+      if (lingering_) Finish();
       break;
     default:
       break;
   }
 }
 
-void Participant::Poll(SteadyClock::time_point now) {
+void Participant::OnRepair(const lcm::ReceiveBuffer* rbuf) {
+  if (finished_) return;
+  if (repair_in_.decode(rbuf->data, 0, rbuf->data_size) < 0) return;
+  if (repair_in_.run_id != id_.run_id) {
+    ++stats_.foreign;
+    return;
+  }
+  if (repair_in_.participant == name_) return;
+  const bool from_clock = repair_in_.participant == kClockName;
+  if (from_clock && !is_clock_) {
+    HeardClock(SteadyClock::now());
+    if (!lingering_) StartRunning();  // GO was lost: the clock is running step k already
+  }
+  // Re-send what is wanted of ours, byte for byte from the cache (never recomputed).
+  if (answer_cache_ && !Stalled(repair_in_.k)) {
+    for (int i = 0; i < repair_in_.n_want; ++i) {
+      if (repair_in_.want_channel[i] != answer_channel_) continue;
+      if (const Bytes* b = answer_cache_->Get(repair_in_.want_k[i])) {
+        PublishBytes(ChannelName(answer_channel_), *b);
+        ++stats_.resent;
+      }
+    }
+  }
+  if (is_clock_) {
+    OnRepairForClock(repair_in_);
+    return;
+  }
+  // The clock re-requests step k: say what we lack to get there.
+  if (from_clock && running() && !Stalled(repair_in_.k)) {
+    WantList wants;
+    ListMissing(repair_in_.k, &wants);
+    if (!wants.empty()) SendRepair(repair_in_.k, wants);
+  }
+}
+
+void Participant::Poll(SteadyClock::time_point now, bool idle) {
   if (finished_ || is_clock_) return;
+  if (lingering_) {
+    if (SecondsBetween(linger_since_, now) > timing_.LingerS()) Finish();  // CLOSE was lost
+    return;
+  }
+  if (!idle) return;  // judge silence only once every waiting message has been handled
   if (!running_) {
     if (SecondsBetween(created_, now) > timing_.handshake_timeout_s) {
       Fail(kExitLockstep,
            fmt::format("no GO from the clock (integrator) within {:g} s of start-up; is it running "
                        "on the same LCM URL and run id?",
                        timing_.handshake_timeout_s),
-           false);
+           false, -1, kClockName);
     }
     return;
   }
-  const double limit_s = timing_.timeout_ms * 1e-3 * (timing_.max_attempts + 2);
-  if (SecondsBetween(last_clock_, now) > limit_s) {
+  if (SecondsBetween(last_clock_, now) > timing_.WatchdogS()) {
     OnStop();
-    Fail(kExitLockstep, fmt::format("the clock (integrator) has been silent for {:.3g} s", limit_s),
-         false);
+    Fail(kExitLockstep,
+         fmt::format("the clock (integrator) has been silent for {:.3g} s", SecondsBetween(last_clock_, now)),
+         true, -1, kClockName);
   }
 }
 
-void Participant::Fail(int exit_code, const std::string& reason, bool broadcast, std::int64_t k) {
+void Participant::Fail(int exit_code, const std::string& reason, bool broadcast, std::int64_t k,
+                       const std::string& culprit) {
   if (finished_) return;
   if (broadcast) SendHandshake(kAbort, k, reason);
   finished_ = true;
   running_ = false;
   exit_code_ = exit_code;
   error_ = reason;
+  culprit_ = culprit;
+  fail_step_ = k;
 }
 
-void Participant::MaybeThrow(std::int64_t k) const {
-  if (faults.throw_at == k) throw std::runtime_error("injected fault (test)");
-  if (faults.crash_at == k) std::abort();
+void Participant::MaybeFault(std::int64_t k) {
+  if (faults_.process == ProcessFault::kNone || k != faults_.at_step || fault_fired_) return;
+  fault_fired_ = true;
+  switch (faults_.process) {
+    case ProcessFault::kThrow:
+      throw std::runtime_error("injected fault ([faults.process] kind = \"throw\")");
+    case ProcessFault::kCrash:
+      std::abort();
+    case ProcessFault::kKill:
+      ::raise(SIGKILL);
+      break;
+    case ProcessFault::kStop:
+      if (faults_.stop_s > 0) {
+        // A helper process continues us after stop_s, as `kill -CONT` from outside would.
+        const pid_t self = ::getpid();
+        if (::fork() == 0) {
+          ::usleep(static_cast<useconds_t>(faults_.stop_s * 1e6));
+          ::kill(self, SIGCONT);
+          ::_exit(0);
+        }
+      }
+      ::raise(SIGSTOP);
+      break;
+    default:
+      break;
+  }
 }
 
 void Participant::Finish() {
@@ -140,9 +383,18 @@ void Participant::Finish() {
   running_ = false;
 }
 
-int RunLoop(lcm::LCM* lcm, const std::vector<Participant*>& participants) {
+void Participant::Interrupt(const std::string& reason) {
+  if (finished_) return;
+  OnStop();
+  Fail(kExitPeerAbort, reason, false);
+}
+
+int RunLoop(lcm::LCM* lcm, const std::vector<Participant*>& participants, const volatile std::sig_atomic_t* stop) {
   constexpr int kPollMs = 5;
   for (;;) {
+    if (stop && *stop) {
+      for (Participant* p : participants) p->Interrupt("interrupted by the user");
+    }
     bool all_done = true;
     for (Participant* p : participants) all_done = all_done && p->finished();
     if (all_done) break;
@@ -154,9 +406,7 @@ int RunLoop(lcm::LCM* lcm, const std::vector<Participant*>& participants) {
       return kExitLockstep;
     }
     const auto now = SteadyClock::now();
-    for (Participant* p : participants) {
-      if (!p->finished()) p->Poll(now);
-    }
+    for (Participant* p : participants) p->Tick(now, r == 0);
   }
   int first_own = 0, first_any = 0;
   for (Participant* p : participants) {

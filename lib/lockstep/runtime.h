@@ -1,21 +1,27 @@
 #pragma once
 /// @file Lockstep runtime shared by every participant: channels, handshake, step mailboxes,
-/// cached answers, the silence watchdog and the event loop. The protocol and its step-index
-/// table are in docs/lockstep.md; every participant's doc comment points there.
+/// cached answers, the repair of lost messages, the silence watchdog, fault injection and the
+/// event loop. The protocol and its step-index table are in docs/lockstep.md; every
+/// participant's doc comment points there.
 ///
 /// The same participant objects run as separate processes, each with its own LCM instance on
 /// `udpm://` (one UDP port per run), or all in one process sharing one `memq://` instance
 /// (memq queues belong to one lcm_t, so in that mode LCM dispatches from one thread).
 #include <array>
-#include <exception>
 #include <chrono>
+#include <csignal>
 #include <cstdint>
+#include <exception>
+#include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include <lcm/lcm-cpp.hpp>
 
+#include "lockstep/faults.h"
 #include "rths/handshake_t.hpp"
+#include "rths/repair_t.hpp"
 
 namespace rths::lockstep {
 
@@ -25,17 +31,32 @@ inline constexpr const char* kChCommand = "RTHS_COMMAND";
 inline constexpr const char* kChMeasured = "RTHS_MEASURED";
 inline constexpr const char* kChCurrent = "RTHS_CURRENT";
 inline constexpr const char* kChAck = "RTHS_ACK";
+inline constexpr const char* kChRepair = "RTHS_REPAIR";
 
-enum Phase : std::int8_t { kRequest = 1, kHello = 2, kGo = 3, kAbort = 4, kDone = 5, kBye = 6 };
+/// Per-step channels by code (the codes travel in repair_t.want_channel).
+enum Channel : std::int8_t { kNoChannel = 0, kDesired = 1, kCommand = 2, kMeasured = 3, kCurrent = 4, kAck = 5 };
+/// Name of a per-step channel ("" for kNoChannel or an unknown code).
+const char* ChannelName(std::int8_t code);
 
-/// Process exit codes, documented in docs/lockstep.md and `rths --help`.
+enum Phase : std::int8_t {
+  kRequest = 1,  ///< clock: who is there? (repeated until every HELLO is in)
+  kHello = 2,    ///< participant: here I am, with my scenario hash
+  kGo = 3,       ///< clock: everyone agrees; step 0 follows
+  kAbort = 4,    ///< anyone (or the supervisor): stop now
+  kDone = 5,     ///< clock: every step is committed; flush (repeated until every BYE is in)
+  kBye = 6,      ///< participant: flushed; answered to every DONE while lingering
+  kClose = 7,    ///< clock: every BYE is in; lingering participants exit
+};
+
+/// Process exit codes, documented in docs/lockstep.md, the README and `rths --help`.
 enum ExitCode : int {
   kExitOk = 0,
-  kExitUsage = 2,          ///< bad command line or scenario (nothing ran)
-  kExitLockstep = 3,       ///< this participant detected a protocol failure (silence, hash mismatch)
-  kExitPeerAbort = 4,      ///< stopped because another participant broadcast ABORT
+  kExitUsage = 2,          ///< bad command line or scenario, or not enough disk (nothing ran)
+  kExitLockstep = 3,       ///< a protocol failure (a participant stopped answering, hash mismatch)
+  kExitPeerAbort = 4,      ///< stopped because another participant (or the supervisor) said ABORT
   kExitInternal = 5,       ///< an exception in this participant's own computation
   kExitSafety = 6,         ///< the safety monitor stopped the run (a limit was left)
+  kExitOutput = 7,         ///< the run's output could not be written (disk full, I/O error)
 };
 
 using SteadyClock = std::chrono::steady_clock;
@@ -49,20 +70,35 @@ struct RunIdentity {
   double dt_s = 0.0;
 };
 
-/// Runtime knobs (from scenario [lockstep]).
+/// Runtime knobs (from the scenario's [lockstep] table; ranges in docs/scenarios.md).
 struct Timing {
-  double timeout_ms = 250.0;        ///< silence before the clock re-requests a step
-  int max_attempts = 8;             ///< requests of one step before the clock aborts
-  double handshake_timeout_s = 20;  ///< wait for every HELLO (clock) / for GO (others)
+  /// Silence before the clock re-requests an incomplete step [ms]; each further re-request of the
+  /// same step waits twice as long, up to max(rerequest_ms, 1000 ms).
+  double rerequest_ms = 100.0;
+  /// A step that has not completed after this long [s] stops the run, naming who stopped
+  /// answering. Participants give up on a silent clock after stall_budget_s + 2 s.
+  double stall_budget_s = 10.0;
+  double handshake_timeout_s = 20;  ///< wait for every HELLO (clock) / for GO (others) [s]
+
+  /// Wait before re-request number `n` (1-based) of one step [s].
+  double RerequestAfterS(int n) const;
+  /// How long a participant that heard nothing from the clock keeps waiting [s].
+  double WatchdogS() const { return stall_budget_s + 2.0; }
+  /// How long a participant lingers after DONE, answering repeated DONEs, without CLOSE [s].
+  double LingerS() const;
 };
 
-/// Test-only fault injection (never set by a scenario; see tests/lockstep_test.cpp).
-struct Faults {
-  std::int64_t drop_first_request_at = -1;  ///< behave as if the first copy of desired k was lost
-  std::int64_t stall_at = -1;               ///< stop answering from step k on (a hung process)
-  std::int64_t throw_at = -1;               ///< throw from the step computation at step k
-  std::int64_t crash_at = -1;               ///< die by SIGABRT at step k (a crashed process)
-  double command_gain = 1.0;                ///< controller: multiply u_k (-1: a sign error)
+/// Counters of what the link lost and what the protocol repaired (summary.json, per participant).
+struct LinkStats {
+  std::int64_t rerequests = 0;         ///< clock: re-requests it sent (repair_t of an incomplete step)
+  std::int64_t steps_rerequested = 0;  ///< clock: steps that needed at least one re-request
+  std::int64_t repair_requests = 0;    ///< repair_t it sent listing inputs it lacked
+  std::int64_t resent = 0;             ///< messages it re-sent from its cache because one lacked them
+  std::int64_t repaired = 0;           ///< messages it lacked, asked for, and then received
+  std::int64_t duplicates = 0;         ///< copies of messages it already held (ignored)
+  std::int64_t stale = 0;              ///< messages of steps it had left behind (ignored)
+  std::int64_t foreign = 0;            ///< messages of another run on the same port (ignored)
+  InjectedFaults injected;             ///< faults injected on its receive path ([faults])
 };
 
 /// Encodes an lcm-gen message into `out` (reusing its capacity: no allocation once sized).
@@ -73,13 +109,18 @@ void Encode(const Msg& msg, Bytes* out) {
   msg.encode(out->data(), 0, n);
 }
 
+/// The run_id and k of an encoded step or repair message (the first two int64 fields after the
+/// 8-byte type hash), without decoding it; false if it is too short.
+bool PeekRunAndStep(const std::uint8_t* data, std::size_t size, std::int64_t* run_id, std::int64_t* k);
+
+/// What a mailbox did with a message.
+enum class Put { kNew, kDuplicate, kStale, kForeign, kBad };
+
 /// Received messages of one channel, kept by step index k in a small ring, decoded into
 /// preallocated slots. The first copy of (channel, k) is "new"; later copies are duplicates.
 template <class Msg, int kDepth = 4>
 class StepMailbox {
  public:
-  enum class Put { kNew, kDuplicate, kStale, kForeign, kBad };
-
   StepMailbox() { ks_.fill(-1); }
 
   /// Decodes `rbuf`; keeps it if it is the first copy of its k for this run.
@@ -104,11 +145,6 @@ class StepMailbox {
   }
   /// k of the message just added (valid after Add returned kNew, kDuplicate or kStale).
   std::int64_t last_k() const { return last_k_; }
-  /// Forgets step k (test-only fault injection: behave as if it had never arrived).
-  void Forget(std::int64_t k) {
-    const int slot = static_cast<int>(k % kDepth);
-    if (ks_[slot] == k) ks_[slot] = -1;
-  }
 
  private:
   std::array<Msg, kDepth> slots_{};
@@ -134,12 +170,35 @@ class AnswerCache {
   std::array<std::int64_t, kDepth> ks_{};
 };
 
-/// Base of every participant: handshake, ABORT/DONE handling, the watchdog on the clock,
-/// failure bookkeeping. A subclass subscribes to its step channels and implements the step.
+/// Messages a participant lacks: (channel, step) pairs, at most kCapacity.
+class WantList {
+ public:
+  static constexpr int kCapacity = 8;
+  void Add(Channel channel, std::int64_t k) {
+    if (n_ < kCapacity && k >= 0) items_[n_++] = {channel, k};
+  }
+  int size() const { return n_; }
+  bool empty() const { return n_ == 0; }
+  Channel channel(int i) const { return items_[i].channel; }
+  std::int64_t k(int i) const { return items_[i].k; }
+
+ private:
+  struct Item {
+    Channel channel;
+    std::int64_t k;
+  };
+  std::array<Item, kCapacity> items_{};
+  int n_ = 0;
+};
+
+/// Base of every participant: subscriptions (through the fault injector), handshake, ABORT /
+/// DONE / CLOSE handling, the repair of lost messages, the watchdog on the clock and failure
+/// bookkeeping. A subclass subscribes to its step channels, declares its answer channel, lists
+/// what it lacks for a step, and implements the step.
 class Participant {
  public:
-  Participant(std::string name, RunIdentity id, Timing timing, lcm::LCM* lcm);
-  virtual ~Participant() = default;
+  Participant(std::string name, RunIdentity id, Timing timing, lcm::LCM* lcm, Faults faults = {});
+  virtual ~Participant();
   Participant(const Participant&) = delete;
   Participant& operator=(const Participant&) = delete;
 
@@ -149,19 +208,40 @@ class Participant {
   int exit_code() const { return exit_code_; }
   /// Why it failed ("" on success).
   const std::string& error() const { return error_; }
+  /// The participant this one blames for its failure ("" if none or itself): the one that
+  /// stopped answering.
+  const std::string& culprit() const { return culprit_; }
+  /// The step being run when it failed (-1 before step 0 or on success).
+  std::int64_t fail_step() const { return fail_step_; }
+  const LinkStats& stats() const { return stats_; }
 
-  /// Called by the event loop after every handled message and on every poll timeout.
-  virtual void Poll(SteadyClock::time_point now);
+  /// Stops now, as if the supervisor had said ABORT (an interrupt): flushes, exit kExitPeerAbort.
+  void Interrupt(const std::string& reason);
 
-  Faults faults;  ///< test-only
+  /// Called by the event loop after every handled message and on every poll timeout: delivers
+  /// held (delayed) messages that are due, then Poll(). `idle` is true when no message was
+  /// waiting: only then may a participant conclude that someone has gone silent.
+  void Tick(SteadyClock::time_point now, bool idle);
 
  protected:
-  /// Called once when GO arrives (the clock calls it itself).
+  using Handler = std::function<void(const lcm::ReceiveBuffer*)>;
+  /// Subscribes `handler` to `channel`; every message passes the fault injector first.
+  void Subscribe(const char* channel, Handler handler);
+  /// Declares this participant's per-step answer channel and its cache: a repair_t that wants
+  /// (channel, k) gets the cached bytes of k re-sent.
+  void SetAnswerChannel(Channel channel, const AnswerCache* cache);
+
+  virtual void Poll(SteadyClock::time_point now, bool idle);
+  /// Called once when GO (or, if GO was lost, the first message of step 0) arrives.
   virtual void OnGo() {}
-  /// Called once when DONE arrives, before BYE is sent: flush and close outputs.
-  virtual void OnDone() {}
+  /// Called once when DONE arrives, before BYE is sent: flush and close outputs. A non-empty
+  /// return is a failure to flush (exit kExitOutput, ABORT broadcast).
+  virtual std::string OnDone() { return {}; }
   /// Called when the run stops abnormally (ABORT or own failure): flush what is committed.
   virtual void OnStop() {}
+  /// Appends to `out` the inputs this participant lacks to advance up to step k (its answer of
+  /// k, or for the plant measured_t k). Called when the clock re-requests step k.
+  virtual void ListMissing(std::int64_t /*k*/, WantList* /*out*/) const {}
 
   /// Publishes raw bytes on a channel.
   void PublishBytes(const char* channel, const Bytes& bytes);
@@ -172,13 +252,24 @@ class Participant {
     cache->Commit(k);
     PublishBytes(channel, *cache->Get(k));
   }
-  /// Re-publishes cached answers of steps k and k+1 (a re-request of step k).
-  void Republish(const char* channel, const AnswerCache& cache, std::int64_t k);
+  /// Counts what a mailbox did with a message (duplicates, stale, foreign; repaired inputs).
+  void Count(Channel channel, Put put, std::int64_t k);
+  /// Adds a message to a mailbox and counts it.
+  template <class Msg, int D>
+  Put Receive(StepMailbox<Msg, D>* box, Channel channel, const lcm::ReceiveBuffer* rbuf) {
+    const Put put = box->Add(rbuf, id_.run_id);
+    Count(channel, put, box->last_k());
+    return put;
+  }
+  /// Sends a repair_t for step k listing `wants` (remembered, to count what gets repaired).
+  void SendRepair(std::int64_t k, const WantList& wants);
 
   /// Marks the clock as alive (call on every message from the clock).
   void HeardClock(SteadyClock::time_point now) { last_clock_ = now; }
-  /// Stops this participant with an exit code; broadcasts ABORT when `broadcast`.
-  void Fail(int exit_code, const std::string& reason, bool broadcast, std::int64_t k = -1);
+  /// Stops this participant with an exit code; broadcasts ABORT when `broadcast`. `culprit`
+  /// names the participant to blame when it is not this one.
+  void Fail(int exit_code, const std::string& reason, bool broadcast, std::int64_t k = -1,
+            const std::string& culprit = "");
   /// Stops cleanly.
   void Finish();
   /// Sends a handshake message of this participant; `roster` (GO only) lists who takes part,
@@ -187,17 +278,14 @@ class Participant {
                      const std::vector<std::string>* roster = nullptr);
 
   bool running() const { return running_ && !finished_; }
-
-  /// Fault injection (test-only): true exactly once, for the first copy of request k.
-  bool InjectDrop(std::int64_t k) {
-    if (faults.drop_first_request_at != k || dropped_) return false;
-    dropped_ = true;
-    return true;
+  /// Process fault (test and rehearsal, [faults.process]): this participant no longer answers
+  /// from step k on.
+  bool Stalled(std::int64_t k) const {
+    return faults_.process == ProcessFault::kStall && k >= faults_.at_step;
   }
-  /// Fault injection (test-only): this participant no longer answers from step k on.
-  bool Stalled(std::int64_t k) const { return faults.stall_at >= 0 && k >= faults.stall_at; }
-  /// Fault injection (test-only): throws from (or crashes in) the step computation of step k.
-  void MaybeThrow(std::int64_t k) const;
+  /// Process fault: throws from (or crashes, kills or stops the process in) the step computation
+  /// of step k.
+  void MaybeFault(std::int64_t k);
   /// Runs a message handler body, turning an exception into a clean, broadcast failure.
   template <class F>
   void Guarded(std::int64_t k, F&& body) {
@@ -209,38 +297,67 @@ class Participant {
     }
   }
   bool IsClock() const { return is_clock_; }
+  const Faults& faults() const { return faults_; }
 
   const std::string name_;
   const RunIdentity id_;
   const Timing timing_;
   lcm::LCM* const lcm_;
   bool is_clock_ = false;
+  LinkStats stats_;
+
+  /// Every handshake message of this run, our own included (the logger records them).
+  virtual void OnHandshakeSeen(const lcm::ReceiveBuffer* /*rbuf*/, const rths::handshake_t& /*msg*/) {}
+  /// Handshake messages addressed to the clock (HELLO, BYE).
+  virtual void OnHandshakeForClock(const rths::handshake_t& /*msg*/, SteadyClock::time_point /*now*/) {}
+  /// A repair_t from another participant, seen by the clock (who is alive, what it lacks).
+  virtual void OnRepairForClock(const rths::repair_t& /*msg*/) {}
 
  private:
-  void OnHandshake(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
+  struct Route;
+  /// A received message: through the fault injector, then DeliverNow.
+  void Deliver(Route* route, const lcm::ReceiveBuffer* rbuf);
+  /// Hands a message to its handler (held messages come back here, past the injector).
+  void DeliverNow(Route* route, const lcm::ReceiveBuffer* rbuf);
+  void OnHandshake(const lcm::ReceiveBuffer* rbuf);
+  void OnRepair(const lcm::ReceiveBuffer* rbuf);
+  void StartRunning();
 
+  Faults faults_;
+  FaultInjector injector_;
+  std::vector<std::unique_ptr<Route>> routes_;
   bool running_ = false;
   bool finished_ = false;
+  bool lingering_ = false;  ///< after DONE and BYE: answering repeated DONEs until CLOSE
+  SteadyClock::time_point linger_since_;
   int exit_code_ = kExitOk;
   std::string error_;
+  std::string culprit_;
+  std::int64_t fail_step_ = -1;
   SteadyClock::time_point created_;
   SteadyClock::time_point last_clock_;
   rths::handshake_t hs_in_{};
   rths::handshake_t hs_out_{};
+  rths::repair_t repair_in_{};
+  rths::repair_t repair_out_{};
   Bytes hs_bytes_;
-  std::int64_t foreign_messages_ = 0;
-  bool dropped_ = false;
-
- protected:
-  /// Handshake messages addressed to the clock (HELLO, BYE, ABORT from others).
-  virtual void OnHandshakeForClock(const rths::handshake_t& /*msg*/, SteadyClock::time_point /*now*/) {}
+  Bytes repair_bytes_;
+  Channel answer_channel_ = kNoChannel;
+  const AnswerCache* answer_cache_ = nullptr;
+  /// Messages asked for in a repair_t and not yet received (to count `repaired`).
+  std::array<std::pair<Channel, std::int64_t>, 16> asked_{};
+  int asked_next_ = 0;
+  bool fault_fired_ = false;
 };
 
 /// Runs participants sharing one LCM instance until every one has finished. In udpm mode the
 /// vector holds one participant; in memq mode all of them. Returns the first non-zero exit
 /// code of a participant that failed on its own (not kExitPeerAbort), else the first
 /// non-zero, else 0.
-int RunLoop(lcm::LCM* lcm, const std::vector<Participant*>& participants);
+/// When `*stop` becomes true (an interrupt), every participant stops at once (exit
+/// kExitPeerAbort, "interrupted"), its committed output flushed.
+int RunLoop(lcm::LCM* lcm, const std::vector<Participant*>& participants,
+            const volatile std::sig_atomic_t* stop = nullptr);
 
 /// Checks the host can do LCM multicast on loopback (`udpm`); returns "" if fine, or a message
 /// telling the user how to fix it (ip route add 224.0.0.0/4 dev lo).

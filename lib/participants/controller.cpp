@@ -4,8 +4,10 @@
 
 namespace rths::participants {
 
-Controller::Controller(const scenario::Scenario& s, lockstep::RunIdentity id, lcm::LCM* lcm)
-    : DesiredMeasuredParticipant("controller", std::move(id), TimingOf(s), lcm, lockstep::kChCommand),
+Controller::Controller(const scenario::Scenario& s, lockstep::RunIdentity id, lcm::LCM* lcm,
+                       lockstep::Faults faults)
+    : DesiredMeasuredParticipant("controller", std::move(id), TimingOf(s), lcm, std::move(faults),
+                                 lockstep::kChCommand, lockstep::kCommand),
       law_(control::MakeTrackingController(s.controller, s.run.dt_s)) {}
 
 void Controller::Compute(std::int64_t, const rths::desired_t& d, const rths::measured_t& m,
@@ -13,7 +15,7 @@ void Controller::Compute(std::int64_t, const rths::desired_t& d, const rths::mea
   const control::Derivatives der{d.r_mm,           d.rd_mm_s,         d.rdd_mm_s2,
                                  d.rddd_mm_s3,     d.acc_prev_mm_s2,  d.vel_prev_mm_s};
   const control::Command c = law_->Step(der, {m.y_mm, m.f_kN, m.current_A});
-  const double g = faults.command_gain;  // 1 outside fault-injection tests
+  const double g = faults().command_gain;  // 1 outside fault-injection tests
   out->u_mm = g * c.u_mm;
   out->u_ff_mm = g * c.u_ff_mm;
   out->u_fb_mm = g * c.u_fb_mm;

@@ -13,7 +13,7 @@ namespace rths::participants {
 
 class Controller final : public DesiredMeasuredParticipant<rths::command_t> {
  public:
-  Controller(const scenario::Scenario& s, lockstep::RunIdentity id, lcm::LCM* lcm);
+  Controller(const scenario::Scenario& s, lockstep::RunIdentity id, lcm::LCM* lcm, lockstep::Faults faults = {});
 
  protected:
   void Compute(std::int64_t k, const rths::desired_t& d, const rths::measured_t& m,

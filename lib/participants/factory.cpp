@@ -1,6 +1,8 @@
 #include "participants/factory.h"
 
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <string>
 
 #include <CLI/CLI.hpp>
@@ -8,6 +10,7 @@
 
 #include "core/error.h"
 #include "participants/controller.h"
+#include "participants/group.h"
 #include "participants/integrator.h"
 #include "participants/logger.h"
 #include "participants/plant.h"
@@ -15,35 +18,70 @@
 
 namespace rths::participants {
 
+namespace fs = std::filesystem;
+
 lockstep::RunIdentity IdentityOf(const scenario::Scenario& s, std::int64_t run_id) {
   return {run_id, s.sha256, s.steps(), s.run.dt_s};
 }
 
 lockstep::Timing TimingOf(const scenario::Scenario& s) {
-  return {s.lockstep.timeout_ms, s.lockstep.max_attempts, s.lockstep.handshake_timeout_s};
+  return {s.lockstep.rerequest_ms, s.lockstep.stall_budget_s, s.lockstep.handshake_timeout_s};
 }
 
-std::unique_ptr<lockstep::Participant> MakeParticipant(std::string_view role,
-                                                       const scenario::Scenario& s,
-                                                       const lockstep::RunIdentity& id,
-                                                       lcm::LCM* lcm, const std::string& out_dir) {
-  if (role == "integrator") return std::make_unique<Integrator>(s, id, lcm);
-  if (role == "controller") return std::make_unique<Controller>(s, id, lcm);
-  if (role == "plant") return std::make_unique<Plant>(s, id, lcm);
-  if (role == "semiactive") return std::make_unique<Semiactive>(s, id, lcm);
+lockstep::Faults FaultsOf(const scenario::Scenario& s, std::string_view role) {
+  const scenario::FaultConfig& c = s.faults;
+  lockstep::Faults f;
+  f.network = {c.drop, c.duplicate, c.delay, c.reorder, c.delay_ms, static_cast<std::uint64_t>(c.seed)};
+  if (c.process_role == role) {
+    f.process = lockstep::ParseProcessFault(c.process_kind);
+    f.at_step = c.process_at_step;
+    f.stop_s = c.process_stop_s;
+  }
+  return f;
+}
+
+std::unique_ptr<lockstep::Participant> MakeParticipant(std::string_view role, const scenario::Scenario& s,
+                                                       const lockstep::RunIdentity& id, lcm::LCM* lcm,
+                                                       const std::string& out_dir, lockstep::Faults faults) {
+  if (role == "integrator") return std::make_unique<Integrator>(s, id, lcm, std::move(faults));
+  if (role == "controller") return std::make_unique<Controller>(s, id, lcm, std::move(faults));
+  if (role == "plant") return std::make_unique<Plant>(s, id, lcm, std::move(faults));
+  if (role == "semiactive") return std::make_unique<Semiactive>(s, id, lcm, std::move(faults));
   if (role == "logger") {
-    return std::make_unique<Logger>(id, TimingOf(s), lcm, out_dir + "/log.lcm",
-                                    out_dir + "/signals.csv");
+    return std::make_unique<Logger>(id, TimingOf(s), lcm, out_dir + "/log.lcm", out_dir + "/signals.csv",
+                                    std::move(faults));
   }
   throw Error("", fmt::format("unknown participant role '{}'", role));
+}
+
+std::unique_ptr<lockstep::Participant> MakeParticipant(std::string_view role, const scenario::Scenario& s,
+                                                       const lockstep::RunIdentity& id, lcm::LCM* lcm,
+                                                       const std::string& out_dir) {
+  return MakeParticipant(role, s, id, lcm, out_dir, FaultsOf(s, role));
 }
 
 void CheckBuildable(const scenario::Scenario& s) {
   lcm::LCM lcm("memq://");
   for (std::string_view role : {"integrator", "controller", "plant", "semiactive"}) {
-    MakeParticipant(role, s, IdentityOf(s, 1), &lcm, "");
+    MakeParticipant(role, s, IdentityOf(s, 1), &lcm, "", {});
   }
 }
+
+namespace {
+/// Writes the participant's outcome for the supervisor; a failure here (disk full) only loses
+/// the statistics: the supervisor still has the exit status.
+void WriteOutcome(const std::string& out_dir, const Outcome& o) {
+  const fs::path dir = fs::path(out_dir) / "logs";
+  const fs::path tmp = dir / (o.role + ".json.tmp"), final_path = dir / (o.role + ".json");
+  {
+    std::ofstream f(tmp);
+    f << OutcomeToJson(o).dump(2) << "\n";
+    if (!f.good()) return;
+  }
+  std::error_code ec;
+  fs::rename(tmp, final_path, ec);
+}
+}  // namespace
 
 int RoleMain(std::string_view role, int argc, char** argv) {
   const std::string name(role);
@@ -51,42 +89,43 @@ int RoleMain(std::string_view role, int argc, char** argv) {
                            name, name)};
   std::string scenario_path, url, out_dir = ".";
   std::int64_t run_id = 0;
-  lockstep::Faults faults;
   app.add_option("--scenario", scenario_path, "scenario TOML file")->required();
   app.add_option("--lcm-url", url, "LCM URL, e.g. udpm://239.255.76.67:7667?ttl=0")->required();
   app.add_option("--run-id", run_id, "run id shared by every participant")->required();
-  app.add_option("--out", out_dir, "output folder (logger)");
-  app.add_option("--fault-drop", faults.drop_first_request_at, "test only: lose request k once")
-      ->group("");
-  app.add_option("--fault-stall", faults.stall_at, "test only: stop answering at step k")->group("");
-  app.add_option("--fault-throw", faults.throw_at, "test only: throw at step k")->group("");
-  app.add_option("--fault-crash", faults.crash_at, "test only: abort() at step k")->group("");
+  app.add_option("--out", out_dir, "output folder (the logger's files; logs/<role>.json for everyone)");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     return app.exit(e) == 0 ? 0 : lockstep::kExitUsage;
   }
+  Outcome o;
+  o.role = name;
   try {
     const scenario::Scenario s = scenario::LoadScenario(scenario_path);
     lcm::LCM lcm(url);
     if (!lcm.good()) {
       std::string hint = lockstep::CheckMulticastRoute();
-      std::fprintf(stderr, "%s: cannot open LCM at %s\n%s\n", name.c_str(), url.c_str(),
-                   hint.c_str());
-      return lockstep::kExitLockstep;
+      o.exit_code = lockstep::kExitLockstep;
+      o.message = fmt::format("cannot open LCM at {}{}{}", url, hint.empty() ? "" : "\n", hint);
+    } else {
+      auto p = MakeParticipant(role, s, IdentityOf(s, run_id), &lcm, out_dir);
+      o.exit_code = lockstep::RunLoop(&lcm, {p.get()});
+      o.message = p->error();
+      o.culprit = p->culprit();
+      o.step = p->fail_step();
+      o.stats = p->stats();
+      o.stats_known = true;
     }
-    auto p = MakeParticipant(role, s, IdentityOf(s, run_id), &lcm, out_dir);
-    p->faults = faults;
-    const int code = lockstep::RunLoop(&lcm, {p.get()});
-    if (code != 0) std::fprintf(stderr, "%s: %s\n", name.c_str(), p->error().c_str());
-    return code;
   } catch (const Error& e) {
-    std::fprintf(stderr, "%s: %s\n", name.c_str(), e.what());
-    return lockstep::kExitUsage;
+    o.exit_code = lockstep::kExitUsage;
+    o.message = e.what();
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "%s: internal error: %s\n", name.c_str(), e.what());
-    return lockstep::kExitInternal;
+    o.exit_code = lockstep::kExitInternal;
+    o.message = fmt::format("internal error: {}", e.what());
   }
+  if (o.exit_code != 0) std::fprintf(stderr, "%s: %s\n", name.c_str(), o.message.c_str());
+  WriteOutcome(out_dir, o);
+  return o.exit_code;
 }
 
 }  // namespace rths::participants

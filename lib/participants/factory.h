@@ -18,13 +18,20 @@ inline constexpr std::string_view kRoles[] = {"integrator", "controller", "plant
 lockstep::RunIdentity IdentityOf(const scenario::Scenario& s, std::int64_t run_id);
 /// Lockstep knobs from the scenario's [lockstep] table.
 lockstep::Timing TimingOf(const scenario::Scenario& s);
+/// The faults of the scenario's [faults] table that `role` is subject to (the network faults
+/// apply to every participant, the process fault to its role only).
+lockstep::Faults FaultsOf(const scenario::Scenario& s, std::string_view role);
 
-/// Builds the participant `role` on `lcm`. The logger writes `out_dir`/log.lcm and
-/// `out_dir`/signals.csv. Throws rths::Error (unknown role, bad model, unwritable output).
-std::unique_ptr<lockstep::Participant> MakeParticipant(std::string_view role,
-                                                       const scenario::Scenario& s,
-                                                       const lockstep::RunIdentity& id,
-                                                       lcm::LCM* lcm, const std::string& out_dir);
+/// Builds the participant `role` on `lcm`, subject to `faults`. The logger writes
+/// `out_dir`/log.lcm and `out_dir`/signals.csv. Throws rths::Error (unknown role, bad model,
+/// unwritable output).
+std::unique_ptr<lockstep::Participant> MakeParticipant(std::string_view role, const scenario::Scenario& s,
+                                                       const lockstep::RunIdentity& id, lcm::LCM* lcm,
+                                                       const std::string& out_dir, lockstep::Faults faults);
+/// As above, with FaultsOf(s, role).
+std::unique_ptr<lockstep::Participant> MakeParticipant(std::string_view role, const scenario::Scenario& s,
+                                                       const lockstep::RunIdentity& id, lcm::LCM* lcm,
+                                                       const std::string& out_dir);
 
 /// Builds every participant but the logger once, off-line, and throws away: a scenario whose
 /// models cannot be built (a structure file with errors, a design that fails) is refused before
@@ -32,7 +39,8 @@ std::unique_ptr<lockstep::Participant> MakeParticipant(std::string_view role,
 void CheckBuildable(const scenario::Scenario& s);
 
 /// main() of procs/<role>: `--scenario FILE --lcm-url URL --run-id N [--out DIR]`.
-/// Exit codes: lockstep::ExitCode.
+/// Exit codes: lockstep::ExitCode. At exit it writes `DIR/logs/<role>.json` (its outcome and
+/// link statistics, participants::OutcomeToJson) for the supervisor.
 int RoleMain(std::string_view role, int argc, char** argv);
 
 }  // namespace rths::participants

@@ -1,17 +1,85 @@
 #include "participants/group.h"
 
+#include <cstring>
 #include <memory>
+
+#include <fmt/core.h>
 
 #include "core/error.h"
 #include "participants/factory.h"
 
 namespace rths::participants {
 
+nlohmann::json StatsToJson(const lockstep::LinkStats& s) {
+  return {{"rerequests", s.rerequests},
+          {"steps_rerequested", s.steps_rerequested},
+          {"repair_requests", s.repair_requests},
+          {"resent", s.resent},
+          {"repaired", s.repaired},
+          {"duplicates_ignored", s.duplicates},
+          {"stale_ignored", s.stale},
+          {"foreign_ignored", s.foreign},
+          {"injected",
+           {{"dropped", s.injected.dropped},
+            {"duplicated", s.injected.duplicated},
+            {"delayed", s.injected.delayed},
+            {"reordered", s.injected.reordered}}}};
+}
+
+nlohmann::json OutcomeToJson(const Outcome& o) {
+  nlohmann::json j = {{"role", o.role},       {"exit_code", o.exit_code},
+                      {"signal", o.signal},   {"message", o.message},
+                      {"culprit", o.culprit}, {"step", o.step},
+                      {"killed_by_supervisor", o.killed_by_supervisor},
+                      {"was_stopped", o.was_stopped}};
+  if (o.stats_known) j["link"] = StatsToJson(o.stats);
+  return j;
+}
+
+Outcome OutcomeFromJson(const nlohmann::json& j) {
+  Outcome o;
+  o.role = j.at("role").get<std::string>();
+  o.exit_code = j.at("exit_code").get<int>();
+  o.signal = j.value("signal", 0);
+  o.message = j.value("message", std::string());
+  o.culprit = j.value("culprit", std::string());
+  o.step = j.value("step", std::int64_t{-1});
+  o.killed_by_supervisor = j.value("killed_by_supervisor", false);
+  o.was_stopped = j.value("was_stopped", false);
+  if (j.contains("link")) {
+    const auto& l = j.at("link");
+    lockstep::LinkStats& s = o.stats;
+    s.rerequests = l.at("rerequests").get<std::int64_t>();
+    s.steps_rerequested = l.at("steps_rerequested").get<std::int64_t>();
+    s.repair_requests = l.at("repair_requests").get<std::int64_t>();
+    s.resent = l.at("resent").get<std::int64_t>();
+    s.repaired = l.at("repaired").get<std::int64_t>();
+    s.duplicates = l.at("duplicates_ignored").get<std::int64_t>();
+    s.stale = l.at("stale_ignored").get<std::int64_t>();
+    s.foreign = l.at("foreign_ignored").get<std::int64_t>();
+    const auto& in = l.at("injected");
+    s.injected = {in.at("dropped").get<std::int64_t>(), in.at("duplicated").get<std::int64_t>(),
+                  in.at("delayed").get<std::int64_t>(), in.at("reordered").get<std::int64_t>()};
+    o.stats_known = true;
+  }
+  return o;
+}
+
 std::vector<Outcome> RunGroupInProcess(const std::vector<scenario::Scenario>& per_role,
                                        std::int64_t run_id, const std::string& out_dir,
-                                       const std::vector<RoleFault>& faults) {
+                                       const std::vector<RoleFault>& faults,
+                                       const volatile std::sig_atomic_t* stop) {
   if (per_role.size() != 1 && per_role.size() != std::size(kGroupOrder)) {
     throw Error("RunGroupInProcess", "give one scenario, or one per role");
+  }
+  for (const auto& s : per_role) {
+    const std::string& kind = s.faults.process_kind;
+    if (kind == "crash" || kind == "kill" || kind == "stop") {
+      throw Error(s.path + ": faults.process.kind",
+                  fmt::format("\"{}\" would take every participant down in one process (memq): use the "
+                              "udpm transport (one process per participant)",
+                              kind));
+    }
   }
   lcm::LCM lcm("memq://");
   if (!lcm.good()) throw Error("RunGroupInProcess", "cannot create a memq:// LCM instance");
@@ -19,33 +87,116 @@ std::vector<Outcome> RunGroupInProcess(const std::vector<scenario::Scenario>& pe
   std::vector<lockstep::Participant*> group;
   for (std::size_t i = 0; i < std::size(kGroupOrder); ++i) {
     const auto& s = per_role[per_role.size() == 1 ? 0 : i];
-    owned.push_back(MakeParticipant(kGroupOrder[i], s, IdentityOf(s, run_id), &lcm, out_dir));
-    for (const auto& f : faults) {
-      if (f.role == kGroupOrder[i]) owned.back()->faults = f.faults;
+    lockstep::Faults f = FaultsOf(s, kGroupOrder[i]);
+    for (const auto& extra : faults) {
+      if (extra.role != kGroupOrder[i]) continue;
+      f.targeted.insert(f.targeted.end(), extra.faults.targeted.begin(), extra.faults.targeted.end());
+      f.command_gain = extra.faults.command_gain;
+      if (extra.faults.process != lockstep::ProcessFault::kNone) {
+        f.process = extra.faults.process;
+        f.at_step = extra.faults.at_step;
+        f.stop_s = extra.faults.stop_s;
+      }
+      if (extra.faults.network.any()) f.network = extra.faults.network;
     }
+    owned.push_back(MakeParticipant(kGroupOrder[i], s, IdentityOf(s, run_id), &lcm, out_dir, std::move(f)));
     group.push_back(owned.back().get());
   }
-  lockstep::RunLoop(&lcm, group);
+  lockstep::RunLoop(&lcm, group, stop);
   std::vector<Outcome> outcomes;
-  for (const auto* p : group) outcomes.push_back({p->name(), p->exit_code(), 0, p->error()});
+  for (const auto* p : group) {
+    Outcome o;
+    o.role = p->name();
+    o.exit_code = p->exit_code();
+    o.message = p->error();
+    o.culprit = p->culprit();
+    o.step = p->fail_step();
+    o.stats = p->stats();
+    o.stats_known = true;
+    outcomes.push_back(std::move(o));
+  }
   return outcomes;
 }
 
+namespace {
+/// 4: killed by a signal it was not sent by the supervisor; 3: failed on its own; 2: detected a
+/// lockstep failure; 1: was told to stop (or killed by the supervisor); 0: fine.
+int Blame(const Outcome& o) {
+  if (o.signal != 0) return o.killed_by_supervisor ? 1 : 4;
+  switch (o.exit_code) {
+    case lockstep::kExitOk: return 0;
+    case lockstep::kExitPeerAbort: return 1;
+    case lockstep::kExitLockstep: return 2;
+    default: return 3;
+  }
+}
+
+const Outcome* Find(const std::vector<Outcome>& outcomes, std::string_view role) {
+  for (const auto& o : outcomes) {
+    if (o.role == role) return &o;
+  }
+  return nullptr;
+}
+}  // namespace
+
 const Outcome* RootCause(const std::vector<Outcome>& outcomes) {
-  auto blame = [](const Outcome& o) {
-    if (o.signal != 0) return 4;
-    switch (o.exit_code) {
-      case lockstep::kExitOk: return 0;
-      case lockstep::kExitPeerAbort: return 1;
-      case lockstep::kExitLockstep: return 2;
-      default: return 3;
-    }
-  };
   const Outcome* worst = nullptr;
   for (const auto& o : outcomes) {
-    if (blame(o) > 0 && (!worst || blame(o) > blame(*worst))) worst = &o;
+    if (Blame(o) > 0 && (!worst || Blame(o) > Blame(*worst))) worst = &o;
   }
   return worst;
+}
+
+Verdict Judge(const std::vector<Outcome>& outcomes) {
+  Verdict v;
+  const Outcome* worst = RootCause(outcomes);
+  if (!worst) return v;
+  v.failed = true;
+  if (Blame(*worst) == 2) {
+    // A lockstep failure: the clock's diagnosis (it sees every answer) before a participant's
+    // watchdog; blame whom it names.
+    for (const auto& o : outcomes) {
+      if (Blame(o) != 2) continue;
+      if (o.role == "integrator") {
+        worst = &o;
+        break;
+      }
+      if (worst->culprit.empty() && !o.culprit.empty()) worst = &o;
+    }
+    v.role = worst->culprit.empty() ? worst->role : worst->culprit;
+    v.exit_code = lockstep::kExitLockstep;
+    v.step = worst->step;
+    v.what = worst->message;
+    if (const Outcome* c = Find(outcomes, v.role); c && c != worst) {
+      if (c->killed_by_supervisor) {
+        v.what += fmt::format("; the supervisor killed {} ({}){}", c->role,
+                              c->signal ? strsignal(c->signal) : "signal",
+                              c->was_stopped ? ": it was stopped (SIGSTOP) and did not answer the abort" : "");
+      } else if (c->signal != 0) {
+        v.what += fmt::format("; {} was killed by signal {} ({})", c->role, c->signal, strsignal(c->signal));
+      } else if (c->exit_code != 0 && !c->message.empty()) {
+        v.what += fmt::format("; {} then exited with code {}: {}", c->role, c->exit_code, c->message);
+      }
+    }
+    if (v.role == "integrator" && v.what.find("integrator") == std::string::npos) {
+      v.what = "integrator (the clock) stopped answering: " + v.what;
+    }
+    return v;
+  }
+  v.role = worst->role;
+  v.step = worst->step;
+  if (worst->signal != 0) {
+    v.exit_code = 128 + worst->signal;
+    v.what = fmt::format("{} was {} by signal {} ({})", worst->role,
+                         worst->killed_by_supervisor ? "killed by the supervisor" : "killed",
+                         worst->signal, strsignal(worst->signal));
+    if (!worst->message.empty()) v.what += ": " + worst->message;
+    return v;
+  }
+  v.exit_code = worst->exit_code;
+  v.what = fmt::format("{} exited with code {}{}{}", worst->role, worst->exit_code,
+                       worst->message.empty() ? "" : ": ", worst->message);
+  return v;
 }
 
 }  // namespace rths::participants

@@ -2,9 +2,12 @@
 /// @file All five participants of a run in this process, on one memq:// LCM instance: what
 /// `rths run --transport memq` does, and what the reproduction studies and tests use to run
 /// many groups side by side (each group has its own instance, so they cannot cross-talk).
+/// Also how a run's outcomes are judged: who is to blame when it fails.
 #include <string>
 #include <string_view>
 #include <vector>
+
+#include <nlohmann/json.hpp>
 
 #include "lockstep/runtime.h"
 #include "scenario/scenario.h"
@@ -15,7 +18,8 @@ namespace rths::participants {
 inline constexpr std::string_view kGroupOrder[] = {"logger", "plant", "controller", "semiactive",
                                                    "integrator"};
 
-/// A test-only fault for one role.
+/// Test-only faults for one role, on top of the scenario's [faults] (targeted faults, a
+/// controller sign error).
 struct RoleFault {
   std::string role;
   lockstep::Faults faults;
@@ -27,18 +31,46 @@ struct Outcome {
   int exit_code = 0;     ///< lockstep::ExitCode, or 128 + signal for a process
   int signal = 0;        ///< the signal that killed the process (0 if none)
   std::string message;   ///< why it failed ("" if it did not)
+  std::string culprit;   ///< whom it blames for the failure ("" if none or itself)
+  std::int64_t step = -1;  ///< the step it failed at (-1 if unknown or before step 0)
+  bool killed_by_supervisor = false;  ///< the supervisor sent the signal that ended it
+  bool was_stopped = false;           ///< ... while it was stopped (SIGSTOP, state T)
+  bool stats_known = false;
+  lockstep::LinkStats stats;
 };
+nlohmann::json OutcomeToJson(const Outcome& o);
+/// Reads what OutcomeToJson wrote; throws nlohmann::json::exception on a malformed object.
+Outcome OutcomeFromJson(const nlohmann::json& j);
+nlohmann::json StatsToJson(const lockstep::LinkStats& s);
 
 /// Runs a whole group on memq://; `out_dir` receives log.lcm and signals.csv. `per_role` holds
 /// one scenario for every role, or five, in kGroupOrder (tests give one role another file).
-/// Throws rths::Error if a participant cannot be built (bad model, unwritable output).
+/// Throws rths::Error if a participant cannot be built (bad model, unwritable output) or the
+/// scenario asks for a process fault that would take this whole process down (crash, kill, stop).
+/// `stop` (optional): set it (from a signal handler) to interrupt the run.
 std::vector<Outcome> RunGroupInProcess(const std::vector<scenario::Scenario>& per_role,
                                        std::int64_t run_id, const std::string& out_dir,
-                                       const std::vector<RoleFault>& faults = {});
+                                       const std::vector<RoleFault>& faults = {},
+                                       const volatile std::sig_atomic_t* stop = nullptr);
 
 /// The outcome to blame for a failed run: one that failed on its own (a signal, an exception)
 /// before one that detected a failure (lockstep) before one that was told to stop; nullptr if
 /// every participant succeeded.
 const Outcome* RootCause(const std::vector<Outcome>& outcomes);
+
+/// A failed run, judged from every participant's outcome.
+struct Verdict {
+  bool failed = false;
+  std::string role;          ///< the participant to blame
+  int exit_code = 0;         ///< the run's exit code (lockstep::ExitCode or 128 + signal)
+  std::string what;          ///< one sentence: what happened to whom, at which step
+  std::int64_t step = -1;    ///< the step it happened at (-1 if unknown)
+};
+/// Blame, in order: a participant killed by a signal the supervisor did not send (a crash or
+/// an outside kill); one that failed on its own (its computation, the safety monitor, its
+/// output); the participant a lockstep failure names as having stopped answering (with "the
+/// supervisor killed it" when it had to); then whoever was told to stop. Participants that only
+/// waited for the culprit are never blamed.
+Verdict Judge(const std::vector<Outcome>& outcomes);
 
 }  // namespace rths::participants

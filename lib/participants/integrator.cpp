@@ -17,8 +17,9 @@ std::string FolderOf(const std::string& path) {
 }
 }  // namespace
 
-Integrator::Integrator(const scenario::Scenario& s, lockstep::RunIdentity id, lcm::LCM* lcm)
-    : ClockParticipant("integrator", id, TimingOf(s), lcm),
+Integrator::Integrator(const scenario::Scenario& s, lockstep::RunIdentity id, lcm::LCM* lcm,
+                       lockstep::Faults faults)
+    : ClockParticipant("integrator", id, TimingOf(s), lcm, std::move(faults)),
       predefined_(s.structure.mode == "predefined"),
       dt_s_(s.run.dt_s),
       safety_(s.safety, s.run.dt_s) {

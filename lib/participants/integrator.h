@@ -22,7 +22,7 @@ namespace rths::participants {
 
 class Integrator final : public lockstep::ClockParticipant {
  public:
-  Integrator(const scenario::Scenario& s, lockstep::RunIdentity id, lcm::LCM* lcm);
+  Integrator(const scenario::Scenario& s, lockstep::RunIdentity id, lcm::LCM* lcm, lockstep::Faults faults = {});
 
  protected:
   void ComputeDesired(std::int64_t k, const rths::measured_t* measured_prev,

@@ -1,102 +1,149 @@
 #include "participants/logger.h"
 
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
 #include <cinttypes>
+#include <cstdio>
+#include <cstring>
+
+#include <fmt/core.h>
 
 #include "core/error.h"
+#include "io/event_log.h"
 
 namespace rths::participants {
 
-using lockstep::StepMailbox;
+namespace {
+constexpr const char* kCsvHeader =
+    "k,t_s,r_mm,u_mm,u_ff_mm,u_fb_mm,y_mm,e_mm,f_kN,i_cmd_A,i_eff_A,ground_acc_mm_s2\n";
+/// A row: k, t and ten numbers printed with %.17g (at most 24 characters each).
+constexpr std::size_t kCsvRowMaxBytes = 20 + 1 + 24 + 10 * (1 + 24) + 1;
 
-Logger::Logger(lockstep::RunIdentity id, lockstep::Timing timing, lcm::LCM* lcm,
-               const std::string& log_path, const std::string& csv_path)
-    : Participant("logger", std::move(id), timing, lcm) {
-  log_ = new lcm::LogFile(log_path, "w");
-  if (!log_->good()) {
-    delete log_;
-    log_ = nullptr;
-    throw Error(log_path, "cannot open the event log for writing");
+int CreateFile(const std::string& path, const char* what) {
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0) throw Error(path, fmt::format("cannot create the {}: {}", what, std::strerror(errno)));
+  return fd;
+}
+}  // namespace
+
+std::int64_t StoredBytesPerStep(int n_dof) {
+  // desired_t: 8 hash + 2x8 (run_id, k) + 7x8 doubles + 4 (n_dof) + 2 n_dof x8; the others are
+  // fixed (hash, run_id, k and their doubles); ack_t is not logged.
+  const std::int64_t desired = 8 + 16 + 7 * 8 + 4 + 16 * static_cast<std::int64_t>(n_dof);
+  const std::int64_t command = 8 + 16 + 3 * 8, measured = 8 + 16 + 3 * 8, current = 8 + 16 + 2 * 8;
+  const std::int64_t events = static_cast<std::int64_t>(
+      io::EventBytes(lockstep::kChDesired, desired) + io::EventBytes(lockstep::kChCommand, command) +
+      io::EventBytes(lockstep::kChMeasured, measured) + io::EventBytes(lockstep::kChCurrent, current));
+  return events + static_cast<std::int64_t>(kCsvRowMaxBytes);
+}
+
+Logger::Logger(lockstep::RunIdentity id, lockstep::Timing timing, lcm::LCM* lcm, const std::string& log_path,
+               const std::string& csv_path, lockstep::Faults faults)
+    : Participant("logger", std::move(id), timing, lcm, std::move(faults)),
+      log_path_(log_path),
+      csv_path_(csv_path) {
+  log_fd_ = CreateFile(log_path_, "event log");
+  try {
+    csv_fd_ = CreateFile(csv_path_, "signals CSV");
+  } catch (...) {
+    ::close(log_fd_);
+    throw;
   }
-  // A buffer far larger than one step's events: stdio never flushes part of a step on its own,
-  // so a killed logger leaves a log that ends on a step boundary.
-  static constexpr std::size_t kBuf = 1 << 20;
-  std::setvbuf(log_->getFilePtr(), nullptr, _IOFBF, kBuf);
-  csv_ = std::fopen(csv_path.c_str(), "w");
-  if (!csv_) throw Error(csv_path, "cannot open the signals CSV for writing");
-  std::setvbuf(csv_, nullptr, _IOFBF, kBuf);
-  std::fprintf(csv_,
-               "k,t_s,r_mm,u_mm,u_ff_mm,u_fb_mm,y_mm,e_mm,f_kN,i_cmd_A,i_eff_A,ground_acc_mm_s2\n");
-  lcm_->subscribe(lockstep::kChHandshake, &Logger::OnHandshakeLog, this);
-  lcm_->subscribe(lockstep::kChDesired, &Logger::OnDesired, this);
-  lcm_->subscribe(lockstep::kChCommand, &Logger::OnCommand, this);
-  lcm_->subscribe(lockstep::kChMeasured, &Logger::OnMeasured, this);
-  lcm_->subscribe(lockstep::kChCurrent, &Logger::OnCurrent, this);
+  if (const std::string why = Append(csv_fd_, csv_path_, reinterpret_cast<const std::uint8_t*>(kCsvHeader),
+                                     std::strlen(kCsvHeader), &csv_end_);
+      !why.empty()) {
+    ::close(log_fd_);
+    ::close(csv_fd_);
+    throw Error(csv_path_, why);
+  }
+  csv_acked_ = csv_end_;
+  step_bytes_.reserve(4096);
+  SetAnswerChannel(lockstep::kAck, &ack_cache_);
+  Subscribe(lockstep::kChDesired, [this](const lcm::ReceiveBuffer* rbuf) {
+    OnStepMessage(&desired_, &raw_desired_, lockstep::kDesired, rbuf);
+  });
+  Subscribe(lockstep::kChCommand, [this](const lcm::ReceiveBuffer* rbuf) {
+    OnStepMessage(&command_, &raw_command_, lockstep::kCommand, rbuf);
+  });
+  Subscribe(lockstep::kChMeasured, [this](const lcm::ReceiveBuffer* rbuf) {
+    OnStepMessage(&measured_, &raw_measured_, lockstep::kMeasured, rbuf);
+  });
+  Subscribe(lockstep::kChCurrent, [this](const lcm::ReceiveBuffer* rbuf) {
+    OnStepMessage(&current_, &raw_current_, lockstep::kCurrent, rbuf);
+  });
 }
 
 Logger::~Logger() {
-  Flush();
-  if (csv_) std::fclose(csv_);
-  delete log_;  // closes the file
+  if (log_fd_ >= 0) ::close(log_fd_);
+  if (csv_fd_ >= 0) ::close(csv_fd_);
 }
 
-void Logger::Flush() {
-  if (log_) std::fflush(log_->getFilePtr());
-  if (csv_) std::fflush(csv_);
-}
-
-void Logger::Write(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
-  lcm::LogEvent ev;
-  ev.eventnum = event_number_++;
-  ev.timestamp = rbuf->recv_utime;  // wall clock; sim time travels in the payload (k)
-  ev.channel = channel;
-  ev.datalen = rbuf->data_size;
-  ev.data = rbuf->data;
-  if (log_->writeEvent(&ev) != 0) throw Error("logger", "writing the event log failed (disk full?)");
-}
-
-void Logger::OnHandshakeLog(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
-  if (!log_ || hs_.decode(rbuf->data, 0, rbuf->data_size) < 0 || hs_.run_id != id_.run_id) return;
-  if (!handshakes_logged_.emplace(hs_.participant, hs_.phase).second) return;
-  Guarded(-1, [&] {
-    Write(rbuf, channel);
-    Flush();
-  });
-}
-
-// One handler per step channel: log the first copy, then see whether step `next_` is complete.
-#define RTHS_LOGGER_HANDLER(Method, box)                                   \
-  void Logger::Method(const lcm::ReceiveBuffer* rbuf, const std::string& channel) { \
-    if (finished()) return;                                                \
-    const auto put = box.Add(rbuf, id_.run_id);                            \
-    if (put != std::remove_reference_t<decltype(box)>::Put::kNew) return;  \
-    Guarded(box.last_k(), [&] {                                            \
-      Write(rbuf, channel);                                                \
-      TryAck();                                                            \
-    });                                                                    \
+std::string Logger::Append(int fd, const std::string& path, const std::uint8_t* data, std::size_t size,
+                           std::int64_t* good_end) {
+  std::size_t done = 0;
+  while (done < size) {
+    const ssize_t n = ::pwrite(fd, data + done, size - done, static_cast<off_t>(*good_end + done));
+    if (n > 0) {
+      done += static_cast<std::size_t>(n);
+      continue;
+    }
+    if (n < 0 && errno == EINTR) continue;
+    const std::string err = n < 0 ? std::strerror(errno) : "no progress (device full?)";
+    // Nothing of a half-written event or row may stay behind.
+    if (::ftruncate(fd, static_cast<off_t>(*good_end)) != 0) {
+      return fmt::format("writing {} failed: {}; cutting it back to {} bytes failed too: {}", path, err,
+                         *good_end, std::strerror(errno));
+    }
+    return fmt::format("writing {} failed: {}", path, err);
   }
-RTHS_LOGGER_HANDLER(OnCommand, command_)
-RTHS_LOGGER_HANDLER(OnMeasured, measured_)
-RTHS_LOGGER_HANDLER(OnCurrent, current_)
-#undef RTHS_LOGGER_HANDLER
+  *good_end += static_cast<std::int64_t>(size);
+  return {};
+}
 
-void Logger::OnDesired(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
+void Logger::FailWrite(const std::string& why, std::int64_t k) {
+  // Both files end on the last acknowledged step (the other file may hold part of step k).
+  const bool cut_log = ::ftruncate(log_fd_, static_cast<off_t>(log_acked_)) == 0;
+  const bool cut_csv = ::ftruncate(csv_fd_, static_cast<off_t>(csv_acked_)) == 0;
+  std::string reason = fmt::format("{} (at step {}; the log and signals.csv end on step {}, the last "
+                                   "acknowledged one{})",
+                                   why, k, next_ - 1, cut_log && cut_csv ? "" : "; cutting them back failed");
+  Fail(lockstep::kExitOutput, "logger: " + reason, true, k);
+}
+
+template <class Msg>
+void Logger::OnStepMessage(lockstep::StepMailbox<Msg>* box, RawRing* raw, lockstep::Channel channel,
+                           const lcm::ReceiveBuffer* rbuf) {
   if (finished()) return;
-  HeardClock(lockstep::SteadyClock::now());
-  const auto put = desired_.Add(rbuf, id_.run_id);
-  const std::int64_t k = desired_.last_k();
-  if (put == StepMailbox<rths::desired_t>::Put::kDuplicate) {
-    if (!Stalled(k)) Republish(lockstep::kChAck, ack_cache_, k);  // a re-request of step k
+  if (Receive(box, channel, rbuf) != lockstep::Put::kNew) return;
+  Raw& slot = (*raw)[box->last_k() % 4];
+  const auto* data = static_cast<const std::uint8_t*>(rbuf->data);
+  slot.bytes.assign(data, data + rbuf->data_size);  // reuses its capacity after the first steps
+  slot.recv_utime = rbuf->recv_utime;
+  Guarded(box->last_k(), [&] { TryAck(); });
+}
+
+void Logger::OnHandshakeSeen(const lcm::ReceiveBuffer* rbuf, const rths::handshake_t& msg) {
+  if (finished() || !handshakes_logged_.emplace(msg.participant, msg.phase).second) return;
+  step_bytes_.clear();
+  io::AppendEvent(&step_bytes_, event_number_, rbuf->recv_utime, lockstep::kChHandshake, rbuf->data,
+                  rbuf->data_size);
+  if (const std::string why = Append(log_fd_, log_path_, step_bytes_.data(), step_bytes_.size(), &log_end_);
+      !why.empty()) {
+    FailWrite(why, msg.k);
     return;
   }
-  if (put != StepMailbox<rths::desired_t>::Put::kNew) return;
-  if (InjectDrop(k)) {
-    desired_.Forget(k);
-    return;
-  }
-  Guarded(k, [&] {
-    Write(rbuf, channel);
-    TryAck();
-  });
+  ++event_number_;
+  log_acked_ = log_end_;  // a whole event between steps: keep it if a later write fails
+}
+
+void Logger::ListMissing(std::int64_t k, lockstep::WantList* out) const {
+  if (next_ > k) return;
+  if (!desired_.Get(next_)) out->Add(lockstep::kDesired, next_);
+  if (!command_.Get(next_)) out->Add(lockstep::kCommand, next_);
+  if (!measured_.Get(next_)) out->Add(lockstep::kMeasured, next_);
+  if (!current_.Get(next_)) out->Add(lockstep::kCurrent, next_);
 }
 
 void Logger::TryAck() {
@@ -107,12 +154,38 @@ void Logger::TryAck() {
     const rths::measured_t* m = measured_.Get(k);
     const rths::current_t* i = current_.Get(k);
     if (!d || !c || !m || !i) return;
-    MaybeThrow(k);
-    std::fprintf(csv_, "%" PRId64 ",%.6f,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n",
-                 k, static_cast<double>(k) * id_.dt_s, d->r_mm, c->u_mm, c->u_ff_mm, c->u_fb_mm,
-                 m->y_mm, d->r_mm - m->y_mm, m->f_kN, i->i_cmd_A, m->current_A,
-                 d->ground_acc_mm_s2);
-    Flush();
+    MaybeFault(k);
+    // The four events of step k in channel order, one write.
+    step_bytes_.clear();
+    const std::size_t slot = static_cast<std::size_t>(k % 4);
+    for (auto [ch, ring] : {std::pair{lockstep::kChDesired, &raw_desired_}, {lockstep::kChCommand, &raw_command_},
+                            {lockstep::kChMeasured, &raw_measured_}, {lockstep::kChCurrent, &raw_current_}}) {
+      const Raw& r = (*ring)[slot];
+      io::AppendEvent(&step_bytes_, event_number_++, r.recv_utime, ch, r.bytes.data(), r.bytes.size());
+    }
+    if (const std::string why = Append(log_fd_, log_path_, step_bytes_.data(), step_bytes_.size(), &log_end_);
+        !why.empty()) {
+      FailWrite(why, k);
+      return;
+    }
+    char row[kCsvRowMaxBytes + 1];
+    const int n = std::snprintf(row, sizeof row,
+                                "%" PRId64 ",%.6f,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n",
+                                k, static_cast<double>(k) * id_.dt_s, d->r_mm, c->u_mm, c->u_ff_mm, c->u_fb_mm,
+                                m->y_mm, d->r_mm - m->y_mm, m->f_kN, i->i_cmd_A, m->current_A,
+                                d->ground_acc_mm_s2);
+    if (n < 0 || static_cast<std::size_t>(n) >= sizeof row) {
+      FailWrite(fmt::format("formatting row {} of {} failed", k, csv_path_), k);
+      return;
+    }
+    if (const std::string why = Append(csv_fd_, csv_path_, reinterpret_cast<const std::uint8_t*>(row),
+                                       static_cast<std::size_t>(n), &csv_end_);
+        !why.empty()) {
+      FailWrite(why, k);
+      return;
+    }
+    log_acked_ = log_end_;
+    csv_acked_ = csv_end_;
     ack_.run_id = id_.run_id;
     ack_.k = k;
     ack_.participant = name_;

@@ -1,15 +1,20 @@
 #pragma once
-/// @file The logger: a lockstep participant that never drops a message (docs/lockstep.md).
+/// @file The logger: a lockstep participant that never drops a message and never acknowledges
+/// a step it could not store (docs/lockstep.md).
 ///
 /// Step k (inputs -> answer):
 ///   desired_t k, command_t k, measured_t k, current_t k  ->  ack_t k
-/// The first copy of every (channel, k) is appended to a standard LCM event log (readable by
-/// lcm-logplayer and lcm-spy) as soon as it arrives; re-sent duplicates are not logged. Once all
-/// four messages of step k are written, the row k of signals.csv is written, both files are
-/// flushed to the kernel, and only then is ack_t k published: the clock cannot advance past a
-/// step the logger has not stored. The handshake is logged on its own channel (first copy per
-/// participant and phase). After an abort, the files hold every step acknowledged so far.
-#include <cstdio>
+/// The first copy of every (channel, k) is kept; re-sent duplicates are ignored. Once all four
+/// messages of step k are in, they are appended to log.lcm (a standard LCM event log, readable by
+/// lcm-logplayer and lcm-spy) in channel order with one write(2), the row k of signals.csv with
+/// another, and only then is ack_t k published: the clock cannot advance past a step the logger
+/// has not handed to the kernel. The handshake is logged on its own channel as it arrives (first
+/// copy per participant and phase).
+///
+/// A failed or short write (disk full, I/O error) stops the run: both files are cut back to the
+/// end of the last acknowledged step (so they end on a whole event and a whole row), ABORT is
+/// broadcast naming the file and the error, and the logger exits with kExitOutput.
+#include <cstdint>
 #include <set>
 #include <string>
 #include <utility>
@@ -23,38 +28,57 @@
 
 namespace rths::participants {
 
+/// Bytes of the stored output per step for a structure with `n_dof` degrees of freedom: the four
+/// events of log.lcm and the signals.csv row (an upper bound for the row). The supervisor uses
+/// it to check the free disk space before a run.
+std::int64_t StoredBytesPerStep(int n_dof);
+
 class Logger : public lockstep::Participant {
  public:
-  /// Opens `log_path` (LCM event log) and `csv_path` (signals) for writing; throws rths::Error.
-  Logger(lockstep::RunIdentity id, lockstep::Timing timing, lcm::LCM* lcm,
-         const std::string& log_path, const std::string& csv_path);
+  /// Creates `log_path` (LCM event log) and `csv_path` (signals); throws rths::Error.
+  Logger(lockstep::RunIdentity id, lockstep::Timing timing, lcm::LCM* lcm, const std::string& log_path,
+         const std::string& csv_path, lockstep::Faults faults = {});
   ~Logger() override;
 
   /// Steps acknowledged so far.
   std::int64_t steps_written() const { return next_; }
 
  protected:
-  void OnDone() override { Flush(); }
-  void OnStop() override { Flush(); }
+  std::string OnDone() override { return {}; }  // every step was written before its ack
+  void ListMissing(std::int64_t k, lockstep::WantList* out) const override;
 
  private:
-  void OnHandshakeLog(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
-  void OnDesired(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
-  void OnCommand(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
-  void OnMeasured(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
-  void OnCurrent(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
-  void Write(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
-  void TryAck();
-  void Flush();
+  /// The raw bytes of one channel's message of a step (what is written to the log).
+  struct Raw {
+    lockstep::Bytes bytes;
+    std::int64_t recv_utime = 0;
+  };
+  using RawRing = std::array<Raw, 4>;
 
-  lcm::LogFile* log_ = nullptr;
-  std::FILE* csv_ = nullptr;
+  template <class Msg>
+  void OnStepMessage(lockstep::StepMailbox<Msg>* box, RawRing* raw, lockstep::Channel channel,
+                     const lcm::ReceiveBuffer* rbuf);
+  void OnHandshakeSeen(const lcm::ReceiveBuffer* rbuf, const rths::handshake_t& msg) override;
+  void TryAck();
+  /// Appends `bytes` to the file `fd` (every byte, or none: on failure the file is cut back to
+  /// `*good_end`); advances `*good_end`. Returns "" or the error, naming the file.
+  std::string Append(int fd, const std::string& path, const std::uint8_t* data, std::size_t size,
+                     std::int64_t* good_end);
+  /// Cuts both files back to the last acknowledged step and stops the run (kExitOutput).
+  void FailWrite(const std::string& why, std::int64_t k);
+
+  std::string log_path_, csv_path_;
+  int log_fd_ = -1, csv_fd_ = -1;
+  std::int64_t log_end_ = 0, csv_end_ = 0;      ///< bytes written, each ending on a whole event / row
+  std::int64_t log_acked_ = 0, csv_acked_ = 0;  ///< ... at the last acknowledged step
   std::int64_t event_number_ = 0;
   std::int64_t next_ = 0;  ///< next step to acknowledge
   lockstep::StepMailbox<rths::desired_t> desired_;
   lockstep::StepMailbox<rths::command_t> command_;
   lockstep::StepMailbox<rths::measured_t> measured_;
   lockstep::StepMailbox<rths::current_t> current_;
+  RawRing raw_desired_{}, raw_command_{}, raw_measured_{}, raw_current_{};
+  lockstep::Bytes step_bytes_;  ///< the step's four events, written at once
   lockstep::AnswerCache ack_cache_;
   rths::ack_t ack_{};
   rths::handshake_t hs_{};

@@ -4,17 +4,34 @@
 
 namespace rths::participants {
 
-using lockstep::StepMailbox;
-
-Plant::Plant(const scenario::Scenario& s, lockstep::RunIdentity id, lcm::LCM* lcm)
-    : Participant("plant", std::move(id), TimingOf(s), lcm),
+Plant::Plant(const scenario::Scenario& s, lockstep::RunIdentity id, lcm::LCM* lcm, lockstep::Faults faults)
+    : Participant("plant", std::move(id), TimingOf(s), lcm, std::move(faults)),
       rig_(models::MakeRig(s.plant, s.run.dt_s)),
       noise_y_mm_(s.plant.noise_y_mm_rms),
       noise_f_kN_(s.plant.noise_f_kN_rms),
       noise_(signal::MakeGaussian(s.plant.noise_seed)) {
-  lcm_->subscribe(lockstep::kChDesired, &Plant::OnDesired, this);
-  lcm_->subscribe(lockstep::kChCommand, &Plant::OnCommand, this);
-  lcm_->subscribe(lockstep::kChCurrent, &Plant::OnCurrent, this);
+  SetAnswerChannel(lockstep::kMeasured, &cache_);
+  Subscribe(lockstep::kChDesired, [this](const lcm::ReceiveBuffer* rbuf) {
+    if (!finished() && Receive(&desired_, lockstep::kDesired, rbuf) == lockstep::Put::kNew &&
+        rig_->TracksDesired()) {
+      TryStep();
+    }
+  });
+  Subscribe(lockstep::kChCommand, [this](const lcm::ReceiveBuffer* rbuf) {
+    if (!finished() && Receive(&command_, lockstep::kCommand, rbuf) == lockstep::Put::kNew) TryStep();
+  });
+  Subscribe(lockstep::kChCurrent, [this](const lcm::ReceiveBuffer* rbuf) {
+    if (!finished() && Receive(&current_, lockstep::kCurrent, rbuf) == lockstep::Put::kNew) TryStep();
+  });
+}
+
+void Plant::ListMissing(std::int64_t k, lockstep::WantList* out) const {
+  if (next_ > k) return;
+  if (rig_->TracksDesired() && !desired_.Get(next_)) out->Add(lockstep::kDesired, next_);
+  if (next_ >= 1) {
+    if (!rig_->TracksDesired() && !command_.Get(next_ - 1)) out->Add(lockstep::kCommand, next_ - 1);
+    if (!current_.Get(next_ - 1)) out->Add(lockstep::kCurrent, next_ - 1);
+  }
 }
 
 void Plant::Publish(std::int64_t k) {
@@ -40,28 +57,6 @@ void Plant::OnGo() {
   });
 }
 
-void Plant::OnDesired(const lcm::ReceiveBuffer* rbuf, const std::string&) {
-  if (finished()) return;
-  HeardClock(lockstep::SteadyClock::now());
-  const auto put = desired_.Add(rbuf, id_.run_id);
-  const std::int64_t k = desired_.last_k();
-  if (put == StepMailbox<rths::desired_t>::Put::kDuplicate && !Stalled(k)) {
-    Republish(lockstep::kChMeasured, cache_, k);  // re-request: cached bytes, never recomputed
-  } else if (put == StepMailbox<rths::desired_t>::Put::kNew && rig_->TracksDesired()) {
-    TryStep();
-  }
-}
-
-void Plant::OnCommand(const lcm::ReceiveBuffer* rbuf, const std::string&) {
-  if (finished()) return;
-  if (command_.Add(rbuf, id_.run_id) == StepMailbox<rths::command_t>::Put::kNew) TryStep();
-}
-
-void Plant::OnCurrent(const lcm::ReceiveBuffer* rbuf, const std::string&) {
-  if (finished()) return;
-  if (current_.Add(rbuf, id_.run_id) == StepMailbox<rths::current_t>::Put::kNew) TryStep();
-}
-
 void Plant::TryStep() {
   if (rig_->TracksDesired()) {
     TryStepIdeal();
@@ -74,7 +69,7 @@ void Plant::TryStep() {
     if (!u || !i) return;
     bool ok = false;
     Guarded(k, [&] {
-      MaybeThrow(k);
+      MaybeFault(k);
       rig_->Step(u->u_mm, i->i_cmd_A);  // hold u_{k-1}, i_{k-1} over [t_{k-1}, t_k)
       Publish(k);
       ok = true;
@@ -98,7 +93,7 @@ void Plant::TryStepIdeal() {
     }
     bool ok = false;
     Guarded(k, [&] {
-      MaybeThrow(k);
+      MaybeFault(k);
       if (k == 0) {
         rig_->StartAt(r->r_mm);  // at rest at r_0 (0 A)
       } else {

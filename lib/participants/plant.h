@@ -30,15 +30,15 @@ namespace rths::participants {
 
 class Plant final : public lockstep::Participant {
  public:
-  Plant(const scenario::Scenario& s, lockstep::RunIdentity id, lcm::LCM* lcm);
+  Plant(const scenario::Scenario& s, lockstep::RunIdentity id, lcm::LCM* lcm, lockstep::Faults faults = {});
 
  protected:
   void OnGo() override;
+  /// The inputs of measured_t next_ (command_t and current_t of next_ - 1; "ideal": desired_t
+  /// next_ and current_t next_ - 1), if it is due by step k.
+  void ListMissing(std::int64_t k, lockstep::WantList* out) const override;
 
  private:
-  void OnDesired(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
-  void OnCommand(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
-  void OnCurrent(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
   void TryStep();
   void TryStepIdeal();
   void Publish(std::int64_t k);

@@ -29,8 +29,10 @@ CurrentSchedule::CurrentSchedule(const scenario::SemiactiveConfig& cfg, double d
 
 double CurrentSchedule::At(std::int64_t k) const { return k % period_ < on_steps_ ? on_A_ : 0.0; }
 
-Semiactive::Semiactive(const scenario::Scenario& s, lockstep::RunIdentity id, lcm::LCM* lcm)
-    : DesiredMeasuredParticipant("semiactive", std::move(id), TimingOf(s), lcm, lockstep::kChCurrent),
+Semiactive::Semiactive(const scenario::Scenario& s, lockstep::RunIdentity id, lcm::LCM* lcm,
+                       lockstep::Faults faults)
+    : DesiredMeasuredParticipant("semiactive", std::move(id), TimingOf(s), lcm, std::move(faults),
+                                 lockstep::kChCurrent, lockstep::kCurrent),
       f_prev_kN_(0.0) {
   if (s.semiactive.mode == "clipped_optimal") {
     const control::ClippedOptimalOptions o{s.semiactive.r_weight, s.semiactive.noise_ratio,

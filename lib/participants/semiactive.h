@@ -31,7 +31,7 @@ class CurrentSchedule {
 
 class Semiactive final : public DesiredMeasuredParticipant<rths::current_t> {
  public:
-  Semiactive(const scenario::Scenario& s, lockstep::RunIdentity id, lcm::LCM* lcm);
+  Semiactive(const scenario::Scenario& s, lockstep::RunIdentity id, lcm::LCM* lcm, lockstep::Faults faults = {});
 
  protected:
   void Compute(std::int64_t k, const rths::desired_t& d, const rths::measured_t& m,

@@ -13,10 +13,16 @@ template <class AnswerMsg>
 class DesiredMeasuredParticipant : public lockstep::Participant {
  public:
   DesiredMeasuredParticipant(std::string name, lockstep::RunIdentity id, lockstep::Timing timing,
-                             lcm::LCM* lcm, const char* answer_channel)
-      : Participant(std::move(name), std::move(id), timing, lcm), channel_(answer_channel) {
-    lcm_->subscribe(lockstep::kChDesired, &DesiredMeasuredParticipant::OnDesired, this);
-    lcm_->subscribe(lockstep::kChMeasured, &DesiredMeasuredParticipant::OnMeasured, this);
+                             lcm::LCM* lcm, lockstep::Faults faults, const char* answer_channel,
+                             lockstep::Channel answer_code)
+      : Participant(std::move(name), std::move(id), timing, lcm, std::move(faults)), channel_(answer_channel) {
+    SetAnswerChannel(answer_code, &cache_);
+    Subscribe(lockstep::kChDesired, [this](const lcm::ReceiveBuffer* rbuf) {
+      if (!finished() && Receive(&desired_, lockstep::kDesired, rbuf) == lockstep::Put::kNew) TryStep();
+    });
+    Subscribe(lockstep::kChMeasured, [this](const lcm::ReceiveBuffer* rbuf) {
+      if (!finished() && Receive(&measured_, lockstep::kMeasured, rbuf) == lockstep::Put::kNew) TryStep();
+    });
   }
 
  protected:
@@ -24,29 +30,14 @@ class DesiredMeasuredParticipant : public lockstep::Participant {
   virtual void Compute(std::int64_t k, const rths::desired_t& d, const rths::measured_t& m,
                        AnswerMsg* out) = 0;
 
- private:
-  using DesiredBox = lockstep::StepMailbox<rths::desired_t>;
+  /// Inputs of the next answer (desired_t and measured_t of step next_), if it is due by step k.
+  void ListMissing(std::int64_t k, lockstep::WantList* out) const override {
+    if (next_ > k) return;
+    if (!desired_.Get(next_)) out->Add(lockstep::kDesired, next_);
+    if (!measured_.Get(next_)) out->Add(lockstep::kMeasured, next_);
+  }
 
-  void OnDesired(const lcm::ReceiveBuffer* rbuf, const std::string&) {
-    if (finished()) return;
-    HeardClock(lockstep::SteadyClock::now());
-    const auto put = desired_.Add(rbuf, id_.run_id);
-    const std::int64_t k = desired_.last_k();
-    if (put == DesiredBox::Put::kDuplicate) {
-      if (!Stalled(k)) Republish(channel_, cache_, k);  // re-request: same bytes, never recomputed
-      return;
-    }
-    if (put != DesiredBox::Put::kNew) return;
-    if (InjectDrop(k)) {
-      desired_.Forget(k);
-      return;
-    }
-    TryStep();
-  }
-  void OnMeasured(const lcm::ReceiveBuffer* rbuf, const std::string&) {
-    if (finished()) return;
-    if (measured_.Add(rbuf, id_.run_id) == lockstep::StepMailbox<rths::measured_t>::Put::kNew) TryStep();
-  }
+ private:
   void TryStep() {
     while (running() && next_ < id_.n_steps && !Stalled(next_)) {
       const rths::desired_t* d = desired_.Get(next_);
@@ -55,7 +46,7 @@ class DesiredMeasuredParticipant : public lockstep::Participant {
       const std::int64_t k = next_;
       bool ok = false;
       Guarded(k, [&] {
-        MaybeThrow(k);
+        MaybeFault(k);
         Compute(k, *d, *m, &answer_);
         answer_.run_id = id_.run_id;
         answer_.k = k;

@@ -480,10 +480,34 @@ void ReadScenario(const toml::table& root, const std::string& file, Scenario* s)
   safety.Finish();
 
   Section lockstep = top.Sub("lockstep");
-  lockstep.Number("timeout_ms", &s->lockstep.timeout_ms);
-  lockstep.Integer("max_attempts", &s->lockstep.max_attempts);
+  if (lockstep.Has("timeout_ms")) {
+    lockstep.Fail("timeout_ms", "was renamed lockstep.rerequest_ms (re-request an incomplete step after this "
+                                "silence [ms], [5, 10000]); the give-up time is lockstep.stall_budget_s");
+  }
+  if (lockstep.Has("max_attempts")) {
+    lockstep.Fail("max_attempts", "was replaced by lockstep.stall_budget_s: how long one step may stay "
+                                  "incomplete before the run stops [s], [1, 3600] (default 10)");
+  }
+  lockstep.Number("rerequest_ms", &s->lockstep.rerequest_ms);
+  lockstep.Number("stall_budget_s", &s->lockstep.stall_budget_s);
   lockstep.Number("handshake_timeout_s", &s->lockstep.handshake_timeout_s);
   lockstep.Finish();
+
+  FaultConfig& fc = s->faults;
+  Section faults = top.Sub("faults");
+  for (auto [key, field] : {std::pair{"drop", &fc.drop}, {"duplicate", &fc.duplicate}, {"delay", &fc.delay},
+                            {"reorder", &fc.reorder}, {"delay_ms", &fc.delay_ms}}) {
+    faults.Number(key, field);
+  }
+  faults.Integer("seed", &fc.seed);
+  faults.Integer("recv_buf_bytes", &fc.recv_buf_bytes);
+  Section process = faults.Sub("process");
+  process.String("role", &fc.process_role);
+  process.String("kind", &fc.process_kind);
+  process.Integer("at_step", &fc.process_at_step);
+  process.Number("stop_s", &fc.process_stop_s);
+  process.Finish();
+  faults.Finish();
 
   top.Finish();
 }
@@ -742,9 +766,34 @@ void ValidateSafety(const SafetyConfig& f, const Check& check) {
 }
 
 void ValidateLockstep(const LockstepConfig& l, const Check& check) {
-  check.InRange("lockstep.timeout_ms", l.timeout_ms, Closed(1.0, 60000.0));
-  check.InRange("lockstep.max_attempts", l.max_attempts, Closed(1, 1000));
+  // Below ~5 ms a re-request would come before a loaded 2-core host has even scheduled the
+  // participants once: it only adds traffic.
+  check.InRange("lockstep.rerequest_ms", l.rerequest_ms, Closed(5.0, 10000.0));
+  check.InRange("lockstep.stall_budget_s", l.stall_budget_s,
+                {std::max(1.0, 4e-3 * l.rerequest_ms), 3600.0, false, false,
+                 "at least 1 s and 4 lockstep.rerequest_ms"});
   check.InRange("lockstep.handshake_timeout_s", l.handshake_timeout_s, Closed(0.1, 600.0));
+}
+
+void ValidateFaults(const FaultConfig& f, std::int64_t steps, const Check& check) {
+  for (auto [key, v] : {std::pair{"faults.drop", f.drop}, {"faults.duplicate", f.duplicate},
+                        {"faults.delay", f.delay}, {"faults.reorder", f.reorder}}) {
+    check.InRange(key, v, Closed(0.0, 0.5));
+  }
+  check.InRange("faults.drop", f.drop + f.duplicate + f.delay + f.reorder,
+                {0.0, 0.5, false, false, "drop + duplicate + delay + reorder must not exceed 0.5"});
+  check.InRange("faults.delay_ms", f.delay_ms, OpenClosed(0.0, 10000.0));
+  check.InRange("faults.seed", static_cast<double>(f.seed), Closed(0.0, 9007199254740992.0));
+  if (f.recv_buf_bytes != 0) {
+    check.InRange("faults.recv_buf_bytes", static_cast<double>(f.recv_buf_bytes),
+                  {1024.0, 134217728.0, false, false, "0 for the host's default, else [1024, 2^27]"});
+  }
+  if (f.process_role.empty() && f.process_kind.empty()) return;
+  check.OneOf("faults.process.role", f.process_role, {"integrator", "controller", "plant", "semiactive", "logger"});
+  check.OneOf("faults.process.kind", f.process_kind, {"stall", "throw", "crash", "kill", "stop"});
+  check.InRange("faults.process.at_step", static_cast<double>(f.process_at_step),
+                {0.0, static_cast<double>(steps), false, true, "a step of the run: [0, steps)"});
+  check.InRange("faults.process.stop_s", f.process_stop_s, Closed(0.0, 3600.0));
 }
 
 }  // namespace
@@ -789,6 +838,7 @@ void ValidateScenario(const Scenario& s) {
   ValidateSemiactive(s.semiactive, check);
   ValidateLockstep(s.lockstep, check);
   ValidateSafety(s.safety, check);
+  ValidateFaults(s.faults, s.steps(), check);
 }
 
 Scenario ParseScenario(std::string_view toml_text, const std::string& path) {
@@ -898,8 +948,18 @@ std::string ToToml(const Scenario& s) {
       f.enabled, TomlNumber(f.stroke_mm), TomlNumber(f.force_kN), TomlNumber(f.max_error_mm),
       TomlNumber(f.growth_window_s), TomlNumber(f.growth_factor), f.growth_windows, TomlNumber(f.growth_floor_mm));
   const auto& l = s.lockstep;
-  o += fmt::format("\n[lockstep]\ntimeout_ms = {}\nmax_attempts = {}\nhandshake_timeout_s = {}\n",
-                   TomlNumber(l.timeout_ms), l.max_attempts, TomlNumber(l.handshake_timeout_s));
+  o += fmt::format("\n[lockstep]\nrerequest_ms = {}\nstall_budget_s = {}\nhandshake_timeout_s = {}\n",
+                   TomlNumber(l.rerequest_ms), TomlNumber(l.stall_budget_s), TomlNumber(l.handshake_timeout_s));
+  const auto& fc = s.faults;
+  o += fmt::format("\n[faults]\ndrop = {}\nduplicate = {}\ndelay = {}\nreorder = {}\ndelay_ms = {}\nseed = {}\n"
+                   "recv_buf_bytes = {}\n",
+                   TomlNumber(fc.drop), TomlNumber(fc.duplicate), TomlNumber(fc.delay), TomlNumber(fc.reorder),
+                   TomlNumber(fc.delay_ms), fc.seed, fc.recv_buf_bytes);
+  if (!fc.process_role.empty() || !fc.process_kind.empty()) {
+    o += fmt::format("\n[faults.process]\nrole = {}\nkind = {}\nat_step = {}\nstop_s = {}\n",
+                     TomlString(fc.process_role), TomlString(fc.process_kind), fc.process_at_step,
+                     TomlNumber(fc.process_stop_s));
+  }
   return o;
 }
 

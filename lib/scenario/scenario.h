@@ -203,9 +203,33 @@ struct SafetyConfig {
 
 /// Lockstep runtime knobs (docs/lockstep.md).
 struct LockstepConfig {
-  double timeout_ms = 250.0;       ///< re-request step k after this silence [ms], [1, 60000]
-  int max_attempts = 8;            ///< abort after this many requests of one step, [1, 1000]
+  /// Re-request an incomplete step after this silence [ms], [5, 10000]; each further re-request
+  /// of the same step waits twice as long, up to max(rerequest_ms, 1000 ms).
+  double rerequest_ms = 100.0;
+  /// Stop the run when one step has not completed for this long [s], [1, 3600] and at least
+  /// 4 rerequest_ms: a participant that stopped answering. A loaded host only slows steps down.
+  double stall_budget_s = 10.0;
   double handshake_timeout_s = 20; ///< abort if not every participant said hello, [0.1, 600]
+};
+
+/// Fault injection, off by default (docs/lockstep.md "Fault injection"): seeded random faults
+/// on every message each participant receives, and one process fault.
+struct FaultConfig {
+  double drop = 0.0;           ///< fraction of received messages lost, [0, 0.5]
+  double duplicate = 0.0;      ///< fraction delivered twice, [0, 0.5]
+  double delay = 0.0;          ///< fraction delivered up to delay_ms late, [0, 0.5]
+  double reorder = 0.0;        ///< fraction delivered after the next message, [0, 0.5]
+  double delay_ms = 20.0;      ///< longest delay [ms], (0, 10000]
+  std::int64_t seed = 1;       ///< [0, 2^53]
+  /// udpm: each participant's UDP receive buffer [bytes] (LCM's recv_buf_size; 0 = the host's
+  /// default), 0 or [1024, 2^27]: a small one loses messages in bursts.
+  std::int64_t recv_buf_bytes = 0;
+  /// [faults.process]: one participant stalls, throws, crashes, is killed or stopped at a step.
+  std::string process_role;    ///< "" (none) or a participant: integrator, controller, plant, semiactive, logger
+  std::string process_kind;    ///< stall | throw | crash | kill | stop (crash, kill, stop: udpm only)
+  std::int64_t process_at_step = 0;  ///< [0, steps)
+  double process_stop_s = 0.0; ///< "stop": continue after this many seconds, 0 = never, [0, 3600]
+  bool any_network() const { return drop > 0 || duplicate > 0 || delay > 0 || reorder > 0; }
 };
 
 struct RunConfig {
@@ -224,6 +248,7 @@ struct Scenario {
   SemiactiveConfig semiactive;
   LockstepConfig lockstep;
   SafetyConfig safety;
+  FaultConfig faults;
 
   /// Number of lockstep steps: round(duration_s / dt_s).
   std::int64_t steps() const;
