@@ -2,9 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
-#include <lcm/lcm-cpp.hpp>
+#include <cstdint>
+#include <type_traits>
+
+#include <fmt/format.h>
 
 #include "core/error.h"
+#include "io/event_log.h"
 #include "lockstep/runtime.h"
 #include "scenario/scenario.h"
 #include "signal/metrics.h"
@@ -12,27 +16,215 @@
 namespace rths::io {
 
 namespace {
-template <class Msg>
-void Store(const lcm::LogEvent* ev, const std::string& path, std::vector<Msg>* by_k, RunLog* log) {
-  Msg m;
-  if (m.decode(ev->data, 0, ev->datalen) < 0) {
-    throw Error(path, "event " + std::to_string(ev->eventnum) + " on " + ev->channel +
-                          " cannot be decoded");
+
+/// Field kinds of the LCM wire format, to check a payload's shape before lcm-gen's decode()
+/// trusts it: decode() resizes arrays to the count in the payload before checking that the
+/// elements are there (a count of 2^31-1 asks for 16 GB) and takes string lengths < 1 as huge.
+enum class Wire { kI8, kI64, kF64, kString, kCount, kF64Array, kStringArray };
+
+/// What is wrong with `d` as the encoding of a message with fingerprint `hash` and fields `layout`
+/// (kCount gives the length of the arrays after it), or "" if nothing: too short, another type's
+/// fingerprint, a string length outside [1, bytes left] or a string without its NUL, an array
+/// count outside [0, what the bytes left can hold], bytes left over after the message.
+std::string WireProblem(const std::vector<std::uint8_t>& d, std::int64_t hash, const std::vector<Wire>& layout) {
+  const std::size_t n = d.size();
+  std::size_t pos = 0;
+  auto left = [&] { return n - pos; };
+  auto get = [&](int bytes) {
+    std::uint64_t v = 0;
+    for (int i = 0; i < bytes; ++i) v = (v << 8) | d[pos + i];
+    pos += bytes;
+    return v;
+  };
+  if (left() < 8) return fmt::format("{} bytes are too short for a message (8-byte type fingerprint)", n);
+  const auto h = static_cast<std::int64_t>(get(8));
+  if (h != hash) {
+    return fmt::format("type fingerprint 0x{:016x} is not the channel's type (0x{:016x})", static_cast<std::uint64_t>(h),
+                       static_cast<std::uint64_t>(hash));
   }
-  if (m.k < 0) throw Error(path, "negative step index on " + ev->channel);
-  const auto k = static_cast<std::size_t>(m.k);
-  if (by_k->size() <= k) by_k->resize(k + 1, [] { Msg e{}; e.k = -1; return e; }());
-  auto& raw = log->payload[ev->channel];
-  if (raw.size() <= k) raw.resize(k + 1);
-  ++log->count[ev->channel];
-  if ((*by_k)[k].k == m.k) {
-    ++log->duplicates[ev->channel];
-    return;
+  std::int64_t count = 0;
+  auto string = [&]() -> std::string {
+    if (left() < 4) return "the message ends inside a string length";
+    const auto len = static_cast<std::int32_t>(get(4));
+    if (len < 1 || static_cast<std::uint64_t>(len) > left())
+      return fmt::format("string length {} is out of range [1, {}] (the bytes left)", len, left());
+    if (d[pos + static_cast<std::size_t>(len) - 1] != 0) return "a string lacks its terminating NUL";
+    pos += static_cast<std::size_t>(len);
+    return "";
+  };
+  for (Wire w : layout) {
+    switch (w) {
+      case Wire::kI8:
+      case Wire::kI64:
+      case Wire::kF64: {
+        const std::size_t bytes = w == Wire::kI8 ? 1 : 8;
+        if (left() < bytes) return fmt::format("the message ends inside a field ({} bytes)", n);
+        pos += bytes;
+        break;
+      }
+      case Wire::kCount:
+        if (left() < 4) return fmt::format("the message ends inside an array length ({} bytes)", n);
+        count = static_cast<std::int32_t>(get(4));
+        if (count < 0 || static_cast<std::uint64_t>(count) > left())
+          return fmt::format("array length {} is out of range [0, {}] (the bytes left)", count, left());
+        break;
+      case Wire::kF64Array:
+        if (static_cast<std::uint64_t>(count) * 8 > left())
+          return fmt::format("an array of {} numbers does not fit in the {} bytes left", count, left());
+        pos += static_cast<std::size_t>(count) * 8;
+        break;
+      case Wire::kStringArray:
+        for (std::int64_t i = 0; i < count; ++i)
+          if (auto p = string(); !p.empty()) return p;
+        break;
+      case Wire::kString:
+        if (auto p = string(); !p.empty()) return p;
+        break;
+    }
   }
-  (*by_k)[k] = m;
-  m.run_id = 0;  // differs between runs by design; everything else must not
-  lockstep::Encode(m, &raw[k]);
+  if (pos != n) return fmt::format("{} bytes left over after the message", n - pos);
+  return "";
 }
+
+// The layouts of lcmtypes/*.lcm, field by field (the tests read real logs through them, so a
+// layout that no longer matches its type is caught at once).
+using enum Wire;
+const std::vector<Wire> kHandshakeLayout = {kI64, kI8,    kString,      kString,      kI64, kF64,
+                                                      kI64, kCount, kStringArray, kStringArray, kString};
+const std::vector<Wire> kDesiredLayout = {kI64, kI64, kF64, kF64, kF64,      kF64,
+                                                    kF64, kF64, kF64, kCount, kF64Array, kF64Array};
+const std::vector<Wire> kCommandLayout = {kI64, kI64, kF64, kF64, kF64};
+const std::vector<Wire> kMeasuredLayout = {kI64, kI64, kF64, kF64, kF64};
+const std::vector<Wire> kCurrentLayout = {kI64, kI64, kF64, kF64};
+
+/// Decodes `ev` as a Msg after checking its shape; throws "<source>: byte N: ..." if it is not one.
+template <class Msg>
+Msg Decode(const LogEvent& ev, const std::vector<Wire>& layout, const std::string& source) {
+  Msg m;
+  std::string problem = WireProblem(ev.data, Msg::getHash(), layout);
+  if (problem.empty() && m.decode(ev.data.data(), 0, static_cast<int>(ev.data.size())) !=
+                             static_cast<int>(ev.data.size()))
+    problem = "lcm decode() refused it";
+  if (!problem.empty()) {
+    throw Error(source, fmt::format("byte {}: event {} on {}: the payload is not a {} ({})", ev.offset_bytes,
+                                    ev.event_number, ev.channel, Msg::getTypeName(), problem));
+  }
+  return m;
+}
+
+/// The messages of one step channel in file order, with where each came from.
+template <class Msg>
+struct StepEvents {
+  const char* channel;
+  std::vector<Msg> msgs;
+  std::vector<std::uint64_t> offsets;
+};
+
+/// Files the messages by k (a missing step has k = -1), counting repeats of a (channel, k).
+template <class Msg>
+void Place(const StepEvents<Msg>& in, std::vector<Msg>* by_k, RunLog* log) {
+  auto& raw = log->payload[in.channel];
+  auto& count = log->count[in.channel];
+  for (const Msg& m0 : in.msgs) {
+    const auto k = static_cast<std::size_t>(m0.k);
+    if (by_k->size() <= k) by_k->resize(k + 1, [] { Msg e{}; e.k = -1; return e; }());
+    if (raw.size() <= k) raw.resize(k + 1);
+    ++count;
+    if ((*by_k)[k].k == m0.k) {
+      ++log->duplicates[in.channel];
+      continue;
+    }
+    (*by_k)[k] = m0;
+    Msg m = m0;
+    m.run_id = 0;  // differs between runs by design; everything else must not
+    lockstep::Encode(m, &raw[k]);
+  }
+}
+
+/// The first message whose k cannot belong to the log: k < 0 or k >= bound. Returns its offset
+/// (or UINT64_MAX) and puts its k in *bad_k.
+template <class Msg>
+std::uint64_t FirstBadStep(const StepEvents<Msg>& in, std::int64_t bound, std::int64_t* bad_k) {
+  for (std::size_t i = 0; i < in.msgs.size(); ++i) {
+    if (in.msgs[i].k < 0 || in.msgs[i].k >= bound) {
+      *bad_k = in.msgs[i].k;
+      return in.offsets[i];
+    }
+  }
+  return UINT64_MAX;
+}
+
+RunLog Read(EventLogReader& reader) {
+  const std::string& source = reader.name();
+  RunLog log;
+  log.source = source;
+  log.file_bytes = reader.size_bytes();
+  StepEvents<rths::desired_t> desired{lockstep::kChDesired, {}, {}};
+  StepEvents<rths::command_t> command{lockstep::kChCommand, {}, {}};
+  StepEvents<rths::measured_t> measured{lockstep::kChMeasured, {}, {}};
+  StepEvents<rths::current_t> current{lockstep::kChCurrent, {}, {}};
+  bool first_desired = true;
+  LogEvent ev;
+  auto keep = [&](auto& events, const std::vector<Wire>& layout) {
+    using Msg = typename std::decay_t<decltype(events.msgs)>::value_type;
+    events.msgs.push_back(Decode<Msg>(ev, layout, source));
+    events.offsets.push_back(ev.offset_bytes);
+  };
+  while (reader.Next(&ev)) {
+    if (ev.channel == lockstep::kChDesired) {
+      keep(desired, kDesiredLayout);
+      if (first_desired) log.first_desired_utime = ev.utime;
+      first_desired = false;
+      log.last_desired_utime = ev.utime;
+    } else if (ev.channel == lockstep::kChCommand) {
+      keep(command, kCommandLayout);
+    } else if (ev.channel == lockstep::kChMeasured) {
+      keep(measured, kMeasuredLayout);
+    } else if (ev.channel == lockstep::kChCurrent) {
+      keep(current, kCurrentLayout);
+    } else if (ev.channel == lockstep::kChHandshake) {
+      const auto h = Decode<rths::handshake_t>(ev, kHandshakeLayout, source);
+      log.run_id = h.run_id;
+      log.n_steps = std::max(log.n_steps, h.n_steps);
+      if (h.phase == lockstep::kDone) log.done = true;
+      log.handshakes.push_back(h);
+    } else {
+      ++log.unknown_events;
+    }
+  }
+  log.events = reader.events();
+  log.truncated_tail = reader.truncated();
+  log.truncated_at_byte = reader.truncated_at_byte();
+
+  // Every k must be able to belong to this log: below the planned steps and below the number of
+  // events (a step has a message on each channel). This also bounds the vectors below.
+  const std::int64_t bound = log.n_steps > 0 ? std::min(log.n_steps, log.events) : log.events;
+  std::int64_t bad_k = 0, k = 0;
+  std::uint64_t at = UINT64_MAX, o = 0;
+  const char* channel = "";
+  auto check = [&](const auto& events) {
+    if ((o = FirstBadStep(events, bound, &k)) < at) at = o, bad_k = k, channel = events.channel;
+  };
+  check(desired);
+  check(command);
+  check(measured);
+  check(current);
+  if (at != UINT64_MAX) {
+    const std::string why =
+        bad_k < 0 ? "a step index is never negative"
+                  : (log.n_steps > 0 && log.n_steps <= log.events
+                         ? fmt::format("the handshake plans {} steps: k in [0, {}]", log.n_steps, log.n_steps - 1)
+                         : fmt::format("the file holds only {} events", log.events));
+    throw Error(source, fmt::format("byte {}: {} message with step index k = {} cannot belong to this log ({})", at,
+                                    channel, bad_k, why));
+  }
+  Place(desired, &log.desired, &log);
+  Place(command, &log.command, &log);
+  Place(measured, &log.measured, &log);
+  Place(current, &log.current, &log);
+  return log;
+}
+
 }  // namespace
 
 std::int64_t RunLog::CompleteSteps() const {
@@ -51,31 +243,24 @@ std::string RunLog::AbortReason() const {
   return "";
 }
 
-RunLog ReadRunLog(const std::string& path) {
-  lcm::LogFile file(path, "r");
-  if (!file.good()) throw Error(path, "cannot open the LCM event log");
-  RunLog log;
-  for (const lcm::LogEvent* ev = file.readNextEvent(); ev; ev = file.readNextEvent()) {
-    if (ev->channel == lockstep::kChDesired) {
-      Store(ev, path, &log.desired, &log);
-      if (log.first_desired_utime == 0) log.first_desired_utime = ev->timestamp;
-      log.last_desired_utime = ev->timestamp;
-    } else if (ev->channel == lockstep::kChCommand) {
-      Store(ev, path, &log.command, &log);
-    } else if (ev->channel == lockstep::kChMeasured) {
-      Store(ev, path, &log.measured, &log);
-    } else if (ev->channel == lockstep::kChCurrent) {
-      Store(ev, path, &log.current, &log);
-    } else if (ev->channel == lockstep::kChHandshake) {
-      rths::handshake_t h;
-      if (h.decode(ev->data, 0, ev->datalen) < 0) throw Error(path, "bad handshake event");
-      log.run_id = h.run_id;
-      log.handshakes.push_back(h);
-    } else {
-      ++log.unknown_events;
-    }
+std::string RunLog::TruncationReason() const {
+  std::string r;
+  if (!done) r = "truncated (the run did not finish: no DONE handshake)";
+  if (truncated_tail) {
+    r += fmt::format("{}the file ends in the middle of an event at byte {} (of {})", r.empty() ? "" : "; ",
+                     truncated_at_byte, file_bytes);
   }
-  return log;
+  return r;
+}
+
+RunLog ReadRunLog(const std::string& path) {
+  EventLogReader reader(path);
+  return Read(reader);
+}
+
+RunLog ReadRunLogBytes(const std::string& name, const std::uint8_t* bytes, std::size_t size_bytes) {
+  EventLogReader reader(name, bytes, size_bytes);
+  return Read(reader);
 }
 
 RunMetrics ComputeMetrics(const RunLog& log) {

@@ -2,6 +2,12 @@
 /// @file Reads a run's LCM event log (log.lcm) back into per-step records, for summaries,
 /// replays and the lockstep regression tests. Runs are compared by decoded payload per
 /// (channel, k): header timestamps are wall-clock and never compared.
+///
+/// The reader trusts nothing in the file (io/event_log.h EventLogReader): garbage, a payload that
+/// does not decode as its channel's type, a negative step index or one that cannot belong to the
+/// log is an rths::Error naming the file and the byte offset of the event. A log that ends early
+/// is not an error: RunLog says whether the clock's DONE is in it (the run finished) and where a
+/// cut-short last event starts, and CompleteSteps() says up to which step it is valid.
 #include <cstdint>
 #include <map>
 #include <string>
@@ -34,10 +40,30 @@ struct RunLog {
   /// Events on channels this reader does not know.
   std::int64_t unknown_events = 0;
 
+  /// The file's path (or the buffer's name) and size [bytes], and its complete events.
+  std::string source;
+  std::uint64_t file_bytes = 0;
+  std::int64_t events = 0;
+  /// Steps the run planned (the largest n_steps of its handshakes; 0 if no handshake says).
+  std::int64_t n_steps = 0;
+  /// True if the log holds the clock's DONE handshake (phase 5): every step was committed and the
+  /// run finished. A log without it is truncated: the run did not finish (aborted, killed, disk
+  /// full); its complete steps are still valid.
+  bool done = false;
+  /// True if the file ends in the middle of an event (a write cut short); that event starts at
+  /// truncated_at_byte and is ignored, everything before it is read.
+  bool truncated_tail = false;
+  std::uint64_t truncated_at_byte = 0;
+
   /// Steps 0..n-1 for which every per-step channel has its message.
   std::int64_t CompleteSteps() const;
   /// The ABORT reason in the log ("" if none).
   std::string AbortReason() const;
+  /// True if the run finished and its log is whole: DONE is in it and no event is cut short.
+  bool Complete() const { return done && !truncated_tail; }
+  /// Why the log is not Complete() ("" if it is): "truncated (the run did not finish: no DONE
+  /// handshake)" and/or "the file ends in the middle of an event at byte N".
+  std::string TruncationReason() const;
 };
 
 /// What a run achieved, computed from its log over its complete steps.
@@ -55,8 +81,15 @@ struct RunMetrics {
 };
 RunMetrics ComputeMetrics(const RunLog& log);
 
-/// Reads `path`; throws rths::Error if it cannot be opened or an event cannot be decoded.
+/// Reads `path`. Throws rths::Error (where = path, problem "byte N: ...") if it cannot be opened,
+/// is empty or not an LCM event log, or an event is corrupt: a payload that does not decode
+/// exactly as its channel's type (RTHS_HANDSHAKE, RTHS_DESIRED, RTHS_COMMAND, RTHS_MEASURED,
+/// RTHS_CURRENT; other channels are counted in unknown_events), a step index k < 0, or a k that
+/// cannot belong to this log (k >= the handshake's n_steps, or k >= the number of events in the
+/// file). A log that ends early is read up to where it ends (RunLog::done, truncated_tail).
 RunLog ReadRunLog(const std::string& path);
+/// ReadRunLog on a log in memory (`name` names it in messages); for tests and fuzzing.
+RunLog ReadRunLogBytes(const std::string& name, const std::uint8_t* bytes, std::size_t size_bytes);
 
 /// Hex SHA-256 over the payloads of every step channel, channel by channel (sorted by name),
 /// k ascending: equal digests mean bit-identical decoded payloads per (channel, k).
