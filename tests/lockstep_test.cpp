@@ -38,21 +38,6 @@ stall_budget_s = 2.0
 handshake_timeout_s = 5.0
 )";
 
-int RunCli(const std::string& args, std::string* output = nullptr) {
-  const fs::path out_txt = fs::temp_directory_path() / ("rths_run_" + std::to_string(::getpid()) + ".txt");
-  const std::string cmd = std::string(RTHS_BIN_DIR) + "/rths-run " + args + " > " + out_txt.string() + " 2>&1";
-  const int status = std::system(cmd.c_str());
-  if (output) {
-    std::ifstream in(out_txt);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    *output = ss.str();
-  }
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
-
-bool UdpmAvailable() { return rths::lockstep::CheckMulticastRoute().empty(); }
-
 }  // namespace
 
 TEST_CASE("logger completeness: an N-step run logs exactly N messages per step channel") {

@@ -1,6 +1,10 @@
 #pragma once
 // Shared by the tests that run whole lockstep groups in this process (memq://).
+#include <sys/wait.h>
 #include <unistd.h>
+
+#include <cstdlib>
+#include <sstream>
 
 #include <filesystem>
 #include <fstream>
@@ -55,5 +59,21 @@ inline MemqRun RunMemq(const std::vector<rths::scenario::Scenario>& per_role, co
   }
   return r;
 }
+
+/// Runs `rths-run ARGS` (the supervisor), its stdout and stderr into `*output`; returns its exit code.
+inline int RunCli(const std::string& args, std::string* output = nullptr, const std::string& prefix = "") {
+  const fs::path out_txt = fs::temp_directory_path() / ("rths_run_" + std::to_string(::getpid()) + ".txt");
+  const std::string cmd = prefix + std::string(RTHS_BIN_DIR) + "/rths-run " + args + " > " + out_txt.string() + " 2>&1";
+  const int status = std::system(cmd.c_str());
+  if (output) {
+    std::ifstream in(out_txt);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    *output = ss.str();
+  }
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+inline bool UdpmAvailable() { return rths::lockstep::CheckMulticastRoute().empty(); }
 
 }  // namespace rths_test

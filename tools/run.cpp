@@ -37,6 +37,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/error.h"
+#include "io/reserved_file.h"
 #include "io/run_log.h"
 #include "lockstep/runtime.h"
 #include "models/structure_file.h"
@@ -120,27 +121,6 @@ double FreeBytes(fs::path dir) {
   struct statvfs st {};
   if (::statvfs(dir.c_str(), &st) != 0) return -1.0;
   return static_cast<double>(st.f_bavail) * static_cast<double>(st.f_frsize);
-}
-
-/// Writes `text` over the reserved summary.json, in place (no new blocks needed), then cuts it
-/// to length. Falls back to a plain write if the reservation is missing or too small.
-bool WriteSummary(const fs::path& path, const std::string& text) {
-  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_CLOEXEC, 0644);
-  if (fd < 0) return false;
-  std::size_t done = 0;
-  bool ok = true;
-  while (done < text.size()) {
-    const ssize_t n = ::pwrite(fd, text.data() + done, text.size() - done, static_cast<off_t>(done));
-    if (n <= 0) {
-      if (n < 0 && errno == EINTR) continue;
-      ok = false;
-      break;
-    }
-    done += static_cast<std::size_t>(n);
-  }
-  ok = ok && ::ftruncate(fd, static_cast<off_t>(text.size())) == 0;
-  ok = (::close(fd) == 0) && ok;
-  return ok;
 }
 
 /// The state letter of /proc/PID/stat ('T': stopped), or 0.
@@ -339,7 +319,7 @@ int main(int argc, char** argv) {
                "logger), wait for it, and write its output folder"};
   std::string scenario_path, default_scenario = "scenarios/default.toml";
   std::string out_arg, transport = "udpm", bin_dir;
-  bool quiet = false;
+  bool quiet = false, skip_space_check = false;
   app.add_option("scenario", scenario_path, "scenario TOML file (default: scenarios/default.toml)");
   app.add_option("--default-scenario", default_scenario, "used when no scenario is given")->group("");
   app.add_option("--out", out_arg, "output folder (default: a new folder under runs/)");
@@ -348,6 +328,8 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--bin-dir", bin_dir, "where the rths-* programs are (default: next to this one)");
   app.add_flag("--quiet", quiet, "print only the output folder");
+  app.add_flag("--skip-space-check", skip_space_check, "tests only: do not check the free disk space first")
+      ->group("");
   app.footer("Exit codes: 0 ok; 2 bad input or not enough disk (nothing ran); 3 a participant stopped "
              "answering (named); 4 stopped by an abort; 5 a participant's computation failed; 6 stopped "
              "by the safety monitor; 7 the output could not be written (disk full); 128+N a participant "
@@ -387,7 +369,7 @@ int main(int argc, char** argv) {
     }
     estimate = EstimateOutputBytes(s);
     const double free_bytes = FreeBytes(out);
-    if (free_bytes >= 0 && estimate > free_bytes) {
+    if (!skip_space_check && free_bytes >= 0 && estimate > free_bytes) {
       throw rths::Error(out.string(),
                         fmt::format("not enough free disk space: this run writes about {} ({} steps), and "
                                     "the file system has {} free; free some space, shorten run.duration_s "
@@ -409,10 +391,9 @@ int main(int argc, char** argv) {
   try {
     fs::create_directories(out);
     fs::copy_file(scenario_path, out / "scenario.toml");
-    std::ofstream reserve(out / "summary.json", std::ios::binary);
-    const std::string placeholder = "{\"status\": \"running\"}\n";
-    reserve << placeholder << std::string(kSummaryReserve - placeholder.size(), ' ');
-    if (!reserve.good()) throw rths::Error((out / "summary.json").string(), "cannot reserve the summary");
+    if (!rths::io::ReserveFile((out / "summary.json").string(), kSummaryReserve, "{\"status\": \"running\"}\n")) {
+      throw rths::Error((out / "summary.json").string(), "cannot reserve the summary (disk full?)");
+    }
   } catch (const std::exception& e) {
     std::error_code ec;
     if (created_out) fs::remove_all(out, ec);
@@ -443,7 +424,7 @@ int main(int argc, char** argv) {
     return rths::lockstep::kExitLockstep;
   }
   const double wall_s = std::chrono::duration<double>(Clock::now() - t0).count();
-  const rths::participants::Verdict verdict = rths::participants::Judge(outcomes);
+  rths::participants::Verdict verdict = rths::participants::Judge(outcomes);
 
   // Summary from the log: whatever was committed, even after a failure.
   nlohmann::json j;
@@ -474,6 +455,10 @@ int main(int argc, char** argv) {
     j["steps"] = 0;
     j["log_error"] = e.what();
   }
+  if (verdict.failed && verdict.step < 0 && steps < s.steps()) {
+    verdict.step = steps;  // a process that died cannot say where: the step it did not finish
+    verdict.what += fmt::format(" during step {}", steps);
+  }
   int code = 0;
   std::string status = "completed";
   if (g_interrupted) {
@@ -500,7 +485,7 @@ int main(int argc, char** argv) {
     p.erase("role");
     j["participants"][o.role] = p;
   }
-  const bool summary_ok = WriteSummary(out / "summary.json", j.dump(2) + "\n");
+  const bool summary_ok = rths::io::OverwriteFile((out / "summary.json").string(), j.dump(2) + "\n");
 
   if (!quiet) {
     std::printf("  steps              %lld of %lld\n", static_cast<long long>(steps),

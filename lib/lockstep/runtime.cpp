@@ -136,6 +136,7 @@ void Participant::DeliverNow(Route* route, const lcm::ReceiveBuffer* rbuf) {
     if (PeekRunAndStep(static_cast<const std::uint8_t*>(rbuf->data), rbuf->data_size, &run_id, &k) &&
         run_id == id_.run_id) {
       HeardClock(SteadyClock::now());
+      last_clock_step_ = std::max(last_clock_step_, k);
       if (!lingering_) StartRunning();
     }
   }
@@ -333,8 +334,9 @@ void Participant::Poll(SteadyClock::time_point now, bool idle) {
   if (SecondsBetween(last_clock_, now) > timing_.WatchdogS()) {
     OnStop();
     Fail(kExitLockstep,
-         fmt::format("the clock (integrator) has been silent for {:.3g} s", SecondsBetween(last_clock_, now)),
-         true, -1, kClockName);
+         fmt::format("step {}: the clock (integrator) stopped answering: silent for {:.3g} s", last_clock_step_,
+                     SecondsBetween(last_clock_, now)),
+         true, last_clock_step_, kClockName);
   }
 }
 

@@ -336,6 +336,7 @@ class Participant {
   std::int64_t fail_step_ = -1;
   SteadyClock::time_point created_;
   SteadyClock::time_point last_clock_;
+  std::int64_t last_clock_step_ = -1;  ///< the latest step the clock requested, as seen here
   rths::handshake_t hs_in_{};
   rths::handshake_t hs_out_{};
   rths::repair_t repair_in_{};

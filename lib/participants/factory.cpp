@@ -1,5 +1,6 @@
 #include "participants/factory.h"
 
+#include <csignal>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -9,6 +10,7 @@
 #include <fmt/core.h>
 
 #include "core/error.h"
+#include "io/reserved_file.h"
 #include "participants/controller.h"
 #include "participants/group.h"
 #include "participants/integrator.h"
@@ -68,19 +70,12 @@ void CheckBuildable(const scenario::Scenario& s) {
 }
 
 namespace {
-/// Writes the participant's outcome for the supervisor; a failure here (disk full) only loses
-/// the statistics: the supervisor still has the exit status.
-void WriteOutcome(const std::string& out_dir, const Outcome& o) {
-  const fs::path dir = fs::path(out_dir) / "logs";
-  const fs::path tmp = dir / (o.role + ".json.tmp"), final_path = dir / (o.role + ".json");
-  {
-    std::ofstream f(tmp);
-    f << OutcomeToJson(o).dump(2) << "\n";
-    if (!f.good()) return;
-  }
-  std::error_code ec;
-  fs::rename(tmp, final_path, ec);
+/// Where a participant process leaves its outcome for the supervisor: `out_dir`/logs/<role>.json.
+std::string OutcomePath(const std::string& out_dir, const std::string& role) {
+  return (fs::path(out_dir) / "logs" / (role + ".json")).string();
 }
+/// Its space is reserved at start-up, so that a disk that fills up during the run cannot take it.
+constexpr std::size_t kOutcomeReserve = 8192;
 }  // namespace
 
 int RoleMain(std::string_view role, int argc, char** argv) {
@@ -98,8 +93,11 @@ int RoleMain(std::string_view role, int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     return app.exit(e) == 0 ? 0 : lockstep::kExitUsage;
   }
+  // A file grown past RLIMIT_FSIZE must fail the write (EFBIG), not kill the process.
+  std::signal(SIGXFSZ, SIG_IGN);
   Outcome o;
   o.role = name;
+  io::ReserveFile(OutcomePath(out_dir, name), kOutcomeReserve, "{}\n");
   try {
     const scenario::Scenario s = scenario::LoadScenario(scenario_path);
     lcm::LCM lcm(url);
@@ -124,7 +122,7 @@ int RoleMain(std::string_view role, int argc, char** argv) {
     o.message = fmt::format("internal error: {}", e.what());
   }
   if (o.exit_code != 0) std::fprintf(stderr, "%s: %s\n", name.c_str(), o.message.c_str());
-  WriteOutcome(out_dir, o);
+  io::OverwriteFile(OutcomePath(out_dir, name), OutcomeToJson(o).dump(2) + "\n");
   return o.exit_code;
 }
 

@@ -1,0 +1,40 @@
+#include "io/reserved_file.h"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
+
+namespace rths::io {
+
+namespace {
+bool WriteAll(int fd, const char* data, std::size_t size) {
+  std::size_t done = 0;
+  while (done < size) {
+    const ssize_t n = ::pwrite(fd, data + done, size - done, static_cast<off_t>(done));
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) return false;
+    done += static_cast<std::size_t>(n);
+  }
+  return true;
+}
+}  // namespace
+
+bool ReserveFile(const std::string& path, std::size_t bytes, const std::string& placeholder) {
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0) return false;
+  std::string text = placeholder;
+  if (text.size() < bytes) text.append(bytes - text.size(), ' ');
+  const bool ok = WriteAll(fd, text.data(), text.size());
+  return (::close(fd) == 0) && ok;
+}
+
+bool OverwriteFile(const std::string& path, const std::string& text) {
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_CLOEXEC, 0644);
+  if (fd < 0) return false;
+  bool ok = WriteAll(fd, text.data(), text.size());
+  ok = ok && ::ftruncate(fd, static_cast<off_t>(text.size())) == 0;
+  return (::close(fd) == 0) && ok;
+}
+
+}  // namespace rths::io
