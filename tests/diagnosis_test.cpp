@@ -379,3 +379,42 @@ TEST_CASE("a fit on an end of its range is not an explanation: a force 20 x off 
   REQUIRE(ds != nullptr);
   CHECK_FALSE(ds->selected);
 }
+
+TEST_CASE("regression: one sample of 1e308 is a clean error, never a crash (the reader and the diagnosis)") {
+  const auto [tr, te] = Records(Noisy(), 3.0);
+  // In memory (past the reader's bounds): the nominal residual overflows; Diagnose refuses it.
+  for (double big : {1e308, 1e200}) {
+    CAPTURE(big);
+    auto bad = tr;
+    bad.y_mm[1000] = big;
+    CHECK_THROWS_WITH_AS(Diagnose({bad}, {te}, PaperModel(), Options{}),
+                         doctest::Contains("residual is not finite"), rths::Error);
+  }
+  // A jump far beyond any actuator's speed (2e9 mm/s) does not push the vmax search past the
+  // effect library's limit of 1e9 mm/s (it used to be refused as a bad vmax).
+  {
+    auto jump = tr;
+    jump.y_mm[1000] += 1e6;
+    CHECK_NOTHROW(Diagnose({jump}, {te}, PaperModel(), Options{}));
+  }
+
+  const std::string bin = std::string(RTHS_BIN_DIR) + "/rths-diagnose";
+  REQUIRE(::access(bin.c_str(), X_OK) == 0);
+  const auto dir = TempDir("huge");
+  rths::io::WriteRigRecord(te, (dir / "good.csv").string());
+  auto huge = tr;
+  huge.y_mm[1000] = 1e308;
+  huge.metadata.clear();
+  rths::io::WriteRigRecord(huge, (dir / "huge.csv").string());  // writes values unchecked, as a lab's file might
+  const std::string out = (dir / "out.txt").string();
+  const std::string cmd = bin + " --train " + (dir / "huge.csv").string() + " --test " + (dir / "good.csv").string() +
+                          " --out " + (dir / "o").string() + " > " + out + " 2>&1";
+  const int st = std::system(cmd.c_str());
+  std::ifstream f(out);
+  const std::string text((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+  CAPTURE(text);
+  REQUIRE(WIFEXITED(st));
+  CHECK(WEXITSTATUS(st) == 2);
+  // Line 1004: magic, dt_s, header on line 3 (no metadata), row k on line 4 + k.
+  CHECK(text.find("huge.csv:1004: column y_mm: 1e+308 is out of range [-10000, 10000] mm") != std::string::npos);
+}

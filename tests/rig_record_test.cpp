@@ -6,6 +6,7 @@
 #include <string>
 
 #include <doctest/doctest.h>
+#include <fmt/format.h>
 
 #include "core/error.h"
 #include "io/rig_record.h"
@@ -61,6 +62,11 @@ std::pair<std::string, std::string> ErrorOf(const fs::path& dir, const std::stri
     return {e.where(), e.problem()};
   }
   return {"", "no error"};
+}
+
+bool Contains(const std::string& s, const std::string& part) {
+  CAPTURE(s);
+  return s.find(part) != std::string::npos;
 }
 
 }  // namespace
@@ -279,4 +285,107 @@ current_A = 2.5
   shortrec.t_s.resize(100), shortrec.u_mm.resize(100), shortrec.y_mm.resize(100), shortrec.f_kN.resize(100),
       shortrec.i_A.resize(100), shortrec.r_mm.resize(100);
   CHECK_THROWS_WITH_AS(rths::io::ValidateRigRecord(shortrec, "x"), doctest::Contains("at least 2 s"), rths::Error);
+}
+
+TEST_CASE("rig record: non-finite and absurd values are refused with file and line; bounds are inclusive") {
+  const auto dir = rths_test::TempDir("rig_record_bounds");
+  const std::string bad = (dir / "bad.csv").string();
+  const std::string ok = Valid();
+  // Row k is on line 6 + k; line 300 holds t = 0.147. Columns: t_s,u_mm,y_mm,f_kN,i_A.
+  for (const std::string v : {"nan", "-nan", "inf", "-inf", "1e999", "-1e400", "infinity"}) {
+    CAPTURE(v);
+    const auto [where, what] = ErrorOf(dir, ReplaceLine(ok, 300, "0.147,0.1," + v + ",0.5,0"));
+    CHECK(where == bad + ":300");
+    CHECK(what == "column y_mm: \"" + v + "\" is not a finite number");
+  }
+  struct Case {
+    std::string row, column, range;
+  };
+  for (const Case& c : std::vector<Case>{{"0.147,0.1,1e308,0.5,0", "y_mm: 1e+308", "[-10000, 10000] mm"},
+                                         {"0.147,-10000.5,0.1,0.5,0", "u_mm: -10000.5", "[-10000, 10000] mm"},
+                                         {"0.147,0.1,0.1,100001,0", "f_kN: 100001", "[-100000, 100000] kN"},
+                                         {"0.147,0.1,0.1,0.5,-100.5", "i_A: -100.5", "[-100, 100] A"},
+                                         {"2e10,0.1,0.1,0.5,0", "t_s: 20000000000", "[-1e+10, 1e+10] s"}}) {
+    CAPTURE(c.row);
+    const auto [where, what] = ErrorOf(dir, ReplaceLine(ok, 300, c.row));
+    CHECK(where == bad + ":300");
+    CHECK(what.find("column " + c.column + " is out of range " + c.range) != std::string::npos);
+  }
+  {  // r_mm has the displacement bound too
+    const std::string text = ReplaceLine(Valid("t_s,u_mm,y_mm,f_kN,i_A,r_mm"), 300, "0.147,0.1,0.1,0.5,0,-2e4");
+    const auto [where, what] = ErrorOf(dir, text);
+    CHECK(where == bad + ":300");
+    CHECK(what.find("column r_mm: -20000 is out of range [-10000, 10000] mm") != std::string::npos);
+  }
+  // The bounds themselves are allowed.
+  const auto edge = rths::io::ParseRigRecord(ReplaceLine(ok, 300, "0.147,-10000,10000,-100000,100"), "edge.csv");
+  CHECK(edge.u_mm[294] == -1e4);
+  CHECK(edge.y_mm[294] == 1e4);
+  CHECK(edge.f_kN[294] == -1e5);
+  CHECK(edge.i_A[294] == 100.0);
+  for (const std::string dt : {"0", "-0.0005", "1e-7", "2", "nan", "1e999"}) {
+    CAPTURE(dt);
+    const auto [where, what] = ErrorOf(dir, ReplaceLine(ok, 2, "# dt_s: " + dt));
+    CHECK(where == bad + ":2");
+    CHECK(what == "dt_s must be a number in [1e-06, 1] s (got \"" + dt + "\")");
+  }
+  // In-memory records get the same checks, named by sample.
+  auto rec = rths::io::ParseRigRecord(ok, "mem.csv");
+  rths::io::ValidateRigRecord(rec, "mem");
+  rec.f_kN[17] = 1e308;
+  CHECK_THROWS_WITH_AS(rths::io::ValidateRigRecord(rec, "mem"),
+                       doctest::Contains("mem: sample 17: column f_kN: 1e+308 is out of range"), rths::Error);
+  rec.f_kN[17] = 0.0;
+  rec.dt_s = 1e-300;
+  CHECK_THROWS_WITH_AS(rths::io::ValidateRigRecord(rec, "mem"), doctest::Contains("dt_s must be in [1e-06, 1] s"),
+                       rths::Error);
+}
+
+TEST_CASE("rig record: ParseRigRecord on text is ReadRigRecord on the file") {
+  const auto dir = rths_test::TempDir("rig_record_parse");
+  const std::string text = Valid("t_s,u_mm,y_mm,f_kN,i_A,r_mm");
+  const auto path = Write(dir, "p.csv", text).string();
+  const auto a = ReadRigRecord(path);
+  const auto b = rths::io::ParseRigRecord(text, path);
+  CHECK(a.source == b.source);
+  CHECK(a.t_s == b.t_s);
+  CHECK(a.y_mm == b.y_mm);
+  CHECK(a.r_mm == b.r_mm);
+  CHECK(a.metadata == b.metadata);
+  CHECK_THROWS_WITH_AS(rths::io::ParseRigRecord("", "empty.csv"),
+                       doctest::Contains("empty.csv:1: not a rig record: the first line must be"), rths::Error);
+}
+
+TEST_CASE("UTFSM files: absurd values and headers are refused with file and line") {
+  const auto dir = rths_test::TempDir("utfsm_bounds");
+  std::string rows;
+  for (int k = 0; k < 3000; ++k) rows += fmt::format("{:.7g} {:.7g} 0 {:.7g}\n", k * 0.001, std::sin(k * 0.01), 100.0);
+  const auto damper = Write(dir, "25mm1Hz0x5A.txt", rows).string();
+  CHECK(rths::io::ReadUtfsmDamper(damper).size() == 3000);
+  auto error_of = [&](const std::string& name, const std::string& text) -> std::string {
+    const auto p = Write(dir, name, text).string();
+    try {
+      rths::io::ReadUtfsm(p);
+    } catch (const rths::Error& e) {
+      return e.what();
+    }
+    FAIL_CHECK("expected an rths::Error for " << name);
+    return "";
+  };
+  CHECK(Contains(error_of("25mm1Hz0x5A.txt", ReplaceLine(rows, 40, "0.039 1e308 0 100")),
+                 "25mm1Hz0x5A.txt:40: x = 1e+308 is out of range [-10000, 10000] mm"));
+  CHECK(Contains(error_of("25mm1Hz0x5A.txt", ReplaceLine(rows, 41, "0.04 0.1 0 1e300")),
+                 "25mm1Hz0x5A.txt:41: F / 1000 = 1e+297 is out of range"));
+  CHECK(Contains(error_of("25mm1Hz0x5A.txt", ReplaceLine(rows, 42, "0.041 0.1 0 1e999")),
+                 "25mm1Hz0x5A.txt:42: expected four numbers"));
+  CHECK(Contains(error_of("25mm1Hz500A.txt", rows), "cannot read the current '500' from the file name"));
+  // The DAQ export: header size and sampling interval bounded, channels bounded after conversion.
+  CHECK(Contains(error_of("daq.txt", "Header Size: 1e300\n"), "daq.txt:1: not a DAQ export"));
+  CHECK(Contains(error_of("daq.txt", "Header Size: 3\nSampling Interval: 1e-300\nSample Number, Date/Time, CHANNEL0, "
+                                     "CHANNEL1, CHANNEL2, Events\n"),
+                 "daq.txt:2: bad Sampling Interval"));
+  std::string daq = "Header Size: 3\nSampling Interval: 0.001\nSample Number, Date/Time, CHANNEL0, CHANNEL1, CHANNEL2, "
+                    "Events\n";
+  for (int k = 0; k < 10; ++k) daq += fmt::format("{},x,0,0,{}\n", k, k == 7 ? "1e306" : "0");
+  CHECK(Contains(error_of("daq.txt", daq), "daq.txt:11: u_mm (10 CHANNEL2) = 1e+307 is out of range"));
 }

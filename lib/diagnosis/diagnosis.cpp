@@ -376,10 +376,13 @@ double FitEffect(const Channel& ch, const std::vector<CandidateSpec>& specs, Par
   }
   const bool refit = p->count(name) > 0;
   std::vector<double> cur = refit ? (*p)[name] : std::vector<double>{};
+  // A non-finite SSE (an overflow on absurd data) ranks last, so the searches below always
+  // have a best point and never compare NaNs.
   auto eval = [&](const std::vector<double>& v) {
     Params q = *p;
     q[name] = v;
-    return ch.Sse(ch.Predict(ToSet(specs, q)));
+    const double sse = ch.Sse(ch.Predict(ToSet(specs, q)));
+    return std::isfinite(sse) ? sse : std::numeric_limits<double>::infinity();
   };
   double best = 0;
   if (spec.params.size() == 1) {
@@ -405,6 +408,7 @@ double FitEffect(const Channel& ch, const std::vector<CandidateSpec>& specs, Par
   const auto& b = spec.params[1];
   std::vector<double> v = cur;
   if (!refit) {
+    v = {a.lo, b.lo};  // kept only if no grid point has a finite SSE
     double fb = std::numeric_limits<double>::infinity();
     for (int i = 0; i < a.grid; ++i) {
       const double xa = std::clamp(std::exp(std::log(a.lo) + (std::log(a.hi) - std::log(a.lo)) * i / (a.grid - 1)), a.lo, a.hi);
@@ -605,7 +609,8 @@ Result Diagnose(const std::vector<io::RigRecord>& train_in, const std::vector<io
   double vmax_meas = 1.0;
   for (const auto& d : train)
     for (std::size_t k = 1; k < d.size(); ++k) vmax_meas = std::max(vmax_meas, std::abs(d.y[k] - d.y[k - 1]) / dt);
-  const auto specs = Candidates(dt, 2.0 * vmax_meas);
+  // At most the effect library's limit for vmax (1e9 mm/s; a jump in a record can exceed it).
+  const auto specs = Candidates(dt, std::min(2.0 * vmax_meas, 1e9));
   // A displacement-only test (u = y in every record, e.g. the UTFSM damper tests) has no
   // displacement channel to diagnose: predicting y from u would only show the model's own lag.
   bool y_ok = false;
@@ -666,6 +671,14 @@ Result Diagnose(const std::vector<io::RigRecord>& train_in, const std::vector<io
     s.sse = s.train.Sse(s.pred_train);
     s.n_train = Count(train);
     const double sse_test = s.test.Sse(s.nom_test);
+    for (const auto& [sse, set] : {std::pair{s.sse, &train}, std::pair{sse_test, &test}}) {
+      if (std::isfinite(sse)) continue;
+      std::string names;
+      for (const auto& d : *set) names += (names.empty() ? "" : ", ") + d.source;
+      throw Error(names, fmt::format("the nominal model's {} residual is not finite: values too large for the "
+                                     "arithmetic (a record's |u|, |y| or |f| is absurd)",
+                                     s.ch == 'y' ? "displacement" : "force"));
+    }
     cs.gap_train_pct = s.train.NrmsePct(s.sse);
     cs.gap_test_pct = s.test.NrmsePct(sse_test);
     const double v_tr = NoiseFloorVar(s.train, s.pred_train), v_te = NoiseFloorVar(s.test, s.nom_test);

@@ -6,6 +6,8 @@
 #include <cstdlib>
 #include <fstream>
 #include <map>
+#include <sstream>
+#include <string_view>
 
 #include <fmt/format.h>
 
@@ -45,6 +47,26 @@ bool ParseFinite(const std::string& s, double* v) {
 }
 
 std::string Where(const std::string& path, std::size_t line) { return fmt::format("{}:{}", path, line); }
+
+/// The bound on |value| of a column and its unit (0 if the column is not one of ours).
+std::pair<double, const char*> BoundOf(std::string_view column) {
+  if (column == "t_s") return {kMaxAbsTimeS, "s"};
+  if (column == "u_mm" || column == "y_mm" || column == "r_mm") return {kMaxAbsDisplacementMm, "mm"};
+  if (column == "f_kN") return {kMaxAbsForceKN, "kN"};
+  if (column == "i_A") return {kMaxAbsCurrentA, "A"};
+  return {0.0, ""};
+}
+
+/// "" if |v| is within the column's bound, else the problem.
+std::string OutOfBounds(std::string_view column, double v) {
+  const auto [bound, unit] = BoundOf(column);
+  if (std::abs(v) <= bound) return "";
+  return fmt::format("column {}: {} is out of range [-{:g}, {:g}] {} (a rig record's bound: an absurd value, or a "
+                     "unit mix-up?)",
+                     column, v, bound, bound, unit);
+}
+
+bool DtInRange(double dt) { return dt >= kMinDtS && dt <= kMaxDtS; }
 
 double Median(std::vector<double> v) {
   std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
@@ -96,8 +118,15 @@ std::string RigRecord::Meta(const std::string& key) const {
 }
 
 RigRecord ReadRigRecord(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw Error(path, "cannot open the rig record");
+  std::ifstream file(path, std::ios::binary);
+  if (!file) throw Error(path, "cannot open the rig record");
+  const std::string text((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+  if (file.bad()) throw Error(path, "cannot read the rig record");
+  return ParseRigRecord(text, path);
+}
+
+RigRecord ParseRigRecord(std::string_view text, const std::string& path) {
+  std::istringstream in{std::string(text)};
   RigRecord rec;
   rec.source = path;
   std::string line;
@@ -119,8 +148,9 @@ RigRecord ReadRigRecord(const std::string& path) {
       if (colon == std::string::npos) continue;  // a plain comment
       const std::string key = Trim(s.substr(1, colon - 1)), value = Trim(s.substr(colon + 1));
       if (key == "dt_s") {
-        if (!ParseFinite(value, &rec.dt_s) || !(rec.dt_s > 0.0))
-          throw Error(Where(path, ln), fmt::format("dt_s must be a number > 0 (got \"{}\")", value));
+        if (!ParseFinite(value, &rec.dt_s) || !DtInRange(rec.dt_s))
+          throw Error(Where(path, ln), fmt::format("dt_s must be a number in [{:g}, {:g}] s (got \"{}\")", kMinDtS,
+                                                  kMaxDtS, value));
         dt_line = ln;
       } else {
         rec.metadata.emplace_back(key, value);
@@ -172,6 +202,7 @@ RigRecord ReadRigRecord(const std::string& path) {
       if (!ParseFinite(f[c], &v)) {
         throw Error(Where(path, ln), fmt::format("column {}: \"{}\" is not a finite number", cols[c], f[c]));
       }
+      if (const auto problem = OutOfBounds(cols[c], v); !problem.empty()) throw Error(Where(path, ln), problem);
       vec->push_back(v);
     }
     row_line.push_back(ln);
@@ -186,14 +217,18 @@ void ValidateRigRecord(const RigRecord& rec, const std::string& where) {
   if (rec.u_mm.size() != n || rec.y_mm.size() != n || rec.f_kN.size() != n || rec.i_A.size() != n ||
       (rec.has_r() && rec.r_mm.size() != n))
     throw Error(where, "the record's columns differ in length");
-  if (!(rec.dt_s > 0.0) || !std::isfinite(rec.dt_s))
-    throw Error(where, fmt::format("dt_s must be > 0 (got {})", rec.dt_s));
+  if (!DtInRange(rec.dt_s))
+    throw Error(where, fmt::format("dt_s must be in [{:g}, {:g}] s (got {})", kMinDtS, kMaxDtS, rec.dt_s));
   const std::vector<std::pair<const char*, const std::vector<double>*>> cols{
       {"t_s", &rec.t_s}, {"u_mm", &rec.u_mm}, {"y_mm", &rec.y_mm}, {"f_kN", &rec.f_kN}, {"i_A", &rec.i_A},
       {"r_mm", &rec.r_mm}};
   for (const auto& [name, v] : cols)
     for (std::size_t k = 0; k < v->size(); ++k)
-      if (!std::isfinite((*v)[k])) throw Error(fmt::format("{}: sample {}", where, k), fmt::format("{} is not finite", name));
+      if (!std::isfinite((*v)[k])) {
+        throw Error(fmt::format("{}: sample {}", where, k), fmt::format("{} is not finite", name));
+      } else if (const auto problem = OutOfBounds(name, (*v)[k]); !problem.empty()) {
+        throw Error(fmt::format("{}: sample {}", where, k), problem);
+      }
   CheckTime(rec.t_s, rec.dt_s, where, [&](std::size_t k) { return fmt::format("{}: sample {}", where, k); });
   CheckDuration(n, rec.dt_s, where);
 }

@@ -16,6 +16,7 @@
 /// Sample pairing (docs/lockstep.md): row k holds u_k, the command held over [t_k, t_{k+1}), and
 /// y_k, f_k measured at t_k; on a rig with a strictly proper actuator y_k depends on u up to k-1.
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -50,22 +51,37 @@ struct RigRecord {
 /// Shortest record accepted [s] (diagnosis.md).
 inline constexpr double kMinRecordS = 2.0;
 
+/// Largest magnitudes a record may hold (ReadRigRecord, ValidateRigRecord): far beyond any lab
+/// rig, yet small enough that no sum of squares or model prediction of the diagnosis and the
+/// identification overflows (a sample of 1e308 used to make every fit NaN).
+inline constexpr double kMaxAbsDisplacementMm = 1e4;  ///< |u_mm|, |y_mm|, |r_mm| [mm] (10 m)
+inline constexpr double kMaxAbsForceKN = 1e5;         ///< |f_kN| [kN] (100 MN)
+inline constexpr double kMaxAbsCurrentA = 100.0;      ///< |i_A| [A]
+inline constexpr double kMaxAbsTimeS = 1e10;          ///< |t_s| [s] (Unix times fit)
+/// The range of dt_s [s]: 1 MHz to 1 Hz sampling.
+inline constexpr double kMinDtS = 1e-6, kMaxDtS = 1.0;
+
 /// Reads a CSV rig record. Throws rths::Error with where = "path:line" (line 1-based, of the
 /// offending line; or "path" if it cannot be opened) for: a missing or wrong first line, a
-/// missing or bad '# dt_s:' line, a missing or duplicated column, a row with the wrong number of
-/// fields, a field that is not a finite number (NaN, inf, text), a non-increasing time, a
-/// non-uniform step or a gap (a step off the median step by more than 1 %; a gap if it exceeds
-/// 1.5 steps), a median step that disagrees with dt_s by more than 1 % (where = the dt_s line),
-/// and fewer than 2 s of data (where = the last line).
+/// missing or bad '# dt_s:' line (a number in [kMinDtS, kMaxDtS]), a missing or duplicated column,
+/// a row with the wrong number of fields, a field that is not a finite number (NaN, inf, 1e999,
+/// text) or is out of its column's bounds (kMaxAbsDisplacementMm, kMaxAbsForceKN, kMaxAbsCurrentA,
+/// kMaxAbsTimeS), a non-increasing time, a non-uniform step or a gap (a step off the median step
+/// by more than 1 %; a gap if it exceeds 1.5 steps), a median step that disagrees with dt_s by
+/// more than 1 % (where = the dt_s line), and fewer than 2 s of data (where = the last line).
 RigRecord ReadRigRecord(const std::string& path);
+
+/// ReadRigRecord on the text of a record (`path` names it in messages and becomes its source).
+RigRecord ParseRigRecord(std::string_view text, const std::string& path);
 
 /// Writes `rec` as a CSV rig record (format above; t_s, u_mm, y_mm, f_kN, i_A[, r_mm]; numbers
 /// with 10 significant digits). Throws rths::Error if the file cannot be written or the vectors
 /// differ in length.
 void WriteRigRecord(const RigRecord& rec, const std::string& path);
 
-/// Checks an in-memory record with the rules of ReadRigRecord (lengths, finite values, uniform
-/// time at dt_s, at least 2 s); `where` names it in the error. Throws rths::Error.
+/// Checks an in-memory record with the rules of ReadRigRecord (lengths, finite values within the
+/// bounds, dt_s in range, uniform time at dt_s, at least 2 s); `where` names it in the error.
+/// Throws rths::Error.
 void ValidateRigRecord(const RigRecord& rec, const std::string& where);
 
 /// A run of ours as a rig record, over its complete steps k = 0 .. CompleteSteps()-1:

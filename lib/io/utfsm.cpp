@@ -32,6 +32,15 @@ bool ParseFinite(const std::string& s, double* v) {
 
 std::string Where(const std::string& path, std::size_t line) { return fmt::format("{}:{}", path, line); }
 
+/// Throws "path:line: <what> = v is out of range [-bound, bound] unit" if |v| > bound (the rig
+/// record's bounds, io/rig_record.h), so an absurd sample is named by its line, not its index.
+void CheckBound(const std::string& path, std::size_t line, const char* what, double v, double bound, const char* unit) {
+  if (std::abs(v) <= bound) return;
+  throw Error(Where(path, line), fmt::format("{} = {} is out of range [-{:g}, {:g}] {} (a rig record's bound: an "
+                                             "absurd value?)",
+                                             what, v, bound, bound, unit));
+}
+
 double Mean(const std::vector<double>& v, std::size_t a, std::size_t b) {
   double s = 0.0;
   for (std::size_t k = a; k < b; ++k) s += v[k];
@@ -51,17 +60,18 @@ RigRecord ReadUtfsmActuator(const std::string& path, const UtfsmActuatorOptions&
   ++ln;
   const auto colon = line.find(':');
   double hsize = 0.0;
-  if (Trim(line.substr(0, colon)) != "Header Size" || colon == std::string::npos ||
-      !ParseFinite(line.substr(colon + 1), &hsize) || hsize < 1)
-    throw Error(Where(path, 1), "not a DAQ export: the first line must be 'Header Size: <lines>'");
+  if (colon == std::string::npos || Trim(line.substr(0, colon)) != "Header Size" ||
+      !ParseFinite(line.substr(colon + 1), &hsize) || hsize < 1 || hsize > 10000 || hsize != std::floor(hsize))
+    throw Error(Where(path, 1), "not a DAQ export: the first line must be 'Header Size: <lines>' (1 to 10000)");
   double dt = 0.0;
   std::string columns;
   while (ln < static_cast<std::size_t>(hsize) && std::getline(in, line)) {
     ++ln;
     const auto c = line.find(':');
     if (c != std::string::npos && Trim(line.substr(0, c)) == "Sampling Interval" &&
-        (!ParseFinite(line.substr(c + 1), &dt) || !(dt > 0.0)))
-      throw Error(Where(path, ln), "bad Sampling Interval");
+        (!ParseFinite(line.substr(c + 1), &dt) || dt < kMinDtS || dt > kMaxDtS))
+      throw Error(Where(path, ln), fmt::format("bad Sampling Interval (a number of seconds in [{:g}, {:g}])", kMinDtS,
+                                               kMaxDtS));
     columns = line;
   }
   if (!(dt > 0.0)) throw Error(Where(path, ln), "no 'Sampling Interval' in the header");
@@ -84,6 +94,9 @@ RigRecord ReadUtfsmActuator(const std::string& path, const UtfsmActuatorOptions&
     y.push_back(10.0 * c0);      // mm
     f.push_back(9.80665 * c1);   // kN (9806.65 N/V)
     u.push_back(10.0 * c2);      // mm
+    CheckBound(path, ln, "y_mm (10 CHANNEL0)", y.back(), kMaxAbsDisplacementMm, "mm");
+    CheckBound(path, ln, "f_kN (9.80665 CHANNEL1)", f.back(), kMaxAbsForceKN, "kN");
+    CheckBound(path, ln, "u_mm (10 CHANNEL2)", u.back(), kMaxAbsDisplacementMm, "mm");
   }
   if (u.empty()) throw Error(path, "no data rows");
 
@@ -144,8 +157,9 @@ double UtfsmCurrentFromName(const std::string& path) {
   std::string cur = stem.substr(hz + 2, stem.size() - hz - 3);
   std::replace(cur.begin(), cur.end(), 'x', '.');
   double v = 0.0;
-  if (!ParseFinite(cur, &v) || v < 0.0)
-    throw Error(path, fmt::format("cannot read the current '{}' from the file name", cur));
+  if (!ParseFinite(cur, &v) || v < 0.0 || v > kMaxAbsCurrentA)
+    throw Error(path, fmt::format("cannot read the current '{}' from the file name (a number of A in [0, {:g}])", cur,
+                                  kMaxAbsCurrentA));
   return v;
 }
 
@@ -168,6 +182,9 @@ RigRecord ReadUtfsmDamper(const std::string& path) {
     if (fields.size() != 4 || !ParseFinite(fields[0], &v[0]) || !ParseFinite(fields[1], &v[1]) ||
         !ParseFinite(fields[2], &v[2]) || !ParseFinite(fields[3], &v[3]))
       throw Error(Where(path, ln), "expected four numbers: t [s], x [mm], xdot [mm/s], F [N]");
+    CheckBound(path, ln, "t", v[0], kMaxAbsTimeS, "s");
+    CheckBound(path, ln, "x", v[1], kMaxAbsDisplacementMm, "mm");
+    CheckBound(path, ln, "F / 1000", v[3] / 1000.0, kMaxAbsForceKN, "kN");
     rec.t_s.push_back(v[0]);
     rec.u_mm.push_back(v[1]);
     rec.y_mm.push_back(v[1]);
