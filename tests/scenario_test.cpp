@@ -105,7 +105,7 @@ TEST_CASE("every file in scenarios/ loads") {
 }
 
 TEST_CASE("omitted keys keep the struct defaults") {
-  const Scenario empty = ParseScenario("", "empty.toml");
+  const Scenario empty = ParseScenario("[run]\nname = \"run\"\n", "minimal.toml");  // one key, at its default
   const Scenario defaults;
   CHECK(empty.run.name == defaults.run.name);
   CHECK(empty.run.dt_s == defaults.run.dt_s);
@@ -356,4 +356,24 @@ TEST_CASE("controller and plant options of Table 1 are validated") {
                 {"semiactive.pulse_duty", "(0, 1)"});
   CheckContains(ErrorOf("[controller]\nmodel = {K = 1.6e7, p = -151.7, b = 250.4, c = 1.061e5}\n"),
                 {"controller.model.p", "stable"});
+}
+
+TEST_CASE("an empty scenario is an error naming the file: empty, only comments, only table headers") {
+  for (const char* text : {"", "\n\n", "# just a comment\n  # another\n", "[run]\n", "[run]\n[structure.ground]\n# none\n",
+                           "[plant.effects]\n"}) {
+    CAPTURE(text);
+    CheckContains(ErrorOf(text, "scenarios/x.toml"), {"scenarios/x.toml: empty scenario: no key is set"});
+  }
+  // A key anywhere, even deep in a table, makes it a scenario.
+  CHECK(ParseScenario("[structure.ground]\nseed = 3\n", "ok.toml").structure.ground.seed == 3);
+  // LoadScenario names the file too.
+  const fs::path dir = TempDir("empty");
+  WriteFile(dir / "empty.toml", "# nothing here\n");
+  try {
+    LoadScenario((dir / "empty.toml").string());
+    FAIL_CHECK("an empty scenario file loaded");
+  } catch (const rths::Error& e) {
+    CHECK(e.where() == (dir / "empty.toml").string());
+    CHECK(std::string(e.problem()).rfind("empty scenario", 0) == 0);
+  }
 }

@@ -851,6 +851,19 @@ Scenario ParseScenario(std::string_view toml_text, const std::string& path) {
     throw Error(fmt::format("{}:{}:{}", file, at.line, at.column),
                 fmt::format("TOML syntax error at line {}, column {}: {}", at.line, at.column, e.description()));
   }
+  // An empty scenario (an empty file, only comments, only table headers) is a mistake, not a
+  // request for the default experiment: at least one key must be set somewhere.
+  struct AnyKey {
+    static bool In(const toml::table& t) {
+      for (auto&& [key, node] : t)
+        if (const toml::table* sub = node.as_table(); !sub || In(*sub)) return true;
+      return false;
+    }
+  };
+  if (!AnyKey::In(root)) {
+    throw Error(file, "empty scenario: no key is set (the text is empty or holds only comments and table headers); "
+                      "set at least one key, e.g. [run] name = \"...\" (every key: docs/scenarios.md)");
+  }
   Scenario s;
   s.path = path;
   ReadScenario(root, file, &s);
