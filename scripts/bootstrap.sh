@@ -14,6 +14,7 @@ packages=(
   libssl-dev                       # SHA-256 of scenario files (libcrypto)
   iproute2                         # ip route, for the multicast route below
   gnuplot-nox                      # figures (PNG via pngcairo)
+  clang-14 libclang-rt-14-dev      # libFuzzer + ASan/UBSan for the fuzz targets (fuzz/, build-fuzz/)
 )
 missing=()
 for p in "${packages[@]}"; do
@@ -41,3 +42,7 @@ fi
 
 cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo
 cmake --build build -j"$(nproc)"
+# The libFuzzer targets (docs/fuzzing.md), with clang in a tree of their own; ctest runs them.
+cmake -S fuzz -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+  -DCMAKE_CXX_COMPILER=clang++-14 -DCMAKE_C_COMPILER=clang-14
+cmake --build build-fuzz -j"$(nproc)"

@@ -675,9 +675,10 @@ Result Diagnose(const std::vector<io::RigRecord>& train_in, const std::vector<io
       if (std::isfinite(sse)) continue;
       std::string names;
       for (const auto& d : *set) names += (names.empty() ? "" : ", ") + d.source;
-      throw Error(names, fmt::format("the nominal model's {} residual is not finite: values too large for the "
-                                     "arithmetic (a record's |u|, |y| or |f| is absurd)",
-                                     s.ch == 'y' ? "displacement" : "force"));
+      throw Error(names, fmt::format("the nominal model's {} residual is not finite: the model diverged on these "
+                                     "records (is dt_s = {} s fine enough for it?) or a value is too large for "
+                                     "the arithmetic",
+                                     s.ch == 'y' ? "displacement" : "force", dt));
     }
     cs.gap_train_pct = s.train.NrmsePct(s.sse);
     cs.gap_test_pct = s.test.NrmsePct(sse_test);
