@@ -16,6 +16,7 @@
 
 #include "core/error.h"
 #include "io/event_log.h"
+#include "io/rig_record.h"
 #include "io/run_log.h"
 #include "lockstep/runtime.h"
 #include "test_support.h"
@@ -36,14 +37,14 @@ Bytes Encoded(const Msg& m) {
   return b;
 }
 
-rths::handshake_t Handshake(std::int8_t phase, std::int64_t n_steps) {
+rths::handshake_t Handshake(std::int8_t phase, std::int64_t n_steps, double dt_s = 0.0005) {
   rths::handshake_t h{};
   h.run_id = 77;
   h.phase = phase;
   h.participant = phase == rths::lockstep::kHello ? "plant" : "clock";
   h.scenario_sha256 = std::string(64, 'a');
   h.n_steps = n_steps;
-  h.dt_s = 0.0005;
+  h.dt_s = dt_s;
   h.k = phase == rths::lockstep::kDone ? n_steps : -1;
   if (phase == rths::lockstep::kGo) {
     h.roster_names = {"integrator", "plant"};
@@ -61,9 +62,9 @@ struct Ev {
 
 /// A run of `n` steps as events: GO, then desired/command/measured/current per step (k as given
 /// by `k_of`), then DONE if `done`.
-std::vector<Ev> SyntheticRun(std::int64_t n, bool done = true) {
+std::vector<Ev> SyntheticRun(std::int64_t n, bool done = true, double dt_s = 0.0005) {
   std::vector<Ev> evs;
-  evs.push_back({rths::lockstep::kChHandshake, Encoded(Handshake(rths::lockstep::kGo, n))});
+  evs.push_back({rths::lockstep::kChHandshake, Encoded(Handshake(rths::lockstep::kGo, n, dt_s))});
   for (std::int64_t k = 0; k < n; ++k) {
     rths::desired_t d{};
     d.run_id = 77, d.k = k, d.r_mm = 0.1 * k, d.n_dof = 2, d.x_mm = {1.0, 2.0}, d.abs_acc_mm_s2 = {3.0, 4.0};
@@ -78,7 +79,7 @@ std::vector<Ev> SyntheticRun(std::int64_t n, bool done = true) {
     evs.push_back({rths::lockstep::kChMeasured, Encoded(m)});
     evs.push_back({rths::lockstep::kChCurrent, Encoded(i)});
   }
-  if (done) evs.push_back({rths::lockstep::kChHandshake, Encoded(Handshake(rths::lockstep::kDone, n))});
+  if (done) evs.push_back({rths::lockstep::kChHandshake, Encoded(Handshake(rths::lockstep::kDone, n, dt_s))});
   return evs;
 }
 
@@ -274,6 +275,21 @@ TEST_CASE("a log without DONE is truncated: the run did not finish, its complete
   CHECK(log.TruncationReason() == "truncated (the run did not finish: no DONE handshake)");
   CHECK(log.CompleteSteps() == 4);
   CHECK(log.n_steps == 4);
+}
+
+TEST_CASE("a truncated log as a rig record: its complete steps, with a warning saying so") {
+  const Bytes whole = LogBytes(SyntheticRun(6, true, 0.5));
+  const auto ok = rths::io::RigRecordFromRunLog(ReadRunLogBytes("whole.lcm", whole.data(), whole.size()), "whole.lcm");
+  CHECK(ok.size() == 6);
+  CHECK(ok.warnings.empty());
+  const Bytes cut = LogBytes(SyntheticRun(6, false, 0.5));
+  const auto rec = rths::io::RigRecordFromRunLog(ReadRunLogBytes("cut.lcm", cut.data(), cut.size() - 3), "cut.lcm");
+  CHECK(rec.size() == 5);
+  REQUIRE(rec.warnings.size() == 1);
+  CHECK(rec.warnings[0].rfind("cut.lcm: the log is truncated (the run did not finish: no DONE handshake); the file "
+                              "ends in the middle of an event at byte ",
+                              0) == 0);
+  CHECK(Contains(rec.warnings[0], "the record holds its 5 complete steps"));
 }
 
 TEST_CASE("payloads: step indices bounded, negative k, wrong types, hostile array and string lengths") {

@@ -55,6 +55,7 @@ int main(int argc, char** argv) {
     if (!reason.empty()) {
       std::printf("  note: the run stopped early (%s); the record holds its complete steps\n", reason.c_str());
     }
+    for (const auto& w : rec.warnings) std::fprintf(stderr, "rths-record: warning: %s\n", w.c_str());
   } catch (const std::exception& e) {
     std::fprintf(stderr, "rths-record: %s\n", e.what());
     return 2;

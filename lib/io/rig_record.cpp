@@ -261,6 +261,10 @@ RigRecord RigRecordFromRunLog(const RunLog& log, const std::string& source) {
   if (!(rec.dt_s > 0.0)) throw Error(source, "the run log has no handshake with the step dt_s");
   const auto n = static_cast<std::size_t>(log.CompleteSteps());
   rec.metadata = {{"source", source + " (LCM run log)"}, {"run_id", std::to_string(log.run_id)}};
+  if (!log.Complete()) {
+    rec.warnings.push_back(fmt::format("{}: the log is {}: the record holds its {} complete steps", source,
+                                       log.TruncationReason(), n));
+  }
   for (std::size_t k = 0; k < n; ++k) {
     rec.t_s.push_back(static_cast<double>(k) * rec.dt_s);
     rec.u_mm.push_back(log.command[k].u_mm);

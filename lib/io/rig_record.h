@@ -87,8 +87,9 @@ void ValidateRigRecord(const RigRecord& rec, const std::string& where);
 /// A run of ours as a rig record, over its complete steps k = 0 .. CompleteSteps()-1:
 /// t = k dt (dt from the handshake), u = command_t.u_mm at k, y = measured_t.y_mm at k,
 /// f = measured_t.f_kN at k, i = current_t.i_cmd_A at k (the semiactive command), r =
-/// desired_t.r_mm at k. Metadata: source, run_id. Throws rths::Error (where = `source`) if the
-/// log has no dt or fails ValidateRigRecord.
+/// desired_t.r_mm at k. Metadata: source, run_id. A log that is not RunLog::Complete() (the run
+/// did not finish, or the file is cut) gives a warning saying so. Throws rths::Error (where =
+/// `source`) if the log has no dt or fails ValidateRigRecord.
 RigRecord RigRecordFromRunLog(const RunLog& log, const std::string& source);
 
 /// True if the file starts with the LCM event-log sync word 0xEDA1DA01.
