@@ -879,8 +879,15 @@ namespace {
 std::string TomlString(const std::string& v) {
   std::string out = "\"";
   for (char ch : v) {
-    if (ch == '"' || ch == '\\') out += '\\';
-    out += ch;
+    const auto c = static_cast<unsigned char>(ch);
+    if (ch == '"' || ch == '\\') {
+      out += '\\';
+      out += ch;
+    } else if ((c < 0x20 && ch != '\t') || c == 0x7F) {  // TOML forbids them unescaped (found by fuzzing)
+      out += fmt::format("\\u{:04X}", c);
+    } else {
+      out += ch;
+    }
   }
   return out + "\"";
 }
