@@ -138,6 +138,12 @@ void ClockParticipant::CheckBarrier() {
   const rths::measured_t* m = measured_.Get(k_);
   const rths::command_t* c = command_.Get(k_);
   if (!m || !c || !current_.Get(k_) || !ack_.Get(k_)) return;
+  if (rerequests_ == 0) {
+    // How long a step takes when nothing is lost (a moving average over ~16 steps): it sets how
+    // soon a silence counts as a loss.
+    const double took_s = Seconds(step_since_, SteadyClock::now());
+    typical_step_s_ = typical_step_s_ > 0 ? typical_step_s_ + (took_s - typical_step_s_) / 16.0 : took_s;
+  }
   if (const std::string_view stop = CheckCommitted(k_, desired_, *m, *c); !stop.empty()) {
     Fail(kExitSafety, std::string(stop), true, k_);
     return;
@@ -184,6 +190,12 @@ void ClockParticipant::FailStalled(SteadyClock::time_point now) {
   Fail(kExitLockstep, reason, true, k_, silent.size() == 1 ? silent.front() : JoinNames(silent));
 }
 
+SteadyClock::time_point ClockParticipant::PollDeadline() const {
+  if (k_ < 0 || Stalled(k_)) return SteadyClock::time_point::max();
+  return last_send_ + std::chrono::duration_cast<SteadyClock::duration>(std::chrono::duration<double>(
+                          timing_.RerequestAfterS(rerequests_ + 1, typical_step_s_)));
+}
+
 void ClockParticipant::Poll(SteadyClock::time_point now, bool idle) {
   if (finished()) return;
   if (k_ < 0) {  // handshake
@@ -218,7 +230,7 @@ void ClockParticipant::Poll(SteadyClock::time_point now, bool idle) {
       Finish();
       return;
     }
-    if (Seconds(last_send_, now) >= timing_.RerequestAfterS(rerequests_ + 1)) {
+    if (Seconds(last_send_, now) >= timing_.RerequestAfterS(rerequests_ + 1, typical_step_s_)) {
       ++rerequests_;
       last_send_ = now;
       SendHandshake(kDone, id_.n_steps);
@@ -229,7 +241,7 @@ void ClockParticipant::Poll(SteadyClock::time_point now, bool idle) {
     FailStalled(now);
     return;
   }
-  if (Seconds(last_send_, now) < timing_.RerequestAfterS(rerequests_ + 1)) return;
+  if (Seconds(last_send_, now) < timing_.RerequestAfterS(rerequests_ + 1, typical_step_s_)) return;
   if (rerequests_ == 0) ++stats_.steps_rerequested;
   ++rerequests_;
   last_send_ = now;

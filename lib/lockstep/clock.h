@@ -43,6 +43,7 @@ class ClockParticipant : public Participant {
   ClockParticipant(std::string name, RunIdentity id, Timing timing, lcm::LCM* lcm, Faults faults = {});
 
   void Poll(SteadyClock::time_point now, bool idle) override;
+  SteadyClock::time_point PollDeadline() const override;
 
   /// Step currently requested (-1 before GO).
   std::int64_t current_step() const { return k_; }
@@ -87,6 +88,7 @@ class ClockParticipant : public Participant {
   std::array<bool, kRoster.size()> reported_{};
   std::int64_t k_ = -1;
   int rerequests_ = 0;  ///< re-requests of the current step (or DONEs after the first)
+  double typical_step_s_ = 0;  ///< moving average of the steps that needed no re-request [s]
   bool done_ = false;
   SteadyClock::time_point step_since_;  ///< when step k_ (or DONE) was first sent
   SteadyClock::time_point last_send_;

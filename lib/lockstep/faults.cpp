@@ -102,6 +102,14 @@ bool FaultInjector::Hold(void* route, const std::uint8_t* data, std::size_t size
   return false;
 }
 
+FaultInjector::Clock::time_point FaultInjector::NextDue() const {
+  Clock::time_point t = Clock::time_point::max();
+  for (const Held& h : held_) {
+    if (h.used) t = std::min(t, h.due);
+  }
+  return t;
+}
+
 bool FaultInjector::holding() const {
   return std::any_of(held_.begin(), held_.end(), [](const Held& h) { return h.used; });
 }

@@ -94,6 +94,8 @@ class FaultInjector {
     }
   }
   bool holding() const;
+  /// When the earliest held message is due (Clock::time_point::max() if none).
+  Clock::time_point NextDue() const;
 
  private:
   struct Held {

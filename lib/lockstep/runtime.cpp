@@ -38,11 +38,16 @@ const char* ChannelName(std::int8_t code) {
   }
 }
 
-double Timing::RerequestAfterS(int n) const {
-  const double first = rerequest_ms * 1e-3;
-  const double cap = std::max(first, 1.0);
+double Timing::RerequestAfterS(int n, double typical_step_s) const {
+  const double longest = rerequest_ms * 1e-3;
+  const double first =
+      typical_step_s > 0 ? std::clamp(8.0 * typical_step_s, std::min(kMinRerequestS, longest), longest) : longest;
+  const double cap = std::max(longest, 1.0);
+  // The first few re-requests come at the same pace (a repair may need several round trips on
+  // a lossy link); then each waits twice as long (a loaded host is not flooded).
+  constexpr int kSteady = 4;
   double wait = first;
-  for (int i = 1; i < n && wait < cap; ++i) wait *= 2.0;
+  for (int i = kSteady; i < n && wait < cap; ++i) wait *= 2.0;
   return std::min(wait, cap);
 }
 
@@ -153,6 +158,11 @@ void Participant::Tick(SteadyClock::time_point now, bool idle) {
     });
   }
   if (!finished_) Poll(now, idle);
+}
+
+SteadyClock::time_point Participant::NextDeadline() const {
+  if (finished_) return SteadyClock::time_point::max();
+  return std::min(injector_.active() ? injector_.NextDue() : SteadyClock::time_point::max(), PollDeadline());
 }
 
 void Participant::PublishBytes(const char* channel, const Bytes& bytes) {
@@ -400,7 +410,11 @@ int RunLoop(lcm::LCM* lcm, const std::vector<Participant*>& participants, const 
     bool all_done = true;
     for (Participant* p : participants) all_done = all_done && p->finished();
     if (all_done) break;
-    const int r = lcm->handleTimeout(kPollMs);
+    // Wake up for the next deadline (a re-request, a held message), at most kPollMs away.
+    auto deadline = SteadyClock::now() + std::chrono::milliseconds(kPollMs);
+    for (const Participant* p : participants) deadline = std::min(deadline, p->NextDeadline());
+    const auto wait = std::chrono::ceil<std::chrono::milliseconds>(deadline - SteadyClock::now()).count();
+    const int r = lcm->handleTimeout(static_cast<int>(std::clamp<std::int64_t>(wait, 0, kPollMs)));
     if (r < 0) {
       for (Participant* p : participants) {
         if (!p->finished()) std::fprintf(stderr, "%s: LCM receive failed\n", p->name().c_str());

@@ -72,16 +72,20 @@ struct RunIdentity {
 
 /// Runtime knobs (from the scenario's [lockstep] table; ranges in docs/scenarios.md).
 struct Timing {
-  /// Silence before the clock re-requests an incomplete step [ms]; each further re-request of the
-  /// same step waits twice as long, up to max(rerequest_ms, 1000 ms).
+  /// The longest silence before the clock re-requests an incomplete step [ms]. When steps are
+  /// fast it re-requests sooner: after 8 typical step times, at least kMinRerequestS. Each
+  /// further re-request of the same step waits twice as long, up to max(rerequest_ms, 1000 ms).
   double rerequest_ms = 100.0;
   /// A step that has not completed after this long [s] stops the run, naming who stopped
   /// answering. Participants give up on a silent clock after stall_budget_s + 2 s.
   double stall_budget_s = 10.0;
   double handshake_timeout_s = 20;  ///< wait for every HELLO (clock) / for GO (others) [s]
 
-  /// Wait before re-request number `n` (1-based) of one step [s].
-  double RerequestAfterS(int n) const;
+  /// The shortest wait before a first re-request [s].
+  static constexpr double kMinRerequestS = 1e-3;
+  /// Wait before re-request number `n` (1-based) of one step [s], when a step typically takes
+  /// `typical_step_s` (0 if not known yet).
+  double RerequestAfterS(int n, double typical_step_s) const;
   /// How long a participant that heard nothing from the clock keeps waiting [s].
   double WatchdogS() const { return stall_budget_s + 2.0; }
   /// How long a participant lingers after DONE, answering repeated DONEs, without CLOSE [s].
@@ -222,6 +226,9 @@ class Participant {
   /// held (delayed) messages that are due, then Poll(). `idle` is true when no message was
   /// waiting: only then may a participant conclude that someone has gone silent.
   void Tick(SteadyClock::time_point now, bool idle);
+  /// The next moment Tick() has something to do without a message arriving (a held message is
+  /// due, a re-request); time_point::max() if none.
+  SteadyClock::time_point NextDeadline() const;
 
  protected:
   using Handler = std::function<void(const lcm::ReceiveBuffer*)>;
@@ -232,6 +239,8 @@ class Participant {
   void SetAnswerChannel(Channel channel, const AnswerCache* cache);
 
   virtual void Poll(SteadyClock::time_point now, bool idle);
+  /// When Poll() next has something to do (default: never; the event loop still polls often).
+  virtual SteadyClock::time_point PollDeadline() const { return SteadyClock::time_point::max(); }
   /// Called once when GO (or, if GO was lost, the first message of step 0) arrives.
   virtual void OnGo() {}
   /// Called once when DONE arrives, before BYE is sent: flush and close outputs. A non-empty
