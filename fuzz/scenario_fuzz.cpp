@@ -4,6 +4,8 @@
 // ToToml text gives the same ToToml text back.
 // File system: ParseScenario only checks that referenced files exist (stat); the scenario's
 // path is in an empty temporary folder, so relative references resolve to nothing.
+#include <unistd.h>
+
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
@@ -14,11 +16,15 @@
 #include "scenario/scenario.h"
 
 namespace {
+char g_dir[] = "/tmp/rths-fuzz-scenario.XXXXXX";
+
+void RemoveDir() { ::rmdir(g_dir); }  // empty: nothing is ever written into it
+
 const std::string& ScenarioPath() {
   static const std::string path = [] {
-    char dir[] = "/tmp/rths-fuzz-scenario.XXXXXX";
-    if (!::mkdtemp(dir)) std::abort();
-    return std::string(dir) + "/fuzz.toml";
+    if (!::mkdtemp(g_dir)) std::abort();
+    std::atexit(RemoveDir);
+    return std::string(g_dir) + "/fuzz.toml";
   }();
   return path;
 }

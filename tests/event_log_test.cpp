@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <random>
 #include <string>
 #include <vector>
@@ -83,13 +84,16 @@ std::vector<Ev> SyntheticRun(std::int64_t n, bool done = true, double dt_s = 0.0
   return evs;
 }
 
-/// The events as an LCM event log; *offsets (if given) gets where each event starts.
-Bytes LogBytes(const std::vector<Ev>& evs, std::vector<std::size_t>* offsets = nullptr) {
+/// The events as an LCM event log; *offsets (if given) gets where each event starts. Event i has
+/// the timestamp utimes[i] if given, else 1000 + i [us].
+Bytes LogBytes(const std::vector<Ev>& evs, std::vector<std::size_t>* offsets = nullptr,
+               const std::vector<std::int64_t>& utimes = {}) {
   Bytes out;
   std::int64_t num = 0;
   for (const auto& e : evs) {
     if (offsets) offsets->push_back(out.size());
-    rths::io::AppendEvent(&out, num, 1000 + num, e.channel, e.payload.data(), e.payload.size());
+    const std::int64_t utime = static_cast<std::size_t>(num) < utimes.size() ? utimes[num] : 1000 + num;
+    rths::io::AppendEvent(&out, num, utime, e.channel, e.payload.data(), e.payload.size());
     ++num;
   }
   return out;
@@ -411,4 +415,22 @@ TEST_CASE("rths log: garbage, empty files and CSVs fail with the file and offset
   CHECK(RunLogTool("compare " + d + "good.lcm " + d + "cut.lcm", &out) == 1);
   CHECK(RunLogTool("--help", &out) == 0);
   CHECK(Contains(out, "Exit codes:"));
+}
+
+TEST_CASE("regression (fuzz_event_log): steps/s from timestamps at the ends of int64 does not overflow") {
+  // Found by fuzz/event_log_fuzz.cpp (UBSan): ComputeMetrics took last - first desired_t timestamp
+  // in int64. The timestamps are whatever the file says.
+  const auto evs = SyntheticRun(3);
+  std::vector<std::int64_t> utimes(evs.size(), 0);
+  utimes[1] = std::numeric_limits<std::int64_t>::min() + 1;  // desired_t k = 0
+  utimes[9] = std::numeric_limits<std::int64_t>::max();      // desired_t k = 2
+  const Bytes b = LogBytes(evs, nullptr, utimes);
+  const auto log = ReadRunLogBytes("utime.lcm", b.data(), b.size());
+  REQUIRE(log.first_desired_utime == utimes[1]);
+  REQUIRE(log.last_desired_utime == utimes[9]);
+  const auto m = rths::io::ComputeMetrics(log);
+  const double span_s = (static_cast<double>(utimes[9]) - static_cast<double>(utimes[1])) * 1e-6;
+  CHECK(m.steps == 3);
+  CHECK(m.steps_per_s > 0.0);  // an int64 difference wraps to a negative span: 0 steps/s
+  CHECK(m.steps_per_s == doctest::Approx(2.0 / span_s));
 }

@@ -288,7 +288,10 @@ RunMetrics ComputeMetrics(const RunLog& log) {
   m.tracking_nrmse_pct = pct(r, y);
   m.accel_extrapolation_rms_err_pct = pct(acc_true, acc_pred);
   m.velocity_prediction_rms_err_pct = pct(vel_true, vel_pred);
-  const double span_s = (log.last_desired_utime - log.first_desired_utime) * 1e-6;
+  // In double: the timestamps are whatever the file says (an int64 difference can overflow;
+  // found by fuzz_event_log).
+  const double span_s =
+      (static_cast<double>(log.last_desired_utime) - static_cast<double>(log.first_desired_utime)) * 1e-6;
   m.steps_per_s = (m.steps > 1 && span_s > 0) ? (m.steps - 1) / span_s : 0.0;
   return m;
 }
