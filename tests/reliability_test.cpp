@@ -227,6 +227,7 @@ role = ")") + role + "\"\n");
     CHECK(output.find(std::string("FAILED: ") + role + " was killed by signal 9") != std::string::npos);
     const auto log = ReadRunLog((dir / "run" / "log.lcm").string());
     CHECK(log.CompleteSteps() == 300);
+    CHECK_FALSE(log.truncated_tail);
     CHECK(CsvLines(dir / "run" / "signals.csv") == 301);
     const auto j = Summary(dir / "run");
     CHECK(j["status"] == "failed");
@@ -319,6 +320,8 @@ void CheckWriteFailure(const fs::path& run, int code, const std::string& output,
   CHECK(steps > 100);
   CHECK(steps < 40000);
   // The log holds whole events only, step after step, and the CSV the same steps.
+  CHECK_FALSE(log.truncated_tail);
+  CHECK_FALSE(log.done);  // the run did not finish, and the log says so
   CHECK(log.count.at("RTHS_DESIRED") == steps);
   CHECK(log.count.at("RTHS_MEASURED") == steps);
   CHECK(CsvLines(run / "signals.csv") == steps + 1);
