@@ -3,6 +3,7 @@
 
 #include <doctest/doctest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <initializer_list>
@@ -389,5 +390,16 @@ TEST_CASE("regression (fuzz_scenario): ToToml escapes control characters, so its
   CHECK(text.find('\f') == std::string::npos);
   const Scenario back = ParseScenario(text, path);
   CHECK(back.structure.file == s.structure.file);
+  CHECK(rths::scenario::ToToml(back) == text);
+}
+
+TEST_CASE("regression (fuzz_scenario): ToToml keeps -0.0 a float, so the round trip is exact") {
+  // Found by fuzz/scenario_fuzz.cpp: discard_s = -0.0 (allowed: [0, 60]) was written as "-0",
+  // which TOML reads as the integer 0, so ToToml of the parsed text differed.
+  const Scenario s = ParseScenario("[structure.ground]\ndiscard_s = -0.0\n", "neg_zero.toml");
+  REQUIRE(std::signbit(s.structure.ground.discard_s));
+  const std::string text = rths::scenario::ToToml(s);
+  const Scenario back = ParseScenario(text, "neg_zero.toml");
+  CHECK(std::signbit(back.structure.ground.discard_s));
   CHECK(rths::scenario::ToToml(back) == text);
 }

@@ -891,7 +891,11 @@ std::string TomlString(const std::string& v) {
   }
   return out + "\"";
 }
-std::string TomlNumber(double v) { return fmt::format("{:.17g}", v); }
+std::string TomlNumber(double v) {
+  // "-0" would read back as the integer 0, i.e. +0.0 (found by fuzzing): keep it a float.
+  if (v == 0.0 && std::signbit(v)) return "-0.0";
+  return fmt::format("{:.17g}", v);
+}
 std::string TomlServo(const ServoModel3& m) {
   if (m.name != "custom") {
     const ServoModel3 preset = ServoPreset(m.name);
