@@ -375,6 +375,7 @@ TEST_CASE("interrupt: a run that will write gigabytes is announced; Ctrl-C stops
   const pid_t pid = ::fork();
   REQUIRE(pid >= 0);
   if (pid == 0) {
+    ::setpgid(0, 0);  // a process group of its own, as a shell job: Ctrl-C reaches all of it
     const std::string cmd = std::string(RTHS_BIN_DIR) + "/rths-run " + scen.string() + " --out " + run.string() +
                             " > " + out_txt.string() + " 2>&1";
     ::execl("/bin/sh", "sh", "-c", ("exec " + cmd).c_str(), static_cast<char*>(nullptr));
@@ -389,7 +390,7 @@ TEST_CASE("interrupt: a run that will write gigabytes is announced; Ctrl-C stops
     exited = ::waitpid(pid, &status, WNOHANG) == pid;
   }
   if (!exited) {
-    ::kill(pid, SIGINT);
+    ::kill(-pid, SIGINT);  // Ctrl-C: to the supervisor and every participant
     REQUIRE(::waitpid(pid, &status, 0) == pid);
   }
   std::ifstream in(out_txt);
@@ -409,6 +410,11 @@ TEST_CASE("interrupt: a run that will write gigabytes is announced; Ctrl-C stops
   const auto j = Summary(run);
   CHECK(j["status"] == "interrupted");
   CHECK(j["steps"] == log.CompleteSteps());
+  for (const auto& [name, p] : j["participants"].items()) {  // each stopped cleanly, by itself
+    CAPTURE(name);
+    CHECK(p["exit_code"] == rths::lockstep::kExitPeerAbort);
+    CHECK(p["message"] == "stopped by a signal (SIGINT or SIGTERM)");
+  }
 }
 
 TEST_CASE("no multicast route: one clear message, nothing left behind, memq works with the same --out") {

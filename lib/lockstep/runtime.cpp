@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
@@ -405,7 +406,7 @@ int RunLoop(lcm::LCM* lcm, const std::vector<Participant*>& participants, const 
   constexpr int kPollMs = 5;
   for (;;) {
     if (stop && *stop) {
-      for (Participant* p : participants) p->Interrupt("interrupted by the user");
+      for (Participant* p : participants) p->Interrupt("stopped by a signal (SIGINT or SIGTERM)");
     }
     bool all_done = true;
     for (Participant* p : participants) all_done = all_done && p->finished();
@@ -414,7 +415,9 @@ int RunLoop(lcm::LCM* lcm, const std::vector<Participant*>& participants, const 
     auto deadline = SteadyClock::now() + std::chrono::milliseconds(kPollMs);
     for (const Participant* p : participants) deadline = std::min(deadline, p->NextDeadline());
     const auto wait = std::chrono::ceil<std::chrono::milliseconds>(deadline - SteadyClock::now()).count();
-    const int r = lcm->handleTimeout(static_cast<int>(std::clamp<std::int64_t>(wait, 0, kPollMs)));
+    errno = 0;
+    int r = lcm->handleTimeout(static_cast<int>(std::clamp<std::int64_t>(wait, 0, kPollMs)));
+    if (r < 0 && errno == EINTR) r = 0;  // a signal (e.g. SIGTERM: handled through `stop`)
     if (r < 0) {
       for (Participant* p : participants) {
         if (!p->finished()) std::fprintf(stderr, "%s: LCM receive failed\n", p->name().c_str());

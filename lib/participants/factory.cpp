@@ -70,6 +70,9 @@ void CheckBuildable(const scenario::Scenario& s) {
 }
 
 namespace {
+volatile std::sig_atomic_t g_stop = 0;
+void OnStopSignal(int) { g_stop = 1; }
+
 /// Where a participant process leaves its outcome for the supervisor: `out_dir`/logs/<role>.json.
 std::string OutcomePath(const std::string& out_dir, const std::string& role) {
   return (fs::path(out_dir) / "logs" / (role + ".json")).string();
@@ -95,6 +98,10 @@ int RoleMain(std::string_view role, int argc, char** argv) {
   }
   // A file grown past RLIMIT_FSIZE must fail the write (EFBIG), not kill the process.
   std::signal(SIGXFSZ, SIG_IGN);
+  // SIGTERM (the supervisor's teardown) or SIGINT (Ctrl-C reaches the whole process group): stop
+  // at once, committed output flushed, and say so in the outcome.
+  std::signal(SIGTERM, OnStopSignal);
+  std::signal(SIGINT, OnStopSignal);
   Outcome o;
   o.role = name;
   io::ReserveFile(OutcomePath(out_dir, name), kOutcomeReserve, "{}\n");
@@ -107,7 +114,7 @@ int RoleMain(std::string_view role, int argc, char** argv) {
       o.message = fmt::format("cannot open LCM at {}{}{}", url, hint.empty() ? "" : "\n", hint);
     } else {
       auto p = MakeParticipant(role, s, IdentityOf(s, run_id), &lcm, out_dir);
-      o.exit_code = lockstep::RunLoop(&lcm, {p.get()});
+      o.exit_code = lockstep::RunLoop(&lcm, {p.get()}, &g_stop);
       o.message = p->error();
       o.culprit = p->culprit();
       o.step = p->fail_step();
