@@ -33,6 +33,5 @@ if [[ $rc -ne 0 ]]; then
   done
   exit 1
 fi
-grep -E "^(#[0-9]+.*DONE|stat::number_of_executed_units|stat::average_exec_per_sec|stat::peak_rss_mb)" "$work/fuzz.log"
 rm -rf "$work"
 exit 0
