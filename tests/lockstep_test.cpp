@@ -2,6 +2,7 @@
 // completeness, re-requests after lost messages, silent/crashing participants, handshake.
 #include <doctest/doctest.h>
 
+#include <cmath>
 #include <cstdio>
 #include <csignal>
 #include <cstdlib>
@@ -14,6 +15,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "io/event_log.h"
 #include "io/run_log.h"
 #include "lockstep/runtime.h"
 #include "participants/factory.h"
@@ -64,6 +66,22 @@ TEST_CASE("logger completeness: an N-step run logs exactly N messages per step c
   CHECK(hellos == 4);  // every participant but the clock
   CHECK(gos == 1);
   CHECK(dones == 1);
+  // Event timestamps are simulated time: GO's wall-clock time + k dt for every event of step k
+  // (so lcm-logplayer --speed 1 replays the test at its own pace), whatever pace the run went at.
+  {
+    rths::io::EventLogReader reader((dir / "log.lcm").string());
+    rths::io::LogEvent e;
+    std::int64_t t0 = -1, checked = 0;
+    while (reader.Next(&e)) {
+      if (e.channel == "RTHS_HANDSHAKE" || e.channel == "RTHS_ACK") continue;
+      std::int64_t run_id = 0, k = 0;
+      REQUIRE(rths::lockstep::PeekRunAndStep(e.data.data(), e.data.size(), &run_id, &k));
+      if (k == 0 && t0 < 0) t0 = e.utime;
+      CHECK(e.utime - t0 == std::llround(static_cast<double>(k) * s.run.dt_s * 1e6));
+      ++checked;
+    }
+    CHECK(checked == 4 * n);
+  }
   // signals.csv: a header and one row per step.
   std::ifstream csv(dir / "signals.csv");
   std::string line;
@@ -227,7 +245,7 @@ TEST_CASE("log.lcm is a standard LCM event log: lcm-logplayer replays it, lcm-lo
     const fs::path replay = dir / ("replay" + std::to_string(attempt) + ".lcm");
     const std::string cmd =
         "lcm-logger --lcm-url='" + url + "' -f " + replay.string() + " > /dev/null 2>&1 & pid=$!; " +
-        "sleep 1; lcm-logplayer --speed=0.02 --lcm-url='" + url + "' " + (dir / "log.lcm").string() +
+        "sleep 1; lcm-logplayer --speed=0.2 --lcm-url='" + url + "' " + (dir / "log.lcm").string() +
         " > /dev/null 2>&1; sleep 0.5; kill -INT $pid; wait $pid";
     REQUIRE(std::system(cmd.c_str()) == 0);
     const auto replayed = ReadRunLog(replay.string());

@@ -281,6 +281,7 @@ std::vector<Outcome> RunUdpm(const std::string& scenario_path, const rths::scena
         o.step = self.step;
         o.stats = self.stats;
         o.stats_known = self.stats_known;
+        o.stepping_s = self.stepping_s;
       }
     } catch (const std::exception&) {
       // a partial file (the disk filled up): keep what the exit status says
@@ -442,7 +443,12 @@ int main(int argc, char** argv) {
     const auto m = rths::io::ComputeMetrics(log);
     steps = m.steps;
     j["steps"] = steps;
-    j["steps_per_s"] = m.steps_per_s;
+    // The pace it ran at: the clock's own time from GO to its last step (the log's timestamps are
+    // simulated time and say nothing of it).
+    double stepping_s = 0;
+    for (const auto& o : outcomes) stepping_s = std::max(stepping_s, o.stepping_s);
+    j["stepping_s"] = stepping_s;
+    j["steps_per_s"] = (steps > 1 && stepping_s > 0) ? static_cast<double>(steps - 1) / stepping_s : 0.0;
     j["tracking_nrmse_pct"] = m.tracking_nrmse_pct;
     j["peak_force_kN"] = m.peak_force_kN;
     j["peak_displacement_mm"] = m.peak_displacement_mm;

@@ -77,7 +77,9 @@ struct RunMetrics {
   double accel_extrapolation_rms_err_pct = 0.0;
   /// Eq. 21's predicted velocity r'_k against v_k one step later [%] (paper: 0.0061 %).
   double velocity_prediction_rms_err_pct = 0.0;
-  double steps_per_s = 0.0;                ///< from the wall-clock log timestamps
+  /// Steps per second of log time, from the desired_t timestamps: 1/dt for logs written by our
+  /// logger (simulated time), the recording pace for logs of other recorders (lcm-logger).
+  double steps_per_s = 0.0;
 };
 RunMetrics ComputeMetrics(const RunLog& log);
 

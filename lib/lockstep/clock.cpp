@@ -112,6 +112,7 @@ void ClockParticipant::SendGo() {
   std::vector<std::string> roster;
   for (const auto& r : kRoster) roster.emplace_back(r.name);
   SendHandshake(kGo, 0, "", &roster);  // several copies; a lost GO is also repaired by step 0
+  go_at_ = SteadyClock::now();
   OnGo();
   try {
     IssueStep(0);
@@ -144,6 +145,7 @@ void ClockParticipant::CheckBarrier() {
     const double took_s = Seconds(step_since_, SteadyClock::now());
     typical_step_s_ = typical_step_s_ > 0 ? typical_step_s_ + (took_s - typical_step_s_) / 16.0 : took_s;
   }
+  stepping_s_ = Seconds(go_at_, SteadyClock::now());
   if (const std::string_view stop = CheckCommitted(k_, desired_, *m, *c); !stop.empty()) {
     Fail(kExitSafety, std::string(stop), true, k_);
     return;

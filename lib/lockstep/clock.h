@@ -91,6 +91,7 @@ class ClockParticipant : public Participant {
   double typical_step_s_ = 0;  ///< moving average of the steps that needed no re-request [s]
   bool done_ = false;
   SteadyClock::time_point step_since_;  ///< when step k_ (or DONE) was first sent
+  SteadyClock::time_point go_at_;
   SteadyClock::time_point last_send_;
   SteadyClock::time_point start_;
 };

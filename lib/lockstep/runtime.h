@@ -218,6 +218,8 @@ class Participant {
   /// The step being run when it failed (-1 before step 0 or on success).
   std::int64_t fail_step() const { return fail_step_; }
   const LinkStats& stats() const { return stats_; }
+  /// Clock only: wall-clock time from GO to the last committed step [s] (0 for the others).
+  double stepping_s() const { return stepping_s_; }
 
   /// Stops now, as if the supervisor had said ABORT (an interrupt): flushes, exit kExitPeerAbort.
   void Interrupt(const std::string& reason);
@@ -314,6 +316,7 @@ class Participant {
   lcm::LCM* const lcm_;
   bool is_clock_ = false;
   LinkStats stats_;
+  double stepping_s_ = 0;
 
   /// Every handshake message of this run, our own included (the logger records them).
   virtual void OnHandshakeSeen(const lcm::ReceiveBuffer* /*rbuf*/, const rths::handshake_t& /*msg*/) {}

@@ -120,6 +120,7 @@ int RoleMain(std::string_view role, int argc, char** argv) {
       o.step = p->fail_step();
       o.stats = p->stats();
       o.stats_known = true;
+      o.stepping_s = p->stepping_s();
     }
   } catch (const Error& e) {
     o.exit_code = lockstep::kExitUsage;

@@ -32,6 +32,7 @@ nlohmann::json OutcomeToJson(const Outcome& o) {
                       {"culprit", o.culprit}, {"step", o.step},
                       {"killed_by_supervisor", o.killed_by_supervisor},
                       {"was_stopped", o.was_stopped}};
+  if (o.stepping_s > 0) j["stepping_s"] = o.stepping_s;
   if (o.stats_known) j["link"] = StatsToJson(o.stats);
   return j;
 }
@@ -46,6 +47,7 @@ Outcome OutcomeFromJson(const nlohmann::json& j) {
   o.step = j.value("step", std::int64_t{-1});
   o.killed_by_supervisor = j.value("killed_by_supervisor", false);
   o.was_stopped = j.value("was_stopped", false);
+  o.stepping_s = j.value("stepping_s", 0.0);
   if (j.contains("link")) {
     const auto& l = j.at("link");
     lockstep::LinkStats& s = o.stats;
@@ -113,6 +115,7 @@ std::vector<Outcome> RunGroupInProcess(const std::vector<scenario::Scenario>& pe
     o.step = p->fail_step();
     o.stats = p->stats();
     o.stats_known = true;
+    o.stepping_s = p->stepping_s();
     outcomes.push_back(std::move(o));
   }
   return outcomes;

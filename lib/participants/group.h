@@ -37,6 +37,7 @@ struct Outcome {
   bool was_stopped = false;           ///< ... while it was stopped (SIGSTOP, state T)
   bool stats_known = false;
   lockstep::LinkStats stats;
+  double stepping_s = 0;  ///< the clock: wall-clock time from GO to the last committed step [s]
 };
 nlohmann::json OutcomeToJson(const Outcome& o);
 /// Reads what OutcomeToJson wrote; throws nlohmann::json::exception on a malformed object.

@@ -4,6 +4,8 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <chrono>
+#include <cmath>
 #include <cinttypes>
 #include <cstdio>
 #include <cstring>
@@ -120,14 +122,14 @@ void Logger::OnStepMessage(lockstep::StepMailbox<Msg>* box, RawRing* raw, lockst
   Raw& slot = (*raw)[box->last_k() % 4];
   const auto* data = static_cast<const std::uint8_t*>(rbuf->data);
   slot.bytes.assign(data, data + rbuf->data_size);  // reuses its capacity after the first steps
-  slot.recv_utime = rbuf->recv_utime;
   Guarded(box->last_k(), [&] { TryAck(); });
 }
 
 void Logger::OnHandshakeSeen(const lcm::ReceiveBuffer* rbuf, const rths::handshake_t& msg) {
   if (finished() || !handshakes_logged_.emplace(msg.participant, msg.phase).second) return;
   step_bytes_.clear();
-  io::AppendEvent(&step_bytes_, event_number_, rbuf->recv_utime, lockstep::kChHandshake, rbuf->data,
+  const std::int64_t utime = start_utime_ < 0 ? rbuf->recv_utime : StepUtime(next_);
+  io::AppendEvent(&step_bytes_, event_number_, utime, lockstep::kChHandshake, rbuf->data,
                   rbuf->data_size);
   if (const std::string why = Append(log_fd_, log_path_, step_bytes_.data(), step_bytes_.size(), &log_end_);
       !why.empty()) {
@@ -136,6 +138,15 @@ void Logger::OnHandshakeSeen(const lcm::ReceiveBuffer* rbuf, const rths::handsha
   }
   ++event_number_;
   log_acked_ = log_end_;  // a whole event between steps: keep it if a later write fails
+}
+
+void Logger::OnGo() {
+  const auto now = std::chrono::system_clock::now().time_since_epoch();
+  start_utime_ = std::chrono::duration_cast<std::chrono::microseconds>(now).count();
+}
+
+std::int64_t Logger::StepUtime(std::int64_t k) const {
+  return start_utime_ + std::llround(static_cast<double>(k) * id_.dt_s * 1e6);
 }
 
 void Logger::ListMissing(std::int64_t k, lockstep::WantList* out) const {
@@ -161,7 +172,7 @@ void Logger::TryAck() {
     for (auto [ch, ring] : {std::pair{lockstep::kChDesired, &raw_desired_}, {lockstep::kChCommand, &raw_command_},
                             {lockstep::kChMeasured, &raw_measured_}, {lockstep::kChCurrent, &raw_current_}}) {
       const Raw& r = (*ring)[slot];
-      io::AppendEvent(&step_bytes_, event_number_++, r.recv_utime, ch, r.bytes.data(), r.bytes.size());
+      io::AppendEvent(&step_bytes_, event_number_++, StepUtime(k), ch, r.bytes.data(), r.bytes.size());
     }
     if (const std::string why = Append(log_fd_, log_path_, step_bytes_.data(), step_bytes_.size(), &log_end_);
         !why.empty()) {

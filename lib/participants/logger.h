@@ -11,6 +11,11 @@
 /// has not handed to the kernel. The handshake is logged on its own channel as it arrives (first
 /// copy per participant and phase).
 ///
+/// Event timestamps are simulated time: the wall-clock time at which the logger started stepping
+/// (GO) plus k dt for the events of step k, so `lcm-logplayer --speed 1` replays a run at the pace
+/// it represents, whatever pace it ran at. Handshake events before GO carry their receive time,
+/// later ones the current step's time.
+///
 /// A failed or short write (disk full, I/O error) stops the run: both files are cut back to the
 /// end of the last acknowledged step (so they end on a whole event and a whole row), ABORT is
 /// broadcast naming the file and the error, and the logger exits with kExitOutput.
@@ -45,14 +50,16 @@ class Logger : public lockstep::Participant {
 
  protected:
   std::string OnDone() override { return {}; }  // every step was written before its ack
+  void OnGo() override;
   void ListMissing(std::int64_t k, lockstep::WantList* out) const override;
 
  private:
   /// The raw bytes of one channel's message of a step (what is written to the log).
   struct Raw {
     lockstep::Bytes bytes;
-    std::int64_t recv_utime = 0;
   };
+  /// Timestamp of the events of step k [us since the epoch]: start + k dt.
+  std::int64_t StepUtime(std::int64_t k) const;
   using RawRing = std::array<Raw, 4>;
 
   template <class Msg>
@@ -72,6 +79,7 @@ class Logger : public lockstep::Participant {
   std::int64_t log_end_ = 0, csv_end_ = 0;      ///< bytes written, each ending on a whole event / row
   std::int64_t log_acked_ = 0, csv_acked_ = 0;  ///< ... at the last acknowledged step
   std::int64_t event_number_ = 0;
+  std::int64_t start_utime_ = -1;  ///< wall-clock time of GO [us since the epoch]; -1 before
   std::int64_t next_ = 0;  ///< next step to acknowledge
   lockstep::StepMailbox<rths::desired_t> desired_;
   lockstep::StepMailbox<rths::command_t> command_;
