@@ -18,6 +18,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <csignal>
@@ -153,9 +154,19 @@ struct Child {
   bool signalled_by_us = false;
 };
 
+/// What `--external` changes: the roles the user runs, and how long everyone waits for them.
+struct ExternalRoles {
+  std::vector<std::string> roles;
+  double join_timeout_s = 0;  ///< 0: the scenario's lockstep.handshake_timeout_s
+  bool has(const std::string& role) const {
+    return std::find(roles.begin(), roles.end(), role) != roles.end();
+  }
+};
+
 std::vector<Outcome> RunUdpm(const std::string& scenario_path, const rths::scenario::Scenario& s,
                              std::int64_t run_id, const fs::path& out, const fs::path& bin_dir,
-                             const std::string& url, Clock::time_point* noticed) {
+                             const std::string& url, const ExternalRoles& external,
+                             const std::vector<std::string>& role_args, Clock::time_point* noticed) {
   fs::create_directories(out / "logs");
   // SIGCHLD, SIGINT and SIGTERM arrive through a signalfd: a dead participant is noticed at once.
   sigset_t mask, old_mask;
@@ -169,10 +180,15 @@ std::vector<Outcome> RunUdpm(const std::string& scenario_path, const rths::scena
 
   std::map<pid_t, Child> children;
   for (const char* role : {"logger", "plant", "controller", "semiactive", "integrator"}) {
+    if (external.has(role)) continue;
     const fs::path exe = bin_dir / fmt::format("rths-{}", role);
     if (!fs::exists(exe)) throw rths::Error("", fmt::format("{} is missing: build first (see README)", exe.string()));
     std::vector<std::string> args{exe.string(), "--scenario", scenario_path,        "--lcm-url", url,
                                   "--run-id",   std::to_string(run_id), "--out", out.string()};
+    args.insert(args.end(), role_args.begin(), role_args.end());
+    if (external.join_timeout_s > 0) {
+      args.insert(args.end(), {"--handshake-timeout-s", fmt::format("{}", external.join_timeout_s)});
+    }
     const fs::path log = out / "logs" / fmt::format("{}.log", role);
     const pid_t pid = ::fork();
     if (pid < 0) throw rths::Error("", "fork failed");
@@ -289,6 +305,12 @@ std::vector<Outcome> RunUdpm(const std::string& scenario_path, const rths::scena
     if (o.exit_code != 0 && o.message.empty() && !o.signal) o.message = LastLine(out / "logs" / (o.role + ".log"));
     outcomes.push_back(std::move(o));
   }
+  for (const auto& role : external.roles) {
+    Outcome o;
+    o.role = role;
+    o.external = true;
+    outcomes.push_back(std::move(o));
+  }
   return outcomes;
 }
 
@@ -329,6 +351,21 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--bin-dir", bin_dir, "where the rths-* programs are (default: next to this one)");
   app.add_flag("--quiet", quiet, "print only the output folder");
+  std::string url_arg, external_arg;
+  std::int64_t run_id_arg = 0;
+  double join_timeout_s = 120.0;
+  app.add_option("--lcm-url", url_arg,
+                 "udpm URL of the run (default: udpm://239.255.76.67:<a free port>?ttl=0); ttl=1 to reach "
+                 "participants on other hosts of the LAN (docs/participant.md)");
+  app.add_option("--run-id", run_id_arg, "run id every participant must use (default: random)")
+      ->check(CLI::Range(std::int64_t{1}, std::int64_t{0x3fffffffffffffff}));
+  app.add_option("--external", external_arg,
+                 "ROLE[,ROLE...]: do not start these participants (controller, plant, semiactive); wait "
+                 "for the user's own to join the handshake (docs/participant.md)");
+  app.add_option("--join-timeout-s", join_timeout_s,
+                 "with --external: how long to wait for the external participants to say HELLO [s]")
+      ->check(CLI::Range(0.1, 86400.0))
+      ->capture_default_str();
   app.add_flag("--skip-space-check", skip_space_check, "tests only: do not check the free disk space first")
       ->group("");
   app.footer("Exit codes: 0 ok; 2 bad input or not enough disk (nothing ran); 3 a participant stopped "
@@ -338,6 +375,44 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
 
   if (scenario_path.empty()) scenario_path = default_scenario;
+  ExternalRoles external;
+  {
+    std::stringstream ss(external_arg);
+    for (std::string role; std::getline(ss, role, ',');) {
+      if (role.empty()) continue;
+      if (role == "integrator" || role == "logger") {
+        std::fprintf(stderr,
+                     "rths run: --external %s: the %s cannot be external (%s); allowed: controller, plant, "
+                     "semiactive\n",
+                     role.c_str(), role.c_str(),
+                     role == "integrator" ? "it is the run's clock" : "the run's record must be written by rths");
+        return rths::lockstep::kExitUsage;
+      }
+      if (role != "controller" && role != "plant" && role != "semiactive") {
+        std::fprintf(stderr, "rths run: --external %s: unknown role; allowed: controller, plant, semiactive\n",
+                     role.c_str());
+        return rths::lockstep::kExitUsage;
+      }
+      if (!external.has(role)) external.roles.push_back(role);
+    }
+    if (!external.roles.empty()) {
+      if (transport != "udpm") {
+        std::fprintf(stderr, "rths run: --external needs the udpm transport (an external process cannot join "
+                             "memq, which lives inside one process)\n");
+        return rths::lockstep::kExitUsage;
+      }
+      external.join_timeout_s = join_timeout_s;
+    }
+    if (!url_arg.empty() && transport != "udpm") {
+      std::fprintf(stderr, "rths run: --lcm-url needs the udpm transport\n");
+      return rths::lockstep::kExitUsage;
+    }
+    if (!url_arg.empty() && url_arg.rfind("udpm://", 0) != 0) {
+      std::fprintf(stderr, "rths run: --lcm-url %s: must be a udpm:// URL (e.g. udpm://239.255.76.67:7667?ttl=0)\n",
+                   url_arg.c_str());
+      return rths::lockstep::kExitUsage;
+    }
+  }
   std::signal(SIGINT, OnSignal);
   std::signal(SIGTERM, OnSignal);
 
@@ -360,8 +435,11 @@ int main(int argc, char** argv) {
       if (const std::string hint = rths::lockstep::CheckMulticastRoute(); !hint.empty()) {
         throw rths::Error("", hint);
       }
-      url = fmt::format("udpm://239.255.76.67:{}?ttl=0", FreeUdpPort());
-      if (s.faults.recv_buf_bytes > 0) url += fmt::format("&recv_buf_size={}", s.faults.recv_buf_bytes);
+      url = url_arg.empty() ? fmt::format("udpm://239.255.76.67:{}?ttl=0", FreeUdpPort()) : url_arg;
+      if (s.faults.recv_buf_bytes > 0) {
+        url += fmt::format("{}recv_buf_size={}", url.find('?') == std::string::npos ? "?" : "&",
+                           s.faults.recv_buf_bytes);
+      }
     }
     out = out_arg.empty() ? DefaultOutDir(s.run.name) : fs::path(out_arg);
     if (fs::exists(out) && !fs::is_empty(out)) {
@@ -405,7 +483,8 @@ int main(int argc, char** argv) {
 
   std::random_device rd;
   const std::int64_t run_id =
-      static_cast<std::int64_t>(((std::uint64_t{rd()} << 32) ^ rd()) & 0x3fffffffffffffffULL) | 1;
+      run_id_arg > 0 ? run_id_arg
+                     : static_cast<std::int64_t>(((std::uint64_t{rd()} << 32) ^ rd()) & 0x3fffffffffffffffULL) | 1;
   std::vector<Outcome> outcomes;
   const auto t0 = Clock::now();
   Clock::time_point noticed{};
@@ -415,9 +494,27 @@ int main(int argc, char** argv) {
                   static_cast<long long>(s.steps()), s.run.dt_s, transport.c_str());
       std::fflush(stdout);
     }
+    if (!external.roles.empty()) {
+      // Always printed (also with --quiet): what the user's participants need to join.
+      std::string roles;
+      for (const auto& r : external.roles) roles += (roles.empty() ? "" : ",") + r;
+      std::printf("external: %s\n", roles.c_str());
+      std::printf("  lcm_url          %s\n", url.c_str());
+      std::printf("  port             %s\n", url.substr(url.rfind(':') + 1, url.find('?') - url.rfind(':') - 1).c_str());
+      std::printf("  run_id           %lld\n", static_cast<long long>(run_id));
+      std::printf("  scenario         %s\n", scenario_path.c_str());
+      std::printf("  scenario_sha256  %s\n", s.sha256.c_str());
+      std::printf("  steps            %lld of %g s each\n", static_cast<long long>(s.steps()), s.run.dt_s);
+      std::printf("  built-in example %s/rths-%s --scenario %s --lcm-url '%s' --run-id %lld\n",
+                  bin_dir.c_str(), external.roles.front().c_str(), scenario_path.c_str(), url.c_str(),
+                  static_cast<long long>(run_id));
+      std::printf("waiting up to %g s for %s to say HELLO (docs/participant.md)\n", external.join_timeout_s,
+                  roles.c_str());
+      std::fflush(stdout);
+    }
     outcomes = transport == "memq"
                    ? rths::participants::RunGroupInProcess({s}, run_id, out.string(), {}, &g_interrupted)
-                   : RunUdpm(scenario_path, s, run_id, out, bin_dir, url, &noticed);
+                   : RunUdpm(scenario_path, s, run_id, out, bin_dir, url, external, {}, &noticed);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "rths run: %s\n", e.what());
     std::error_code ec;
@@ -461,7 +558,7 @@ int main(int argc, char** argv) {
     j["steps"] = 0;
     j["log_error"] = e.what();
   }
-  if (verdict.failed && verdict.step < 0 && steps < s.steps()) {
+  if (verdict.failed && verdict.step < 0 && verdict.exit_code > 128 && steps < s.steps()) {
     verdict.step = steps;  // a process that died cannot say where: the step it did not finish
     verdict.what += fmt::format(" during step {}", steps);
   }

@@ -333,9 +333,13 @@ void Participant::Poll(SteadyClock::time_point now, bool idle) {
   }
   if (!idle) return;  // judge silence only once every waiting message has been handled
   if (!running_) {
-    if (SecondsBetween(created_, now) > timing_.handshake_timeout_s) {
+    // While the clock keeps asking (REQUEST every 100 ms) it is alive and judges the handshake
+    // itself (it names who did not say HELLO); give up only on a clock silent for the whole
+    // handshake timeout.
+    const SteadyClock::time_point since = std::max(created_, last_clock_);
+    if (SecondsBetween(since, now) > timing_.handshake_timeout_s) {
       Fail(kExitLockstep,
-           fmt::format("no GO from the clock (integrator) within {:g} s of start-up; is it running "
+           fmt::format("no GO from the clock (integrator): nothing heard from it for {:g} s; is it running "
                        "on the same LCM URL and run id?",
                        timing_.handshake_timeout_s),
            false, -1, kClockName);

@@ -91,6 +91,11 @@ int RoleMain(std::string_view role, int argc, char** argv) {
   app.add_option("--lcm-url", url, "LCM URL, e.g. udpm://239.255.76.67:7667?ttl=0")->required();
   app.add_option("--run-id", run_id, "run id shared by every participant")->required();
   app.add_option("--out", out_dir, "output folder (the logger's files; logs/<role>.json for everyone)");
+  double handshake_timeout_s = 0;
+  app.add_option("--handshake-timeout-s", handshake_timeout_s,
+                 "wait this long for the handshake instead of the scenario's lockstep.handshake_timeout_s "
+                 "(rths run --external: time for the external participants to join) [s]")
+      ->check(CLI::Range(0.1, 86400.0));
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -106,7 +111,9 @@ int RoleMain(std::string_view role, int argc, char** argv) {
   o.role = name;
   io::ReserveFile(OutcomePath(out_dir, name), kOutcomeReserve, "{}\n");
   try {
-    const scenario::Scenario s = scenario::LoadScenario(scenario_path);
+    scenario::Scenario s = scenario::LoadScenario(scenario_path);
+    // Not part of the handshake's identity (the hash is of the file): only how long to wait.
+    if (handshake_timeout_s > 0) s.lockstep.handshake_timeout_s = handshake_timeout_s;
     lcm::LCM lcm(url);
     if (!lcm.good()) {
       std::string hint = lockstep::CheckMulticastRoute();

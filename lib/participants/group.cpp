@@ -33,6 +33,7 @@ nlohmann::json OutcomeToJson(const Outcome& o) {
                       {"killed_by_supervisor", o.killed_by_supervisor},
                       {"was_stopped", o.was_stopped}};
   if (o.stepping_s > 0) j["stepping_s"] = o.stepping_s;
+  if (o.external) j["external"] = true;
   if (o.stats_known) j["link"] = StatsToJson(o.stats);
   return j;
 }
@@ -48,6 +49,7 @@ Outcome OutcomeFromJson(const nlohmann::json& j) {
   o.killed_by_supervisor = j.value("killed_by_supervisor", false);
   o.was_stopped = j.value("was_stopped", false);
   o.stepping_s = j.value("stepping_s", 0.0);
+  o.external = j.value("external", false);
   if (j.contains("link")) {
     const auto& l = j.at("link");
     lockstep::LinkStats& s = o.stats;

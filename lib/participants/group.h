@@ -38,6 +38,7 @@ struct Outcome {
   bool stats_known = false;
   lockstep::LinkStats stats;
   double stepping_s = 0;  ///< the clock: wall-clock time from GO to the last committed step [s]
+  bool external = false;  ///< run by the user (`rths run --external`): not started or watched by us
 };
 nlohmann::json OutcomeToJson(const Outcome& o);
 /// Reads what OutcomeToJson wrote; throws nlohmann::json::exception on a malformed object.
