@@ -40,6 +40,7 @@
 #include "core/error.h"
 #include "io/reserved_file.h"
 #include "io/run_log.h"
+#include "lockstep/realtime.h"
 #include "lockstep/runtime.h"
 #include "models/structure_file.h"
 #include "participants/factory.h"
@@ -298,6 +299,8 @@ std::vector<Outcome> RunUdpm(const std::string& scenario_path, const rths::scena
         o.stats = self.stats;
         o.stats_known = self.stats_known;
         o.stepping_s = self.stepping_s;
+        o.realtime_setup = self.realtime_setup;
+        o.realtime_json = self.realtime_json;
       }
     } catch (const std::exception&) {
       // a partial file (the disk filled up): keep what the exit status says
@@ -362,6 +365,10 @@ int main(int argc, char** argv) {
   app.add_option("--external", external_arg,
                  "ROLE[,ROLE...]: do not start these participants (controller, plant, semiactive); wait "
                  "for the user's own to join the handshake (docs/participant.md)");
+  bool realtime = false;
+  app.add_flag("--realtime", realtime,
+               "pace the run to the wall clock at the scenario's dt (as [realtime] enabled = true): "
+               "latency percentiles and deadline misses in summary.json (docs/realtime.md)");
   app.add_option("--join-timeout-s", join_timeout_s,
                  "with --external: how long to wait for the external participants to say HELLO [s]")
       ->check(CLI::Range(0.1, 86400.0))
@@ -370,8 +377,8 @@ int main(int argc, char** argv) {
       ->group("");
   app.footer("Exit codes: 0 ok; 2 bad input or not enough disk (nothing ran); 3 a participant stopped "
              "answering (named); 4 stopped by an abort; 5 a participant's computation failed; 6 stopped "
-             "by the safety monitor; 7 the output could not be written (disk full); 128+N a participant "
-             "was killed by signal N; 130 interrupted.");
+             "by the safety monitor; 7 the output could not be written (disk full); 8 real-time mode: too many "
+             "consecutive deadline misses; 128+N a participant was killed by signal N; 130 interrupted.");
   CLI11_PARSE(app, argc, argv);
 
   if (scenario_path.empty()) scenario_path = default_scenario;
@@ -423,6 +430,7 @@ int main(int argc, char** argv) {
   std::string url = "memq://";
   try {
     s = rths::scenario::LoadScenario(scenario_path);
+    if (realtime) s.realtime.enabled = true;
     rths::participants::CheckBuildable(s);
     const std::string& kind = s.faults.process_kind;
     if (transport == "memq" && (kind == "crash" || kind == "kill" || kind == "stop")) {
@@ -486,6 +494,7 @@ int main(int argc, char** argv) {
       run_id_arg > 0 ? run_id_arg
                      : static_cast<std::int64_t>(((std::uint64_t{rd()} << 32) ^ rd()) & 0x3fffffffffffffffULL) | 1;
   std::vector<Outcome> outcomes;
+  rths::lockstep::RealtimeSetup memq_setup;
   const auto t0 = Clock::now();
   Clock::time_point noticed{};
   try {
@@ -512,9 +521,17 @@ int main(int argc, char** argv) {
                   roles.c_str());
       std::fflush(stdout);
     }
-    outcomes = transport == "memq"
-                   ? rths::participants::RunGroupInProcess({s}, run_id, out.string(), {}, &g_interrupted)
-                   : RunUdpm(scenario_path, s, run_id, out, bin_dir, url, external, {}, &noticed);
+    std::vector<std::string> role_args;
+    if (realtime) role_args.push_back("--realtime");
+    if (transport == "memq") {
+      if (s.realtime.enabled) {
+        // Every participant runs on this thread: the set-up is this process's.
+        memq_setup = rths::lockstep::EnterRealtime(s.realtime.sched_fifo, s.realtime.priority, s.realtime.lock_memory);
+      }
+      outcomes = rths::participants::RunGroupInProcess({s}, run_id, out.string(), {}, &g_interrupted);
+    } else {
+      outcomes = RunUdpm(scenario_path, s, run_id, out, bin_dir, url, external, role_args, &noticed);
+    }
   } catch (const std::exception& e) {
     std::fprintf(stderr, "rths run: %s\n", e.what());
     std::error_code ec;
@@ -569,7 +586,9 @@ int main(int argc, char** argv) {
     code = 130;
   } else if (verdict.failed) {
     code = verdict.exit_code != 0 ? verdict.exit_code : rths::lockstep::kExitLockstep;
-    status = code == rths::lockstep::kExitSafety ? "stopped by the safety monitor" : "failed";
+    status = code == rths::lockstep::kExitSafety     ? "stopped by the safety monitor"
+             : code == rths::lockstep::kExitRealtime ? "stopped by the miss policy"
+                                                     : "failed";
   }
   j["status"] = status;
   j["exit_code"] = code;
@@ -582,6 +601,39 @@ int main(int argc, char** argv) {
     }
   }
   j["link"] = LinkTotals(outcomes);
+  // Paced runs: the clock's latency figures, and what each process got of SCHED_FIFO / mlockall.
+  std::string rt_line;
+  if (s.realtime.enabled) {
+    nlohmann::json rt;
+    for (const auto& o : outcomes) {
+      if (const nlohmann::json r = o.RealtimeJson(); !r.is_null()) rt = r;
+    }
+    if (rt.is_null()) rt = nlohmann::json::object();
+    int fifo = 0, locked = 0, processes = 0;
+    std::string notes;
+    auto count = [&](const rths::lockstep::RealtimeSetup& r, const std::string& who) {
+      if (!r.tried) return;
+      ++processes;
+      fifo += r.fifo;
+      locked += r.memory_locked;
+      if (!r.note.empty() && notes.find(r.note) == std::string::npos) notes += (notes.empty() ? "" : "; ") + who + ": " + r.note;
+    };
+    if (transport == "memq") {
+      count(memq_setup, "rths run (memq: every participant)");
+    } else {
+      for (const auto& o : outcomes) count(o.realtime_setup, o.role);
+    }
+    rt["processes"] = processes;
+    rt["sched_fifo_processes"] = fifo;
+    rt["memory_locked_processes"] = locked;
+    rt["priority"] = s.realtime.priority;
+    rt["setup_notes"] = notes;
+    rt["max_consecutive_misses_policy"] = s.realtime.max_consecutive_misses;
+    j["realtime"] = rt;
+    rt_line = fmt::format("SCHED_FIFO {} in {} of {} process(es), memory locked in {} of {}", s.realtime.priority,
+                          fifo, processes, locked, processes);
+    if (!notes.empty()) rt_line += "\n  NOT real-time      " + notes;
+  }
   j["participants"] = nlohmann::json::object();
   for (const auto& o : outcomes) {
     nlohmann::json p = rths::participants::OutcomeToJson(o);
@@ -599,6 +651,20 @@ int main(int argc, char** argv) {
       std::printf("  rate               %.0f steps/s (%.2fx real time)\n", j["steps_per_s"].get<double>(),
                   j["steps_per_s"].get<double>() * s.run.dt_s);
     }
+    if (j.contains("realtime") && j["realtime"].contains("steps")) {
+      const auto& rt = j["realtime"];
+      const double period_us = rt["period_us"].get<double>();
+      std::printf("  real time          paced at %.0f Hz (dt %g ms); %s\n", 1e6 / period_us, period_us / 1e3,
+                  rt_line.c_str());
+      std::printf("  step latency       p50 %.0f us, p99 %.0f us, p99.9 %.0f us, max %.0f us (request to barrier)\n",
+                  rt["latency_p50_us"].get<double>(), rt["latency_p99_us"].get<double>(),
+                  rt["latency_p999_us"].get<double>(), rt["latency_max_us"].get<double>());
+      std::printf("  deadline misses    %lld of %lld steps (%.4f %%), longest run %lld\n",
+                  static_cast<long long>(rt["deadline_misses"].get<std::int64_t>()),
+                  static_cast<long long>(rt["steps"].get<std::int64_t>()),
+                  100.0 * rt["miss_fraction"].get<double>(),
+                  static_cast<long long>(rt["max_consecutive_misses"].get<std::int64_t>()));
+    }
     const auto rerequests = j["link"]["rerequests"].get<std::int64_t>();
     if (rerequests > 0) {
       std::printf("  link               %lld re-requests, %lld messages repaired\n",
@@ -615,6 +681,8 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "rths run: interrupted; the group was stopped\n");
   } else if (code == rths::lockstep::kExitSafety) {
     std::fprintf(stderr, "rths run: STOPPED by the safety monitor: %s\n", verdict.what.c_str());
+  } else if (code == rths::lockstep::kExitRealtime) {
+    std::fprintf(stderr, "rths run: STOPPED by the real-time miss policy: %s\n", verdict.what.c_str());
   } else {
     std::fprintf(stderr, "rths run: FAILED: %s\n", verdict.what.c_str());
   }

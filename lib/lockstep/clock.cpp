@@ -1,5 +1,6 @@
 #include "lockstep/clock.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <exception>
 
@@ -45,6 +46,8 @@ ClockParticipant::ClockParticipant(std::string name, RunIdentity id, Timing timi
   }
   start_ = SteadyClock::now();
   last_send_ = start_ - std::chrono::seconds(1);
+  rt_.paced = timing_.pacing.enabled;
+  rt_.period_s = timing_.pacing.period_s;
   SetAnswerChannel(kDesired, &desired_cache_);
   auto on_answer = [this](auto* box, Channel ch) {
     return [this, box, ch](const lcm::ReceiveBuffer* rbuf) {
@@ -121,6 +124,35 @@ void ClockParticipant::SendGo() {
   }
 }
 
+SteadyClock::time_point ClockParticipant::ReleaseOf(std::int64_t k) const {
+  return go_at_ + std::chrono::duration_cast<SteadyClock::duration>(
+                      std::chrono::duration<double>(static_cast<double>(k) * timing_.pacing.period_s));
+}
+
+bool ClockParticipant::AccountStep(SteadyClock::time_point now) {
+  rt_.latency.Add(Seconds(step_since_, now));
+  ++rt_.steps;
+  if (!rt_.paced) return true;
+  if (now > ReleaseOf(k_ + 1)) {
+    ++rt_.misses;
+    if (rt_.first_miss_step < 0) rt_.first_miss_step = k_;
+    rt_.max_consecutive_misses = std::max(rt_.max_consecutive_misses, ++consecutive_misses_);
+    const std::int64_t limit = timing_.pacing.max_consecutive_misses;
+    if (limit > 0 && consecutive_misses_ >= limit) {
+      Fail(kExitRealtime,
+           fmt::format("step {}: {} consecutive deadline misses (realtime.max_consecutive_misses = {}): this step "
+                       "took {:.3g} ms for a {:.3g} ms period; {} of {} steps missed so far",
+                       k_, consecutive_misses_, limit, 1e3 * Seconds(step_since_, now), 1e3 * rt_.period_s,
+                       rt_.misses, rt_.steps),
+           true, k_);
+      return false;
+    }
+  } else {
+    consecutive_misses_ = 0;
+  }
+  return true;
+}
+
 void ClockParticipant::IssueStep(std::int64_t k) {
   MaybeFault(k);
   const rths::measured_t* prev = k > 0 ? measured_.Get(k - 1) : nullptr;
@@ -131,6 +163,7 @@ void ClockParticipant::IssueStep(std::int64_t k) {
   rerequests_ = 0;
   reported_.fill(false);
   step_since_ = last_send_ = SteadyClock::now();
+  if (rt_.paced) rt_.max_release_late_s = std::max(rt_.max_release_late_s, Seconds(ReleaseOf(k), step_since_));
   Answer(kChDesired, &desired_cache_, k, desired_);
 }
 
@@ -145,16 +178,22 @@ void ClockParticipant::CheckBarrier() {
     const double took_s = Seconds(step_since_, SteadyClock::now());
     typical_step_s_ = typical_step_s_ > 0 ? typical_step_s_ + (took_s - typical_step_s_) / 16.0 : took_s;
   }
-  stepping_s_ = Seconds(go_at_, SteadyClock::now());
+  const auto now = SteadyClock::now();
+  stepping_s_ = Seconds(go_at_, now);
   if (const std::string_view stop = CheckCommitted(k_, desired_, *m, *c); !stop.empty()) {
     Fail(kExitSafety, std::string(stop), true, k_);
     return;
   }
+  if (!AccountStep(now)) return;
   if (k_ + 1 >= id_.n_steps) {
     done_ = true;
     rerequests_ = 0;
     step_since_ = last_send_ = SteadyClock::now();
     SendHandshake(kDone, id_.n_steps);
+    return;
+  }
+  if (rt_.paced && now < ReleaseOf(k_ + 1)) {
+    release_ = ReleaseOf(k_ + 1);  // Poll() issues it when the event loop wakes up at the release
     return;
   }
   try {
@@ -193,6 +232,7 @@ void ClockParticipant::FailStalled(SteadyClock::time_point now) {
 }
 
 SteadyClock::time_point ClockParticipant::PollDeadline() const {
+  if (release_ != SteadyClock::time_point::max()) return release_;
   if (k_ < 0 || Stalled(k_)) return SteadyClock::time_point::max();
   return last_send_ + std::chrono::duration_cast<SteadyClock::duration>(std::chrono::duration<double>(
                           timing_.RerequestAfterS(rerequests_ + 1, typical_step_s_)));
@@ -216,6 +256,16 @@ void ClockParticipant::Poll(SteadyClock::time_point now, bool idle) {
     if (Seconds(last_send_, now) >= kHandshakeRepeatS) {
       SendHandshake(kRequest);
       last_send_ = now;
+    }
+    return;
+  }
+  if (release_ != SteadyClock::time_point::max()) {  // paced: step k_ is complete, k_+1 not yet due
+    if (now < release_) return;
+    release_ = SteadyClock::time_point::max();
+    try {
+      IssueStep(k_ + 1);
+    } catch (const std::exception& e) {
+      Fail(kExitInternal, fmt::format("{}: step {}: {}", name_, k_ + 1, e.what()), true, k_ + 1);
     }
     return;
   }

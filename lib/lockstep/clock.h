@@ -13,6 +13,8 @@
 /// neither answered nor said what they lacked (the silent ones) apart from those that only
 /// waited. Steps are never skipped: step k+1 is issued only after the barrier of step k.
 /// After the last step: DONE until every BYE is in, then CLOSE.
+/// Paced (Timing::pacing, docs/realtime.md): step k is released at GO + k dt of the wall clock,
+/// not as soon as step k-1 completes; every step's latency and deadline are accounted.
 #include <array>
 #include <string>
 #include <string_view>
@@ -47,6 +49,8 @@ class ClockParticipant : public Participant {
 
   /// Step currently requested (-1 before GO).
   std::int64_t current_step() const { return k_; }
+  const RealtimeStats* realtime() const override { return &rt_; }
+  SteadyClock::time_point ReleaseAt() const override { return release_; }
 
  protected:
   /// Computes desired_t k into `*out`. `measured_prev` is measured_t k-1 (nullptr for k = 0).
@@ -74,6 +78,11 @@ class ClockParticipant : public Participant {
   void SendGo();
   /// Fails the run: step k_ has been incomplete for the whole stall budget.
   void FailStalled(SteadyClock::time_point now);
+  /// Counts step k_'s latency and, when paced, whether it met its deadline; false if the miss
+  /// policy stopped the run.
+  bool AccountStep(SteadyClock::time_point now);
+  /// Paced: when step k is released (t0 + k dt).
+  SteadyClock::time_point ReleaseOf(std::int64_t k) const;
 
   StepMailbox<rths::measured_t> measured_;
   StepMailbox<rths::command_t> command_;
@@ -91,7 +100,11 @@ class ClockParticipant : public Participant {
   double typical_step_s_ = 0;  ///< moving average of the steps that needed no re-request [s]
   bool done_ = false;
   SteadyClock::time_point step_since_;  ///< when step k_ (or DONE) was first sent
-  SteadyClock::time_point go_at_;
+  SteadyClock::time_point go_at_;  ///< GO; paced: t0, the release of step 0
+  /// Paced: the next step's release while waiting for it, else time_point::max().
+  SteadyClock::time_point release_ = SteadyClock::time_point::max();
+  RealtimeStats rt_;
+  std::int64_t consecutive_misses_ = 0;
   SteadyClock::time_point last_send_;
   SteadyClock::time_point start_;
 };

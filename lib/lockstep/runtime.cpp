@@ -1,6 +1,7 @@
 #include "lockstep/runtime.h"
 
 #include <signal.h>
+#include <time.h>
 #include <sys/types.h>
 #include <unistd.h>
 
@@ -415,6 +416,27 @@ int RunLoop(lcm::LCM* lcm, const std::vector<Participant*>& participants, const 
     bool all_done = true;
     for (Participant* p : participants) all_done = all_done && p->finished();
     if (all_done) break;
+    // A paced clock waiting for its next release: handle what has arrived, then sleep to the
+    // release on an absolute deadline (no drift, no millisecond rounding).
+    auto release = SteadyClock::time_point::max();
+    for (const Participant* p : participants) release = std::min(release, p->ReleaseAt());
+    if (release != SteadyClock::time_point::max()) {
+      int handled = 0;
+      while (handled < 64 && lcm->handleTimeout(0) > 0) {
+        ++handled;
+        const auto now = SteadyClock::now();
+        for (Participant* p : participants) p->Tick(now, false);
+      }
+      // steady_clock is CLOCK_MONOTONIC (libstdc++ on Linux); a release already past returns at once.
+      const auto ns = std::chrono::duration_cast<std::chrono::nanoseconds>(release.time_since_epoch()).count();
+      const timespec ts{static_cast<time_t>(ns / 1000000000), static_cast<long>(ns % 1000000000)};
+      while (::clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR) {
+        if (stop && *stop) break;
+      }
+      const auto now = SteadyClock::now();
+      for (Participant* p : participants) p->Tick(now, true);
+      continue;
+    }
     // Wake up for the next deadline (a re-request, a held message), at most kPollMs away.
     auto deadline = SteadyClock::now() + std::chrono::milliseconds(kPollMs);
     for (const Participant* p : participants) deadline = std::min(deadline, p->NextDeadline());

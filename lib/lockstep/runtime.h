@@ -20,6 +20,7 @@
 #include <lcm/lcm-cpp.hpp>
 
 #include "lockstep/faults.h"
+#include "lockstep/realtime.h"
 #include "rths/handshake_t.hpp"
 #include "rths/repair_t.hpp"
 
@@ -57,6 +58,7 @@ enum ExitCode : int {
   kExitInternal = 5,       ///< an exception in this participant's own computation
   kExitSafety = 6,         ///< the safety monitor stopped the run (a limit was left)
   kExitOutput = 7,         ///< the run's output could not be written (disk full, I/O error)
+  kExitRealtime = 8,       ///< real-time mode: the miss policy stopped the run (docs/realtime.md)
 };
 
 using SteadyClock = std::chrono::steady_clock;
@@ -90,6 +92,8 @@ struct Timing {
   double WatchdogS() const { return stall_budget_s + 2.0; }
   /// How long a participant lingers after DONE, answering repeated DONEs, without CLOSE [s].
   double LingerS() const;
+  /// The clock's real-time pacing ([realtime]; off: as fast as the participants answer).
+  Pacing pacing;
 };
 
 /// Counters of what the link lost and what the protocol repaired (summary.json, per participant).
@@ -220,6 +224,11 @@ class Participant {
   const LinkStats& stats() const { return stats_; }
   /// Clock only: wall-clock time from GO to the last committed step [s] (0 for the others).
   double stepping_s() const { return stepping_s_; }
+  /// Clock only: step latencies and deadline misses (nullptr for the others).
+  virtual const RealtimeStats* realtime() const { return nullptr; }
+  /// Paced clock only: when the next step is to be released (the event loop sleeps until then
+  /// with clock_nanosleep on CLOCK_MONOTONIC); time_point::max() if no release is pending.
+  virtual SteadyClock::time_point ReleaseAt() const { return SteadyClock::time_point::max(); }
 
   /// Stops now, as if the supervisor had said ABORT (an interrupt): flushes, exit kExitPeerAbort.
   void Interrupt(const std::string& reason);

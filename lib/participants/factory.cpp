@@ -27,7 +27,9 @@ lockstep::RunIdentity IdentityOf(const scenario::Scenario& s, std::int64_t run_i
 }
 
 lockstep::Timing TimingOf(const scenario::Scenario& s) {
-  return {s.lockstep.rerequest_ms, s.lockstep.stall_budget_s, s.lockstep.handshake_timeout_s};
+  lockstep::Timing t{s.lockstep.rerequest_ms, s.lockstep.stall_budget_s, s.lockstep.handshake_timeout_s};
+  t.pacing = {s.realtime.enabled, s.run.dt_s, s.realtime.max_consecutive_misses};
+  return t;
 }
 
 lockstep::Faults FaultsOf(const scenario::Scenario& s, std::string_view role) {
@@ -96,6 +98,8 @@ int RoleMain(std::string_view role, int argc, char** argv) {
                  "wait this long for the handshake instead of the scenario's lockstep.handshake_timeout_s "
                  "(rths run --external: time for the external participants to join) [s]")
       ->check(CLI::Range(0.1, 86400.0));
+  bool realtime = false;
+  app.add_flag("--realtime", realtime, "real-time paced mode, as if the scenario said [realtime] enabled = true");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -114,6 +118,11 @@ int RoleMain(std::string_view role, int argc, char** argv) {
     scenario::Scenario s = scenario::LoadScenario(scenario_path);
     // Not part of the handshake's identity (the hash is of the file): only how long to wait.
     if (handshake_timeout_s > 0) s.lockstep.handshake_timeout_s = handshake_timeout_s;
+    if (realtime) s.realtime.enabled = true;  // pacing is not part of the identity either
+    if (s.realtime.enabled) {
+      o.realtime_setup = lockstep::EnterRealtime(s.realtime.sched_fifo, s.realtime.priority, s.realtime.lock_memory);
+      if (!o.realtime_setup.note.empty()) std::fprintf(stderr, "%s: %s\n", name.c_str(), o.realtime_setup.note.c_str());
+    }
     lcm::LCM lcm(url);
     if (!lcm.good()) {
       std::string hint = lockstep::CheckMulticastRoute();
@@ -128,6 +137,7 @@ int RoleMain(std::string_view role, int argc, char** argv) {
       o.stats = p->stats();
       o.stats_known = true;
       o.stepping_s = p->stepping_s();
+      if (const auto* rt = p->realtime()) o.realtime = *rt;
     }
   } catch (const Error& e) {
     o.exit_code = lockstep::kExitUsage;

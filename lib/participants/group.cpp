@@ -1,5 +1,6 @@
 #include "participants/group.h"
 
+#include <cmath>
 #include <cstring>
 #include <memory>
 
@@ -26,6 +27,34 @@ nlohmann::json StatsToJson(const lockstep::LinkStats& s) {
             {"reordered", s.injected.reordered}}}};
 }
 
+nlohmann::json RealtimeToJson(const lockstep::RealtimeStats& r) {
+  const auto& h = r.latency;
+  nlohmann::json bins = nlohmann::json::array();
+  for (int i = 0; i < lockstep::LatencyHistogram::kBins; ++i) {
+    if (h.bin(i) == 0) continue;
+    const double hi = lockstep::LatencyHistogram::UpperEdge(i);
+    bins.push_back({1e6 * lockstep::LatencyHistogram::LowerEdge(i), std::isfinite(hi) ? 1e6 * hi : -1.0, h.bin(i)});
+  }
+  return {{"paced", r.paced},
+          {"period_us", 1e6 * r.period_s},
+          {"steps", r.steps},
+          {"deadline_misses", r.misses},
+          {"miss_fraction", r.steps > 0 ? static_cast<double>(r.misses) / static_cast<double>(r.steps) : 0.0},
+          {"max_consecutive_misses", r.max_consecutive_misses},
+          {"first_miss_step", r.first_miss_step},
+          {"latency_p50_us", 1e6 * h.Quantile(0.5)},
+          {"latency_p99_us", 1e6 * h.Quantile(0.99)},
+          {"latency_p999_us", 1e6 * h.Quantile(0.999)},
+          {"latency_max_us", 1e6 * h.max_s()},
+          {"max_release_late_us", 1e6 * r.max_release_late_s},
+          {"latency_histogram_us", bins}};
+}
+
+nlohmann::json Outcome::RealtimeJson() const {
+  if (realtime.steps > 0) return RealtimeToJson(realtime);
+  return realtime_json;
+}
+
 nlohmann::json OutcomeToJson(const Outcome& o) {
   nlohmann::json j = {{"role", o.role},       {"exit_code", o.exit_code},
                       {"signal", o.signal},   {"message", o.message},
@@ -34,6 +63,13 @@ nlohmann::json OutcomeToJson(const Outcome& o) {
                       {"was_stopped", o.was_stopped}};
   if (o.stepping_s > 0) j["stepping_s"] = o.stepping_s;
   if (o.external) j["external"] = true;
+  if (o.realtime_setup.tried) {
+    j["realtime_setup"] = {{"sched_fifo", o.realtime_setup.fifo},
+                           {"priority", o.realtime_setup.priority},
+                           {"memory_locked", o.realtime_setup.memory_locked},
+                           {"note", o.realtime_setup.note}};
+  }
+  if (const nlohmann::json rt = o.RealtimeJson(); !rt.is_null()) j["realtime"] = rt;
   if (o.stats_known) j["link"] = StatsToJson(o.stats);
   return j;
 }
@@ -50,6 +86,15 @@ Outcome OutcomeFromJson(const nlohmann::json& j) {
   o.was_stopped = j.value("was_stopped", false);
   o.stepping_s = j.value("stepping_s", 0.0);
   o.external = j.value("external", false);
+  if (j.contains("realtime_setup")) {
+    const auto& r = j.at("realtime_setup");
+    o.realtime_setup.tried = true;
+    o.realtime_setup.fifo = r.value("sched_fifo", false);
+    o.realtime_setup.priority = r.value("priority", 0);
+    o.realtime_setup.memory_locked = r.value("memory_locked", false);
+    o.realtime_setup.note = r.value("note", std::string());
+  }
+  if (j.contains("realtime")) o.realtime_json = j.at("realtime");
   if (j.contains("link")) {
     const auto& l = j.at("link");
     lockstep::LinkStats& s = o.stats;
@@ -118,6 +163,7 @@ std::vector<Outcome> RunGroupInProcess(const std::vector<scenario::Scenario>& pe
     o.stats = p->stats();
     o.stats_known = true;
     o.stepping_s = p->stepping_s();
+    if (const auto* rt = p->realtime()) o.realtime = *rt;
     outcomes.push_back(std::move(o));
   }
   return outcomes;

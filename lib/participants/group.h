@@ -39,7 +39,17 @@ struct Outcome {
   lockstep::LinkStats stats;
   double stepping_s = 0;  ///< the clock: wall-clock time from GO to the last committed step [s]
   bool external = false;  ///< run by the user (`rths run --external`): not started or watched by us
+  lockstep::RealtimeSetup realtime_setup;  ///< paced runs: SCHED_FIFO / mlockall achieved
+  /// The clock: step latencies and deadline misses (realtime.paced false for the others).
+  lockstep::RealtimeStats realtime;
+  /// ... as read back from a participant process's outcome file (RealtimeToJson), if any.
+  nlohmann::json realtime_json;
+  /// The realtime JSON of either source (null if none).
+  nlohmann::json RealtimeJson() const;
 };
+/// The clock's latency figures as JSON (summary.json "realtime"): percentiles and max [us],
+/// misses, the non-empty histogram bins as [lower_us, upper_us, count].
+nlohmann::json RealtimeToJson(const lockstep::RealtimeStats& r);
 nlohmann::json OutcomeToJson(const Outcome& o);
 /// Reads what OutcomeToJson wrote; throws nlohmann::json::exception on a malformed object.
 Outcome OutcomeFromJson(const nlohmann::json& j);

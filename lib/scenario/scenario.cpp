@@ -493,6 +493,15 @@ void ReadScenario(const toml::table& root, const std::string& file, Scenario* s)
   lockstep.Number("handshake_timeout_s", &s->lockstep.handshake_timeout_s);
   lockstep.Finish();
 
+  RealtimeConfig& rt = s->realtime;
+  Section realtime = top.Sub("realtime");
+  realtime.Bool("enabled", &rt.enabled);
+  realtime.Integer("max_consecutive_misses", &rt.max_consecutive_misses);
+  realtime.Bool("sched_fifo", &rt.sched_fifo);
+  realtime.Integer("priority", &rt.priority);
+  realtime.Bool("lock_memory", &rt.lock_memory);
+  realtime.Finish();
+
   FaultConfig& fc = s->faults;
   Section faults = top.Sub("faults");
   for (auto [key, field] : {std::pair{"drop", &fc.drop}, {"duplicate", &fc.duplicate}, {"delay", &fc.delay},
@@ -775,6 +784,11 @@ void ValidateLockstep(const LockstepConfig& l, const Check& check) {
   check.InRange("lockstep.handshake_timeout_s", l.handshake_timeout_s, Closed(0.1, 600.0));
 }
 
+void ValidateRealtime(const RealtimeConfig& r, const Check& check) {
+  check.InRange("realtime.max_consecutive_misses", static_cast<double>(r.max_consecutive_misses), Closed(0.0, 1e9));
+  check.InRange("realtime.priority", r.priority, Closed(1, 99));
+}
+
 void ValidateFaults(const FaultConfig& f, std::int64_t steps, const Check& check) {
   for (auto [key, v] : {std::pair{"faults.drop", f.drop}, {"faults.duplicate", f.duplicate},
                         {"faults.delay", f.delay}, {"faults.reorder", f.reorder}}) {
@@ -837,6 +851,7 @@ void ValidateScenario(const Scenario& s) {
   ValidatePlant(s.plant, s.run.dt_s, check);
   ValidateSemiactive(s.semiactive, check);
   ValidateLockstep(s.lockstep, check);
+  ValidateRealtime(s.realtime, check);
   ValidateSafety(s.safety, check);
   ValidateFaults(s.faults, s.steps(), check);
 }
@@ -974,6 +989,10 @@ std::string ToToml(const Scenario& s) {
   const auto& l = s.lockstep;
   o += fmt::format("\n[lockstep]\nrerequest_ms = {}\nstall_budget_s = {}\nhandshake_timeout_s = {}\n",
                    TomlNumber(l.rerequest_ms), TomlNumber(l.stall_budget_s), TomlNumber(l.handshake_timeout_s));
+  const auto& rt = s.realtime;
+  o += fmt::format("\n[realtime]\nenabled = {}\nmax_consecutive_misses = {}\nsched_fifo = {}\npriority = {}\n"
+                   "lock_memory = {}\n",
+                   rt.enabled, rt.max_consecutive_misses, rt.sched_fifo, rt.priority, rt.lock_memory);
   const auto& fc = s.faults;
   o += fmt::format("\n[faults]\ndrop = {}\nduplicate = {}\ndelay = {}\nreorder = {}\ndelay_ms = {}\nseed = {}\n"
                    "recv_buf_bytes = {}\n",

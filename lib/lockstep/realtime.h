@@ -1,0 +1,78 @@
+#pragma once
+/// @file Real-time paced mode (docs/realtime.md): the clock's pacing knobs, the per-step latency
+/// and deadline-miss statistics it keeps, and the process set-up (SCHED_FIFO, mlockall) every
+/// participant process tries when pacing is on.
+///
+/// Step k is released (desired_t k published) at t_k = t0 + k dt on CLOCK_MONOTONIC, t0 the
+/// moment of GO, waiting with clock_nanosleep(TIMER_ABSTIME) (absolute deadlines: no drift). Its
+/// latency is the time from that publication to its barrier being complete (every answer of
+/// step k in, the logger's ack included). Step k misses its deadline when its barrier completes
+/// after t_{k+1} = t0 + (k+1) dt. A late step is not skipped: the next one is released at once
+/// (steps are never skipped), so a run that falls behind catches up to the wall clock.
+#include <array>
+#include <cstdint>
+#include <string>
+
+namespace rths::lockstep {
+
+/// How the clock paces steps (from the scenario's [realtime] table).
+struct Pacing {
+  bool enabled = false;
+  double period_s = 0.0;  ///< dt [s]
+  /// Stop the run (exit kExitRealtime) after this many consecutive misses; 0 = never.
+  std::int64_t max_consecutive_misses = 0;
+};
+
+/// Durations in log-spaced bins: 100 per decade from 1 us to 100 s (neighbouring bin edges 2.3 %
+/// apart), plus an underflow and an overflow bin. Adding allocates nothing.
+class LatencyHistogram {
+ public:
+  static constexpr int kPerDecade = 100;
+  static constexpr int kDecades = 8;
+  static constexpr double kLowestS = 1e-6;
+  static constexpr int kBins = kPerDecade * kDecades + 2;  ///< [0] underflow, [kBins-1] overflow
+
+  void Add(double seconds);
+  std::int64_t count() const { return count_; }
+  double max_s() const { return max_s_; }
+  /// The q-quantile (0 < q <= 1) [s]: the upper edge of the bin that holds it (at most max_s()),
+  /// so it is never below the true value and at most 2.3 % above it. 0 if empty.
+  double Quantile(double q) const;
+  /// Lower and upper edge of bin i [s] (bin 0: [0, 1 us); the last bin: [100 s, inf)).
+  static double LowerEdge(int i);
+  static double UpperEdge(int i);
+  std::int64_t bin(int i) const { return bins_[i]; }
+
+ private:
+  std::array<std::int64_t, kBins> bins_{};
+  std::int64_t count_ = 0;
+  double max_s_ = 0.0;
+};
+
+/// What the clock measured of a run's pace.
+struct RealtimeStats {
+  bool paced = false;
+  double period_s = 0.0;
+  std::int64_t steps = 0;                   ///< steps whose barrier completed
+  std::int64_t misses = 0;                  ///< of them, completed after their deadline
+  std::int64_t max_consecutive_misses = 0;  ///< longest run of consecutive misses
+  std::int64_t first_miss_step = -1;
+  LatencyHistogram latency;                 ///< request -> barrier complete, every step
+  /// How late step releases were (wake-up jitter; catching up after a miss) [s]: max.
+  double max_release_late_s = 0.0;
+};
+
+/// What a process achieved when it tried to run in real time.
+struct RealtimeSetup {
+  bool tried = false;
+  bool fifo = false;        ///< running under SCHED_FIFO
+  int priority = 0;         ///< ... at this priority
+  bool memory_locked = false;
+  std::string note;         ///< what was not permitted, and why ("" if everything worked)
+};
+
+/// Tries SCHED_FIFO at `priority` (if `fifo`) and mlockall(MCL_CURRENT | MCL_FUTURE) (if `lock`)
+/// for the calling process; says plainly what was not permitted (errno text and what grants it).
+RealtimeSetup EnterRealtime(bool fifo, int priority, bool lock);
+
+}  // namespace rths::lockstep
