@@ -10,6 +10,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "io/log_compare.h"
 #include "io/run_log.h"
 
 namespace {
@@ -110,6 +111,12 @@ int main(int argc, char** argv) {
       for (std::size_t k = 0; k < pa.size(); ++k) {
         if (pa[k] != it->second[k]) {
           std::printf("%s: first difference at k = %zu\n", ch.c_str(), k);
+          if (ch == "RTHS_DESIRED" || ch == "RTHS_COMMAND" || ch == "RTHS_MEASURED" || ch == "RTHS_CURRENT") {
+            // How much, field by field (B - A).
+            const auto d = rths::io::CompareChannel(a, b, ch, static_cast<std::int64_t>(pa.size()));
+            const std::string text = rths::io::Describe(d);
+            if (const auto nl = text.find('\n'); nl != std::string::npos) std::printf("%s\n", text.substr(nl + 1).c_str());
+          }
           ++differences;
           break;
         }
