@@ -136,6 +136,7 @@ void Participant::Deliver(Route* route, const lcm::ReceiveBuffer* rbuf) {
 
 void Participant::DeliverNow(Route* route, const lcm::ReceiveBuffer* rbuf) {
   if (finished_) return;
+  if (follow_) last_clock_ = SteadyClock::now();  // any message counts as the feed being alive
   if (!is_clock_ && route->channel == kChDesired) {
     // Only the clock publishes desired_t: it is alive, and it has sent GO (a lost GO is
     // repaired here: the first message of a step of our run starts us).
@@ -233,6 +234,13 @@ void Participant::SendHandshake(Phase phase, std::int64_t k, const std::string& 
   for (int i = 0; i < copies; ++i) {
     lcm_->publish(kChHandshake, hs_bytes_.data(), static_cast<unsigned int>(hs_bytes_.size()));
   }
+}
+
+void Participant::Follow(double idle_exit_s) {
+  follow_ = true;
+  follow_idle_s_ = idle_exit_s;
+  last_clock_ = SteadyClock::now();
+  StartRunning();
 }
 
 void Participant::StartRunning() {
@@ -333,6 +341,10 @@ void Participant::Poll(SteadyClock::time_point now, bool idle) {
     return;
   }
   if (!idle) return;  // judge silence only once every waiting message has been handled
+  if (follow_) {
+    if (running_ && SecondsBetween(last_clock_, now) > follow_idle_s_) Finish();
+    return;
+  }
   if (!running_) {
     // While the clock keeps asking (REQUEST every 100 ms) it is alive and judges the handshake
     // itself (it names who did not say HELLO); give up only on a clock silent for the whole

@@ -232,6 +232,11 @@ class Participant {
 
   /// Stops now, as if the supervisor had said ABORT (an interrupt): flushes, exit kExitPeerAbort.
   void Interrupt(const std::string& reason);
+  /// Follow mode (a participant fed by `lcm-logplayer`, docs/replay.md): no handshake and no
+  /// clock; it starts at once, answers each step as soon as its inputs arrive, and finishes
+  /// (exit 0) after `idle_exit_s` without a message of its run. Nothing re-requests a lost
+  /// message: a lost input stops its answers there.
+  void Follow(double idle_exit_s);
 
   /// Called by the event loop after every handled message and on every poll timeout: delivers
   /// held (delayed) messages that are due, then Poll(). `idle` is true when no message was
@@ -350,6 +355,8 @@ class Participant {
   bool running_ = false;
   bool finished_ = false;
   bool lingering_ = false;  ///< after DONE and BYE: answering repeated DONEs until CLOSE
+  bool follow_ = false;     ///< follow mode (Follow())
+  double follow_idle_s_ = 0;
   SteadyClock::time_point linger_since_;
   int exit_code_ = kExitOk;
   std::string error_;

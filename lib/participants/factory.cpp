@@ -98,6 +98,15 @@ int RoleMain(std::string_view role, int argc, char** argv) {
                  "wait this long for the handshake instead of the scenario's lockstep.handshake_timeout_s "
                  "(rths run --external: time for the external participants to join) [s]")
       ->check(CLI::Range(0.1, 86400.0));
+  bool follow = false;
+  double follow_idle_s = 2.0;
+  app.add_flag("--follow", follow,
+               "follow mode: no handshake, no clock; answer each step as soon as its inputs arrive (fed by "
+               "lcm-logplayer from a recorded log, with that log's --run-id; docs/replay.md). Delivery is not "
+               "guaranteed: a lost input stops the answers there");
+  app.add_option("--follow-idle-s", follow_idle_s, "follow mode: finish after this long without a message [s]")
+      ->check(CLI::Range(0.1, 3600.0))
+      ->capture_default_str();
   bool realtime = false;
   app.add_flag("--realtime", realtime, "real-time paced mode, as if the scenario said [realtime] enabled = true");
   try {
@@ -130,6 +139,10 @@ int RoleMain(std::string_view role, int argc, char** argv) {
       o.message = fmt::format("cannot open LCM at {}{}{}", url, hint.empty() ? "" : "\n", hint);
     } else {
       auto p = MakeParticipant(role, s, IdentityOf(s, run_id), &lcm, out_dir);
+      if (follow) {
+        if (role == "integrator") throw Error("--follow", "the integrator is the clock: it cannot follow");
+        p->Follow(follow_idle_s);
+      }
       o.exit_code = lockstep::RunLoop(&lcm, {p.get()}, &g_stop);
       o.message = p->error();
       o.culprit = p->culprit();
