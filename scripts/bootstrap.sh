@@ -14,6 +14,7 @@ packages=(
   libssl-dev                       # SHA-256 of scenario files (libcrypto)
   iproute2                         # ip route, for the multicast route below
   gnuplot-nox                      # figures (PNG via pngcairo)
+  default-jdk-headless liblcm-java # the Java types jar (lcm-spy, MATLAB) and examples/java_plant
   clang-14 libclang-rt-14-dev      # libFuzzer + ASan/UBSan for the fuzz targets (fuzz/, build-fuzz/)
 )
 missing=()
