@@ -143,14 +143,9 @@ int RoleMain(std::string_view role, int argc, char** argv) {
         if (role == "integrator") throw Error("--follow", "the integrator is the clock: it cannot follow");
         p->Follow(follow_idle_s);
       }
-      o.exit_code = lockstep::RunLoop(&lcm, {p.get()}, &g_stop);
-      o.message = p->error();
-      o.culprit = p->culprit();
-      o.step = p->fail_step();
-      o.stats = p->stats();
-      o.stats_known = true;
-      o.stepping_s = p->stepping_s();
-      if (const auto* rt = p->realtime()) o.realtime = *rt;
+      const int rc = lockstep::RunLoop(&lcm, {p.get()}, &g_stop);
+      o = OutcomeOf(*p, o);
+      if (o.exit_code == 0) o.exit_code = rc;  // e.g. the LCM receive failed
     }
   } catch (const Error& e) {
     o.exit_code = lockstep::kExitUsage;

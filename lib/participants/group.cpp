@@ -50,6 +50,19 @@ nlohmann::json RealtimeToJson(const lockstep::RealtimeStats& r) {
           {"latency_histogram_us", bins}};
 }
 
+Outcome OutcomeOf(const lockstep::Participant& p, Outcome o) {
+  o.role = p.name();
+  o.exit_code = p.exit_code();
+  o.message = p.error();
+  o.culprit = p.culprit();
+  o.step = p.fail_step();
+  o.stats = p.stats();
+  o.stats_known = true;
+  o.stepping_s = p.stepping_s();
+  if (const auto* rt = p.realtime()) o.realtime = *rt;
+  return o;
+}
+
 nlohmann::json Outcome::RealtimeJson() const {
   if (realtime.steps > 0) return RealtimeToJson(realtime);
   return realtime_json;
@@ -153,19 +166,7 @@ std::vector<Outcome> RunGroupInProcess(const std::vector<scenario::Scenario>& pe
   }
   lockstep::RunLoop(&lcm, group, stop);
   std::vector<Outcome> outcomes;
-  for (const auto* p : group) {
-    Outcome o;
-    o.role = p->name();
-    o.exit_code = p->exit_code();
-    o.message = p->error();
-    o.culprit = p->culprit();
-    o.step = p->fail_step();
-    o.stats = p->stats();
-    o.stats_known = true;
-    o.stepping_s = p->stepping_s();
-    if (const auto* rt = p->realtime()) o.realtime = *rt;
-    outcomes.push_back(std::move(o));
-  }
+  for (const auto* p : group) outcomes.push_back(OutcomeOf(*p));
   return outcomes;
 }
 

@@ -50,6 +50,9 @@ struct Outcome {
 /// The clock's latency figures as JSON (summary.json "realtime"): percentiles and max [us],
 /// misses, the non-empty histogram bins as [lower_us, upper_us, count].
 nlohmann::json RealtimeToJson(const lockstep::RealtimeStats& r);
+/// How a finished participant ended: its exit code, message, culprit, step, link statistics and
+/// (the clock) its stepping time and latency figures. Keeps `base`'s other fields.
+Outcome OutcomeOf(const lockstep::Participant& p, Outcome base = {});
 nlohmann::json OutcomeToJson(const Outcome& o);
 /// Reads what OutcomeToJson wrote; throws nlohmann::json::exception on a malformed object.
 Outcome OutcomeFromJson(const nlohmann::json& j);

@@ -115,18 +115,7 @@ std::vector<Outcome> RunReplay(const scenario::Scenario& s, const io::RunLog& re
   for (auto& p : owned) group.push_back(p.get());
   lockstep::RunLoop(&lcm, group, stop);
   std::vector<Outcome> outcomes;
-  for (const auto* p : group) {
-    Outcome o;
-    o.role = p->name();
-    o.exit_code = p->exit_code();
-    o.message = p->error();
-    o.culprit = p->culprit();
-    o.step = p->fail_step();
-    o.stats = p->stats();
-    o.stats_known = true;
-    o.stepping_s = p->stepping_s();
-    outcomes.push_back(std::move(o));
-  }
+  for (const auto* p : group) outcomes.push_back(OutcomeOf(*p));
   return outcomes;
 }
 
