@@ -410,10 +410,15 @@ TEST_CASE("interrupt: a run that will write gigabytes is announced; Ctrl-C stops
   const auto j = Summary(run);
   CHECK(j["status"] == "interrupted");
   CHECK(j["steps"] == log.CompleteSteps());
-  for (const auto& [name, p] : j["participants"].items()) {  // each stopped cleanly, by itself
+  // Each stopped cleanly (exit 4, output flushed). Ctrl-C reaches every process of the group at
+  // once, and the supervisor also broadcasts ABORT on it: a participant may handle either first
+  // (seen once in CI on a loaded host), so either reason is a clean stop.
+  for (const auto& [name, p] : j["participants"].items()) {
     CAPTURE(name);
     CHECK(p["exit_code"] == rths::lockstep::kExitPeerAbort);
-    CHECK(p["message"] == "stopped by a signal (SIGINT or SIGTERM)");
+    const std::string why = p["message"].get<std::string>();
+    CHECK((why == "stopped by a signal (SIGINT or SIGTERM)" ||
+           why == "supervisor aborted the run: interrupted by the user"));
   }
 }
 
