@@ -9,7 +9,7 @@
 // deadlines, at most 20 s): misses that this row shows too are the host's, not rths's.
 // Each run is `rths run --realtime` of the scenario with run.duration_s = S (default 60), so a
 // run takes S seconds of wall time. Prints one row per transport and writes DIR/latency.png and
-// DIR/<transport>/summary.json (DIR default: runs/bench-realtime-<time>).
+// DIR/<transport>/summary.json (DIR default: runs/<time>-bench-realtime).
 #include <time.h>
 #include <unistd.h>
 
@@ -18,7 +18,6 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -30,6 +29,7 @@
 #include <fmt/core.h>
 #include <nlohmann/json.hpp>
 
+#include "io/output_folder.h"
 #include "lockstep/realtime.h"
 #include "report/plot.h"
 #include "scenario/scenario.h"
@@ -76,20 +76,13 @@ int main(int argc, char** argv) {
   std::string scenario_path = "scenarios/default.toml", out_arg, transports_arg = "memq,udpm";
   app.add_option("--seconds", seconds, "simulated (= wall) seconds per run")->capture_default_str();
   app.add_option("--scenario", scenario_path, "scenario to pace")->capture_default_str();
-  app.add_option("--out", out_arg, "output folder (default: runs/bench-realtime-<time>)");
+  app.add_option("--out", out_arg, "output folder (default: runs/<time>-bench-realtime)");
   app.add_option("--transports", transports_arg, "comma-separated: memq, udpm")->capture_default_str();
   CLI11_PARSE(app, argc, argv);
 
   const fs::path bin_dir = fs::read_symlink("/proc/self/exe").parent_path();
   fs::path out = out_arg;
-  if (out.empty()) {
-    char stamp[32];
-    const std::time_t t = std::time(nullptr);
-    std::tm tm{};
-    gmtime_r(&t, &tm);
-    std::strftime(stamp, sizeof stamp, "%Y%m%d-%H%M%S", &tm);
-    out = fs::path("runs") / (std::string("bench-realtime-") + stamp);
-  }
+  if (out.empty()) out = rths::io::NewOutputFolder("bench-realtime");
   fs::create_directories(out);
   rths::scenario::Scenario s = rths::scenario::LoadScenario(scenario_path);
   s.run.duration_s = seconds;

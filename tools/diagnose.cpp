@@ -5,7 +5,6 @@
 // on the test records. Writes DIR/diagnosis.json and DIR/report.html (+ PNG plots), prints a
 // summary. Exit 0 ok, 2 bad input (a bad record names its file and line), 1 other failure.
 #include <cstdio>
-#include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -17,26 +16,10 @@
 #include "core/error.h"
 #include "diagnosis/diagnosis.h"
 #include "diagnosis/report.h"
+#include "io/output_folder.h"
 #include "io/rig_record.h"
 
 namespace fs = std::filesystem;
-
-namespace {
-
-/// runs/<UTC time>-diagnose[-N]: a new folder, never an existing one.
-fs::path DefaultOut() {
-  const std::time_t now = std::time(nullptr);
-  std::tm tm{};
-  gmtime_r(&now, &tm);
-  char buf[32];
-  std::strftime(buf, sizeof buf, "%Y%m%d-%H%M%S", &tm);
-  fs::path base = fs::path("runs") / (std::string(buf) + "-diagnose");
-  fs::path p = base;
-  for (int j = 2; fs::exists(p); ++j) p = base.string() + "-" + std::to_string(j);
-  return p;
-}
-
-}  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{"rths diagnose: where the model is wrong, which unmodelled effect, how far the gap shrinks"};
@@ -71,7 +54,7 @@ int main(int argc, char** argv) {
   try {
     rths::diagnosis::Traces traces;
     const auto r = rths::diagnosis::Diagnose(tr, te, model, o, &traces);
-    const fs::path dir = out.empty() ? DefaultOut() : fs::path(out);
+    const fs::path dir = out.empty() ? rths::io::NewOutputFolder("diagnose") : fs::path(out);
     fs::create_directories(dir);
     {
       std::ofstream f(dir / "diagnosis.json");

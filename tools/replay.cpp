@@ -9,10 +9,8 @@
 // scenario.toml and replay.json.
 #include <csignal>
 #include <cstdio>
-#include <ctime>
 #include <filesystem>
 #include <fstream>
-#include <random>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -23,6 +21,7 @@
 
 #include "core/error.h"
 #include "io/log_compare.h"
+#include "io/output_folder.h"
 #include "io/run_log.h"
 #include "lockstep/runtime.h"
 #include "participants/group.h"
@@ -37,18 +36,6 @@ volatile std::sig_atomic_t g_interrupted = 0;
 void OnSignal(int) { g_interrupted = 1; }
 
 constexpr int kIdentical = 0, kDiffer = 1, kBadInput = 2;
-
-fs::path DefaultOutDir(const std::string& name) {
-  const std::time_t t = std::time(nullptr);
-  std::tm tm{};
-  gmtime_r(&t, &tm);
-  char stamp[32];
-  std::strftime(stamp, sizeof stamp, "%Y%m%d-%H%M%S", &tm);
-  fs::path base = fs::path("runs") / fmt::format("{}-replay-{}", stamp, name);
-  fs::path p = base;
-  for (int i = 2; fs::exists(p); ++i) p = base.string() + "-" + std::to_string(i);
-  return p;
-}
 
 /// The scenario hash the recorded participants announced ("" if the log has no handshake).
 std::string RecordedSha(const rths::io::RunLog& log) {
@@ -128,7 +115,7 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "rths replay: note: the scenario has %lld steps, the log %lld: replaying %lld\n",
                    static_cast<long long>(s.steps()), static_cast<long long>(complete), static_cast<long long>(steps));
     }
-    out = out_arg.empty() ? DefaultOutDir(s.run.name) : fs::path(out_arg);
+    out = out_arg.empty() ? rths::io::NewOutputFolder("replay-" + s.run.name) : fs::path(out_arg);
     if (fs::exists(out) && !fs::is_empty(out)) {
       throw rths::Error(out.string(), "output folder exists and is not empty; refusing to overwrite (choose another --out)");
     }
@@ -148,8 +135,7 @@ int main(int argc, char** argv) {
                 recorded_sha.c_str());
   }
   std::fflush(stdout);
-  std::random_device rd;
-  const std::int64_t run_id = static_cast<std::int64_t>(((std::uint64_t{rd()} << 32) ^ rd()) & 0x3fffffffffffffffULL) | 1;
+  const std::int64_t run_id = rths::lockstep::NewRunId();
   std::vector<rths::participants::Outcome> outcomes;
   try {
     outcomes = rths::participants::RunReplay(s, record, steps, live, run_id, out.string(), &g_interrupted);

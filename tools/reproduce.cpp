@@ -5,7 +5,6 @@
 // lib/report (report/reproduce.h); this file parses options and prints.
 #include <chrono>
 #include <cstdio>
-#include <ctime>
 #include <filesystem>
 #include <string>
 #include <tuple>
@@ -14,26 +13,11 @@
 #include <fmt/core.h>
 
 #include "core/error.h"
+#include "io/output_folder.h"
 #include "report/reproduce.h"
 #include "report/studies.h"
 
 namespace fs = std::filesystem;
-
-namespace {
-
-fs::path DefaultOutDir(const std::string& name, bool quick) {
-  const std::time_t t = std::time(nullptr);
-  std::tm tm{};
-  gmtime_r(&t, &tm);
-  char stamp[32];
-  std::strftime(stamp, sizeof stamp, "%Y%m%d-%H%M%S", &tm);
-  const fs::path base = fs::path("runs") / fmt::format("{}-reproduce-{}{}", stamp, name, quick ? "-quick" : "");
-  fs::path p = base;
-  for (int i = 2; fs::exists(p); ++i) p = base.string() + "-" + std::to_string(i);
-  return p;
-}
-
-}  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{"rths reproduce: reproduce a figure or table of Phillips & Spencer (2013) into a new folder"};
@@ -52,7 +36,8 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
 
   rths::report::ReproduceOptions opts;
-  opts.out_dir = out_arg.empty() ? DefaultOutDir(name, quick) : fs::path(out_arg);
+  opts.out_dir = out_arg.empty() ? rths::io::NewOutputFolder(fmt::format("reproduce-{}{}", name, quick ? "-quick" : ""))
+                                  : fs::path(out_arg);
   opts.quick = quick;
   opts.plant = plant;
   opts.jobs = jobs;

@@ -24,11 +24,9 @@
 #include <csignal>
 #include <cstdio>
 #include <cstring>
-#include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <map>
-#include <random>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -38,6 +36,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/error.h"
+#include "io/output_folder.h"
 #include "io/reserved_file.h"
 #include "io/run_log.h"
 #include "lockstep/realtime.h"
@@ -89,18 +88,6 @@ int FreeUdpPort() {
   }
   ::close(fd);
   return ntohs(a.sin_port);
-}
-
-fs::path DefaultOutDir(const std::string& name) {
-  const std::time_t t = std::time(nullptr);
-  std::tm tm{};
-  gmtime_r(&t, &tm);
-  char stamp[32];
-  std::strftime(stamp, sizeof stamp, "%Y%m%d-%H%M%S", &tm);
-  fs::path base = fs::path("runs") / fmt::format("{}-{}", stamp, name);
-  fs::path p = base;
-  for (int i = 2; fs::exists(p); ++i) p = base.string() + "-" + std::to_string(i);
-  return p;
 }
 
 std::string Megabytes(double bytes) { return fmt::format("{:.1f} MB", bytes / 1e6); }
@@ -449,7 +436,7 @@ int main(int argc, char** argv) {
                            s.faults.recv_buf_bytes);
       }
     }
-    out = out_arg.empty() ? DefaultOutDir(s.run.name) : fs::path(out_arg);
+    out = out_arg.empty() ? rths::io::NewOutputFolder(s.run.name) : fs::path(out_arg);
     if (fs::exists(out) && !fs::is_empty(out)) {
       throw rths::Error(out.string(), "output folder exists and is not empty; refusing to overwrite "
                                       "a previous run (choose another --out)");
@@ -489,10 +476,7 @@ int main(int argc, char** argv) {
   }
   if (bin_dir.empty()) bin_dir = fs::read_symlink("/proc/self/exe").parent_path().string();
 
-  std::random_device rd;
-  const std::int64_t run_id =
-      run_id_arg > 0 ? run_id_arg
-                     : static_cast<std::int64_t>(((std::uint64_t{rd()} << 32) ^ rd()) & 0x3fffffffffffffffULL) | 1;
+  const std::int64_t run_id = run_id_arg > 0 ? run_id_arg : rths::lockstep::NewRunId();
   std::vector<Outcome> outcomes;
   rths::lockstep::RealtimeSetup memq_setup;
   const auto t0 = Clock::now();

@@ -172,13 +172,13 @@ void ClockParticipant::CheckBarrier() {
   const rths::measured_t* m = measured_.Get(k_);
   const rths::command_t* c = command_.Get(k_);
   if (!m || !c || !current_.Get(k_) || !ack_.Get(k_)) return;
+  const auto now = SteadyClock::now();
   if (rerequests_ == 0) {
     // How long a step takes when nothing is lost (a moving average over ~16 steps): it sets how
     // soon a silence counts as a loss.
-    const double took_s = Seconds(step_since_, SteadyClock::now());
+    const double took_s = Seconds(step_since_, now);
     typical_step_s_ = typical_step_s_ > 0 ? typical_step_s_ + (took_s - typical_step_s_) / 16.0 : took_s;
   }
-  const auto now = SteadyClock::now();
   stepping_s_ = Seconds(go_at_, now);
   if (const std::string_view stop = CheckCommitted(k_, desired_, *m, *c); !stop.empty()) {
     Fail(kExitSafety, std::string(stop), true, k_);
@@ -196,6 +196,10 @@ void ClockParticipant::CheckBarrier() {
     release_ = ReleaseOf(k_ + 1);  // Poll() issues it when the event loop wakes up at the release
     return;
   }
+  IssueNext();
+}
+
+void ClockParticipant::IssueNext() {
   try {
     IssueStep(k_ + 1);
   } catch (const std::exception& e) {
@@ -262,11 +266,7 @@ void ClockParticipant::Poll(SteadyClock::time_point now, bool idle) {
   if (release_ != SteadyClock::time_point::max()) {  // paced: step k_ is complete, k_+1 not yet due
     if (now < release_) return;
     release_ = SteadyClock::time_point::max();
-    try {
-      IssueStep(k_ + 1);
-    } catch (const std::exception& e) {
-      Fail(kExitInternal, fmt::format("{}: step {}: {}", name_, k_ + 1, e.what()), true, k_ + 1);
-    }
+    IssueNext();
     return;
   }
   if (Stalled(k_)) return;

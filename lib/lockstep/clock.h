@@ -75,6 +75,8 @@ class ClockParticipant : public Participant {
  private:
   void CheckBarrier();
   void IssueStep(std::int64_t k);
+  /// Issues step k_ + 1; an exception from its computation fails the run.
+  void IssueNext();
   void SendGo();
   /// Fails the run: step k_ has been incomplete for the whole stall budget.
   void FailStalled(SteadyClock::time_point now);

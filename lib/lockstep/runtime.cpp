@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <random>
 #include <sstream>
 #include <stdexcept>
 
@@ -51,6 +52,11 @@ double Timing::RerequestAfterS(int n, double typical_step_s) const {
   double wait = first;
   for (int i = kSteady; i < n && wait < cap; ++i) wait *= 2.0;
   return std::min(wait, cap);
+}
+
+std::int64_t NewRunId() {
+  std::random_device rd;
+  return static_cast<std::int64_t>(((std::uint64_t{rd()} << 32) ^ rd()) & 0x3fffffffffffffffULL) | 1;
 }
 
 double Timing::LingerS() const { return std::min(stall_budget_s, std::max(0.5, 10.0 * rerequest_ms * 1e-3)); }

@@ -72,6 +72,9 @@ struct RunIdentity {
   double dt_s = 0.0;
 };
 
+/// A fresh random run id (62 bits, odd: never 0), for a new run or replay.
+std::int64_t NewRunId();
+
 /// Runtime knobs (from the scenario's [lockstep] table; ranges in docs/scenarios.md).
 struct Timing {
   /// The longest silence before the clock re-requests an incomplete step [ms]. When steps are

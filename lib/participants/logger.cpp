@@ -119,9 +119,9 @@ void Logger::OnStepMessage(lockstep::StepMailbox<Msg>* box, RawRing* raw, lockst
                            const lcm::ReceiveBuffer* rbuf) {
   if (finished()) return;
   if (Receive(box, channel, rbuf) != lockstep::Put::kNew) return;
-  Raw& slot = (*raw)[box->last_k() % 4];
+  lockstep::Bytes& slot = (*raw)[box->last_k() % 4];
   const auto* data = static_cast<const std::uint8_t*>(rbuf->data);
-  slot.bytes.assign(data, data + rbuf->data_size);  // reuses its capacity after the first steps
+  slot.assign(data, data + rbuf->data_size);  // reuses its capacity after the first steps
   Guarded(box->last_k(), [&] { TryAck(); });
 }
 
@@ -171,8 +171,8 @@ void Logger::TryAck() {
     const std::size_t slot = static_cast<std::size_t>(k % 4);
     for (auto [ch, ring] : {std::pair{lockstep::kChDesired, &raw_desired_}, {lockstep::kChCommand, &raw_command_},
                             {lockstep::kChMeasured, &raw_measured_}, {lockstep::kChCurrent, &raw_current_}}) {
-      const Raw& r = (*ring)[slot];
-      io::AppendEvent(&step_bytes_, event_number_++, StepUtime(k), ch, r.bytes.data(), r.bytes.size());
+      const lockstep::Bytes& r = (*ring)[slot];
+      io::AppendEvent(&step_bytes_, event_number_++, StepUtime(k), ch, r.data(), r.size());
     }
     if (const std::string why = Append(log_fd_, log_path_, step_bytes_.data(), step_bytes_.size(), &log_end_);
         !why.empty()) {

@@ -54,13 +54,10 @@ class Logger : public lockstep::Participant {
   void ListMissing(std::int64_t k, lockstep::WantList* out) const override;
 
  private:
-  /// The raw bytes of one channel's message of a step (what is written to the log).
-  struct Raw {
-    lockstep::Bytes bytes;
-  };
   /// Timestamp of the events of step k [us since the epoch]: start + k dt.
   std::int64_t StepUtime(std::int64_t k) const;
-  using RawRing = std::array<Raw, 4>;
+  /// The raw bytes of one channel's messages of the last four steps (what is written to the log).
+  using RawRing = std::array<lockstep::Bytes, 4>;
 
   template <class Msg>
   void OnStepMessage(lockstep::StepMailbox<Msg>* box, RawRing* raw, lockstep::Channel channel,

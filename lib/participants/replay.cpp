@@ -74,10 +74,9 @@ bool IsLive(const std::vector<std::string>& live, std::string_view role) {
 }  // namespace
 
 const char* AnswerChannelOf(std::string_view role) {
-  if (role == "integrator") return lockstep::kChDesired;
-  if (role == "controller") return lockstep::kChCommand;
-  if (role == "plant") return lockstep::kChMeasured;
-  if (role == "semiactive") return lockstep::kChCurrent;
+  for (const auto& r : lockstep::kRoster) {
+    if (role == r.name && role != "logger") return r.channel;
+  }
   throw Error("replay", fmt::format("unknown role '{}' (live roles: integrator, controller, plant, semiactive)", role));
 }
 

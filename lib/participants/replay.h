@@ -18,9 +18,8 @@
 
 namespace rths::participants {
 
-/// Roles that can be live in a replay (the logger always is).
-inline constexpr std::string_view kReplayRoles[] = {"integrator", "controller", "plant", "semiactive"};
-/// The channel each role answers on.
+/// The channel a role answers on (lockstep::kRoster); throws rths::Error for a role that cannot be
+/// live in a replay (the logger always is).
 const char* AnswerChannelOf(std::string_view role);
 
 /// Replays steps 0..steps-1 of `record` (steps <= record.CompleteSteps()) in this process on
