@@ -31,7 +31,7 @@
 
 #include "io/output_folder.h"
 #include "lockstep/realtime.h"
-#include "report/plot.h"
+#include "io/plot.h"
 #include "scenario/scenario.h"
 
 namespace fs = std::filesystem;
@@ -107,10 +107,10 @@ int main(int argc, char** argv) {
                 100.0 * static_cast<double>(missed) / static_cast<double>(std::max<std::int64_t>(h.count(), 1)),
                 1e6 * h.Quantile(0.5), 1e6 * h.Quantile(0.99), 1e6 * h.Quantile(0.999), 1e6 * h.max_s());
   }
-  rths::report::Figure fig;
+  rths::io::Figure fig;
   fig.name = "latency";
   fig.title = fmt::format("Step latency (request to barrier), paced at {:g} Hz for {:g} s", 1.0 / s.run.dt_s, seconds);
-  auto panel = rths::report::MakePanel("", "Latency [us] (log-spaced bins, 100 per decade)",
+  auto panel = rths::io::MakePanel("", "Latency [us] (log-spaced bins, 100 per decade)",
                                        "Steps per bin (log scale)");
   panel.log_x = true;
   panel.log_y = true;
@@ -144,7 +144,7 @@ int main(int argc, char** argv) {
                 rt["latency_max_us"].get<double>(), rt["sched_fifo_processes"].get<int>(),
                 rt["processes"].get<int>(), rt["memory_locked_processes"].get<int>(), rt["processes"].get<int>(),
                 rt["setup_notes"].get<std::string>().empty() ? "" : " (see summary.json setup_notes)");
-    auto series = rths::report::MakeSeries(fmt::format("{}: p99.9 {:.0f} us, {} misses of {}", t,
+    auto series = rths::io::MakeSeries(fmt::format("{}: p99.9 {:.0f} us, {} misses of {}", t,
                                                        rt["latency_p999_us"].get<double>(), misses, steps));
     series.with = "steps";
     for (const auto& b : rt["latency_histogram_us"]) {
@@ -156,7 +156,7 @@ int main(int argc, char** argv) {
     panel.series.push_back(std::move(series));
   }
   {
-    auto deadline = rths::report::MakeSeries(fmt::format("deadline: dt = {:g} us", 1e6 * s.run.dt_s), "black", 2);
+    auto deadline = rths::io::MakeSeries(fmt::format("deadline: dt = {:g} us", 1e6 * s.run.dt_s), "black", 2);
     deadline.x = {1e6 * s.run.dt_s, 1e6 * s.run.dt_s};
     deadline.y = {1.0, seconds / s.run.dt_s};
     panel.series.push_back(std::move(deadline));
@@ -164,7 +164,7 @@ int main(int argc, char** argv) {
   fs::remove(paced);
   fig.panels.push_back(panel);
   try {
-    const auto files = rths::report::Plot(fig, out);
+    const auto files = rths::io::Plot(fig, out);
     std::printf("histogram: %s\n", files.png.string().c_str());
   } catch (const std::exception& e) {
     std::printf("no histogram: %s\n", e.what());

@@ -54,7 +54,7 @@ struct Eval {
   double fit_mag_pct[2]{}, fit_phase_deg[2]{};
   double frf_mag_pct[2]{}, frf_phase_deg[2]{};  // measured H1 vs the Eq.'s ZOH response
   double frf_rms[2]{};  // RMS complex relative error of H1 against the Eq.'s ZOH response, 0.5-40 Hz
-  scenario::ServoModel3 fit[2];
+  models::ServoModel3 fit[2];
   double cost = 0, max_abs = 0;
 };
 
@@ -104,7 +104,7 @@ std::vector<double> SimulateDp(const models::PhysicalRig& rig, double current_A,
 }
 
 // E1 at one current: identify the damper-loaded rig.
-ident::IdentifyResult RunE1(const scenario::PhysicalActuatorConfig& cfg, double current_A,
+ident::IdentifyResult RunE1(const models::PhysicalActuatorConfig& cfg, double current_A,
                             const std::vector<double>& u, bool cvode) {
   ident::IdentifyOptions io;
   io.fit.poles = 3;
@@ -134,7 +134,7 @@ ident::IdentifyResult RunE1(const scenario::PhysicalActuatorConfig& cfg, double 
 
 // The damper's equivalent spring-dashpot on the E1 record of the loaded rig (CVODE): least squares
 // F = k x + c x' over the record after the fade-in, and the residual's RMS relative to F's.
-void PrintEquivalent(const scenario::PhysicalActuatorConfig& cfg, const std::vector<double>& u) {
+void PrintEquivalent(const models::PhysicalActuatorConfig& cfg, const std::vector<double>& u) {
   for (double current_A : {0.0, 2.5}) {
     const auto rig = models::PhysicalRig::Make(cfg, kDt, models::RigLoad::kMrDamper, true);
     models::PhysicalRigStepper stepper(rig);
@@ -164,7 +164,7 @@ void PrintEquivalent(const scenario::PhysicalActuatorConfig& cfg, const std::vec
   }
 }
 
-Eval Evaluate(const scenario::PhysicalActuatorConfig& cfg, const std::vector<double>& u, bool cvode) {
+Eval Evaluate(const models::PhysicalActuatorConfig& cfg, const std::vector<double>& u, bool cvode) {
   Eval e;
   const double currents[2] = {0.0, 2.5};
   const char* names[2] = {"0.0A", "2.5A"};
@@ -175,7 +175,7 @@ Eval Evaluate(const scenario::PhysicalActuatorConfig& cfg, const std::vector<dou
   const ident::IdentifyResult* rs[2] = {&r0, &r1};
   double sum = 0;
   for (int j = 0; j < 2; ++j) {
-    const auto ref = scenario::ServoPreset(names[j]);
+    const auto ref = models::ServoPreset(names[j]);
     const auto fit = rs[j]->fit.model.ToServoModel3();
     e.fit[j] = fit;
     const double got[4] = {fit.K, fit.p, fit.b, fit.c}, want[4] = {ref.K, ref.p, ref.b, ref.c};
@@ -210,7 +210,7 @@ struct Param {
   bool free = false;
 };
 
-void Apply(const std::vector<Param>& ps, scenario::PhysicalActuatorConfig* c) {
+void Apply(const std::vector<Param>& ps, models::PhysicalActuatorConfig* c) {
   for (const auto& p : ps) {
     if (p.name == "hz") c->valve_hz = p.value;
     if (p.name == "zeta") c->valve_zeta = p.value;
@@ -246,7 +246,7 @@ int main(int argc, char** argv) {
   bool cvode = false;
   int iters = 150;
   std::string free_list = "hz,zeta,gain,beta,leak";
-  const scenario::PhysicalActuatorConfig d;
+  const models::PhysicalActuatorConfig d;
   std::vector<Param> ps{{"hz", d.valve_hz},
                         {"zeta", d.valve_zeta},
                         {"gain", d.kp_per_m * d.kq_m3_s / d.area_m2},
@@ -298,7 +298,7 @@ int main(int argc, char** argv) {
         if (p.name == "beta") p.value = logu(0.7e9, 1.8e9);
         if (p.name == "leak") p.value = logu(1e-13, 1e-10);
       }
-      scenario::PhysicalActuatorConfig c;
+      models::PhysicalActuatorConfig c;
       Apply(q, &c);
       try {
         const Eval e = Evaluate(c, u, cvode);
@@ -329,7 +329,7 @@ int main(int argc, char** argv) {
   };
   auto cost = [&](const std::vector<double>& x, bool print) {
     const auto q = at(x);
-    scenario::PhysicalActuatorConfig c;
+    models::PhysicalActuatorConfig c;
     Apply(q, &c);
     Eval e;
     try {
@@ -348,7 +348,7 @@ int main(int argc, char** argv) {
   std::vector<double> f(n + 1);
   f[0] = cost(simplex[0], true);
   if (iters <= 0 || n == 0) {
-    scenario::PhysicalActuatorConfig c;
+    models::PhysicalActuatorConfig c;
     Apply(at(simplex[0]), &c);
     if (g_dp == 0.0) PrintEquivalent(c, u);
     return 0;

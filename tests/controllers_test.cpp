@@ -29,9 +29,9 @@
 namespace ctl = rths::control;
 namespace sig = rths::signal;
 namespace mdl = rths::models;
-using rths::scenario::ControllerConfig;
-using rths::scenario::ServoModel3;
-using rths::scenario::ServoPreset;
+using rths::control::ControllerConfig;
+using rths::models::ServoModel3;
+using rths::models::ServoPreset;
 using cd = std::complex<double>;
 using std::numbers::pi;
 

@@ -173,7 +173,7 @@ double Command(int k) { return 10.0 * std::sin(2 * kPi * 2.0 * k * kDt); }  // m
 }  // namespace
 
 TEST_CASE("linear rig: current dynamics at a constant current change nothing, bit for bit") {
-  const rths::scenario::ServoModel3 avg{};  // Eq. 30
+  const rths::models::ServoModel3 avg{};  // Eq. 30
   for (double current : {0.0, 1.25, 2.5}) {
     const LinearRig plain = LinearRig::Make(avg, kDt, true);
     const LinearRig dyn = LinearRig::Make(avg, kDt, true, MrDamperParams::Table3(), 1e-8, true);
@@ -193,7 +193,7 @@ TEST_CASE("linear rig: current dynamics at a constant current change nothing, bi
 }
 
 TEST_CASE("linear rig: a current pulse reaches the damper through Eq. 40 and the low-pass") {
-  const rths::scenario::ServoModel3 avg{};
+  const rths::models::ServoModel3 avg{};
   const LinearRig plain = LinearRig::Make(avg, kDt, true);
   const LinearRig dyn = LinearRig::Make(avg, kDt, true, MrDamperParams::Table3(), 1e-8, true);
   const CurrentDriver driver = CurrentDriver::Make({}, kDt);
@@ -222,7 +222,7 @@ TEST_CASE("linear rig: a current pulse reaches the damper through Eq. 40 and the
 }
 
 TEST_CASE("Rig (linear): current_A is the effective current, starting steady at the first command") {
-  rths::scenario::PlantConfig cfg;  // linear, mr_damper, current_dynamics on
+  rths::models::PlantConfig cfg;  // linear, mr_damper, current_dynamics on
   auto rig = MakeRig(cfg, kDt);
   CHECK(rig->k() == 0);
   CHECK(rig->current_A() == 0.0);  // at rest, nothing commanded yet

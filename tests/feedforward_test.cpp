@@ -15,7 +15,7 @@
 #include "scenario/scenario.h"
 
 namespace ctl = rths::control;
-using rths::scenario::ServoModel3;
+using rths::models::ServoModel3;
 using std::numbers::pi;
 
 #include "alloc_counter.h"

@@ -23,7 +23,7 @@ using cd = std::complex<double>;
 using rths::ident::FitOptions;
 using rths::ident::FitPoleModel;
 using rths::ident::PoleModel;
-using rths::scenario::ServoModel3;
+using rths::models::ServoModel3;
 
 const ServoModel3 kEq28{1.730e7, 182.7, 225.3, 9.499e4, "0.0A"};
 const ServoModel3 kEq29{1.613e7, 134.2, 324.6, 1.211e5, "2.5A"};

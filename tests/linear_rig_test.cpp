@@ -14,7 +14,7 @@
 #include "models/linear_rig.h"
 
 using namespace rths::models;
-using rths::scenario::ServoModel3;
+using rths::models::ServoModel3;
 
 // Count every heap allocation of the process (CVODE uses malloc, C++ new ends in malloc).
 #include "alloc_counter.h"

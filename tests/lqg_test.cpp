@@ -16,7 +16,7 @@
 #include "scenario/scenario.h"
 
 namespace ctl = rths::control;
-using rths::scenario::ServoPreset;
+using rths::models::ServoPreset;
 
 namespace {
 
@@ -176,7 +176,7 @@ TEST_CASE("LQG regulates a plant disturbed from rest (deviation system, Eqs. 23-
 }
 
 TEST_CASE("LQG design errors name the key") {
-  rths::scenario::LqgConfig w;
+  rths::control::LqgConfig w;
   w.W = 0.0;
   try {
     ctl::MakeLqgDesign(ServoPreset("avg"), w, kDt);

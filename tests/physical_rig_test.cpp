@@ -29,7 +29,7 @@
 
 using namespace rths::models;
 using cd = std::complex<double>;
-using rths::scenario::PhysicalActuatorConfig;
+using rths::models::PhysicalActuatorConfig;
 
 namespace {
 
@@ -238,7 +238,7 @@ TEST_CASE("(a) E1 on the damper-loaded rig (16 s records): how close the identif
   io.fit.zoh_dt_s = kDt;
   const double current[2] = {0.0, 2.5};
   const char* cond[2] = {"0.0A", "2.5A"};
-  rths::scenario::ServoModel3 fit[2];
+  rths::models::ServoModel3 fit[2];
   double lag_ms[2];
   for (int j = 0; j < 2; ++j) {
     const std::string name = cond[j];
@@ -253,7 +253,7 @@ TEST_CASE("(a) E1 on the damper-loaded rig (16 s records): how close the identif
       stepper.Step(&s, u[k], current[j]);
     }
     const auto id = rths::ident::Identify(u, y, kDt, io);
-    const auto ref = rths::scenario::ServoPreset(cond[j]);
+    const auto ref = rths::models::ServoPreset(cond[j]);
     fit[j] = id.fit.model.ToServoModel3();
     lag_ms[j] = 1e3 * id.fit.model.DcLagS();
     const double ref_lag_ms = 1e3 * rths::ident::PoleModel::FromServoModel3(ref).DcLagS();
@@ -454,7 +454,7 @@ TEST_CASE("(d) repeatable: bit-identical runs, and a step depends only on (state
 TEST_CASE("Rig::Step allocates nothing; time per step, physical vs linear") {
   for (const std::string kind : {"linear", "physical"}) {
     for (const bool pulse : {false, true}) {
-      rths::scenario::PlantConfig cfg;  // MR damper, current dynamics on
+      rths::models::PlantConfig cfg;  // MR damper, current dynamics on
       cfg.kind = kind;
       auto rig = MakeRig(cfg, kDt);
       const int steps = 4000;
@@ -488,7 +488,7 @@ TEST_CASE("Make validates") {
   CHECK_THROWS_AS(PhysicalRig::Make(PhysicalActuatorConfig{}, kDt, RigLoad::kSpringDashpot, false,
                                     MrDamperParams::Table3(), {-1.0, 0.0}),
                   rths::Error);
-  rths::scenario::PlantConfig cfg;
+  rths::models::PlantConfig cfg;
   cfg.kind = "hydraulic";
   CHECK_THROWS_AS(MakeRig(cfg, kDt), rths::Error);
 }

@@ -1,4 +1,4 @@
-// lib/report: RFC 4180 CSV writing and parsing, and the gnuplot wrapper (a real PNG, a script
+// lib/io: RFC 4180 CSV writing and parsing, and the gnuplot wrapper (a real PNG, a script
 // with the labels and legend entries, clear errors).
 #include <doctest/doctest.h>
 
@@ -10,11 +10,11 @@
 #include <vector>
 
 #include "core/error.h"
-#include "report/csv.h"
-#include "report/plot.h"
+#include "io/csv.h"
+#include "io/plot.h"
 #include "test_support.h"
 
-using namespace rths::report;
+using namespace rths::io;
 using rths_test::TempDir;
 
 namespace {

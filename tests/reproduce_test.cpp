@@ -17,7 +17,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/error.h"
-#include "report/csv.h"
+#include "io/csv.h"
 #include "report/reproduce.h"
 #include "scenario/scenario.h"
 #include "test_support.h"
@@ -79,7 +79,7 @@ TEST_CASE("fig5 (E6): the six peaks within 2 % of the reference, the CSV and the
   REQUIRE(r.ours_peak_kN.size() == 6);
   for (int i = 0; i < 6; ++i) CHECK(r.ours_peak_kN[i] == doctest::Approx(reference[i]).epsilon(0.02));
 
-  const auto csv = ReadCsvFile(opts.out_dir / "fig5_peaks.csv");
+  const auto csv = rths::io::ReadCsvFile(opts.out_dir / "fig5_peaks.csv");
   REQUIRE(csv.size() == 7);
   CHECK(csv[0] == std::vector<std::string>{"current_A", "paper_peak_kN", "ours_peak_kN"});
   for (int i = 0; i < 6; ++i) {
@@ -126,7 +126,7 @@ TEST_CASE("table2 --quick on the linear plant") {
   CHECK(raw.find("\"G_FF,0.0A + LP\"") != std::string::npos);   // names with commas are quoted
   CHECK(raw.find("\"G_FF,avgA + LQG\"") != std::string::npos);
   CHECK(raw.find(",Bumpless + LP,") != std::string::npos);      // and names without are not
-  const auto csv = ReadCsvFile(opts.out_dir / "table2.csv");
+  const auto csv = rths::io::ReadCsvFile(opts.out_dir / "table2.csv");
   REQUIRE(csv.size() == 37);
   CHECK(csv[0] == std::vector<std::string>{"condition", "controller", "band_hz", "paper_pct", "ours_pct"});
   std::map<std::string, double> ours;  // "cond|controller|band" -> ours_pct
@@ -243,7 +243,7 @@ TEST_CASE("fig6 --quick on the linear plant (E1): the fits recover Eqs. 28 and 2
   CHECK(r.verdict.holds);
 
   // From the file, against the paper's numbers typed in here (Eqs. 28-30).
-  const auto csv = ReadCsvFile(opts.out_dir / "fig6_models.csv");
+  const auto csv = rths::io::ReadCsvFile(opts.out_dir / "fig6_models.csv");
   REQUIRE(csv.size() == 13);
   CHECK(csv[0] == std::vector<std::string>{"condition", "parameter", "paper", "ours", "diff_pct"});
   const std::map<std::string, double> eq{{"0.0A K", 1.730e7}, {"0.0A p", 182.7}, {"0.0A b", 225.3},
@@ -282,7 +282,7 @@ TEST_CASE("fig6 --quick on the linear plant (E1): the fits recover Eqs. 28 and 2
                             "title '0.0 A'", "title '2.5 A'", "title 'fitted 3-pole models'"}) {
     CHECK_MESSAGE(gp.find(label) != std::string::npos, label);
   }
-  const auto curves = ReadCsvFile(opts.out_dir / "fig6.csv");
+  const auto curves = rths::io::ReadCsvFile(opts.out_dir / "fig6.csv");
   CHECK(curves[0] == std::vector<std::string>{"condition", "f_hz", "magnitude", "phase_deg", "time_lag_ms", "coherence"});
 }
 
@@ -301,7 +301,7 @@ TEST_CASE("fig7 and fig8 --quick on the linear plant (E2): one curve per control
              : std::vector<std::string>{"None", "3rd Poly 10ms", "Lead Comp 10ms", "G_FF,2.5A + LP", "G_FF,2.5A", "G_FF,avgA + LQG"};
 
     // The CSV: exact header, the six names in order, frequencies over (0, 50] Hz.
-    const auto csv = ReadCsvFile(opts.out_dir / (std::string(figure) + ".csv"));
+    const auto csv = rths::io::ReadCsvFile(opts.out_dir / (std::string(figure) + ".csv"));
     REQUIRE(csv.size() > 6 * 100);
     CHECK(csv[0] == std::vector<std::string>{"controller", "f_hz", "magnitude", "phase_deg", "time_lag_ms", "coherence"});
     std::vector<std::string> seen;

@@ -24,7 +24,7 @@
 
 namespace fs = std::filesystem;
 using rths::scenario::ParseScenario;
-using rths::scenario::PlantConfig;
+using rths::models::PlantConfig;
 using rths::scenario::Scenario;
 
 namespace {

@@ -29,7 +29,7 @@ std::string FirstTrip(Monitor& m, int n, auto&& signal) {
 }  // namespace
 
 TEST_CASE("each limit trips on its own, naming the signal, the value and the key") {
-  rths::scenario::SafetyConfig cfg;
+  rths::safety::SafetyConfig cfg;
   {
     Monitor m(cfg, kDt);
     CHECK(m.Check(0, 1.0, 1.0, 1.0, 1.0).empty());
@@ -67,7 +67,7 @@ TEST_CASE("each limit trips on its own, naming the signal, the value and the key
 }
 
 TEST_CASE("divergence trips on exponential growth long before the hard limits") {
-  rths::scenario::SafetyConfig cfg;
+  rths::safety::SafetyConfig cfg;
   Monitor m(cfg, kDt);
   // Tracking error e = 0.1 mm * exp(3 t) sin(2 pi 20 t): the hard limits are far away when it trips.
   const std::string why = FirstTrip(m, 40000, [](int k, double* r, double* u, double* y, double* f) {
@@ -86,7 +86,7 @@ TEST_CASE("divergence trips on exponential growth long before the hard limits") 
 }
 
 TEST_CASE("a bounded random response, with its start-up, never trips") {
-  rths::scenario::SafetyConfig cfg;
+  rths::safety::SafetyConfig cfg;
   Monitor m(cfg, kDt);
   const int n = 120000;  // 60 s
   const auto r = rths::signal::Blwn(15.0, 20.0, kDt, n, 3, 2.0);

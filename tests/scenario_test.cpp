@@ -134,17 +134,17 @@ rms_mm_s2 = 900
 }
 
 TEST_CASE("servo models: presets and inline tables") {
-  const auto a = rths::scenario::ServoPreset("0.0A");
+  const auto a = rths::models::ServoPreset("0.0A");
   CHECK(a.K == 1.730e7);
   CHECK(a.p == 182.7);
   CHECK(a.b == 225.3);
   CHECK(a.c == 9.499e4);
-  const auto b = rths::scenario::ServoPreset("2.5A");
+  const auto b = rths::models::ServoPreset("2.5A");
   CHECK(b.K == 1.613e7);
   CHECK(b.p == 134.2);
   CHECK(b.b == 324.6);
   CHECK(b.c == 1.211e5);
-  CHECK_THROWS_AS(rths::scenario::ServoPreset("1.0A"), rths::Error);
+  CHECK_THROWS_AS(rths::models::ServoPreset("1.0A"), rths::Error);
 
   const Scenario s = ParseScenario(R"(
 [controller]

@@ -11,7 +11,7 @@
 
 using rths::models::LinearServo;
 using rths::models::LinearServoState;
-using rths::scenario::ServoModel3;
+using rths::models::ServoModel3;
 
 namespace {
 

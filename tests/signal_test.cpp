@@ -411,7 +411,7 @@ TEST_CASE("history: errors name the file and line") {
 
 TEST_CASE("history: MakeSignal dispatches on kind") {
   const double dt = 0.0005;
-  rths::scenario::SignalSpec spec;
+  rths::signal::SignalSpec spec;
   spec.kind = "zero";
   CHECK(sig::MakeSignal(spec, dt, 5, "") == std::vector<double>(5, 0.0));
 

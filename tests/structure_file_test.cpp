@@ -63,7 +63,7 @@ TEST_CASE("structure files round-trip, and bad files are refused naming file and
 }
 
 TEST_CASE("semiactive schedules: the 0.5 Hz, 50 % pulse of Table 2 and the constant modes") {
-  rths::scenario::SemiactiveConfig cfg;
+  rths::control::SemiactiveConfig cfg;
   cfg.mode = "pulse";
   const rths::participants::CurrentSchedule pulse(cfg, 0.0005);
   int on = 0;

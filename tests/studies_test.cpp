@@ -11,7 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "io/run_log.h"
-#include "report/csv.h"
+#include "io/csv.h"
 #include "report/studies.h"
 #include "test_support.h"
 
@@ -70,7 +70,7 @@ TEST_CASE("fig9 --quick: fig9.csv with the exact header, 36 rows, the Table 2 na
   o.jobs = 2;
   o.log = [](std::string_view line) { MESSAGE(std::string(line)); };
   const auto res = report::ReproduceFig9(o);
-  const auto csv = report::ReadCsvFile(o.out_dir / "fig9.csv");
+  const auto csv = io::ReadCsvFile(o.out_dir / "fig9.csv");
   REQUIRE(csv.size() == 37);
   CHECK(csv[0] == std::vector<std::string>{"f_hz", "controller", "rms_pct", "stopped"});
   const std::set<std::string> names{"None", "3rd Poly 8ms", "Lead Comp 8ms", "G_FF,0.0A + LP", "G_FF,0.0A",

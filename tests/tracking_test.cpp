@@ -17,14 +17,14 @@
 namespace ctl = rths::control;
 namespace sig = rths::signal;
 namespace mdl = rths::models;
-using rths::scenario::ServoModel3;
+using rths::models::ServoModel3;
 
 namespace {
 
 constexpr double kDt = 0.0005;          // 2 kHz
 constexpr std::size_t kSteps = 120000;  // 60 s kept (models.md section 9)
 constexpr double kDiscardS = 2.0;       // first 2 s discarded
-constexpr std::uint64_t kSeed = 1;      // the scenario default (scenario::SignalSpec::seed)
+constexpr std::uint64_t kSeed = 1;      // the scenario default (signal::SignalSpec::seed)
 constexpr std::size_t kSettle = 200;    // 0.1 s: the start-up transient (see below)
 
 ServoModel3 AvgModel() {  // Eq. 30

@@ -27,8 +27,27 @@
 #include <Eigen/Core>
 
 #include "models/structure.h"
+#include <string>
 
 namespace rths::control {
+
+/// Semiactive current (procs/semiactive). Constant modes, or the 0.5 Hz pulse of Table 2;
+/// clipped-optimal control later.
+struct SemiactiveConfig {
+  /// "passive_off" (0 A) | "passive_on" (max_current_A) | "constant" (current_A) |
+  /// "pulse" (max_current_A for the first pulse_duty of every period 1/pulse_hz, then 0 A) |
+  /// "clipped_optimal" (needs structure.mode = "rths").
+  std::string mode = "passive_off";
+  double current_A = 0.0;            ///< for "constant": [0, max_current_A]
+  double max_current_A = 2.5;        ///< (0, 5]
+  double pulse_hz = 0.5;             ///< "pulse": frequency [Hz], (0, 0.25/dt)
+  double pulse_duty = 0.5;           ///< "pulse": fraction of the period at max current, (0, 1)
+  // "clipped_optimal" (Dyke et al. 1996; docs/semiactive.md): an H2/LQG nominal controller on the
+  // structure, i = max_current_A when (f_c - f) f > 0, else 0.
+  double r_weight = 1e-2;            ///< weight on the force (in units of capacity), (0, 1e6]
+  double noise_ratio = 25.0;         ///< ground-motion / sensor noise intensity (Dyke), (0, 1e6]
+  double capacity_kN = 200.0;        ///< one damper's capacity (force unit of the cost), (0, 1e6]
+};
 
 /// Design knobs (scenario [semiactive]).
 struct ClippedOptimalOptions {

@@ -37,11 +37,11 @@ std::string Pole(std::complex<double> z, double dt) {
                      std::abs(z), wn / (2.0 * std::numbers::pi), wn > 0 ? -s.real() / wn : 1.0);
 }
 
-std::string ModelText(const scenario::ServoModel3& m) {
+std::string ModelText(const models::ServoModel3& m) {
   return fmt::format("{} (K = {:.6g}, p = {:.6g}, b = {:.6g}, c = {:.6g})", m.name, m.K, m.p, m.b, m.c);
 }
 
-nlohmann::json ModelJson(const scenario::ServoModel3& m) {
+nlohmann::json ModelJson(const models::ServoModel3& m) {
   return {{"name", m.name}, {"K", m.K}, {"p", m.p}, {"b", m.b}, {"c", m.c}};
 }
 
@@ -53,7 +53,7 @@ nlohmann::json SosJson(const signal::Sos& sos) {
 
 }  // namespace
 
-DesignSummary DesignController(const scenario::ControllerConfig& cfg, double dt_s) {
+DesignSummary DesignController(const control::ControllerConfig& cfg, double dt_s) {
   const auto controller = MakeTrackingController(cfg, dt_s);
   DesignSummary s;
   s.config = cfg;
@@ -66,12 +66,12 @@ DesignSummary DesignController(const scenario::ControllerConfig& cfg, double dt_
   if (const auto* p = dynamic_cast<const BumplessInverseLowpass*>(c)) s.lowpass = {p->low(), p->high()};
   if (const auto* p = dynamic_cast<const FeedforwardLqg*>(c)) s.feedforward = p->feedforward(), s.lqg = p->design();
 
-  std::vector<std::pair<scenario::ServoModel3, double>> models;
+  std::vector<std::pair<models::ServoModel3, double>> models;
   const bool uses_model = cfg.kind == "ff" || cfg.kind == "ff_lp" || cfg.kind == "ff_lqg";
   if (uses_model && cfg.model.name == "custom") models.emplace_back(cfg.model, 0.0);
-  models.emplace_back(scenario::ServoPreset("0.0A"), 0.0);
-  models.emplace_back(scenario::ServoPreset("avg"), 0.5 * cfg.current_high_A);
-  models.emplace_back(scenario::ServoPreset("2.5A"), cfg.current_high_A);
+  models.emplace_back(models::ServoPreset("0.0A"), 0.0);
+  models.emplace_back(models::ServoPreset("avg"), 0.5 * cfg.current_high_A);
+  models.emplace_back(models::ServoPreset("2.5A"), cfg.current_high_A);
   for (const auto& [model, current] : models) {
     PlantCheck pc{model, current, {}, std::nullopt};
     const ControllerLti lti = controller->Linearize(current);

@@ -23,14 +23,14 @@ struct TrackingPoint {
 
 /// The controller on one linear ZOH plant model.
 struct PlantCheck {
-  scenario::ServoModel3 model;
+  models::ServoModel3 model;
   double current_A = 0.0;              ///< current assumed for `bumpless_lp` (0 / 1.25 / 2.5 A)
   std::vector<TrackingPoint> tracking; ///< G_yr at 1 .. 50 Hz
   std::optional<LoopAnalysis> loop;    ///< feedback loop (ff_lqg only)
 };
 
 struct DesignSummary {
-  scenario::ControllerConfig config;
+  control::ControllerConfig config;
   double dt_s = 0.0;
   std::optional<FeedforwardCoefficients> feedforward;  ///< ff, ff_lqg
   std::optional<Poly3Design> poly3;
@@ -46,6 +46,6 @@ struct DesignSummary {
 };
 
 /// Designs (as MakeTrackingController does, with the same errors) and analyses the controller.
-DesignSummary DesignController(const scenario::ControllerConfig& cfg, double dt_s);
+DesignSummary DesignController(const control::ControllerConfig& cfg, double dt_s);
 
 }  // namespace rths::control

@@ -8,7 +8,7 @@
 
 namespace rths::control {
 
-FeedforwardCoefficients MakeFeedforwardCoefficients(const scenario::ServoModel3& m) {
+FeedforwardCoefficients MakeFeedforwardCoefficients(const models::ServoModel3& m) {
   const auto check = [&](const char* name, double v) {
     if (!(v > 0.0) || !std::isfinite(v)) {
       throw Error(fmt::format("servo model \"{}\": {}", m.name, name),

@@ -9,7 +9,7 @@
 /// in advance, from central differences of the whole record.
 #include <vector>
 
-#include "scenario/scenario.h"
+#include "models/servo_linear.h"
 
 namespace rths::control {
 
@@ -21,7 +21,7 @@ struct FeedforwardCoefficients {
 
 /// Expands (s + p)(s^2 + b s + c) / K. Throws rths::Error unless K, p, b, c are all finite
 /// and > 0 (a stable, minimum-phase model).
-FeedforwardCoefficients MakeFeedforwardCoefficients(const scenario::ServoModel3& model);
+FeedforwardCoefficients MakeFeedforwardCoefficients(const models::ServoModel3& model);
 
 /// Estimates of the desired trajectory at step i, as used by Eq. 19.
 struct Derivatives {

@@ -35,7 +35,7 @@ signal::Biquad Tustin(const AnalogSection& a, double c) {
 }
 
 /// The analog sections of LP(s) G^-1(s), each with unit DC gain except the first (gain p c / K).
-std::vector<AnalogSection> AnalogSections(const scenario::ServoModel3& m, int order, double wc) {
+std::vector<AnalogSection> AnalogSections(const models::ServoModel3& m, int order, double wc) {
   const double pi = std::numbers::pi;
   std::vector<AnalogSection> out;
   const double w2 = wc * wc;
@@ -66,7 +66,7 @@ cd InverseLowpassDesign::Analog(double f_hz) const {
   return h;
 }
 
-InverseLowpassDesign MakeInverseLowpass(const scenario::ServoModel3& model, int order, double cutoff_hz,
+InverseLowpassDesign MakeInverseLowpass(const models::ServoModel3& model, int order, double cutoff_hz,
                                         double dt_s, const std::string& key) {
   RequireServoModel(model, key);
   if (order < 3 || order > 8) {

@@ -21,7 +21,7 @@
 namespace rths::control {
 
 struct InverseLowpassDesign {
-  scenario::ServoModel3 model;  ///< the inverted servo model
+  models::ServoModel3 model;  ///< the inverted servo model
   int order = 3;                ///< Butterworth order N
   double cutoff_hz = 0.0;       ///< f_c [Hz]
   double dt_s = 0.0;            ///< Tustin step [s]
@@ -35,7 +35,7 @@ struct InverseLowpassDesign {
 /// Designs C_d(z). `key` names the model in errors (e.g. "controller.model_low"). Throws rths::Error
 /// naming "controller.lp_order" unless order is in [3, 8], "controller.lp_cutoff_hz" unless
 /// 0 < cutoff_hz < 0.5 / dt_s, `key` unless K, p, b, c > 0.
-InverseLowpassDesign MakeInverseLowpass(const scenario::ServoModel3& model, int order, double cutoff_hz,
+InverseLowpassDesign MakeInverseLowpass(const models::ServoModel3& model, int order, double cutoff_hz,
                                         double dt_s, const std::string& key);
 
 /// `ff_lp`: u_k = C_d(z) r_k (r only; filter at rest before the first step).

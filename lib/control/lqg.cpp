@@ -13,7 +13,7 @@
 
 namespace rths::control {
 
-LqgDesign MakeLqgDesign(const scenario::ServoModel3& m, const scenario::LqgConfig& w, double dt_s) {
+LqgDesign MakeLqgDesign(const models::ServoModel3& m, const control::LqgConfig& w, double dt_s) {
   RequireServoModel(m, "controller.model");
   if (!(dt_s > 0.0) || !std::isfinite(dt_s)) throw Error("run.dt_s", fmt::format("{}: allowed > 0", dt_s));
   for (auto [key, v, zero_ok] : {std::tuple{"controller.lqg.q", w.q, false}, {"controller.lqg.w_f_hz", w.w_f_hz, false},
@@ -73,7 +73,7 @@ DiscreteSs LqgDesign::Feedback() const {
   return {reg * i_lc, reg * L, -Kc * i_lc, -(Kc * L).value(), dt_s};
 }
 
-FeedforwardLqg::FeedforwardLqg(const scenario::ServoModel3& model, const scenario::LqgConfig& weights,
+FeedforwardLqg::FeedforwardLqg(const models::ServoModel3& model, const control::LqgConfig& weights,
                                bool half_step_ahead, double dt_s)
     : a_(FeedforwardFor(model, "controller.model")),
       half_step_ahead_(half_step_ahead),

@@ -30,8 +30,8 @@ using Vector5d = Eigen::Matrix<double, 5, 1>;
 using RowVector5d = Eigen::Matrix<double, 1, 5>;
 
 struct LqgDesign {
-  scenario::ServoModel3 model;  ///< design model (Eq. 30 in the paper)
-  scenario::LqgConfig weights;  ///< q, shaping filter, W, V
+  models::ServoModel3 model;  ///< design model (Eq. 30 in the paper)
+  control::LqgConfig weights;  ///< q, shaping filter, W, V
   double dt_s = 0.0;
   Matrix5d A;                   ///< A_a, continuous
   Vector5d B;                   ///< B_a
@@ -56,12 +56,12 @@ struct LqgDesign {
 
 /// Designs the LQG. Throws rths::Error naming "controller.model" for a bad model and
 /// "controller.lqg" (with LQR or Kalman) when a Riccati equation has no stabilising solution.
-LqgDesign MakeLqgDesign(const scenario::ServoModel3& model, const scenario::LqgConfig& weights, double dt_s);
+LqgDesign MakeLqgDesign(const models::ServoModel3& model, const control::LqgConfig& weights, double dt_s);
 
 /// `ff_lqg`: u_k = u_FF,k (Eq. 19 of `model`, or half a step ahead) + u_FB,k (the recursion above).
 class FeedforwardLqg final : public TrackingController {
  public:
-  FeedforwardLqg(const scenario::ServoModel3& model, const scenario::LqgConfig& weights, bool half_step_ahead,
+  FeedforwardLqg(const models::ServoModel3& model, const control::LqgConfig& weights, bool half_step_ahead,
                  double dt_s);
   Command Step(const Derivatives& d, const Measurement& m) override;
   ControllerLti Linearize(double current_A) const override;

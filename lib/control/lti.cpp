@@ -68,7 +68,7 @@ DiscreteSs Blend(const DiscreteSs& h1, double w1, const DiscreteSs& h2, double w
   return s;
 }
 
-DiscreteSs ServoZoh(const scenario::ServoModel3& m, double dt_s) {
+DiscreteSs ServoZoh(const models::ServoModel3& m, double dt_s) {
   const models::LinearServo g = models::LinearServo::Make(m, dt_s);
   return {g.Phi, g.Gamma, g.C, 0.0, dt_s};
 }

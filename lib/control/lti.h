@@ -7,7 +7,7 @@
 
 #include <Eigen/Core>
 
-#include "scenario/scenario.h"
+#include "models/servo_linear.h"
 #include "signal/butterworth.h"
 
 namespace rths::control {
@@ -38,7 +38,7 @@ DiscreteSs Series(const DiscreteSs& h1, const DiscreteSs& h2);
 DiscreteSs Blend(const DiscreteSs& h1, double w1, const DiscreteSs& h2, double w2);
 /// The three-pole servo model G(s) = K / ((s + p)(s^2 + b s + c)) (Eq. 15, N = 3) discretised
 /// with a zero-order hold (models::LinearServo: phase variables, y_k = C z_k, strictly proper).
-DiscreteSs ServoZoh(const scenario::ServoModel3& m, double dt_s);
+DiscreteSs ServoZoh(const models::ServoModel3& m, double dt_s);
 
 /// Diagonal similarity d (powers of 2) such that diag(d)^-1 M diag(d) has rows and columns of
 /// comparable 1-norm (Parlett & Reinsch 1969, as LAPACK's dgebal without permutation).

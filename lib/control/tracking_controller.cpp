@@ -11,7 +11,7 @@
 
 namespace rths::control {
 
-void RequireServoModel(const scenario::ServoModel3& m, const std::string& key) {
+void RequireServoModel(const models::ServoModel3& m, const std::string& key) {
   for (double v : {m.K, m.p, m.b, m.c}) {
     if (!(v > 0.0) || !std::isfinite(v)) {
       throw Error(key, fmt::format("servo model \"{}\" (K = {}, p = {}, b = {}, c = {}): all must be finite "
@@ -21,7 +21,7 @@ void RequireServoModel(const scenario::ServoModel3& m, const std::string& key) {
   }
 }
 
-FeedforwardCoefficients FeedforwardFor(const scenario::ServoModel3& m, const std::string& key) {
+FeedforwardCoefficients FeedforwardFor(const models::ServoModel3& m, const std::string& key) {
   RequireServoModel(m, key);
   return MakeFeedforwardCoefficients(m);
 }
@@ -38,7 +38,7 @@ DiscreteSs FeedforwardFir(const FeedforwardCoefficients& a, bool half_step_ahead
   return Fir(h, dt_s);
 }
 
-std::unique_ptr<TrackingController> MakeTrackingController(const scenario::ControllerConfig& cfg,
+std::unique_ptr<TrackingController> MakeTrackingController(const control::ControllerConfig& cfg,
                                                            double dt_s) {
   if (!(dt_s > 0.0) || !std::isfinite(dt_s)) throw Error("run.dt_s", fmt::format("{}: allowed > 0", dt_s));
   const std::string& k = cfg.kind;

@@ -13,7 +13,7 @@
 
 #include "control/feedforward.h"
 #include "control/lti.h"
-#include "scenario/scenario.h"
+#include "control/controller_config.h"
 
 namespace rths::control {
 
@@ -65,9 +65,9 @@ class NoCompensation final : public TrackingController {
 };
 
 /// Throws rths::Error(key, ...) unless K, p, b, c are finite and > 0 (stable, minimum phase).
-void RequireServoModel(const scenario::ServoModel3& m, const std::string& key);
+void RequireServoModel(const models::ServoModel3& m, const std::string& key);
 /// MakeFeedforwardCoefficients(m), with errors naming the scenario key (e.g. "controller.model").
-FeedforwardCoefficients FeedforwardFor(const scenario::ServoModel3& m, const std::string& key);
+FeedforwardCoefficients FeedforwardFor(const models::ServoModel3& m, const std::string& key);
 
 /// F(z) of the feedforward u = a0 r + a1 r' + a2 r'' + a3 r''' (Eq. 19, or half a step ahead) with
 /// the derivatives of Eqs. 20-22: an FIR filter on r_k .. r_{k-3}.
@@ -77,7 +77,7 @@ DiscreteSs FeedforwardFir(const FeedforwardCoefficients& a, bool half_step_ahead
 /// u_k = a0 r_k + a1 r'_k + a2 r''_k + a3 r'''_k, coefficients computed from K and the poles.
 class ModelFeedforward final : public TrackingController {
  public:
-  ModelFeedforward(const scenario::ServoModel3& model, bool half_step_ahead, double dt_s)
+  ModelFeedforward(const models::ServoModel3& model, bool half_step_ahead, double dt_s)
       : a_(MakeFeedforwardCoefficients(model)), half_step_ahead_(half_step_ahead), dt_s_(dt_s) {}
   Command Step(const Derivatives& d, const Measurement&) override {
     const double u = FeedforwardCommand(a_, d, half_step_ahead_, dt_s_);
@@ -97,7 +97,7 @@ class ModelFeedforward final : public TrackingController {
 /// Builds the controller a scenario names, designing it from the scenario's models. Throws
 /// rths::Error naming the key ("controller.kind", "controller.delay_ms", "controller.lqg", ...)
 /// for an unknown kind or a design that fails.
-std::unique_ptr<TrackingController> MakeTrackingController(const scenario::ControllerConfig& cfg,
+std::unique_ptr<TrackingController> MakeTrackingController(const control::ControllerConfig& cfg,
                                                            double dt_s);
 
 }  // namespace rths::control

@@ -52,7 +52,7 @@ inline constexpr double kRk4StepLambda = 0.8;
 
 /// The nominal model: what the lab believes its rig is.
 struct NominalModel {
-  scenario::ServoModel3 actuator{};        ///< displacement path (default Eq. 30, "avg")
+  models::ServoModel3 actuator{};        ///< displacement path (default Eq. 30, "avg")
   bool has_damper = true;                  ///< false: the force channel is not diagnosed
   models::MrDamperParams damper{};         ///< Spencer model (default Table 3)
   bool current_dynamics = true;            ///< Eq. 40 + 75 Hz low-pass on the current

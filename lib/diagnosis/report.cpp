@@ -8,7 +8,7 @@
 
 #include "core/error.h"
 #include "diagnosis/localise.h"
-#include "report/plot.h"
+#include "io/plot.h"
 #include "signal/spectral.h"
 
 namespace rths::diagnosis {
@@ -35,7 +35,7 @@ std::vector<double> Residual(const std::vector<double>& m, const std::vector<dou
 }
 
 /// Spectra of one channel (first test record): measured, nominal residual, final residual.
-report::Figure SpectrumFigure(const Traces::Record& t, const std::string& ch, std::size_t first) {
+io::Figure SpectrumFigure(const Traces::Record& t, const std::string& ch, std::size_t first) {
   const auto& m = ch == "y" ? t.y_meas : t.f_meas;
   const auto& pn = ch == "y" ? t.y_nom : t.f_nom;
   const auto& pf = ch == "y" ? t.y_fin : t.f_fin;
@@ -45,18 +45,18 @@ report::Figure SpectrumFigure(const Traces::Record& t, const std::string& ch, st
   const auto sn = signal::WelchPsd(Residual(m, pn, first), t.dt_s, L);
   const auto sf = signal::WelchPsd(Residual(m, pf, first), t.dt_s, L);
   const std::string unit = ch == "y" ? "mm^2/Hz" : "kN^2/Hz";
-  report::Figure fig;
+  io::Figure fig;
   fig.name = "spectrum_" + ch;
   const fs::path src(t.source);
   const std::string shown = src.filename() == "log.lcm" && !src.parent_path().filename().empty()
                                 ? (src.parent_path().filename() / src.filename()).string()
                                 : src.filename().string();
-  auto p = report::MakePanel(fmt::format("channel {}: spectra (test record {})", ch, shown),
+  auto p = io::MakePanel(fmt::format("channel {}: spectra (test record {})", ch, shown),
                              "frequency [Hz]", "PSD [" + unit + "]");
   p.log_x = p.log_y = true;
-  auto s1 = report::MakeSeries("measured", "#1f77b4");
-  auto s2 = report::MakeSeries("residual, nominal model", "#d62728");
-  auto s3 = report::MakeSeries("residual, with the verdict's effects", "#2ca02c");
+  auto s1 = io::MakeSeries("measured", "#1f77b4");
+  auto s2 = io::MakeSeries("residual, nominal model", "#d62728");
+  auto s3 = io::MakeSeries("residual, with the verdict's effects", "#2ca02c");
   for (std::size_t j = 1; j < sm.size(); ++j) {
     const double f = static_cast<double>(j) / (t.dt_s * static_cast<double>(L));
     s1.x.push_back(f), s1.y.push_back(sm[j] > 0 ? sm[j] : NAN);
@@ -68,7 +68,7 @@ report::Figure SpectrumFigure(const Traces::Record& t, const std::string& ch, st
   return fig;
 }
 
-report::Figure FrfFigure(const Traces::Record& t, std::size_t first) {
+io::Figure FrfFigure(const Traces::Record& t, std::size_t first) {
   std::vector<double> u(t.u.begin() + static_cast<std::ptrdiff_t>(first), t.u.end());
   std::vector<double> ym(t.y_meas.begin() + static_cast<std::ptrdiff_t>(first), t.y_meas.end());
   std::vector<double> yn(t.y_nom.begin() + static_cast<std::ptrdiff_t>(first), t.y_nom.end());
@@ -78,22 +78,22 @@ report::Figure FrfFigure(const Traces::Record& t, std::size_t first) {
   const auto hn = signal::H1Estimate(u, yn, t.dt_s, L);
   const auto hf = signal::H1Estimate(u, yf, t.dt_s, L);
   const auto phm = signal::UnwrapPhase(hm.h), phn = signal::UnwrapPhase(hn.h), phf = signal::UnwrapPhase(hf.h);
-  report::Figure fig;
+  io::Figure fig;
   fig.name = "frf_y";
   fig.title = "u -> y: measured vs model (H1, test record)";
-  auto pm = report::MakePanel("", "frequency [Hz]", "|G_yu| [mm/mm]");
-  auto pp = report::MakePanel("", "frequency [Hz]", "phase [deg]");
-  auto pc = report::MakePanel("", "frequency [Hz]", "coherence u -> y_meas");
+  auto pm = io::MakePanel("", "frequency [Hz]", "|G_yu| [mm/mm]");
+  auto pp = io::MakePanel("", "frequency [Hz]", "phase [deg]");
+  auto pc = io::MakePanel("", "frequency [Hz]", "coherence u -> y_meas");
   // Up to twice the highest frequency where the test excitation is coherent (gamma^2 > 0.5).
   double fcoh = 5.0;
   for (std::size_t j = 1; j < hm.f_hz.size(); ++j)
     if (hm.coherence[j] > 0.5) fcoh = std::max(fcoh, hm.f_hz[j]);
   const double fmax = std::min({2.0 * fcoh, 100.0, 0.5 / t.dt_s});
   for (auto* p : {&pm, &pp, &pc}) p->x_range = std::make_pair(0.0, fmax);
-  auto a1 = report::MakeSeries("measured", "#1f77b4"), a2 = report::MakeSeries("nominal model", "#d62728", 2),
-       a3 = report::MakeSeries("with the verdict's effects", "#2ca02c", 3);
+  auto a1 = io::MakeSeries("measured", "#1f77b4"), a2 = io::MakeSeries("nominal model", "#d62728", 2),
+       a3 = io::MakeSeries("with the verdict's effects", "#2ca02c", 3);
   auto b1 = a1, b2 = a2, b3 = a3;
-  auto c1 = report::MakeSeries("", "#1f77b4");
+  auto c1 = io::MakeSeries("", "#1f77b4");
   for (std::size_t j = 1; j < hm.f_hz.size() && hm.f_hz[j] <= fmax; ++j) {
     const double f = hm.f_hz[j];
     a1.x.push_back(f), a1.y.push_back(std::abs(hm.h[j]));
@@ -115,14 +115,14 @@ report::Figure FrfFigure(const Traces::Record& t, std::size_t first) {
 }
 
 /// RMS residual (nominal) inside vs outside each condition, as bars drawn with boxes-like lines.
-report::Figure ConditionFigure(const Result& r) {
-  report::Figure fig;
+io::Figure ConditionFigure(const Result& r) {
+  io::Figure fig;
   fig.name = "conditions";
   for (const std::string ch : {"y", "f"}) {
-    auto p = report::MakePanel(fmt::format("channel {}: share of residual energy vs share of samples", ch), "condition #",
+    auto p = io::MakePanel(fmt::format("channel {}: share of residual energy vs share of samples", ch), "condition #",
                                "[%]");
-    auto s1 = report::MakeSeries("share of residual energy", "#d62728");
-    auto s2 = report::MakeSeries("share of samples", "#1f77b4");
+    auto s1 = io::MakeSeries("share of residual energy", "#d62728");
+    auto s2 = io::MakeSeries("share of samples", "#1f77b4");
     s1.with = s2.with = "linespoints";
     std::string names;
     int j = 0;
@@ -142,11 +142,11 @@ report::Figure ConditionFigure(const Result& r) {
   return fig;
 }
 
-report::Figure TraceFigure(const Traces::Record& t, const std::string& ch) {
+io::Figure TraceFigure(const Traces::Record& t, const std::string& ch) {
   const auto& m = ch == "y" ? t.y_meas : t.f_meas;
   const auto& pn = ch == "y" ? t.y_nom : t.f_nom;
   const auto& pf = ch == "y" ? t.y_fin : t.f_fin;
-  report::Figure fig;
+  io::Figure fig;
   fig.name = "trace_" + ch;
   // The 2 s window with the largest nominal residual energy.
   const auto w = static_cast<std::size_t>(std::lround(2.0 / t.dt_s));
@@ -159,11 +159,11 @@ report::Figure TraceFigure(const Traces::Record& t, const std::string& ch) {
   }
   const std::size_t b = std::min(m.size(), best + w);
   const std::string unit = ch == "y" ? "mm" : "kN";
-  auto p1 = report::MakePanel(fmt::format("channel {}: measured and predicted", ch), "t [s]", ch + " [" + unit + "]");
-  auto p2 = report::MakePanel("residual", "t [s]", "[" + unit + "]");
-  auto s1 = report::MakeSeries("measured", "#1f77b4"), s2 = report::MakeSeries("nominal", "#d62728", 2),
-       s3 = report::MakeSeries("with the verdict's effects", "#2ca02c", 3);
-  auto r1 = report::MakeSeries("nominal", "#d62728"), r2 = report::MakeSeries("with the verdict's effects", "#2ca02c");
+  auto p1 = io::MakePanel(fmt::format("channel {}: measured and predicted", ch), "t [s]", ch + " [" + unit + "]");
+  auto p2 = io::MakePanel("residual", "t [s]", "[" + unit + "]");
+  auto s1 = io::MakeSeries("measured", "#1f77b4"), s2 = io::MakeSeries("nominal", "#d62728", 2),
+       s3 = io::MakeSeries("with the verdict's effects", "#2ca02c", 3);
+  auto r1 = io::MakeSeries("nominal", "#d62728"), r2 = io::MakeSeries("with the verdict's effects", "#2ca02c");
   for (std::size_t k = best; k < b; ++k) {
     const double tt = static_cast<double>(k) * t.dt_s;
     s1.x.push_back(tt), s1.y.push_back(m[k]);
@@ -184,10 +184,10 @@ report::Figure TraceFigure(const Traces::Record& t, const std::string& ch) {
 void WriteReport(const Result& r, const Traces& traces, const fs::path& dir) {
   std::vector<std::string> pngs;
   std::string plot_note;
-  if (!traces.test.empty() && report::GnuplotAvailable()) {
+  if (!traces.test.empty() && io::GnuplotAvailable()) {
     const auto& t = traces.test[0];
     const auto first = static_cast<std::size_t>(std::lround(r.options.warmup_s / t.dt_s));
-    std::vector<report::Figure> figs = {SpectrumFigure(t, "y", first), FrfFigure(t, first)};
+    std::vector<io::Figure> figs = {SpectrumFigure(t, "y", first), FrfFigure(t, first)};
     if (!t.f_nom.empty()) figs.push_back(SpectrumFigure(t, "f", first));
     figs.push_back(ConditionFigure(r));
     figs.push_back(TraceFigure(t, "y"));
@@ -195,7 +195,7 @@ void WriteReport(const Result& r, const Traces& traces, const fs::path& dir) {
     for (const auto& f : figs) {
       if (f.panels.empty()) continue;
       try {
-        report::Plot(f, dir);
+        io::Plot(f, dir);
         pngs.push_back(f.name + ".png");
       } catch (const std::exception& e) {
         plot_note += fmt::format("<p>plot {} failed: {}</p>\n", f.name, Esc(e.what()));

@@ -1,7 +1,7 @@
 #pragma once
 /// @file The human-readable report of `rths diagnose`: DIR/report.html, self-contained HTML
 /// (tables: summary, channels, bands, conditions, time windows, effects) with PNG plots beside it
-/// made by gnuplot (report/plot.h): residual spectrum vs measured spectrum, model-vs-measured
+/// made by gnuplot (io/plot.h): residual spectrum vs measured spectrum, model-vs-measured
 /// FRF (u -> y) with coherence, residual against the state conditions, before/after traces.
 /// Without gnuplot the HTML is written without the plots (a note says so).
 #include <filesystem>

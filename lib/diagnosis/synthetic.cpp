@@ -56,7 +56,7 @@ io::RigRecord MakeRecordBlocks(const Excitation& ex, const Truth& truth, const s
   r.u_mm = u;
   r.i_A = i;
   const double dt = ex.dt_s;
-  const auto servo = models::LinearServo::Make(scenario::ServoPreset("avg"), dt);
+  const auto servo = models::LinearServo::Make(models::ServoPreset("avg"), dt);
   models::LinearServoState xs;
   models::DisplacementEffects dfx(truth.effects, dt);
   models::ForceEffects ffx(truth.effects, dt);
@@ -129,9 +129,9 @@ io::RigRecord MakeRecordRig(const Excitation& ex, const Truth& truth, const std:
   std::vector<double> u, i;
   MakeInputs(ex, &u, &i);
   const std::size_t n = u.size();
-  scenario::PlantConfig plant;
+  models::PlantConfig plant;
   plant.kind = "linear";
-  plant.actuator = scenario::ServoPreset("avg");
+  plant.actuator = models::ServoPreset("avg");
   plant.specimen = "mr_damper";
   plant.current_dynamics = true;
   plant.effects = truth.effects;

@@ -232,15 +232,15 @@ double PoleModel::DcLagS() const {
   return d.size() > 1 ? d[1] / d[0] : 0.0;
 }
 
-scenario::ServoModel3 PoleModel::ToServoModel3() const {
+models::ServoModel3 PoleModel::ToServoModel3() const {
   if (Order() != 3 || b.size() != 1)
     throw Error("PoleModel", fmt::format("a scenario's servo model has 3 poles (this one has {})", Order()));
-  scenario::ServoModel3 m;
+  models::ServoModel3 m;
   m.K = K, m.p = p, m.b = b[0], m.c = c[0], m.name = "custom";
   return m;
 }
 
-PoleModel PoleModel::FromServoModel3(const scenario::ServoModel3& s) {
+PoleModel PoleModel::FromServoModel3(const models::ServoModel3& s) {
   PoleModel m;
   m.K = s.K, m.p = s.p, m.b = {s.b}, m.c = {s.c};
   return m;

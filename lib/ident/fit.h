@@ -6,7 +6,7 @@
 ///     G(s) = K / ( (s + p)^[N odd] prod_{j=1..floor(N/2)} (s^2 + b_j s + c_j) ),
 /// with K, p, b_j, c_j > 0. Every factor with positive coefficients is Hurwitz, so the fitted
 /// poles are stable by construction (a quadratic factor holds a complex pair or two real poles).
-/// For N = 3 this is the paper's K / ((s + p)(s^2 + b s + c)) of Eqs. 28-30 (scenario::ServoModel3).
+/// For N = 3 this is the paper's K / ((s + p)(s^2 + b s + c)) of Eqs. 28-30 (models::ServoModel3).
 ///
 /// Fit, on the points f_k of the band [lo, hi] with weights w_k (from the coherence gamma_k^2):
 ///   1. linear start (Levy, refined by Sanathanan-Koerner iterations): with s' = j w / w0,
@@ -53,8 +53,8 @@ struct PoleModel {
   /// Low-frequency time lag -d phase / d w at w = 0: d_1 / d_0 [s].
   double DcLagS() const;
   /// The N = 3 model as K, p, b, c (name "custom"). Throws rths::Error unless N = 3.
-  scenario::ServoModel3 ToServoModel3() const;
-  static PoleModel FromServoModel3(const scenario::ServoModel3& m);
+  models::ServoModel3 ToServoModel3() const;
+  static PoleModel FromServoModel3(const models::ServoModel3& m);
 };
 
 /// Zero-order-hold discretisation of a PoleModel: x_{k+1} = Phi x_k + Gamma u_k, y_k = C x_k, in a

@@ -14,6 +14,26 @@
 
 namespace rths::lockstep {
 
+/// Fault injection, off by default (docs/lockstep.md "Fault injection"): seeded random faults
+/// on every message each participant receives, and one process fault.
+struct FaultConfig {
+  double drop = 0.0;           ///< fraction of received messages lost, [0, 0.5]
+  double duplicate = 0.0;      ///< fraction delivered twice, [0, 0.5]
+  double delay = 0.0;          ///< fraction delivered up to delay_ms late, [0, 0.5]
+  double reorder = 0.0;        ///< fraction delivered after the next message, [0, 0.5]
+  double delay_ms = 20.0;      ///< longest delay [ms], (0, 10000]
+  std::int64_t seed = 1;       ///< [0, 2^53]
+  /// udpm: each participant's UDP receive buffer [bytes] (LCM's recv_buf_size; 0 = the host's
+  /// default), 0 or [1024, 2^27]: a small one loses messages in bursts.
+  std::int64_t recv_buf_bytes = 0;
+  /// [faults.process]: one participant stalls, throws, crashes, is killed or stopped at a step.
+  std::string process_role;    ///< "" (none) or a participant: integrator, controller, plant, semiactive, logger
+  std::string process_kind;    ///< stall | throw | crash | kill | stop (crash, kill, stop: udpm only)
+  std::int64_t process_at_step = 0;  ///< [0, steps)
+  double process_stop_s = 0.0; ///< "stop": continue after this many seconds, 0 = never, [0, 3600]
+  bool any_network() const { return drop > 0 || duplicate > 0 || delay > 0 || reorder > 0; }
+};
+
 /// Seeded random faults on every message a participant receives.
 struct NetworkFaults {
   double drop = 0.0;        ///< fraction of messages lost, [0, 0.5]

@@ -15,6 +15,19 @@
 
 namespace rths::lockstep {
 
+/// Real-time paced mode (docs/realtime.md; `rths run --realtime` turns it on): the clock issues
+/// step k at t0 + k dt of the wall clock (absolute deadlines) and counts the steps that complete
+/// after their deadline t0 + (k+1) dt.
+struct RealtimeConfig {
+  bool enabled = false;                    ///< pace the clock to wall time
+  /// Miss policy: 0 = continue and count; N > 0 = stop the run (exit 8) after N consecutive
+  /// deadline misses, [0, 1e9].
+  std::int64_t max_consecutive_misses = 0;
+  bool sched_fifo = true;                  ///< try SCHED_FIFO for every participant process
+  int priority = 80;                       ///< its SCHED_FIFO priority, [1, 99]
+  bool lock_memory = true;                 ///< try mlockall(MCL_CURRENT | MCL_FUTURE)
+};
+
 /// How the clock paces steps (from the scenario's [realtime] table).
 struct Pacing {
   bool enabled = false;

@@ -26,6 +26,17 @@
 
 namespace rths::lockstep {
 
+/// Lockstep runtime knobs (docs/lockstep.md).
+struct LockstepConfig {
+  /// Re-request an incomplete step after this silence [ms], [5, 10000]; each further re-request
+  /// of the same step waits twice as long, up to max(rerequest_ms, 1000 ms).
+  double rerequest_ms = 100.0;
+  /// Stop the run when one step has not completed for this long [s], [1, 3600] and at least
+  /// 4 rerequest_ms: a participant that stopped answering. A loaded host only slows steps down.
+  double stall_budget_s = 10.0;
+  double handshake_timeout_s = 20; ///< abort if not every participant said hello, [0.1, 600]
+};
+
 inline constexpr const char* kChHandshake = "RTHS_HANDSHAKE";
 inline constexpr const char* kChDesired = "RTHS_DESIRED";
 inline constexpr const char* kChCommand = "RTHS_COMMAND";

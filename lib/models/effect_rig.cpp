@@ -30,7 +30,7 @@ std::uint64_t EffectNoiseSeed(std::uint64_t noise_seed) {
   return z ^ (z >> 31);
 }
 
-EffectRigModel EffectRigModel::Make(const scenario::PlantConfig& plant, double dt_s) {
+EffectRigModel EffectRigModel::Make(const models::PlantConfig& plant, double dt_s) {
   if (plant.kind != "linear") {
     throw Error("plant.kind", fmt::format("rig mode needs plant.kind = \"linear\" (got \"{}\"): the effects act "
                                           "around the linear actuator model",
@@ -212,7 +212,7 @@ void EffectRig::Measure() {
   f_meas_ = f;
 }
 
-std::unique_ptr<Rig> MakeEffectRig(const scenario::PlantConfig& plant, double dt_s) {
+std::unique_ptr<Rig> MakeEffectRig(const models::PlantConfig& plant, double dt_s) {
   return std::make_unique<EffectRig>(EffectRigModel::Make(plant, dt_s));
 }
 

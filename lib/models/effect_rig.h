@@ -1,7 +1,7 @@
 #pragma once
 /// @file The rig mode of procs/plant (docs/rig_mode.md): the linear rig (Eqs. 28-30 + the MR
 /// damper, lib/models/linear_rig.h) with effects of the library (lib/models/rig_effects.h)
-/// switched on, plus two disturbances outside the library (scenario::UnmodelledConfig), seeded.
+/// switched on, plus two disturbances outside the library (models::UnmodelledConfig), seeded.
 /// This is how a user rehearses a real rig, and how the diagnosis is tested. Units: mm, kN, A, s.
 ///
 /// One step k -> k+1, command u_k [mm] and commanded current i_k [A] held over [t_k, t_{k+1}):
@@ -53,7 +53,7 @@
 #include "models/rig.h"
 #include "models/rig_effects.h"
 #include "models/servo_linear.h"
-#include "scenario/scenario.h"
+#include "models/rig.h"
 #include "signal/random.h"
 
 namespace rths::models {
@@ -62,14 +62,14 @@ namespace rths::models {
 struct EffectRigModel {
   LinearRig rig;                           ///< servo, damper, current dynamics, CVODE tolerance
   EffectSet effects;                       ///< library effects that are on
-  scenario::UnmodelledConfig unmodelled;   ///< ripple on y, extra spring on f
+  models::UnmodelledConfig unmodelled;   ///< ripple on y, extra spring on f
   std::uint64_t noise_seed = 7;            ///< plant.noise_seed (the stream is derived from it)
   /// load_coupling with the same-sample force f_{k+1} (solved per step) instead of f_k (**).
   bool coupling_same_sample = false;
 
   /// From the scenario's plant (kind must be "linear"; specimen "mr_damper" | "none") at the step
   /// dt_s [s]. Validates everything; throws rths::Error naming the bad key.
-  static EffectRigModel Make(const scenario::PlantConfig& plant, double dt_s);
+  static EffectRigModel Make(const models::PlantConfig& plant, double dt_s);
 };
 
 /// The seed of the rig's own noise stream, derived from plant.noise_seed (SplitMix64 finaliser),
@@ -134,6 +134,6 @@ class EffectRig final : public Rig {
 };
 
 /// The rig-mode rig for `plant` (EffectRigModel::Make + EffectRig).
-std::unique_ptr<Rig> MakeEffectRig(const scenario::PlantConfig& plant, double dt_s);
+std::unique_ptr<Rig> MakeEffectRig(const models::PlantConfig& plant, double dt_s);
 
 }  // namespace rths::models

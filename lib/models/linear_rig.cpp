@@ -9,7 +9,7 @@
 
 namespace rths::models {
 
-LinearRig LinearRig::Make(const scenario::ServoModel3& actuator, double dt_s, bool has_damper,
+LinearRig LinearRig::Make(const models::ServoModel3& actuator, double dt_s, bool has_damper,
                           const MrDamperParams& damper, double rtol, bool current_dynamics) {
   if (!(rtol > 0.0 && rtol <= 1e-2))
     throw Error("LinearRig: rtol", fmt::format("must be in (0, 1e-2] (got {})", rtol));

@@ -20,7 +20,7 @@
 #include "models/mr_damper.h"
 #include "models/ode.h"
 #include "models/servo_linear.h"
-#include "scenario/scenario.h"
+#include "models/servo_linear.h"
 
 namespace rths::models {
 
@@ -34,7 +34,7 @@ struct LinearRig {
   CurrentDriver driver;           ///< used if current_dynamics
 
   /// Validates everything (rths::Error on a bad value).
-  static LinearRig Make(const scenario::ServoModel3& actuator, double dt_s, bool has_damper,
+  static LinearRig Make(const models::ServoModel3& actuator, double dt_s, bool has_damper,
                         const MrDamperParams& damper = MrDamperParams::Table3(),
                         double rtol = 1e-8, bool current_dynamics = false);
 };

@@ -111,13 +111,13 @@ class IdealRig final : public Rig {
 
 }  // namespace
 
-bool HasDamper(const scenario::PlantConfig& plant) {
+bool HasDamper(const models::PlantConfig& plant) {
   if (plant.specimen == "mr_damper") return true;
   if (plant.specimen == "none") return false;
   throw Error("plant.specimen", fmt::format("\"{}\" is not one of \"mr_damper\", \"none\"", plant.specimen));
 }
 
-std::unique_ptr<Rig> MakeRig(const scenario::PlantConfig& plant, double dt_s) {
+std::unique_ptr<Rig> MakeRig(const models::PlantConfig& plant, double dt_s) {
   const bool damper = HasDamper(plant);
   if (plant.RigMode()) {  // effects or unmodelled disturbances on: docs/rig_mode.md
     if (plant.kind != "linear") {

@@ -13,10 +13,49 @@
 /// constant current stays exactly constant and equals the commanded one from k = 1 on.
 #include <cstdint>
 #include <memory>
+#include <string>
+#include "models/mr_damper.h"
+#include "models/rig_effects.h"
+#include "models/servo_linear.h"
+#include "models/servo_physical.h"
 
-#include "scenario/scenario.h"
 
 namespace rths::models {
+
+/// "Physical" substructure and loading system (procs/plant).
+struct PlantConfig {
+  /// "linear": the three-pole model `actuator` (Eqs. 28-30), ZOH-discretised, unaffected by the
+  /// specimen; "physical": the servovalve / oil column / piston model of models.md section 5
+  /// loaded by the damper force (control-structure interaction); "ideal": the pure numerical
+  /// simulation, a loading system that tracks perfectly (y_k = r_k, the damper driven by the
+  /// desired motion; answers measured_t k from desired_t k: docs/lockstep.md, footnote).
+  std::string kind = "linear";
+  ServoModel3 actuator{};              ///< "linear": servohydraulic model
+  PhysicalActuatorConfig physical{};   ///< "physical": its parameters
+  std::string specimen = "mr_damper";  ///< "mr_damper" (Eqs. 32-39, Table 3) | "none"
+  /// Damper current dynamics: the driver lag of Eq. 40 and a 75 Hz second-order Butterworth
+  /// low-pass between the commanded and the effective current. false: effective = commanded.
+  bool current_dynamics = true;
+  double noise_y_mm_rms = 0.0;         ///< Gaussian sensor noise on y [mm], [0, 10]
+  double noise_f_kN_rms = 0.0;         ///< Gaussian sensor noise on f [kN], [0, 100]
+  std::uint64_t noise_seed = 7;
+  double cvode_rtol = 1e-8;            ///< CVODE relative tolerance, (0, 1e-2]
+  /// The Spencer MR damper of every rig (`[plant.damper]`, Eqs. 32-39; default Table 3).
+  MrDamperParams damper{};
+  /// Rig mode (docs/rig_mode.md): effects of the library switched on, `[plant.effects.<name>]`
+  /// (kind = "linear" only). Empty: the nominal plant.
+  EffectSet effects{};
+  /// Rig mode, `[plant.effects.load_coupling] same_sample`: true (default) couples with the force
+  /// of the same sample, y_k = x_k - c f_k, solved per step, as a real series compliance does:
+  /// stable for any compliance (what the diagnosis fits, from the measured f_k); false with the
+  /// force of the previous sample, y_k = x_k - c f_{k-1}, cheaper, but the one-sample loop diverges
+  /// with the stiff damper once c (alpha A + 2 B / dt) > 1 (c > 7e-4 mm/kN at 2.5 A; docs/rig_mode.md).
+  bool load_coupling_same_sample = true;
+  /// Rig mode: disturbances outside the library, `[plant.unmodelled]` (kind = "linear" only).
+  UnmodelledConfig unmodelled{};
+  /// true if the plant runs in rig mode (effects or unmodelled disturbances on).
+  bool RigMode() const { return !effects.Empty() || !unmodelled.Empty(); }
+};
 
 class Rig {
  public:
@@ -51,9 +90,9 @@ class Rig {
 /// With effects or unmodelled disturbances on (plant.RigMode()), the rig mode of
 /// lib/models/effect_rig.h, which needs kind "linear"; otherwise the nominal rigs, unchanged.
 /// Throws rths::Error for a bad kind or value.
-std::unique_ptr<Rig> MakeRig(const scenario::PlantConfig& plant, double dt_s);
+std::unique_ptr<Rig> MakeRig(const models::PlantConfig& plant, double dt_s);
 
 /// plant.specimen: true for "mr_damper", false for "none"; throws rths::Error otherwise.
-bool HasDamper(const scenario::PlantConfig& plant);
+bool HasDamper(const models::PlantConfig& plant);
 
 }  // namespace rths::models

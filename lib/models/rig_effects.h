@@ -23,6 +23,21 @@
 
 namespace rths::models {
 
+/// Disturbances of the rig mode that are deliberately NOT in the effect library
+/// (models/rig_effects.h), so that the diagnosis can be tested on its "unknown" verdict
+/// (docs/rig_mode.md). All off (0) by default.
+struct UnmodelledConfig {
+  /// Periodic disturbance on the measured displacement (e.g. supply-pressure ripple):
+  /// y_meas += ripple_mm sin(2 pi ripple_hz t_k). Amplitude [mm], [0, 10].
+  double ripple_mm = 0.0;
+  double ripple_hz = 0.0;            ///< [Hz], (0, 0.5/run.dt_s) when ripple_mm > 0, else [0, ...)
+  /// Extra spring force on the measured force (e.g. an accumulator): f += k y, y the specimen
+  /// displacement before noise [kN/mm], [-100, 100].
+  double stiffness_kN_per_mm = 0.0;
+  /// true if every disturbance is off.
+  bool Empty() const { return ripple_mm == 0.0 && stiffness_kN_per_mm == 0.0; }
+};
+
 /// The library's effect names, exactly as in the contract (the JSON and the scenario use them).
 inline constexpr std::array<std::string_view, 10> kEffectNames = {
     "pure_delay",        "gain_error", "load_coupling",         "oil_column_resonance",

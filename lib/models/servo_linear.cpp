@@ -11,7 +11,7 @@
 
 namespace rths::models {
 
-LinearServo LinearServo::Make(const scenario::ServoModel3& m, double dt_s) {
+LinearServo LinearServo::Make(const models::ServoModel3& m, double dt_s) {
   const auto positive = [](double v) { return std::isfinite(v) && v > 0.0; };
   if (!positive(m.K) || !positive(m.p) || !positive(m.b) || !positive(m.c))
     throw Error("LinearServo", fmt::format("K, p, b, c must be finite and > 0 (got K = {}, p = {}, "
@@ -83,6 +83,14 @@ double TimeLagS(const LinearServo& m, double f_hz, bool discrete) {
     prev = h;
   }
   return -phase / (2.0 * std::numbers::pi * f_hz);
+}
+
+ServoModel3 ServoPreset(std::string_view name) {
+  if (name == "0.0A") return {1.730e7, 182.7, 225.3, 9.499e4, "0.0A"};  // Eq. 28
+  if (name == "2.5A") return {1.613e7, 134.2, 324.6, 1.211e5, "2.5A"};  // Eq. 29
+  if (name == "avg") return {1.600e7, 151.7, 250.4, 1.061e5, "avg"};    // Eq. 30
+  throw Error("ServoPreset", fmt::format("unknown servo model preset \"{}\" (allowed: \"0.0A\", \"2.5A\", \"avg\")",
+                                         name));
 }
 
 }  // namespace rths::models

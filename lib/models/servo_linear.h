@@ -14,10 +14,25 @@
 #include <complex>
 
 #include <Eigen/Core>
+#include <string>
+#include <string_view>
 
-#include "scenario/scenario.h"
 
 namespace rths::models {
+
+/// A three-pole servohydraulic model G(s) = K / ((s + p)(s^2 + b s + c)) (Eq. 15 with N = 3;
+/// Eqs. 28-30 of the paper are presets). In a file: a preset name ("0.0A", "2.5A", "avg")
+/// or a table {K = ..., p = ..., b = ..., c = ...}. All four must be > 0 (stable, minimum phase).
+struct ServoModel3 {
+  double K = 1.600e7;  ///< gain [1/s^3] (mm/mm at DC: K / (p c))
+  double p = 151.7;    ///< real pole at s = -p [1/s]
+  double b = 250.4;    ///< quadratic factor s^2 + b s + c [1/s]
+  double c = 1.061e5;  ///< [1/s^2]
+  std::string name = "avg";  ///< preset name, or "custom"
+};
+/// The paper's identified models: "0.0A" (Eq. 28), "2.5A" (Eq. 29), "avg" (Eq. 30).
+/// Throws rths::Error for an unknown name.
+ServoModel3 ServoPreset(std::string_view name);
 
 /// Immutable description of one linear servo (continuous and ZOH matrices).
 struct LinearServo {
@@ -27,11 +42,11 @@ struct LinearServo {
   Eigen::Matrix3d Phi;                ///< e^{A dt}
   Eigen::Vector3d Gamma;              ///< int_0^dt e^{A s} ds B
   double dt_s = 0.0;                  ///< ZOH step [s]
-  double K = 0, p = 0, b = 0, c = 0;  ///< model coefficients (scenario::ServoModel3)
+  double K = 0, p = 0, b = 0, c = 0;  ///< model coefficients (models::ServoModel3)
 
   /// Builds the realisation and its exact ZOH discretisation (augmented-matrix exponential,
   /// computed in a balanced state basis). Throws rths::Error unless K, p, b, c > 0 and dt_s > 0.
-  static LinearServo Make(const scenario::ServoModel3& m, double dt_s);
+  static LinearServo Make(const models::ServoModel3& m, double dt_s);
   /// Static gain K / (p c) [mm/mm] (identical for the continuous and the ZOH model).
   double DcGain() const;
 };

@@ -19,7 +19,7 @@ Error Bad(const char* field, double v, const char* range) {
 
 }  // namespace
 
-PhysicalActuator PhysicalActuator::Make(const scenario::PhysicalActuatorConfig& c) {
+PhysicalActuator PhysicalActuator::Make(const models::PhysicalActuatorConfig& c) {
   const auto positive = [](double v) { return std::isfinite(v) && v > 0.0; };
   const auto nonnegative = [](double v) { return std::isfinite(v) && v >= 0.0; };
   if (!positive(c.area_m2)) throw Bad("area_m2", c.area_m2, "> 0");
@@ -92,7 +92,7 @@ std::complex<double> SmallSignalResponse(const PhysicalActuator& a, const Spring
   return loop / (z + loop);
 }
 
-PhysicalRig PhysicalRig::Make(const scenario::PhysicalActuatorConfig& actuator, double dt_s,
+PhysicalRig PhysicalRig::Make(const models::PhysicalActuatorConfig& actuator, double dt_s,
                               RigLoad load, bool current_dynamics, const MrDamperParams& damper,
                               const SpringDashpot& spring, double rtol) {
   PhysicalRig r;

@@ -39,11 +39,25 @@
 #include "models/current_driver.h"
 #include "models/mr_damper.h"
 #include "models/ode.h"
-#include "scenario/scenario.h"
 
 namespace rths::models {
 
-/// The actuator's parameters, SI (models.md section 5; scenario::PhysicalActuatorConfig).
+/// The physics-based servohydraulic actuator (models.md section 5). SI units inside, as named.
+struct PhysicalActuatorConfig {
+  double area_m2 = 0.0271;             ///< piston area A, (0, 1]
+  double supply_pressure_Pa = 20.7e6;  ///< P_s, (0, 1e9]
+  double volume_m3 = 9.26e-3;          ///< total oil volume V_t, (0, 1]
+  double piston_mass_kg = 150.0;       ///< moving mass m, (0, 1e5]
+  double piston_damping_N_s_m = 0.0;   ///< c_p, [0, 1e9]
+  double valve_hz = 70.24;             ///< servovalve natural frequency w_v / 2 pi [Hz], (0, 1e4]
+  double valve_zeta = 0.583;           ///< servovalve damping zeta_v, (0, 10]
+  double kq_m3_s = 1.09e-2;            ///< flow gain K_q at full spool, (0, 10]
+  double kp_per_m = 331.4;             ///< inner-loop gain K_p [1/m] (K_p K_q / A = 133.3 1/s), (0, 1e6]
+  double beta_Pa = 1.172e9;            ///< effective bulk modulus beta_e, (0, 1e12]
+  double leakage_m3_s_Pa = 2.693e-11;  ///< total leakage coefficient C_tot, [0, 1e-6]
+};
+
+/// The actuator's parameters, SI (models.md section 5; models::PhysicalActuatorConfig).
 struct PhysicalActuator {
   double area_m2 = 0.0;               ///< piston area A [m^2]
   double supply_pressure_Pa = 0.0;    ///< P_s [Pa]
@@ -58,7 +72,7 @@ struct PhysicalActuator {
   double leakage_m3_s_Pa = 0.0;       ///< total leakage coefficient C_tot [m^3/(s Pa)]
 
   /// Converts (valve_hz -> rad/s) and validates; throws rths::Error naming the bad field.
-  static PhysicalActuator Make(const scenario::PhysicalActuatorConfig& c);
+  static PhysicalActuator Make(const models::PhysicalActuatorConfig& c);
   /// K_q / A [m/s]: the piston speed at full spool with no load (0.40 m/s by default).
   double VelocityLimitM_s() const { return kq_m3_s / area_m2; }
   /// 1 / K_p [m]: the inner-loop error beyond which the valve saturates (3.0 mm by default).
@@ -134,7 +148,7 @@ struct PhysicalRig {
   int rk4_substeps = 4;           ///< kRk4: fixed steps per dt, [1, 1000]
 
   /// Validates everything; throws rths::Error naming the bad value.
-  static PhysicalRig Make(const scenario::PhysicalActuatorConfig& actuator, double dt_s,
+  static PhysicalRig Make(const models::PhysicalActuatorConfig& actuator, double dt_s,
                           RigLoad load, bool current_dynamics,
                           const MrDamperParams& damper = MrDamperParams::Table3(),
                           const SpringDashpot& spring = {}, double rtol = 1e-8);

@@ -172,7 +172,7 @@ Modes ModalAnalysis(const StructureMatrices& m) {
   return out;
 }
 
-LinearStructure StructureFromScenario(const scenario::StructureConfig& st, const std::string& scenario_path) {
+LinearStructure StructureFromScenario(const models::StructureConfig& st, const std::string& scenario_path) {
   if (st.kind != "file") {
     return LinearStructure::Sdof(st.mass_kg, st.frequency_hz, st.damping_ratio, st.specimen_count);
   }

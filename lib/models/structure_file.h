@@ -15,9 +15,30 @@
 #include <Eigen/Core>
 
 #include "models/structure.h"
-#include "scenario/scenario.h"
+#include "signal/history.h"
 
 namespace rths::models {
+
+/// Numerical substructure (procs/integrator).
+struct StructureConfig {
+  std::string mode = "rths";  ///< "rths" (central difference, Eqs. 1-3) | "predefined" (r from a history)
+  /// mode = "rths": "sdof" (mass, frequency, damping below) | "file" (M, K, C from `file`, a
+  /// structure file: docs/structures.md; e.g. data/buildings/ohtori9_ns.txt).
+  std::string kind = "sdof";
+  std::string file;           ///< kind = "file": path, relative to the scenario file's folder
+  int actuator_dof = 1;       ///< kind = "file": DOF the specimen acts on, 1-based (1 = first story)
+  // kind = "sdof":
+  double mass_kg = 20000.0;          ///< (0, 1e9]
+  double frequency_hz = 5.0;         ///< natural frequency (0, 1/(pi dt)) -- central-difference limit omega dt < 2
+  double damping_ratio = 0.02;       ///< [0, 1)
+  double specimen_count = 1.0;       ///< measured force multiplier (18 dampers act as one) (0, 1000]
+  signal::SignalSpec ground{};               ///< ground acceleration [mm/s^2]
+  // mode = "predefined": the desired displacement itself [mm].
+  signal::SignalSpec desired{"blwn", 5.0, 2.78, 1, 2.0, "", 0.0, 1.0, 0.5};
+  /// How the integrator gets r', r'', r''' in predefined mode: "extrapolated" (Eqs. 20-22, the
+  /// causal RTHS path) | "central" (offline, non-causal central differences of the known record).
+  std::string derivatives = "extrapolated";
+};
 
 /// M [kN s^2/mm], K [kN/mm], C [kN s/mm].
 struct StructureMatrices {
@@ -47,6 +68,6 @@ Modes ModalAnalysis(const StructureMatrices& m);
 /// The numerical substructure a scenario describes: the SDOF of [structure], or the matrices of
 /// structure.file with the specimen on structure.actuator_dof (1-based). Throws rths::Error naming
 /// the scenario key or the structure file's line.
-LinearStructure StructureFromScenario(const scenario::StructureConfig& st, const std::string& scenario_path);
+LinearStructure StructureFromScenario(const models::StructureConfig& st, const std::string& scenario_path);
 
 }  // namespace rths::models

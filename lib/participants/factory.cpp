@@ -33,7 +33,7 @@ lockstep::Timing TimingOf(const scenario::Scenario& s) {
 }
 
 lockstep::Faults FaultsOf(const scenario::Scenario& s, std::string_view role) {
-  const scenario::FaultConfig& c = s.faults;
+  const lockstep::FaultConfig& c = s.faults;
   lockstep::Faults f;
   f.network = {c.drop, c.duplicate, c.delay, c.reorder, c.delay_ms, static_cast<std::uint64_t>(c.seed)};
   if (c.process_role == role) {

@@ -9,7 +9,7 @@
 
 namespace rths::participants {
 
-CurrentSchedule::CurrentSchedule(const scenario::SemiactiveConfig& cfg, double dt_s) {
+CurrentSchedule::CurrentSchedule(const control::SemiactiveConfig& cfg, double dt_s) {
   if (cfg.mode == "passive_off") {
     on_A_ = 0.0;
   } else if (cfg.mode == "passive_on") {

@@ -21,7 +21,7 @@ namespace rths::participants {
 /// Throws rths::Error for a mode that is not a schedule.
 class CurrentSchedule {
  public:
-  CurrentSchedule(const scenario::SemiactiveConfig& cfg, double dt_s);
+  CurrentSchedule(const control::SemiactiveConfig& cfg, double dt_s);
   double At(std::int64_t k) const;
 
  private:

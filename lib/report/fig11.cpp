@@ -12,14 +12,22 @@
 
 #include "core/error.h"
 #include "io/run_log.h"
-#include "report/csv.h"
-#include "report/plot.h"
+#include "io/csv.h"
+#include "io/plot.h"
 #include "report/studies.h"
 #include "signal/metrics.h"
 
 namespace rths::report {
 
 namespace fs = std::filesystem;
+using io::Series;
+using io::Panel;
+using io::Figure;
+using io::MakePanel;
+using io::MakeSeries;
+using io::Plot;
+using io::GnuplotAvailable;
+using io::FormatSig;
 
 namespace {
 
@@ -100,10 +108,10 @@ Series Thin(Series s, const std::vector<double>& x, const std::vector<double>& y
 }  // namespace
 
 std::vector<Fig11Controller> Fig11Controllers() {
-  scenario::ControllerConfig poly = ControllerKind("poly3");
+  control::ControllerConfig poly = ControllerKind("poly3");
   poly.delay_ms = 9.0;
-  scenario::ControllerConfig lqg = ControllerKind("ff_lqg");
-  lqg.model = scenario::ServoPreset("avg");
+  control::ControllerConfig lqg = ControllerKind("ff_lqg");
+  lqg.model = models::ServoPreset("avg");
   return {{"3rd Poly 9ms", poly}, {"Bumpless + LP", ControllerKind("bumpless_lp")}, {"G_FF,avgA + LQG", lqg}};
 }
 

@@ -7,13 +7,20 @@
 
 #include "core/error.h"
 #include "models/mr_damper.h"
-#include "report/csv.h"
-#include "report/plot.h"
+#include "io/csv.h"
+#include "io/plot.h"
 #include "report/reproduce.h"
 
 namespace rths::report {
 
 namespace fs = std::filesystem;
+using io::Series;
+using io::Panel;
+using io::Figure;
+using io::MakePanel;
+using io::MakeSeries;
+using io::Plot;
+using io::CsvWriter;
 
 namespace {
 

@@ -12,13 +12,21 @@
 
 #include "core/error.h"
 #include "io/run_log.h"
-#include "report/csv.h"
-#include "report/plot.h"
+#include "io/csv.h"
+#include "io/plot.h"
 #include "report/studies.h"
 
 namespace rths::report {
 
 namespace fs = std::filesystem;
+using io::Series;
+using io::Panel;
+using io::Figure;
+using io::MakePanel;
+using io::Plot;
+using io::GnuplotAvailable;
+using io::CsvWriter;
+using io::FormatSig;
 
 fs::path FindSourceFile(const std::string& rel) {
   std::vector<fs::path> roots;
@@ -93,7 +101,7 @@ scenario::Scenario Fig9Scenario(const scenario::Scenario& base, double f_hz, con
   s.structure.ground.rms = Fig9GroundRms(f_hz);
   s.controller = c.controller;
   s.plant.kind = plant;
-  s.plant.actuator = scenario::ServoPreset("0.0A");
+  s.plant.actuator = models::ServoPreset("0.0A");
   s.semiactive.mode = "passive_off";
   return s;
 }
@@ -194,7 +202,7 @@ Fig9Result ReproduceFig9(const ReproduceOptions& opts) {
 
   res.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   {
-    const scenario::SafetyConfig lim = base.safety;
+    const safety::SafetyConfig lim = base.safety;
     std::ofstream md(opts.out_dir / "fig9.md");
     md << "# Fig. 9: SDOF RTHS parametric study\n\n"
        << fmt::format("Made by `rths reproduce fig9{} --plant {}`: {} runs of {:g} s in {:.0f} s wall time "

@@ -14,13 +14,21 @@
 
 #include "core/error.h"
 #include "ident/identify.h"
-#include "report/csv.h"
-#include "report/plot.h"
+#include "io/csv.h"
+#include "io/plot.h"
 #include "report/reproduce.h"
 
 namespace rths::report {
 
 namespace fs = std::filesystem;
+using io::Series;
+using io::Panel;
+using io::Figure;
+using io::MakePanel;
+using io::MakeSeries;
+using io::Plot;
+using io::CsvWriter;
+using io::FormatSig;
 
 namespace {
 
@@ -166,8 +174,8 @@ BodeCurve BodeFromModel(const std::string& name, const ident::PoleModel& model, 
   return c;
 }
 
-scenario::SignalSpec FrequencyExcitation() {
-  scenario::SignalSpec spec;
+signal::SignalSpec FrequencyExcitation() {
+  signal::SignalSpec spec;
   spec.kind = "blwn";
   spec.band_hz = kBandHz;
   spec.rms = kRmsMm;
@@ -177,7 +185,7 @@ scenario::SignalSpec FrequencyExcitation() {
   return spec;
 }
 
-scenario::Scenario FrequencyScenario(const std::string& condition, const scenario::ControllerConfig& controller,
+scenario::Scenario FrequencyScenario(const std::string& condition, const control::ControllerConfig& controller,
                                      const std::string& plant, double duration_s) {
   if (condition != "0.0A" && condition != "2.5A") {
     throw Error("FrequencyScenario", fmt::format("condition '{}' (allowed: 0.0A, 2.5A)", condition));
@@ -191,7 +199,7 @@ scenario::Scenario FrequencyScenario(const std::string& condition, const scenari
   s.structure.desired = FrequencyExcitation();
   s.controller = controller;
   s.plant.kind = plant;
-  s.plant.actuator = scenario::ServoPreset(condition);
+  s.plant.actuator = models::ServoPreset(condition);
   s.plant.specimen = "mr_damper";
   s.semiactive.mode = condition == "0.0A" ? "passive_off" : "passive_on";
   s.semiactive.max_current_A = 2.5;
@@ -207,7 +215,7 @@ Fig6Result ReproduceFig6(const ReproduceOptions& opts) {
   const std::vector<std::string> conditions{"0.0A", "2.5A"};
   std::vector<RunSpec> specs;
   for (const auto& cond : conditions) {
-    scenario::ControllerConfig none;
+    control::ControllerConfig none;
     none.kind = "none";
     auto s = FrequencyScenario(cond, none, opts.plant, duration);
     s.run.name = Slug("fig6 " + cond);
@@ -229,7 +237,7 @@ Fig6Result ReproduceFig6(const ReproduceOptions& opts) {
     res.measured.push_back(BodeFromEstimate(conditions[j] == "0.0A" ? "0.0 A" : "2.5 A", ids.back().frf, kPlotMaxHz));
     Fig6Model m;
     m.condition = conditions[j];
-    m.paper = scenario::ServoPreset(conditions[j]);
+    m.paper = models::ServoPreset(conditions[j]);
     m.fit = ids.back().fit;
     res.models.push_back(m);
     if (opts.log) opts.log(fmt::format("fig6 {}:\n{}", conditions[j], ids.back().fit.Report()));
@@ -252,7 +260,7 @@ Fig6Result ReproduceFig6(const ReproduceOptions& opts) {
     }
     Fig6Model m;
     m.condition = "avg";
-    m.paper = scenario::ServoPreset("avg");
+    m.paper = models::ServoPreset("avg");
     m.fit = ident::FitPoleModel(a.f_hz, h, coh, io.fit);
     res.models.push_back(m);
   }

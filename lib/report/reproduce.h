@@ -4,8 +4,8 @@
 /// tests/reproduce_test.cpp calls them directly.
 ///
 /// Every function writes into opts.out_dir (created; refused if it exists and is not empty):
-/// CSV tables (RFC 4180, report/csv.h), Markdown where there is a table, PNG figures made with
-/// gnuplot (report/plot.h) and, for lockstep studies, every run's folder under out_dir/runs/.
+/// CSV tables (RFC 4180, io/csv.h), Markdown where there is a table, PNG figures made with
+/// gnuplot (io/plot.h) and, for lockstep studies, every run's folder under out_dir/runs/.
 #include <cstdint>
 #include <filesystem>
 #include <functional>
@@ -60,7 +60,7 @@ struct Table2Controller {
   double paper_pct_5 = 0.0;        ///< Table 2, 0-5 Hz BLWN
   double paper_pct_15 = 0.0;       ///< Table 2, 0-15 Hz BLWN
   std::string paper_text_5, paper_text_15;  ///< as printed ("16.0", "0.942")
-  scenario::ControllerConfig controller;    ///< kind and design
+  control::ControllerConfig controller;    ///< kind and design
 };
 /// The 18 controller rows of Table 2, in the paper's order.
 std::vector<Table2Controller> Table2Controllers();
@@ -102,9 +102,9 @@ std::vector<Claim> CheckTable2Claims(const std::vector<Table2Row>& rows);
 
 /// Controller settings of a Table 1 row: the kind alone; with the delay it compensates (poly3,
 /// lead) [ms]; or with its design model (a preset: "0.0A", "2.5A", "avg").
-scenario::ControllerConfig ControllerKind(const std::string& kind);
-scenario::ControllerConfig ControllerDelay(const std::string& kind, double delay_ms);
-scenario::ControllerConfig ControllerModel(const std::string& kind, const std::string& preset);
+control::ControllerConfig ControllerKind(const std::string& kind);
+control::ControllerConfig ControllerDelay(const std::string& kind, double delay_ms);
+control::ControllerConfig ControllerModel(const std::string& kind, const std::string& preset);
 
 // --- Frequency-domain studies: Fig. 6 (E1) and Figs. 7-8 (E2) ------------------------------
 
@@ -127,17 +127,17 @@ BodeCurve BodeFromModel(const std::string& name, const ident::PoleModel& model, 
 
 /// The excitation of E1 and E2: BLWN 0-50 Hz, RMS 0.254 mm, seed 1, 2 s discarded, faded in over
 /// 0.5 s (the command of E1; the desired displacement of E2).
-scenario::SignalSpec FrequencyExcitation();
+signal::SignalSpec FrequencyExcitation();
 
 /// The scenario of one frequency-domain run (E1, E2): desired r = BLWN 0-50 Hz, RMS 0.254 mm,
 /// seed 1, faded in over 0.5 s; the damper attached at the condition's constant current
 /// ("0.0A" or "2.5A"); the plant ("linear": Eq. 28 or 29).
-scenario::Scenario FrequencyScenario(const std::string& condition, const scenario::ControllerConfig& controller,
+scenario::Scenario FrequencyScenario(const std::string& condition, const control::ControllerConfig& controller,
                                      const std::string& plant, double duration_s);
 
 struct Fig6Model {
   std::string condition;            ///< "0.0A", "2.5A", "avg" (the fit of the averaged response)
-  scenario::ServoModel3 paper;      ///< Eq. 28, 29, 30
+  models::ServoModel3 paper;      ///< Eq. 28, 29, 30
   ident::FitSummary fit;            ///< our 3-pole fit (ZOH-aware)
   double max_diff_pct = 0.0;        ///< largest |ours / paper - 1| over K, p, b, c [%]
 };

@@ -48,7 +48,7 @@ void RequirePlant(const std::string& plant, const fs::path& scratch_parent) {
     s.structure.desired.taper_s = 0.02;
     s.controller.kind = "none";
     s.plant.kind = kind;
-    s.plant.actuator = scenario::ServoPreset("2.5A");
+    s.plant.actuator = models::ServoPreset("2.5A");
     s.plant.specimen = "mr_damper";
     s.semiactive.mode = "passive_on";
     specs.push_back({fmt::format("plant probe ({})", kind), s, scratch / kind});
@@ -77,21 +77,21 @@ void RequirePlant(const std::string& plant, const fs::path& scratch_parent) {
   }
 }
 
-scenario::ControllerConfig ControllerKind(const std::string& kind) {
-  scenario::ControllerConfig c;
+control::ControllerConfig ControllerKind(const std::string& kind) {
+  control::ControllerConfig c;
   c.kind = kind;
   return c;
 }
 
-scenario::ControllerConfig ControllerDelay(const std::string& kind, double delay_ms) {
+control::ControllerConfig ControllerDelay(const std::string& kind, double delay_ms) {
   auto c = ControllerKind(kind);
   c.delay_ms = delay_ms;
   return c;
 }
 
-scenario::ControllerConfig ControllerModel(const std::string& kind, const std::string& preset) {
+control::ControllerConfig ControllerModel(const std::string& kind, const std::string& preset) {
   auto c = ControllerKind(kind);
-  c.model = scenario::ServoPreset(preset);
+  c.model = models::ServoPreset(preset);
   return c;
 }
 

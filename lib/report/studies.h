@@ -27,7 +27,7 @@ std::string StoppedText(const RunResult& r);
 
 struct Fig9Controller {
   std::string name;                      ///< Table 2's name for 0.0 A, e.g. "3rd Poly 8ms"
-  scenario::ControllerConfig controller;
+  control::ControllerConfig controller;
 };
 /// The six controllers of Table 2's 0.0 A rows, in the paper's order.
 std::vector<Fig9Controller> Fig9Controllers();
@@ -66,7 +66,7 @@ Fig9Result ReproduceFig9(const ReproduceOptions& opts);
 
 struct Fig11Controller {
   std::string name;                      ///< "3rd Poly 9ms" | "Bumpless + LP" | "G_FF,avgA + LQG"
-  scenario::ControllerConfig controller;
+  control::ControllerConfig controller;
 };
 std::vector<Fig11Controller> Fig11Controllers();
 /// "passive_off", "passive_on", "clipped_optimal".

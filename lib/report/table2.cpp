@@ -10,12 +10,14 @@
 #include <fmt/format.h>
 
 #include "core/error.h"
-#include "report/csv.h"
+#include "io/csv.h"
 #include "report/reproduce.h"
 
 namespace rths::report {
 
 namespace fs = std::filesystem;
+using io::CsvWriter;
+using io::FormatSig;
 
 namespace {
 
@@ -78,7 +80,7 @@ scenario::Scenario Table2Scenario(const Table2Controller& row, double band_hz, c
   s.structure.derivatives = "extrapolated";  // Eqs. 20-22, the causal RTHS path
   // models.md section 9: 8th-order Butterworth BLWN, 2 s discarded, fixed seed; faded in over
   // 0.5 s so that the actuator is not asked for a step at k = 0 (docs/safety.md).
-  s.structure.desired = scenario::SignalSpec{};
+  s.structure.desired = signal::SignalSpec{};
   s.structure.desired.kind = "blwn";
   s.structure.desired.band_hz = band_hz;
   s.structure.desired.rms = band_hz < 10 ? 2.78 : 0.595;
@@ -87,7 +89,7 @@ scenario::Scenario Table2Scenario(const Table2Controller& row, double band_hz, c
   s.structure.desired.taper_s = kTaperS;
   s.controller = row.controller;
   s.plant.kind = plant;
-  s.plant.actuator = scenario::ServoPreset(row.condition == "0.0A"   ? "0.0A"
+  s.plant.actuator = models::ServoPreset(row.condition == "0.0A"   ? "0.0A"
                                            : row.condition == "2.5A" ? "2.5A"
                                                                      : "avg");
   s.plant.specimen = "mr_damper";

@@ -8,7 +8,7 @@
 
 namespace rths::safety {
 
-Monitor::Monitor(const scenario::SafetyConfig& cfg, double dt_s)
+Monitor::Monitor(const safety::SafetyConfig& cfg, double dt_s)
     : cfg_(cfg), dt_s_(dt_s), window_steps_(std::llround(cfg.growth_window_s / dt_s)) {
   if (window_steps_ < 1) throw Error("safety.growth_window_s", "shorter than one step");
 }

@@ -8,14 +8,28 @@
 
 #include <fmt/format.h>
 
-#include "scenario/scenario.h"
 
 namespace rths::safety {
+
+/// Safety monitor (docs/safety.md): the clock stops the run, cleanly, when a limit is left.
+/// Defaults are the paper's actuator ratings (556 kN, +/-152.4 mm stroke).
+struct SafetyConfig {
+  bool enabled = true;
+  double stroke_mm = 152.4;        ///< |r|, |u|, |y| must stay within, (0, 10000]
+  double force_kN = 556.0;         ///< |f| must stay within, (0, 1e6]
+  double max_error_mm = 25.0;      ///< |r - y| must stay within, (0, 10000]
+  /// Divergence: the peak |r - y| over consecutive windows of growth_window_s grows by at least
+  /// growth_factor every window for growth_windows windows, above growth_floor_mm.
+  double growth_window_s = 0.25;   ///< (0, 10]; at least one period of the oscillation to watch
+  double growth_factor = 1.3;      ///< (1, 1000]
+  int growth_windows = 4;          ///< [2, 1000]
+  double growth_floor_mm = 0.5;    ///< (0, 10000]
+};
 
 class Monitor {
  public:
   /// Throws rths::Error if the window is shorter than one step.
-  Monitor(const scenario::SafetyConfig& cfg, double dt_s);
+  Monitor(const safety::SafetyConfig& cfg, double dt_s);
 
   /// Checks the signals of step k, in order of k: desired r_k [mm], command u_k [mm],
   /// measured y_k [mm] and f_k [kN]. Returns "" while every limit holds, else the reason
@@ -34,7 +48,7 @@ class Monitor {
     return {reason_.data(), static_cast<std::size_t>(w.out - reason_.data())};
   }
 
-  const scenario::SafetyConfig cfg_;
+  const safety::SafetyConfig cfg_;
   const double dt_s_;
   const std::int64_t window_steps_;
   double window_peak_ = 0.0;      ///< peak |r - y| in the current window [mm]

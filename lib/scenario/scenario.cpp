@@ -26,6 +26,21 @@
 #include "core/error.h"
 
 namespace rths::scenario {
+
+using control::ControllerConfig;
+using control::SemiactiveConfig;
+using lockstep::FaultConfig;
+using lockstep::LockstepConfig;
+using lockstep::RealtimeConfig;
+using models::PhysicalActuatorConfig;
+using models::PlantConfig;
+using models::ServoModel3;
+using models::ServoPreset;
+using models::StructureConfig;
+using models::UnmodelledConfig;
+using safety::SafetyConfig;
+using signal::SignalSpec;
+
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
@@ -811,14 +826,6 @@ void ValidateFaults(const FaultConfig& f, std::int64_t steps, const Check& check
 }
 
 }  // namespace
-
-ServoModel3 ServoPreset(std::string_view name) {
-  if (name == "0.0A") return {1.730e7, 182.7, 225.3, 9.499e4, "0.0A"};  // Eq. 28
-  if (name == "2.5A") return {1.613e7, 134.2, 324.6, 1.211e5, "2.5A"};  // Eq. 29
-  if (name == "avg") return {1.600e7, 151.7, 250.4, 1.061e5, "avg"};    // Eq. 30
-  throw Error("ServoPreset", fmt::format("unknown servo model preset \"{}\" (allowed: \"0.0A\", \"2.5A\", \"avg\")",
-                                         name));
-}
 
 std::int64_t Scenario::steps() const { return std::llround(run.duration_s / run.dt_s); }
 

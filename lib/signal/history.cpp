@@ -182,7 +182,7 @@ std::vector<double> LoadHistory(const std::string& path, double file_dt_s, doubl
   return x;
 }
 
-std::vector<double> MakeSignal(const scenario::SignalSpec& spec, double dt_s, std::size_t n,
+std::vector<double> MakeSignal(const signal::SignalSpec& spec, double dt_s, std::size_t n,
                                const std::string& scenario_dir) {
   std::vector<double> x;
   if (spec.kind == "blwn") {

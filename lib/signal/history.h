@@ -1,13 +1,31 @@
 #pragma once
 /// @file Time histories read or generated at the edge: ground accelerations and desired
-/// displacements (scenario::SignalSpec).
+/// displacements (signal::SignalSpec).
 #include <cstddef>
 #include <string>
 #include <vector>
+#include <cstdint>
 
-#include "scenario/scenario.h"
 
 namespace rths::signal {
+
+/// A time history generated or read at the edge (ground acceleration or desired displacement).
+struct SignalSpec {
+  std::string kind = "blwn";  ///< "blwn" | "file" | "zero"
+  // kind = "blwn": Gaussian white noise through an 8th-order Butterworth low-pass at band_hz,
+  // scaled to rms, with the first discard_s seconds thrown away (models.md section 9).
+  double band_hz = 30.0;      ///< upper band edge [Hz], (0, 0.5/dt)
+  double rms = 1500.0;        ///< RMS in the signal's unit (mm/s^2 for ground, mm for desired), > 0
+  std::uint64_t seed = 1;     ///< generator seed
+  double discard_s = 2.0;     ///< start-up transient thrown away [s], [0, 60]
+  // kind = "file": one column (values at file_dt_s) or two columns (t [s], value).
+  std::string file;           ///< path, relative to the scenario file's folder (after parsing: absolute)
+  double file_dt_s = 0.0;     ///< step of a one-column file [s]; 0 = the file has a time column
+  double scale = 1.0;         ///< multiply the file's values by this to get the signal's unit
+  /// Raised-cosine fade-in over the first taper_s seconds [s], [0, 60]: a BLWN record cut after
+  /// its discarded start begins mid-motion, which would ask the actuator for a step.
+  double taper_s = 0.0;
+};
 
 /// Reads a time history from a text file and resamples it to the run's step.
 ///
@@ -33,7 +51,7 @@ std::vector<double> LoadHistory(const std::string& path, double file_dt_s, doubl
 ///   kind "zero": n zeros.
 /// Then the first spec.taper_s seconds are faded in (ApplyTaper).
 /// Throws rths::Error for any other kind, and whatever the chosen generator throws.
-std::vector<double> MakeSignal(const scenario::SignalSpec& spec, double dt_s, std::size_t n,
+std::vector<double> MakeSignal(const signal::SignalSpec& spec, double dt_s, std::size_t n,
                                const std::string& scenario_dir);
 
 /// Fades a record in from zero over its first taper_s seconds with a raised cosine,

@@ -13,7 +13,7 @@
 #include <utility>
 #include <vector>
 
-namespace rths::report {
+namespace rths::io {
 
 /// One curve.
 struct Series {
@@ -79,4 +79,4 @@ bool GnuplotAvailable(const std::string& program = "gnuplot");
 /// A string as a gnuplot single-quoted literal ('' for a quote inside).
 std::string GnuplotQuote(const std::string& s);
 
-}  // namespace rths::report
+}  // namespace rths::io

@@ -9,7 +9,7 @@
 #include <string_view>
 #include <vector>
 
-namespace rths::report {
+namespace rths::io {
 
 /// One field, quoted only when it must be (comma, double quote, CR or LF inside).
 std::string CsvField(std::string_view field);
@@ -47,4 +47,4 @@ class CsvWriter {
 /// ("46.07", "0.4631"); "nan" for NaN.
 std::string FormatSig(double v, int digits = 4);
 
-}  // namespace rths::report
+}  // namespace rths::io

@@ -1,4 +1,4 @@
-#include "report/plot.h"
+#include "io/plot.h"
 
 #include <sys/wait.h>
 #include <unistd.h>
@@ -15,7 +15,7 @@
 
 #include "core/error.h"
 
-namespace rths::report {
+namespace rths::io {
 
 namespace fs = std::filesystem;
 
@@ -234,4 +234,4 @@ PlotFiles Plot(const Figure& fig, const fs::path& dir) {
   return files;
 }
 
-}  // namespace rths::report
+}  // namespace rths::io

@@ -1,4 +1,4 @@
-#include "report/csv.h"
+#include "io/csv.h"
 
 #include <cmath>
 #include <fstream>
@@ -8,7 +8,7 @@
 
 #include "core/error.h"
 
-namespace rths::report {
+namespace rths::io {
 
 std::string CsvField(std::string_view field) {
   if (field.find_first_of(",\"\r\n") == std::string_view::npos) return std::string(field);
@@ -136,4 +136,4 @@ std::string FormatSig(double v, int digits) {
   return fmt::format("{:.{}g}", v, digits);
 }
 
-}  // namespace rths::report
+}  // namespace rths::io
