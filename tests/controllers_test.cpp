@@ -41,7 +41,9 @@ constexpr double kDt = 0.0005;  // 2 kHz
 
 ControllerConfig Config(const std::string& kind, const char* model = "avg", double delay_ms = 9.0) {
   ControllerConfig c;
-  c.kind = kind;
+  // "unknown": a value no kind has (only a corrupted config can hold one).
+  c.kind = kind == "unknown" ? static_cast<rths::control::ControllerKind>(42)
+                             : rths::ParseName(rths::control::kControllerKindNames, kind, "kind");
   c.model = ServoPreset(model);
   c.delay_ms = delay_ms;
   return c;
@@ -386,7 +388,7 @@ TEST_CASE("MakeTrackingController refuses bad designs with errors naming the sce
     const char* key;
   };
   const Case cases[] = {
-      {"pid", [](ControllerConfig*) {}, "controller.kind"},
+      {"unknown", [](ControllerConfig*) {}, "controller.kind"},
       {"poly3", [](ControllerConfig* c) { c->delay_ms = 16.0; }, "controller.delay_ms"},  // > max_delay_ms
       {"poly3", [](ControllerConfig* c) { c->delay_ms = 0.0; }, "controller.delay_ms"},
       {"lead", [](ControllerConfig* c) { c->delay_ms = -1.0; }, "controller.delay_ms"},

@@ -249,7 +249,7 @@ TEST_CASE("JSON: the contract's fields and keys") {
     for (const auto& k : keys.at(name)) CHECK(e["params"].contains(k));
     if (name == "sensor_noise") CHECK_FALSE(e["selected"].get<bool>());
   }
-  CHECK(names.size() == rths::models::kEffectNames.size());
+  CHECK(names.size() == rths::models::kEffects.size());
   REQUIRE(j["verdict"].is_array());
   CHECK(j["verdict"] == nlohmann::json({"pure_delay", "damper_scale"}));
   // The selected effects come first, in the order of the verdict.

@@ -455,7 +455,7 @@ TEST_CASE("Rig::Step allocates nothing; time per step, physical vs linear") {
   for (const std::string kind : {"linear", "physical"}) {
     for (const bool pulse : {false, true}) {
       rths::models::PlantConfig cfg;  // MR damper, current dynamics on
-      cfg.kind = kind;
+      cfg.kind = rths::ParseName(rths::models::kPlantKindNames, kind, "kind");
       auto rig = MakeRig(cfg, kDt);
       const int steps = 4000;
       double sum = 0;
@@ -489,7 +489,7 @@ TEST_CASE("Make validates") {
                                     MrDamperParams::Table3(), {-1.0, 0.0}),
                   rths::Error);
   rths::models::PlantConfig cfg;
-  cfg.kind = "hydraulic";
+  cfg.kind = static_cast<rths::models::PlantKind>(42);  // not a loading system
   CHECK_THROWS_AS(MakeRig(cfg, kDt), rths::Error);
 }
 

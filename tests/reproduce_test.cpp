@@ -226,9 +226,9 @@ TEST_CASE("table2 --quick on the linear plant") {
     const auto j = nlohmann::json::parse(Slurp(d / "summary.json"));
     CHECK(j["scenario_sha256"].get<std::string>() == s.sha256);
     CHECK(j["steps"].get<std::int64_t>() == s.steps());
-    CHECK(s.structure.mode == "predefined");
-    CHECK(s.plant.specimen == "mr_damper");
-    CHECK(s.plant.kind == "linear");
+    CHECK(s.structure.mode == rths::models::StructureMode::kPredefined);
+    CHECK(s.plant.specimen == rths::models::Specimen::kMrDamper);
+    CHECK(s.plant.kind == rths::models::PlantKind::kLinear);
   }
   CHECK(runs == 36);
 }

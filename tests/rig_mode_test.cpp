@@ -52,7 +52,7 @@ void CheckContains(const std::string& message, std::initializer_list<std::string
 /// A plant of kind "linear" (Eq. 30), the Table 3 damper, current dynamics on.
 PlantConfig LinearPlant() {
   PlantConfig p;
-  p.kind = "linear";
+  p.kind = rths::models::PlantKind::kLinear;
   return p;
 }
 
@@ -329,7 +329,7 @@ TEST_CASE("rig mode: identity effects give the nominal linear rig bit for bit; n
 
 TEST_CASE("rig mode: pure_delay shifts the step response by tau") {
   PlantConfig p = LinearPlant();
-  p.specimen = "none";
+  p.specimen = rths::models::Specimen::kNone;
   const Response nominal = Drive(p, 400, Constant(1.0), Zero());
   for (double tau_ms : {2.0, 3.3, 7.75}) {
     CAPTURE(tau_ms);
@@ -500,7 +500,7 @@ TEST_CASE("rig mode: load_coupling makes y lower by c f, coulomb_friction by los
   }
 
   PlantConfig fr = LinearPlant();
-  fr.specimen = "none";
+  fr.specimen = rths::models::Specimen::kNone;
   fr.effects.coulomb_friction = rths::models::CoulombFriction{0.3, 0.5};
   auto rf = rths::models::MakeRig(fr, kDt);
   auto* ef = AsEffectRig(rf.get());
@@ -518,7 +518,7 @@ TEST_CASE("rig mode: load_coupling makes y lower by c f, coulomb_friction by los
 TEST_CASE("rig mode: oil_column_resonance amplifies a sine at f_hz by about 1 / (2 zeta)") {
   const double f_hz = 60.0, zeta = 0.05;
   PlantConfig p = LinearPlant();
-  p.specimen = "none";
+  p.specimen = rths::models::Specimen::kNone;
   PlantConfig o = p;
   o.effects.oil_column_resonance = rths::models::OilColumnResonance{f_hz, zeta};
   auto ratio = [&](double f) {
@@ -601,7 +601,7 @@ TEST_CASE("rig mode: Step allocates nothing, with every effect on") {
 TEST_CASE("rig mode: MakeRig refuses effects on a physical or ideal plant") {
   for (const char* kind : {"physical", "ideal"}) {
     PlantConfig p;
-    p.kind = kind;
+    p.kind = rths::ParseName(rths::models::kPlantKindNames, kind, "kind");
     p.effects.gain_error = rths::models::GainError{1.1};
     try {
       rths::models::MakeRig(p, kDt);

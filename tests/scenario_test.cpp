@@ -5,10 +5,13 @@
 
 #include <cmath>
 #include <filesystem>
+#include <functional>
 #include <fstream>
 #include <initializer_list>
 #include <string>
 #include <string_view>
+#include <utility>
+#include <vector>
 
 #include "core/error.h"
 
@@ -59,21 +62,21 @@ TEST_CASE("the default scenario file loads with the issue's values") {
   CHECK(s.run.dt_s == 0.0005);
   CHECK(s.run.duration_s == 20.0);
   CHECK(s.steps() == 40000);
-  CHECK(s.structure.mode == "rths");
+  CHECK(s.structure.mode == rths::models::StructureMode::kRths);
   CHECK(s.structure.mass_kg == 20000.0);
   CHECK(s.structure.frequency_hz == 5.0);
   CHECK(s.structure.damping_ratio == 0.02);
-  CHECK(s.structure.ground.kind == "blwn");
+  CHECK(s.structure.ground.kind == rths::signal::SignalKind::kBlwn);
   CHECK(s.structure.ground.band_hz == 30.0);
   CHECK(s.structure.ground.rms == 1500.0);
   CHECK(s.structure.ground.seed == 1);
-  CHECK(s.controller.kind == "ff");
+  CHECK(s.controller.kind == rths::control::ControllerKind::kFf);
   CHECK(s.controller.model.name == "avg");
   CHECK(s.controller.model.K == 1.600e7);
   CHECK(s.plant.actuator.name == "avg");
   CHECK(s.plant.actuator.p == 151.7);
-  CHECK(s.plant.specimen == "mr_damper");
-  CHECK(s.semiactive.mode == "passive_off");
+  CHECK(s.plant.specimen == rths::models::Specimen::kMrDamper);
+  CHECK(s.semiactive.mode == rths::control::SemiactiveMode::kPassiveOff);
   CHECK(s.semiactive.current_A == 0.0);
   CHECK(s.sha256.size() == 64);
   CHECK(s.path.find("default.toml") != std::string::npos);
@@ -83,14 +86,14 @@ TEST_CASE("the tracking scenarios are predefined 0-5 Hz records") {
   for (const char* kind : {"ff", "none"}) {
     CAPTURE(kind);
     const Scenario s = LoadScenario((kSourceDir / "scenarios" / (std::string("tracking_") + kind + "_0-5hz.toml")).string());
-    CHECK(s.structure.mode == "predefined");
-    CHECK(s.structure.desired.kind == "blwn");
+    CHECK(s.structure.mode == rths::models::StructureMode::kPredefined);
+    CHECK(s.structure.desired.kind == rths::signal::SignalKind::kBlwn);
     CHECK(s.structure.desired.band_hz == 5.0);
     CHECK(s.structure.desired.rms == 2.78);
     CHECK(s.run.duration_s == 60.0);
     CHECK(s.plant.actuator.name == "avg");
-    CHECK(s.plant.specimen == "none");
-    CHECK(s.controller.kind == kind);
+    CHECK(s.plant.specimen == rths::models::Specimen::kNone);
+    CHECK(rths::NameOf(rths::control::kControllerKindNames, s.controller.kind) == kind);
   }
 }
 
@@ -317,24 +320,24 @@ TEST_CASE("ToToml writes every key: parsing it gives back the same scenario") {
     CAPTURE(entry.path().string());
     auto s = rths::scenario::LoadScenario(entry.path().string());
     // Exercise non-default values of the newer tables too.
-    s.controller.kind = "bumpless_lp";
+    s.controller.kind = rths::control::ControllerKind::kBumplessLp;
     s.controller.model = {1.5e7, 150.0, 250.0, 1.0e5, "custom"};
     s.controller.lqg.q = 12.5;
-    s.plant.kind = "physical";
+    s.plant.kind = rths::models::PlantKind::kPhysical;
     s.plant.effects = {};     // the rig mode (scenarios/rig_mode_example.toml) needs kind "linear"
     s.plant.unmodelled = {};
     s.plant.physical.valve_hz = 71.0;
-    s.semiactive.mode = "pulse";
+    s.semiactive.mode = rths::control::SemiactiveMode::kPulse;
     s.semiactive.pulse_duty = 0.25;
     const std::string text = rths::scenario::ToToml(s);
     const auto back = rths::scenario::ParseScenario(text, (kSourceDir / "scenarios/x.toml").string());
     CHECK(rths::scenario::ToToml(back) == text);
-    CHECK(back.controller.kind == "bumpless_lp");
+    CHECK(back.controller.kind == rths::control::ControllerKind::kBumplessLp);
     CHECK(back.controller.model.K == 1.5e7);
     CHECK(back.controller.model.name == "custom");
     CHECK(back.controller.model_low.name == "0.0A");
     CHECK(back.controller.lqg.q == 12.5);
-    CHECK(back.plant.kind == "physical");
+    CHECK(back.plant.kind == rths::models::PlantKind::kPhysical);
     CHECK(back.plant.physical.valve_hz == 71.0);
     CHECK(back.semiactive.pulse_duty == 0.25);
     CHECK(back.run.dt_s == s.run.dt_s);
@@ -402,4 +405,153 @@ TEST_CASE("regression (fuzz_scenario): ToToml keeps -0.0 a float, so the round t
   const Scenario back = ParseScenario(text, "neg_zero.toml");
   CHECK(std::signbit(back.structure.ground.discard_s));
   CHECK(rths::scenario::ToToml(back) == text);
+}
+
+namespace {
+/// A scenario in which every field differs from its default (and is valid), so that a key missing
+/// from the schema (read, write or check) changes the round trip. `rig_mode`: the plant is the
+/// linear rig with every effect and unmodelled disturbance on (they need plant.kind = "linear");
+/// otherwise the physical rig without them.
+Scenario EveryFieldChanged(const fs::path& dir, bool rig_mode) {
+  namespace m = rths::models;
+  namespace c = rths::control;
+  WriteFile(dir / "desired.txt", "0 0\n0.5 1\n1 0\n");
+  Scenario s;
+  s.run = {"every_field", 0.001, 3.0};
+  auto& st = s.structure;
+  st.mode = m::StructureMode::kPredefined;
+  st.kind = m::StructureKind::kFile;
+  st.file = (dir / "not_read_in_predefined_mode.txt").string();
+  st.actuator_dof = 3;
+  st.mass_kg = 12345.0;
+  st.frequency_hz = 3.25;
+  st.damping_ratio = 0.045;
+  st.specimen_count = 2.5;
+  st.derivatives = m::Derivatives::kCentral;
+  st.ground = {rths::signal::SignalKind::kZero, 21.0, 1234.5, 5, 1.25, "unused.txt", 0.01, 2.0, 0.3};
+  st.desired = {rths::signal::SignalKind::kFile, 7.0, 3.5, 6, 0.75, (dir / "desired.txt").string(), 0.0, -1.5, 0.1};
+  auto& ct = s.controller;
+  ct.kind = c::ControllerKind::kLead;
+  ct.model = {1.5e7, 150.0, 250.0, 1.0e5, "custom"};
+  ct.half_step_ahead = true;
+  ct.delay_ms = 7.5;
+  ct.max_delay_ms = 12.0;
+  ct.lead_tp_ms = 0.7;
+  ct.lp_cutoff_hz = 200.0;
+  ct.lp_order = 4;
+  ct.model_low = rths::models::ServoPreset("avg");
+  ct.model_high = {1.7e7, 140.0, 300.0, 1.2e5, "custom"};
+  ct.current_high_A = 2.0;
+  ct.lqg = {11.0, 4.0, 0.8, 0.6, 2.0, 3.0};
+  auto& p = s.plant;
+  p.kind = rig_mode ? m::PlantKind::kLinear : m::PlantKind::kPhysical;
+  p.actuator = rths::models::ServoPreset("2.5A");
+  p.physical = {0.03, 21e6, 9e-3, 160.0, 10.0, 71.0, 0.6, 1.1e-2, 330.0, 1.2e9, 3e-11};
+  p.specimen = m::Specimen::kNone;
+  p.current_dynamics = false;
+  p.noise_y_mm_rms = 0.01;
+  p.noise_f_kN_rms = 0.02;
+  p.noise_seed = 9;
+  p.cvode_rtol = 1e-7;
+  auto& d = p.damper;
+  for (double* v : {&d.alpha_a, &d.alpha_b, &d.alpha_c, &d.c0_a, &d.c0_b, &d.c0_c, &d.c1_a, &d.c1_b, &d.c1_c,
+                    &d.beta_a, &d.beta_b, &d.beta_c, &d.gamma_a, &d.gamma_b, &d.gamma_c, &d.A}) {
+    *v *= 1.1;
+  }
+  d.n = 2.5;
+  d.k0 = 0.01;
+  d.k1 = 0.02;
+  d.x0 = 1.5;
+  if (rig_mode) {
+    p.effects.pure_delay = m::PureDelay{1.5};
+    p.effects.gain_error = m::GainError{1.05};
+    p.effects.load_coupling = m::LoadCoupling{0.01};
+    p.effects.oil_column_resonance = m::OilColumnResonance{80.0, 0.1};
+    p.effects.coulomb_friction = m::CoulombFriction{0.05, 0.8};
+    p.effects.backlash = m::Backlash{0.02};
+    p.effects.servovalve_saturation = m::ServovalveSaturation{300.0};
+    p.effects.sensor_noise = m::SensorNoise{0.003, 0.04};
+    p.effects.current_lag = m::CurrentLag{12.0};
+    p.effects.damper_scale = m::DamperScale{0.9};
+    p.load_coupling_same_sample = false;
+    p.unmodelled = {0.01, 30.0, 0.5};
+  }
+  s.semiactive = {c::SemiactiveMode::kConstant, 1.0, 2.0, 1.0, 0.3, 0.02, 20.0, 150.0};
+  s.safety = {false, 100.0, 400.0, 20.0, 0.5, 1.5, 5, 0.7};
+  s.lockstep = {50.0, 20.0, 5.0};
+  s.realtime = {true, 5, false, 50, false};
+  auto& f = s.faults;
+  f = {0.01, 0.02, 0.03, 0.04, 10.0, 3, 4096, "plant", rths::lockstep::ProcessFault::kStall, 10, 1.5};
+  return s;
+}
+}  // namespace
+
+TEST_CASE("round trip of a scenario whose every field differs from its default: the structs come back equal") {
+  const fs::path dir = TempDir("every_field");
+  for (const bool rig_mode : {false, true}) {
+    CAPTURE(rig_mode);
+    Scenario s = EveryFieldChanged(dir, rig_mode);
+    s.path = (dir / "every.toml").string();
+    rths::scenario::ValidateScenario(s);  // the test's scenario is itself valid
+    // Every table differs from its default as a whole.
+    const Scenario defaults;
+    CHECK(s.run != defaults.run);
+    CHECK(s.structure.ground != defaults.structure.ground);
+    CHECK(s.structure.desired != defaults.structure.desired);
+    CHECK(s.controller.lqg != defaults.controller.lqg);
+    CHECK(s.plant.physical != defaults.plant.physical);
+    CHECK(s.plant.damper != defaults.plant.damper);
+    CHECK(s.semiactive != defaults.semiactive);
+    CHECK(s.safety != defaults.safety);
+    CHECK(s.lockstep != defaults.lockstep);
+    CHECK(s.realtime != defaults.realtime);
+    CHECK(s.faults != defaults.faults);
+
+    const std::string text = rths::scenario::ToToml(s);
+    Scenario back = ParseScenario(text, s.path);
+    back.sha256.clear();
+    CHECK(back.run == s.run);
+    CHECK(back.structure == s.structure);
+    CHECK(back.controller == s.controller);
+    CHECK(back.plant.effects == s.plant.effects);
+    CHECK(back.plant.unmodelled == s.plant.unmodelled);
+    CHECK(back.plant.damper == s.plant.damper);
+    CHECK(back.plant == s.plant);
+    CHECK(back.semiactive == s.semiactive);
+    CHECK(back.safety == s.safety);
+    CHECK(back.lockstep == s.lockstep);
+    CHECK(back.realtime == s.realtime);
+    CHECK(back.faults == s.faults);
+    CHECK(back == s);
+  }
+}
+
+TEST_CASE("a field changed away from its default survives ToToml one at a time (no key silently dropped)") {
+  // Each single change must show up in the text ToToml writes and come back from it.
+  const fs::path dir = TempDir("one_field");
+  const Scenario changed = EveryFieldChanged(dir, true);
+  const Scenario base;
+  const std::string base_text = rths::scenario::ToToml(base);
+  std::vector<std::pair<const char*, std::function<void(Scenario&)>>> edits = {
+      {"structure", [&](Scenario& s) { s.structure = changed.structure; }},
+      {"controller", [&](Scenario& s) { s.controller = changed.controller; }},
+      {"plant", [&](Scenario& s) { s.plant = changed.plant; }},
+      {"semiactive", [&](Scenario& s) { s.semiactive = changed.semiactive; }},
+      {"safety", [&](Scenario& s) { s.safety = changed.safety; }},
+      {"lockstep", [&](Scenario& s) { s.lockstep = changed.lockstep; }},
+      {"realtime", [&](Scenario& s) { s.realtime = changed.realtime; }},
+      {"faults", [&](Scenario& s) { s.faults = changed.faults; }},
+  };
+  for (auto& [table, edit] : edits) {
+    CAPTURE(table);
+    Scenario s = base;
+    s.run = changed.run;
+    edit(s);
+    const std::string text = rths::scenario::ToToml(s);
+    CHECK(text != base_text);
+    Scenario back = ParseScenario(text, (dir / "one.toml").string());
+    back.path = s.path;
+    back.sha256 = s.sha256;
+    CHECK(back == s);
+  }
 }

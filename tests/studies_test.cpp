@@ -37,8 +37,8 @@ TEST_CASE("ideal plant: y_k == r_k bit for bit, f_k the damper's force, determin
   auto s = Base("fig9_base.toml");
   s.run.duration_s = 1.0;
   s.structure.frequency_hz = 5.0;
-  s.plant.kind = "ideal";
-  s.controller.kind = "none";
+  s.plant.kind = rths::models::PlantKind::kIdeal;
+  s.controller.kind = rths::control::ControllerKind::kNone;
   std::string digest[2];
   for (int rep = 0; rep < 2; ++rep) {
     const auto dir = TempDir(fmt::format("ideal_{}", rep));
@@ -127,12 +127,12 @@ TEST_CASE("fig9: a parallel sweep gives the same numbers as the same runs one at
 TEST_CASE("9-story lockstep regression: a short run's payload digest is identical across repeats") {
   auto s = Base("fig11_base.toml");
   s.run.duration_s = 0.5;
-  s.semiactive.mode = "clipped_optimal";
+  s.semiactive.mode = rths::control::SemiactiveMode::kClippedOptimal;
   std::string digest[2];
   for (int rep = 0; rep < 2; ++rep) {
     const auto dir = TempDir(fmt::format("nine_{}", rep));
     const auto sc = AsFile(s, dir);
-    REQUIRE(sc.structure.kind == "file");
+    REQUIRE(sc.structure.kind == rths::models::StructureKind::kFile);
     const auto r = rths_test::RunMemq({sc}, dir);
     REQUIRE(r.code == 0);
     const auto log = io::ReadRunLog((dir / "log.lcm").string());

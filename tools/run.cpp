@@ -96,7 +96,7 @@ std::string Megabytes(double bytes) { return fmt::format("{:.1f} MB", bytes / 1e
 /// copied scenario and the participants' own logs.
 double EstimateOutputBytes(const rths::scenario::Scenario& s) {
   int n_dof = 1;
-  if (s.structure.mode != "predefined") {
+  if (s.structure.mode != rths::models::StructureMode::kPredefined) {
     n_dof = static_cast<int>(rths::models::StructureFromScenario(s.structure, s.path).M.rows());
   }
   return static_cast<double>(s.steps()) * static_cast<double>(rths::participants::StoredBytesPerStep(n_dof)) +
@@ -419,12 +419,12 @@ int main(int argc, char** argv) {
     s = rths::scenario::LoadScenario(scenario_path);
     if (realtime) s.realtime.enabled = true;
     rths::participants::CheckBuildable(s);
-    const std::string& kind = s.faults.process_kind;
-    if (transport == "memq" && (kind == "crash" || kind == "kill" || kind == "stop")) {
+    const rths::lockstep::ProcessFault kind = s.faults.process_kind;
+    if (transport == "memq" && rths::lockstep::EndsProcess(kind)) {
       throw rths::Error(scenario_path + ": faults.process.kind",
                         fmt::format("\"{}\" would take every participant down with the one memq process: "
                                     "use --transport udpm",
-                                    kind));
+                                    rths::NameOf(rths::lockstep::kProcessFaultNames, kind)));
     }
     if (transport == "udpm") {
       if (const std::string hint = rths::lockstep::CheckMulticastRoute(); !hint.empty()) {

@@ -26,10 +26,19 @@
 
 #include <Eigen/Core>
 
+#include "core/names.h"
 #include "models/structure.h"
-#include <string>
 
 namespace rths::control {
+
+/// How the semiactive participant sets the damper current (SemiactiveConfig::mode).
+enum class SemiactiveMode { kPassiveOff, kPassiveOn, kConstant, kPulse, kClippedOptimal };
+inline constexpr std::array<Named<SemiactiveMode>, 5> kSemiactiveModeNames = {
+    {{SemiactiveMode::kPassiveOff, "passive_off"},
+     {SemiactiveMode::kPassiveOn, "passive_on"},
+     {SemiactiveMode::kConstant, "constant"},
+     {SemiactiveMode::kPulse, "pulse"},
+     {SemiactiveMode::kClippedOptimal, "clipped_optimal"}}};
 
 /// Semiactive current (procs/semiactive). Constant modes, or the 0.5 Hz pulse of Table 2;
 /// clipped-optimal control later.
@@ -37,7 +46,7 @@ struct SemiactiveConfig {
   /// "passive_off" (0 A) | "passive_on" (max_current_A) | "constant" (current_A) |
   /// "pulse" (max_current_A for the first pulse_duty of every period 1/pulse_hz, then 0 A) |
   /// "clipped_optimal" (needs structure.mode = "rths").
-  std::string mode = "passive_off";
+  SemiactiveMode mode = SemiactiveMode::kPassiveOff;
   double current_A = 0.0;            ///< for "constant": [0, max_current_A]
   double max_current_A = 2.5;        ///< (0, 5]
   double pulse_hz = 0.5;             ///< "pulse": frequency [Hz], (0, 0.25/dt)
@@ -47,6 +56,7 @@ struct SemiactiveConfig {
   double r_weight = 1e-2;            ///< weight on the force (in units of capacity), (0, 1e6]
   double noise_ratio = 25.0;         ///< ground-motion / sensor noise intensity (Dyke), (0, 1e6]
   double capacity_kN = 200.0;        ///< one damper's capacity (force unit of the cost), (0, 1e6]
+  bool operator==(const SemiactiveConfig&) const = default;
 };
 
 /// Design knobs (scenario [semiactive]).

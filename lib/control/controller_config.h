@@ -3,6 +3,7 @@
 /// paper): plain structs with defaults, filled by the scenario's [controller] table.
 #include <string>
 
+#include "core/names.h"
 #include "models/servo_linear.h"
 
 namespace rths::control {
@@ -17,7 +18,19 @@ struct LqgConfig {
   double eta_f = 0.5;    ///< shaping filter zero (roll-off), [0, 100]
   double W = 1.0;        ///< process-noise intensity, (0, 1e12]
   double V = 1.0;        ///< measurement-noise intensity, (0, 1e12]
+  bool operator==(const LqgConfig&) const = default;
 };
+
+/// The outer-loop controllers of Table 1 (ControllerConfig::kind).
+enum class ControllerKind { kNone, kFf, kPoly3, kLead, kFfLp, kBumplessLp, kFfLqg };
+inline constexpr std::array<Named<ControllerKind>, 7> kControllerKindNames = {
+    {{ControllerKind::kNone, "none"},
+     {ControllerKind::kFf, "ff"},
+     {ControllerKind::kPoly3, "poly3"},
+     {ControllerKind::kLead, "lead"},
+     {ControllerKind::kFfLp, "ff_lp"},
+     {ControllerKind::kBumplessLp, "bumpless_lp"},
+     {ControllerKind::kFfLqg, "ff_lqg"}}};
 
 /// Outer-loop tracking controller (procs/controller); Table 1 of the paper.
 struct ControllerConfig {
@@ -26,7 +39,7 @@ struct ControllerConfig {
   /// "ff_lp" (model inverse with a Butterworth low-pass, Carrion & Spencer 2007) |
   /// "bumpless_lp" (ff_lp for model_low and model_high blended by damper current) |
   /// "ff_lqg" (ff with `model` plus LQG feedback designed on `model`, Eqs. 23-27).
-  std::string kind = "ff";
+  ControllerKind kind = ControllerKind::kFf;
   models::ServoModel3 model{};         ///< design model for "ff", "ff_lp", "ff_lqg"
   /// models.md section 2: evaluate the feedforward half a step ahead to cancel the ZOH's
   /// half-sample lag in simulation. false = the paper's Eq. 19.
@@ -40,6 +53,7 @@ struct ControllerConfig {
   models::ServoModel3 model_high{1.613e7, 134.2, 324.6, 1.211e5, "2.5A"};  ///< at current_high_A (Eq. 29)
   double current_high_A = 2.5;  ///< "bumpless_lp": lambda = i_eff / current_high_A, (0, 5]
   LqgConfig lqg{};              ///< "ff_lqg"
+  bool operator==(const ControllerConfig&) const = default;
 };
 
 }  // namespace rths::control

@@ -67,7 +67,7 @@ DesignSummary DesignController(const control::ControllerConfig& cfg, double dt_s
   if (const auto* p = dynamic_cast<const FeedforwardLqg*>(c)) s.feedforward = p->feedforward(), s.lqg = p->design();
 
   std::vector<std::pair<models::ServoModel3, double>> models;
-  const bool uses_model = cfg.kind == "ff" || cfg.kind == "ff_lp" || cfg.kind == "ff_lqg";
+  const bool uses_model = cfg.kind == control::ControllerKind::kFf || cfg.kind == control::ControllerKind::kFfLp || cfg.kind == control::ControllerKind::kFfLqg;
   if (uses_model && cfg.model.name == "custom") models.emplace_back(cfg.model, 0.0);
   models.emplace_back(models::ServoPreset("0.0A"), 0.0);
   models.emplace_back(models::ServoPreset("avg"), 0.5 * cfg.current_high_A);
@@ -86,7 +86,7 @@ DesignSummary DesignController(const control::ControllerConfig& cfg, double dt_s
 }
 
 std::string DesignSummary::Report() const {
-  std::string o = fmt::format("controller: {} (dt = {} s)\n", config.kind, dt_s);
+  std::string o = fmt::format("controller: {} (dt = {} s)\n", NameOf(kControllerKindNames, config.kind), dt_s);
   if (feedforward) {
     const auto& a = *feedforward;
     o += fmt::format("feedforward G_FF(s) = a0 + a1 s + a2 s^2 + a3 s^3 (Eq. 17) of {}{}:\n"
@@ -135,7 +135,7 @@ std::string DesignSummary::Report() const {
   }
   for (const PlantCheck& p : plants) {
     o += fmt::format("on the ZOH plant {}{}:\n", ModelText(p.model),
-                     config.kind == "bumpless_lp" ? fmt::format(" at {} A", p.current_A) : "");
+                     config.kind == control::ControllerKind::kBumplessLp ? fmt::format(" at {} A", p.current_A) : "");
     o += "  f [Hz]    |G_yr|   lag [ms]\n";
     for (const auto& t : p.tracking) o += fmt::format("  {:6.1f}  {:8.4f}  {:8.4f}\n", t.f_hz, t.magnitude, t.lag_ms);
     if (p.loop) {
@@ -155,7 +155,7 @@ std::string DesignSummary::Report() const {
 
 nlohmann::json DesignSummary::ToJson() const {
   nlohmann::json j;
-  j["kind"] = config.kind;
+  j["kind"] = NameOf(kControllerKindNames, config.kind);
   j["dt_s"] = dt_s;
   if (feedforward) {
     j["feedforward"] = {{"model", ModelJson(config.model)},

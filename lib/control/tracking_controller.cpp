@@ -41,8 +41,8 @@ DiscreteSs FeedforwardFir(const FeedforwardCoefficients& a, bool half_step_ahead
 std::unique_ptr<TrackingController> MakeTrackingController(const control::ControllerConfig& cfg,
                                                            double dt_s) {
   if (!(dt_s > 0.0) || !std::isfinite(dt_s)) throw Error("run.dt_s", fmt::format("{}: allowed > 0", dt_s));
-  const std::string& k = cfg.kind;
-  if (k == "poly3" || k == "lead") {
+  const ControllerKind k = cfg.kind;
+  if (k == ControllerKind::kPoly3 || k == ControllerKind::kLead) {
     if (!(cfg.delay_ms <= cfg.max_delay_ms)) {
       throw Error("controller.delay_ms",
                   fmt::format("{} ms: allowed (0, controller.max_delay_ms = {} ms] (extrapolation beyond it "
@@ -50,28 +50,27 @@ std::unique_ptr<TrackingController> MakeTrackingController(const control::Contro
                               cfg.delay_ms, cfg.max_delay_ms));
     }
   }
-  if (k == "none") return std::make_unique<NoCompensation>(dt_s);
-  if (k == "ff") {
+  if (k == ControllerKind::kNone) return std::make_unique<NoCompensation>(dt_s);
+  if (k == ControllerKind::kFf) {
     RequireServoModel(cfg.model, "controller.model");
     return std::make_unique<ModelFeedforward>(cfg.model, cfg.half_step_ahead, dt_s);
   }
-  if (k == "poly3") return std::make_unique<PolynomialExtrapolation>(MakePoly3(cfg.delay_ms * 1e-3, dt_s), dt_s);
-  if (k == "lead") {
+  if (k == ControllerKind::kPoly3) return std::make_unique<PolynomialExtrapolation>(MakePoly3(cfg.delay_ms * 1e-3, dt_s), dt_s);
+  if (k == ControllerKind::kLead) {
     return std::make_unique<LeadCompensator>(MakeLead(cfg.delay_ms * 1e-3, cfg.lead_tp_ms * 1e-3, dt_s), dt_s);
   }
-  if (k == "ff_lp") {
+  if (k == ControllerKind::kFfLp) {
     return std::make_unique<InverseLowpass>(
         MakeInverseLowpass(cfg.model, cfg.lp_order, cfg.lp_cutoff_hz, dt_s, "controller.model"));
   }
-  if (k == "bumpless_lp") {
+  if (k == ControllerKind::kBumplessLp) {
     return std::make_unique<BumplessInverseLowpass>(
         MakeInverseLowpass(cfg.model_low, cfg.lp_order, cfg.lp_cutoff_hz, dt_s, "controller.model_low"),
         MakeInverseLowpass(cfg.model_high, cfg.lp_order, cfg.lp_cutoff_hz, dt_s, "controller.model_high"),
         cfg.current_high_A);
   }
-  if (k == "ff_lqg") return std::make_unique<FeedforwardLqg>(cfg.model, cfg.lqg, cfg.half_step_ahead, dt_s);
-  throw Error("controller.kind",
-              fmt::format("unknown controller '{}' (allowed: none, ff, poly3, lead, ff_lp, bumpless_lp, ff_lqg)", k));
+  if (k == ControllerKind::kFfLqg) return std::make_unique<FeedforwardLqg>(cfg.model, cfg.lqg, cfg.half_step_ahead, dt_s);
+  throw Error("controller.kind", "unknown controller");
 }
 
 }  // namespace rths::control

@@ -30,7 +30,7 @@ NominalModel LoadModel(const std::string& path) {
   m.actuator = s.plant.actuator;
   m.damper = s.plant.damper;
   m.current_dynamics = s.plant.current_dynamics;
-  m.has_damper = !actuator_only && s.plant.specimen == "mr_damper";
+  m.has_damper = !actuator_only && s.plant.specimen == models::Specimen::kMrDamper;
   m.source = fmt::format("{}: [plant] actuator K={:.6g} p={:.6g} b={:.6g} c={:.6g}", path, m.actuator.K,
                          m.actuator.p, m.actuator.b, m.actuator.c);
   if (actuator_only) {
@@ -39,15 +39,15 @@ NominalModel LoadModel(const std::string& path) {
                                   path));
   } else if (!m.has_damper) {
     m.notes.push_back(fmt::format("{}: plant.specimen = \"{}\": the force channel is not diagnosed", path,
-                                  s.plant.specimen));
+                                  NameOf(models::kSpecimenNames, s.plant.specimen)));
   } else {
     m.source += fmt::format("; Spencer damper from [plant.damper]; current dynamics {}",
                             m.current_dynamics ? "Eq. 40 + 75 Hz" : "off");
   }
-  if (s.plant.kind != "linear")
+  if (s.plant.kind != models::PlantKind::kLinear)
     m.notes.push_back(fmt::format("{}: plant.kind = \"{}\": the diagnosis uses the 3-pole [plant] actuator "
                                   "as the displacement model",
-                                  path, s.plant.kind));
+                                  path, NameOf(models::kPlantKindNames, s.plant.kind)));
   if (s.plant.RigMode())
     m.notes.push_back(fmt::format("{}: the file switches rig-mode effects on; the nominal model ignores them", path));
   return m;

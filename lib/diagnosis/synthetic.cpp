@@ -130,9 +130,9 @@ io::RigRecord MakeRecordRig(const Excitation& ex, const Truth& truth, const std:
   MakeInputs(ex, &u, &i);
   const std::size_t n = u.size();
   models::PlantConfig plant;
-  plant.kind = "linear";
+  plant.kind = models::PlantKind::kLinear;
   plant.actuator = models::ServoPreset("avg");
-  plant.specimen = "mr_damper";
+  plant.specimen = models::Specimen::kMrDamper;
   plant.current_dynamics = true;
   plant.effects = truth.effects;
   plant.noise_seed = truth.noise_seed;

@@ -20,15 +20,6 @@ std::int64_t BigEndian64(const std::uint8_t* p) {
 }
 }  // namespace
 
-ProcessFault ParseProcessFault(std::string_view kind) {
-  if (kind == "stall") return ProcessFault::kStall;
-  if (kind == "throw") return ProcessFault::kThrow;
-  if (kind == "crash") return ProcessFault::kCrash;
-  if (kind == "kill") return ProcessFault::kKill;
-  if (kind == "stop") return ProcessFault::kStop;
-  return ProcessFault::kNone;
-}
-
 FaultInjector::FaultInjector(const Faults& faults, std::uint64_t stream)
     : active_(faults.network.any() || !faults.targeted.empty()),
       network_(faults.network),

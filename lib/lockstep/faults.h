@@ -12,7 +12,25 @@
 #include <string_view>
 #include <vector>
 
+#include "core/names.h"
+
 namespace rths::lockstep {
+
+/// What a process fault does at its step.
+enum class ProcessFault {
+  kNone,
+  kStall,  ///< stops answering from the step on (a hung computation; the process stays alive)
+  kThrow,  ///< an exception in the step computation (exit 5, ABORT broadcast)
+  kCrash,  ///< abort(): dies by SIGABRT (udpm only)
+  kKill,   ///< raise(SIGKILL), as `kill -9` from outside (udpm only)
+  kStop,   ///< raise(SIGSTOP), as `kill -STOP`; continued after stop_s if stop_s > 0 (udpm only)
+};
+inline constexpr std::array<Named<ProcessFault>, 5> kProcessFaultNames = {
+    {{ProcessFault::kStall, "stall"},
+     {ProcessFault::kThrow, "throw"},
+     {ProcessFault::kCrash, "crash"},
+     {ProcessFault::kKill, "kill"},
+     {ProcessFault::kStop, "stop"}}};
 
 /// Fault injection, off by default (docs/lockstep.md "Fault injection"): seeded random faults
 /// on every message each participant receives, and one process fault.
@@ -28,10 +46,11 @@ struct FaultConfig {
   std::int64_t recv_buf_bytes = 0;
   /// [faults.process]: one participant stalls, throws, crashes, is killed or stopped at a step.
   std::string process_role;    ///< "" (none) or a participant: integrator, controller, plant, semiactive, logger
-  std::string process_kind;    ///< stall | throw | crash | kill | stop (crash, kill, stop: udpm only)
+  ProcessFault process_kind = ProcessFault::kNone;  ///< stall | throw | crash | kill | stop (the last three: udpm only)
   std::int64_t process_at_step = 0;  ///< [0, steps)
   double process_stop_s = 0.0; ///< "stop": continue after this many seconds, 0 = never, [0, 3600]
   bool any_network() const { return drop > 0 || duplicate > 0 || delay > 0 || reorder > 0; }
+  bool operator==(const FaultConfig&) const = default;
 };
 
 /// Seeded random faults on every message a participant receives.
@@ -45,17 +64,11 @@ struct NetworkFaults {
   bool any() const { return drop > 0 || duplicate > 0 || delay > 0 || reorder > 0; }
 };
 
-/// What a process fault does at its step.
-enum class ProcessFault {
-  kNone,
-  kStall,  ///< stops answering from the step on (a hung computation; the process stays alive)
-  kThrow,  ///< an exception in the step computation (exit 5, ABORT broadcast)
-  kCrash,  ///< abort(): dies by SIGABRT (udpm only)
-  kKill,   ///< raise(SIGKILL), as `kill -9` from outside (udpm only)
-  kStop,   ///< raise(SIGSTOP), as `kill -STOP`; continued after stop_s if stop_s > 0 (udpm only)
-};
-/// "stall", "throw", "crash", "kill", "stop"; kNone for anything else.
-ProcessFault ParseProcessFault(std::string_view kind);
+/// true for the faults that end or freeze the whole process (crash, kill, stop): with the memq
+/// transport every participant shares it, so these need udpm.
+constexpr bool EndsProcess(ProcessFault f) {
+  return f == ProcessFault::kCrash || f == ProcessFault::kKill || f == ProcessFault::kStop;
+}
 
 /// One deterministic fault at one receiver (tests): the first message on `channel` whose step
 /// is k (per-step and repair channels) or whose phase is `phase` (handshake) is acted upon.

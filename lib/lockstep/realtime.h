@@ -26,6 +26,7 @@ struct RealtimeConfig {
   bool sched_fifo = true;                  ///< try SCHED_FIFO for every participant process
   int priority = 80;                       ///< its SCHED_FIFO priority, [1, 99]
   bool lock_memory = true;                 ///< try mlockall(MCL_CURRENT | MCL_FUTURE)
+  bool operator==(const RealtimeConfig&) const = default;
 };
 
 /// How the clock paces steps (from the scenario's [realtime] table).

@@ -35,6 +35,7 @@ struct LockstepConfig {
   /// 4 rerequest_ms: a participant that stopped answering. A loaded host only slows steps down.
   double stall_budget_s = 10.0;
   double handshake_timeout_s = 20; ///< abort if not every participant said hello, [0.1, 600]
+  bool operator==(const LockstepConfig&) const = default;
 };
 
 inline constexpr const char* kChHandshake = "RTHS_HANDSHAKE";

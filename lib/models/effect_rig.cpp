@@ -31,10 +31,10 @@ std::uint64_t EffectNoiseSeed(std::uint64_t noise_seed) {
 }
 
 EffectRigModel EffectRigModel::Make(const models::PlantConfig& plant, double dt_s) {
-  if (plant.kind != "linear") {
+  if (plant.kind != PlantKind::kLinear) {
     throw Error("plant.kind", fmt::format("rig mode needs plant.kind = \"linear\" (got \"{}\"): the effects act "
                                           "around the linear actuator model",
-                                          plant.kind));
+                                          NameOf(kPlantKindNames, plant.kind)));
   }
   const bool damper = HasDamper(plant);
   plant.effects.Validate(dt_s, "plant");

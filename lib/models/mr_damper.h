@@ -34,6 +34,7 @@ struct MrDamperParams {
   /// Throws rths::Error naming the first invalid field (c0, c1 > 0; alpha, beta, gamma, A,
   /// k0, k1 >= 0; rates >= 0; n >= 1; all finite).
   void Validate() const;
+  bool operator==(const MrDamperParams&) const = default;
 };
 
 /// The model's coefficients at one current (Eqs. 35-39); units as in MrDamperParams.

@@ -111,43 +111,37 @@ class IdealRig final : public Rig {
 
 }  // namespace
 
-bool HasDamper(const models::PlantConfig& plant) {
-  if (plant.specimen == "mr_damper") return true;
-  if (plant.specimen == "none") return false;
-  throw Error("plant.specimen", fmt::format("\"{}\" is not one of \"mr_damper\", \"none\"", plant.specimen));
-}
+bool HasDamper(const models::PlantConfig& plant) { return plant.specimen == Specimen::kMrDamper; }
 
 std::unique_ptr<Rig> MakeRig(const models::PlantConfig& plant, double dt_s) {
   const bool damper = HasDamper(plant);
   if (plant.RigMode()) {  // effects or unmodelled disturbances on: docs/rig_mode.md
-    if (plant.kind != "linear") {
+    if (plant.kind != PlantKind::kLinear) {
       throw Error(plant.effects.Empty() ? "plant.unmodelled" : "plant.effects",
                   fmt::format("rig mode needs plant.kind = \"linear\" (got \"{}\"): the effects act around "
                               "the linear actuator model",
-                              plant.kind));
+                              NameOf(kPlantKindNames, plant.kind)));
     }
     return MakeEffectRig(plant, dt_s);
   }
-  if (plant.kind == "linear") {  // the nominal linear rig, unchanged
-    return std::make_unique<LinearRigAdapter>(LinearRig::Make(plant.actuator, dt_s, damper,
-                                                              plant.damper,
-                                                              plant.cvode_rtol,
-                                                              plant.current_dynamics));
+  switch (plant.kind) {
+    case PlantKind::kLinear:  // the nominal linear rig, unchanged
+      return std::make_unique<LinearRigAdapter>(LinearRig::Make(plant.actuator, dt_s, damper,
+                                                                plant.damper,
+                                                                plant.cvode_rtol,
+                                                                plant.current_dynamics));
+    case PlantKind::kPhysical:
+      return std::make_unique<PhysicalRigAdapter>(
+          PhysicalRig::Make(plant.physical, dt_s, damper ? RigLoad::kMrDamper : RigLoad::kNone,
+                            plant.current_dynamics, plant.damper, {},
+                            plant.cvode_rtol));
+    case PlantKind::kIdeal:
+      if (!(plant.cvode_rtol > 0.0 && plant.cvode_rtol <= 1e-2))
+        throw Error("plant.cvode_rtol", fmt::format("must be in (0, 1e-2] (got {})", plant.cvode_rtol));
+      return std::make_unique<IdealRig>(plant.damper, damper, plant.current_dynamics, dt_s,
+                                        plant.cvode_rtol);
   }
-  if (plant.kind == "physical") {
-    return std::make_unique<PhysicalRigAdapter>(
-        PhysicalRig::Make(plant.physical, dt_s, damper ? RigLoad::kMrDamper : RigLoad::kNone,
-                          plant.current_dynamics, plant.damper, {},
-                          plant.cvode_rtol));
-  }
-  if (plant.kind == "ideal") {
-    if (!(plant.cvode_rtol > 0.0 && plant.cvode_rtol <= 1e-2))
-      throw Error("plant.cvode_rtol", fmt::format("must be in (0, 1e-2] (got {})", plant.cvode_rtol));
-    return std::make_unique<IdealRig>(plant.damper, damper, plant.current_dynamics, dt_s,
-                                      plant.cvode_rtol);
-  }
-  throw Error("plant.kind",
-              fmt::format("\"{}\" is not one of \"linear\", \"physical\", \"ideal\"", plant.kind));
+  throw Error("plant.kind", "unknown loading system");
 }
 
 }  // namespace rths::models

@@ -18,9 +18,19 @@
 #include "models/rig_effects.h"
 #include "models/servo_linear.h"
 #include "models/servo_physical.h"
-
+#include "core/names.h"
 
 namespace rths::models {
+
+/// The loading system (PlantConfig::kind): the linear three-pole model, the servovalve / oil
+/// column / piston model ("physical" in files: docs/models.md section 5), or ideal tracking.
+enum class PlantKind { kLinear, kPhysical, kIdeal };
+inline constexpr std::array<Named<PlantKind>, 3> kPlantKindNames = {
+    {{PlantKind::kLinear, "linear"}, {PlantKind::kPhysical, "physical"}, {PlantKind::kIdeal, "ideal"}}};
+/// The specimen on the actuator (PlantConfig::specimen).
+enum class Specimen { kMrDamper, kNone };
+inline constexpr std::array<Named<Specimen>, 2> kSpecimenNames = {
+    {{Specimen::kMrDamper, "mr_damper"}, {Specimen::kNone, "none"}}};
 
 /// "Physical" substructure and loading system (procs/plant).
 struct PlantConfig {
@@ -29,10 +39,10 @@ struct PlantConfig {
   /// loaded by the damper force (control-structure interaction); "ideal": the pure numerical
   /// simulation, a loading system that tracks perfectly (y_k = r_k, the damper driven by the
   /// desired motion; answers measured_t k from desired_t k: docs/lockstep.md, footnote).
-  std::string kind = "linear";
+  PlantKind kind = PlantKind::kLinear;
   ServoModel3 actuator{};              ///< "linear": servohydraulic model
   PhysicalActuatorConfig physical{};   ///< "physical": its parameters
-  std::string specimen = "mr_damper";  ///< "mr_damper" (Eqs. 32-39, Table 3) | "none"
+  Specimen specimen = Specimen::kMrDamper;  ///< "mr_damper" (Eqs. 32-39, Table 3) | "none"
   /// Damper current dynamics: the driver lag of Eq. 40 and a 75 Hz second-order Butterworth
   /// low-pass between the commanded and the effective current. false: effective = commanded.
   bool current_dynamics = true;
@@ -55,6 +65,7 @@ struct PlantConfig {
   UnmodelledConfig unmodelled{};
   /// true if the plant runs in rig mode (effects or unmodelled disturbances on).
   bool RigMode() const { return !effects.Empty() || !unmodelled.Empty(); }
+  bool operator==(const PlantConfig&) const = default;
 };
 
 class Rig {

@@ -2,77 +2,142 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 
 #include <Eigen/Dense>
 #include <unsupported/Eigen/MatrixFunctions>
+
+#include <fmt/format.h>
 
 #include "core/error.h"
 
 namespace rths::models {
 namespace {
 
-void Check(bool ok, std::string_view where, std::string_view effect, std::string_view key,
-           double value, std::string_view range) {
-  if (ok && std::isfinite(value)) return;
-  throw Error(std::string(where) + (where.empty() ? "" : ": ") + "effects." +
-                  std::string(effect) + "." + std::string(key),
-              "value " + std::to_string(value) + " is out of range; allowed " +
-                  std::string(range));
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+/// A parameter's accessor: the field of the effect's struct, if the effect is on.
+template <auto kEffect, auto kField>
+double* FieldOf(EffectSet& set) {
+  auto& effect = set.*kEffect;
+  return effect ? &((*effect).*kField) : nullptr;
 }
+template <auto kEffect>
+void TurnOn(EffectSet& set) {
+  (set.*kEffect).emplace();
+}
+template <auto kEffect>
+bool IsOn(const EffectSet& set) {
+  return (set.*kEffect).has_value();
+}
+
+// key, valid [lo, hi], open ends, hi per dt, required | fitted, search [lo, hi], log, grid,
+// search hi per dt, search hi from data | accessor
+constexpr EffectParam kNoParam{};
 
 }  // namespace
 
+const std::array<EffectInfo, 10> kEffects = {{
+    {"pure_delay", 'y', true,
+     {{{"tau_ms", 0.0, 100.0, false, false, 0.0, true, true, 0.0, 40.0, false, 81, 0.0, false,
+        FieldOf<&EffectSet::pure_delay, &PureDelay::tau_ms>},
+       kNoParam}},
+     1, TurnOn<&EffectSet::pure_delay>, IsOn<&EffectSet::pure_delay>},
+    {"gain_error", 'y', true,
+     {{{"gain", 0.5, 2.0, false, false, 0.0, true, true, 0.5, 2.0, true, 41, 0.0, false,
+        FieldOf<&EffectSet::gain_error, &GainError::gain>},
+       kNoParam}},
+     1, TurnOn<&EffectSet::gain_error>, IsOn<&EffectSet::gain_error>},
+    // The diagnosis searches c >= 0 only: an actuator yields under load.
+    {"load_coupling", 'y', true,
+     {{{"compliance_mm_per_kN", -1.0, 1.0, false, false, 0.0, true, true, 0.0, 0.2, false, 81, 0.0, false,
+        FieldOf<&EffectSet::load_coupling, &LoadCoupling::compliance_mm_per_kN>},
+       kNoParam}},
+     1, TurnOn<&EffectSet::load_coupling>, IsOn<&EffectSet::load_coupling>},
+    {"oil_column_resonance", 'y', true,
+     {{{"f_hz", 0.0, kInf, true, true, 0.45, true, true, 2.0, 0.0, true, 40, 0.4, false,
+        FieldOf<&EffectSet::oil_column_resonance, &OilColumnResonance::f_hz>},
+       {"zeta", 0.0, 2.0, true, false, 0.0, false, true, 0.02, 1.5, true, 10, 0.0, false,
+        FieldOf<&EffectSet::oil_column_resonance, &OilColumnResonance::zeta>}}},
+     2, TurnOn<&EffectSet::oil_column_resonance>, IsOn<&EffectSet::oil_column_resonance>},
+    {"coulomb_friction", 'y', true,
+     {{{"loss_mm", 0.0, 10.0, false, false, 0.0, true, true, 1e-3, 10.0, true, 31, 0.0, false,
+        FieldOf<&EffectSet::coulomb_friction, &CoulombFriction::loss_mm>},
+       {"v_smooth_mm_s", 0.0, 1000.0, true, false, 0.0, false, false, 0.0, 0.0, false, 0, 0.0, false,
+        FieldOf<&EffectSet::coulomb_friction, &CoulombFriction::v_smooth_mm_s>}}},
+     2, TurnOn<&EffectSet::coulomb_friction>, IsOn<&EffectSet::coulomb_friction>},
+    {"backlash", 'y', true,
+     {{{"gap_mm", 0.0, 10.0, false, false, 0.0, true, true, 1e-3, 10.0, true, 31, 0.0, false,
+        FieldOf<&EffectSet::backlash, &Backlash::gap_mm>},
+       kNoParam}},
+     1, TurnOn<&EffectSet::backlash>, IsOn<&EffectSet::backlash>},
+    {"servovalve_saturation", 'y', true,
+     {{{"vmax_mm_per_s", 0.0, 1e9, true, false, 0.0, true, true, 1.0, 0.0, true, 31, 0.0, true,
+        FieldOf<&EffectSet::servovalve_saturation, &ServovalveSaturation::vmax_mm_per_s>},
+       kNoParam}},
+     1, TurnOn<&EffectSet::servovalve_saturation>, IsOn<&EffectSet::servovalve_saturation>},
+    // The noise floor, not an effect the diagnosis selects; a table needs one of its keys.
+    {"sensor_noise", 'b', false,
+     {{{"rms_y_mm", 0.0, 10.0, false, false, 0.0, false, false, 0.0, 0.0, false, 0, 0.0, false,
+        FieldOf<&EffectSet::sensor_noise, &SensorNoise::rms_y_mm>},
+       {"rms_f_kN", 0.0, 100.0, false, false, 0.0, false, false, 0.0, 0.0, false, 0, 0.0, false,
+        FieldOf<&EffectSet::sensor_noise, &SensorNoise::rms_f_kN>}}},
+     2, TurnOn<&EffectSet::sensor_noise>, IsOn<&EffectSet::sensor_noise>},
+    {"current_lag", 'f', true,
+     {{{"tau_ms", 0.0, 1000.0, false, false, 0.0, true, true, 0.5, 1000.0, true, 12, 0.0, false,
+        FieldOf<&EffectSet::current_lag, &CurrentLag::tau_ms>},
+       kNoParam}},
+     1, TurnOn<&EffectSet::current_lag>, IsOn<&EffectSet::current_lag>},
+    // grid 0: fitted in closed form (least squares of the force's scale).
+    {"damper_scale", 'f', true,
+     {{{"scale", 0.1, 10.0, false, false, 0.0, true, true, 0.1, 10.0, true, 0, 0.0, false,
+        FieldOf<&EffectSet::damper_scale, &DamperScale::scale>},
+       kNoParam}},
+     1, TurnOn<&EffectSet::damper_scale>, IsOn<&EffectSet::damper_scale>},
+}};
+
+const EffectInfo* FindEffect(std::string_view name) {
+  for (const EffectInfo& e : kEffects)
+    if (e.name == name) return &e;
+  return nullptr;
+}
+
+const EffectParam* EffectInfo::param(std::string_view key) const {
+  for (const EffectParam& p : params())
+    if (p.key == key) return &p;
+  return nullptr;
+}
+
+bool EffectParam::Valid(double v, double dt_s) const {
+  const double h = Hi(dt_s);
+  const bool above = lo_open ? v > lo : v >= lo;
+  const bool below = hi_open ? v < h : v <= h;
+  return std::isfinite(v) && above && below;
+}
+
+std::string EffectParam::RangeText(double dt_s) const {
+  std::string text = fmt::format("{}{}, {}{}", lo_open ? '(' : '[', lo, Hi(dt_s), hi_open ? ')' : ']');
+  if (hi_per_dt > 0.0) text += fmt::format(" ({} / dt)", hi_per_dt);
+  return text;
+}
+
 bool EffectSet::Empty() const {
-  return !pure_delay && !gain_error && !load_coupling && !oil_column_resonance &&
-         !coulomb_friction && !backlash && !servovalve_saturation && !sensor_noise &&
-         !current_lag && !damper_scale;
+  for (const EffectInfo& e : kEffects)
+    if (e.is_on(*this)) return false;
+  return true;
 }
 
 void EffectSet::Validate(double dt_s, std::string_view where) const {
-  if (pure_delay)
-    Check(pure_delay->tau_ms >= 0 && pure_delay->tau_ms <= 100, where, "pure_delay", "tau_ms",
-          pure_delay->tau_ms, "[0, 100] ms");
-  if (gain_error)
-    Check(gain_error->gain >= 0.5 && gain_error->gain <= 2, where, "gain_error", "gain",
-          gain_error->gain, "[0.5, 2]");
-  if (load_coupling)
-    Check(std::abs(load_coupling->compliance_mm_per_kN) <= 1, where, "load_coupling",
-          "compliance_mm_per_kN", load_coupling->compliance_mm_per_kN, "[-1, 1] mm/kN");
-  if (oil_column_resonance) {
-    const double f_max = 0.45 / dt_s;
-    Check(oil_column_resonance->f_hz > 0 && oil_column_resonance->f_hz < f_max, where,
-          "oil_column_resonance", "f_hz", oil_column_resonance->f_hz,
-          "(0, " + std::to_string(f_max) + ") Hz (0.45 / dt)");
-    Check(oil_column_resonance->zeta > 0 && oil_column_resonance->zeta <= 2, where,
-          "oil_column_resonance", "zeta", oil_column_resonance->zeta, "(0, 2]");
+  EffectSet copy = *this;  // the accessors give mutable fields
+  for (const EffectInfo& e : kEffects) {
+    for (const EffectParam& p : e.params()) {
+      const double* v = p.field(copy);
+      if (v == nullptr || p.Valid(*v, dt_s)) continue;
+      throw Error(fmt::format("{}{}effects.{}.{}", where, where.empty() ? "" : ": ", e.name, p.key),
+                  fmt::format("value {} is out of range; allowed {}", *v, p.RangeText(dt_s)));
+    }
   }
-  if (coulomb_friction) {
-    Check(coulomb_friction->loss_mm >= 0 && coulomb_friction->loss_mm <= 10, where,
-          "coulomb_friction", "loss_mm", coulomb_friction->loss_mm, "[0, 10] mm");
-    Check(coulomb_friction->v_smooth_mm_s > 0 && coulomb_friction->v_smooth_mm_s <= 1000, where,
-          "coulomb_friction", "v_smooth_mm_s", coulomb_friction->v_smooth_mm_s,
-          "(0, 1000] mm/s");
-  }
-  if (backlash)
-    Check(backlash->gap_mm >= 0 && backlash->gap_mm <= 10, where, "backlash", "gap_mm",
-          backlash->gap_mm, "[0, 10] mm");
-  if (servovalve_saturation)
-    Check(servovalve_saturation->vmax_mm_per_s > 0 && servovalve_saturation->vmax_mm_per_s <= 1e9,
-          where, "servovalve_saturation", "vmax_mm_per_s", servovalve_saturation->vmax_mm_per_s,
-          "(0, 1e9] mm/s");
-  if (sensor_noise) {
-    Check(sensor_noise->rms_y_mm >= 0 && sensor_noise->rms_y_mm <= 10, where, "sensor_noise",
-          "rms_y_mm", sensor_noise->rms_y_mm, "[0, 10] mm");
-    Check(sensor_noise->rms_f_kN >= 0 && sensor_noise->rms_f_kN <= 100, where, "sensor_noise",
-          "rms_f_kN", sensor_noise->rms_f_kN, "[0, 100] kN");
-  }
-  if (current_lag)
-    Check(current_lag->tau_ms >= 0 && current_lag->tau_ms <= 1000, where, "current_lag",
-          "tau_ms", current_lag->tau_ms, "[0, 1000] ms");
-  if (damper_scale)
-    Check(damper_scale->scale >= 0.1 && damper_scale->scale <= 10, where, "damper_scale",
-          "scale", damper_scale->scale, "[0.1, 10]");
 }
 
 DisplacementEffects::DisplacementEffects(const EffectSet& effects, double dt_s)

@@ -18,6 +18,8 @@
 /// per-step calls allocate nothing (the delay line is sized once, at construction).
 #include <array>
 #include <optional>
+#include <span>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -36,39 +38,34 @@ struct UnmodelledConfig {
   double stiffness_kN_per_mm = 0.0;
   /// true if every disturbance is off.
   bool Empty() const { return ripple_mm == 0.0 && stiffness_kN_per_mm == 0.0; }
+  bool operator==(const UnmodelledConfig&) const = default;
 };
 
-/// The library's effect names, exactly as in the contract (the JSON and the scenario use them).
-inline constexpr std::array<std::string_view, 10> kEffectNames = {
-    "pure_delay",        "gain_error", "load_coupling",         "oil_column_resonance",
-    "coulomb_friction",  "backlash",   "servovalve_saturation", "sensor_noise",
-    "current_lag",       "damper_scale"};
-
 /// Transport delay of the command: u_d(t) = u(t - tau), linear interpolation between samples.
-struct PureDelay { double tau_ms = 0.0; };                          ///< [0, 100] ms
+struct PureDelay { double tau_ms = 0.0; bool operator==(const PureDelay&) const = default; };                          ///< [0, 100] ms
 /// Static gain mismatch of the displacement path: the actuator model sees gain * u.
-struct GainError { double gain = 1.0; };                            ///< [0.5, 2]
+struct GainError { double gain = 1.0; bool operator==(const GainError&) const = default; };                            ///< [0.5, 2]
 /// The actuator yields under the specimen force: y_k = x_k - compliance * f, with f the force
 /// the caller couples with (Post's f_kN: the diagnosis passes the measured f_k; the rig mode the
 /// true f_k of the same sample, solved per step, or f_{k-1} on request: docs/rig_mode.md).
-struct LoadCoupling { double compliance_mm_per_kN = 0.0; };         ///< [-1, 1] mm/kN
+struct LoadCoupling { double compliance_mm_per_kN = 0.0; bool operator==(const LoadCoupling&) const = default; };         ///< [-1, 1] mm/kN
 /// An extra, lightly damped mode in series: w^2 / (s^2 + 2 zeta w s + w^2), w = 2 pi f_hz
 /// (unity at DC), discretised exactly with a zero-order hold on its input.
-struct OilColumnResonance { double f_hz = 60.0; double zeta = 0.05; };  ///< f in (0, 0.45/dt), zeta (0, 2]
+struct OilColumnResonance { double f_hz = 60.0; double zeta = 0.05; bool operator==(const OilColumnResonance&) const = default; };  ///< f in (0, 0.45/dt), zeta (0, 2]
 /// Seal friction: displacement lost against the direction of motion,
 /// y = x - loss * tanh(x' / v_smooth), x' = (x_k - x_{k-1}) / dt of the block's input.
-struct CoulombFriction { double loss_mm = 0.0; double v_smooth_mm_s = 0.5; };  ///< loss [0, 10] mm
+struct CoulombFriction { double loss_mm = 0.0; double v_smooth_mm_s = 0.5; bool operator==(const CoulombFriction&) const = default; };  ///< loss [0, 10] mm
 /// Dead band (play operator): y holds until its input has moved gap/2 past it, then follows.
-struct Backlash { double gap_mm = 0.0; };                           ///< [0, 10] mm
+struct Backlash { double gap_mm = 0.0; bool operator==(const Backlash&) const = default; };                           ///< [0, 10] mm
 /// Flow limit: the output moves at most vmax * dt per step towards its input (rate limiter).
-struct ServovalveSaturation { double vmax_mm_per_s = 1e9; };        ///< > 0
+struct ServovalveSaturation { double vmax_mm_per_s = 1e9; bool operator==(const ServovalveSaturation&) const = default; };        ///< > 0
 /// Gaussian measurement noise added to a channel (rig mode only); rms in the channel's unit.
-struct SensorNoise { double rms_y_mm = 0.0; double rms_f_kN = 0.0; };  ///< >= 0
+struct SensorNoise { double rms_y_mm = 0.0; double rms_f_kN = 0.0; bool operator==(const SensorNoise&) const = default; };  ///< >= 0
 /// Extra first-order lag of the damper current, 1 / (tau s + 1), exact ZOH, in series with the
 /// model's own current dynamics.
-struct CurrentLag { double tau_ms = 0.0; };                         ///< [0, 1000] ms
+struct CurrentLag { double tau_ms = 0.0; bool operator==(const CurrentLag&) const = default; };                         ///< [0, 1000] ms
 /// Damper force level drift: f = scale * f_model.
-struct DamperScale { double scale = 1.0; };                         ///< [0.1, 10]
+struct DamperScale { double scale = 1.0; bool operator==(const DamperScale&) const = default; };                         ///< [0.1, 10]
 
 /// Which effects are on, with their parameters. Default: none (the nominal model).
 struct EffectSet {
@@ -87,7 +84,60 @@ struct EffectSet {
   /// Throws rths::Error naming the effect and parameter out of its range (ranges above) for a
   /// time step dt_s [s]; `where` prefixes the message (e.g. the scenario file and table).
   void Validate(double dt_s, std::string_view where) const;
+  bool operator==(const EffectSet&) const = default;
 };
+
+/// One parameter of an effect: everything the scenario reader, the validators, the rig mode
+/// and the diagnosis need to know about it, in one place.
+struct EffectParam {
+  std::string_view key;   ///< name in scenario files and diagnosis.json (the unit is in the name)
+  /// Valid range [lo, hi] (open ends as flagged). If hi_per_dt > 0 the upper end is
+  /// hi_per_dt / dt_s instead (a frequency below Nyquist).
+  double lo, hi;
+  bool lo_open, hi_open;
+  double hi_per_dt;
+  bool required;          ///< a scenario's [plant.effects.<name>] table must give it
+  /// Diagnosis search range (docs/diagnosis.md "Fitting"): [search_lo, search_hi], on a grid of
+  /// `grid` points (0: closed form), in log space if `log`. search_hi_per_dt > 0: the upper end
+  /// is search_hi_per_dt / dt_s; search_hi_from_data: given per record (servovalve_saturation:
+  /// twice the largest measured velocity). fitted = false: the diagnosis keeps the default.
+  bool fitted;
+  double search_lo, search_hi;
+  bool log;
+  int grid;
+  double search_hi_per_dt;
+  bool search_hi_from_data;
+  /// The parameter in a set where the effect is on (nullptr if it is off).
+  double* (*field)(EffectSet&);
+
+  double Lo() const { return lo; }
+  /// Upper end of the valid range at time step dt_s [s].
+  double Hi(double dt_s) const { return hi_per_dt > 0.0 ? hi_per_dt / dt_s : hi; }
+  /// true if v is in the valid range at dt_s (and finite).
+  bool Valid(double v, double dt_s) const;
+  /// "[0, 100] ms"-style description of the valid range at dt_s, for messages.
+  std::string RangeText(double dt_s) const;
+};
+
+/// One effect of the library (the order of the table is the contract's).
+struct EffectInfo {
+  std::string_view name;      ///< exactly as in the contract (scenario tables, diagnosis.json)
+  char channel;               ///< 'y': displacement path, 'f': force path, 'b': both (noise)
+  bool diagnosable;           ///< the diagnosis may select it (sensor_noise: no, the floor)
+  std::array<EffectParam, 2> params_storage;
+  std::size_t param_count;
+  void (*turn_on)(EffectSet&);       ///< switches it on with its defaults
+  bool (*is_on)(const EffectSet&);
+
+  std::span<const EffectParam> params() const { return {params_storage.data(), param_count}; }
+  const EffectParam* param(std::string_view key) const;
+};
+
+/// The effect library: one entry per effect. Adding an effect is one entry here (plus its
+/// struct above, its member of EffectSet and its block in the classes below).
+extern const std::array<EffectInfo, 10> kEffects;
+/// The entry called `name`, or nullptr.
+const EffectInfo* FindEffect(std::string_view name);
 
 /// The displacement path's effects around an actuator model (order in the file comment).
 /// Use: per step k, u_act = Pre(u_k) goes into the actuator model, whose output x at t_k goes

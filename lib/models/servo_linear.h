@@ -29,6 +29,7 @@ struct ServoModel3 {
   double b = 250.4;    ///< quadratic factor s^2 + b s + c [1/s]
   double c = 1.061e5;  ///< [1/s^2]
   std::string name = "avg";  ///< preset name, or "custom"
+  bool operator==(const ServoModel3&) const = default;
 };
 /// The paper's identified models: "0.0A" (Eq. 28), "2.5A" (Eq. 29), "avg" (Eq. 30).
 /// Throws rths::Error for an unknown name.

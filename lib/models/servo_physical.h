@@ -55,6 +55,7 @@ struct PhysicalActuatorConfig {
   double kp_per_m = 331.4;             ///< inner-loop gain K_p [1/m] (K_p K_q / A = 133.3 1/s), (0, 1e6]
   double beta_Pa = 1.172e9;            ///< effective bulk modulus beta_e, (0, 1e12]
   double leakage_m3_s_Pa = 2.693e-11;  ///< total leakage coefficient C_tot, [0, 1e-6]
+  bool operator==(const PhysicalActuatorConfig&) const = default;
 };
 
 /// The actuator's parameters, SI (models.md section 5; models::PhysicalActuatorConfig).

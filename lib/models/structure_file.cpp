@@ -173,7 +173,7 @@ Modes ModalAnalysis(const StructureMatrices& m) {
 }
 
 LinearStructure StructureFromScenario(const models::StructureConfig& st, const std::string& scenario_path) {
-  if (st.kind != "file") {
+  if (st.kind != StructureKind::kFile) {
     return LinearStructure::Sdof(st.mass_kg, st.frequency_hz, st.damping_ratio, st.specimen_count);
   }
   const StructureMatrices m = LoadStructureFile(st.file);

@@ -14,17 +14,31 @@
 
 #include <Eigen/Core>
 
+#include "core/names.h"
 #include "models/structure.h"
 #include "signal/history.h"
 
 namespace rths::models {
 
+/// Where the reference displacement comes from (StructureConfig::mode).
+enum class StructureMode { kRths, kPredefined };
+inline constexpr std::array<Named<StructureMode>, 2> kStructureModeNames = {
+    {{StructureMode::kRths, "rths"}, {StructureMode::kPredefined, "predefined"}}};
+/// What the numerical substructure is (StructureConfig::kind).
+enum class StructureKind { kSdof, kFile };
+inline constexpr std::array<Named<StructureKind>, 2> kStructureKindNames = {
+    {{StructureKind::kSdof, "sdof"}, {StructureKind::kFile, "file"}}};
+/// How the integrator gets r', r'', r''' in predefined mode (StructureConfig::derivatives).
+enum class Derivatives { kExtrapolated, kCentral };
+inline constexpr std::array<Named<Derivatives>, 2> kDerivativesNames = {
+    {{Derivatives::kExtrapolated, "extrapolated"}, {Derivatives::kCentral, "central"}}};
+
 /// Numerical substructure (procs/integrator).
 struct StructureConfig {
-  std::string mode = "rths";  ///< "rths" (central difference, Eqs. 1-3) | "predefined" (r from a history)
+  StructureMode mode = StructureMode::kRths;  ///< "rths" (central difference, Eqs. 1-3) | "predefined" (r from a history)
   /// mode = "rths": "sdof" (mass, frequency, damping below) | "file" (M, K, C from `file`, a
   /// structure file: docs/structures.md; e.g. data/buildings/ohtori9_ns.txt).
-  std::string kind = "sdof";
+  StructureKind kind = StructureKind::kSdof;
   std::string file;           ///< kind = "file": path, relative to the scenario file's folder
   int actuator_dof = 1;       ///< kind = "file": DOF the specimen acts on, 1-based (1 = first story)
   // kind = "sdof":
@@ -34,10 +48,11 @@ struct StructureConfig {
   double specimen_count = 1.0;       ///< measured force multiplier (18 dampers act as one) (0, 1000]
   signal::SignalSpec ground{};               ///< ground acceleration [mm/s^2]
   // mode = "predefined": the desired displacement itself [mm].
-  signal::SignalSpec desired{"blwn", 5.0, 2.78, 1, 2.0, "", 0.0, 1.0, 0.5};
+  signal::SignalSpec desired{signal::SignalKind::kBlwn, 5.0, 2.78, 1, 2.0, "", 0.0, 1.0, 0.5};
   /// How the integrator gets r', r'', r''' in predefined mode: "extrapolated" (Eqs. 20-22, the
   /// causal RTHS path) | "central" (offline, non-causal central differences of the known record).
-  std::string derivatives = "extrapolated";
+  Derivatives derivatives = Derivatives::kExtrapolated;
+  bool operator==(const StructureConfig&) const = default;
 };
 
 /// M [kN s^2/mm], K [kN/mm], C [kN s/mm].

@@ -37,7 +37,7 @@ lockstep::Faults FaultsOf(const scenario::Scenario& s, std::string_view role) {
   lockstep::Faults f;
   f.network = {c.drop, c.duplicate, c.delay, c.reorder, c.delay_ms, static_cast<std::uint64_t>(c.seed)};
   if (c.process_role == role) {
-    f.process = lockstep::ParseProcessFault(c.process_kind);
+    f.process = c.process_kind;
     f.at_step = c.process_at_step;
     f.stop_s = c.process_stop_s;
   }

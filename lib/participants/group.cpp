@@ -135,12 +135,12 @@ std::vector<Outcome> RunGroupInProcess(const std::vector<scenario::Scenario>& pe
     throw Error("RunGroupInProcess", "give one scenario, or one per role");
   }
   for (const auto& s : per_role) {
-    const std::string& kind = s.faults.process_kind;
-    if (kind == "crash" || kind == "kill" || kind == "stop") {
+    const lockstep::ProcessFault kind = s.faults.process_kind;
+    if (lockstep::EndsProcess(kind)) {
       throw Error(s.path + ": faults.process.kind",
                   fmt::format("\"{}\" would take every participant down in one process (memq): use the "
                               "udpm transport (one process per participant)",
-                              kind));
+                              NameOf(lockstep::kProcessFaultNames, kind)));
     }
   }
   lcm::LCM lcm("memq://");

@@ -20,14 +20,14 @@ std::string FolderOf(const std::string& path) {
 Integrator::Integrator(const scenario::Scenario& s, lockstep::RunIdentity id, lcm::LCM* lcm,
                        lockstep::Faults faults)
     : ClockParticipant("integrator", id, TimingOf(s), lcm, std::move(faults)),
-      predefined_(s.structure.mode == "predefined"),
+      predefined_(s.structure.mode == models::StructureMode::kPredefined),
       dt_s_(s.run.dt_s),
       safety_(s.safety, s.run.dt_s) {
   const auto n = static_cast<std::size_t>(id.n_steps);
   const std::string dir = FolderOf(s.path);
   if (predefined_) {
     r_mm_ = signal::MakeSignal(s.structure.desired, dt_s_, n, dir);
-    if (s.structure.derivatives == "central") central_ = control::CentralDerivatives(r_mm_, dt_s_);
+    if (s.structure.derivatives == models::Derivatives::kCentral) central_ = control::CentralDerivatives(r_mm_, dt_s_);
     state_.x = Eigen::VectorXd::Zero(1);
     state_.abs_acc_prev = Eigen::VectorXd::Zero(1);
   } else {

@@ -10,21 +10,21 @@
 namespace rths::participants {
 
 CurrentSchedule::CurrentSchedule(const control::SemiactiveConfig& cfg, double dt_s) {
-  if (cfg.mode == "passive_off") {
+  if (cfg.mode == control::SemiactiveMode::kPassiveOff) {
     on_A_ = 0.0;
-  } else if (cfg.mode == "passive_on") {
+  } else if (cfg.mode == control::SemiactiveMode::kPassiveOn) {
     on_A_ = cfg.max_current_A;
-  } else if (cfg.mode == "constant") {
+  } else if (cfg.mode == control::SemiactiveMode::kConstant) {
     on_A_ = cfg.current_A;
-  } else if (cfg.mode == "pulse") {
+  } else if (cfg.mode == control::SemiactiveMode::kPulse) {
     on_A_ = cfg.max_current_A;
     period_ = std::max<std::int64_t>(2, std::llround(1.0 / (cfg.pulse_hz * dt_s)));
     on_steps_ = std::llround(cfg.pulse_duty * static_cast<double>(period_));
   } else {
-    throw Error("semiactive.mode", "'" + cfg.mode +
+    throw Error("semiactive.mode", "'" + std::string(NameOf(control::kSemiactiveModeNames, cfg.mode)) +
                                        "' is not a schedule (allowed: passive_off, passive_on, constant, pulse)");
   }
-  if (cfg.mode != "pulse") on_steps_ = period_;
+  if (cfg.mode != control::SemiactiveMode::kPulse) on_steps_ = period_;
 }
 
 double CurrentSchedule::At(std::int64_t k) const { return k % period_ < on_steps_ ? on_A_ : 0.0; }
@@ -34,7 +34,7 @@ Semiactive::Semiactive(const scenario::Scenario& s, lockstep::RunIdentity id, lc
     : DesiredMeasuredParticipant("semiactive", std::move(id), TimingOf(s), lcm, std::move(faults),
                                  lockstep::kChCurrent, lockstep::kCurrent),
       f_prev_kN_(0.0) {
-  if (s.semiactive.mode == "clipped_optimal") {
+  if (s.semiactive.mode == control::SemiactiveMode::kClippedOptimal) {
     const control::ClippedOptimalOptions o{s.semiactive.r_weight, s.semiactive.noise_ratio,
                                            s.semiactive.capacity_kN, s.semiactive.max_current_A};
     clipped_ = std::make_unique<control::ClippedOptimal>(control::DesignClippedOptimal(

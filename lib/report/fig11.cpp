@@ -125,8 +125,8 @@ scenario::Scenario Fig11Scenario(const scenario::Scenario& base, const Fig11Cont
   s.run.name = Slug(fmt::format("fig11 {} {} {}", plant == "ideal" ? kNumerical : c.name, semiactive, plant));
   s.run.duration_s = duration_s;
   s.controller = c.controller;
-  s.plant.kind = plant;
-  s.semiactive.mode = semiactive;
+  s.plant.kind = ParseName(models::kPlantKindNames, plant, "plant");
+  s.semiactive.mode = ParseName(control::kSemiactiveModeNames, semiactive, "semiactive");
   return s;
 }
 

@@ -95,14 +95,14 @@ scenario::Scenario Fig9Scenario(const scenario::Scenario& base, double f_hz, con
   s.sha256.clear();
   s.run.name = Slug(fmt::format("fig9 {}hz {}", FreqText(f_hz), c.name));
   s.run.duration_s = duration_s;
-  s.structure.mode = "rths";
-  s.structure.kind = "sdof";
+  s.structure.mode = models::StructureMode::kRths;
+  s.structure.kind = models::StructureKind::kSdof;
   s.structure.frequency_hz = f_hz;
   s.structure.ground.rms = Fig9GroundRms(f_hz);
   s.controller = c.controller;
-  s.plant.kind = plant;
+  s.plant.kind = ParseName(models::kPlantKindNames, plant, "--plant");
   s.plant.actuator = models::ServoPreset("0.0A");
-  s.semiactive.mode = "passive_off";
+  s.semiactive.mode = control::SemiactiveMode::kPassiveOff;
   return s;
 }
 

@@ -176,7 +176,7 @@ BodeCurve BodeFromModel(const std::string& name, const ident::PoleModel& model, 
 
 signal::SignalSpec FrequencyExcitation() {
   signal::SignalSpec spec;
-  spec.kind = "blwn";
+  spec.kind = signal::SignalKind::kBlwn;
   spec.band_hz = kBandHz;
   spec.rms = kRmsMm;
   spec.seed = 1;
@@ -194,14 +194,14 @@ scenario::Scenario FrequencyScenario(const std::string& condition, const control
   s.run.name = "freq";
   s.run.dt_s = kDt;
   s.run.duration_s = duration_s;
-  s.structure.mode = "predefined";
-  s.structure.derivatives = "extrapolated";
+  s.structure.mode = models::StructureMode::kPredefined;
+  s.structure.derivatives = models::Derivatives::kExtrapolated;
   s.structure.desired = FrequencyExcitation();
   s.controller = controller;
-  s.plant.kind = plant;
+  s.plant.kind = ParseName(models::kPlantKindNames, plant, "--plant");
   s.plant.actuator = models::ServoPreset(condition);
-  s.plant.specimen = "mr_damper";
-  s.semiactive.mode = condition == "0.0A" ? "passive_off" : "passive_on";
+  s.plant.specimen = models::Specimen::kMrDamper;
+  s.semiactive.mode = condition == "0.0A" ? control::SemiactiveMode::kPassiveOff : control::SemiactiveMode::kPassiveOn;
   s.semiactive.max_current_A = 2.5;
   return s;
 }
@@ -216,7 +216,7 @@ Fig6Result ReproduceFig6(const ReproduceOptions& opts) {
   std::vector<RunSpec> specs;
   for (const auto& cond : conditions) {
     control::ControllerConfig none;
-    none.kind = "none";
+    none.kind = control::ControllerKind::kNone;
     auto s = FrequencyScenario(cond, none, opts.plant, duration);
     s.run.name = Slug("fig6 " + cond);
     specs.push_back({fmt::format("fig6 {} G_yu", cond), s, opts.out_dir / "runs" / Slug("gyu " + cond)});

@@ -41,16 +41,16 @@ void RequirePlant(const std::string& plant, const fs::path& scratch_parent) {
     scenario::Scenario s;
     s.run.name = fmt::format("probe-{}", kind);
     s.run.duration_s = 0.1;
-    s.structure.mode = "predefined";
-    s.structure.desired.kind = "blwn";
+    s.structure.mode = models::StructureMode::kPredefined;
+    s.structure.desired.kind = signal::SignalKind::kBlwn;
     s.structure.desired.band_hz = 50.0;
     s.structure.desired.rms = 0.254;
     s.structure.desired.taper_s = 0.02;
-    s.controller.kind = "none";
-    s.plant.kind = kind;
+    s.controller.kind = control::ControllerKind::kNone;
+    s.plant.kind = ParseName(models::kPlantKindNames, kind, "--plant");
     s.plant.actuator = models::ServoPreset("2.5A");
-    s.plant.specimen = "mr_damper";
-    s.semiactive.mode = "passive_on";
+    s.plant.specimen = models::Specimen::kMrDamper;
+    s.semiactive.mode = control::SemiactiveMode::kPassiveOn;
     specs.push_back({fmt::format("plant probe ({})", kind), s, scratch / kind});
   }
   std::string problem;
@@ -79,7 +79,7 @@ void RequirePlant(const std::string& plant, const fs::path& scratch_parent) {
 
 control::ControllerConfig ControllerKind(const std::string& kind) {
   control::ControllerConfig c;
-  c.kind = kind;
+  c.kind = ParseName(control::kControllerKindNames, kind, "controller.kind");
   return c;
 }
 

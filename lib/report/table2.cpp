@@ -76,29 +76,29 @@ scenario::Scenario Table2Scenario(const Table2Controller& row, double band_hz, c
   s.run.name = Slug(fmt::format("table2 {} {}hz {}", row.condition, BandText(band_hz), row.name));
   s.run.dt_s = 0.0005;
   s.run.duration_s = duration_s;
-  s.structure.mode = "predefined";
-  s.structure.derivatives = "extrapolated";  // Eqs. 20-22, the causal RTHS path
+  s.structure.mode = models::StructureMode::kPredefined;
+  s.structure.derivatives = models::Derivatives::kExtrapolated;  // Eqs. 20-22, the causal RTHS path
   // models.md section 9: 8th-order Butterworth BLWN, 2 s discarded, fixed seed; faded in over
   // 0.5 s so that the actuator is not asked for a step at k = 0 (docs/safety.md).
   s.structure.desired = signal::SignalSpec{};
-  s.structure.desired.kind = "blwn";
+  s.structure.desired.kind = signal::SignalKind::kBlwn;
   s.structure.desired.band_hz = band_hz;
   s.structure.desired.rms = band_hz < 10 ? 2.78 : 0.595;
   s.structure.desired.seed = 1;
   s.structure.desired.discard_s = 2.0;
   s.structure.desired.taper_s = kTaperS;
   s.controller = row.controller;
-  s.plant.kind = plant;
+  s.plant.kind = ParseName(models::kPlantKindNames, plant, "--plant");
   s.plant.actuator = models::ServoPreset(row.condition == "0.0A"   ? "0.0A"
                                            : row.condition == "2.5A" ? "2.5A"
                                                                      : "avg");
-  s.plant.specimen = "mr_damper";
+  s.plant.specimen = models::Specimen::kMrDamper;
   if (row.condition == "0.0A") {
-    s.semiactive.mode = "passive_off";
+    s.semiactive.mode = control::SemiactiveMode::kPassiveOff;
   } else if (row.condition == "2.5A") {
-    s.semiactive.mode = "passive_on";
+    s.semiactive.mode = control::SemiactiveMode::kPassiveOn;
   } else {
-    s.semiactive.mode = "pulse";  // 0.5 Hz, 50 % duty between 0 and 2.5 A
+    s.semiactive.mode = control::SemiactiveMode::kPulse;  // 0.5 Hz, 50 % duty between 0 and 2.5 A
     s.semiactive.pulse_hz = 0.5;
     s.semiactive.pulse_duty = 0.5;
   }

@@ -24,6 +24,7 @@ struct SafetyConfig {
   double growth_factor = 1.3;      ///< (1, 1000]
   int growth_windows = 4;          ///< [2, 1000]
   double growth_floor_mm = 0.5;    ///< (0, 10000]
+  bool operator==(const SafetyConfig&) const = default;
 };
 
 class Monitor {

@@ -24,6 +24,7 @@
 #include <toml++/toml.h>
 
 #include "core/error.h"
+#include "core/names.h"
 
 namespace rths::scenario {
 
@@ -279,265 +280,8 @@ class Section {
   std::vector<std::string_view> tables_;  // declared sub-tables
 };
 
-/// The physical actuator's keys, in file order, with where each goes (read, validate, write).
-std::vector<std::pair<const char*, double*>> PhysicalFields(PhysicalActuatorConfig* p) {
-  return {{"area_m2", &p->area_m2},
-          {"supply_pressure_Pa", &p->supply_pressure_Pa},
-          {"volume_m3", &p->volume_m3},
-          {"piston_mass_kg", &p->piston_mass_kg},
-          {"piston_damping_N_s_m", &p->piston_damping_N_s_m},
-          {"valve_hz", &p->valve_hz},
-          {"valve_zeta", &p->valve_zeta},
-          {"kq_m3_s", &p->kq_m3_s},
-          {"kp_per_m", &p->kp_per_m},
-          {"beta_Pa", &p->beta_Pa},
-          {"leakage_m3_s_Pa", &p->leakage_m3_s_Pa}};
-}
-
-/// The Spencer damper's keys ([plant.damper]), in file order: every MrDamperParams field.
-std::vector<std::pair<const char*, double*>> DamperFields(models::MrDamperParams* d) {
-  return {{"alpha_a", &d->alpha_a}, {"alpha_b", &d->alpha_b}, {"alpha_c", &d->alpha_c},
-          {"c0_a", &d->c0_a},       {"c0_b", &d->c0_b},       {"c0_c", &d->c0_c},
-          {"c1_a", &d->c1_a},       {"c1_b", &d->c1_b},       {"c1_c", &d->c1_c},
-          {"beta_a", &d->beta_a},   {"beta_b", &d->beta_b},   {"beta_c", &d->beta_c},
-          {"gamma_a", &d->gamma_a}, {"gamma_b", &d->gamma_b}, {"gamma_c", &d->gamma_c},
-          {"A", &d->A},             {"n", &d->n},             {"k0", &d->k0},
-          {"k1", &d->k1},           {"x0", &d->x0}};
-}
-
-/// One parameter of an effect of the library: its key, where it goes, whether the table must
-/// give it.
-struct EffectKey {
-  const char* key;
-  double* field;
-  bool required;
-};
-
-/// The keys of each effect present in `e` (the contract's parameter names, models/rig_effects.h),
-/// in file order; effects that are off have no keys. `e` must outlive the result.
-std::vector<std::pair<const char*, std::vector<EffectKey>>> EffectKeys(models::EffectSet* e) {
-  std::vector<std::pair<const char*, std::vector<EffectKey>>> out;
-  if (e->pure_delay) out.push_back({"pure_delay", {{"tau_ms", &e->pure_delay->tau_ms, true}}});
-  if (e->gain_error) out.push_back({"gain_error", {{"gain", &e->gain_error->gain, true}}});
-  if (e->load_coupling)
-    out.push_back({"load_coupling", {{"compliance_mm_per_kN", &e->load_coupling->compliance_mm_per_kN, true}}});
-  if (e->oil_column_resonance)
-    out.push_back({"oil_column_resonance",
-                   {{"f_hz", &e->oil_column_resonance->f_hz, true}, {"zeta", &e->oil_column_resonance->zeta, false}}});
-  if (e->coulomb_friction)
-    out.push_back({"coulomb_friction",
-                   {{"loss_mm", &e->coulomb_friction->loss_mm, true},
-                    {"v_smooth_mm_s", &e->coulomb_friction->v_smooth_mm_s, false}}});
-  if (e->backlash) out.push_back({"backlash", {{"gap_mm", &e->backlash->gap_mm, true}}});
-  if (e->servovalve_saturation)
-    out.push_back({"servovalve_saturation", {{"vmax_mm_per_s", &e->servovalve_saturation->vmax_mm_per_s, true}}});
-  if (e->sensor_noise)
-    out.push_back({"sensor_noise",
-                   {{"rms_y_mm", &e->sensor_noise->rms_y_mm, false}, {"rms_f_kN", &e->sensor_noise->rms_f_kN, false}}});
-  if (e->current_lag) out.push_back({"current_lag", {{"tau_ms", &e->current_lag->tau_ms, true}}});
-  if (e->damper_scale) out.push_back({"damper_scale", {{"scale", &e->damper_scale->scale, true}}});
-  return out;
-}
-
-/// Switches on, with its defaults, the effect called `name` (one of models::kEffectNames).
-void TurnOn(models::EffectSet* e, std::string_view name) {
-  if (name == "pure_delay") e->pure_delay.emplace();
-  if (name == "gain_error") e->gain_error.emplace();
-  if (name == "load_coupling") e->load_coupling.emplace();
-  if (name == "oil_column_resonance") e->oil_column_resonance.emplace();
-  if (name == "coulomb_friction") e->coulomb_friction.emplace();
-  if (name == "backlash") e->backlash.emplace();
-  if (name == "servovalve_saturation") e->servovalve_saturation.emplace();
-  if (name == "sensor_noise") e->sensor_noise.emplace();
-  if (name == "current_lag") e->current_lag.emplace();
-  if (name == "damper_scale") e->damper_scale.emplace();
-}
-
-/// [plant.effects]: one sub-table per effect that is on; an unknown name is refused by Finish()
-/// with the list of the library's names.
-void ReadEffects(Section& effects, models::EffectSet* out, bool* same_sample) {
-  models::EffectSet e;
-  std::vector<Section> tables;
-  tables.reserve(models::kEffectNames.size());
-  for (std::string_view name : models::kEffectNames) {
-    tables.push_back(effects.Sub(name));
-    if (tables.back().Present()) TurnOn(&e, name);
-  }
-  effects.Finish();
-  for (auto& [name, keys] : EffectKeys(&e)) {
-    Section* table = nullptr;
-    for (std::size_t i = 0; i < models::kEffectNames.size(); ++i) {
-      if (models::kEffectNames[i] == name) table = &tables[i];
-    }
-    for (const EffectKey& k : keys) table->Number(k.key, k.field);
-    if (std::string_view(name) == "load_coupling") table->Bool("same_sample", same_sample);  // rig only
-    table->Finish();
-    for (const EffectKey& k : keys) {
-      if (k.required && !table->Has(k.key)) {
-        table->Fail(k.key, fmt::format("missing (the effect \"{}\" needs it; remove the table to switch the "
-                                       "effect off)",
-                                       name));
-      }
-    }
-    if (std::string_view(name) == "sensor_noise" && !table->Has("rms_y_mm") && !table->Has("rms_f_kN")) {
-      table->Fail("rms_y_mm", "missing (sensor_noise needs rms_y_mm, rms_f_kN or both)");
-    }
-  }
-  *out = e;
-}
-
-/// `rms_key` is the unit-bearing name of SignalSpec::rms in this table.
-void ReadSignal(Section& section, std::string_view rms_key, SignalSpec* s) {
-  section.String("kind", &s->kind);
-  section.Number("band_hz", &s->band_hz);
-  section.Number(rms_key, &s->rms);
-  section.Integer("seed", &s->seed);
-  section.Number("discard_s", &s->discard_s);
-  section.String("file", &s->file);
-  section.Number("file_dt_s", &s->file_dt_s);
-  section.Number("scale", &s->scale);
-  section.Number("taper_s", &s->taper_s);
-  section.Finish();
-}
-
-void ReadScenario(const toml::table& root, const std::string& file, Scenario* s) {
-  Section top(file, &root, "");
-
-  Section run = top.Sub("run");
-  run.String("name", &s->run.name);
-  run.Number("dt_s", &s->run.dt_s);
-  run.Number("duration_s", &s->run.duration_s);
-  run.Finish();
-
-  Section structure = top.Sub("structure");
-  StructureConfig& st = s->structure;
-  structure.String("mode", &st.mode);
-  structure.String("kind", &st.kind);
-  structure.String("file", &st.file);
-  structure.Integer("actuator_dof", &st.actuator_dof);
-  structure.Number("mass_kg", &st.mass_kg);
-  structure.Number("frequency_hz", &st.frequency_hz);
-  structure.Number("damping_ratio", &st.damping_ratio);
-  structure.Number("specimen_count", &st.specimen_count);
-  structure.String("derivatives", &st.derivatives);
-  Section ground = structure.Sub("ground");
-  ReadSignal(ground, "rms_mm_s2", &st.ground);
-  Section desired = structure.Sub("desired");
-  ReadSignal(desired, "rms_mm", &st.desired);
-  structure.Finish();
-
-  ControllerConfig& c = s->controller;
-  Section controller = top.Sub("controller");
-  controller.String("kind", &c.kind);
-  controller.Servo("model", &c.model);
-  controller.Bool("half_step_ahead", &c.half_step_ahead);
-  controller.Number("delay_ms", &c.delay_ms);
-  controller.Number("max_delay_ms", &c.max_delay_ms);
-  controller.Number("lead_tp_ms", &c.lead_tp_ms);
-  controller.Number("lp_cutoff_hz", &c.lp_cutoff_hz);
-  controller.Integer("lp_order", &c.lp_order);
-  controller.Servo("model_low", &c.model_low);
-  controller.Servo("model_high", &c.model_high);
-  controller.Number("current_high_A", &c.current_high_A);
-  Section lqg = controller.Sub("lqg");
-  for (auto [key, field] : {std::pair{"q", &c.lqg.q}, {"w_f_hz", &c.lqg.w_f_hz}, {"xi_f", &c.lqg.xi_f},
-                            {"eta_f", &c.lqg.eta_f}, {"W", &c.lqg.W}, {"V", &c.lqg.V}}) {
-    lqg.Number(key, field);
-  }
-  lqg.Finish();
-  controller.Finish();
-
-  PlantConfig& pl = s->plant;
-  Section plant = top.Sub("plant");
-  plant.String("kind", &pl.kind);
-  plant.Servo("actuator", &s->plant.actuator);
-  Section physical = plant.Sub("physical");
-  for (auto [key, field] : PhysicalFields(&pl.physical)) physical.Number(key, field);
-  physical.Finish();
-  plant.Bool("current_dynamics", &pl.current_dynamics);
-  plant.String("specimen", &s->plant.specimen);
-  plant.Number("noise_y_mm_rms", &s->plant.noise_y_mm_rms);
-  plant.Number("noise_f_kN_rms", &s->plant.noise_f_kN_rms);
-  plant.Integer("noise_seed", &s->plant.noise_seed);
-  plant.Number("cvode_rtol", &s->plant.cvode_rtol);
-  Section damper = plant.Sub("damper");
-  for (auto [key, field] : DamperFields(&pl.damper)) damper.Number(key, field);
-  damper.Finish();
-  Section effects = plant.Sub("effects");
-  ReadEffects(effects, &pl.effects, &pl.load_coupling_same_sample);
-  Section unmodelled = plant.Sub("unmodelled");
-  unmodelled.Number("ripple_mm", &pl.unmodelled.ripple_mm);
-  unmodelled.Number("ripple_hz", &pl.unmodelled.ripple_hz);
-  unmodelled.Number("stiffness_kN_per_mm", &pl.unmodelled.stiffness_kN_per_mm);
-  unmodelled.Finish();
-  plant.Finish();
-
-  Section semiactive = top.Sub("semiactive");
-  semiactive.String("mode", &s->semiactive.mode);
-  semiactive.Number("current_A", &s->semiactive.current_A);
-  semiactive.Number("max_current_A", &s->semiactive.max_current_A);
-  semiactive.Number("pulse_hz", &s->semiactive.pulse_hz);
-  semiactive.Number("pulse_duty", &s->semiactive.pulse_duty);
-  semiactive.Number("r_weight", &s->semiactive.r_weight);
-  semiactive.Number("noise_ratio", &s->semiactive.noise_ratio);
-  semiactive.Number("capacity_kN", &s->semiactive.capacity_kN);
-  semiactive.Finish();
-
-  SafetyConfig& sf = s->safety;
-  Section safety = top.Sub("safety");
-  safety.Bool("enabled", &sf.enabled);
-  for (auto [key, field] : {std::pair{"stroke_mm", &sf.stroke_mm}, {"force_kN", &sf.force_kN},
-                            {"max_error_mm", &sf.max_error_mm}, {"growth_window_s", &sf.growth_window_s},
-                            {"growth_factor", &sf.growth_factor}, {"growth_floor_mm", &sf.growth_floor_mm}}) {
-    safety.Number(key, field);
-  }
-  safety.Integer("growth_windows", &sf.growth_windows);
-  safety.Finish();
-
-  Section lockstep = top.Sub("lockstep");
-  if (lockstep.Has("timeout_ms")) {
-    lockstep.Fail("timeout_ms", "was renamed lockstep.rerequest_ms (re-request an incomplete step after this "
-                                "silence [ms], [5, 10000]); the give-up time is lockstep.stall_budget_s");
-  }
-  if (lockstep.Has("max_attempts")) {
-    lockstep.Fail("max_attempts", "was replaced by lockstep.stall_budget_s: how long one step may stay "
-                                  "incomplete before the run stops [s], [1, 3600] (default 10)");
-  }
-  lockstep.Number("rerequest_ms", &s->lockstep.rerequest_ms);
-  lockstep.Number("stall_budget_s", &s->lockstep.stall_budget_s);
-  lockstep.Number("handshake_timeout_s", &s->lockstep.handshake_timeout_s);
-  lockstep.Finish();
-
-  RealtimeConfig& rt = s->realtime;
-  Section realtime = top.Sub("realtime");
-  realtime.Bool("enabled", &rt.enabled);
-  realtime.Integer("max_consecutive_misses", &rt.max_consecutive_misses);
-  realtime.Bool("sched_fifo", &rt.sched_fifo);
-  realtime.Integer("priority", &rt.priority);
-  realtime.Bool("lock_memory", &rt.lock_memory);
-  realtime.Finish();
-
-  FaultConfig& fc = s->faults;
-  Section faults = top.Sub("faults");
-  for (auto [key, field] : {std::pair{"drop", &fc.drop}, {"duplicate", &fc.duplicate}, {"delay", &fc.delay},
-                            {"reorder", &fc.reorder}, {"delay_ms", &fc.delay_ms}}) {
-    faults.Number(key, field);
-  }
-  faults.Integer("seed", &fc.seed);
-  faults.Integer("recv_buf_bytes", &fc.recv_buf_bytes);
-  Section process = faults.Sub("process");
-  process.String("role", &fc.process_role);
-  process.String("kind", &fc.process_kind);
-  process.Integer("at_step", &fc.process_at_step);
-  process.Number("stop_s", &fc.process_stop_s);
-  process.Finish();
-  faults.Finish();
-
-  top.Finish();
-}
-
 // ---------------------------------------------------------------------------------------
-// Pass 2: one validator per struct (ranges as documented in scenario.h).
+// Allowed values.
 
 /// An interval of allowed values; `note` explains a computed bound.
 struct Range {
@@ -551,6 +295,8 @@ Range Closed(double lo, double hi) { return {lo, hi, false, false}; }
 Range OpenClosed(double lo, double hi) { return {lo, hi, true, false}; }
 Range ClosedOpen(double lo, double hi) { return {lo, hi, false, true}; }
 Range Open(double lo, double hi) { return {lo, hi, true, true}; }
+/// Any value (a seed, a flag): the type is the only check.
+const Range kAny{-kInf, kInf, false, false};
 
 class Check {
  public:
@@ -581,29 +327,6 @@ class Check {
   std::string file_;
 };
 
-/// Where a `kind = "file"` path points: relative paths are relative to the scenario's folder.
-std::filesystem::path ResolveSignalFile(const std::string& scenario_path, const std::string& file) {
-  std::filesystem::path p(file);
-  if (p.is_relative()) p = std::filesystem::path(scenario_path).parent_path() / p;
-  return std::filesystem::absolute(p).lexically_normal();
-}
-
-void ValidateRun(const RunConfig& r, const Check& check) {
-  if (r.name.empty() || !std::all_of(r.name.begin(), r.name.end(), [](char c) {
-        return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' ||
-               c == '-' || c == '.';
-      })) {
-    check.Fail("run.name", fmt::format("\"{}\" is not a usable name (allowed: non-empty, letters, digits, "
-                                       "'_', '-', '.')",
-                                       r.name));
-  }
-  check.InRange("run.dt_s", r.dt_s, Closed(1e-5, 0.01));
-  check.InRange("run.duration_s", r.duration_s, OpenClosed(0.0, 36000.0));
-  if (r.duration_s < r.dt_s) {
-    check.Fail("run.duration_s", fmt::format("{} is shorter than one step (run.dt_s = {})", r.duration_s, r.dt_s));
-  }
-}
-
 void ValidateServo(const ServoModel3& m, std::string_view key, const Check& check) {
   for (auto [name, v] : {std::pair{"K", m.K}, {"p", m.p}, {"b", m.b}, {"c", m.c}}) {
     check.InRange(fmt::format("{}.{}", key, name), v,
@@ -611,293 +334,304 @@ void ValidateServo(const ServoModel3& m, std::string_view key, const Check& chec
   }
 }
 
-void ValidateSignal(const SignalSpec& s, std::string_view prefix, std::string_view rms_key, double dt_s,
-                    const std::string& scenario_path, const Check& check) {
-  auto key = [&](std::string_view k) { return fmt::format("{}.{}", prefix, k); };
-  check.OneOf(key("kind"), s.kind, {"blwn", "file", "zero"});
-  const double nyquist = 0.5 / dt_s;
-  check.InRange(key("band_hz"), s.band_hz,
-                {0.0, nyquist, true, true, "below the Nyquist frequency 0.5/run.dt_s"});
-  check.InRange(key(rms_key), s.rms, Open(0.0, kInf));
-  check.InRange(key("discard_s"), s.discard_s, Closed(0.0, 60.0));
-  check.InRange(key("file_dt_s"), s.file_dt_s, Closed(0.0, 10.0));
-  check.InRange(key("taper_s"), s.taper_s, Closed(0.0, 60.0));
-  if (!std::isfinite(s.scale) || s.scale == 0.0) {
-    check.Fail(key("scale"), fmt::format("{} is not allowed (allowed: any finite value other than 0)", s.scale));
-  }
-  if (s.kind == "file") {
-    if (s.file.empty()) check.Fail(key("file"), "missing: kind = \"file\" needs a file path");
-    const std::filesystem::path resolved = ResolveSignalFile(scenario_path, s.file);
-    std::error_code ec;
-    if (!std::filesystem::is_regular_file(resolved, ec)) {
-      check.Fail(key("file"), fmt::format("file not found: {} (paths are relative to the scenario file's folder)",
-                                          resolved.string()));
-    }
-  }
+// ---------------------------------------------------------------------------------------
+// The schema: every table's keys, each listed once, in file order, with its allowed range.
+// Three visitors walk it: Reader (TOML -> structs: keys and types), Writer (structs -> TOML
+// text, every key explicit) and Checker (each value in its range). A visitor V has
+//   Number(key, double&, Range)      Integer(key, Int&, Range = kAny)   Bool(key, bool&)
+//   String(key, std::string&)        Choice(key, E&, names)              Servo(key, ServoModel3&)
+//   Table(key, fields, present = true)   Effects(key, EffectSet&, bool& same_sample)
+//   Renamed(key, message)  (a key that was renamed: the reader refuses it with the message)
+// Ranges may depend on other fields and on dt (given by the Context); checks that need files
+// or several keys at once are in the Validate* functions after the walk.
+
+/// What a range may depend on besides the table's own fields.
+struct Context {
+  double dt_s;
+  std::int64_t steps;
+};
+
+template <typename V>
+void SignalFields(V& v, SignalSpec& s, std::string_view rms_key, const Context& cx) {
+  v.Choice("kind", s.kind, signal::kSignalKindNames);
+  v.Number("band_hz", s.band_hz, {0.0, 0.5 / cx.dt_s, true, true, "below the Nyquist frequency 0.5/run.dt_s"});
+  v.Number(rms_key, s.rms, Open(0.0, kInf));
+  v.Integer("seed", s.seed);
+  v.Number("discard_s", s.discard_s, Closed(0.0, 60.0));
+  v.String("file", s.file);
+  v.Number("file_dt_s", s.file_dt_s, Closed(0.0, 10.0));
+  v.Number("scale", s.scale, kAny);  // finite and not 0: ValidateSignal
+  v.Number("taper_s", s.taper_s, Closed(0.0, 60.0));
 }
 
-void ValidateStructure(const StructureConfig& st, double dt_s, const std::string& scenario_path,
-                       const Check& check) {
-  check.OneOf("structure.mode", st.mode, {"rths", "predefined"});
-  check.OneOf("structure.kind", st.kind, {"sdof", "file"});
-  if (st.mode == "rths" && st.kind == "file") {
-    if (st.file.empty()) check.Fail("structure.file", "missing: kind = \"file\" needs a structure file");
-    const std::filesystem::path resolved = ResolveSignalFile(scenario_path, st.file);
-    std::error_code ec;
-    if (!std::filesystem::is_regular_file(resolved, ec)) {
-      check.Fail("structure.file", fmt::format("file not found: {} (paths are relative to the scenario file's "
-                                               "folder)",
-                                               resolved.string()));
-    }
-    check.InRange("structure.actuator_dof", st.actuator_dof,
-                  {1, 10000, false, false, "1-based; at most the structure's number of DOFs"});
-  }
-  check.InRange("structure.mass_kg", st.mass_kg, OpenClosed(0.0, 1e9));
+template <typename V>
+void RunFields(V& v, RunConfig& r, const Context&) {
+  v.String("name", r.name);
+  v.Number("dt_s", r.dt_s, Closed(1e-5, 0.01));
+  v.Number("duration_s", r.duration_s, OpenClosed(0.0, 36000.0));
+}
+
+template <typename V>
+void StructureFields(V& v, StructureConfig& st, const Context& cx) {
+  v.Choice("mode", st.mode, models::kStructureModeNames);
+  v.Number("mass_kg", st.mass_kg, OpenClosed(0.0, 1e9));
   // Central difference is stable for omega dt < 2, i.e. f < 1 / (pi dt).
-  const double f_max = 1.0 / (kPi * dt_s);
-  check.InRange("structure.frequency_hz", st.frequency_hz,
-                {0.0, f_max, true, true, "central-difference stability limit 1/(pi run.dt_s)"});
-  check.InRange("structure.damping_ratio", st.damping_ratio, ClosedOpen(0.0, 1.0));
-  check.InRange("structure.specimen_count", st.specimen_count, OpenClosed(0.0, 1000.0));
-  check.OneOf("structure.derivatives", st.derivatives, {"extrapolated", "central"});
-  ValidateSignal(st.ground, "structure.ground", "rms_mm_s2", dt_s, scenario_path, check);
-  ValidateSignal(st.desired, "structure.desired", "rms_mm", dt_s, scenario_path, check);
+  v.Number("frequency_hz", st.frequency_hz,
+           {0.0, 1.0 / (kPi * cx.dt_s), true, true, "central-difference stability limit 1/(pi run.dt_s)"});
+  v.Number("damping_ratio", st.damping_ratio, ClosedOpen(0.0, 1.0));
+  v.Number("specimen_count", st.specimen_count, OpenClosed(0.0, 1000.0));
+  v.Choice("derivatives", st.derivatives, models::kDerivativesNames);
+  v.Choice("kind", st.kind, models::kStructureKindNames);
+  v.String("file", st.file);
+  v.Integer("actuator_dof", st.actuator_dof);  // ValidateStructure: when kind = "file"
+  v.Table("ground", [&](V& t) { SignalFields(t, st.ground, "rms_mm_s2", cx); });
+  v.Table("desired", [&](V& t) { SignalFields(t, st.desired, "rms_mm", cx); });
 }
 
-void ValidateController(const ControllerConfig& c, double dt_s, const Check& check) {
-  check.OneOf("controller.kind", c.kind, {"none", "ff", "poly3", "lead", "ff_lp", "bumpless_lp", "ff_lqg"});
-  ValidateServo(c.model, "controller.model", check);
-  ValidateServo(c.model_low, "controller.model_low", check);
-  ValidateServo(c.model_high, "controller.model_high", check);
-  check.InRange("controller.max_delay_ms", c.max_delay_ms, OpenClosed(0.0, 100.0));
-  check.InRange("controller.delay_ms", c.delay_ms,
-                {0.0, c.max_delay_ms, true, false,
-                 "extrapolation beyond controller.max_delay_ms amplifies noise too much; raise that "
-                 "bound deliberately if you mean it"});
-  check.InRange("controller.lead_tp_ms", c.lead_tp_ms, OpenClosed(0.0, 100.0));
-  const bool uses_lp = c.kind == "ff_lp" || c.kind == "bumpless_lp";
-  check.InRange("controller.lp_cutoff_hz", c.lp_cutoff_hz,
-                {0.0, uses_lp ? 0.5 / dt_s : kInf, true, true,
-                 uses_lp ? "below the Nyquist frequency 0.5/run.dt_s" : ""});
-  check.InRange("controller.lp_order", c.lp_order,
-                {3, 8, false, false, "the three-pole inverse needs at least order 3 to be proper"});
-  check.InRange("controller.current_high_A", c.current_high_A, OpenClosed(0.0, 5.0));
-  check.InRange("controller.lqg.q", c.lqg.q, OpenClosed(0.0, 1e12));
-  check.InRange("controller.lqg.w_f_hz", c.lqg.w_f_hz, OpenClosed(0.0, 1000.0));
-  check.InRange("controller.lqg.xi_f", c.lqg.xi_f, OpenClosed(0.0, 10.0));
-  check.InRange("controller.lqg.eta_f", c.lqg.eta_f, Closed(0.0, 100.0));
-  check.InRange("controller.lqg.W", c.lqg.W, OpenClosed(0.0, 1e12));
-  check.InRange("controller.lqg.V", c.lqg.V, OpenClosed(0.0, 1e12));
+template <typename V>
+void ControllerFields(V& v, ControllerConfig& c, const Context& cx) {
+  v.Choice("kind", c.kind, control::kControllerKindNames);
+  v.Servo("model", c.model);
+  v.Bool("half_step_ahead", c.half_step_ahead);
+  v.Number("delay_ms", c.delay_ms,
+           {0.0, c.max_delay_ms, true, false,
+            "extrapolation beyond controller.max_delay_ms amplifies noise too much; raise that bound "
+            "deliberately if you mean it"});
+  v.Number("max_delay_ms", c.max_delay_ms, OpenClosed(0.0, 100.0));
+  v.Number("lead_tp_ms", c.lead_tp_ms, OpenClosed(0.0, 100.0));
+  const bool uses_lp = c.kind == control::ControllerKind::kFfLp || c.kind == control::ControllerKind::kBumplessLp;
+  v.Number("lp_cutoff_hz", c.lp_cutoff_hz,
+           {0.0, uses_lp ? 0.5 / cx.dt_s : kInf, true, true, uses_lp ? "below the Nyquist frequency 0.5/run.dt_s" : ""});
+  v.Integer("lp_order", c.lp_order, {3, 8, false, false, "the three-pole inverse needs at least order 3 to be proper"});
+  v.Servo("model_low", c.model_low);
+  v.Servo("model_high", c.model_high);
+  v.Number("current_high_A", c.current_high_A, OpenClosed(0.0, 5.0));
+  v.Table("lqg", [&](V& t) {
+    t.Number("q", c.lqg.q, OpenClosed(0.0, 1e12));
+    t.Number("w_f_hz", c.lqg.w_f_hz, OpenClosed(0.0, 1000.0));
+    t.Number("xi_f", c.lqg.xi_f, OpenClosed(0.0, 10.0));
+    t.Number("eta_f", c.lqg.eta_f, Closed(0.0, 100.0));
+    t.Number("W", c.lqg.W, OpenClosed(0.0, 1e12));
+    t.Number("V", c.lqg.V, OpenClosed(0.0, 1e12));
+  });
 }
 
-void ValidatePhysical(const PhysicalActuatorConfig& p, const Check& check) {
-  const std::vector<std::pair<const char*, Range>> ranges = {
-      {"area_m2", OpenClosed(0, 1)},          {"supply_pressure_Pa", OpenClosed(0, 1e9)},
-      {"volume_m3", OpenClosed(0, 1)},        {"piston_mass_kg", OpenClosed(0, 1e5)},
-      {"piston_damping_N_s_m", Closed(0, 1e9)}, {"valve_hz", OpenClosed(0, 1e4)},
-      {"valve_zeta", OpenClosed(0, 10)},      {"kq_m3_s", OpenClosed(0, 10)},
-      {"kp_per_m", OpenClosed(0, 1e6)},       {"beta_Pa", OpenClosed(0, 1e12)},
-      {"leakage_m3_s_Pa", Closed(0, 1e-6)}};
-  PhysicalActuatorConfig copy = p;
-  const auto fields = PhysicalFields(&copy);
-  for (std::size_t i = 0; i < fields.size(); ++i) {
-    check.InRange(fmt::format("plant.physical.{}", fields[i].first), *fields[i].second, ranges[i].second);
+template <typename V>
+void PhysicalFields(V& v, PhysicalActuatorConfig& p) {
+  v.Number("area_m2", p.area_m2, OpenClosed(0, 1));
+  v.Number("supply_pressure_Pa", p.supply_pressure_Pa, OpenClosed(0, 1e9));
+  v.Number("volume_m3", p.volume_m3, OpenClosed(0, 1));
+  v.Number("piston_mass_kg", p.piston_mass_kg, OpenClosed(0, 1e5));
+  v.Number("piston_damping_N_s_m", p.piston_damping_N_s_m, Closed(0, 1e9));
+  v.Number("valve_hz", p.valve_hz, OpenClosed(0, 1e4));
+  v.Number("valve_zeta", p.valve_zeta, OpenClosed(0, 10));
+  v.Number("kq_m3_s", p.kq_m3_s, OpenClosed(0, 10));
+  v.Number("kp_per_m", p.kp_per_m, OpenClosed(0, 1e6));
+  v.Number("beta_Pa", p.beta_Pa, OpenClosed(0, 1e12));
+  v.Number("leakage_m3_s_Pa", p.leakage_m3_s_Pa, Closed(0, 1e-6));
+}
+
+/// Every MrDamperParams field; their ranges are the model's own (MrDamperParams::Validate).
+template <typename V>
+void DamperFields(V& v, models::MrDamperParams& d) {
+  for (auto [key, field] : {std::pair{"alpha_a", &d.alpha_a}, {"alpha_b", &d.alpha_b}, {"alpha_c", &d.alpha_c},
+                            {"c0_a", &d.c0_a},       {"c0_b", &d.c0_b},       {"c0_c", &d.c0_c},
+                            {"c1_a", &d.c1_a},       {"c1_b", &d.c1_b},       {"c1_c", &d.c1_c},
+                            {"beta_a", &d.beta_a},   {"beta_b", &d.beta_b},   {"beta_c", &d.beta_c},
+                            {"gamma_a", &d.gamma_a}, {"gamma_b", &d.gamma_b}, {"gamma_c", &d.gamma_c},
+                            {"A", &d.A},             {"n", &d.n},             {"k0", &d.k0},
+                            {"k1", &d.k1},           {"x0", &d.x0}}) {
+    v.Number(key, *field, kAny);
   }
 }
 
-/// The allowed range of each effect parameter (models/rig_effects.h), for the scenario's messages.
-Range EffectRange(std::string_view effect, std::string_view key, double dt_s) {
-  if (effect == "pure_delay") return Closed(0.0, 100.0);
-  if (effect == "gain_error") return Closed(0.5, 2.0);
-  if (effect == "load_coupling") return Closed(-1.0, 1.0);
-  if (effect == "oil_column_resonance") {
-    if (key == "f_hz") return {0.0, 0.45 / dt_s, true, true, "below 0.45/run.dt_s"};
-    return OpenClosed(0.0, 2.0);
-  }
-  if (effect == "coulomb_friction") return key == "loss_mm" ? Closed(0.0, 10.0) : OpenClosed(0.0, 1000.0);
-  if (effect == "backlash") return Closed(0.0, 10.0);
-  if (effect == "servovalve_saturation") return OpenClosed(0.0, 1e9);
-  if (effect == "sensor_noise") return key == "rms_y_mm" ? Closed(0.0, 10.0) : Closed(0.0, 100.0);
-  if (effect == "current_lag") return Closed(0.0, 1000.0);
-  return Closed(0.1, 10.0);  // damper_scale
+template <typename V>
+void PlantFields(V& v, PlantConfig& p, const Context& cx) {
+  v.Choice("kind", p.kind, models::kPlantKindNames);
+  v.Servo("actuator", p.actuator);
+  v.Choice("specimen", p.specimen, models::kSpecimenNames);
+  v.Bool("current_dynamics", p.current_dynamics);
+  v.Number("noise_y_mm_rms", p.noise_y_mm_rms, Closed(0.0, 10.0));
+  v.Number("noise_f_kN_rms", p.noise_f_kN_rms, Closed(0.0, 100.0));
+  v.Integer("noise_seed", p.noise_seed);
+  v.Number("cvode_rtol", p.cvode_rtol, OpenClosed(0.0, 1e-2));
+  v.Table("physical", [&](V& t) { PhysicalFields(t, p.physical); });
+  v.Table("damper", [&](V& t) { DamperFields(t, p.damper); });
+  v.Table("unmodelled", [&](V& t) {
+    UnmodelledConfig& u = p.unmodelled;
+    t.Number("ripple_mm", u.ripple_mm, Closed(0.0, 10.0));
+    t.Number("ripple_hz", u.ripple_hz,
+             {0.0, 0.5 / cx.dt_s, u.ripple_mm > 0.0, true,
+              u.ripple_mm > 0.0 ? "a ripple needs a frequency below the Nyquist frequency 0.5/run.dt_s"
+                                : "below the Nyquist frequency 0.5/run.dt_s"});
+    t.Number("stiffness_kN_per_mm", u.stiffness_kN_per_mm, Closed(-100.0, 100.0));
+  });
+  v.Effects("effects", p.effects, p.load_coupling_same_sample);
 }
 
-void ValidateEffects(const PlantConfig& p, double dt_s, const Check& check) {
-  models::EffectSet e = p.effects;
-  for (auto& [name, keys] : EffectKeys(&e)) {
-    for (const EffectKey& k : keys) {
-      check.InRange(fmt::format("plant.effects.{}.{}", name, k.key), *k.field, EffectRange(name, k.key, dt_s));
-    }
-  }
-  p.effects.Validate(dt_s, check.file() + ": plant.effects");  // the library's own ranges
-  const UnmodelledConfig& u = p.unmodelled;
-  check.InRange("plant.unmodelled.ripple_mm", u.ripple_mm, Closed(0.0, 10.0));
-  check.InRange("plant.unmodelled.ripple_hz", u.ripple_hz,
-                {0.0, 0.5 / dt_s, u.ripple_mm > 0.0, true,
-                 u.ripple_mm > 0.0 ? "a ripple needs a frequency below the Nyquist frequency 0.5/run.dt_s"
-                                   : "below the Nyquist frequency 0.5/run.dt_s"});
-  check.InRange("plant.unmodelled.stiffness_kN_per_mm", u.stiffness_kN_per_mm, Closed(-100.0, 100.0));
-  if (p.RigMode() && p.kind != "linear") {
-    check.Fail(p.effects.Empty() ? "plant.unmodelled" : "plant.effects",
-               fmt::format("rig mode needs plant.kind = \"linear\" (got \"{}\"): the effects act around the "
-                           "linear actuator model",
-                           p.kind));
-  }
+template <typename V>
+void SemiactiveFields(V& v, SemiactiveConfig& s, const Context& cx) {
+  v.Choice("mode", s.mode, control::kSemiactiveModeNames);
+  v.Number("current_A", s.current_A, {0.0, s.max_current_A, false, false, "at most semiactive.max_current_A"});
+  v.Number("max_current_A", s.max_current_A, OpenClosed(0.0, 5.0));
+  v.Number("pulse_hz", s.pulse_hz,
+           {0.0, 0.25 / cx.dt_s, true, true, "at least four steps per period: below 0.25/run.dt_s"});
+  v.Number("pulse_duty", s.pulse_duty, Open(0.0, 1.0));
+  v.Number("r_weight", s.r_weight, OpenClosed(0.0, 1e6));
+  v.Number("noise_ratio", s.noise_ratio, OpenClosed(0.0, 1e6));
+  v.Number("capacity_kN", s.capacity_kN, OpenClosed(0.0, 1e6));
 }
 
-void ValidateDamper(const models::MrDamperParams& d, const Check& check) {
-  try {
-    d.Validate();
-  } catch (const Error& e) {
-    // "MrDamperParams: alpha_a" -> plant.damper.alpha_a
-    const std::string& w = e.where();
-    const std::size_t colon = w.rfind(": ");
-    check.Fail(fmt::format("plant.damper.{}", colon == std::string::npos ? w : w.substr(colon + 2)), e.problem());
-  }
+template <typename V>
+void SafetyFields(V& v, SafetyConfig& f, const Context&) {
+  v.Bool("enabled", f.enabled);
+  v.Number("stroke_mm", f.stroke_mm, OpenClosed(0.0, 10000.0));
+  v.Number("force_kN", f.force_kN, OpenClosed(0.0, 1e6));
+  v.Number("max_error_mm", f.max_error_mm, OpenClosed(0.0, 10000.0));
+  v.Number("growth_window_s", f.growth_window_s, OpenClosed(0.0, 10.0));
+  v.Number("growth_factor", f.growth_factor, OpenClosed(1.0, 1000.0));
+  v.Integer("growth_windows", f.growth_windows, Closed(2, 1000));
+  v.Number("growth_floor_mm", f.growth_floor_mm, OpenClosed(0.0, 10000.0));
 }
 
-void ValidatePlant(const PlantConfig& p, double dt_s, const Check& check) {
-  check.OneOf("plant.kind", p.kind, {"linear", "physical", "ideal"});
-  ValidateServo(p.actuator, "plant.actuator", check);
-  ValidatePhysical(p.physical, check);
-  check.OneOf("plant.specimen", p.specimen, {"mr_damper", "none"});
-  check.InRange("plant.noise_y_mm_rms", p.noise_y_mm_rms, Closed(0.0, 10.0));
-  check.InRange("plant.noise_f_kN_rms", p.noise_f_kN_rms, Closed(0.0, 100.0));
-  check.InRange("plant.cvode_rtol", p.cvode_rtol, OpenClosed(0.0, 1e-2));
-  ValidateDamper(p.damper, check);
-  ValidateEffects(p, dt_s, check);
-}
-
-void ValidateSemiactive(const SemiactiveConfig& s, const Check& check) {
-  check.OneOf("semiactive.mode", s.mode, {"passive_off", "passive_on", "constant", "pulse", "clipped_optimal"});
-  check.InRange("semiactive.r_weight", s.r_weight, OpenClosed(0.0, 1e6));
-  check.InRange("semiactive.noise_ratio", s.noise_ratio, OpenClosed(0.0, 1e6));
-  check.InRange("semiactive.capacity_kN", s.capacity_kN, OpenClosed(0.0, 1e6));
-  check.InRange("semiactive.pulse_duty", s.pulse_duty, Open(0.0, 1.0));
-  check.InRange("semiactive.max_current_A", s.max_current_A, OpenClosed(0.0, 5.0));
-  check.InRange("semiactive.current_A", s.current_A,
-                {0.0, s.max_current_A, false, false, "at most semiactive.max_current_A"});
-}
-
-void ValidateSafety(const SafetyConfig& f, const Check& check) {
-  check.InRange("safety.stroke_mm", f.stroke_mm, OpenClosed(0.0, 10000.0));
-  check.InRange("safety.force_kN", f.force_kN, OpenClosed(0.0, 1e6));
-  check.InRange("safety.max_error_mm", f.max_error_mm, OpenClosed(0.0, 10000.0));
-  check.InRange("safety.growth_window_s", f.growth_window_s, OpenClosed(0.0, 10.0));
-  check.InRange("safety.growth_factor", f.growth_factor, OpenClosed(1.0, 1000.0));
-  check.InRange("safety.growth_windows", f.growth_windows, Closed(2, 1000));
-  check.InRange("safety.growth_floor_mm", f.growth_floor_mm, OpenClosed(0.0, 10000.0));
-}
-
-void ValidateLockstep(const LockstepConfig& l, const Check& check) {
+template <typename V>
+void LockstepFields(V& v, LockstepConfig& l, const Context&) {
+  v.Renamed("timeout_ms", "was renamed lockstep.rerequest_ms (re-request an incomplete step after this silence "
+                          "[ms], [5, 10000]); the give-up time is lockstep.stall_budget_s");
+  v.Renamed("max_attempts", "was replaced by lockstep.stall_budget_s: how long one step may stay incomplete "
+                            "before the run stops [s], [1, 3600] (default 10)");
   // Below ~5 ms a re-request would come before a loaded 2-core host has even scheduled the
   // participants once: it only adds traffic.
-  check.InRange("lockstep.rerequest_ms", l.rerequest_ms, Closed(5.0, 10000.0));
-  check.InRange("lockstep.stall_budget_s", l.stall_budget_s,
-                {std::max(1.0, 4e-3 * l.rerequest_ms), 3600.0, false, false,
-                 "at least 1 s and 4 lockstep.rerequest_ms"});
-  check.InRange("lockstep.handshake_timeout_s", l.handshake_timeout_s, Closed(0.1, 600.0));
+  v.Number("rerequest_ms", l.rerequest_ms, Closed(5.0, 10000.0));
+  v.Number("stall_budget_s", l.stall_budget_s,
+           {std::max(1.0, 4e-3 * l.rerequest_ms), 3600.0, false, false, "at least 1 s and 4 lockstep.rerequest_ms"});
+  v.Number("handshake_timeout_s", l.handshake_timeout_s, Closed(0.1, 600.0));
 }
 
-void ValidateRealtime(const RealtimeConfig& r, const Check& check) {
-  check.InRange("realtime.max_consecutive_misses", static_cast<double>(r.max_consecutive_misses), Closed(0.0, 1e9));
-  check.InRange("realtime.priority", r.priority, Closed(1, 99));
+template <typename V>
+void RealtimeFields(V& v, RealtimeConfig& r, const Context&) {
+  v.Bool("enabled", r.enabled);
+  v.Integer("max_consecutive_misses", r.max_consecutive_misses, Closed(0.0, 1e9));
+  v.Bool("sched_fifo", r.sched_fifo);
+  v.Integer("priority", r.priority, Closed(1, 99));
+  v.Bool("lock_memory", r.lock_memory);
 }
 
-void ValidateFaults(const FaultConfig& f, std::int64_t steps, const Check& check) {
-  for (auto [key, v] : {std::pair{"faults.drop", f.drop}, {"faults.duplicate", f.duplicate},
-                        {"faults.delay", f.delay}, {"faults.reorder", f.reorder}}) {
-    check.InRange(key, v, Closed(0.0, 0.5));
+template <typename V>
+void FaultFields(V& v, FaultConfig& f, const Context& cx) {
+  for (auto [key, field] : {std::pair{"drop", &f.drop}, {"duplicate", &f.duplicate}, {"delay", &f.delay},
+                            {"reorder", &f.reorder}}) {
+    v.Number(key, *field, Closed(0.0, 0.5));
   }
-  check.InRange("faults.drop", f.drop + f.duplicate + f.delay + f.reorder,
-                {0.0, 0.5, false, false, "drop + duplicate + delay + reorder must not exceed 0.5"});
-  check.InRange("faults.delay_ms", f.delay_ms, OpenClosed(0.0, 10000.0));
-  check.InRange("faults.seed", static_cast<double>(f.seed), Closed(0.0, 9007199254740992.0));
-  if (f.recv_buf_bytes != 0) {
-    check.InRange("faults.recv_buf_bytes", static_cast<double>(f.recv_buf_bytes),
-                  {1024.0, 134217728.0, false, false, "0 for the host's default, else [1024, 2^27]"});
-  }
-  if (f.process_role.empty() && f.process_kind.empty()) return;
-  check.OneOf("faults.process.role", f.process_role, {"integrator", "controller", "plant", "semiactive", "logger"});
-  check.OneOf("faults.process.kind", f.process_kind, {"stall", "throw", "crash", "kill", "stop"});
-  check.InRange("faults.process.at_step", static_cast<double>(f.process_at_step),
-                {0.0, static_cast<double>(steps), false, true, "a step of the run: [0, steps)"});
-  check.InRange("faults.process.stop_s", f.process_stop_s, Closed(0.0, 3600.0));
+  v.Number("delay_ms", f.delay_ms, OpenClosed(0.0, 10000.0));
+  v.Integer("seed", f.seed, Closed(0.0, 9007199254740992.0));
+  v.Integer("recv_buf_bytes", f.recv_buf_bytes);  // 0 or a range: ValidateFaults
+  const bool present = !f.process_role.empty() || f.process_kind != lockstep::ProcessFault::kNone;
+  v.Table(
+      "process",
+      [&](V& t) {
+        t.String("role", f.process_role);
+        t.Choice("kind", f.process_kind, lockstep::kProcessFaultNames);
+        t.Integer("at_step", f.process_at_step,
+                  {0.0, static_cast<double>(cx.steps), false, true, "a step of the run: [0, steps)"});
+        t.Number("stop_s", f.process_stop_s, Closed(0.0, 3600.0));
+      },
+      present);
 }
 
-}  // namespace
-
-std::int64_t Scenario::steps() const { return std::llround(run.duration_s / run.dt_s); }
-
-std::string Sha256Hex(std::string_view bytes) {
-  unsigned char digest[EVP_MAX_MD_SIZE];
-  unsigned int length = 0;
-  if (EVP_Digest(bytes.data(), bytes.size(), digest, &length, EVP_sha256(), nullptr) != 1) {
-    throw Error("Sha256Hex", "OpenSSL EVP_Digest(sha256) failed");
-  }
-  static constexpr char kHex[] = "0123456789abcdef";
-  std::string hex;
-  hex.reserve(2 * length);
-  for (unsigned int i = 0; i < length; ++i) {
-    hex += kHex[digest[i] >> 4];
-    hex += kHex[digest[i] & 0x0f];
-  }
-  return hex;
+template <typename V>
+void ScenarioFields(V& v, Scenario& s) {
+  const Context cx{s.run.dt_s, s.steps()};
+  v.Table("run", [&](V& t) { RunFields(t, s.run, cx); });
+  v.Table("structure", [&](V& t) { StructureFields(t, s.structure, cx); });
+  v.Table("controller", [&](V& t) { ControllerFields(t, s.controller, cx); });
+  v.Table("plant", [&](V& t) { PlantFields(t, s.plant, cx); });
+  v.Table("semiactive", [&](V& t) { SemiactiveFields(t, s.semiactive, cx); });
+  v.Table("safety", [&](V& t) { SafetyFields(t, s.safety, cx); });
+  v.Table("lockstep", [&](V& t) { LockstepFields(t, s.lockstep, cx); });
+  v.Table("realtime", [&](V& t) { RealtimeFields(t, s.realtime, cx); });
+  v.Table("faults", [&](V& t) { FaultFields(t, s.faults, cx); });
 }
 
-void ValidateScenario(const Scenario& s) {
-  const Check check(DisplayName(s.path));
-  ValidateRun(s.run, check);
-  ValidateStructure(s.structure, s.run.dt_s, s.path, check);
-  ValidateController(s.controller, s.run.dt_s, check);
-  if (s.semiactive.mode == "clipped_optimal" && s.structure.mode != "rths") {
-    check.Fail("semiactive.mode", "\"clipped_optimal\" needs a structure to control (structure.mode = \"rths\")");
-  }
-  check.InRange("semiactive.pulse_hz", s.semiactive.pulse_hz,
-                {0.0, 0.25 / s.run.dt_s, true, true, "at least four steps per period: below 0.25/run.dt_s"});
-  ValidatePlant(s.plant, s.run.dt_s, check);
-  ValidateSemiactive(s.semiactive, check);
-  ValidateLockstep(s.lockstep, check);
-  ValidateRealtime(s.realtime, check);
-  ValidateSafety(s.safety, check);
-  ValidateFaults(s.faults, s.steps(), check);
-}
+// ---------------------------------------------------------------------------------------
+// Reader: TOML -> structs (keys and types; ranges are the Checker's).
 
-Scenario ParseScenario(std::string_view toml_text, const std::string& path) {
-  const std::string file = DisplayName(path);
-  toml::table root;
-  try {
-    root = toml::parse(toml_text, path);
-  } catch (const toml::parse_error& e) {
-    const toml::source_position& at = e.source().begin;
-    throw Error(fmt::format("{}:{}:{}", file, at.line, at.column),
-                fmt::format("TOML syntax error at line {}, column {}: {}", at.line, at.column, e.description()));
+class Reader {
+ public:
+  explicit Reader(Section* section) : section_(section) {}
+
+  void Number(std::string_view key, double& v, const Range&) { section_->Number(key, &v); }
+  template <typename Int>
+  void Integer(std::string_view key, Int& v, const Range& = kAny) {
+    section_->Integer(key, &v);
   }
-  // An empty scenario (an empty file, only comments, only table headers) is a mistake, not a
-  // request for the default experiment: at least one key must be set somewhere.
-  struct AnyKey {
-    static bool In(const toml::table& t) {
-      for (auto&& [key, node] : t)
-        if (const toml::table* sub = node.as_table(); !sub || In(*sub)) return true;
-      return false;
+  void Bool(std::string_view key, bool& v) { section_->Bool(key, &v); }
+  void String(std::string_view key, std::string& v) { section_->String(key, &v); }
+  template <typename E, std::size_t N>
+  void Choice(std::string_view key, E& v, const std::array<Named<E>, N>& names) {
+    std::string name;
+    section_->String(key, &name);  // declares the key
+    if (!section_->Has(key)) return;
+    const std::optional<E> value = ValueOf(names, name);
+    if (!value) section_->Fail(key, fmt::format("\"{}\" is not allowed (allowed: {})", name, QuotedNames(names)));
+    v = *value;
+  }
+  void Servo(std::string_view key, ServoModel3& m) { section_->Servo(key, &m); }
+  template <typename F>
+  void Table(std::string_view key, F&& fields, bool /*present*/ = true) {
+    Section sub = section_->Sub(key);
+    Reader reader(&sub);
+    fields(reader);
+    sub.Finish();
+  }
+  void Renamed(std::string_view key, std::string message) {
+    if (section_->Has(key)) section_->Fail(key, std::move(message));
+  }
+
+  /// [plant.effects]: one sub-table per effect that is on (models::kEffects); an unknown name is
+  /// refused by Finish() with the list of the library's names.
+  void Effects(std::string_view key, models::EffectSet& out, bool& same_sample) {
+    Section effects = section_->Sub(key);
+    models::EffectSet e;
+    std::vector<Section> tables;
+    tables.reserve(models::kEffects.size());
+    for (const models::EffectInfo& info : models::kEffects) {
+      tables.push_back(effects.Sub(info.name));
+      if (tables.back().Present()) info.turn_on(e);
     }
-  };
-  if (!AnyKey::In(root)) {
-    throw Error(file, "empty scenario: no key is set (the text is empty or holds only comments and table headers); "
-                      "set at least one key, e.g. [run] name = \"...\" (every key: docs/scenarios.md)");
+    effects.Finish();
+    for (std::size_t i = 0; i < models::kEffects.size(); ++i) {
+      const models::EffectInfo& info = models::kEffects[i];
+      if (!info.is_on(e)) continue;
+      Section& table = tables[i];
+      for (const models::EffectParam& p : info.params()) table.Number(p.key, p.field(e));
+      if (info.name == "load_coupling") table.Bool("same_sample", &same_sample);  // rig only
+      table.Finish();
+      for (const models::EffectParam& p : info.params()) {
+        if (p.required && !table.Has(p.key)) {
+          table.Fail(p.key, fmt::format("missing (the effect \"{}\" needs it; remove the table to switch the "
+                                        "effect off)",
+                                        info.name));
+        }
+      }
+      bool any = false;
+      for (const models::EffectParam& p : info.params()) any = any || table.Has(p.key);
+      if (!any) {
+        std::string keys;
+        for (const models::EffectParam& p : info.params()) keys += (keys.empty() ? "" : ", ") + std::string(p.key);
+        table.Fail(info.params()[0].key, fmt::format("missing ({} needs at least one of {})", info.name, keys));
+      }
+    }
+    out = e;
   }
-  Scenario s;
-  s.path = path;
-  ReadScenario(root, file, &s);
-  ValidateScenario(s);
-  for (SignalSpec* signal : {&s.structure.ground, &s.structure.desired}) {
-    if (signal->kind == "file") signal->file = ResolveSignalFile(path, signal->file).string();
-  }
-  if (!s.structure.file.empty()) s.structure.file = ResolveSignalFile(path, s.structure.file).string();
-  return s;
-}
 
-namespace {
+ private:
+  Section* section_;
+};
+
+// ---------------------------------------------------------------------------------------
+// Writer: structs -> TOML text, every key explicit (a table's own keys, then its sub-tables).
+
 std::string TomlString(const std::string& v) {
   std::string out = "\"";
   for (char ch : v) {
@@ -926,91 +660,270 @@ std::string TomlServo(const ServoModel3& m) {
   return fmt::format("{{ K = {}, p = {}, b = {}, c = {} }}", TomlNumber(m.K), TomlNumber(m.p), TomlNumber(m.b),
                      TomlNumber(m.c));
 }
-void WriteSignal(std::string* out, const char* table, const char* rms_key, const SignalSpec& g) {
-  *out += fmt::format("\n[{}]\nkind = {}\nband_hz = {}\n{} = {}\nseed = {}\ndiscard_s = {}\n", table,
-                      TomlString(g.kind), TomlNumber(g.band_hz), rms_key, TomlNumber(g.rms), g.seed,
-                      TomlNumber(g.discard_s));
-  *out += fmt::format("file = {}\nfile_dt_s = {}\nscale = {}\ntaper_s = {}\n", TomlString(g.file),
-                      TomlNumber(g.file_dt_s), TomlNumber(g.scale), TomlNumber(g.taper_s));
+
+class Writer {
+ public:
+  explicit Writer(std::string path) : path_(std::move(path)) {}
+
+  void Number(std::string_view key, double& v, const Range&) { Key(key, TomlNumber(v)); }
+  template <typename Int>
+  void Integer(std::string_view key, Int& v, const Range& = kAny) {
+    Key(key, fmt::format("{}", v));
+  }
+  void Bool(std::string_view key, bool& v) { Key(key, v ? "true" : "false"); }
+  void String(std::string_view key, std::string& v) { Key(key, TomlString(v)); }
+  template <typename E, std::size_t N>
+  void Choice(std::string_view key, E& v, const std::array<Named<E>, N>& names) {
+    Key(key, TomlString(std::string(NameOf(names, v))));
+  }
+  void Servo(std::string_view key, ServoModel3& m) { Key(key, TomlServo(m)); }
+  template <typename F>
+  void Table(std::string_view key, F&& fields, bool present = true) {
+    if (!present) return;
+    Writer sub(Join(key));
+    fields(sub);
+    tables_ += sub.Text();
+  }
+  void Renamed(std::string_view, const std::string&) {}
+  void Effects(std::string_view key, models::EffectSet& e, bool& same_sample) {
+    for (const models::EffectInfo& info : models::kEffects) {
+      if (!info.is_on(e)) continue;
+      Writer table(Join(key) + "." + std::string(info.name));
+      for (const models::EffectParam& p : info.params()) table.Number(p.key, *p.field(e), kAny);
+      if (info.name == "load_coupling") table.Bool("same_sample", same_sample);
+      tables_ += table.Text();
+    }
+  }
+
+  /// "\n[path]\n" and the keys (if the table has keys of its own), then the sub-tables.
+  std::string Text() const { return (keys_.empty() ? "" : fmt::format("\n[{}]\n", path_) + keys_) + tables_; }
+
+ private:
+  std::string Join(std::string_view key) const { return path_.empty() ? std::string(key) : path_ + "." + std::string(key); }
+  void Key(std::string_view key, const std::string& value) { keys_ += fmt::format("{} = {}\n", key, value); }
+
+  std::string path_;
+  std::string keys_;
+  std::string tables_;
+};
+
+// ---------------------------------------------------------------------------------------
+// Checker: every value in its range; messages name "<file>: <dotted.key>".
+
+class Checker {
+ public:
+  Checker(const Check* check, std::string prefix, double dt_s)
+      : check_(check), prefix_(std::move(prefix)), dt_s_(dt_s) {}
+
+  void Number(std::string_view key, double& v, const Range& r) { check_->InRange(Dotted(key), v, r); }
+  template <typename Int>
+  void Integer(std::string_view key, Int& v, const Range& r = kAny) {
+    check_->InRange(Dotted(key), static_cast<double>(v), r);
+  }
+  void Bool(std::string_view, bool&) {}
+  void String(std::string_view, std::string&) {}
+  template <typename E, std::size_t N>
+  void Choice(std::string_view key, E& v, const std::array<Named<E>, N>& names) {
+    if (NameOf(names, v).empty()) {
+      check_->Fail(Dotted(key), fmt::format("not set (allowed: {})", QuotedNames(names)));
+    }
+  }
+  void Servo(std::string_view key, ServoModel3& m) { ValidateServo(m, Dotted(key), *check_); }
+  template <typename F>
+  void Table(std::string_view key, F&& fields, bool present = true) {
+    if (!present) return;
+    Checker sub(check_, Dotted(key) + ".", dt_s_);
+    fields(sub);
+  }
+  void Renamed(std::string_view, const std::string&) {}
+  /// The library's ranges (models::kEffects) at run.dt_s.
+  void Effects(std::string_view key, models::EffectSet& e, bool&) {
+    for (const models::EffectInfo& info : models::kEffects) {
+      for (const models::EffectParam& p : info.params()) {
+        const double* v = p.field(e);
+        if (v == nullptr) continue;
+        const Range range{p.lo, p.Hi(dt_s_), p.lo_open, p.hi_open,
+                          p.hi_per_dt > 0.0 ? fmt::format("below {}/run.dt_s", p.hi_per_dt) : ""};
+        check_->InRange(fmt::format("{}.{}.{}", Dotted(key), info.name, p.key), *v, range);
+      }
+    }
+  }
+
+ private:
+  std::string Dotted(std::string_view key) const { return prefix_ + std::string(key); }
+
+  const Check* check_;
+  std::string prefix_;
+  double dt_s_;
+};
+
+// ---------------------------------------------------------------------------------------
+// Checks across keys and against files (after the per-key ranges).
+
+/// Where a `kind = "file"` path points: relative paths are relative to the scenario's folder.
+std::filesystem::path ResolveSignalFile(const std::string& scenario_path, const std::string& file) {
+  std::filesystem::path p(file);
+  if (p.is_relative()) p = std::filesystem::path(scenario_path).parent_path() / p;
+  return std::filesystem::absolute(p).lexically_normal();
 }
+
+void CheckFileExists(const Check& check, const std::string& key, const std::string& scenario_path,
+                     const std::string& file) {
+  const std::filesystem::path resolved = ResolveSignalFile(scenario_path, file);
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(resolved, ec)) {
+    check.Fail(key, fmt::format("file not found: {} (paths are relative to the scenario file's folder)",
+                                resolved.string()));
+  }
+}
+
+void ValidateRun(const RunConfig& r, const Check& check) {
+  if (r.name.empty() || !std::all_of(r.name.begin(), r.name.end(), [](char c) {
+        return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' ||
+               c == '-' || c == '.';
+      })) {
+    check.Fail("run.name", fmt::format("\"{}\" is not a usable name (allowed: non-empty, letters, digits, "
+                                       "'_', '-', '.')",
+                                       r.name));
+  }
+  if (r.duration_s < r.dt_s) {
+    check.Fail("run.duration_s", fmt::format("{} is shorter than one step (run.dt_s = {})", r.duration_s, r.dt_s));
+  }
+}
+
+void ValidateSignal(const SignalSpec& s, std::string_view prefix, const std::string& scenario_path,
+                    const Check& check) {
+  auto key = [&](std::string_view k) { return fmt::format("{}.{}", prefix, k); };
+  if (!std::isfinite(s.scale) || s.scale == 0.0) {
+    check.Fail(key("scale"), fmt::format("{} is not allowed (allowed: any finite value other than 0)", s.scale));
+  }
+  if (s.kind == signal::SignalKind::kFile) {
+    if (s.file.empty()) check.Fail(key("file"), "missing: kind = \"file\" needs a file path");
+    CheckFileExists(check, key("file"), scenario_path, s.file);
+  }
+}
+
+void ValidateStructure(const StructureConfig& st, const std::string& scenario_path, const Check& check) {
+  if (st.mode == models::StructureMode::kRths && st.kind == models::StructureKind::kFile) {
+    if (st.file.empty()) check.Fail("structure.file", "missing: kind = \"file\" needs a structure file");
+    CheckFileExists(check, "structure.file", scenario_path, st.file);
+    check.InRange("structure.actuator_dof", st.actuator_dof,
+                  {1, 10000, false, false, "1-based; at most the structure's number of DOFs"});
+  }
+  ValidateSignal(st.ground, "structure.ground", scenario_path, check);
+  ValidateSignal(st.desired, "structure.desired", scenario_path, check);
+}
+
+void ValidatePlant(const PlantConfig& p, const Check& check) {
+  try {
+    p.damper.Validate();
+  } catch (const Error& e) {
+    // "MrDamperParams: alpha_a" -> plant.damper.alpha_a
+    const std::string& w = e.where();
+    const std::size_t colon = w.rfind(": ");
+    check.Fail(fmt::format("plant.damper.{}", colon == std::string::npos ? w : w.substr(colon + 2)), e.problem());
+  }
+  if (p.RigMode() && p.kind != models::PlantKind::kLinear) {
+    check.Fail(p.effects.Empty() ? "plant.unmodelled" : "plant.effects",
+               fmt::format("rig mode needs plant.kind = \"linear\" (got \"{}\"): the effects act around the "
+                           "linear actuator model",
+                           NameOf(models::kPlantKindNames, p.kind)));
+  }
+}
+
+void ValidateFaults(const FaultConfig& f, const Check& check) {
+  check.InRange("faults.drop", f.drop + f.duplicate + f.delay + f.reorder,
+                {0.0, 0.5, false, false, "drop + duplicate + delay + reorder must not exceed 0.5"});
+  if (f.recv_buf_bytes != 0) {
+    check.InRange("faults.recv_buf_bytes", static_cast<double>(f.recv_buf_bytes),
+                  {1024.0, 134217728.0, false, false, "0 for the host's default, else [1024, 2^27]"});
+  }
+  if (f.process_role.empty() && f.process_kind == lockstep::ProcessFault::kNone) return;
+  check.OneOf("faults.process.role", f.process_role, {"integrator", "controller", "plant", "semiactive", "logger"});
+  if (f.process_kind == lockstep::ProcessFault::kNone) {
+    check.Fail("faults.process.kind", fmt::format("missing (allowed: {})", QuotedNames(lockstep::kProcessFaultNames)));
+  }
+}
+
 }  // namespace
 
+std::int64_t Scenario::steps() const { return std::llround(run.duration_s / run.dt_s); }
+
+std::string Sha256Hex(std::string_view bytes) {
+  unsigned char digest[EVP_MAX_MD_SIZE];
+  unsigned int length = 0;
+  if (EVP_Digest(bytes.data(), bytes.size(), digest, &length, EVP_sha256(), nullptr) != 1) {
+    throw Error("Sha256Hex", "OpenSSL EVP_Digest(sha256) failed");
+  }
+  static constexpr char kHex[] = "0123456789abcdef";
+  std::string hex;
+  hex.reserve(2 * length);
+  for (unsigned int i = 0; i < length; ++i) {
+    hex += kHex[digest[i] >> 4];
+    hex += kHex[digest[i] & 0x0f];
+  }
+  return hex;
+}
+
+void ValidateScenario(const Scenario& s) {
+  const Check check(DisplayName(s.path));
+  Scenario copy = s;  // the visitors take mutable references
+  Checker checker(&check, "", s.run.dt_s);
+  // run.dt_s and run.duration_s first: every other range and check depends on them.
+  checker.Table("run", [&](Checker& t) { RunFields(t, copy.run, Context{s.run.dt_s, s.steps()}); });
+  ValidateRun(s.run, check);
+  ScenarioFields(checker, copy);
+  ValidateStructure(s.structure, s.path, check);
+  if (s.semiactive.mode == control::SemiactiveMode::kClippedOptimal &&
+      s.structure.mode != models::StructureMode::kRths) {
+    check.Fail("semiactive.mode", "\"clipped_optimal\" needs a structure to control (structure.mode = \"rths\")");
+  }
+  ValidatePlant(s.plant, check);
+  ValidateFaults(s.faults, check);
+}
+
+Scenario ParseScenario(std::string_view toml_text, const std::string& path) {
+  const std::string file = DisplayName(path);
+  toml::table root;
+  try {
+    root = toml::parse(toml_text, path);
+  } catch (const toml::parse_error& e) {
+    const toml::source_position& at = e.source().begin;
+    throw Error(fmt::format("{}:{}:{}", file, at.line, at.column),
+                fmt::format("TOML syntax error at line {}, column {}: {}", at.line, at.column, e.description()));
+  }
+  // An empty scenario (an empty file, only comments, only table headers) is a mistake, not a
+  // request for the default experiment: at least one key must be set somewhere.
+  struct AnyKey {
+    static bool In(const toml::table& t) {
+      for (auto&& [key, node] : t)
+        if (const toml::table* sub = node.as_table(); !sub || In(*sub)) return true;
+      return false;
+    }
+  };
+  if (!AnyKey::In(root)) {
+    throw Error(file, "empty scenario: no key is set (the text is empty or holds only comments and table headers); "
+                      "set at least one key, e.g. [run] name = \"...\" (every key: docs/scenarios.md)");
+  }
+  Scenario s;
+  s.path = path;
+  Section top(file, &root, "");
+  Reader reader(&top);
+  ScenarioFields(reader, s);
+  top.Finish();
+  ValidateScenario(s);
+  for (SignalSpec* signal : {&s.structure.ground, &s.structure.desired}) {
+    if (signal->kind == signal::SignalKind::kFile) signal->file = ResolveSignalFile(path, signal->file).string();
+  }
+  if (!s.structure.file.empty()) s.structure.file = ResolveSignalFile(path, s.structure.file).string();
+  return s;
+}
+
 std::string ToToml(const Scenario& s) {
-  std::string o = "# Written by rths (scenario::ToToml): every key, explicit.\n";
-  const auto& r = s.run;
-  o += fmt::format("\n[run]\nname = {}\ndt_s = {}\nduration_s = {}\n", TomlString(r.name), TomlNumber(r.dt_s),
-                   TomlNumber(r.duration_s));
-  const auto& st = s.structure;
-  o += fmt::format(
-      "\n[structure]\nmode = {}\nmass_kg = {}\nfrequency_hz = {}\ndamping_ratio = {}\nspecimen_count = "
-      "{}\nderivatives = {}\nkind = {}\nfile = {}\nactuator_dof = {}\n",
-      TomlString(st.mode), TomlNumber(st.mass_kg), TomlNumber(st.frequency_hz), TomlNumber(st.damping_ratio),
-      TomlNumber(st.specimen_count), TomlString(st.derivatives), TomlString(st.kind), TomlString(st.file),
-      st.actuator_dof);
-  WriteSignal(&o, "structure.ground", "rms_mm_s2", st.ground);
-  WriteSignal(&o, "structure.desired", "rms_mm", st.desired);
-  const auto& c = s.controller;
-  o += fmt::format(
-      "\n[controller]\nkind = {}\nmodel = {}\nhalf_step_ahead = {}\ndelay_ms = {}\nmax_delay_ms = {}\n"
-      "lead_tp_ms = {}\nlp_cutoff_hz = {}\nlp_order = {}\nmodel_low = {}\nmodel_high = {}\n"
-      "current_high_A = {}\n",
-      TomlString(c.kind), TomlServo(c.model), c.half_step_ahead, TomlNumber(c.delay_ms),
-      TomlNumber(c.max_delay_ms), TomlNumber(c.lead_tp_ms), TomlNumber(c.lp_cutoff_hz), c.lp_order,
-      TomlServo(c.model_low), TomlServo(c.model_high), TomlNumber(c.current_high_A));
-  o += fmt::format("\n[controller.lqg]\nq = {}\nw_f_hz = {}\nxi_f = {}\neta_f = {}\nW = {}\nV = {}\n",
-                   TomlNumber(c.lqg.q), TomlNumber(c.lqg.w_f_hz), TomlNumber(c.lqg.xi_f), TomlNumber(c.lqg.eta_f),
-                   TomlNumber(c.lqg.W), TomlNumber(c.lqg.V));
-  const auto& p = s.plant;
-  o += fmt::format(
-      "\n[plant]\nkind = {}\nactuator = {}\nspecimen = {}\ncurrent_dynamics = {}\nnoise_y_mm_rms = {}\n"
-      "noise_f_kN_rms = {}\nnoise_seed = {}\ncvode_rtol = {}\n",
-      TomlString(p.kind), TomlServo(p.actuator), TomlString(p.specimen), p.current_dynamics,
-      TomlNumber(p.noise_y_mm_rms), TomlNumber(p.noise_f_kN_rms), p.noise_seed, TomlNumber(p.cvode_rtol));
-  o += "\n[plant.physical]\n";
-  PhysicalActuatorConfig phys = p.physical;
-  for (auto [key, field] : PhysicalFields(&phys)) o += fmt::format("{} = {}\n", key, TomlNumber(*field));
-  o += "\n[plant.damper]\n";
-  models::MrDamperParams damper = p.damper;
-  for (auto [key, field] : DamperFields(&damper)) o += fmt::format("{} = {}\n", key, TomlNumber(*field));
-  o += fmt::format("\n[plant.unmodelled]\nripple_mm = {}\nripple_hz = {}\nstiffness_kN_per_mm = {}\n",
-                   TomlNumber(p.unmodelled.ripple_mm), TomlNumber(p.unmodelled.ripple_hz),
-                   TomlNumber(p.unmodelled.stiffness_kN_per_mm));
-  models::EffectSet effects = p.effects;
-  for (auto& [name, keys] : EffectKeys(&effects)) {
-    o += fmt::format("\n[plant.effects.{}]\n", name);
-    for (const EffectKey& k : keys) o += fmt::format("{} = {}\n", k.key, TomlNumber(*k.field));
-    if (std::string_view(name) == "load_coupling") o += fmt::format("same_sample = {}\n", p.load_coupling_same_sample);
-  }
-  const auto& sa = s.semiactive;
-  o += fmt::format(
-      "\n[semiactive]\nmode = {}\ncurrent_A = {}\nmax_current_A = {}\npulse_hz = {}\npulse_duty = {}\n"
-      "r_weight = {}\nnoise_ratio = {}\ncapacity_kN = {}\n",
-      TomlString(sa.mode), TomlNumber(sa.current_A), TomlNumber(sa.max_current_A), TomlNumber(sa.pulse_hz),
-      TomlNumber(sa.pulse_duty), TomlNumber(sa.r_weight), TomlNumber(sa.noise_ratio), TomlNumber(sa.capacity_kN));
-  const auto& f = s.safety;
-  o += fmt::format(
-      "\n[safety]\nenabled = {}\nstroke_mm = {}\nforce_kN = {}\nmax_error_mm = {}\ngrowth_window_s = {}\n"
-      "growth_factor = {}\ngrowth_windows = {}\ngrowth_floor_mm = {}\n",
-      f.enabled, TomlNumber(f.stroke_mm), TomlNumber(f.force_kN), TomlNumber(f.max_error_mm),
-      TomlNumber(f.growth_window_s), TomlNumber(f.growth_factor), f.growth_windows, TomlNumber(f.growth_floor_mm));
-  const auto& l = s.lockstep;
-  o += fmt::format("\n[lockstep]\nrerequest_ms = {}\nstall_budget_s = {}\nhandshake_timeout_s = {}\n",
-                   TomlNumber(l.rerequest_ms), TomlNumber(l.stall_budget_s), TomlNumber(l.handshake_timeout_s));
-  const auto& rt = s.realtime;
-  o += fmt::format("\n[realtime]\nenabled = {}\nmax_consecutive_misses = {}\nsched_fifo = {}\npriority = {}\n"
-                   "lock_memory = {}\n",
-                   rt.enabled, rt.max_consecutive_misses, rt.sched_fifo, rt.priority, rt.lock_memory);
-  const auto& fc = s.faults;
-  o += fmt::format("\n[faults]\ndrop = {}\nduplicate = {}\ndelay = {}\nreorder = {}\ndelay_ms = {}\nseed = {}\n"
-                   "recv_buf_bytes = {}\n",
-                   TomlNumber(fc.drop), TomlNumber(fc.duplicate), TomlNumber(fc.delay), TomlNumber(fc.reorder),
-                   TomlNumber(fc.delay_ms), fc.seed, fc.recv_buf_bytes);
-  if (!fc.process_role.empty() || !fc.process_kind.empty()) {
-    o += fmt::format("\n[faults.process]\nrole = {}\nkind = {}\nat_step = {}\nstop_s = {}\n",
-                     TomlString(fc.process_role), TomlString(fc.process_kind), fc.process_at_step,
-                     TomlNumber(fc.process_stop_s));
-  }
-  return o;
+  Scenario copy = s;  // the visitors take mutable references
+  Writer writer("");
+  ScenarioFields(writer, copy);
+  return "# Written by rths (scenario::ToToml): every key, explicit.\n" + writer.Text();
 }
 
 Scenario LoadScenario(const std::string& path) {

@@ -26,6 +26,7 @@ struct RunConfig {
   std::string name = "run";
   double dt_s = 0.0005;       ///< lockstep step [s], [1e-5, 0.01]
   double duration_s = 20.0;   ///< simulated time [s], (0, 36000]
+  bool operator==(const RunConfig&) const = default;
 };
 
 /// Everything a run needs, gathered from one file: each table's struct lives beside the component
@@ -46,6 +47,7 @@ struct Scenario {
 
   /// Number of lockstep steps: round(duration_s / dt_s).
   std::int64_t steps() const;
+  bool operator==(const Scenario&) const = default;
 };
 
 /// Reads, hashes, parses and validates a scenario file. Throws rths::Error.

@@ -185,17 +185,20 @@ std::vector<double> LoadHistory(const std::string& path, double file_dt_s, doubl
 std::vector<double> MakeSignal(const signal::SignalSpec& spec, double dt_s, std::size_t n,
                                const std::string& scenario_dir) {
   std::vector<double> x;
-  if (spec.kind == "blwn") {
-    x = Blwn(spec.band_hz, spec.rms, dt_s, n, spec.seed, spec.discard_s);
-  } else if (spec.kind == "file") {
+  switch (spec.kind) {
+    case SignalKind::kBlwn:
+      x = Blwn(spec.band_hz, spec.rms, dt_s, n, spec.seed, spec.discard_s);
+      break;
+    case SignalKind::kFile: {
     if (spec.file.empty()) throw Error("signal.file", "empty path for kind = \"file\"");
     std::filesystem::path p(spec.file);
     if (p.is_relative() && !scenario_dir.empty()) p = std::filesystem::path(scenario_dir) / p;
     x = LoadHistory(p.string(), spec.file_dt_s, spec.scale, dt_s, n);
-  } else if (spec.kind == "zero") {
-    x.assign(n, 0.0);
-  } else {
-    throw Error("signal.kind", fmt::format("\"{}\": allowed \"blwn\", \"file\", \"zero\"", spec.kind));
+      break;
+    }
+    case SignalKind::kZero:
+      x.assign(n, 0.0);
+      break;
   }
   ApplyTaper(spec.taper_s, dt_s, &x);
   return x;

@@ -6,12 +6,18 @@
 #include <vector>
 #include <cstdint>
 
+#include "core/names.h"
 
 namespace rths::signal {
 
+/// How a time history is made (SignalSpec::kind).
+enum class SignalKind { kBlwn, kFile, kZero };
+inline constexpr std::array<Named<SignalKind>, 3> kSignalKindNames = {
+    {{SignalKind::kBlwn, "blwn"}, {SignalKind::kFile, "file"}, {SignalKind::kZero, "zero"}}};
+
 /// A time history generated or read at the edge (ground acceleration or desired displacement).
 struct SignalSpec {
-  std::string kind = "blwn";  ///< "blwn" | "file" | "zero"
+  SignalKind kind = SignalKind::kBlwn;  ///< "blwn" | "file" | "zero"
   // kind = "blwn": Gaussian white noise through an 8th-order Butterworth low-pass at band_hz,
   // scaled to rms, with the first discard_s seconds thrown away (models.md section 9).
   double band_hz = 30.0;      ///< upper band edge [Hz], (0, 0.5/dt)
@@ -25,6 +31,7 @@ struct SignalSpec {
   /// Raised-cosine fade-in over the first taper_s seconds [s], [0, 60]: a BLWN record cut after
   /// its discarded start begins mid-motion, which would ask the actuator for a step.
   double taper_s = 0.0;
+  bool operator==(const SignalSpec&) const = default;
 };
 
 /// Reads a time history from a text file and resamples it to the run's step.
