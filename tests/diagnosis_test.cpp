@@ -4,6 +4,7 @@
 #include <unistd.h>
 #include <sys/wait.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -13,6 +14,7 @@
 #include <string>
 
 #include <doctest/doctest.h>
+#include <fmt/format.h>
 
 #include "core/error.h"
 #include "diagnosis/diagnosis.h"
@@ -417,4 +419,66 @@ TEST_CASE("regression: one sample of 1e308 is a clean error, never a crash (the 
   CHECK(WEXITSTATUS(st) == 2);
   // Line 1004: magic, dt_s, header on line 3 (no metadata), row k on line 4 + k.
   CHECK(text.find("huge.csv:1004: column y_mm: 1e+308 is out of range [-10000, 10000] mm") != std::string::npos);
+}
+
+TEST_CASE("options: the defaults are valid, each bad field is named with its range, Diagnose refuses them") {
+  std::string why;
+  CHECK(Options{}.IsValid(&why));
+  CHECK(why.empty());
+  struct Bad {
+    std::function<void(Options*)> set;
+    std::string field, range;
+  };
+  const std::vector<Bad> bad = {
+      {[](Options* o) { o->none_ratio = 0.9; }, "none_ratio", ">= 1"},
+      {[](Options* o) { o->min_excess_reduction = 1.0; }, "min_excess_reduction", "(0, 1)"},
+      {[](Options* o) { o->warmup_s = std::nan(""); }, "warmup_s", ">= 0"},
+      {[](Options* o) { o->noise_band_hi = 0.4; }, "noise_band_hi", "(0.5, 1]"},
+      {[](Options* o) { o->refit_grid = 1; }, "refit_grid", "[2, 1000]"},
+      {[](Options* o) { o->swap_passes = -1; }, "swap_passes", "[0, 100]"},
+      {[](Options* o) { o->max_smooth_cycles_per_sample = 0.5; }, "max_smooth_cycles_per_sample", "(0, 0.5)"},
+  };
+  const auto [tr, te] = Records(Noisy(), 3.0);
+  for (const auto& b : bad) {
+    CAPTURE(b.field);
+    Options o;
+    b.set(&o);
+    CHECK_FALSE(o.IsValid(&why));
+    CHECK(why.find(b.field + " = ") == 0);
+    CHECK(why.find("allowed " + b.range) != std::string::npos);
+    CHECK_THROWS_WITH_AS(Diagnose({tr}, {te}, PaperModel(), o), doctest::Contains(b.field.c_str()), rths::Error);
+  }
+}
+
+TEST_CASE("options: the ones used are written into the JSON, every field") {
+  const auto [tr, te] = Records(Noisy(), 3.0);
+  Options o;
+  o.none_ratio = 1.7;
+  o.refit_rounds = 5;
+  const auto j = ToJson(Diagnose({tr}, {te}, PaperModel(), o))["options"];
+  CHECK(j == ToJson(o));
+  CHECK(j["none_ratio"] == 1.7);
+  CHECK(j["refit_rounds"] == 5);
+  CHECK(j["min_test_shrink_pct"] == 30.0);
+  CHECK(j["detrend"] == false);
+  CHECK(j.size() == 37);  // one per field of Options
+}
+
+TEST_CASE("Summary: the brief report is the verdict and each channel's shrink; the full one is unchanged") {
+  Truth t = Noisy();
+  t.effects.pure_delay = m::PureDelay{4.0};
+  const auto [tr, te] = Records(t);
+  const auto r = Diagnose({tr}, {te}, PaperModel(), Options{});
+  const std::string full = Summary(r), brief = Summary(r, SummaryDetail::kBrief);
+  CHECK(Summary(r, SummaryDetail::kFull) == full);
+  CHECK(full.rfind("model: ", 0) == 0);
+  CHECK(full.find("effects (test NRMSE after, shrink):") != std::string::npos);
+  CHECK(brief.rfind("verdict: pure_delay\n", 0) == 0);
+  const auto* y = r.Channel("y");
+  CHECK(brief.find(fmt::format("channel y: explained, test NRMSE {:.3f} % -> {:.3f} % (shrink {:.1f} %)",
+                               y->gap_test_pct, y->after_test_pct, ShrinkPct(y->gap_test_pct, y->after_test_pct))) !=
+        std::string::npos);
+  CHECK(brief.find("channel f: noise") != std::string::npos);
+  CHECK(std::count(brief.begin(), brief.end(), '\n') <= 4);
+  CHECK(brief.size() < full.size() / 2);
 }

@@ -1,9 +1,10 @@
-// rths diagnose --train A [B ...] --test C [D ...] [--model MODEL.toml] [--out DIR] [--detrend]
+// rths diagnose --train A [B ...] --test C [D ...] [--model MODEL.toml] [--out DIR] [--detrend] [--brief]
 // The sim-to-real gap diagnosis (../shared/spec/diagnosis.md, docs/diagnosis.md): reads rig
 // records (CSV or our LCM logs), predicts them with the nominal model, localises the residual,
 // fits every effect of the library on the training records, selects greedily, scores the shrink
 // on the test records. Writes DIR/diagnosis.json and DIR/report.html (+ PNG plots), prints a
-// summary. Exit 0 ok, 2 bad input (a bad record names its file and line), 1 other failure.
+// summary (--brief: the verdict and each channel's shrink only). Exit 0 ok, 2 bad input (a bad
+// record names its file and line), 1 other failure.
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -26,6 +27,7 @@ int main(int argc, char** argv) {
   std::vector<std::string> train, test;
   std::string model_file, out;
   rths::diagnosis::Options o;
+  bool brief = false;
   app.add_option("--train", train, "training records (CSV rig records or LCM logs)")->required()->expected(1, -1);
   app.add_option("--test", test, "held-out test records")->required()->expected(1, -1);
   app.add_option("--model", model_file, "nominal model: a scenario TOML or a file written by rths identify "
@@ -34,6 +36,7 @@ int main(int argc, char** argv) {
   app.add_flag("--detrend", o.detrend, "remove each record's mean of u, y and f first");
   app.add_option("--none-ratio", o.none_ratio, "residual/noise-floor power ratio at or below which a channel is noise");
   app.add_option("--smooth-hz", o.smooth_hz, "zero-phase smoothing of the y residual for the force channel's motion [Hz] (default 20)");
+  app.add_flag("--brief", brief, "print only the verdict and each channel's shrink (the files are the same)");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -67,7 +70,8 @@ int main(int argc, char** argv) {
     } catch (const std::exception& e) {
       report_note = fmt::format("warning: report.html: {}\n", e.what());
     }
-    std::printf("rths diagnose\n%s%s", rths::diagnosis::Summary(r).c_str(), report_note.c_str());
+    const auto detail = brief ? rths::diagnosis::SummaryDetail::kBrief : rths::diagnosis::SummaryDetail::kFull;
+    std::printf("rths diagnose\n%s%s", rths::diagnosis::Summary(r, detail).c_str(), report_note.c_str());
     std::printf("output: %s\n", dir.string().c_str());
   } catch (const rths::Error& e) {
     std::fprintf(stderr, "rths diagnose: %s\n", e.what());

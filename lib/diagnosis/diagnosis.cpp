@@ -3,18 +3,16 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 #include <functional>
-#include <memory>
+#include <limits>
 #include <numeric>
 #include <optional>
-#include <set>
 
 #include <fmt/format.h>
 
 #include "core/error.h"
 #include "diagnosis/localise.h"
+#include "diagnosis/stages.h"
 #include "signal/spectral.h"
 
 namespace rths::diagnosis {
@@ -41,50 +39,106 @@ const ChannelSummary* Result::Channel(const std::string& c) const {
   return nullptr;
 }
 
+bool Options::IsValid(std::string* error) const {
+  auto fail = [error](std::string m) {
+    if (error) *error = std::move(m);
+    return false;
+  };
+  // A real field within [lo, hi] (open ends where lo_open / hi_open).
+  auto real = [&](const char* name, double v, double lo, double hi, bool lo_open, bool hi_open) {
+    const bool ok = std::isfinite(v) && (lo_open ? v > lo : v >= lo) && (hi_open ? v < hi : v <= hi);
+    if (ok) return true;
+    const std::string range = std::isinf(hi) ? fmt::format("{} {}", lo_open ? ">" : ">=", lo)
+                                             : fmt::format("{}{}, {}{}", lo_open ? "(" : "[", lo, hi, hi_open ? ")" : "]");
+    return fail(fmt::format("{} = {}: allowed {}", name, v, range));
+  };
+  auto integer = [&](const char* name, int v, int lo, int hi) {
+    if (v >= lo && v <= hi) return true;
+    return fail(fmt::format("{} = {}: allowed [{}, {}]", name, v, lo, hi));
+  };
+  const double inf = std::numeric_limits<double>::infinity();
+  const int imax = std::numeric_limits<int>::max();
+  return real("warmup_s", warmup_s, 0.0, inf, false, true) &&
+         real("smooth_hz", smooth_hz, 0.0, inf, true, true) &&
+         real("max_smooth_cycles_per_sample", max_smooth_cycles_per_sample, 0.0, 0.5, true, true) &&
+         real("displacement_only_smooth_factor", displacement_only_smooth_factor, 0.0, inf, true, true) &&
+         real("vmax_search_factor", vmax_search_factor, 1.0, inf, false, true) &&
+         real("noise_band_lo", noise_band_lo, 0.0, 1.0, false, true) &&
+         real("noise_band_hi", noise_band_hi, noise_band_lo, 1.0, true, false) &&
+         integer("noise_psd_segment", noise_psd_segment, 8, 1 << 20) &&
+         integer("whiteness_lags", whiteness_lags, 1, 10000) &&
+         integer("correlation_max_lag", correlation_max_lag, 1, imax - 1) &&
+         integer("correlation_lag_divisor", correlation_lag_divisor, 1, imax) &&
+         real("none_ratio", none_ratio, 1.0, inf, false, true) &&
+         real("min_excess_reduction", min_excess_reduction, 0.0, 1.0, true, true) &&
+         real("min_floor_gain", min_floor_gain, 0.0, inf, false, true) &&
+         integer("max_effects_per_channel", max_effects_per_channel, 1, imax) &&
+         real("at_bound_fraction", at_bound_fraction, 0.0, 0.5, false, true) &&
+         integer("swap_passes", swap_passes, 0, 100) &&
+         real("swap_min_gain", swap_min_gain, 0.0, 1.0, false, true) &&
+         real("min_test_shrink_pct", min_test_shrink_pct, 0.0, 100.0, false, false) &&
+         real("max_test_worsening", max_test_worsening, 0.0, inf, false, true) &&
+         integer("golden_iters_y", golden_iters_y, 0, 200) &&
+         integer("golden_iters_f", golden_iters_f, 0, 200) &&
+         integer("refit_golden_iters_y", refit_golden_iters_y, 0, 200) &&
+         integer("refit_golden_iters_f", refit_golden_iters_f, 0, 200) &&
+         real("refit_bracket_factor", refit_bracket_factor, 1.0, inf, true, true) &&
+         real("refit_bracket_fraction", refit_bracket_fraction, 0.0, 1.0, true, false) &&
+         integer("refit_grid", refit_grid, 2, 1000) &&
+         integer("simplex_evals", simplex_evals, 3, 100000) &&
+         integer("refit_simplex_evals", refit_simplex_evals, 3, 100000) &&
+         real("simplex_step_grid_fraction", simplex_step_grid_fraction, 0.0, inf, true, true) &&
+         real("refit_simplex_step_first", refit_simplex_step_first, 0.0, inf, true, true) &&
+         real("refit_simplex_step_second", refit_simplex_step_second, 0.0, inf, true, true) &&
+         real("refit_rel_tol", refit_rel_tol, 0.0, 1.0, false, true) &&
+         integer("trial_refit_rounds", trial_refit_rounds, 1, 1000) &&
+         integer("refit_rounds", refit_rounds, 1, 1000) &&
+         integer("prune_refit_rounds", prune_refit_rounds, 1, 1000);
+}
+
 // ------------------------------------------------------------------------------------------
 // Effects as parameter vectors
 
-namespace {
+namespace stages {
 
-struct ParamSpec {
-  const char* key;
-  double lo, hi;
-  bool log;
-  int grid;
-};
-struct CandidateSpec {
-  const char* name;
-  char channel;  // 'y' or 'f'
-  std::vector<ParamSpec> params;
-};
-
-/// The fitted parameters and their search ranges (docs/diagnosis.md "Fitting"). vmax's upper end
-/// is set per data set (twice the largest measured velocity).
-std::vector<CandidateSpec> Candidates(double dt_s, double vmax_hi) {
-  return {
-      {"pure_delay", 'y', {{"tau_ms", 0.0, 40.0, false, 81}}},
-      {"gain_error", 'y', {{"gain", 0.5, 2.0, true, 41}}},
-      {"load_coupling", 'y', {{"compliance_mm_per_kN", 0.0, 0.2, false, 81}}},  // yields: c >= 0
-      {"oil_column_resonance", 'y', {{"f_hz", 2.0, 0.4 / dt_s, true, 40}, {"zeta", 0.02, 1.5, true, 10}}},
-      {"coulomb_friction", 'y', {{"loss_mm", 1e-3, 10.0, true, 31}}},
-      {"backlash", 'y', {{"gap_mm", 1e-3, 10.0, true, 31}}},
-      {"servovalve_saturation", 'y', {{"vmax_mm_per_s", 1.0, vmax_hi, true, 31}}},
-      {"current_lag", 'f', {{"tau_ms", 0.5, 1000.0, true, 12}}},
-      {"damper_scale", 'f', {{"scale", 0.1, 10.0, true, 0}}},  // closed form
-  };
+std::vector<CandidateSpec> Candidates(double dt_s, double data_hi) {
+  std::vector<CandidateSpec> out;
+  for (const models::EffectInfo& e : models::kEffects) {
+    if (!e.diagnosable) continue;
+    CandidateSpec c{&e, std::string(e.name), e.channel, {}};
+    for (const models::EffectParam& p : e.params()) {
+      if (!p.fitted) continue;
+      const double hi = p.search_hi_from_data ? data_hi
+                        : p.search_hi_per_dt > 0.0 ? p.search_hi_per_dt / dt_s
+                                                   : p.search_hi;
+      c.params.push_back({std::string(p.key), p.search_lo, hi, p.log, p.grid});
+    }
+    out.push_back(std::move(c));
+  }
+  return out;
 }
 
-using Params = std::map<std::string, std::vector<double>>;  // effect name -> values (spec order)
+}  // namespace stages
 
-/// true if a fitted parameter sits on an end of its search range (within 0.1 % of the range, in
-/// log space for log parameters; a closed-form fit is clipped to its range): the effect's model does not describe the residual there, so it
-/// is not selected (e.g. a "resonance" pushed to the highest frequency, a lag at its floor).
-bool AtBound(const CandidateSpec& spec, const std::vector<double>& v) {
+namespace {
+
+using stages::CandidateSpec;
+using stages::Channel;
+using stages::Data;
+using stages::ParamSpec;
+using stages::Params;
+using stages::ToSet;
+
+/// true if a fitted parameter sits on an end of its search range (within `fraction` of the range,
+/// Options::at_bound_fraction, in log space for log parameters; a closed-form fit is clipped to its
+/// range): the effect's model does not describe the residual there, so it is not selected (e.g. a
+/// "resonance" pushed to the highest frequency, a lag at its floor).
+bool AtBound(const CandidateSpec& spec, const std::vector<double>& v, double fraction) {
   for (std::size_t j = 0; j < spec.params.size() && j < v.size(); ++j) {
     const auto& p = spec.params[j];
     const double lo = p.log ? std::log(p.lo) : p.lo, hi = p.log ? std::log(p.hi) : p.hi;
     const double x = p.log ? std::log(std::max(v[j], 1e-300)) : v[j];
-    const double tol = 1e-3 * (hi - lo);
+    const double tol = fraction * (hi - lo);
     if (x <= lo + tol || x >= hi - tol) return true;
   }
   return false;
@@ -106,35 +160,20 @@ const CandidateSpec& SpecOf(const std::vector<CandidateSpec>& c, const std::stri
 }  // namespace
 
 void SetEffect(models::EffectSet* set, const std::string& name, const std::map<std::string, double>& p) {
-  auto get = [&](const char* key) {
-    const auto it = p.find(key);
-    if (it == p.end()) throw Error("effect " + name, fmt::format("missing parameter {}", key));
-    return it->second;
-  };
-  if (name == "pure_delay") set->pure_delay = models::PureDelay{get("tau_ms")};
-  else if (name == "gain_error") set->gain_error = models::GainError{get("gain")};
-  else if (name == "load_coupling") set->load_coupling = models::LoadCoupling{get("compliance_mm_per_kN")};
-  else if (name == "oil_column_resonance") set->oil_column_resonance = models::OilColumnResonance{get("f_hz"), get("zeta")};
-  else if (name == "coulomb_friction") {
-    models::CoulombFriction c;
-    c.loss_mm = get("loss_mm");
-    if (p.count("v_smooth_mm_s")) c.v_smooth_mm_s = p.at("v_smooth_mm_s");
-    set->coulomb_friction = c;
-  } else if (name == "backlash") set->backlash = models::Backlash{get("gap_mm")};
-  else if (name == "servovalve_saturation") set->servovalve_saturation = models::ServovalveSaturation{get("vmax_mm_per_s")};
-  else if (name == "current_lag") set->current_lag = models::CurrentLag{get("tau_ms")};
-  else if (name == "damper_scale") set->damper_scale = models::DamperScale{get("scale")};
-  else if (name == "sensor_noise") {
-    models::SensorNoise s;
-    if (p.count("rms_y_mm")) s.rms_y_mm = p.at("rms_y_mm");
-    if (p.count("rms_f_kN")) s.rms_f_kN = p.at("rms_f_kN");
-    set->sensor_noise = s;
-  } else {
-    throw Error("effect", fmt::format("unknown effect \"{}\"", name));
+  const models::EffectInfo* info = models::FindEffect(name);
+  if (info == nullptr) throw Error("effect", fmt::format("unknown effect \"{}\"", name));
+  info->turn_on(*set);  // its defaults
+  for (const models::EffectParam& q : info->params()) {
+    const auto it = p.find(std::string(q.key));
+    if (it != p.end()) {
+      *q.field(*set) = it->second;
+    } else if (q.required) {
+      throw Error("effect " + name, fmt::format("missing parameter {}", q.key));
+    }
   }
 }
 
-namespace {
+namespace stages {
 
 models::EffectSet ToSet(const std::vector<CandidateSpec>& specs, const Params& p) {
   models::EffectSet set;
@@ -149,15 +188,6 @@ models::EffectSet ToSet(const std::vector<CandidateSpec>& specs, const Params& p
 
 // ------------------------------------------------------------------------------------------
 // The data and the two channels' sums of squares
-
-struct Data {
-  std::string source;
-  double dt = 0;
-  std::vector<double> u, y, f, i;
-  SmoothedMotion motion;
-  std::size_t first = 0;
-  std::size_t size() const { return u.size(); }
-};
 
 Data Prepare(const io::RigRecord& r, const Options& o) {
   Data d;
@@ -178,6 +208,10 @@ Data Prepare(const io::RigRecord& r, const Options& o) {
   return d;
 }
 
+}  // namespace stages
+
+namespace {
+
 double Sse(std::span<const double> m, std::span<const double> p, std::size_t first) {
   double s = 0;
   for (std::size_t k = first; k < m.size(); ++k) {
@@ -191,68 +225,67 @@ double SumSq(std::span<const double> m, std::size_t first) {
   for (std::size_t k = first; k < m.size(); ++k) s += m[k] * m[k];
   return s;
 }
+
+}  // namespace
+
+namespace stages {
+
 std::size_t Count(const std::vector<Data>& ds) {
   std::size_t n = 0;
   for (const auto& d : ds) n += d.size() - d.first;
   return n;
 }
 
-/// Evaluates a channel's predictions for an effect set over a set of records.
-class Channel {
- public:
-  Channel(char ch, const std::vector<Data>* recs, const models::LinearServo* servo, const ForcePredictor* fp)
-      : ch_(ch), recs_(recs), servo_(servo), fp_(fp) {
-    for (const auto& d : *recs_) meas2_ += SumSq(ch_ == 'y' ? d.y : d.f, d.first);
-  }
-  /// Predictions per record. For 'f' with damper_scale in the set, the scale is replaced by the
-  /// least-squares one over these records (closed form) and written back to *scale_out.
-  std::vector<std::vector<double>> Predict(const models::EffectSet& set, double* scale_out = nullptr,
-                                           std::optional<double> fixed_scale = std::nullopt) const {
-    std::vector<std::vector<double>> out;
-    out.reserve(recs_->size());
-    if (ch_ == 'y') {
-      for (const auto& d : *recs_) out.push_back(PredictDisplacement(*servo_, set, d.u, d.f));
-      return out;
-    }
-    for (const auto& d : *recs_) out.push_back(fp_->PredictUnscaled(d.motion, d.i, set));
-    if (set.damper_scale) {
-      double s = fixed_scale.value_or(0.0);
-      if (!fixed_scale) {
-        double num = 0, den = 0;
-        for (std::size_t r = 0; r < recs_->size(); ++r) {
-          const auto& d = (*recs_)[r];
-          for (std::size_t k = d.first; k < d.size(); ++k) {
-            num += d.f[k] * out[r][k];
-            den += out[r][k] * out[r][k];
-          }
-        }
-        s = den > 0 ? std::clamp(num / den, 0.1, 10.0) : 1.0;
-      }
-      for (auto& v : out)
-        for (double& x : v) x *= s;
-      if (scale_out) *scale_out = s;
-    }
+Channel::Channel(char ch, const std::vector<Data>* recs, const models::LinearServo* servo, const ForcePredictor* fp)
+    : ch_(ch), recs_(recs), servo_(servo), fp_(fp) {
+  for (const auto& d : *recs_) meas2_ += SumSq(ch_ == 'y' ? d.y : d.f, d.first);
+}
+
+std::vector<std::vector<double>> Channel::Predict(const models::EffectSet& set, double* scale_out,
+                                                  std::optional<double> fixed_scale) const {
+  std::vector<std::vector<double>> out;
+  out.reserve(recs_->size());
+  if (ch_ == 'y') {
+    for (const auto& d : *recs_) out.push_back(PredictDisplacement(*servo_, set, d.u, d.f));
     return out;
   }
-  double Sse(const std::vector<std::vector<double>>& pred) const {
-    double s = 0;
-    for (std::size_t r = 0; r < recs_->size(); ++r) {
-      const auto& d = (*recs_)[r];
-      s += diagnosis::Sse(ch_ == 'y' ? d.y : d.f, pred[r], d.first);
+  for (const auto& d : *recs_) out.push_back(fp_->PredictUnscaled(d.motion, d.i, set));
+  if (set.damper_scale) {
+    double s = fixed_scale.value_or(0.0);
+    if (!fixed_scale) {
+      double num = 0, den = 0;
+      for (std::size_t r = 0; r < recs_->size(); ++r) {
+        const auto& d = (*recs_)[r];
+        for (std::size_t k = d.first; k < d.size(); ++k) {
+          num += d.f[k] * out[r][k];
+          den += out[r][k] * out[r][k];
+        }
+      }
+      s = den > 0 ? std::clamp(num / den, 0.1, 10.0) : 1.0;
     }
-    return s;
+    for (auto& v : out)
+      for (double& x : v) x *= s;
+    if (scale_out) *scale_out = s;
   }
-  double NrmsePct(double sse) const { return meas2_ > 0 ? 100.0 * std::sqrt(sse / meas2_) : std::nan(""); }
-  const std::vector<Data>& recs() const { return *recs_; }
-  std::span<const double> Meas(std::size_t r) const { return ch_ == 'y' ? (*recs_)[r].y : (*recs_)[r].f; }
+  return out;
+}
 
- private:
-  char ch_;
-  const std::vector<Data>* recs_;
-  const models::LinearServo* servo_;
-  const ForcePredictor* fp_;
-  double meas2_ = 0;
-};
+double Channel::Sse(const std::vector<std::vector<double>>& pred) const {
+  double s = 0;
+  for (std::size_t r = 0; r < recs_->size(); ++r) {
+    const auto& d = (*recs_)[r];
+    s += diagnosis::Sse(ch_ == 'y' ? d.y : d.f, pred[r], d.first);
+  }
+  return s;
+}
+
+double Channel::NrmsePct(double sse) const { return meas2_ > 0 ? 100.0 * std::sqrt(sse / meas2_) : std::nan(""); }
+
+std::span<const double> Channel::Meas(std::size_t r) const { return ch_ == 'y' ? (*recs_)[r].y : (*recs_)[r].f; }
+
+}  // namespace stages
+
+namespace {
 
 /// Golden-section search of a function of one variable on [a, b] (a < b), iters iterations.
 double Golden(const std::function<double(double)>& f, double a, double b, int iters, double* fbest) {
@@ -361,10 +394,12 @@ std::vector<double> NelderMead2(const std::function<double(const std::vector<dou
 
 /// Fits the parameters of `name` (others in p held) on the channel; returns the SSE and updates
 /// p[name]. If p already holds `name` (a refit), the search is local around its value: a bracket
-/// of a factor 1.3 (log parameters) or +-5 % of the range (linear ones), 5 points and golden
-/// section (2 parameters: Nelder-Mead in log coordinates from the current point); else the whole
-/// range: the grid and golden section (2 parameters: the 2-D grid, then Nelder-Mead).
-double FitEffect(const Channel& ch, const std::vector<CandidateSpec>& specs, Params* p, const std::string& name) {
+/// of a factor o.refit_bracket_factor (log parameters) or +- o.refit_bracket_fraction of the range
+/// (linear ones), o.refit_grid points and golden section (2 parameters: Nelder-Mead in log
+/// coordinates from the current point); else the whole range: the grid and golden section
+/// (2 parameters: the 2-D grid, then Nelder-Mead).
+double FitEffect(const Channel& ch, const std::vector<CandidateSpec>& specs, Params* p, const std::string& name,
+                 const Options& o) {
   const auto& spec = SpecOf(specs, name);
   const bool is_f = spec.channel == 'f';
   if (name == "damper_scale") {
@@ -387,17 +422,18 @@ double FitEffect(const Channel& ch, const std::vector<CandidateSpec>& specs, Par
   double best = 0;
   if (spec.params.size() == 1) {
     ParamSpec ps = spec.params[0];
-    int giters = is_f ? 12 : 24;
+    int giters = is_f ? o.golden_iters_f : o.golden_iters_y;
     if (refit) {
       const double v = cur[0];
       if (ps.log) {
-        ps.lo = std::max(spec.params[0].lo, v / 1.3), ps.hi = std::min(spec.params[0].hi, v * 1.3);
+        ps.lo = std::max(spec.params[0].lo, v / o.refit_bracket_factor);
+        ps.hi = std::min(spec.params[0].hi, v * o.refit_bracket_factor);
       } else {
-        const double w = 0.05 * (spec.params[0].hi - spec.params[0].lo);
+        const double w = o.refit_bracket_fraction * (spec.params[0].hi - spec.params[0].lo);
         ps.lo = std::max(spec.params[0].lo, v - w), ps.hi = std::min(spec.params[0].hi, v + w);
       }
-      ps.grid = 5;
-      giters = is_f ? 8 : 14;
+      ps.grid = o.refit_grid;
+      giters = is_f ? o.refit_golden_iters_f : o.refit_golden_iters_y;
     }
     const double x = Minimise1D([&](double x) { return eval({x}); }, ps, giters, &best, refit ? cur : std::vector<double>{});
     (*p)[name] = {x};
@@ -424,16 +460,20 @@ double FitEffect(const Channel& ch, const std::vector<CandidateSpec>& specs, Par
     if (xa < a.lo || xa > a.hi || xb < b.lo || xb > b.hi) return std::numeric_limits<double>::infinity();
     return eval({xa, xb});
   };
-  const double step_a = refit ? 0.05 : 0.5 * (std::log(a.hi) - std::log(a.lo)) / (a.grid - 1);
-  const double step_b = refit ? 0.1 : 0.5 * (std::log(b.hi) - std::log(b.lo)) / (b.grid - 1);
-  const auto t = NelderMead2(flog, {std::log(v[0]), std::log(v[1])}, {step_a, step_b}, refit ? 24 : 48, &best);
+  const double step_a = refit ? o.refit_simplex_step_first
+                              : o.simplex_step_grid_fraction * (std::log(a.hi) - std::log(a.lo)) / (a.grid - 1);
+  const double step_b = refit ? o.refit_simplex_step_second
+                              : o.simplex_step_grid_fraction * (std::log(b.hi) - std::log(b.lo)) / (b.grid - 1);
+  const auto t = NelderMead2(flog, {std::log(v[0]), std::log(v[1])}, {step_a, step_b},
+                             refit ? o.refit_simplex_evals : o.simplex_evals, &best);
   (*p)[name] = {std::exp(t[0]), std::exp(t[1])};
   return best;
 }
 
 /// Refits every effect of p, coordinate-wise (each with the others held), until a round
-/// improves the SSE by less than 1e-4 of it (at most `rounds` rounds). Returns the SSE.
-double RefitAll(const Channel& ch, const std::vector<CandidateSpec>& specs, Params* p, double sse, int rounds = 3) {
+/// improves the SSE by less than o.refit_rel_tol of it (at most `rounds` rounds). Returns the SSE.
+double RefitAll(const Channel& ch, const std::vector<CandidateSpec>& specs, Params* p, double sse, int rounds,
+                const Options& o) {
   if (p->empty()) return sse;
   for (int r = 0; r < rounds; ++r) {
     double s = sse;
@@ -443,11 +483,10 @@ double RefitAll(const Channel& ch, const std::vector<CandidateSpec>& specs, Para
            return v;
          }()) {
       Params q = *p;
-      const double sn = FitEffect(ch, specs, &q, name);
-      if (std::getenv("RTHS_DIAG_DEBUG")) std::fprintf(stderr, "  refit %s: %g -> %g (%g)\n", name.c_str(), s, sn, q[name][0]);
+      const double sn = FitEffect(ch, specs, &q, name, o);
       if (sn < s) s = sn, *p = q;
     }
-    const bool done = sse - s < 1e-4 * sse;
+    const bool done = sse - s < o.refit_rel_tol * sse;
     sse = s;
     if (done) break;
   }
@@ -455,8 +494,9 @@ double RefitAll(const Channel& ch, const std::vector<CandidateSpec>& specs, Para
 }
 
 /// Integrated autocorrelation time of the channel's residual (all records concatenated per
-/// record, summed): tau = 1 + 2 sum_{l>=1} r_l up to the first r_l <= 0, at most 2000 lags.
-double IntegratedCorrelationTime(const Channel& ch, const std::vector<std::vector<double>>& pred) {
+/// record, summed): tau = 1 + 2 sum_{l>=1} r_l up to the first r_l <= 0, at most
+/// o.correlation_max_lag lags and n / o.correlation_lag_divisor of a record of n samples.
+double IntegratedCorrelationTime(const Channel& ch, const std::vector<std::vector<double>>& pred, const Options& o) {
   std::vector<double> acc;
   for (std::size_t r = 0; r < ch.recs().size(); ++r) {
     const auto& d = ch.recs()[r];
@@ -479,7 +519,8 @@ double IntegratedCorrelationTime(const Channel& ch, const std::vector<std::vecto
       p[j] = std::norm(x);
     }
     const auto R = signal::RealDft(p);
-    const std::size_t L = std::min<std::size_t>(2001, n / 4);
+    const std::size_t L = std::min<std::size_t>(static_cast<std::size_t>(o.correlation_max_lag) + 1,
+                                                n / static_cast<std::size_t>(o.correlation_lag_divisor));
     if (acc.size() < L) acc.resize(L, 0.0);
     for (std::size_t l = 0; l < L; ++l) acc[l] += R[l].real() / static_cast<double>(N);
   }
@@ -493,9 +534,10 @@ double IntegratedCorrelationTime(const Channel& ch, const std::vector<std::vecto
   return tau;
 }
 
-/// Noise floor of a residual set: sigma^2 = median PSD over [0.5, 0.95] f_Nyq x f_Nyq, PSDs of
-/// the records averaged with weights by their length.
-double NoiseFloorVar(const Channel& ch, const std::vector<std::vector<double>>& pred) {
+/// Noise floor of a residual set: sigma^2 = median PSD over [o.noise_band_lo, o.noise_band_hi]
+/// f_Nyq x f_Nyq, PSDs (Welch, segments of o.noise_psd_segment samples) of the records averaged
+/// with weights by their length.
+double NoiseFloorVar(const Channel& ch, const std::vector<std::vector<double>>& pred, const Options& o) {
   std::vector<double> psd;
   double wsum = 0;
   double nyq = 0;
@@ -504,7 +546,7 @@ double NoiseFloorVar(const Channel& ch, const std::vector<std::vector<double>>& 
     const auto& d = ch.recs()[r];
     const auto meas = ch.Meas(r);
     const std::size_t n = d.size() - d.first;
-    L = std::min<std::size_t>(256, n);
+    L = std::min<std::size_t>(static_cast<std::size_t>(o.noise_psd_segment), n);
     nyq = 0.5 / d.dt;
     std::vector<double> e(n);
     for (std::size_t k = 0; k < n; ++k) e[k] = meas[d.first + k] - pred[r][d.first + k];
@@ -519,16 +561,17 @@ double NoiseFloorVar(const Channel& ch, const std::vector<std::vector<double>>& 
   const double df = 2.0 * nyq / static_cast<double>(L);
   for (std::size_t j = 0; j < psd.size(); ++j) {
     const double f = static_cast<double>(j) * df;
-    if (f >= 0.5 * nyq && f <= 0.95 * nyq) top.push_back(psd[j] / wsum);
+    if (f >= o.noise_band_lo * nyq && f <= o.noise_band_hi * nyq) top.push_back(psd[j] / wsum);
   }
   if (top.empty()) return 0.0;
   std::nth_element(top.begin(), top.begin() + static_cast<std::ptrdiff_t>(top.size() / 2), top.end());
   return top[top.size() / 2] * nyq;
 }
 
-/// n sum_{l=1..20} r_l^2 of the residual (records pooled by summing autocovariances).
-double Whiteness(const Channel& ch, const std::vector<std::vector<double>>& pred) {
-  const int L = 20;
+/// n sum_{l=1..L} r_l^2 of the residual, L = o.whiteness_lags (records pooled by summing
+/// autocovariances).
+double Whiteness(const Channel& ch, const std::vector<std::vector<double>>& pred, const Options& o) {
+  const int L = o.whiteness_lags;
   std::vector<double> c(L + 1, 0.0);
   double n_tot = 0;
   for (std::size_t r = 0; r < ch.recs().size(); ++r) {
@@ -556,17 +599,310 @@ std::map<std::string, double> ParamMap(const std::vector<CandidateSpec>& specs, 
   std::map<std::string, double> m;
   const auto& s = SpecOf(specs, name);
   for (std::size_t j = 0; j < s.params.size(); ++j) m[s.params[j].key] = v[j];
-  if (name == "coulomb_friction") m["v_smooth_mm_s"] = models::CoulombFriction{}.v_smooth_mm_s;
+  // The parameters the diagnosis does not fit keep their defaults (coulomb_friction's v_smooth).
+  models::EffectSet defaults;
+  s.info->turn_on(defaults);
+  for (const models::EffectParam& q : s.info->params()) {
+    if (!q.fitted) m[std::string(q.key)] = *q.field(defaults);
+  }
   return m;
 }
 
 }  // namespace
 
 // ------------------------------------------------------------------------------------------
+// The stages of one channel (stages.h)
 
-Result Diagnose(const std::vector<io::RigRecord>& train_in, const std::vector<io::RigRecord>& test_in,
-                const NominalModel& model, const Options& o, Traces* traces) {
-  const auto t_start = std::chrono::steady_clock::now();
+namespace stages {
+
+void ScoreNominal(ChannelState* s, const Options& o) {
+  ChannelSummary& cs = s->summary;
+  cs.channel = std::string(1, s->ch);
+  cs.diagnosed = true;
+  s->sel.clear();
+  s->order.clear();
+  s->pred_train = s->train.Predict({});
+  s->nom_test = s->test.Predict({});
+  s->sse = s->train.Sse(s->pred_train);
+  s->n_train = Count(s->train.recs());
+  const double sse_test = s->test.Sse(s->nom_test);
+  const double dt = s->train.recs().front().dt;
+  for (const auto& [sse, set] : {std::pair{s->sse, &s->train.recs()}, std::pair{sse_test, &s->test.recs()}}) {
+    if (std::isfinite(sse)) continue;
+    std::string names;
+    for (const auto& d : *set) names += (names.empty() ? "" : ", ") + d.source;
+    throw Error(names, fmt::format("the nominal model's {} residual is not finite: the model diverged on these "
+                                   "records (is dt_s = {} s fine enough for it?) or a value is too large for "
+                                   "the arithmetic",
+                                   s->ch == 'y' ? "displacement" : "force", dt));
+  }
+  cs.gap_train_pct = s->train.NrmsePct(s->sse);
+  cs.gap_test_pct = s->test.NrmsePct(sse_test);
+  const double v_tr = NoiseFloorVar(s->train, s->pred_train, o), v_te = NoiseFloorVar(s->test, s->nom_test, o);
+  const double n_tr = static_cast<double>(Count(s->train.recs())), n_te = static_cast<double>(Count(s->test.recs()));
+  s->var_floor = (v_tr * n_tr + v_te * n_te) / (n_tr + n_te);
+  cs.noise_rms = std::sqrt(s->var_floor);
+  const double ms = (s->sse + sse_test) / (n_tr + n_te);
+  cs.floor_ratio = s->var_floor > 0 ? ms / s->var_floor : std::numeric_limits<double>::infinity();
+  cs.floor_ratio_test = s->var_floor > 0 ? (sse_test / n_te) / s->var_floor : std::numeric_limits<double>::infinity();
+  cs.whiteness = Whiteness(s->test, s->nom_test, o);
+  s->structured = cs.floor_ratio > o.none_ratio;
+  s->sse_nominal = s->sse;
+  s->excess_nominal = s->sse_nominal - static_cast<double>(s->n_train) * s->var_floor;
+}
+
+void MarkNotDiagnosed(ChannelState* s) {
+  s->summary.diagnosed = false;
+  s->summary.status = "not diagnosed";
+  s->structured = false;
+  s->fin_test = s->nom_test;
+  s->pred_train_fin = s->pred_train;
+}
+
+void SelectEffects(ChannelState* sp, const std::vector<CandidateSpec>& specs, const Options& o) {
+  ChannelState& s = *sp;
+  for (;;) {
+    std::optional<Trial> best;
+    const double tau = IntegratedCorrelationTime(s.train, s.pred_train, o);
+    const double n_eff = std::max(1.0, static_cast<double>(s.n_train) / tau);
+    const double excess = s.sse - static_cast<double>(s.n_train) * s.var_floor;
+    // Only a channel whose current residual is still above its floor gets another effect.
+    const bool still_structured = s.sse > o.none_ratio * static_cast<double>(s.n_train) * s.var_floor;
+    for (const auto& spec : specs) {
+      if (spec.channel != s.ch || s.sel.count(spec.name)) continue;
+      Trial t;
+      t.name = spec.name;
+      t.params = s.sel;
+      double sse = FitEffect(s.train, specs, &t.params, spec.name, o);
+      sse = RefitAll(s.train, specs, &t.params, sse, o.trial_refit_rounds, o);  // joint refit
+      t.sse = sse;
+      const int p = static_cast<int>(spec.params.size());
+      t.dbic = n_eff * std::log(std::max(sse, 1e-300) / std::max(s.sse, 1e-300)) + p * std::log(n_eff);
+      t.excess_red = excess > 0 ? (s.sse - sse) / excess : 0.0;
+      // The candidate's own share: the trial's set without it (the others as refitted).
+      Params without = t.params;
+      without.erase(spec.name);
+      const double sse_wo = s.train.Sse(s.train.Predict(ToSet(specs, without)));
+      const double excess_wo = sse_wo - static_cast<double>(s.n_train) * s.var_floor;
+      t.marginal_red = excess_wo > 0 ? (sse_wo - sse) / excess_wo : 0.0;
+      t.pass = s.structured && still_structured && t.dbic < 0 && t.excess_red >= o.min_excess_reduction &&
+               t.marginal_red >= o.min_excess_reduction &&
+               (sse_wo - sse) >= o.min_floor_gain * static_cast<double>(s.n_train) * s.var_floor &&
+               static_cast<int>(s.order.size()) < o.max_effects_per_channel &&
+               !AtBound(spec, t.params.at(spec.name), o.at_bound_fraction);
+      s.last_trial[spec.name] = t;
+      if (t.pass && (!best || t.excess_red > best->excess_red)) best = t;
+    }
+    if (!best) break;
+    s.sel = best->params;
+    s.order.push_back(best->name);
+    s.sel_stats[best->name] = {best->excess_red, best->dbic};
+    s.sse = RefitAll(s.train, specs, &s.sel, best->sse, o.refit_rounds, o);
+    s.pred_train = s.train.Predict(ToSet(specs, s.sel));
+    s.sse = s.train.Sse(s.pred_train);
+    s.last_trial.erase(best->name);
+  }
+}
+
+void SwapEffects(ChannelState* sp, const std::vector<CandidateSpec>& specs, const Options& o,
+                 std::vector<std::string>* warnings) {
+  ChannelState& s = *sp;
+  // E.g. a fast oil-column mode standing in for a delay.
+  for (int sw = 0; sw < o.swap_passes && !s.order.empty(); ++sw) {
+    double best_sse = s.sse * (1.0 - o.swap_min_gain);
+    std::optional<std::pair<std::size_t, Params>> swap;
+    std::string swap_in;
+    for (std::size_t j = 0; j < s.order.size(); ++j) {
+      for (const auto& spec : specs) {
+        if (spec.channel != s.ch || s.sel.count(spec.name)) continue;
+        Params q = s.sel;
+        q.erase(s.order[j]);
+        double sq = FitEffect(s.train, specs, &q, spec.name, o);
+        sq = RefitAll(s.train, specs, &q, sq, o.refit_rounds, o);
+        if (AtBound(spec, q.at(spec.name), o.at_bound_fraction)) continue;  // not an explanation
+        if (sq < best_sse) best_sse = sq, swap = std::make_pair(j, q), swap_in = spec.name;
+      }
+    }
+    if (!swap) break;
+    warnings->push_back(fmt::format("channel {}: {} replaced by {} (training SSE {:.4g} -> {:.4g})", s.summary.channel,
+                                    s.order[swap->first], swap_in, s.sse, best_sse));
+    s.sel_stats[swap_in] = s.sel_stats[s.order[swap->first]];
+    s.order[swap->first] = swap_in;
+    s.sel = swap->second;
+    s.sse = best_sse;
+  }
+}
+
+void PruneEffects(ChannelState* sp, const std::vector<CandidateSpec>& specs, const Options& o,
+                  std::vector<std::string>* warnings) {
+  ChannelState& s = *sp;
+  for (bool pruned = true; pruned && s.order.size() > 1;) {
+    pruned = false;
+    double least = o.min_excess_reduction;
+    std::optional<std::pair<std::size_t, Params>> drop;
+    double drop_sse = 0;
+    for (std::size_t j = 0; j < s.order.size(); ++j) {
+      Params q = s.sel;
+      q.erase(s.order[j]);
+      const double sq =
+          RefitAll(s.train, specs, &q, s.train.Sse(s.train.Predict(ToSet(specs, q))), o.prune_refit_rounds, o);
+      const double ex = sq - static_cast<double>(s.n_train) * s.var_floor;
+      const double share = ex > 0 ? (sq - s.sse) / ex : 0.0;
+      if (share < least) least = share, drop = std::make_pair(j, q), drop_sse = sq;
+    }
+    if (drop) {
+      warnings->push_back(fmt::format("channel {}: {} pruned (its own share of the excess {:.0f} % < {:.0f} %)",
+                                      s.summary.channel, s.order[drop->first], 100.0 * least,
+                                      100.0 * o.min_excess_reduction));
+      s.order.erase(s.order.begin() + static_cast<std::ptrdiff_t>(drop->first));
+      s.sel = drop->second;
+      s.sse = drop_sse;
+      pruned = true;
+    }
+  }
+  s.pred_train = s.train.Predict(ToSet(specs, s.sel));
+  s.sse = s.train.Sse(s.pred_train);
+}
+
+void RetainOnTest(ChannelState* sp, const std::vector<CandidateSpec>& specs, const Options& o,
+                  std::vector<std::string>* warnings) {
+  ChannelState& s = *sp;
+  // A fit of training misfit that does not carry over to the test records is not retained.
+  const double before = s.summary.gap_test_pct;
+  Params cum;
+  double prev = before;
+  std::vector<std::string> kept;
+  for (const auto& name : s.order) {
+    cum[name] = s.sel.at(name);
+    const double after = s.test.NrmsePct(s.test.Sse(s.test.Predict(ToSet(specs, cum), nullptr, FittedScale(cum))));
+    if (after > prev * (1.0 + o.max_test_worsening)) {
+      warnings->push_back(fmt::format("channel {}: {} (selected on the training records) raises the test NRMSE "
+                                      "from {:.4g} % to {:.4g} %: not retained",
+                                      s.summary.channel, name, prev, after));
+      cum.erase(name);
+    } else {
+      kept.push_back(name);
+      prev = after;
+    }
+  }
+  if (kept.size() != s.order.size()) {
+    Params q;
+    for (const auto& n : kept) q[n] = s.sel.at(n);
+    s.order = kept;
+    s.sel = q;
+    s.sse = RefitAll(s.train, specs, &s.sel, s.train.Sse(s.train.Predict(ToSet(specs, s.sel))), o.refit_rounds, o);
+    s.pred_train = s.train.Predict(ToSet(specs, s.sel));
+  }
+}
+
+void ScoreSelected(const ChannelState& s, const std::vector<CandidateSpec>& specs, EffectResults* er) {
+  const double before = s.summary.gap_test_pct;
+  Params cum;
+  for (const auto& name : s.order) {
+    cum[name] = s.sel.at(name);
+    const auto sset = ToSet(specs, cum);
+    const std::optional<double> fixed = FittedScale(cum);
+    const auto pt = s.test.Predict(sset, nullptr, fixed);
+    const auto ptr = s.train.Predict(sset, nullptr, fixed);
+    const auto stats = s.sel_stats.find(name);
+    EffectResult e;
+    e.name = name;
+    e.channel = s.summary.channel;
+    e.params = ParamMap(specs, name, s.sel.at(name));
+    e.test_nrmse_after = s.test.NrmsePct(s.test.Sse(pt));
+    e.train_nrmse_after = s.train.NrmsePct(s.train.Sse(ptr));
+    e.shrink_pct = ShrinkPct(before, e.test_nrmse_after);
+    e.selected = true;
+    e.excess_reduction = stats == s.sel_stats.end() ? 0.0 : stats->second.first;
+    e.delta_bic = stats == s.sel_stats.end() ? 0.0 : stats->second.second;
+    (*er)[name] = e;
+  }
+}
+
+void ApplyShrinkRule(ChannelState* sp, const std::vector<CandidateSpec>& specs, const Options& o,
+                     std::vector<std::string>* warnings, EffectResults* er) {
+  ChannelState& s = *sp;
+  ChannelSummary& cs = s.summary;
+  const double before = cs.gap_test_pct;
+  auto fin = s.test.Predict(ToSet(specs, s.sel), nullptr, FittedScale(s.sel));
+  cs.after_test_pct = s.test.NrmsePct(s.test.Sse(fin));
+  const bool test_structured = cs.floor_ratio_test > o.none_ratio;
+  bool retained = !s.order.empty();
+  if (retained && test_structured && ShrinkPct(before, cs.after_test_pct) < o.min_test_shrink_pct) {
+    warnings->push_back(fmt::format(
+        "channel {}: the effects selected on the training records ({}) shrink the test gap by only {:.1f} % "
+        "(< {:.0f} %): not retained",
+        cs.channel, fmt::join(s.order, ", "), ShrinkPct(before, cs.after_test_pct), o.min_test_shrink_pct));
+    for (const auto& n : s.order) (*er)[n].selected = false;
+    cs.after_test_pct = before;
+    retained = false;
+  } else if (retained && !test_structured) {
+    warnings->push_back(fmt::format("channel {}: the test records' residual is at the noise floor; the effects "
+                                    "were found on the training records only",
+                                    cs.channel));
+  }
+  if (retained) {
+    s.fin_test = std::move(fin);
+    s.pred_train_fin = s.pred_train;
+  } else {
+    s.fin_test = s.nom_test;
+    s.pred_train_fin = s.train.Predict({});
+  }
+  if (!s.structured) cs.status = "noise";
+  else if (retained) cs.status = "explained";
+  else cs.status = "unexplained";
+  s.retained = retained;
+}
+
+void ScoreCandidates(ChannelState* sp, const std::vector<CandidateSpec>& specs, const Options& o, EffectResults* er) {
+  ChannelState& s = *sp;
+  const double before = s.summary.gap_test_pct;
+  if (!s.retained && !s.order.empty()) {
+    for (auto& [name, t] : s.last_trial) {
+      Params q;
+      t.sse = FitEffect(s.train, specs, &q, name, o);
+      t.params = q;
+      t.excess_red = s.excess_nominal > 0 ? (s.sse_nominal - t.sse) / s.excess_nominal : 0.0;
+      t.dbic = std::nan("");
+    }
+    for (const auto& name : s.order) {
+      Trial t;
+      t.name = name;
+      t.sse = FitEffect(s.train, specs, &t.params, name, o);
+      t.excess_red = s.excess_nominal > 0 ? (s.sse_nominal - t.sse) / s.excess_nominal : 0.0;
+      t.dbic = std::nan("");
+      s.last_trial[name] = t;
+      er->erase(name);
+    }
+  }
+  for (const auto& [name, t] : s.last_trial) {
+    if (er->count(name)) continue;
+    const auto pt = s.test.Predict(ToSet(specs, t.params), nullptr, FittedScale(t.params));
+    EffectResult e;
+    e.name = name;
+    e.channel = s.summary.channel;
+    e.params = ParamMap(specs, name, t.params.at(name));
+    e.test_nrmse_after = s.test.NrmsePct(s.test.Sse(pt));
+    e.train_nrmse_after = s.train.NrmsePct(t.sse);
+    e.shrink_pct = ShrinkPct(before, e.test_nrmse_after);
+    e.excess_reduction = t.excess_red;
+    e.delta_bic = t.dbic;
+    (*er)[name] = e;
+  }
+}
+
+}  // namespace stages
+
+// ------------------------------------------------------------------------------------------
+// Around the stages: the records, the candidates, the ranking, the verdict, the localisation
+
+namespace {
+
+using stages::ChannelState;
+using stages::EffectResults;
+
+/// The records' common dt [s]. Throws rths::Error if a set is empty or a record's dt differs.
+double CommonDt(const std::vector<io::RigRecord>& train_in, const std::vector<io::RigRecord>& test_in) {
   if (train_in.empty()) throw Error("--train", "at least one training record is needed");
   if (test_in.empty()) throw Error("--test", "at least one test record is needed");
   const double dt = train_in[0].dt_s;
@@ -575,404 +911,122 @@ Result Diagnose(const std::vector<io::RigRecord>& train_in, const std::vector<io
       if (std::abs(r.dt_s - dt) > 1e-9 * dt)
         throw Error(r.source, fmt::format("dt_s {} differs from the first training record's {} (one dt per diagnosis)",
                                           r.dt_s, dt));
-  Result res;
-  res.options = o;
-  res.dt_s = dt;
-  res.model_source = model.source;
-  for (const auto& n : model.notes) res.warnings.push_back(n);
-  for (const auto* set : {&train_in, &test_in})
-    for (const auto& r : *set)
-      for (const auto& w : r.warnings) res.warnings.push_back(w);
+  return dt;
+}
 
-  std::vector<Data> train, test;
-  for (const auto& r : train_in) train.push_back(Prepare(r, o));
-  for (const auto& r : test_in) test.push_back(Prepare(r, o));
-  for (const auto& d : train) res.train.push_back(d.source);
-  for (const auto& d : test) res.test.push_back(d.source);
-  res.samples = Count(train) + Count(test);
-
-  const auto servo = models::LinearServo::Make(model.actuator, dt);
-  std::optional<ForcePredictor> fp;
-  if (model.has_damper) fp.emplace(model.damper, model.current_dynamics, dt);
-  // A force channel that is all zeros cannot be diagnosed either.
+/// true if the force channel can be diagnosed: the model has a damper and the training records'
+/// force is not all zero; else false and a warning says why.
+bool ForceChannelUsable(const NominalModel& model, const std::vector<Data>& train, std::vector<std::string>* warnings) {
   bool force_ok = model.has_damper;
   if (force_ok) {
     double s = 0;
     for (const auto& d : train) s += SumSq(d.f, d.first);
     if (!(s > 0)) {
       force_ok = false;
-      res.warnings.push_back("the training records' force is zero: the force channel is not diagnosed");
+      warnings->push_back("the training records' force is zero: the force channel is not diagnosed");
     }
   } else {
-    res.warnings.push_back("the model has no damper part: the force channel is not diagnosed");
+    warnings->push_back("the model has no damper part: the force channel is not diagnosed");
   }
+  return force_ok;
+}
+
+/// Upper end of vmax's search range [mm/s]: o.vmax_search_factor x the largest measured velocity
+/// of the training records, at most the effect library's limit for vmax (1e9 mm/s; a jump in a
+/// record can exceed it).
+double VmaxSearchHi(const std::vector<Data>& train, double dt, const Options& o) {
   double vmax_meas = 1.0;
   for (const auto& d : train)
     for (std::size_t k = 1; k < d.size(); ++k) vmax_meas = std::max(vmax_meas, std::abs(d.y[k] - d.y[k - 1]) / dt);
-  // At most the effect library's limit for vmax (1e9 mm/s; a jump in a record can exceed it).
-  const auto specs = Candidates(dt, std::min(2.0 * vmax_meas, 1e9));
-  // A displacement-only test (u = y in every record, e.g. the UTFSM damper tests) has no
-  // displacement channel to diagnose: predicting y from u would only show the model's own lag.
+  return std::min(o.vmax_search_factor * vmax_meas, 1e9);
+}
+
+/// false if u = y in every record (a displacement-only test, e.g. the UTFSM damper tests: predicting
+/// y from u would only show the model's own lag), with a warning; else true.
+bool DisplacementChannelUsable(const std::vector<Data>& train, const std::vector<Data>& test,
+                               std::vector<std::string>* warnings) {
   bool y_ok = false;
   for (const auto* set : {&train, &test})
     for (const auto& d : *set) y_ok |= d.u != d.y;
   if (!y_ok)
-    res.warnings.push_back("u = y in every record (a displacement-only test): the displacement channel is not diagnosed");
+    warnings->push_back("u = y in every record (a displacement-only test): the displacement channel is not diagnosed");
+  return y_ok;
+}
 
-  // The channels are diagnosed one after the other: y first, then f, whose motion input is the
-  // measured y seen through y's final model (ModelAidedMotion).
-  std::vector<char> chans = {'y'};
-  if (force_ok) chans.push_back('f');
-  struct ChState {
-    ChState(char c, Channel tr, Channel te) : ch(c), train(std::move(tr)), test(std::move(te)) {}
-    char ch;
-    Channel train, test;
-    Params sel;                       // selected effects and their parameters
-    std::vector<std::string> order;   // selected names in order
-    double sse = 0;                   // training SSE with sel
-    double var_floor = 0;             // sigma^2
-    std::size_t n_train = 0;
-    bool structured = false;
-    std::vector<std::vector<double>> pred_train;  // with sel
-    std::vector<std::vector<double>> nom_test;    // nominal, test
-    std::vector<std::vector<double>> fin_test;    // final (retained effects), test
-    std::vector<std::vector<double>> pred_train_fin;  // final (retained effects), training
-    Params keep;                      // retained effects
-  };
-  std::vector<std::unique_ptr<ChState>> st;
-  std::map<std::string, EffectResult> er;
-  std::vector<std::string> verdict;
-  const ForcePredictor* fpp = fp ? &*fp : nullptr;
-  for (char chan : chans) {
-    if (chan == 'f') {
-      // The motion of the damper: y's final model plus the zero-phase-smoothed residual.
-      const auto& ys = *st[0];
-      if (!y_ok) {
-        // No displacement model to lean on (u = y): the measured y, zero-phase smoothed at a
-        // cutoff above the excitation (4 x smooth_hz, at most 0.45 / dt).
-        const double fc = std::min(4.0 * o.smooth_hz, 0.45 / dt);
-        for (auto& d : train) d.motion = SmoothMotion(d.y, dt, fc);
-        for (auto& d : test) d.motion = SmoothMotion(d.y, dt, fc);
-      } else {
-        for (std::size_t r = 0; r < train.size(); ++r)
-          train[r].motion = ModelAidedMotion(train[r].y, ys.pred_train_fin[r], dt, std::min(o.smooth_hz, 0.45 / dt));
-        for (std::size_t r = 0; r < test.size(); ++r)
-          test[r].motion = ModelAidedMotion(test[r].y, ys.fin_test[r], dt, std::min(o.smooth_hz, 0.45 / dt));
-      }
-    }
-    st.push_back(std::make_unique<ChState>(chan, Channel(chan, &train, &servo, fpp), Channel(chan, &test, &servo, fpp)));
-    auto& s = *st.back();
-    // --- nominal residuals, noise floor, gap
-    ChannelSummary cs;
-    cs.channel = std::string(1, s.ch);
-    cs.diagnosed = true;
-    s.pred_train = s.train.Predict({});
-    s.nom_test = s.test.Predict({});
-    s.sse = s.train.Sse(s.pred_train);
-    s.n_train = Count(train);
-    const double sse_test = s.test.Sse(s.nom_test);
-    for (const auto& [sse, set] : {std::pair{s.sse, &train}, std::pair{sse_test, &test}}) {
-      if (std::isfinite(sse)) continue;
-      std::string names;
-      for (const auto& d : *set) names += (names.empty() ? "" : ", ") + d.source;
-      throw Error(names, fmt::format("the nominal model's {} residual is not finite: the model diverged on these "
-                                     "records (is dt_s = {} s fine enough for it?) or a value is too large for "
-                                     "the arithmetic",
-                                     s.ch == 'y' ? "displacement" : "force", dt));
-    }
-    cs.gap_train_pct = s.train.NrmsePct(s.sse);
-    cs.gap_test_pct = s.test.NrmsePct(sse_test);
-    const double v_tr = NoiseFloorVar(s.train, s.pred_train), v_te = NoiseFloorVar(s.test, s.nom_test);
-    const double n_tr = static_cast<double>(Count(train)), n_te = static_cast<double>(Count(test));
-    s.var_floor = (v_tr * n_tr + v_te * n_te) / (n_tr + n_te);
-    cs.noise_rms = std::sqrt(s.var_floor);
-    const double ms = (s.sse + sse_test) / (n_tr + n_te);
-    cs.floor_ratio = s.var_floor > 0 ? ms / s.var_floor : std::numeric_limits<double>::infinity();
-    cs.floor_ratio_test = s.var_floor > 0 ? (sse_test / n_te) / s.var_floor : std::numeric_limits<double>::infinity();
-    cs.whiteness = Whiteness(s.test, s.nom_test);
-    s.structured = cs.floor_ratio > o.none_ratio;
-    if (s.ch == 'y' && !y_ok) {
-      cs.diagnosed = false;
-      cs.status = "not diagnosed";
-      s.structured = false;
-      s.fin_test = s.nom_test;
-      s.pred_train_fin = s.pred_train;
-      res.channels.push_back(cs);
-      continue;
-    }
-    const double sse_nom = s.sse;
-    const double excess_nom = sse_nom - static_cast<double>(s.n_train) * s.var_floor;
+/// The cutoff of the y residual's smoothing for the damper's motion [Hz].
+double MotionCutoffHz(const Options& o, double dt) { return std::min(o.smooth_hz, o.max_smooth_cycles_per_sample / dt); }
 
-    // --- greedy selection on the training records
-    struct Trial {
-      std::string name;
-      Params params;  // the channel's whole set with this candidate
-      double sse = 0, excess_red = 0, dbic = 0, marginal_red = 0;
-      bool pass = false;
-    };
-    std::map<std::string, Trial> last_trial;  // latest trial of every candidate
-    std::map<std::string, std::pair<double, double>> sel_stats;  // selected: (excess reduction, dBIC) when added
-    for (;;) {
-      std::optional<Trial> best;
-      const double tau = IntegratedCorrelationTime(s.train, s.pred_train);
-      const double n_eff = std::max(1.0, static_cast<double>(s.n_train) / tau);
-      const double excess = s.sse - static_cast<double>(s.n_train) * s.var_floor;
-      // Only a channel whose current residual is still above its floor gets another effect.
-      const bool still_structured = s.sse > o.none_ratio * static_cast<double>(s.n_train) * s.var_floor;
-      for (const auto& spec : specs) {
-        if (spec.channel != s.ch || s.sel.count(spec.name)) continue;
-        Trial t;
-        t.name = spec.name;
-        t.params = s.sel;
-        double sse = FitEffect(s.train, specs, &t.params, spec.name);
-        sse = RefitAll(s.train, specs, &t.params, sse, 2);  // joint refit, two coordinate rounds
-        t.sse = sse;
-        const int p = static_cast<int>(spec.params.size());
-        t.dbic = n_eff * std::log(std::max(sse, 1e-300) / std::max(s.sse, 1e-300)) + p * std::log(n_eff);
-        t.excess_red = excess > 0 ? (s.sse - sse) / excess : 0.0;
-        // The candidate's own share: the trial's set without it (the others as refitted).
-        Params without = t.params;
-        without.erase(spec.name);
-        const double sse_wo = s.train.Sse(s.train.Predict(ToSet(specs, without)));
-        const double excess_wo = sse_wo - static_cast<double>(s.n_train) * s.var_floor;
-        t.marginal_red = excess_wo > 0 ? (sse_wo - sse) / excess_wo : 0.0;
-        t.pass = s.structured && still_structured && t.dbic < 0 && t.excess_red >= o.min_excess_reduction &&
-                 t.marginal_red >= o.min_excess_reduction &&
-                 (sse_wo - sse) >= o.min_floor_gain * static_cast<double>(s.n_train) * s.var_floor &&
-                 static_cast<int>(s.order.size()) < o.max_effects_per_channel &&
-                 !AtBound(spec, t.params.at(spec.name));
-        last_trial[spec.name] = t;
-        if (t.pass && (!best || t.excess_red > best->excess_red)) best = t;
-      }
-      if (!best) break;
-      s.sel = best->params;
-      s.order.push_back(best->name);
-      sel_stats[best->name] = {best->excess_red, best->dbic};
-      s.sse = RefitAll(s.train, specs, &s.sel, best->sse, 6);
-      s.pred_train = s.train.Predict(ToSet(specs, s.sel));
-      s.sse = s.train.Sse(s.pred_train);
-      last_trial.erase(best->name);
-    }
-    // Swaps: an effect of the set replaced by another candidate (fitted, then the set refitted)
-    // when that lowers the training SSE by more than 0.1 % (e.g. a fast oil-column mode
-    // standing in for a delay); then pruning: an effect whose own share of the set's excess
-    // (the set refitted without it) is below min_excess_reduction is removed.
-    for (int sw = 0; sw < 2 && !s.order.empty(); ++sw) {
-      double best_sse = s.sse * (1.0 - 1e-3);
-      std::optional<std::pair<std::size_t, Params>> swap;
-      std::string swap_in;
-      for (std::size_t j = 0; j < s.order.size(); ++j) {
-        for (const auto& spec : specs) {
-          if (spec.channel != s.ch || s.sel.count(spec.name)) continue;
-          Params q = s.sel;
-          q.erase(s.order[j]);
-          double sq = FitEffect(s.train, specs, &q, spec.name);
-          sq = RefitAll(s.train, specs, &q, sq, 6);
-          if (AtBound(spec, q.at(spec.name))) continue;  // not an explanation (AtBound)
-          if (std::getenv("RTHS_DIAG_DEBUG")) std::fprintf(stderr, "swap %s -> %s: %g (now %g)\n", s.order[j].c_str(), spec.name, sq, s.sse);
-          if (sq < best_sse) best_sse = sq, swap = std::make_pair(j, q), swap_in = spec.name;
-        }
-      }
-      if (!swap) break;
-      res.warnings.push_back(fmt::format("channel {}: {} replaced by {} (training SSE {:.4g} -> {:.4g})", cs.channel,
-                                         s.order[swap->first], swap_in, s.sse, best_sse));
-      sel_stats[swap_in] = sel_stats[s.order[swap->first]];
-      s.order[swap->first] = swap_in;
-      s.sel = swap->second;
-      s.sse = best_sse;
-    }
-    for (bool pruned = true; pruned && s.order.size() > 1;) {
-      pruned = false;
-      double least = o.min_excess_reduction;
-      std::optional<std::pair<std::size_t, Params>> drop;
-      double drop_sse = 0;
-      for (std::size_t j = 0; j < s.order.size(); ++j) {
-        Params q = s.sel;
-        q.erase(s.order[j]);
-        const double sq = RefitAll(s.train, specs, &q, s.train.Sse(s.train.Predict(ToSet(specs, q))), 2);
-        const double ex = sq - static_cast<double>(s.n_train) * s.var_floor;
-        const double share = ex > 0 ? (sq - s.sse) / ex : 0.0;
-        if (share < least) least = share, drop = std::make_pair(j, q), drop_sse = sq;
-      }
-      if (drop) {
-        res.warnings.push_back(fmt::format("channel {}: {} pruned (its own share of the excess {:.0f} % < {:.0f} %)", cs.channel,
-                                           s.order[drop->first], 100.0 * least, 100.0 * o.min_excess_reduction));
-        s.order.erase(s.order.begin() + static_cast<std::ptrdiff_t>(drop->first));
-        s.sel = drop->second;
-        s.sse = drop_sse;
-        pruned = true;
-      }
-    }
-    s.pred_train = s.train.Predict(ToSet(specs, s.sel));
-    s.sse = s.train.Sse(s.pred_train);
-
-    // --- test scores; the 30 % rule
-    const double before = cs.gap_test_pct;
-    // An effect whose addition (in the order of selection) makes the test NRMSE worse by more
-    // than max_test_worsening is not retained (a fit of training misfit that does not carry
-    // over); the rest are refitted on the training records without it.
-    {
-      Params cum;
-      double prev = before;
-      std::vector<std::string> kept;
-      for (const auto& name : s.order) {
-        cum[name] = s.sel.at(name);
-        const double after = s.test.NrmsePct(s.test.Sse(s.test.Predict(ToSet(specs, cum), nullptr, FittedScale(cum))));
-        if (after > prev * (1.0 + o.max_test_worsening)) {
-          res.warnings.push_back(fmt::format("channel {}: {} (selected on the training records) raises the test NRMSE "
-                                             "from {:.4g} % to {:.4g} %: not retained",
-                                             cs.channel, name, prev, after));
-          cum.erase(name);
-        } else {
-          kept.push_back(name);
-          prev = after;
-        }
-      }
-      if (kept.size() != s.order.size()) {
-        Params q;
-        for (const auto& n : kept) q[n] = s.sel.at(n);
-        s.order = kept;
-        s.sel = q;
-        s.sse = RefitAll(s.train, specs, &s.sel, s.train.Sse(s.train.Predict(ToSet(specs, s.sel))), 6);
-        s.pred_train = s.train.Predict(ToSet(specs, s.sel));
-      }
-    }
-    Params cum;
-    for (const auto& name : s.order) {
-      cum[name] = s.sel.at(name);
-      const auto sset = ToSet(specs, cum);
-      const std::optional<double> fixed = FittedScale(cum);
-      const auto pt = s.test.Predict(sset, nullptr, fixed);
-      const auto ptr = s.train.Predict(sset, nullptr, fixed);
-      EffectResult e;
-      e.name = name;
-      e.channel = cs.channel;
-      e.params = ParamMap(specs, name, s.sel.at(name));
-      e.test_nrmse_after = s.test.NrmsePct(s.test.Sse(pt));
-      e.train_nrmse_after = s.train.NrmsePct(s.train.Sse(ptr));
-      e.shrink_pct = ShrinkPct(before, e.test_nrmse_after);
-      e.selected = true;
-      e.excess_reduction = sel_stats[name].first;
-      e.delta_bic = sel_stats[name].second;
-      er[name] = e;
-    }
-    auto fin = s.test.Predict(ToSet(specs, s.sel), nullptr, FittedScale(s.sel));
-    cs.after_test_pct = s.test.NrmsePct(s.test.Sse(fin));
-    const bool test_structured = cs.floor_ratio_test > o.none_ratio;
-    bool retained = !s.order.empty();
-    if (retained && test_structured && ShrinkPct(before, cs.after_test_pct) < o.min_test_shrink_pct) {
-      res.warnings.push_back(fmt::format(
-          "channel {}: the effects selected on the training records ({}) shrink the test gap by only {:.1f} % "
-          "(< {:.0f} %): not retained",
-          cs.channel, fmt::join(s.order, ", "), ShrinkPct(before, cs.after_test_pct), o.min_test_shrink_pct));
-      for (const auto& n : s.order) er[n].selected = false;
-      cs.after_test_pct = before;
-      retained = false;
-    } else if (retained && !test_structured) {
-      res.warnings.push_back(fmt::format("channel {}: the test records' residual is at the noise floor; the effects "
-                                         "were found on the training records only",
-                                         cs.channel));
-    }
-    if (retained) {
-      s.keep = s.sel;
-      s.fin_test = std::move(fin);
-      s.pred_train_fin = s.pred_train;
-      for (const auto& n : s.order) verdict.push_back(n);
-    } else {
-      s.fin_test = s.nom_test;
-      s.pred_train_fin = s.train.Predict({});
-    }
-    if (!s.structured) cs.status = "noise";
-    else if (retained) cs.status = "explained";
-    else cs.status = "unexplained";
-    // Candidates not selected: their latest trial (fitted on top of the selected ones). If the
-    // selection was not retained, every candidate is refitted alone on the nominal model so that
-    // its numbers stand on their own.
-    if (!retained && !s.order.empty()) {
-      for (auto& [name, t] : last_trial) {
-        Params q;
-        t.sse = FitEffect(s.train, specs, &q, name);
-        t.params = q;
-        t.excess_red = excess_nom > 0 ? (sse_nom - t.sse) / excess_nom : 0.0;
-        t.dbic = std::nan("");
-      }
-      for (const auto& name : s.order) {
-        Trial t;
-        t.name = name;
-        t.sse = FitEffect(s.train, specs, &t.params, name);
-        t.excess_red = excess_nom > 0 ? (sse_nom - t.sse) / excess_nom : 0.0;
-        t.dbic = std::nan("");
-        last_trial[name] = t;
-        er.erase(name);
-      }
-    }
-    for (const auto& [name, t] : last_trial) {
-      if (er.count(name)) continue;
-      const auto pt = s.test.Predict(ToSet(specs, t.params), nullptr, FittedScale(t.params));
-      EffectResult e;
-      e.name = name;
-      e.channel = cs.channel;
-      e.params = ParamMap(specs, name, t.params.at(name));
-      e.test_nrmse_after = s.test.NrmsePct(s.test.Sse(pt));
-      e.train_nrmse_after = s.train.NrmsePct(t.sse);
-      e.shrink_pct = ShrinkPct(before, e.test_nrmse_after);
-      e.excess_reduction = t.excess_red;
-      e.delta_bic = t.dbic;
-      er[name] = e;
-    }
-    res.channels.push_back(cs);
+/// The motion of the damper in every record: y's final model plus the zero-phase-smoothed
+/// residual (ModelAidedMotion); without a displacement model to lean on (u = y), the measured y
+/// smoothed at a cutoff above the excitation.
+void SetForceMotion(std::vector<Data>* train, std::vector<Data>* test, const ChannelState& y, bool y_ok,
+                    const Options& o, double dt) {
+  if (!y_ok) {
+    const double fc = std::min(o.displacement_only_smooth_factor * o.smooth_hz, o.max_smooth_cycles_per_sample / dt);
+    for (auto& d : *train) d.motion = SmoothMotion(d.y, dt, fc);
+    for (auto& d : *test) d.motion = SmoothMotion(d.y, dt, fc);
+    return;
   }
-  if (!force_ok) {
-    ChannelSummary cs;
-    cs.channel = "f";
-    cs.diagnosed = false;
-    cs.status = "not diagnosed";
-    res.channels.push_back(cs);
-  }
+  for (std::size_t r = 0; r < train->size(); ++r)
+    (*train)[r].motion = ModelAidedMotion((*train)[r].y, y.pred_train_fin[r], dt, MotionCutoffHz(o, dt));
+  for (std::size_t r = 0; r < test->size(); ++r)
+    (*test)[r].motion = ModelAidedMotion((*test)[r].y, y.fin_test[r], dt, MotionCutoffHz(o, dt));
+}
 
-  // Verdict and ranking.
+/// res->effects: the verdict's effects in its order, the other candidates by shrink, then the
+/// sensor_noise entry (the noise floor, never selected) of each diagnosed channel among the
+/// first n_states.
+void RankEffects(const std::vector<std::string>& verdict, EffectResults* er, std::size_t n_states, Result* res) {
   int pos = 0;
   for (const auto& n : verdict) {
-    er[n].order = pos++;
-    res.effects.push_back(er[n]);
+    (*er)[n].order = pos++;
+    res->effects.push_back((*er)[n]);
   }
   std::vector<EffectResult> rest;
-  for (const auto& [n, e] : er)
+  for (const auto& [n, e] : *er)
     if (e.order < 0) rest.push_back(e);
   std::sort(rest.begin(), rest.end(), [](const EffectResult& a, const EffectResult& b) { return a.shrink_pct > b.shrink_pct; });
-  for (auto& e : rest) res.effects.push_back(e);
-  // sensor_noise: the noise floor of each diagnosed channel, never selected.
-  for (std::size_t c = 0; c < st.size(); ++c) {
-    if (!res.channels[c].diagnosed) continue;
+  for (auto& e : rest) res->effects.push_back(e);
+  for (std::size_t c = 0; c < n_states; ++c) {
+    if (!res->channels[c].diagnosed) continue;
     EffectResult e;
     e.name = "sensor_noise";
-    e.channel = res.channels[c].channel;
-    e.params["rms"] = res.channels[c].noise_rms;
-    e.test_nrmse_after = res.channels[c].gap_test_pct;
-    e.train_nrmse_after = res.channels[c].gap_train_pct;
+    e.channel = res->channels[c].channel;
+    e.params["rms"] = res->channels[c].noise_rms;
+    e.test_nrmse_after = res->channels[c].gap_test_pct;
+    e.train_nrmse_after = res->channels[c].gap_train_pct;
     e.shrink_pct = 0;
-    res.effects.push_back(e);
+    res->effects.push_back(e);
   }
-  bool any_structured = false;
-  for (const auto& s : st) any_structured |= s->structured;
-  if (!verdict.empty()) {
-    res.verdict = verdict;
-    for (const auto& cs : res.channels)
-      if (cs.status == "unexplained")
-        res.warnings.push_back(fmt::format("channel {}: a structured residual remains that no candidate explains", cs.channel));
-  } else {
-    res.verdict = {any_structured ? "unknown" : "none"};
-  }
+}
 
-  // --- where (test records, nominal model)
+/// res->verdict: the retained effects in order; else "unknown" if a channel is structured, "none"
+/// if not. A channel left unexplained beside retained effects is a warning.
+void FormVerdict(const std::vector<std::string>& verdict, const std::vector<ChannelState>& st, Result* res) {
+  bool any_structured = false;
+  for (const auto& s : st) any_structured |= s.structured;
+  if (!verdict.empty()) {
+    res->verdict = verdict;
+    for (const auto& cs : res->channels)
+      if (cs.status == "unexplained")
+        res->warnings.push_back(fmt::format("channel {}: a structured residual remains that no candidate explains", cs.channel));
+  } else {
+    res->verdict = {any_structured ? "unknown" : "none"};
+  }
+}
+
+/// Where (test records, nominal model): bands, conditions and time windows of every diagnosed
+/// channel's residual; the test records' traces if traces is not null.
+void LocaliseAndTrace(const std::vector<ChannelState>& st, const std::vector<Data>& test, const Options& o, double dt,
+                      Result* res, Traces* traces) {
   for (std::size_t c = 0; c < st.size(); ++c) {
-    auto& s = *st[c];
+    const auto& s = st[c];
     std::vector<LocaliseInput> li;
     std::vector<SmoothedMotion> motions;
     motions.reserve(test.size());
     for (std::size_t r = 0; r < test.size(); ++r) {
       const auto& d = test[r];
-      motions.push_back(d.motion.v_mm_s.empty() ? ModelAidedMotion(d.y, st[0]->fin_test[r], dt, std::min(o.smooth_hz, 0.45 / dt))
+      motions.push_back(d.motion.v_mm_s.empty() ? ModelAidedMotion(d.y, st[0].fin_test[r], dt, MotionCutoffHz(o, dt))
                                                 : d.motion);
       LocaliseInput in;
       in.source = d.source;
@@ -986,7 +1040,7 @@ Result Diagnose(const std::vector<io::RigRecord>& train_in, const std::vector<io
       in.i = d.i;
       li.push_back(in);
     }
-    if (res.channels[c].diagnosed) Localise(std::string(1, s.ch), li, &res.bands, &res.conditions, &res.time);
+    if (res->channels[c].diagnosed) Localise(std::string(1, s.ch), li, &res->bands, &res->conditions, &res->time);
     if (traces && c == 0) {
       traces->test.clear();
       for (std::size_t r = 0; r < test.size(); ++r) {
@@ -1002,18 +1056,134 @@ Result Diagnose(const std::vector<io::RigRecord>& train_in, const std::vector<io
         tr.y_fin = s.fin_test[r];
         tr.f_meas = d.f;
         if (st.size() > 1) {
-          tr.f_nom = st[1]->nom_test[r];
-          tr.f_fin = st[1]->fin_test[r];
+          tr.f_nom = st[1].nom_test[r];
+          tr.f_fin = st[1].fin_test[r];
         }
         traces->test.push_back(std::move(tr));
       }
     }
   }
+}
+
+}  // namespace
+
+// ------------------------------------------------------------------------------------------
+
+Result Diagnose(const std::vector<io::RigRecord>& train_in, const std::vector<io::RigRecord>& test_in,
+                const NominalModel& model, const Options& o, Traces* traces) {
+  const auto t_start = std::chrono::steady_clock::now();
+  std::string why;
+  if (!o.IsValid(&why)) throw Error("diagnosis options", why);
+  const double dt = CommonDt(train_in, test_in);
+  Result res;
+  res.options = o;
+  res.dt_s = dt;
+  res.model_source = model.source;
+  for (const auto& n : model.notes) res.warnings.push_back(n);
+  for (const auto* set : {&train_in, &test_in})
+    for (const auto& r : *set)
+      for (const auto& w : r.warnings) res.warnings.push_back(w);
+
+  std::vector<Data> train, test;
+  for (const auto& r : train_in) train.push_back(stages::Prepare(r, o));
+  for (const auto& r : test_in) test.push_back(stages::Prepare(r, o));
+  for (const auto& d : train) res.train.push_back(d.source);
+  for (const auto& d : test) res.test.push_back(d.source);
+  res.samples = stages::Count(train) + stages::Count(test);
+
+  const auto servo = models::LinearServo::Make(model.actuator, dt);
+  std::optional<ForcePredictor> fp;
+  if (model.has_damper) fp.emplace(model.damper, model.current_dynamics, dt);
+  const ForcePredictor* fpp = fp ? &*fp : nullptr;
+  // A force channel that is all zeros cannot be diagnosed either.
+  const bool force_ok = ForceChannelUsable(model, train, &res.warnings);
+  const auto specs = stages::Candidates(dt, VmaxSearchHi(train, dt, o));
+  const bool y_ok = DisplacementChannelUsable(train, test, &res.warnings);
+
+  // The channels are diagnosed one after the other: y first, then f, whose motion input is the
+  // measured y seen through y's final model (ModelAidedMotion).
+  std::vector<char> chans = {'y'};
+  if (force_ok) chans.push_back('f');
+  std::vector<ChannelState> st;
+  st.reserve(chans.size());  // st[0] is referenced while f's state is added
+  EffectResults er;
+  std::vector<std::string> verdict;
+  for (char chan : chans) {
+    if (chan == 'f') SetForceMotion(&train, &test, st[0], y_ok, o, dt);
+    st.emplace_back(chan, Channel(chan, &train, &servo, fpp), Channel(chan, &test, &servo, fpp));
+    auto& s = st.back();
+    stages::ScoreNominal(&s, o);
+    if (s.ch == 'y' && !y_ok) {
+      stages::MarkNotDiagnosed(&s);
+      res.channels.push_back(s.summary);
+      continue;
+    }
+    stages::SelectEffects(&s, specs, o);
+    stages::SwapEffects(&s, specs, o, &res.warnings);
+    stages::PruneEffects(&s, specs, o, &res.warnings);
+    stages::RetainOnTest(&s, specs, o, &res.warnings);
+    stages::ScoreSelected(s, specs, &er);
+    stages::ApplyShrinkRule(&s, specs, o, &res.warnings, &er);
+    if (s.retained)
+      for (const auto& n : s.order) verdict.push_back(n);
+    stages::ScoreCandidates(&s, specs, o, &er);
+    res.channels.push_back(s.summary);
+  }
+  if (!force_ok) {
+    ChannelSummary cs;
+    cs.channel = "f";
+    cs.diagnosed = false;
+    cs.status = "not diagnosed";
+    res.channels.push_back(cs);
+  }
+  RankEffects(verdict, &er, st.size(), &res);
+  FormVerdict(verdict, st, &res);
+  LocaliseAndTrace(st, test, o, dt, &res, traces);
   res.runtime_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
   return res;
 }
 
 // ------------------------------------------------------------------------------------------
+
+nlohmann::json ToJson(const Options& o) {
+  return {{"warmup_s", o.warmup_s},
+          {"detrend", o.detrend},
+          {"smooth_hz", o.smooth_hz},
+          {"max_smooth_cycles_per_sample", o.max_smooth_cycles_per_sample},
+          {"displacement_only_smooth_factor", o.displacement_only_smooth_factor},
+          {"vmax_search_factor", o.vmax_search_factor},
+          {"noise_band_lo", o.noise_band_lo},
+          {"noise_band_hi", o.noise_band_hi},
+          {"noise_psd_segment", o.noise_psd_segment},
+          {"whiteness_lags", o.whiteness_lags},
+          {"correlation_max_lag", o.correlation_max_lag},
+          {"correlation_lag_divisor", o.correlation_lag_divisor},
+          {"none_ratio", o.none_ratio},
+          {"min_excess_reduction", o.min_excess_reduction},
+          {"min_floor_gain", o.min_floor_gain},
+          {"max_effects_per_channel", o.max_effects_per_channel},
+          {"at_bound_fraction", o.at_bound_fraction},
+          {"swap_passes", o.swap_passes},
+          {"swap_min_gain", o.swap_min_gain},
+          {"min_test_shrink_pct", o.min_test_shrink_pct},
+          {"max_test_worsening", o.max_test_worsening},
+          {"golden_iters_y", o.golden_iters_y},
+          {"golden_iters_f", o.golden_iters_f},
+          {"refit_golden_iters_y", o.refit_golden_iters_y},
+          {"refit_golden_iters_f", o.refit_golden_iters_f},
+          {"refit_bracket_factor", o.refit_bracket_factor},
+          {"refit_bracket_fraction", o.refit_bracket_fraction},
+          {"refit_grid", o.refit_grid},
+          {"simplex_evals", o.simplex_evals},
+          {"refit_simplex_evals", o.refit_simplex_evals},
+          {"simplex_step_grid_fraction", o.simplex_step_grid_fraction},
+          {"refit_simplex_step_first", o.refit_simplex_step_first},
+          {"refit_simplex_step_second", o.refit_simplex_step_second},
+          {"refit_rel_tol", o.refit_rel_tol},
+          {"trial_refit_rounds", o.trial_refit_rounds},
+          {"refit_rounds", o.refit_rounds},
+          {"prune_refit_rounds", o.prune_refit_rounds}};
+}
 
 nlohmann::json ToJson(const Result& r) {
   using nlohmann::json;
@@ -1088,18 +1258,31 @@ nlohmann::json ToJson(const Result& r) {
   j["samples"] = r.samples;
   j["runtime_s"] = r.runtime_s;
   j["warnings"] = r.warnings;
-  j["options"] = {{"warmup_s", r.options.warmup_s},
-                  {"smooth_hz", r.options.smooth_hz},
-                  {"none_ratio", r.options.none_ratio},
-                  {"min_excess_reduction", r.options.min_excess_reduction},
-                  {"min_floor_gain", r.options.min_floor_gain},
-                  {"max_test_worsening", r.options.max_test_worsening},
-                  {"min_test_shrink_pct", r.options.min_test_shrink_pct},
-                  {"detrend", r.options.detrend}};
+  j["options"] = ToJson(r.options);
   return j;
 }
 
-std::string Summary(const Result& r) {
+namespace {
+
+/// The brief report: the verdict and, per channel, its status and test NRMSE before -> after.
+std::string BriefSummary(const Result& r) {
+  std::string s = fmt::format("verdict: {}\n", fmt::join(r.verdict, ", "));
+  for (const auto& c : r.channels) {
+    if (!c.diagnosed) {
+      s += fmt::format("channel {}: not diagnosed\n", c.channel);
+      continue;
+    }
+    s += fmt::format("channel {}: {}, test NRMSE {:.3f} % -> {:.3f} % (shrink {:.1f} %)\n", c.channel, c.status,
+                     c.gap_test_pct, c.after_test_pct, ShrinkPct(c.gap_test_pct, c.after_test_pct));
+  }
+  if (!r.warnings.empty()) s += fmt::format("warnings: {} (in the full report)\n", r.warnings.size());
+  return s;
+}
+
+}  // namespace
+
+std::string Summary(const Result& r, SummaryDetail detail) {
+  if (detail == SummaryDetail::kBrief) return BriefSummary(r);
   std::string s;
   s += fmt::format("model: {}\n", r.model_source);
   s += fmt::format("records: {} training, {} test, dt {} s, {} samples\n", r.train.size(), r.test.size(), r.dt_s, r.samples);

@@ -9,15 +9,21 @@
 #include <fmt/format.h>
 
 #include "core/error.h"
+#include "models/rig_effects.h"
 #include "signal/random.h"
 
 namespace rths::diagnosis {
 
 namespace {
 
-const std::vector<std::string> kSingles = {"pure_delay",       "gain_error", "load_coupling",         "oil_column_resonance",
-                                           "coulomb_friction", "backlash",   "servovalve_saturation", "current_lag",
-                                           "damper_scale"};
+// Every effect the diagnosis may select (models::kEffects, in the library's order); HarnessTruth
+// draws each one's true parameters.
+const std::vector<std::string> kSingles = [] {
+  std::vector<std::string> v;
+  for (const models::EffectInfo& e : models::kEffects)
+    if (e.diagnosable) v.emplace_back(e.name);
+  return v;
+}();
 const std::vector<std::string> kPairs = {"pure_delay+damper_scale", "gain_error+current_lag", "pure_delay+gain_error",
                                          "backlash+damper_scale", "load_coupling+current_lag",
                                          "oil_column_resonance+coulomb_friction"};

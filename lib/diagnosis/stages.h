@@ -1,0 +1,190 @@
+#pragma once
+/// @file The stages of Diagnose (diagnosis.h), over one channel's state: internal to
+/// lib/diagnosis, exposed so that each stage can be tested alone (tests/diagnosis_stages_test.cpp).
+///
+/// Per channel (y, then f), in this order:
+///   ScoreNominal      nominal residuals, gap, noise floor, floor ratios, whiteness;
+///   SelectEffects     greedy selection on the training records (rules (a)-(c) of diagnosis.h);
+///   SwapEffects       an effect replaced by another candidate that fits the training records better;
+///   PruneEffects      an effect whose own share of the excess is below min_excess_reduction removed;
+///   RetainOnTest      an effect that raises the test NRMSE by more than max_test_worsening dropped;
+///   ScoreSelected     the selected effects' numbers, cumulative in selection order;
+///   ApplyShrinkRule   the min_test_shrink_pct rule, the channel's status and final predictions;
+///   ScoreCandidates   the numbers of the candidates not selected.
+/// Diagnose gathers the records and the candidates, runs these for each channel, then ranks the
+/// effects, forms the verdict and localises the residual.
+#include <map>
+#include <optional>
+#include <span>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "diagnosis/channel_models.h"
+#include "diagnosis/diagnosis.h"
+#include "io/rig_record.h"
+#include "models/rig_effects.h"
+#include "models/servo_linear.h"
+
+namespace rths::diagnosis::stages {
+
+/// One fitted parameter of a candidate and its search range, resolved for the data set.
+struct ParamSpec {
+  std::string key;  ///< the parameter's key in models::kEffects
+  double lo, hi;    ///< search range, in the parameter's unit
+  bool log;         ///< searched in log space
+  int grid;         ///< grid points over [lo, hi] (0: closed form)
+};
+/// One candidate effect: an entry of models::kEffects that the diagnosis may select, with the
+/// search ranges of its fitted parameters.
+struct CandidateSpec {
+  const models::EffectInfo* info;
+  std::string name;
+  char channel;  // 'y' or 'f'
+  std::vector<ParamSpec> params;
+};
+
+/// The candidates: every diagnosable entry of models::kEffects in the library's order, with the
+/// search range of each fitted parameter (docs/diagnosis.md "Fitting"): an upper end given per dt
+/// is search_hi_per_dt / dt_s (oil_column_resonance's f_hz: 0.4 / dt_s); one given by the data
+/// (servovalve_saturation's vmax) is data_hi.
+std::vector<CandidateSpec> Candidates(double dt_s, double data_hi);
+
+/// Effect name -> parameter values, in the order of its CandidateSpec's params.
+using Params = std::map<std::string, std::vector<double>>;
+
+/// The effect set of a parameter map. Throws rths::Error for an unknown name.
+models::EffectSet ToSet(const std::vector<CandidateSpec>& specs, const Params& p);
+
+/// One record as the diagnosis uses it.
+struct Data {
+  std::string source;
+  double dt = 0;                    ///< [s]
+  std::vector<double> u, y, f, i;   ///< [mm], [mm], [kN], [A] (detrended if Options::detrend)
+  SmoothedMotion motion;            ///< the damper's motion (set once y is diagnosed)
+  std::size_t first = 0;            ///< first sample of every sum (warmup_s / dt, at most half the record)
+  std::size_t size() const { return u.size(); }
+};
+
+/// The record's signals (detrended if o.detrend) and its first sample; no motion yet.
+Data Prepare(const io::RigRecord& r, const Options& o);
+
+/// Samples in the sums (k >= first) of every record.
+std::size_t Count(const std::vector<Data>& ds);
+
+/// Evaluates a channel's predictions for an effect set over a set of records (held by pointer:
+/// the records, the servo and the force predictor must outlive it).
+class Channel {
+ public:
+  /// ch: 'y' or 'f'; fp may be null for 'y'.
+  Channel(char ch, const std::vector<Data>* recs, const models::LinearServo* servo, const ForcePredictor* fp);
+  /// Predictions per record. For 'f' with damper_scale in the set, the scale is replaced by the
+  /// least-squares one over these records (closed form, clipped to [0.1, 10]) and written back to
+  /// *scale_out; with fixed_scale, that scale is used instead.
+  std::vector<std::vector<double>> Predict(const models::EffectSet& set, double* scale_out = nullptr,
+                                           std::optional<double> fixed_scale = std::nullopt) const;
+  /// Sum of squared residuals over the records (k >= first).
+  double Sse(const std::vector<std::vector<double>>& pred) const;
+  /// NRMSE [%] of a sum of squared residuals over these records.
+  double NrmsePct(double sse) const;
+  const std::vector<Data>& recs() const { return *recs_; }
+  /// The measured channel of record r.
+  std::span<const double> Meas(std::size_t r) const;
+
+ private:
+  char ch_;
+  const std::vector<Data>* recs_;
+  const models::LinearServo* servo_;
+  const ForcePredictor* fp_;
+  double meas2_ = 0;
+};
+
+/// A candidate's latest trial: the channel's whole set with it, fitted on the training records.
+struct Trial {
+  std::string name;
+  Params params;              ///< the channel's whole set with this candidate
+  double sse = 0;             ///< training SSE of the set
+  double excess_red = 0;      ///< rule (b): the fraction of the channel's excess it removes
+  double dbic = 0;            ///< rule (a): the change of BIC
+  double marginal_red = 0;    ///< rule (b): its own share of the excess without it
+  bool pass = false;          ///< every rule holds
+};
+
+/// One channel's state through the stages.
+struct ChannelState {
+  ChannelState(char c, Channel tr, Channel te) : ch(c), train(std::move(tr)), test(std::move(te)) {}
+  char ch;                           ///< 'y' or 'f'
+  Channel train, test;               ///< the training and test records of the channel
+  ChannelSummary summary;            ///< the channel's numbers (filled by the stages)
+
+  // Set by ScoreNominal.
+  std::size_t n_train = 0;           ///< samples in the training sums
+  double var_floor = 0;              ///< sigma^2, train and test pooled [mm^2 or kN^2]
+  bool structured = false;           ///< rho_c > none_ratio (train and test pooled)
+  double sse_nominal = 0;            ///< training SSE of the nominal model
+  double excess_nominal = 0;         ///< sse_nominal - n_train sigma^2
+  std::vector<std::vector<double>> nom_test;  ///< nominal predictions, test records
+
+  // The selection (SelectEffects .. RetainOnTest).
+  Params sel;                        ///< selected effects and their parameters
+  std::vector<std::string> order;    ///< selected names in the order they were added
+  double sse = 0;                    ///< training SSE with sel
+  std::vector<std::vector<double>> pred_train;  ///< predictions with sel, training records
+  std::map<std::string, Trial> last_trial;      ///< latest trial of every candidate not selected
+  std::map<std::string, std::pair<double, double>> sel_stats;  ///< selected: (excess reduction, dBIC) when added
+
+  // Set by ApplyShrinkRule.
+  bool retained = false;             ///< the selected effects are kept (the verdict names them)
+  std::vector<std::vector<double>> fin_test;        ///< final (retained effects), test records
+  std::vector<std::vector<double>> pred_train_fin;  ///< final (retained effects), training records
+};
+
+/// Effect name -> its numbers, over both channels (names are unique across channels).
+using EffectResults = std::map<std::string, EffectResult>;
+
+/// Nominal residuals on both sets, the gap, the noise floor (train and test pooled), the floor
+/// ratios and the whiteness; sets summary (diagnosed), n_train, var_floor, structured,
+/// sse_nominal, excess_nominal, nom_test, and sel = {}, sse, pred_train of the nominal model.
+/// Throws rths::Error naming the records if a nominal residual is not finite.
+void ScoreNominal(ChannelState* s, const Options& o);
+
+/// The channel is not diagnosed (a displacement-only test's y): its final model is the nominal one.
+void MarkNotDiagnosed(ChannelState* s);
+
+/// Greedy selection on the training records (diagnosis.h, rules (a)-(c)): while some candidate
+/// passes, adds the one removing the largest fraction of the excess and refits the set jointly.
+/// Sets sel, order, sse, pred_train, sel_stats, last_trial.
+void SelectEffects(ChannelState* s, const std::vector<CandidateSpec>& specs, const Options& o);
+
+/// Up to o.swap_passes times: the effect of the set whose replacement by another candidate (fitted,
+/// then the set refitted) lowers the training SSE the most, by more than o.swap_min_gain of it, is
+/// replaced. Each swap is a warning.
+void SwapEffects(ChannelState* s, const std::vector<CandidateSpec>& specs, const Options& o,
+                 std::vector<std::string>* warnings);
+
+/// While the set holds two or more effects: the effect with the smallest own share of the excess
+/// (the set refitted without it), if below o.min_excess_reduction, is removed. Each removal is a
+/// warning. On return pred_train and sse are those of the final set.
+void PruneEffects(ChannelState* s, const std::vector<CandidateSpec>& specs, const Options& o,
+                  std::vector<std::string>* warnings);
+
+/// In selection order, an effect whose addition raises the channel's test NRMSE by more than
+/// o.max_test_worsening (relative) is dropped (a warning); if any was, the rest are refitted on the
+/// training records.
+void RetainOnTest(ChannelState* s, const std::vector<CandidateSpec>& specs, const Options& o,
+                  std::vector<std::string>* warnings);
+
+/// The selected effects' numbers, each with the effects selected before it (selected = true).
+void ScoreSelected(const ChannelState& s, const std::vector<CandidateSpec>& specs, EffectResults* er);
+
+/// The test NRMSE with the selected set; the min_test_shrink_pct rule on a structured test
+/// residual (a warning and er's entries unselected if it fails); sets retained, the summary's
+/// after_test_pct and status, fin_test and pred_train_fin.
+void ApplyShrinkRule(ChannelState* s, const std::vector<CandidateSpec>& specs, const Options& o,
+                     std::vector<std::string>* warnings, EffectResults* er);
+
+/// The candidates not selected, from their latest trial; if a selection was not retained, every
+/// candidate is refitted alone on the nominal model first (its numbers then stand on their own).
+void ScoreCandidates(ChannelState* s, const std::vector<CandidateSpec>& specs, const Options& o, EffectResults* er);
+
+}  // namespace rths::diagnosis::stages

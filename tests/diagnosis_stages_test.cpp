@@ -1,0 +1,191 @@
+// The stages of the diagnosis one at a time (lib/diagnosis/stages.h), on short synthetic records
+// from the effect blocks: the nominal scoring, the greedy selection, the pruning, the held-out
+// retention and the shrink rule, each run on a channel state set up by hand.
+#include <algorithm>
+#include <string>
+#include <vector>
+
+#include <doctest/doctest.h>
+
+#include "diagnosis/diagnosis.h"
+#include "diagnosis/stages.h"
+#include "diagnosis/synthetic.h"
+#include "models/servo_linear.h"
+
+using namespace rths::diagnosis;
+namespace m = rths::models;
+namespace st = rths::diagnosis::stages;
+
+namespace {
+
+/// Short training (BLWN 0-25 Hz) and test (BLWN 0-8 Hz) records with sensor noise.
+std::pair<rths::io::RigRecord, rths::io::RigRecord> Records(const m::EffectSet& effects) {
+  Truth truth;
+  truth.effects = effects;
+  truth.effects.sensor_noise = m::SensorNoise{0.01, 0.2};
+  Excitation tr;
+  tr.duration_s = 6.0;
+  tr.band_hz = 25.0;
+  tr.rms_mm = 4.0;
+  tr.seed = 3;
+  Excitation te = tr;
+  te.band_hz = 8.0;
+  te.rms_mm = 5.0;
+  te.seed = 1003;
+  Truth t2 = truth;
+  t2.noise_seed += 17;
+  return {MakeRecordBlocks(tr, truth, "train"), MakeRecordBlocks(te, t2, "test")};
+}
+
+/// The displacement channel of one training and one test record, as Diagnose sets it up.
+struct YChannel {
+  YChannel(const m::EffectSet& effects, const Options& o = {}) {
+    const auto [tr, te] = Records(effects);
+    train.push_back(st::Prepare(tr, o));
+    test.push_back(st::Prepare(te, o));
+    servo = m::LinearServo::Make(PaperModel().actuator, tr.dt_s);
+    specs = st::Candidates(tr.dt_s, 1e4);
+    state.emplace_back('y', st::Channel('y', &train, &servo, nullptr), st::Channel('y', &test, &servo, nullptr));
+  }
+  st::ChannelState& s() { return state.front(); }
+  /// Holds the given effects as the selection (in this order), with the training SSE they give.
+  void Select(const st::Params& sel, const std::vector<std::string>& order) {
+    s().sel = sel;
+    s().order = order;
+    s().pred_train = s().train.Predict(st::ToSet(specs, sel));
+    s().sse = s().train.Sse(s().pred_train);
+  }
+  std::vector<st::Data> train, test;
+  m::LinearServo servo;
+  std::vector<st::CandidateSpec> specs;
+  std::vector<st::ChannelState> state;  // one element (a ChannelState needs its channels to be made)
+};
+
+bool Mentions(const std::vector<std::string>& warnings, const std::string& a, const std::string& b) {
+  return std::any_of(warnings.begin(), warnings.end(), [&](const std::string& w) {
+    return w.find(a) != std::string::npos && w.find(b) != std::string::npos;
+  });
+}
+
+}  // namespace
+
+TEST_CASE("ScoreNominal: a noise-only residual is at its floor, a delayed one is structured") {
+  const Options o;
+  YChannel noise(m::EffectSet{});
+  st::ScoreNominal(&noise.s(), o);
+  CHECK(noise.s().summary.diagnosed);
+  CHECK(noise.s().summary.noise_rms == doctest::Approx(0.01).epsilon(0.15));
+  CHECK(noise.s().summary.floor_ratio <= o.none_ratio);
+  CHECK_FALSE(noise.s().structured);
+  CHECK(noise.s().sse == noise.s().sse_nominal);
+
+  m::EffectSet delay;
+  delay.pure_delay = m::PureDelay{4.0};
+  YChannel delayed(delay);
+  st::ScoreNominal(&delayed.s(), o);
+  CHECK(delayed.s().structured);
+  CHECK(delayed.s().summary.floor_ratio > 10.0 * o.none_ratio);
+  CHECK(delayed.s().excess_nominal > 0.0);
+}
+
+TEST_CASE("SelectEffects: picks the known effect and its parameter, and nothing on noise") {
+  const Options o;
+  m::EffectSet delay;
+  delay.pure_delay = m::PureDelay{4.0};
+  YChannel y(delay);
+  st::ScoreNominal(&y.s(), o);
+  const double sse_nominal = y.s().sse;
+  st::SelectEffects(&y.s(), y.specs, o);
+  REQUIRE(y.s().order == std::vector<std::string>{"pure_delay"});
+  CHECK(y.s().sel.at("pure_delay")[0] == doctest::Approx(4.0).epsilon(0.05));
+  CHECK(y.s().sse < 0.1 * sse_nominal);
+  CHECK(y.s().last_trial.count("pure_delay") == 0);  // selected: no longer a trial
+  CHECK(y.s().last_trial.count("gain_error") == 1);  // tried on top of the delay, not passed
+  CHECK_FALSE(y.s().last_trial.at("gain_error").pass);
+
+  YChannel noise(m::EffectSet{});
+  st::ScoreNominal(&noise.s(), o);
+  st::SelectEffects(&noise.s(), noise.specs, o);
+  CHECK(noise.s().order.empty());
+  CHECK(noise.s().last_trial.size() == 7);  // every displacement candidate tried
+}
+
+TEST_CASE("PruneEffects: an effect that explains nothing is removed, two needed ones are kept") {
+  const Options o;
+  {
+    m::EffectSet delay;
+    delay.pure_delay = m::PureDelay{4.0};
+    YChannel y(delay);
+    st::ScoreNominal(&y.s(), o);
+    y.Select({{"pure_delay", {4.0}}, {"gain_error", {1.0}}}, {"pure_delay", "gain_error"});  // gain 1: no effect
+    std::vector<std::string> warnings;
+    st::PruneEffects(&y.s(), y.specs, o, &warnings);
+    CHECK(y.s().order == std::vector<std::string>{"pure_delay"});
+    CHECK(y.s().sel.count("gain_error") == 0);
+    CHECK(Mentions(warnings, "gain_error", "pruned"));
+    CHECK(y.s().sse == y.s().train.Sse(y.s().train.Predict(st::ToSet(y.specs, y.s().sel))));
+  }
+  {
+    m::EffectSet both;
+    both.pure_delay = m::PureDelay{4.0};
+    both.gain_error = m::GainError{1.1};
+    YChannel y(both);
+    st::ScoreNominal(&y.s(), o);
+    y.Select({{"pure_delay", {4.0}}, {"gain_error", {1.1}}}, {"pure_delay", "gain_error"});
+    std::vector<std::string> warnings;
+    st::PruneEffects(&y.s(), y.specs, o, &warnings);
+    CHECK(y.s().order == std::vector<std::string>{"pure_delay", "gain_error"});
+    CHECK(warnings.empty());
+  }
+}
+
+TEST_CASE("RetainOnTest: an effect that raises the held-out NRMSE is dropped, the rest refitted") {
+  Options o;
+  m::EffectSet delay;
+  delay.pure_delay = m::PureDelay{4.0};
+  YChannel y(delay);
+  st::ScoreNominal(&y.s(), o);
+  // A 30 % gain error on top of the right delay: the test records get worse with it.
+  y.Select({{"pure_delay", {4.0}}, {"gain_error", {1.3}}}, {"pure_delay", "gain_error"});
+  std::vector<std::string> warnings;
+  st::RetainOnTest(&y.s(), y.specs, o, &warnings);
+  CHECK(y.s().order == std::vector<std::string>{"pure_delay"});
+  CHECK(y.s().sel.count("gain_error") == 0);
+  CHECK(y.s().sel.at("pure_delay")[0] == doctest::Approx(4.0).epsilon(0.05));  // refitted alone
+  CHECK(Mentions(warnings, "gain_error", "not retained"));
+
+  // The right effect alone is retained, without a warning.
+  y.Select({{"pure_delay", {4.0}}}, {"pure_delay"});
+  warnings.clear();
+  st::RetainOnTest(&y.s(), y.specs, o, &warnings);
+  CHECK(y.s().order == std::vector<std::string>{"pure_delay"});
+  CHECK(warnings.empty());
+}
+
+TEST_CASE("ApplyShrinkRule: a selection short of min_test_shrink_pct is not retained") {
+  m::EffectSet delay;
+  delay.pure_delay = m::PureDelay{4.0};
+  for (const double required : {30.0, 100.0}) {
+    CAPTURE(required);
+    Options o;
+    o.min_test_shrink_pct = required;  // 100 %: no model shrinks a noisy gap that far
+    YChannel y(delay);
+    st::ScoreNominal(&y.s(), o);
+    y.Select({{"pure_delay", {4.0}}}, {"pure_delay"});
+    st::EffectResults er;
+    st::ScoreSelected(y.s(), y.specs, &er);
+    REQUIRE(er.count("pure_delay") == 1);
+    CHECK(er.at("pure_delay").selected);
+    CHECK(er.at("pure_delay").shrink_pct > 50.0);
+    std::vector<std::string> warnings;
+    st::ApplyShrinkRule(&y.s(), y.specs, o, &warnings, &er);
+    const bool kept = required < 50.0;
+    CHECK(y.s().retained == kept);
+    CHECK(er.at("pure_delay").selected == kept);
+    CHECK(y.s().summary.status == (kept ? "explained" : "unexplained"));
+    CHECK(Mentions(warnings, "pure_delay", "not retained") == !kept);
+    CHECK(y.s().fin_test.size() == 1);
+    if (kept) CHECK(y.s().summary.after_test_pct < 0.5 * y.s().summary.gap_test_pct);
+    else CHECK(y.s().summary.after_test_pct == y.s().summary.gap_test_pct);
+  }
+}
