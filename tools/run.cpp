@@ -45,6 +45,7 @@
 #include "participants/factory.h"
 #include "participants/group.h"
 #include "participants/logger.h"
+#include "participants/run_summary.h"
 #include "scenario/scenario.h"
 
 namespace fs = std::filesystem;
@@ -304,27 +305,6 @@ std::vector<Outcome> RunUdpm(const std::string& scenario_path, const rths::scena
   return outcomes;
 }
 
-nlohmann::json LinkTotals(const std::vector<Outcome>& outcomes) {
-  rths::lockstep::LinkStats t;
-  for (const auto& o : outcomes) {
-    if (!o.stats_known) continue;
-    const auto& s = o.stats;
-    t.rerequests += s.rerequests;
-    t.steps_rerequested += s.steps_rerequested;
-    t.repair_requests += s.repair_requests;
-    t.resent += s.resent;
-    t.repaired += s.repaired;
-    t.duplicates += s.duplicates;
-    t.stale += s.stale;
-    t.foreign += s.foreign;
-    t.injected.dropped += s.injected.dropped;
-    t.injected.duplicated += s.injected.duplicated;
-    t.injected.delayed += s.injected.delayed;
-    t.injected.reordered += s.injected.reordered;
-  }
-  return rths::participants::StatsToJson(t);
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -526,67 +506,22 @@ int main(int argc, char** argv) {
   rths::participants::Verdict verdict = rths::participants::Judge(outcomes);
 
   // Summary from the log: whatever was committed, even after a failure.
-  nlohmann::json j;
-  j["scenario"] = scenario_path;
-  j["scenario_sha256"] = s.sha256;
-  j["run_id"] = run_id;
-  j["transport"] = transport;
-  j["lcm_url"] = url;
-  j["steps_expected"] = s.steps();
-  j["wall_s"] = wall_s;
-  j["output_estimate_bytes"] = estimate;
-  std::int64_t steps = 0;
-  try {
-    const auto log = rths::io::ReadRunLog((out / "log.lcm").string());
-    const auto m = rths::io::ComputeMetrics(log);
-    steps = m.steps;
-    j["steps"] = steps;
-    // The pace it ran at: the clock's own time from GO to its last step (the log's timestamps are
-    // simulated time and say nothing of it).
-    double stepping_s = 0;
-    for (const auto& o : outcomes) stepping_s = std::max(stepping_s, o.stepping_s);
-    j["stepping_s"] = stepping_s;
-    j["steps_per_s"] = (steps > 1 && stepping_s > 0) ? static_cast<double>(steps - 1) / stepping_s : 0.0;
-    j["tracking_nrmse_pct"] = m.tracking_nrmse_pct;
-    j["peak_force_kN"] = m.peak_force_kN;
-    j["peak_displacement_mm"] = m.peak_displacement_mm;
-    j["accel_extrapolation_rms_err_pct"] = m.accel_extrapolation_rms_err_pct;
-    j["velocity_prediction_rms_err_pct"] = m.velocity_prediction_rms_err_pct;
-    std::int64_t dups = 0;
-    for (const auto& [ch, n] : log.duplicates) dups += n;
-    j["duplicates_logged"] = dups;
-  } catch (const std::exception& e) {
-    j["steps"] = 0;
-    j["log_error"] = e.what();
+  rths::participants::RunSummary sum;
+  sum.scenario = scenario_path;
+  sum.scenario_sha256 = s.sha256;
+  sum.run_id = run_id;
+  sum.transport = transport;
+  sum.lcm_url = url;
+  sum.steps_expected = s.steps();
+  sum.wall_s = wall_s;
+  sum.output_estimate_bytes = estimate;
+  rths::participants::ReadLog((out / "log.lcm").string(), &sum);
+  rths::participants::SetOutcomes(outcomes, &sum);
+  rths::participants::SetVerdict(verdict, g_interrupted != 0, &sum);
+  if (sum.failure && noticed != Clock::time_point{}) {
+    sum.failure->teardown_s = std::chrono::duration<double>(Clock::now() - noticed).count();
   }
-  if (verdict.failed && verdict.step < 0 && verdict.exit_code > 128 && steps < s.steps()) {
-    verdict.step = steps;  // a process that died cannot say where: the step it did not finish
-    verdict.what += fmt::format(" during step {}", steps);
-  }
-  int code = 0;
-  std::string status = "completed";
-  if (g_interrupted) {
-    status = "interrupted";
-    code = 130;
-  } else if (verdict.failed) {
-    code = verdict.exit_code != 0 ? verdict.exit_code : rths::lockstep::kExitLockstep;
-    status = code == rths::lockstep::kExitSafety     ? "stopped by the safety monitor"
-             : code == rths::lockstep::kExitRealtime ? "stopped by the miss policy"
-                                                     : "failed";
-  }
-  j["status"] = status;
-  j["exit_code"] = code;
-  j["stopped"] = g_interrupted ? std::string("interrupted by the user") : verdict.failed ? verdict.what : "no";
-  if (verdict.failed) {
-    j["failure"] = {{"participant", verdict.role}, {"step", verdict.step}, {"what", verdict.what},
-                    {"exit_code", verdict.exit_code}};
-    if (noticed != Clock::time_point{}) {
-      j["failure"]["teardown_s"] = std::chrono::duration<double>(Clock::now() - noticed).count();
-    }
-  }
-  j["link"] = LinkTotals(outcomes);
   // Paced runs: the clock's latency figures, and what each process got of SCHED_FIFO / mlockall.
-  std::string rt_line;
   if (s.realtime.enabled) {
     nlohmann::json rt;
     for (const auto& o : outcomes) {
@@ -613,50 +548,15 @@ int main(int argc, char** argv) {
     rt["priority"] = s.realtime.priority;
     rt["setup_notes"] = notes;
     rt["max_consecutive_misses_policy"] = s.realtime.max_consecutive_misses;
-    j["realtime"] = rt;
-    rt_line = fmt::format("SCHED_FIFO {} in {} of {} process(es), memory locked in {} of {}", s.realtime.priority,
-                          fifo, processes, locked, processes);
-    if (!notes.empty()) rt_line += "\n  NOT real-time      " + notes;
+    sum.realtime = rt;
   }
-  j["participants"] = nlohmann::json::object();
-  for (const auto& o : outcomes) {
-    nlohmann::json p = rths::participants::OutcomeToJson(o);
-    p.erase("role");
-    j["participants"][o.role] = p;
-  }
-  const bool summary_ok = rths::io::OverwriteFile((out / "summary.json").string(), j.dump(2) + "\n");
-
-  if (!quiet) {
-    std::printf("  steps              %lld of %lld\n", static_cast<long long>(steps),
-                static_cast<long long>(s.steps()));
-    if (j.contains("tracking_nrmse_pct")) {
-      std::printf("  tracking error     %.3f %% (RMS, Eq. 31)\n", j["tracking_nrmse_pct"].get<double>());
-      std::printf("  peak damper force  %.2f kN\n", j["peak_force_kN"].get<double>());
-      std::printf("  rate               %.0f steps/s (%.2fx real time)\n", j["steps_per_s"].get<double>(),
-                  j["steps_per_s"].get<double>() * s.run.dt_s);
-    }
-    if (j.contains("realtime") && j["realtime"].contains("steps")) {
-      const auto& rt = j["realtime"];
-      const double period_us = rt["period_us"].get<double>();
-      std::printf("  real time          paced at %.0f Hz (dt %g ms); %s\n", 1e6 / period_us, period_us / 1e3,
-                  rt_line.c_str());
-      std::printf("  step latency       p50 %.0f us, p99 %.0f us, p99.9 %.0f us, max %.0f us (request to barrier)\n",
-                  rt["latency_p50_us"].get<double>(), rt["latency_p99_us"].get<double>(),
-                  rt["latency_p999_us"].get<double>(), rt["latency_max_us"].get<double>());
-      std::printf("  deadline misses    %lld of %lld steps (%.4f %%), longest run %lld\n",
-                  static_cast<long long>(rt["deadline_misses"].get<std::int64_t>()),
-                  static_cast<long long>(rt["steps"].get<std::int64_t>()),
-                  100.0 * rt["miss_fraction"].get<double>(),
-                  static_cast<long long>(rt["max_consecutive_misses"].get<std::int64_t>()));
-    }
-    const auto rerequests = j["link"]["rerequests"].get<std::int64_t>();
-    if (rerequests > 0) {
-      std::printf("  link               %lld re-requests, %lld messages repaired\n",
-                  static_cast<long long>(rerequests), static_cast<long long>(j["link"]["repaired"].get<std::int64_t>()));
-    }
-  }
+  const bool summary_ok = rths::io::OverwriteFile((out / "summary.json").string(), sum.ToJson().dump(2) + "\n");
+  if (!quiet) std::fputs(sum.Report(s.run.dt_s).c_str(), stdout);
   std::fflush(stdout);
   if (!summary_ok) std::fprintf(stderr, "rths run: could not write %s\n", (out / "summary.json").c_str());
+  const int code = sum.exit_code;
+  const std::string what = sum.failure ? sum.failure->what : "";
+  const std::int64_t steps = sum.steps;
   if (code == 0) {
     std::printf("output: %s\n", out.string().c_str());
     return 0;
@@ -664,11 +564,11 @@ int main(int argc, char** argv) {
   if (g_interrupted) {
     std::fprintf(stderr, "rths run: interrupted; the group was stopped\n");
   } else if (code == rths::lockstep::kExitSafety) {
-    std::fprintf(stderr, "rths run: STOPPED by the safety monitor: %s\n", verdict.what.c_str());
+    std::fprintf(stderr, "rths run: STOPPED by the safety monitor: %s\n", what.c_str());
   } else if (code == rths::lockstep::kExitRealtime) {
-    std::fprintf(stderr, "rths run: STOPPED by the real-time miss policy: %s\n", verdict.what.c_str());
+    std::fprintf(stderr, "rths run: STOPPED by the real-time miss policy: %s\n", what.c_str());
   } else {
-    std::fprintf(stderr, "rths run: FAILED: %s\n", verdict.what.c_str());
+    std::fprintf(stderr, "rths run: FAILED: %s\n", what.c_str());
   }
   if (steps > 0) {
     std::printf("output: %s (log complete up to step %lld)\n", out.string().c_str(), static_cast<long long>(steps) - 1);

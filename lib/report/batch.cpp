@@ -6,7 +6,6 @@
 #include <cmath>
 #include <fstream>
 #include <mutex>
-#include <random>
 #include <thread>
 
 #include <fmt/format.h>
@@ -15,8 +14,10 @@
 
 #include "core/error.h"
 #include "io/run_log.h"
+#include "lockstep/runtime.h"
 #include "participants/factory.h"
 #include "participants/group.h"
+#include "participants/run_summary.h"
 
 namespace rths::report {
 
@@ -92,65 +93,58 @@ void Preflight(const std::vector<RunSpec>& specs) {
 
 namespace {
 
-std::int64_t NewRunId() {
-  static std::mutex m;
-  static std::mt19937_64 gen{std::random_device{}()};
-  std::lock_guard<std::mutex> lock(m);
-  return static_cast<std::int64_t>(gen() & 0x3fffffffffffffffULL) | 1;
-}
-
 RunResult RunOne(const RunSpec& spec) {
   RunResult res;
   res.label = spec.label;
   res.dir = spec.dir;
-  nlohmann::json j;
+  participants::RunSummary sum;
+  sum.label = spec.label;
+  sum.scenario = (spec.dir / "scenario.toml").string();
+  sum.run_id = lockstep::NewRunId();
+  sum.transport = "memq";
   const auto t0 = std::chrono::steady_clock::now();
-  scenario::Scenario s;
-  std::int64_t run_id = NewRunId();
+  std::string error;
+  if (fs::exists(spec.dir / "log.lcm")) {  // the folder's run and its summary stay as they are
+    res.error = Error(spec.dir.string(), "holds a run already; refusing to overwrite it").what();
+    return res;
+  }
   try {
-    if (fs::exists(spec.dir / "log.lcm")) {
-      throw Error(spec.dir.string(), "holds a run already; refusing to overwrite it");
-    }
-    s = WriteScenarioFile(spec);
-    const auto outcomes = participants::RunGroupInProcess({s}, run_id, spec.dir.string());
+    const scenario::Scenario s = WriteScenarioFile(spec);
+    sum.scenario_sha256 = s.sha256;
+    sum.steps_expected = s.steps();
+    const auto outcomes = participants::RunGroupInProcess({s}, sum.run_id, spec.dir.string());
+    participants::SetOutcomes(outcomes, &sum);
     if (const auto* culprit = participants::RootCause(outcomes)) {
-      res.error = fmt::format("{} exited with code {}: {}", culprit->role, culprit->exit_code, culprit->message);
+      error = fmt::format("{} exited with code {}: {}", culprit->role, culprit->exit_code, culprit->message);
     }
-    j["participants"] = nlohmann::json::object();
-    for (const auto& o : outcomes) j["participants"][o.role] = {{"exit_code", o.exit_code}, {"message", o.message}};
-  } catch (const std::exception& e) {
-    res.error = e.what();
-  }
-  res.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  try {
-    if (fs::exists(spec.dir / "log.lcm")) {
-      const io::RunMetrics m = io::ComputeMetrics(io::ReadRunLog((spec.dir / "log.lcm").string()));
-      res.steps = m.steps;
-      res.tracking_pct = m.tracking_nrmse_pct;
-      res.peak_force_kN = m.peak_force_kN;
-      if (res.error.empty() && res.steps != s.steps()) {
-        res.error = fmt::format("the log holds {} of {} steps", res.steps, s.steps());
-      }
+    sum.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    participants::ReadLog((spec.dir / "log.lcm").string(), &sum);
+    participants::SetVerdict(participants::Judge(outcomes), false, &sum);
+    if (error.empty() && !sum.log_error.empty()) error = sum.log_error;
+    if (error.empty() && sum.steps != s.steps()) {
+      error = fmt::format("the log holds {} of {} steps", sum.steps, s.steps());
     }
   } catch (const std::exception& e) {
-    if (res.error.empty()) res.error = e.what();
+    error = e.what();
+    sum.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    if (fs::exists(spec.dir / "log.lcm")) participants::ReadLog((spec.dir / "log.lcm").string(), &sum);
   }
-  res.ok = res.error.empty();
-  j["label"] = spec.label;
-  j["scenario"] = (spec.dir / "scenario.toml").string();
-  j["scenario_sha256"] = s.sha256;
-  j["run_id"] = run_id;
-  j["transport"] = "memq";
-  j["steps_expected"] = s.steps();
-  j["steps"] = res.steps;
-  j["wall_s"] = res.wall_s;
-  j["steps_per_s"] = res.wall_s > 0 ? res.steps / res.wall_s : 0.0;
-  j["tracking_nrmse_pct"] = res.tracking_pct;
-  j["peak_force_kN"] = res.peak_force_kN;
-  j["stopped"] = res.ok ? std::string("no") : res.error;
+  if (!error.empty()) {
+    if (sum.exit_code == 0) sum.exit_code = lockstep::kExitLockstep;
+    sum.status = "failed";
+    sum.stopped = error;
+  }
+  res.error = error;
+  res.ok = error.empty();
+  res.wall_s = sum.wall_s;
+  res.steps = sum.steps;
+  if (sum.metrics) {
+    res.tracking_pct = sum.metrics->tracking_nrmse_pct;
+    res.peak_force_kN = sum.metrics->peak_force_kN;
+  }
   try {
     fs::create_directories(spec.dir);
-    std::ofstream(spec.dir / "summary.json") << j.dump(2) << "\n";
+    std::ofstream(spec.dir / "summary.json") << sum.ToJson().dump(2) << "\n";
   } catch (const std::exception&) {
   }
   return res;

@@ -1,0 +1,153 @@
+#include "participants/run_summary.h"
+
+#include <algorithm>
+#include <exception>
+
+#include <fmt/format.h>
+
+namespace rths::participants {
+
+double RunSummary::steps_per_s() const {
+  return (steps > 1 && stepping_s > 0) ? static_cast<double>(steps - 1) / stepping_s : 0.0;
+}
+
+nlohmann::json RunSummary::ToJson() const {
+  nlohmann::json j;
+  if (!label.empty()) j["label"] = label;
+  j["scenario"] = scenario;
+  j["scenario_sha256"] = scenario_sha256;
+  j["run_id"] = run_id;
+  j["transport"] = transport;
+  if (!lcm_url.empty()) j["lcm_url"] = lcm_url;
+  j["steps_expected"] = steps_expected;
+  j["wall_s"] = wall_s;
+  if (output_estimate_bytes > 0) j["output_estimate_bytes"] = output_estimate_bytes;
+  j["steps"] = steps;
+  if (metrics) {
+    j["stepping_s"] = stepping_s;
+    j["steps_per_s"] = steps_per_s();
+    j["tracking_nrmse_pct"] = metrics->tracking_nrmse_pct;
+    j["peak_force_kN"] = metrics->peak_force_kN;
+    j["peak_displacement_mm"] = metrics->peak_displacement_mm;
+    j["accel_extrapolation_rms_err_pct"] = metrics->accel_extrapolation_rms_err_pct;
+    j["velocity_prediction_rms_err_pct"] = metrics->velocity_prediction_rms_err_pct;
+    j["duplicates_logged"] = duplicates_logged;
+  }
+  if (!log_error.empty()) j["log_error"] = log_error;
+  j["status"] = status;
+  j["exit_code"] = exit_code;
+  j["stopped"] = stopped;
+  if (failure) {
+    j["failure"] = {{"participant", failure->participant},
+                    {"step", failure->step},
+                    {"what", failure->what},
+                    {"exit_code", failure->exit_code}};
+    if (failure->teardown_s) j["failure"]["teardown_s"] = *failure->teardown_s;
+  }
+  j["link"] = StatsToJson(link);
+  if (!realtime.is_null()) j["realtime"] = realtime;
+  j["participants"] = nlohmann::json::object();
+  for (const Outcome& o : participants) {
+    nlohmann::json p = OutcomeToJson(o);
+    p.erase("role");
+    j["participants"][o.role] = p;
+  }
+  return j;
+}
+
+std::string RunSummary::Report(double dt_s) const {
+  std::string o = fmt::format("  steps              {} of {}\n", steps, steps_expected);
+  if (metrics) {
+    o += fmt::format("  tracking error     {:.3f} % (RMS, Eq. 31)\n", metrics->tracking_nrmse_pct);
+    o += fmt::format("  peak damper force  {:.2f} kN\n", metrics->peak_force_kN);
+    o += fmt::format("  rate               {:.0f} steps/s ({:.2f}x real time)\n", steps_per_s(),
+                     steps_per_s() * dt_s);
+  }
+  if (realtime.is_object() && realtime.contains("steps")) {
+    const auto& rt = realtime;
+    const double period_us = rt["period_us"].get<double>();
+    const int processes = rt.value("processes", 0);
+    std::string setup = fmt::format("SCHED_FIFO {} in {} of {} process(es), memory locked in {} of {}",
+                                    rt.value("priority", 0), rt.value("sched_fifo_processes", 0), processes,
+                                    rt.value("memory_locked_processes", 0), processes);
+    if (const std::string notes = rt.value("setup_notes", std::string()); !notes.empty()) {
+      setup += "\n  NOT real-time      " + notes;
+    }
+    o += fmt::format("  real time          paced at {:.0f} Hz (dt {:g} ms); {}\n", 1e6 / period_us, period_us / 1e3,
+                     setup);
+    o += fmt::format("  step latency       p50 {:.0f} us, p99 {:.0f} us, p99.9 {:.0f} us, max {:.0f} us "
+                     "(request to barrier)\n",
+                     rt["latency_p50_us"].get<double>(), rt["latency_p99_us"].get<double>(),
+                     rt["latency_p999_us"].get<double>(), rt["latency_max_us"].get<double>());
+    o += fmt::format("  deadline misses    {} of {} steps ({:.4f} %), longest run {}\n",
+                     rt["deadline_misses"].get<std::int64_t>(), rt["steps"].get<std::int64_t>(),
+                     100.0 * rt["miss_fraction"].get<double>(), rt["max_consecutive_misses"].get<std::int64_t>());
+  }
+  if (link.rerequests > 0) {
+    o += fmt::format("  link               {} re-requests, {} messages repaired\n", link.rerequests, link.repaired);
+  }
+  return o;
+}
+
+void ReadLog(const std::string& log_path, RunSummary* s) {
+  try {
+    const io::RunLog log = io::ReadRunLog(log_path);
+    const io::RunMetrics m = io::ComputeMetrics(log);
+    s->steps = m.steps;
+    s->metrics = m;
+    s->duplicates_logged = 0;
+    for (const auto& [channel, n] : log.duplicates) s->duplicates_logged += n;
+    s->log_error.clear();
+  } catch (const std::exception& e) {
+    s->steps = 0;
+    s->metrics.reset();
+    s->log_error = e.what();
+  }
+}
+
+void SetOutcomes(const std::vector<Outcome>& outcomes, RunSummary* s) {
+  s->participants = outcomes;
+  s->stepping_s = 0.0;
+  s->link = {};
+  lockstep::LinkStats& t = s->link;
+  for (const Outcome& o : outcomes) {
+    s->stepping_s = std::max(s->stepping_s, o.stepping_s);
+    if (!o.stats_known) continue;
+    const lockstep::LinkStats& l = o.stats;
+    t.rerequests += l.rerequests;
+    t.steps_rerequested += l.steps_rerequested;
+    t.repair_requests += l.repair_requests;
+    t.resent += l.resent;
+    t.repaired += l.repaired;
+    t.duplicates += l.duplicates;
+    t.stale += l.stale;
+    t.foreign += l.foreign;
+    t.injected.dropped += l.injected.dropped;
+    t.injected.duplicated += l.injected.duplicated;
+    t.injected.delayed += l.injected.delayed;
+    t.injected.reordered += l.injected.reordered;
+  }
+}
+
+void SetVerdict(Verdict verdict, bool interrupted, RunSummary* s) {
+  if (verdict.failed && verdict.step < 0 && verdict.exit_code > 128 && s->steps < s->steps_expected) {
+    verdict.step = s->steps;  // a process that died cannot say where: the step it did not finish
+    verdict.what += fmt::format(" during step {}", s->steps);
+  }
+  s->exit_code = 0;
+  s->status = "completed";
+  if (interrupted) {
+    s->status = "interrupted";
+    s->exit_code = 130;
+  } else if (verdict.failed) {
+    s->exit_code = verdict.exit_code != 0 ? verdict.exit_code : lockstep::kExitLockstep;
+    s->status = s->exit_code == lockstep::kExitSafety     ? "stopped by the safety monitor"
+                : s->exit_code == lockstep::kExitRealtime ? "stopped by the miss policy"
+                                                          : "failed";
+  }
+  s->stopped = interrupted ? std::string("interrupted by the user") : verdict.failed ? verdict.what : "no";
+  s->failure.reset();
+  if (verdict.failed) s->failure = RunSummary::Failure{verdict.role, verdict.step, verdict.what, verdict.exit_code, {}};
+}
+
+}  // namespace rths::participants

@@ -1,0 +1,75 @@
+#pragma once
+/// @file What one run's summary.json holds, for `rths run` and for every run of a reproduction:
+/// filled from the participants' outcomes and the run's log, written once (ToJson), and printed
+/// from the struct (Report), never re-read from the file.
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "io/run_log.h"
+#include "lockstep/runtime.h"
+#include "participants/group.h"
+
+namespace rths::participants {
+
+struct RunSummary {
+  std::string label;              ///< a reproduction's run label ("" for `rths run`)
+  std::string scenario;           ///< the scenario file the run used
+  std::string scenario_sha256;
+  std::int64_t run_id = 0;
+  std::string transport;          ///< "memq" or "udpm"
+  std::string lcm_url;            ///< udpm: the run's URL ("" for memq)
+  std::int64_t steps_expected = 0;
+  double wall_s = 0.0;            ///< [s] start to end, set-up and teardown included
+  std::int64_t output_estimate_bytes = 0;  ///< `rths run`: output estimated before the run (0: none)
+
+  // From the log (ReadLog): whatever was committed, even after a failure.
+  std::int64_t steps = 0;         ///< complete steps in the log
+  std::optional<io::RunMetrics> metrics;  ///< Eq. 31 error, peaks, extrapolation errors (if the log was read)
+  std::int64_t duplicates_logged = 0;     ///< duplicate events in the log, all channels
+  std::string log_error;          ///< why the log could not be read ("" if it could)
+
+  // From the outcomes (SetOutcomes, SetVerdict).
+  double stepping_s = 0.0;        ///< [s] the clock's GO to its last committed step
+  std::string status = "completed";  ///< completed | interrupted | stopped by the safety monitor |
+                                     ///< stopped by the miss policy | failed
+  int exit_code = 0;              ///< the run's exit code (lockstep::ExitCode, 130 interrupted, 128 + signal)
+  std::string stopped = "no";     ///< "no", or why the run stopped
+  struct Failure {
+    std::string participant;      ///< whom the verdict blames
+    std::int64_t step = -1;       ///< the step it happened at (-1 if unknown)
+    std::string what;
+    int exit_code = 0;
+    std::optional<double> teardown_s;  ///< [s] from noticing the failure to the group's end
+  };
+  std::optional<Failure> failure;
+  lockstep::LinkStats link;       ///< every participant's link statistics, summed
+  /// Paced runs: the clock's latency figures (RealtimeToJson) plus what each process got of
+  /// SCHED_FIFO / mlockall; null when the run was not paced.
+  nlohmann::json realtime;
+  std::vector<Outcome> participants;  ///< how each participant ended
+
+  /// Steps per second of the clock's stepping time (0 if unknown).
+  double steps_per_s() const;
+  nlohmann::json ToJson() const;
+  /// The terminal lines after a run (steps, Eq. 31 error, peak force, rate, real-time figures,
+  /// link repairs); dt_s [s] turns the rate into a multiple of real time.
+  std::string Report(double dt_s) const;
+};
+
+/// Sets steps, metrics and duplicates_logged from the run's log at `log_path`, or log_error
+/// (steps 0) if it cannot be read.
+void ReadLog(const std::string& log_path, RunSummary* s);
+
+/// Sets participants, stepping_s (the clock's) and link (summed over the participants whose
+/// statistics are known).
+void SetOutcomes(const std::vector<Outcome>& outcomes, RunSummary* s);
+
+/// Sets status, exit_code, stopped and failure from the group's verdict. A process that died
+/// cannot say where: its step is then the first one the log does not hold (call ReadLog first).
+void SetVerdict(Verdict verdict, bool interrupted, RunSummary* s);
+
+}  // namespace rths::participants
