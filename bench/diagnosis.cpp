@@ -2,7 +2,7 @@
 // The diagnosis's validation harness (lib/diagnosis/harness.h, docs/diagnosis.md "Harness"):
 // records with known effects, diagnosed without the truth; prints one line per case, the
 // confusion table (true effect vs verdict), the held-out shrink per effect and the scores against
-// issue 5's targets; then the runtime of one diagnosis on a 60 s / 2 kHz training and test record.
+// harness targets (docs/diagnosis.md); then the runtime of one diagnosis on a 60 s / 2 kHz training and test record.
 #include <chrono>
 #include <cstdio>
 #include <string>

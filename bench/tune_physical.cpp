@@ -1,4 +1,4 @@
-// bench-tune_physical: tunes the physics-based actuator (models.md section 5,
+// bench-tune_physical: tunes the physics-based actuator (docs/models.md section 5,
 // lib/models/servo_physical.h) so that E1 run on the rig loaded by the nonlinear MR damper
 // (Table 3) identifies as Eqs. 28 (0.0 A) and 29 (2.5 A).
 //

@@ -1,6 +1,6 @@
 #pragma once
 // Counts every heap allocation of this test binary (malloc, calloc, realloc, and so operator
-// new), so a test can check that a per-step path allocates nothing (style.md item 2).
+// new), so a test can check that a per-step path allocates nothing (a rule of the code: README "Layout").
 // Include in exactly one translation unit per test binary: it replaces the C allocator entry
 // points with counting wrappers around glibc's own.
 #include <atomic>

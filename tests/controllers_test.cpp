@@ -1,7 +1,7 @@
 // Tests for the tracking controllers of Table 1 (lib/control: baselines, inverse_lowpass, lqg,
-// tracking_controller): design values of models.md section 3, the discrete controllers against their
-// continuous designs, E2 (experiments.md) on a plant equal to the design model, the offline
-// time-domain numbers of models.md section 10, allocation-free steps, and refused designs.
+// tracking_controller): design values of docs/models.md section 3, the discrete controllers against their
+// continuous designs, E2 (docs/experiments.md) on a plant equal to the design model, the offline
+// time-domain numbers of docs/models.md section 10, allocation-free steps, and refused designs.
 #include <doctest/doctest.h>
 
 #include <cmath>
@@ -63,7 +63,7 @@ std::vector<double> Simulate(const ctl::DiscreteSs& s, const std::vector<double>
 }  // namespace
 
 // ---------------------------------------------------------------------------------------------
-// Design values (models.md section 3)
+// Design values (docs/models.md section 3)
 
 TEST_CASE("poly3: Horiuchi coefficients for 8 / 9 / 10 ms at 2 kHz, sum 1, Nyquist gain") {
   struct Case { double ms; std::array<double, 4> c; double nyquist; };
@@ -202,7 +202,7 @@ TEST_CASE("every controller's Step() is its Linearize() (and bumpless blends, ne
 }
 
 // ---------------------------------------------------------------------------------------------
-// E2 (experiments.md): G_yr = C(z) G_d(z) on a plant equal to the design model, evaluated at
+// E2 (docs/experiments.md): G_yr = C(z) G_d(z) on a plant equal to the design model, evaluated at
 // z = e^{j w dt}; lag = -arg G_yr / w.
 
 namespace {
@@ -288,7 +288,7 @@ TEST_CASE("E2: the lead compensator's magnitude grows above 10 Hz and its lag is
 }
 
 // ---------------------------------------------------------------------------------------------
-// Offline time-domain tracking (models.md section 10) on the linear ZOH plants, 60 s BLWN records
+// Offline time-domain tracking (docs/models.md section 10) on the linear ZOH plants, 60 s BLWN records
 // (section 9, seed 1, as tracking_test.cpp), derivatives by Eqs. 20-22, scored by Eq. 31.
 
 namespace {
@@ -324,11 +324,11 @@ Score Track(const ControllerConfig& cfg, const char* plant, const std::vector<do
 // The BLWN record starts mid-motion (r_0 != 0 after the 2 s discard) while the plant starts at rest,
 // so each run pays a start-up transient that depends on the generator's r_0 (tracking_test.cpp); the
 // feedback of ff_lqg pays most (e_0 = -r_0 drives the estimator). The reference values of
-// models.md section 10 agree with our figures after the first 0.1 s (they were computed independently,
+// docs/models.md section 10 agree with our figures after the first 0.1 s (they were computed independently,
 // with another generator, evidently without that transient), so those are asserted. Tolerance: 10 %
 // relative, the spread of the independent FF computation against ours (0.46 vs 0.449 %, 1.33 vs
 // 1.311 %: 2-3 %) with margin for a different noise record; every row sits within 5 %.
-TEST_CASE("time domain: models.md section 10 on the linear ZOH plants (0-5 Hz 2.78 mm, 0-15 Hz 0.595 mm)") {
+TEST_CASE("time domain: docs/models.md section 10 on the linear ZOH plants (0-5 Hz 2.78 mm, 0-15 Hz 0.595 mm)") {
   const std::vector<double> r5 = sig::Blwn(5.0, 2.78, kDt, kSteps, 1, 2.0);
   const std::vector<double> r15 = sig::Blwn(15.0, 0.595, kDt, kSteps, 1, 2.0);
   struct Row {
@@ -348,7 +348,7 @@ TEST_CASE("time domain: models.md section 10 on the linear ZOH plants (0-5 Hz 2.
       {"FF 0.0A + LP (318 Hz, Tustin)", lp, "0.0A", 2.33, 6.98},
       {"Bumpless + LP at 0 A", bumpless, "0.0A", 2.33, 6.98},
   };
-  std::printf("Eq. 31 [%%], whole record / after 0.1 s (models.md section 10 reference):\n");
+  std::printf("Eq. 31 [%%], whole record / after 0.1 s (docs/models.md section 10 reference):\n");
   for (const Row& row : rows) {
     CAPTURE(row.name);
     CAPTURE(row.plant);

@@ -1,7 +1,7 @@
 // The diagnosis's validation harness, CI size (lib/diagnosis/harness.h; the full one is
 // bench/diagnosis.cpp): records with known effects made by the plant's RIG MODE
 // (models::MakeRig with plant.effects / plant.unmodelled), diagnosed without the truth, scored
-// against issue 5's targets. Fewer and shorter records than the bench (2 seeds, 6 s), the same
+// against the harness targets (docs/diagnosis.md "Validation harness"). Fewer and shorter records than the bench (2 seeds, 6 s), the same
 // targets on what it runs.
 #include <cstdio>
 
@@ -12,7 +12,7 @@
 
 using namespace rths::diagnosis;
 
-TEST_CASE("harness (rig mode): confusion table and held-out shrink meet issue 5's targets") {
+TEST_CASE("harness (rig mode): confusion table and held-out shrink meet the harness targets") {
   HarnessOptions o;
   o.seeds = 2;
   o.duration_s = 6.0;

@@ -1,4 +1,4 @@
-// The sim-to-real gap diagnosis (lib/diagnosis, ../shared/spec/diagnosis.md, docs/diagnosis.md):
+// The sim-to-real gap diagnosis (lib/diagnosis, docs/rig_record.md, docs/diagnosis.md):
 // arithmetic, the force predictor against CVODE, each effect recovered from a synthetic record,
 // none / unknown, the JSON of the contract, the model file, bad input.
 #include <unistd.h>

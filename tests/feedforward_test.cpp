@@ -1,4 +1,4 @@
-// Tests for lib/control/feedforward: coefficients (Eq. 17, models.md section 2), derivative
+// Tests for lib/control/feedforward: coefficients (Eq. 17, docs/models.md section 2), derivative
 // extrapolation (Eqs. 20-22) against Taylor-series closed forms, central differences, Eq. 19.
 #include <doctest/doctest.h>
 
@@ -22,7 +22,7 @@ using std::numbers::pi;
 
 namespace {
 
-// Eqs. 28-30 (models.md section 1).
+// Eqs. 28-30 (docs/models.md section 1).
 ServoModel3 Model(double K, double p, double b, double c, const char* name) {
   ServoModel3 m;
   m.K = K;
@@ -45,7 +45,7 @@ std::complex<double> Gff(const ctl::FeedforwardCoefficients& a, std::complex<dou
 
 }  // namespace
 
-TEST_CASE("feedforward: coefficients match models.md section 2") {
+TEST_CASE("feedforward: coefficients match docs/models.md section 2") {
   struct Case {
     const ServoModel3* m;
     double a0, a1, a2, a3;

@@ -1,5 +1,5 @@
 // Identification (ident/fit.h, ident/identify.h): exact recovery from exact frequency responses,
-// E1 on the linear plants (experiments.md), and the real UTFSM chirp record.
+// E1 on the linear plants (docs/experiments.md), and the real UTFSM chirp record.
 #include <cmath>
 #include <complex>
 #include <string>
@@ -84,7 +84,7 @@ TEST_CASE("the fit recovers K, p, b, c of Eqs. 28-30 from their exact frequency 
       CHECK(fit.rms_rel_error < 1e-8);
       CHECK(fit.converged);
     }
-    // DC gain and DC lag d1/d0 against models.md section 1.
+    // DC gain and DC lag d1/d0 against docs/models.md section 1.
     FitOptions o;
     const auto fit = FitPoleModel(frf.f, frf.h, frf.coh, o);
     const double d0 = m.p * m.c, d1 = m.p * m.b + m.c;

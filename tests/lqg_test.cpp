@@ -1,5 +1,5 @@
 // Tests for lib/control/dare, lti (ZOH, Van Loan), lqg and analysis: the DARE against closed forms
-// and under bad scaling, the LQG gains and loop margins of models.md section 4, and the closed loop.
+// and under bad scaling, the LQG gains and loop margins of docs/models.md section 4, and the closed loop.
 #include <doctest/doctest.h>
 
 #include <cmath>
@@ -100,7 +100,7 @@ TEST_CASE("ZOH and Van Loan: first-order closed forms") {
   CHECK(q2(1, 1) == doctest::Approx(q * kDt).epsilon(1e-12));
 }
 
-TEST_CASE("LQG on Eq. 30 with the proposed weights: the gains of models.md section 4") {
+TEST_CASE("LQG on Eq. 30 with the proposed weights: the gains of docs/models.md section 4") {
   const ctl::LqgDesign d = ctl::MakeLqgDesign(ServoPreset("avg"), {}, kDt);
   const double kc[5] = {2.10864, 7.86211e-3, 1.53391e-5, 2.48463e2, 9.43955};
   const double l[5] = {1.46074e-1, 2.30356e1, -1.07472e3, 1.54374e-4, 1.63384e-2};

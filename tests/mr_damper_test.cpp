@@ -59,7 +59,7 @@ double PeakAfter(const Run& r, double t_from) {
 
 TEST_CASE("E6: peak force at 25.4 mm, 1 Hz within 2 % of the reference") {
   const double current[] = {0.0, 0.5, 1.0, 1.5, 2.0, 2.5};
-  const double reference_kN[] = {18.3, 77.9, 139.6, 166.8, 179.7, 187.0};  // experiments.md E6
+  const double reference_kN[] = {18.3, 77.9, 139.6, 166.8, 179.7, 187.0};  // docs/experiments.md E6
   for (int i = 0; i < 6; ++i) {
     CAPTURE(current[i]);
     const double peak = PeakAfter(Simulate(current[i]), 1.0);  // 2nd and 3rd cycles

@@ -1,4 +1,4 @@
-// Physics-based servohydraulic rig (models.md section 5, lib/models/servo_physical.h): its
+// Physics-based servohydraulic rig (docs/models.md section 5, lib/models/servo_physical.h): its
 // linearisation against Eqs. 28-29, the limits it reproduces, the MR damper load (E6 peaks,
 // control-structure interaction), repeatability, allocation-free steps and timing, and the plant
 // participant with plant.kind = "physical" through the lockstep.
@@ -46,8 +46,8 @@ struct Tf3 {  // Eqs. 28-29: K / ((s + p)(s^2 + b s + c))
 const Tf3 kEq28{1.730e7, 182.7, 225.3, 9.499e4};
 const Tf3 kEq29{1.613e7, 134.2, 324.6, 1.211e5};
 
-// The fitted inner-loop gain of models.md section 5 is the product K_p K_q / A = 133.3 1/s;
-// The scenario default K_p = 331.4 1/m is that product to four digits (models.md rounds it to 331,
+// The fitted inner-loop gain of docs/models.md section 5 is the product K_p K_q / A = 133.3 1/s;
+// The scenario default K_p = 331.4 1/m is that product to four digits (docs/models.md rounds it to 331,
 // which gives 133.1 1/s and misses the 1.9 deg phase bound at 0.0 A by 0.035 deg).
 PhysicalActuatorConfig FittedConfig() {
   PhysicalActuatorConfig c;
@@ -287,7 +287,7 @@ TEST_CASE("(a) E1 on the damper-loaded rig (16 s records): how close the identif
   // (0.0 A: K +27 %, b +32 %, c +21 %; 2.5 A: K -17 %, c -14 %). From Eq. 28 to Eq. 29 the
   // complex pair moves up and is damped more (b x 1.44, c x 1.27); the loaded rig's pair barely
   // moves with the current (ratios about 1.03 and 0.91). bench/tune_physical.cpp searched the
-  // valve and oil-column parameters of models.md section 5 for both conditions at once: the best
+  // valve and oil-column parameters of docs/models.md section 5 for both conditions at once: the best
   // balance is about 17 % (K, b, c split +/-), so no retuning of those parameters meets 8 %.
   MESSAGE("b 2.5A/0.0A " << fit[1].b / fit[0].b << " (Eqs.: 1.441), c 2.5A/0.0A " << fit[1].c / fit[0].c
                          << " (Eqs.: 1.275)");

@@ -1,4 +1,4 @@
-// Reliability (issue 9, docs/lockstep.md "Repair", "When things go wrong"): any single lost,
+// Reliability (docs/lockstep.md "Repair", "When things go wrong"): any single lost,
 // duplicated, delayed or reordered message is repaired; random faults on every channel leave the
 // run bit-identical; a dead or stopped participant is named; a full disk stops the run with the
 // files ending on the last acknowledged step; starved CPUs and tiny socket buffers only slow a

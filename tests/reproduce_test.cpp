@@ -1,7 +1,7 @@
 // `rths reproduce`: the library functions tools/reproduce.cpp calls (lib/report/reproduce.h),
 // run here directly. fig5 against the E6 reference peaks; table2 --quick on the linear plant:
 // the file's shape (RFC 4180, exact header and names), its numbers against the paper's Table 2
-// and the independent computations of experiments.md E3 / models.md section 10, and the claims
+// and the independent computations of docs/experiments.md E3 / docs/models.md section 10, and the claims
 // written into table2.md against the numbers in table2.csv.
 #include <doctest/doctest.h>
 
@@ -75,7 +75,7 @@ TEST_CASE("fig5 (E6): the six peaks within 2 % of the reference, the CSV and the
   opts.out_dir = dir / "out";
   opts.quick = true;
   const Fig5Result r = ReproduceFig5(opts);
-  const double reference[] = {18.3, 77.9, 139.6, 166.8, 179.7, 187.0};  // experiments.md E6
+  const double reference[] = {18.3, 77.9, 139.6, 166.8, 179.7, 187.0};  // docs/experiments.md E6
   REQUIRE(r.ours_peak_kN.size() == 6);
   for (int i = 0; i < 6; ++i) CHECK(r.ours_peak_kN[i] == doctest::Approx(reference[i]).epsilon(0.02));
 
@@ -160,12 +160,12 @@ TEST_CASE("table2 --quick on the linear plant") {
   CHECK(at("2.5A", "None", "0-15") == doctest::Approx(51.7).epsilon(2.5 / 51.7));
   // Under the pulse the linear plant is Eq. 30 (the brief: pulse -> "avg"), which does not feel the
   // current: its None error is Eq. 30's, computed independently as 16.5 / 46.1 % with a ZOH at
-  // 2 kHz (experiments.md E3), against the paper's 18.1 / 49.2. Check against that computation
+  // 2 kHz (docs/experiments.md E3), against the paper's 18.1 / 49.2. Check against that computation
   // (+/- 2 points for a finite record); 49.2 is out of reach of this plant, and table2.md says so.
   CHECK(at("pulse", "None", "0-5") == doctest::Approx(16.5).epsilon(2.0 / 16.5));
   CHECK(at("pulse", "None", "0-15") == doctest::Approx(46.1).epsilon(2.0 / 46.1));
 
-  // --- compensated rows against the independent linear computation (models.md section 10):
+  // --- compensated rows against the independent linear computation (docs/models.md section 10):
   // FF matching the plant 0.46 / 1.33 %, FF + LP 2.33 / 6.98 %, 3rd Poly 8 ms 0.63 / 3.42 %.
   // Quick (6 s) records: a wide band, but an off-by-one step (1.4 / 4.0 %) would fail it.
   CHECK(at("0.0A", "G_FF,0.0A", "0-5") == doctest::Approx(0.46).epsilon(0.3));
@@ -203,7 +203,7 @@ TEST_CASE("table2 --quick on the linear plant") {
   CHECK(result.claims[1].holds == c2);
   CHECK(result.claims[2].holds == c3);
   CHECK(result.claims[3].holds == c4);
-  // On a linear plant (1)-(3) hold (models.md section 10, computed independently).
+  // On a linear plant (1)-(3) hold (docs/models.md section 10, computed independently).
   CHECK(c1);
   CHECK(c2);
   CHECK(c3);
@@ -261,7 +261,7 @@ TEST_CASE("fig6 --quick on the linear plant (E1): the fits recover Eqs. 28 and 2
     CHECK(Number(csv[i][4]) == doctest::Approx(100.0 * (ours / eq.at(key) - 1.0)).epsilon(1e-3).scale(1.0));
   }
   // The measured curves: 0.0 A lags about 7.85 ms and 2.5 A about 10.1 ms at low frequency
-  // (models.md section 1, d1/d0, plus half a sample for the hold).
+  // (docs/models.md section 1, d1/d0, plus half a sample for the hold).
   REQUIRE(r.measured.size() == 2);
   double lag0 = 0, lag25 = 0;
   int n = 0;

@@ -1,4 +1,4 @@
-// Rig records (io/rig_record.h): the CSV format of diagnosis.md with every error it names, our
+// Rig records (io/rig_record.h): the CSV format of docs/diagnosis.md with every error it names, our
 // LCM run logs as records, and the UTFSM measured data (io/utfsm.h).
 #include <cmath>
 #include <filesystem>

@@ -53,7 +53,7 @@ TEST_CASE("realisation is the phase-variable form of G") {
   const LinearServo s = LinearServo::Make(kModelAvg, kDt);
   CHECK(s.A(0, 1) == 1.0);
   CHECK(s.A(1, 2) == 1.0);
-  CHECK(s.A(2, 0) == doctest::Approx(-1.60954e7).epsilon(1e-5));  // -d0 (models.md table)
+  CHECK(s.A(2, 0) == doctest::Approx(-1.60954e7).epsilon(1e-5));  // -d0 (docs/models.md table)
   CHECK(s.A(2, 1) == doctest::Approx(-144085.7).epsilon(1e-6));   // -d1
   CHECK(s.A(2, 2) == doctest::Approx(-402.1).epsilon(1e-9));      // -d2
   CHECK(s.B(2) == 1.600e7);
@@ -89,7 +89,7 @@ TEST_CASE("time index: y_k depends on u up to u_{k-1} only") {
   CHECK(Output(s, st) == doctest::Approx(a.y(2 * kDt) - a.y(kDt)).epsilon(1e-9));
 }
 
-TEST_CASE("DC gains and time lags of Eqs. 28-30 (models.md section 1)") {
+TEST_CASE("DC gains and time lags of Eqs. 28-30 (docs/models.md section 1)") {
   struct Row {
     ServoModel3 model;
     double dc_gain, dc_lag_ms;

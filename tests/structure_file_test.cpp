@@ -18,7 +18,7 @@ TEST_CASE("the 9-story building file: frequencies, masses, 2 % damping in every 
   // Half the building's seismic mass, in kN s^2/mm (1e6 kg): 5.05e5 + 7 * 4.945e5 + 5.35e5 kg.
   CHECK(m.M.sum() == doctest::Approx((5.05e5 + 7 * 4.945e5 + 5.35e5) * 1e-6).epsilon(1e-12));
   const auto modes = ModalAnalysis(m);
-  const double computed[] = {0.443, 1.181, 2.053, 3.092, 4.258};  // models.md section 8 (computed)
+  const double computed[] = {0.443, 1.181, 2.053, 3.092, 4.258};  // docs/models.md section 8 (computed)
   const double paper[] = {0.443, 1.18, 2.05, 3.09, 4.27};         // the paper's first five modes
   for (int i = 0; i < 5; ++i) {
     CAPTURE(i);

@@ -1,4 +1,4 @@
-// The RTHS studies (experiments.md E4, E5): the ideal plant (pure numerical simulation), Fig. 9 and
+// The RTHS studies (docs/experiments.md E4, E5): the ideal plant (pure numerical simulation), Fig. 9 and
 // Fig. 11 quick reproductions, parallel = serial, and a 9-story lockstep regression.
 #include <cmath>
 #include <cstring>

@@ -1,4 +1,4 @@
-// Issue 2 / experiments.md E3 through the whole lockstep system: the tracking scenarios of
+// docs/experiments.md E3 through the whole lockstep system: the tracking scenarios of
 // scenarios/ (Eq. 30 plant, ZOH at 2 kHz, predefined BLWN, 60 s) run as a participant group,
 // and Eq. 31 on the logged r_k, y_k must meet the same bounds as the offline check.
 #include <doctest/doctest.h>

@@ -1,7 +1,7 @@
-// Offline tracking check (issue 2; experiments.md E3; models.md sections 2 and 9): the proposed
+// Offline tracking check (docs/experiments.md E3; docs/models.md sections 2 and 9): the proposed
 // feedforward (Eqs. 19-22) driving the linear servo model (Eq. 30, ZOH at 2 kHz), scored by
 // Eq. 31 on 60 s BLWN records. Expected values are the independent computations quoted in
-// experiments.md E3 and a closed-form lag estimate, not outputs of this code.
+// docs/experiments.md E3 and a closed-form lag estimate, not outputs of this code.
 #include <doctest/doctest.h>
 
 #include <cmath>
@@ -22,7 +22,7 @@ using rths::models::ServoModel3;
 namespace {
 
 constexpr double kDt = 0.0005;          // 2 kHz
-constexpr std::size_t kSteps = 120000;  // 60 s kept (models.md section 9)
+constexpr std::size_t kSteps = 120000;  // 60 s kept (docs/models.md section 9)
 constexpr double kDiscardS = 2.0;       // first 2 s discarded
 constexpr std::uint64_t kSeed = 1;      // the scenario default (signal::SignalSpec::seed)
 constexpr std::size_t kSettle = 200;    // 0.1 s: the start-up transient (see below)
@@ -102,11 +102,11 @@ void Band(double band_hz, double rms, double none_ref, double ff_max) {
   std::printf("  %-36s %7.3f  %7.3f\n", "FF avg, offline central differences", cen.full, cen.steady);
   std::printf("  %-36s %7s  %7.3f\n", "estimate: pure lag of dt/2", "", lag);
 
-  // experiments.md E3: None on the ZOH Eq. 30 model is 16.5 / 46.1 % (flat band spectrum).
+  // docs/experiments.md E3: None on the ZOH Eq. 30 model is 16.5 / 46.1 % (flat band spectrum).
   CHECK(none.full == doctest::Approx(none_ref).epsilon(2.0 / none_ref));
-  // Required (issue 2): < 1 % / < 2.5 %; independent computations 0.45-0.7 % / 1.3-1.9 %.
+  // Required (docs/experiments.md E3): < 1 % / < 2.5 %; independent computations 0.45-0.7 % / 1.3-1.9 %.
   CHECK(ff.full < ff_max);
-  // One extra step of delay must be clearly worse (experiments.md E3: about 1.4 / 4.0 %).
+  // One extra step of delay must be clearly worse (docs/experiments.md E3: about 1.4 / 4.0 %).
   CHECK(late.full > 2.0 * ff.full);
 
   // After the start-up transient the record is tracked up to the hold's half-sample lag:

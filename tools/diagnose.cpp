@@ -1,5 +1,5 @@
 // rths diagnose --train A [B ...] --test C [D ...] [--model MODEL.toml] [--out DIR] [--detrend] [--brief]
-// The sim-to-real gap diagnosis (../shared/spec/diagnosis.md, docs/diagnosis.md): reads rig
+// The sim-to-real gap diagnosis (docs/rig_record.md, docs/diagnosis.md): reads rig
 // records (CSV or our LCM logs), predicts them with the nominal model, localises the residual,
 // fits every effect of the library on the training records, selects greedily, scores the shrink
 // on the test records. Writes DIR/diagnosis.json and DIR/report.html (+ PNG plots), prints a

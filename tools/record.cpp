@@ -1,5 +1,5 @@
 // rths-record RUN_DIR [--out FILE.csv]
-// Writes a run's plant-side signals as a CSV rig record (../shared/spec/diagnosis.md "Rig record,
+// Writes a run's plant-side signals as a CSV rig record (docs/rig_record.md "Rig record,
 // CSV"; io/rig_record.h): t_s, u_mm (command_t), y_mm and f_kN (measured_t, as the plant published
 // them: with its sensor noise), i_A (current_t, the commanded current), r_mm (desired_t), over the
 // run's complete steps. So a run of ours (e.g. the rig mode: docs/rig_mode.md) can go to

@@ -1,6 +1,6 @@
 // rths-reproduce: `rths reproduce NAME [--out DIR] [--quick] [--plant physical|linear] [--jobs N]`.
 //
-// Reproduces one figure or table of the paper (experiments.md) into a new folder: CSV tables,
+// Reproduces one figure or table of the paper (docs/experiments.md) into a new folder: CSV tables,
 // Markdown, PNG figures and, for the lockstep studies, every run's folder. The work is done by
 // lib/report (report/reproduce.h); this file parses options and prints.
 #include <chrono>

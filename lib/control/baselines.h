@@ -1,5 +1,5 @@
 #pragma once
-/// @file The delay-compensation baselines of Table 1 (models.md section 3), both designed for
+/// @file The delay-compensation baselines of Table 1 (docs/models.md section 3), both designed for
 /// the DC time lag tau of the servo model (8 / 9 / 10 ms for Eqs. 28 / 30 / 29) and fed with the
 /// desired displacement r only.
 #include <array>

@@ -1,5 +1,5 @@
 #pragma once
-/// @file Clipped-optimal semiactive control of an MR damper (Dyke et al. 1996; models.md
+/// @file Clipped-optimal semiactive control of an MR damper (Dyke et al. 1996; docs/models.md
 /// section 7; docs/semiactive.md).
 ///
 /// Nominal controller: H2/LQG on the linear structure M x'' + C x' + K x + s f = -M iota a_g
@@ -15,7 +15,7 @@
 /// the cross term.
 /// Estimator: Kalman filter on the same model with the measured force as a known input, the
 /// ground acceleration as white process noise of intensity `noise_ratio` times that of each
-/// acceleration sensor's noise (Dyke's ratio 25: an assumption, as models.md says).
+/// acceleration sensor's noise (Dyke's ratio 25: an assumption, as docs/models.md says).
 /// Law: f_c = -K_lqr q_hat;  i = i_max if (f_c - f) f > 0, else 0  (H(0) = 0).
 ///
 /// Step indices (docs/lockstep.md): at step k the freshest absolute accelerations are those of
@@ -40,8 +40,8 @@ inline constexpr std::array<Named<SemiactiveMode>, 5> kSemiactiveModeNames = {
      {SemiactiveMode::kPulse, "pulse"},
      {SemiactiveMode::kClippedOptimal, "clipped_optimal"}}};
 
-/// Semiactive current (procs/semiactive). Constant modes, or the 0.5 Hz pulse of Table 2;
-/// clipped-optimal control later.
+/// Semiactive current (procs/semiactive): constant modes, the 0.5 Hz pulse of Table 2, or
+/// clipped-optimal control of the structure (docs/semiactive.md).
 struct SemiactiveConfig {
   /// "passive_off" (0 A) | "passive_on" (max_current_A) | "constant" (current_A) |
   /// "pulse" (max_current_A for the first pulse_duty of every period 1/pulse_hz, then 0 A) |

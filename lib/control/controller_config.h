@@ -8,7 +8,7 @@
 
 namespace rths::control {
 
-/// LQG feedback on the deviation system (Eqs. 23-27, models.md section 4). The cost is
+/// LQG feedback on the deviation system (Eqs. 23-27, docs/models.md section 4). The cost is
 /// sum(q e_k^2 + u_FB,k^2); the disturbance is white noise of intensity W through the
 /// second-order shaping filter of Eq. 27; the measurement noise has intensity V.
 struct LqgConfig {
@@ -41,7 +41,7 @@ struct ControllerConfig {
   /// "ff_lqg" (ff with `model` plus LQG feedback designed on `model`, Eqs. 23-27).
   ControllerKind kind = ControllerKind::kFf;
   models::ServoModel3 model{};         ///< design model for "ff", "ff_lp", "ff_lqg"
-  /// models.md section 2: evaluate the feedforward half a step ahead to cancel the ZOH's
+  /// docs/models.md section 2: evaluate the feedforward half a step ahead to cancel the ZOH's
   /// half-sample lag in simulation. false = the paper's Eq. 19.
   bool half_step_ahead = false;
   double delay_ms = 9.0;        ///< "poly3", "lead": the delay compensated [ms], (0, max_delay_ms]

@@ -1,5 +1,5 @@
 #pragma once
-/// @file Discrete algebraic Riccati equation (LQR and Kalman designs, models.md section 4).
+/// @file Discrete algebraic Riccati equation (LQR and Kalman designs, docs/models.md section 4).
 ///
 ///   X = A^T X A - A^T X B (R + B^T X B)^-1 B^T X A + Q,   K = (R + B^T X B)^-1 B^T X A,
 ///

@@ -14,7 +14,7 @@
 
 namespace rths::control {
 
-/// G_yr at one frequency (experiments.md E2).
+/// G_yr at one frequency (docs/experiments.md E2).
 struct TrackingPoint {
   double f_hz = 0.0;
   double magnitude = 0.0;  ///< |G_yr| [-]

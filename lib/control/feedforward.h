@@ -1,6 +1,6 @@
 #pragma once
 /// @file The proposed model-based feedforward (Phillips & Spencer 2013, Eqs. 16-22;
-/// models.md section 2). Signals in mm, time in s.
+/// docs/models.md section 2). Signals in mm, time in s.
 ///
 /// The servohydraulic model G(s) = K / ((s + p)(s^2 + b s + c)) (Eq. 15, N = 3) is inverted
 /// exactly: G_FF(s) = (s + p)(s^2 + b s + c) / K = a0 + a1 s + a2 s^2 + a3 s^3 (Eqs. 16-17), i.e.
@@ -77,7 +77,7 @@ DerivativeRecords CentralDerivatives(const std::vector<double>& r, double dt);
 
 /// Feedforward command u_i [mm] (Eq. 19):
 ///   u = a0 r + a1 r' + a2 r'' + a3 r'''.
-/// With half_step_ahead (models.md section 2), each derivative is first advanced half a step by
+/// With half_step_ahead (docs/models.md section 2), each derivative is first advanced half a step by
 /// its Taylor series so the zero-order hold's half-sample lag is cancelled in simulation:
 ///   u = a0 (r + dt/2 r') + a1 (r' + dt/2 r'') + a2 (r'' + dt/2 r''') + a3 r'''.
 /// Allocates nothing.

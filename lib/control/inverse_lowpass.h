@@ -1,5 +1,5 @@
 #pragma once
-/// @file Model inverse with a low-pass filter (Carrion & Spencer 2007; models.md section 3):
+/// @file Model inverse with a low-pass filter (Carrion & Spencer 2007; docs/models.md section 3):
 /// the `ff_lp` and `bumpless_lp` controllers of Table 1.
 ///
 /// C(s) = LP(s) G^-1(s),  G^-1(s) = (s + p)(s^2 + b s + c) / K  (Eq. 16, N = 3),

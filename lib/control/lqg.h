@@ -1,5 +1,5 @@
 #pragma once
-/// @file The proposed controller G_FF + LQG (Eqs. 14, 19, 23-27; models.md sections 2 and 4):
+/// @file The proposed controller G_FF + LQG (Eqs. 14, 19, 23-27; docs/models.md sections 2 and 4):
 /// the model-inverse feedforward of `model` plus LQG feedback on the deviation system.
 ///
 /// Deviation system (Eqs. 12-13, 23-24) in phase variables of G(s) = K / (s^3 + d2 s^2 + d1 s + d0):
@@ -16,9 +16,9 @@
 /// Step k (e_k = y_k - r_k, the deviation output y~ of Eq. 13, minus the tracking error of Eq. 6):
 ///   x+_k = x-_k + L (e_k - C_a x-_k);  u_FB,k = -K_c x+_k;  x-_{k+1} = Phi x+_k + Gamma u_FB,k;
 ///   u_k = u_FF,k + u_FB,k   (Eq. 14), x-_0 = 0.
-/// With the paper's weights (q = 10, w_f = 2 pi 3, xi_f = 0.7, eta_f = 0.5, W = V = 1) and Eq. 30:
+/// With the default weights (q = 10, w_f = 2 pi 3, xi_f = 0.7, eta_f = 0.5, W = V = 1) and Eq. 30:
 /// K_c = [2.10864, 7.86211e-3, 1.53391e-5, 2.48463e2, 9.43955],
-/// L = [1.46074e-1, 2.30356e1, -1.07472e3, 1.54374e-4, 1.63384e-2] (models.md section 4).
+/// L = [1.46074e-1, 2.30356e1, -1.07472e3, 1.54374e-4, 1.63384e-2] (docs/models.md section 4).
 #include <Eigen/Core>
 
 #include "control/tracking_controller.h"

@@ -1,5 +1,5 @@
 #pragma once
-/// @file The nominal model of the sim-to-real diagnosis (../shared/spec/diagnosis.md "Model",
+/// @file The nominal model of the sim-to-real diagnosis (docs/rig_record.md "Model",
 /// docs/diagnosis.md) and its two channel predictors, with effects of the library
 /// (models/rig_effects.h) inserted. Units: mm, kN, A, s. Offline analysis: these functions
 /// allocate.

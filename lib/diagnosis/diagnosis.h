@@ -1,5 +1,5 @@
 #pragma once
-/// @file The sim-to-real gap diagnosis (`rths diagnose`; contract ../shared/spec/diagnosis.md,
+/// @file The sim-to-real gap diagnosis (`rths diagnose`; contract docs/rig_record.md,
 /// method docs/diagnosis.md): where the nominal model is wrong, which effect of the library
 /// (models/rig_effects.h) explains it, and how far the held-out gap shrinks once it is added.
 ///
@@ -200,7 +200,7 @@ struct Traces {
 Result Diagnose(const std::vector<io::RigRecord>& train, const std::vector<io::RigRecord>& test,
                 const NominalModel& model, const Options& options, Traces* traces = nullptr);
 
-/// The contract's JSON (diagnosis.md "Output") with our extra fields; "options" holds
+/// The contract's JSON (docs/diagnosis.md "Output") with our extra fields; "options" holds
 /// ToJson(r.options).
 nlohmann::json ToJson(const Result& r);
 

@@ -1,5 +1,5 @@
 #pragma once
-/// @file The diagnosis's validation harness (issue 5 "Done means"; bench/diagnosis.cpp and
+/// @file The diagnosis's validation harness (docs/diagnosis.md "Validation harness"; bench/diagnosis.cpp and
 /// tests/diagnosis_harness_test.cpp): records with known effects, diagnosed without the truth,
 /// scored as a confusion table and held-out shrink.
 ///

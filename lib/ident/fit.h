@@ -1,6 +1,6 @@
 #pragma once
 /// @file Fitting the servohydraulic model of Eq. 15 to a measured frequency response
-/// (experiments.md E1, docs/identification.md).
+/// (docs/experiments.md E1, docs/identification.md).
 ///
 /// Model (Eq. 15, no time delay): G(s) = K / prod_{i=1..N} (s - p_i), kept in factored form
 ///     G(s) = K / ( (s + p)^[N odd] prod_{j=1..floor(N/2)} (s^2 + b_j s + c_j) ),

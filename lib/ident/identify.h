@@ -1,6 +1,6 @@
 #pragma once
 /// @file Identification of the servohydraulic model from a record of command u and measured y
-/// (`rths identify`, experiments.md E1, docs/identification.md):
+/// (`rths identify`, docs/experiments.md E1, docs/identification.md):
 ///   1. G_yu(f) by the H1 estimator with coherence (signal/spectral.h, Welch, Hann, 50 %);
 ///   2. Eq. 15 fitted over a band by ident::FitPoleModel (ident/fit.h), leaving out the points
 ///      where the input has (next to) no power;

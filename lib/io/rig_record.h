@@ -1,6 +1,6 @@
 #pragma once
 /// @file The rig record: one test on a rig (ours or another lab's) as uniformly sampled
-/// command, measurement, force and current (../shared/spec/diagnosis.md "Rig record, CSV").
+/// command, measurement, force and current (docs/rig_record.md "Rig record, CSV").
 ///
 /// CSV format (v1):
 ///     # rths rig record v1              <- first line, required
@@ -48,7 +48,7 @@ struct RigRecord {
   std::string Meta(const std::string& key) const;
 };
 
-/// Shortest record accepted [s] (diagnosis.md).
+/// Shortest record accepted [s] (docs/diagnosis.md).
 inline constexpr double kMinRecordS = 2.0;
 
 /// Largest magnitudes a record may hold (ReadRigRecord, ValidateRigRecord): far beyond any lab

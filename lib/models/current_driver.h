@@ -1,5 +1,5 @@
 #pragma once
-/// @file The MR damper's current dynamics (paper Eq. 40 and its 75 Hz low-pass; models.md
+/// @file The MR damper's current dynamics (paper Eq. 40 and its 75 Hz low-pass; docs/models.md
 /// section 6): the commanded current i_d [A] becomes the effective current i_c [A] that enters
 /// Eqs. 35-39,
 ///

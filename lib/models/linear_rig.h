@@ -1,5 +1,5 @@
 #pragma once
-/// @file The "physical" plant of procs/plant (issue 2): the linear servohydraulic model
+/// @file The linear rig (plant.kind = "linear" of procs/plant): the linear servohydraulic model
 /// (Eqs. 28-30, exact ZOH) moving an MR damper specimen (Eqs. 32-39). Units: mm, kN, s, A.
 ///
 /// One step k -> k+1 with the command u_k [mm] and the damper current i_k [A] held over
@@ -19,7 +19,6 @@
 #include "models/current_driver.h"
 #include "models/mr_damper.h"
 #include "models/ode.h"
-#include "models/servo_linear.h"
 #include "models/servo_linear.h"
 
 namespace rths::models {

@@ -1,6 +1,6 @@
 #pragma once
 /// @file The Spencer et al. (1997) phenomenological MR damper model, as identified for the
-/// 200-kN damper of the paper (Eqs. 32-39, Table 3; models.md section 6). Units: mm, kN, s, A.
+/// 200-kN damper of the paper (Eqs. 32-39, Table 3; docs/models.md section 6). Units: mm, kN, s, A.
 ///
 /// States y [mm] (internal displacement) and z [mm] (Bouc-Wen evolutionary variable), driven by
 /// the damper displacement x [mm] and velocity x' [mm/s]:

@@ -1,6 +1,6 @@
 #pragma once
 /// @file One interface for the plant participant's loading system + specimen: the linear rig
-/// (Eqs. 28-30 with the MR damper, lib/models/linear_rig.h) or the physics-based rig (models.md
+/// (Eqs. 28-30 with the MR damper, lib/models/linear_rig.h) or the physics-based rig (docs/models.md
 /// section 5, lib/models/servo_physical.h), both with the optional current dynamics (Eq. 40 and
 /// the 75 Hz low-pass, lib/models/current_driver.h). Units: mm, kN, A, s (docs/units.md).
 ///
@@ -35,7 +35,7 @@ inline constexpr std::array<Named<Specimen>, 2> kSpecimenNames = {
 /// "Physical" substructure and loading system (procs/plant).
 struct PlantConfig {
   /// "linear": the three-pole model `actuator` (Eqs. 28-30), ZOH-discretised, unaffected by the
-  /// specimen; "physical": the servovalve / oil column / piston model of models.md section 5
+  /// specimen; "physical": the servovalve / oil column / piston model of docs/models.md section 5
   /// loaded by the damper force (control-structure interaction); "ideal": the pure numerical
   /// simulation, a loading system that tracks perfectly (y_k = r_k, the damper driven by the
   /// desired motion; answers measured_t k from desired_t k: docs/lockstep.md, footnote).
@@ -90,7 +90,7 @@ class Rig {
   virtual void StartAt(double /*x_mm*/) {}
 };
 
-/// "ideal" (the pure numerical simulation: the damper model in place of the physical plant): a
+/// "ideal" (the pure numerical simulation: the damper model driven by the desired motion, no actuator): a
 /// loading system that tracks perfectly. Step(r_k, i_{k-1}) drives the damper with x(t) linear from
 /// r_{k-1} to r_k over [t_{k-1}, t_k] (velocity (r_k - r_{k-1}) / dt) at the current i_{k-1}
 /// (through the current dynamics if on), so y_k = r_k exactly and f_k is the damper force at t_k

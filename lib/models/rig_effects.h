@@ -1,5 +1,5 @@
 #pragma once
-/// @file The effect library of the sim-to-real diagnosis (../shared/spec/diagnosis.md, "The
+/// @file The effect library of the sim-to-real diagnosis (docs/rig_record.md, "The
 /// effect library"): unmodelled effects of a real rig, as small per-sample blocks shared by the
 /// plant's rig mode (procs/plant, which switches them on to rehearse a real rig) and by the
 /// diagnosis (lib/diagnosis, which adds them to the nominal model to explain a residual).

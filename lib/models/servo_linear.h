@@ -3,7 +3,7 @@
 /// displacement command u [mm] to measured displacement y [mm], discretised exactly with a
 /// zero-order hold at the lockstep step dt.
 ///
-/// Realisation (phase variables, models.md section 4): with (s + p)(s^2 + b s + c) =
+/// Realisation (phase variables, docs/models.md section 4): with (s + p)(s^2 + b s + c) =
 /// s^3 + d2 s^2 + d1 s + d0, d2 = p + b, d1 = p b + c, d0 = p c, and z = [y, y', y''] / 1
 /// ([mm, mm/s, mm/s^2]):
 ///

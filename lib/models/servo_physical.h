@@ -1,5 +1,5 @@
 #pragma once
-/// @file The physics-based servohydraulic actuator (models.md section 5; the structure of the
+/// @file The physics-based servohydraulic actuator (docs/models.md section 5; the structure of the
 /// paper's Fig. 2 after Dyke et al. 1995) and the rig it forms with a specimen. SI inside
 /// (m, m/s, Pa, m^3/s, N, kg); the rig's interface is in paper units (u, y in mm, force in kN,
 /// current in A) and converts at the boundary (docs/units.md).
@@ -21,9 +21,9 @@
 /// F_load is the specimen's force on the piston [N], positive when it resists positive x:
 /// the MR damper (Eqs. 32-39, lib/models/mr_damper.h, in mm and kN: F_load = 1e3 F(1e3 x,
 /// 1e3 x', i_c)), or a linear spring-dashpot F_load = k x + c x' (tests, the equivalent damper
-/// of models.md section 5), or nothing.
+/// of docs/models.md section 5), or nothing.
 ///
-/// Limits it reproduces (models.md section 5): the velocity limit K_q / A (full spool, no load),
+/// Limits it reproduces (docs/models.md section 5): the velocity limit K_q / A (full spool, no load),
 /// valve saturation for |u - x| > 1 / K_p, and the flow factor sqrt(1 - p_L / P_s) (0.81 at
 /// 190 kN), a force-dependent gain loss absent from the linear models (Eqs. 28-30).
 ///
@@ -42,7 +42,7 @@
 
 namespace rths::models {
 
-/// The physics-based servohydraulic actuator (models.md section 5). SI units inside, as named.
+/// The physics-based servohydraulic actuator (docs/models.md section 5). SI units inside, as named.
 struct PhysicalActuatorConfig {
   double area_m2 = 0.0271;             ///< piston area A, (0, 1]
   double supply_pressure_Pa = 20.7e6;  ///< P_s, (0, 1e9]
@@ -58,7 +58,7 @@ struct PhysicalActuatorConfig {
   bool operator==(const PhysicalActuatorConfig&) const = default;
 };
 
-/// The actuator's parameters, SI (models.md section 5; models::PhysicalActuatorConfig).
+/// The actuator's parameters, SI (docs/models.md section 5; models::PhysicalActuatorConfig).
 struct PhysicalActuator {
   double area_m2 = 0.0;               ///< piston area A [m^2]
   double supply_pressure_Pa = 0.0;    ///< P_s [Pa]
@@ -113,7 +113,7 @@ struct SpringDashpot {
   double c_N_s_m = 0.0;  ///< damping [N s/m], >= 0
 };
 /// The MR damper's equivalent spring-dashpot at the identification input (BLWN 0-50 Hz,
-/// 0.254 mm RMS; models.md section 5): 0.0 A and 2.5 A.
+/// 0.254 mm RMS; docs/models.md section 5): 0.0 A and 2.5 A.
 inline constexpr SpringDashpot kEquivalentDamper0A{1.10e7, 2.58e5};
 inline constexpr SpringDashpot kEquivalentDamper2p5A{1.31e8, 1.91e5};
 

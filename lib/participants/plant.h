@@ -10,7 +10,7 @@
 /// (y_k = r_k) and current_t k-1 instead; measured_t 0 waits for desired_t 0 (docs/lockstep.md,
 /// footnote).
 ///
-/// The rig is plant.kind's (models::MakeRig: "linear", Eqs. 28-30; "physical", models.md
+/// The rig is plant.kind's (models::MakeRig: "linear", Eqs. 28-30; "physical", docs/models.md
 /// section 5; docs/plant.md). measured_t k carries y_k [mm], f_k [kN] (plus the scenario's sensor
 /// noise) and current_A = the effective damper current i_c(t_k) [A] (after Eq. 40 and the 75 Hz
 /// low-pass when plant.current_dynamics; 0 at k = 0).

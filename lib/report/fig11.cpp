@@ -1,5 +1,5 @@
-// Fig. 11 (experiments.md E5): the 9-story building (one NS frame, half the seismic mass, shear
-// model of models.md section 8) with 18 MR dampers at the first story under El Centro NS x 0.5;
+// Fig. 11 (docs/experiments.md E5): the 9-story building (one NS frame, half the seismic mass, shear
+// model of docs/models.md section 8) with 18 MR dampers at the first story under El Centro NS x 0.5;
 // 3 controllers x 3 semiactive modes of RTHS, plus the pure numerical simulation (plant.kind =
 // "ideal": the damper model driven by the desired motion) for each semiactive mode.
 #include <algorithm>
@@ -14,6 +14,7 @@
 #include "io/run_log.h"
 #include "io/csv.h"
 #include "io/plot.h"
+#include "io/source_tree.h"
 #include "report/studies.h"
 #include "signal/metrics.h"
 
@@ -134,7 +135,7 @@ Fig11Result ReproduceFig11(const ReproduceOptions& opts) {
   const auto t0 = std::chrono::steady_clock::now();
   PrepareOutDir(opts.out_dir);
   if (opts.plant != "ideal") RequirePlant(opts.plant, opts.out_dir);
-  const fs::path base_file = FindSourceFile("scenarios/fig11_base.toml");
+  const fs::path base_file = io::FindSourceFile("scenarios/fig11_base.toml");
   const scenario::Scenario base = scenario::LoadScenario(base_file.string());
   const double duration = opts.quick ? kFig11QuickS : kFig11FullS;
   const auto controllers = Fig11Controllers();

@@ -1,4 +1,4 @@
-// Fig. 5 (experiments.md E6): the 200-kN MR damper model (Eqs. 32-39, Table 3) under a prescribed
+// Fig. 5 (docs/experiments.md E6): the 200-kN MR damper model (Eqs. 32-39, Table 3) under a prescribed
 // 25.4 mm, 1 Hz sine at six constant currents.
 #include <cmath>
 #include <numbers>

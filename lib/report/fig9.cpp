@@ -1,11 +1,8 @@
-// Fig. 9 (experiments.md E4): SDOF RTHS parametric study. 6 natural frequencies x 6 controllers,
+// Fig. 9 (docs/experiments.md E4): SDOF RTHS parametric study. 6 natural frequencies x 6 controllers,
 // each pair one lockstep group (in-process, memq://), `jobs` at a time; Eq. 31 on r_k, y_k.
-#include <unistd.h>
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <cstdlib>
 #include <fstream>
 
 #include <fmt/format.h>
@@ -14,6 +11,7 @@
 #include "io/run_log.h"
 #include "io/csv.h"
 #include "io/plot.h"
+#include "io/source_tree.h"
 #include "report/studies.h"
 
 namespace rths::report {
@@ -27,31 +25,6 @@ using io::Plot;
 using io::GnuplotAvailable;
 using io::CsvWriter;
 using io::FormatSig;
-
-fs::path FindSourceFile(const std::string& rel) {
-  std::vector<fs::path> roots;
-  if (const char* env = std::getenv("RTHS_SOURCE_DIR"); env && *env) roots.emplace_back(env);
-  std::error_code ec;
-  for (fs::path p = fs::current_path(ec); !ec && !p.empty(); p = p.parent_path()) {
-    roots.push_back(p);
-    if (p == p.root_path()) break;
-  }
-  char exe[4096];
-  const ssize_t n = ::readlink("/proc/self/exe", exe, sizeof exe - 1);
-  if (n > 0) {
-    exe[n] = '\0';
-    for (fs::path p = fs::path(exe).parent_path(); !p.empty(); p = p.parent_path()) {
-      roots.push_back(p);
-      if (p == p.root_path()) break;
-    }
-  }
-  roots.push_back(fs::path(__FILE__).parent_path().parent_path().parent_path());  // lib/report/..
-  for (const auto& r : roots) {
-    if (fs::exists(r / rel, ec)) return fs::weakly_canonical(r / rel);
-  }
-  throw Error(rel, "not found in the source tree (set RTHS_SOURCE_DIR to the rths checkout, or run "
-                   "from inside it)");
-}
 
 std::string StoppedText(const RunResult& r) {
   if (r.ok) return "no";
@@ -110,7 +83,7 @@ Fig9Result ReproduceFig9(const ReproduceOptions& opts) {
   const auto t0 = std::chrono::steady_clock::now();
   PrepareOutDir(opts.out_dir);
   if (opts.plant != "ideal") RequirePlant(opts.plant, opts.out_dir);
-  const fs::path base_file = FindSourceFile("scenarios/fig9_base.toml");
+  const fs::path base_file = io::FindSourceFile("scenarios/fig9_base.toml");
   const scenario::Scenario base = scenario::LoadScenario(base_file.string());
   const double duration = opts.quick ? kFig9QuickS : kFig9FullS;
 

@@ -1,5 +1,5 @@
 #pragma once
-/// @file The reproductions of the paper's figures and tables (experiments.md), as library
+/// @file The reproductions of the paper's figures and tables (docs/experiments.md), as library
 /// functions: tools/reproduce.cpp (`rths reproduce NAME`) parses options and calls these, and
 /// tests/reproduce_test.cpp calls them directly.
 ///
@@ -22,8 +22,8 @@ namespace rths::report {
 
 struct ReproduceOptions {
   std::filesystem::path out_dir;          ///< where the files go
-  bool quick = false;                     ///< shorter records (tests); full: experiments.md lengths
-  std::string plant = "physical";         ///< "physical" (models.md section 5) | "linear" (Eqs. 28-30)
+  bool quick = false;                     ///< shorter records (tests); full: docs/experiments.md lengths
+  std::string plant = "physical";         ///< "physical" (docs/models.md section 5) | "linear" (Eqs. 28-30)
   int jobs = 2;                           ///< lockstep groups run at the same time (threads)
   std::function<void(std::string_view)> log;  ///< progress lines ("" = silent)
   std::string gnuplot = "gnuplot";        ///< plotting program
@@ -42,7 +42,7 @@ void RequirePlant(const std::string& plant, const std::filesystem::path& scratch
 
 struct Fig5Result {
   std::vector<double> current_A;        ///< 0, 0.5, ..., 2.5
-  std::vector<double> paper_peak_kN;    ///< the reference of experiments.md E6
+  std::vector<double> paper_peak_kN;    ///< the reference of docs/experiments.md E6
   std::vector<double> ours_peak_kN;     ///< max |F| over the 2nd and 3rd cycles
 };
 /// The E6 reference peaks [kN] at 0, 0.5, 1.0, 1.5, 2.0, 2.5 A.
@@ -65,7 +65,7 @@ struct Table2Controller {
 /// The 18 controller rows of Table 2, in the paper's order.
 std::vector<Table2Controller> Table2Controllers();
 
-/// The scenario of one Table 2 run: predefined BLWN (models.md section 9; 0-5 Hz RMS 2.78 mm
+/// The scenario of one Table 2 run: predefined BLWN (docs/models.md section 9; 0-5 Hz RMS 2.78 mm
 /// or 0-15 Hz RMS 0.595 mm, fixed seed), the damper attached, the condition's current and the
 /// plant ("linear" uses Eq. 28 / 29 / 30 for 0.0A / 2.5A / pulse).
 scenario::Scenario Table2Scenario(const Table2Controller& row, double band_hz, const std::string& plant,
@@ -80,7 +80,7 @@ struct Table2Row {
   std::filesystem::path run_dir;
 };
 
-/// One of the paper's claims (experiments.md E3) checked on our table.
+/// One of the paper's claims (docs/experiments.md E3) checked on our table.
 struct Claim {
   std::string text;
   bool holds = false;

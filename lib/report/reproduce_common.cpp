@@ -63,7 +63,7 @@ void RequirePlant(const std::string& plant, const fs::path& scratch_parent) {
       problem = "the linear plant failed in a 0.1 s probe: " + results[1].error;
     } else if (ReadTrace(results[0].dir).y_mm == ReadTrace(results[1].dir).y_mm) {
       problem = "this build's plant ignores plant.kind = \"physical\" (it gave the linear model's "
-                "numbers bit for bit): the physics-based actuator of models.md section 5 is not "
+                "numbers bit for bit): the physics-based actuator of docs/models.md section 5 is not "
                 "available yet";
     }
   } catch (const Error& e) {

@@ -1,5 +1,5 @@
 #pragma once
-/// @file The two RTHS studies of the paper (experiments.md E4 and E5): the SDOF parametric study of
+/// @file The two RTHS studies of the paper (docs/experiments.md E4 and E5): the SDOF parametric study of
 /// Fig. 9 and the 9-story building with semiactive control of Fig. 11. Both load a base scenario
 /// from the source tree (scenarios/fig9_base.toml, scenarios/fig11_base.toml), vary it in code,
 /// write every variant in full into its run folder (report/batch.h) and run the lockstep groups
@@ -13,11 +13,6 @@
 #include "scenario/scenario.h"
 
 namespace rths::report {
-
-/// The file `rel` (e.g. "scenarios/fig9_base.toml") in the source tree: under $RTHS_SOURCE_DIR if
-/// set, else searched upwards from the current folder, from the executable's folder and from this
-/// source file's compile-time location. Throws rths::Error naming where it looked.
-std::filesystem::path FindSourceFile(const std::string& rel);
 
 /// The "stopped" field of a study: "no" for a run that ran to the end, else the reason (the
 /// safety monitor's message, or the failure) on one line.

@@ -1,4 +1,4 @@
-// Table 2 (experiments.md E3): tracking of predefined BLWN displacement histories, 36 lockstep
+// Table 2 (docs/experiments.md E3): tracking of predefined BLWN displacement histories, 36 lockstep
 // runs (3 conditions x 6 controllers x 2 bands), Eq. 31 on the logged r_k, y_k.
 #include <algorithm>
 #include <chrono>
@@ -22,7 +22,7 @@ using io::FormatSig;
 namespace {
 
 constexpr double kBands[] = {5.0, 15.0};
-constexpr double kFullDurationS = 60.0;   // models.md section 9: at least 60 s
+constexpr double kFullDurationS = 60.0;   // docs/models.md section 9: at least 60 s
 // --quick: 6 s for the compensated rows; 20 s for the "None" rows, whose check against the paper
 // (within 2.5 points) needs a steadier number: with seed 1 the 20 s None errors on the linear plants
 // are within 0.5 points of the 60 s ones, and over 30 seeds their spread is 0.6-1.1 points (sd).
@@ -78,7 +78,7 @@ scenario::Scenario Table2Scenario(const Table2Controller& row, double band_hz, c
   s.run.duration_s = duration_s;
   s.structure.mode = models::StructureMode::kPredefined;
   s.structure.derivatives = models::Derivatives::kExtrapolated;  // Eqs. 20-22, the causal RTHS path
-  // models.md section 9: 8th-order Butterworth BLWN, 2 s discarded, fixed seed; faded in over
+  // docs/models.md section 9: 8th-order Butterworth BLWN, 2 s discarded, fixed seed; faded in over
   // 0.5 s so that the actuator is not asked for a step at k = 0 (docs/safety.md).
   s.structure.desired = signal::SignalSpec{};
   s.structure.desired.kind = signal::SignalKind::kBlwn;
@@ -191,7 +191,7 @@ std::string PlantDescription(const std::string& plant) {
            "0.0 A, Eq. 29 for 2.5 A, Eq. 30 (average) under the pulse; the MR damper (Eqs. 32-40) is "
            "attached and driven, but a linear plant's displacement does not feel its force";
   }
-  return "the physics-based servohydraulic actuator (models.md section 5: servovalve, oil column, "
+  return "the physics-based servohydraulic actuator (docs/models.md section 5: servovalve, oil column, "
          "piston) loaded by the MR damper (Eqs. 32-40) at the condition's current";
 }
 
@@ -210,7 +210,7 @@ void WriteMarkdown(const fs::path& file, const ReproduceOptions& opts, const std
      << "**Plant: " << opts.plant << "** — " << PlantDescription(opts.plant) << ".\n\n"
      << "Each number is Eq. 31, the RMS error of the measured displacement y_k against the desired "
         "r_k over every step of one lockstep run (2 kHz). Desired displacement: band-limited white "
-        "noise (models.md section 9: 8th-order Butterworth, 2 s discarded, seed 1, faded in over 0.5 s), "
+        "noise (docs/models.md section 9: 8th-order Butterworth, 2 s discarded, seed 1, faded in over 0.5 s), "
         "0-5 Hz RMS "
         "2.78 mm or 0-15 Hz RMS 0.595 mm, "
      << (opts.quick ? fmt::format("{:g} s records (--quick; the \"None\" rows {:g} s)", quick_s, kQuickNoneDurationS)
@@ -226,13 +226,13 @@ void WriteMarkdown(const fs::path& file, const ReproduceOptions& opts, const std
     md << fmt::format("| {} | {} | {} | {} | {} | {} |\n", row.condition, row.name, row.paper_text_5,
                       a ? Pct(a->ours_pct) : "-", row.paper_text_15, b ? Pct(b->ours_pct) : "-");
   }
-  md << "\n## The paper's claims (experiments.md E3), checked on this table\n\n";
+  md << "\n## The paper's claims (docs/experiments.md E3), checked on this table\n\n";
   for (const auto& c : claims) {
     md << fmt::format("- **{}** {}.  \n  {}\n", c.holds ? "Holds:" : "Does not hold:", c.text, c.detail);
   }
   md << "\n## Order of the controllers, best first\n\n"
      << "Where ours differs from the paper's order it is a finding about the plant, not a failure "
-        "(experiments.md E3; models.md section 10: on a linear plant FF + LP falls behind the "
+        "(docs/experiments.md E3; docs/models.md section 10: on a linear plant FF + LP falls behind the "
         "polynomial and the lead at 0-15 Hz).\n\n"
      << "| Condition | Band | Paper | Ours | Same order |\n|---|---|---|---|---|\n";
   for (const char* cond : {"0.0A", "2.5A", "pulse"}) {

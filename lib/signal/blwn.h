@@ -1,5 +1,5 @@
 #pragma once
-/// @file Band-limited white noise, the convention for every test record (models.md section 9).
+/// @file Band-limited white noise, the convention for every test record (docs/models.md section 9).
 #include <cstddef>
 #include <cstdint>
 #include <vector>

@@ -1,5 +1,5 @@
 #pragma once
-/// @file Digital Butterworth low-pass as cascaded second-order sections (models.md section 9).
+/// @file Digital Butterworth low-pass as cascaded second-order sections (docs/models.md section 9).
 ///
 /// Design: the analog Butterworth prototype of order N,
 ///   |H_a(j W)|^2 = 1 / (1 + (W / W_c)^(2N)),
@@ -9,7 +9,7 @@
 /// so the digital filter is exactly -3 dB at fc and
 ///   |H(e^{j 2 pi f / fs})|^2 = 1 / (1 + (tan(pi f / fs) / tan(pi fc / fs))^(2N)).
 /// Each section is run in direct form II transposed. A cascade of sections stays accurate at
-/// low fc / fs where the expanded transfer function does not (models.md section 9).
+/// low fc / fs where the expanded transfer function does not (docs/models.md section 9).
 #include <array>
 #include <complex>
 #include <vector>

@@ -19,7 +19,7 @@ inline constexpr std::array<Named<SignalKind>, 3> kSignalKindNames = {
 struct SignalSpec {
   SignalKind kind = SignalKind::kBlwn;  ///< "blwn" | "file" | "zero"
   // kind = "blwn": Gaussian white noise through an 8th-order Butterworth low-pass at band_hz,
-  // scaled to rms, with the first discard_s seconds thrown away (models.md section 9).
+  // scaled to rms, with the first discard_s seconds thrown away (docs/models.md section 9).
   double band_hz = 30.0;      ///< upper band edge [Hz], (0, 0.5/dt)
   double rms = 1500.0;        ///< RMS in the signal's unit (mm/s^2 for ground, mm for desired), > 0
   std::uint64_t seed = 1;     ///< generator seed

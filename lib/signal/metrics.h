@@ -1,5 +1,5 @@
 #pragma once
-/// @file Tracking metrics (experiments.md E3).
+/// @file Tracking metrics (docs/experiments.md E3).
 #include <cstddef>
 #include <span>
 

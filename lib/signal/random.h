@@ -1,5 +1,5 @@
 #pragma once
-/// @file Portable, seeded Gaussian noise (models.md section 9; plant sensor noise).
+/// @file Portable, seeded Gaussian noise (docs/models.md section 9; plant sensor noise).
 ///
 /// std::normal_distribution's algorithm is implementation-defined, so the same seed gives
 /// different records under libstdc++, libc++ and MSVC. Here everything after the engine is

@@ -1,5 +1,5 @@
 #pragma once
-/// @file Welch spectral estimates and the H1 frequency-response estimator (experiments.md E1,
+/// @file Welch spectral estimates and the H1 frequency-response estimator (docs/experiments.md E1,
 /// docs/identification.md). Offline analysis only: these functions allocate.
 ///
 /// Conventions, for two records u_k, y_k (k = 0 .. n-1) at step dt [s], fs = 1/dt:

@@ -1,0 +1,13 @@
+#pragma once
+/// @file Files of the rths checkout (a study's base scenario) found from wherever a command runs.
+#include <filesystem>
+#include <string>
+
+namespace rths::io {
+
+/// The file `rel` (e.g. "scenarios/fig9_base.toml") in the source tree: under $RTHS_SOURCE_DIR if
+/// set, else searched upwards from the current folder, from the executable's folder and from this
+/// source file's compile-time location. Throws rths::Error naming where it looked.
+std::filesystem::path FindSourceFile(const std::string& rel);
+
+}  // namespace rths::io
