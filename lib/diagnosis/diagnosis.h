@@ -140,7 +140,7 @@ struct TimeWindow {
 
 /// One candidate effect as fitted and scored.
 struct EffectResult {
-  std::string name;                       ///< a library name (models::kEffectNames)
+  std::string name;                       ///< a library name (models::kEffects)
   std::string channel;                    ///< "y" or "f"
   std::map<std::string, double> params;   ///< the contract's keys (plus documented extras)
   double train_nrmse_after = 0;           ///< training NRMSE of the channel with it [%]
