@@ -13,6 +13,7 @@
 #include <set>
 #include <string>
 
+#include <Eigen/Core>
 #include <doctest/doctest.h>
 #include <fmt/format.h>
 
@@ -21,6 +22,7 @@
 #include "diagnosis/synthetic.h"
 #include "io/rig_record.h"
 #include "models/mr_damper.h"
+#include "models/servo_linear.h"
 
 namespace fs = std::filesystem;
 using namespace rths::diagnosis;
@@ -124,7 +126,7 @@ TEST_CASE("model-aided motion keeps the model's content and smooths only the res
     yhat.push_back(std::sin(2 * std::numbers::pi * 50 * t));  // 50 Hz, above the 20 Hz smoother
     y.push_back(yhat.back() + 0.1);                            // + an offset (passes the smoother)
   }
-  const auto mo = ModelAidedMotion(y, yhat, dt, 20.0);
+  const auto mo = ModelAidedMotion(y, yhat, {}, dt, 20.0);
   for (int k = 100; k < 3900; k += 37) CHECK(mo.x_mm[k] == doctest::Approx(y[k]).epsilon(1e-6));
   const auto plain = SmoothMotion(y, dt, 20.0);
   double d = 0;
@@ -173,6 +175,62 @@ TEST_CASE("each effect of the library is named and its parameter recovered (synt
       CHECK(e->shrink_pct == doctest::Approx(ShrinkPct(r.Channel(e->channel)->gap_test_pct, e->test_nrmse_after)));
     }
   }
+}
+
+TEST_CASE("the displacement prediction's velocity is the servo's exact one, not a difference quotient") {
+  // A held command makes the third derivative jump at every sample: a difference quotient of sampled y errs by
+  // O(dt^2 K du). Reference: the same servo at dt/16 with the same held commands, velocity by a
+  // central difference on the fine grid (error (dt/16)^2 smaller).
+  const double dt = 0.0005;
+  const int fine = 16;
+  const auto coarse = m::LinearServo::Make(PaperModel().actuator, dt);
+  const auto sub = m::LinearServo::Make(PaperModel().actuator, dt / fine);
+  std::vector<double> u, i;
+  Excitation ex;
+  ex.duration_s = 2.0;
+  ex.band_hz = 40.0;
+  MakeInputs(ex, &u, &i);
+  std::vector<double> v;
+  const auto y = PredictDisplacement(coarse, {}, u, {}, &v);
+  std::vector<double> yf;  // fine samples, yf[k * fine] at t_k
+  Eigen::Vector3d z = Eigen::Vector3d::Zero();
+  for (std::size_t k = 0; k < u.size(); ++k)
+    for (int j = 0; j < fine; ++j) {
+      yf.push_back(z(0));
+      z = sub.Phi * z + sub.Gamma * u[k];
+    }
+  double err_model = 0, err_quotient = 0, vmax = 0;
+  for (std::size_t k = 2; k + 2 < u.size(); ++k) {
+    const std::size_t f = k * fine;
+    const double ref = (yf[f + 1] - yf[f - 1]) / (2 * dt / fine);
+    CHECK(y[k] == doctest::Approx(yf[f]).epsilon(1e-9).scale(1.0));
+    err_model = std::max(err_model, std::abs(v[k] - ref));
+    err_quotient = std::max(err_quotient, std::abs((y[k + 1] - y[k - 1]) / (2 * dt) - ref));
+    vmax = std::max(vmax, std::abs(ref));
+  }
+  INFO("max |v| " << vmax << " mm/s, model error " << err_model << ", quotient error " << err_quotient);
+  CHECK(err_model < 1e-3 * vmax);
+  CHECK(err_model < 0.05 * err_quotient);
+}
+
+TEST_CASE("nominal records sit at the noise floor whatever the excitation band (none, not unknown)") {
+  // Training BLWN up to 40 Hz with a staircase current, test to 12 Hz, white noise 0.002 mm and
+  // 0.05 kN: the force prediction must not carry its own error above the floor.
+  Truth t;
+  t.effects.sensor_noise = m::SensorNoise{0.002, 0.05};
+  Excitation tr;
+  tr.duration_s = 6.0;
+  tr.band_hz = 40.0;
+  tr.seed = 3;
+  Excitation te = tr;
+  te.band_hz = 12.0;
+  te.seed = 1003;
+  Truth t2 = t;
+  t2.noise_seed += 5;
+  const auto r = Diagnose({MakeRecordRig(tr, t, "train")}, {MakeRecordRig(te, t2, "test")}, PaperModel(), Options{});
+  INFO(Summary(r));
+  CHECK(r.verdict == std::vector<std::string>{"none"});
+  CHECK(r.Channel("f")->floor_ratio <= Options{}.none_ratio);
 }
 
 TEST_CASE("a record with sensor noise only: verdict none, noise floors measured") {

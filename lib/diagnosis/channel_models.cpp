@@ -63,6 +63,20 @@ void FilterInPlace(const signal::Sos& sos, std::vector<double>* x) {
 
 }  // namespace
 
+/// v = dx/dt of samples x: the fourth-order central difference
+/// (-x_{k+2} + 8 x_{k+1} - 8 x_{k-1} + x_{k-2}) / (12 dt) inside (relative error (w dt)^4 / 30 at
+/// angular frequency w), the second-order one next to the ends, one-sided at the ends.
+void Differentiate(const std::vector<double>& x, double dt_s, std::vector<double>* v) {
+  const std::size_t n = x.size();
+  v->assign(n, 0.0);
+  for (std::size_t k = 2; k + 2 < n; ++k)
+    (*v)[k] = (-x[k + 2] + 8.0 * x[k + 1] - 8.0 * x[k - 1] + x[k - 2]) / (12.0 * dt_s);
+  for (std::size_t k : {std::size_t{1}, n - 2})
+    if (k >= 1 && k + 1 < n) (*v)[k] = (x[k + 1] - x[k - 1]) / (2.0 * dt_s);
+  (*v)[0] = (x[1] - x[0]) / dt_s;
+  (*v)[n - 1] = (x[n - 1] - x[n - 2]) / dt_s;
+}
+
 SmoothedMotion SmoothMotion(std::span<const double> y_mm, double dt_s, double smooth_hz) {
   const std::size_t n = y_mm.size();
   if (n < 4) throw Error("SmoothMotion", "need at least 4 samples");
@@ -83,30 +97,37 @@ SmoothedMotion SmoothMotion(std::span<const double> y_mm, double dt_s, double sm
   SmoothedMotion m;
   m.x_mm.assign(w.begin() + static_cast<std::ptrdiff_t>(pad), w.begin() + static_cast<std::ptrdiff_t>(pad + n));
   m.v_mm_s.resize(n);
-  for (std::size_t k = 1; k + 1 < n; ++k) m.v_mm_s[k] = (m.x_mm[k + 1] - m.x_mm[k - 1]) / (2.0 * dt_s);
-  m.v_mm_s[0] = (m.x_mm[1] - m.x_mm[0]) / dt_s;
-  m.v_mm_s[n - 1] = (m.x_mm[n - 1] - m.x_mm[n - 2]) / dt_s;
+  Differentiate(m.x_mm, dt_s, &m.v_mm_s);
   return m;
 }
 
-SmoothedMotion ModelAidedMotion(std::span<const double> y_mm, std::span<const double> yhat_mm, double dt_s,
-                                double smooth_hz) {
+SmoothedMotion ModelAidedMotion(std::span<const double> y_mm, std::span<const double> yhat_mm,
+                                std::span<const double> vhat_mm_s, double dt_s, double smooth_hz) {
   const std::size_t n = y_mm.size();
-  if (yhat_mm.size() != n) throw Error("ModelAidedMotion", "lengths differ");
+  if (yhat_mm.size() != n || (!vhat_mm_s.empty() && vhat_mm_s.size() != n))
+    throw Error("ModelAidedMotion", "lengths differ");
   std::vector<double> res(n);
   for (std::size_t k = 0; k < n; ++k) res[k] = y_mm[k] - yhat_mm[k];
-  SmoothedMotion m = SmoothMotion(res, dt_s, smooth_hz);
+  SmoothedMotion m = SmoothMotion(res, dt_s, smooth_hz);  // x = S(res), v = its derivative
   for (std::size_t k = 0; k < n; ++k) m.x_mm[k] += yhat_mm[k];
-  for (std::size_t k = 1; k + 1 < n; ++k) m.v_mm_s[k] = (m.x_mm[k + 1] - m.x_mm[k - 1]) / (2.0 * dt_s);
-  m.v_mm_s[0] = (m.x_mm[1] - m.x_mm[0]) / dt_s;
-  m.v_mm_s[n - 1] = (m.x_mm[n - 1] - m.x_mm[n - 2]) / dt_s;
+  if (vhat_mm_s.empty()) {
+    Differentiate(m.x_mm, dt_s, &m.v_mm_s);
+  } else {
+    for (std::size_t k = 0; k < n; ++k) m.v_mm_s[k] += vhat_mm_s[k];
+  }
   return m;
 }
 
 std::vector<double> PredictDisplacement(const models::LinearServo& servo, const models::EffectSet& effects,
-                                        std::span<const double> u_mm, std::span<const double> f_kN) {
+                                        std::span<const double> u_mm, std::span<const double> f_kN,
+                                        std::vector<double>* v_mm_s) {
   const std::size_t n = u_mm.size();
   std::vector<double> y(n);
+  std::vector<double> servo_v;  // the servo's exact velocity z1 at t_k (phase variables)
+  if (v_mm_s != nullptr) {
+    servo_v.resize(n);
+    v_mm_s->resize(n);
+  }
   models::DisplacementEffects fx(effects, servo.dt_s);
   // Plain 3x3 arithmetic (this is the inner loop of every fit).
   const Eigen::Matrix3d& P = servo.Phi;
@@ -116,11 +137,20 @@ std::vector<double> PredictDisplacement(const models::LinearServo& servo, const 
     // load_coupling acts on the measured force of the same sample (see the header).
     const double fk = k < f_kN.size() ? f_kN[k] : 0.0;
     y[k] = fx.Post(z0, fk);
+    if (v_mm_s != nullptr) {
+      servo_v[k] = z1;
+      (*v_mm_s)[k] = y[k] - z0;  // the output effects' share, differentiated below
+    }
     const double ua = fx.Pre(u_mm[k]);
     const double n0 = P(0, 0) * z0 + P(0, 1) * z1 + P(0, 2) * z2 + G(0) * ua;
     const double n1 = P(1, 0) * z0 + P(1, 1) * z1 + P(1, 2) * z2 + G(1) * ua;
     const double n2 = P(2, 0) * z0 + P(2, 1) * z1 + P(2, 2) * z2 + G(2) * ua;
     z0 = n0, z1 = n1, z2 = n2;
+  }
+  if (v_mm_s != nullptr && n >= 2) {
+    std::vector<double> post_v;
+    Differentiate(*v_mm_s, servo.dt_s, &post_v);
+    for (std::size_t k = 0; k < n; ++k) (*v_mm_s)[k] = servo_v[k] + post_v[k];
   }
   return y;
 }

@@ -841,6 +841,7 @@ void ApplyShrinkRule(ChannelState* sp, const std::vector<CandidateSpec>& specs, 
                                     "were found on the training records only",
                                     cs.channel));
   }
+  s.fin_set = retained ? ToSet(specs, s.sel) : models::EffectSet{};
   if (retained) {
     s.fin_test = std::move(fin);
     s.pred_train_fin = s.pred_train;
@@ -960,17 +961,21 @@ double MotionCutoffHz(const Options& o, double dt) { return std::min(o.smooth_hz
 /// residual (ModelAidedMotion); without a displacement model to lean on (u = y), the measured y
 /// smoothed at a cutoff above the excitation.
 void SetForceMotion(std::vector<Data>* train, std::vector<Data>* test, const ChannelState& y, bool y_ok,
-                    const Options& o, double dt) {
+                    const models::LinearServo& servo, const Options& o, double dt) {
   if (!y_ok) {
     const double fc = std::min(o.displacement_only_smooth_factor * o.smooth_hz, o.max_smooth_cycles_per_sample / dt);
     for (auto& d : *train) d.motion = SmoothMotion(d.y, dt, fc);
     for (auto& d : *test) d.motion = SmoothMotion(d.y, dt, fc);
     return;
   }
-  for (std::size_t r = 0; r < train->size(); ++r)
-    (*train)[r].motion = ModelAidedMotion((*train)[r].y, y.pred_train_fin[r], dt, MotionCutoffHz(o, dt));
-  for (std::size_t r = 0; r < test->size(); ++r)
-    (*test)[r].motion = ModelAidedMotion((*test)[r].y, y.fin_test[r], dt, MotionCutoffHz(o, dt));
+  // The final model's own velocity (exact for the servo) under the smoothed residual's.
+  auto motion = [&](const Data& d) {
+    std::vector<double> vhat;
+    const std::vector<double> yhat = PredictDisplacement(servo, y.fin_set, d.u, d.f, &vhat);
+    return ModelAidedMotion(d.y, yhat, vhat, dt, MotionCutoffHz(o, dt));
+  };
+  for (auto& d : *train) d.motion = motion(d);
+  for (auto& d : *test) d.motion = motion(d);
 }
 
 /// res->effects: the verdict's effects in its order, the other candidates by shrink, then the
@@ -1026,7 +1031,7 @@ void LocaliseAndTrace(const std::vector<ChannelState>& st, const std::vector<Dat
     motions.reserve(test.size());
     for (std::size_t r = 0; r < test.size(); ++r) {
       const auto& d = test[r];
-      motions.push_back(d.motion.v_mm_s.empty() ? ModelAidedMotion(d.y, st[0].fin_test[r], dt, MotionCutoffHz(o, dt))
+      motions.push_back(d.motion.v_mm_s.empty() ? ModelAidedMotion(d.y, st[0].fin_test[r], {}, dt, MotionCutoffHz(o, dt))
                                                 : d.motion);
       LocaliseInput in;
       in.source = d.source;
@@ -1109,7 +1114,7 @@ Result Diagnose(const std::vector<io::RigRecord>& train_in, const std::vector<io
   EffectResults er;
   std::vector<std::string> verdict;
   for (char chan : chans) {
-    if (chan == 'f') SetForceMotion(&train, &test, st[0], y_ok, o, dt);
+    if (chan == 'f') SetForceMotion(&train, &test, st[0], y_ok, servo, o, dt);
     st.emplace_back(chan, Channel(chan, &train, &servo, fpp), Channel(chan, &test, &servo, fpp));
     auto& s = st.back();
     stages::ScoreNominal(&s, o);

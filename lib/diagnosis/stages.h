@@ -135,6 +135,7 @@ struct ChannelState {
 
   // Set by ApplyShrinkRule.
   bool retained = false;             ///< the selected effects are kept (the verdict names them)
+  models::EffectSet fin_set;         ///< the final model's effects (retained ones, else none)
   std::vector<std::vector<double>> fin_test;        ///< final (retained effects), test records
   std::vector<std::vector<double>> pred_train_fin;  ///< final (retained effects), training records
 };
