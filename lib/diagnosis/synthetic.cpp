@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 
 #include "core/error.h"
+#include "models/coupling_solver.h"
 #include "models/current_driver.h"
 #include "models/mr_damper.h"
 #include "models/rig.h"
@@ -34,6 +35,12 @@ void MakeInputs(const Excitation& ex, std::vector<double>* u_mm, std::vector<dou
 }
 
 namespace {
+
+/// The driver's state one step on (a copy).
+models::CurrentDriverState Advanced(const models::CurrentDriver& driver, models::CurrentDriverState cs) {
+  models::Advance(driver, &cs);
+  return cs;
+}
 
 io::RigRecord Empty(const Excitation& ex, const std::string& name, std::size_t n) {
   io::RigRecord r;
@@ -72,53 +79,76 @@ io::RigRecord MakeRecordBlocks(const Excitation& ex, const Truth& truth, const s
   // continuous motion (cubic Hermite through its samples x_k with its velocities C A z_k, exact
   // for a cubic, close for the servo) plus a linear interpolation of what the effects add,
   // d_k = y_k - x_k.
-  double x_prev = 0.0, xd_prev = 0.0, d_prev = 0.0, f_prev = 0.0;
+  // load_coupling sees the force of the same sample, as in the rig mode: a fixed point solved
+  // by models::SolveCoupledForce, each trial re-integrating the step from the saved state.
+  double x_prev = 0.0, xd_prev = 0.0, d_prev = 0.0, f_prev = 0.0, f_prev2 = 0.0;
   for (std::size_t k = 0; k < n; ++k) {
     const double x = models::Output(servo, xs), xd = models::OutputVelocity(servo, xs);
-    const double y = dfx.Post(x, f_prev);
-    const double d = y - x;
-    const double dd = k > 0 ? (d - d_prev) / dt : 0.0;
-    const double v = xd + dd;
-    if (k > 0) {
-      const int m = 8;
-      const double h = dt / m;
-      auto at = [&](double tau, double* pos, double* vel) {
-        const double t = tau / dt, t2 = t * t, t3 = t2 * t;
-        *pos = (2 * t3 - 3 * t2 + 1) * x_prev + (t3 - 2 * t2 + t) * dt * xd_prev + (-2 * t3 + 3 * t2) * x + (t3 - t2) * dt * xd +
-               d_prev + dd * tau;
-        *vel = ((6 * t2 - 6 * t) * x_prev + (3 * t2 - 4 * t + 1) * dt * xd_prev + (-6 * t2 + 6 * t) * x + (3 * t2 - 2 * t) * dt * xd) / dt +
-               dd;
-      };
-      for (int j = 0; j < m; ++j) {
-        const double ta = j * h;
-        auto coef = [&](double tau) { return models::CoefficientsAt(damper, models::EffectiveCurrentAt(driver, cs, tau)); };
-        const auto ca = coef(ta), cb = coef(ta + 0.5 * h), cc = coef(ta + h);
-        double pa, va, pb, vb, pc, vc;
-        at(ta, &pa, &va);
-        at(ta + 0.5 * h, &pb, &vb);
-        at(ta + h, &pc, &vc);
-        const auto r1 = models::DamperRates(ca, ds, pa, va);
-        const models::MrDamperState s2{ds.y_mm + 0.5 * h * r1.ydot_mm_s, ds.z_mm + 0.5 * h * r1.zdot_mm_s};
-        const auto r2 = models::DamperRates(cb, s2, pb, vb);
-        const models::MrDamperState s3{ds.y_mm + 0.5 * h * r2.ydot_mm_s, ds.z_mm + 0.5 * h * r2.zdot_mm_s};
-        const auto r3 = models::DamperRates(cb, s3, pb, vb);
-        const models::MrDamperState s4{ds.y_mm + h * r3.ydot_mm_s, ds.z_mm + h * r3.zdot_mm_s};
-        const auto r4 = models::DamperRates(cc, s4, pc, vc);
-        ds.y_mm += h / 6.0 * (r1.ydot_mm_s + 2 * r2.ydot_mm_s + 2 * r3.ydot_mm_s + r4.ydot_mm_s);
-        ds.z_mm += h / 6.0 * (r1.zdot_mm_s + 2 * r2.zdot_mm_s + 2 * r3.zdot_mm_s + r4.zdot_mm_s);
+    // One trial: the output effects (a copy, committed by the caller) fed the force f_in.
+    models::DisplacementEffects dfx_try = dfx;
+    models::MrDamperState ds_try = ds;
+    double y = 0.0, f = 0.0;
+    auto trial = [&](double f_in) {
+      dfx_try = dfx;
+      ds_try = ds;
+      y = dfx_try.Post(x, f_in);
+      const double d = y - x;
+      const double dd = k > 0 ? (d - d_prev) / dt : 0.0;
+      const double v = xd + dd;
+      if (k > 0) {
+        const int m = 8;
+        const double h = dt / m;
+        auto at = [&](double tau, double* pos, double* vel) {
+          const double t = tau / dt, t2 = t * t, t3 = t2 * t;
+          *pos = (2 * t3 - 3 * t2 + 1) * x_prev + (t3 - 2 * t2 + t) * dt * xd_prev + (-2 * t3 + 3 * t2) * x +
+                 (t3 - t2) * dt * xd + d_prev + dd * tau;
+          *vel = ((6 * t2 - 6 * t) * x_prev + (3 * t2 - 4 * t + 1) * dt * xd_prev + (-6 * t2 + 6 * t) * x +
+                  (3 * t2 - 2 * t) * dt * xd) / dt +
+                 dd;
+        };
+        for (int j = 0; j < m; ++j) {
+          const double ta = j * h;
+          auto coef = [&](double tau) { return models::CoefficientsAt(damper, models::EffectiveCurrentAt(driver, cs, tau)); };
+          const auto ca = coef(ta), cb = coef(ta + 0.5 * h), cc = coef(ta + h);
+          double pa, va, pb, vb, pc, vc;
+          at(ta, &pa, &va);
+          at(ta + 0.5 * h, &pb, &vb);
+          at(ta + h, &pc, &vc);
+          const auto r1 = models::DamperRates(ca, ds_try, pa, va);
+          const models::MrDamperState s2{ds_try.y_mm + 0.5 * h * r1.ydot_mm_s, ds_try.z_mm + 0.5 * h * r1.zdot_mm_s};
+          const auto r2 = models::DamperRates(cb, s2, pb, vb);
+          const models::MrDamperState s3{ds_try.y_mm + 0.5 * h * r2.ydot_mm_s, ds_try.z_mm + 0.5 * h * r2.zdot_mm_s};
+          const auto r3 = models::DamperRates(cb, s3, pb, vb);
+          const models::MrDamperState s4{ds_try.y_mm + h * r3.ydot_mm_s, ds_try.z_mm + h * r3.zdot_mm_s};
+          const auto r4 = models::DamperRates(cc, s4, pc, vc);
+          ds_try.y_mm += h / 6.0 * (r1.ydot_mm_s + 2 * r2.ydot_mm_s + 2 * r3.ydot_mm_s + r4.ydot_mm_s);
+          ds_try.z_mm += h / 6.0 * (r1.zdot_mm_s + 2 * r2.zdot_mm_s + 2 * r3.zdot_mm_s + r4.zdot_mm_s);
+        }
       }
-      models::Advance(driver, &cs);
+      const double ic = models::EffectiveCurrentA(driver, k > 0 ? Advanced(driver, cs) : cs);
+      f = ffx.Force(models::DamperForceKn(models::CoefficientsAt(damper, ic), ds_try, y, v));
+      f += truth.stiffness_kN_per_mm * y;
+      return f - f_in;
+    };
+    if (truth.effects.load_coupling) {
+      const double f_start = k >= 2 ? 2.0 * f_prev - f_prev2 : f_prev;
+      const auto solved = models::SolveCoupledForce(trial, f_start, truth.effects.load_coupling->compliance_mm_per_kN, 20);
+      if (!std::isfinite(f)) throw Error(name, fmt::format("load_coupling: the force of sample {} is not finite", k));
+      (void)solved;  // unconverged (a sticking seal): the closest trial, as the rig mode takes it
+    } else {
+      trial(f_prev);
     }
-    const double ic = models::EffectiveCurrentA(driver, cs);
-    double f = ffx.Force(models::DamperForceKn(models::CoefficientsAt(damper, ic), ds, y, v));
-    f += truth.stiffness_kN_per_mm * y;
+    dfx = dfx_try;
+    ds = ds_try;
+    if (k > 0) models::Advance(driver, &cs);
+    const double d = y - x;
     const double t = static_cast<double>(k) * dt;
     r.y_mm[k] = y + truth.ripple_mm * std::sin(2.0 * M_PI * truth.ripple_hz * t) + sy * signal::NextGaussian(&g);
     r.f_kN[k] = f + sf * signal::NextGaussian(&g);
     // Step k -> k+1.
     models::Hold(driver, &cs, ffx.Current(i[k]));
     models::Step(servo, &xs, dfx.Pre(u[k]));
-    x_prev = x, xd_prev = xd, d_prev = d, f_prev = f;
+    x_prev = x, xd_prev = xd, d_prev = d, f_prev2 = f_prev, f_prev = f;
   }
   r.metadata.push_back({"generator", "diagnosis::MakeRecordBlocks"});
   io::ValidateRigRecord(r, name);

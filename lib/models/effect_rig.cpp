@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include "core/error.h"
+#include "models/coupling_solver.h"
 
 namespace rths::models {
 namespace {
@@ -138,54 +139,22 @@ void EffectRig::Step(double u_mm, double i_cmd_A) {
     y1 = disp_.Post(x1, f_);
     f1 = Trial(x0, x1, next, y1, i_end, &damper);
   } else {
-    // Load coupling: y_{k+1} = Post(x_{k+1}, f_{k+1}) with the force of the same sample. Root of
-    // h(f) = Phi(f) - f, Phi(f) = the force at the end of the step when the coupling sees f (each
-    // evaluation re-integrates the step from the saved state). For c > 0, Phi does not increase
-    // with f (more force, less displacement, less force), so h decreases strictly and f_k and
-    // Phi(f_k) bracket the root: the Illinois variant of regula falsi then converges. Without a
-    // bracket (c < 0) it takes secant steps.
+    // Load coupling: y_{k+1} = Post(x_{k+1}, f_{k+1}) with the force of the same sample
+    // (models/coupling_solver.h).
     auto eval = [&](double f_in) {
       scratch_ = disp_;  // same sizes: no allocation
       y1 = scratch_.Post(x1, f_in);
       f1 = Trial(x0, x1, next, y1, i_end, &damper);
       return f1 - f_in;
     };
-    // Tolerance: y_{k+1} is off by c h, so |h| <= 1e-9 mm / |c| (or 1e-8 relative, CVODE's level).
-    const double c = std::abs(m_.effects.load_coupling->compliance_mm_per_kN);
-    const auto tol = [c](double f) { return std::max(1e-8 * (1.0 + std::abs(f)), c > 0.0 ? 1e-9 / c : 0.0); };
-    double fa = k_ >= 1 ? 2.0 * f_ - f_prev_ : f_;  // linear extrapolation of the force
+    const double f_start = k_ >= 1 ? 2.0 * f_ - f_prev_ : f_;  // linear extrapolation of the force
     f_prev_ = f_;
-    double ha = eval(fa);
-    double fb = fa + ha;
-    double hb = ha == 0.0 ? 0.0 : eval(fb);
-    if (ha == 0.0) fb = fa;
-    double f_best = fb, h_best = hb;
-    int it = 0;
-    while (std::abs(hb) > tol(fb) && std::abs(fb - fa) > 1e-12 * (1.0 + std::abs(fb)) &&
-           it < kMaxCouplingIterations) {
-      const bool bracket = (ha < 0.0) != (hb < 0.0);
-      const double fc = hb != ha ? fb - hb * (fb - fa) / (hb - ha) : 0.5 * (fa + fb);
-      const double hc = eval(fc);
-      if (!bracket || (hc < 0.0) != (hb < 0.0)) {
-        fa = fb;
-        ha = hb;
-      } else {
-        ha *= 0.5;  // Illinois: the stale end's value halved
-      }
-      fb = fc;
-      hb = hc;
-      if (std::abs(hb) < std::abs(h_best)) f_best = fb, h_best = hb;
-      ++it;
-    }
-    if (!std::isfinite(hb)) {
+    const CoupledForce solved =
+        SolveCoupledForce(eval, f_start, m_.effects.load_coupling->compliance_mm_per_kN, kMaxCouplingIterations);
+    if (!std::isfinite(f1)) {
       throw Error("EffectRig: load_coupling", fmt::format("the force of step {} is not finite", k_ + 1));
     }
-    if (std::abs(hb) > 1e-6 * (1.0 + std::abs(fb))) {
-      // No root to the tolerance: Phi jumps across f = Phi(f) (coulomb_friction's steep sign near
-      // zero velocity makes Phi non-monotone: a sticking seal). Take the closest trial.
-      ++unconverged_steps_;
-      if (fb != f_best) hb = eval(f_best);
-    }
+    if (!solved.converged) ++unconverged_steps_;
     std::swap(disp_, scratch_);  // the state of the accepted evaluation (swap: no allocation)
   }
   damper_ = damper;
