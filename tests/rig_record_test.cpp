@@ -389,3 +389,57 @@ TEST_CASE("UTFSM files: absurd values and headers are refused with file and line
   for (int k = 0; k < 10; ++k) daq += fmt::format("{},x,0,0,{}\n", k, k == 7 ? "1e306" : "0");
   CHECK(Contains(error_of("daq.txt", daq), "daq.txt:11: u_mm (10 CHANNEL2) = 1e+307 is out of range"));
 }
+
+namespace {
+/// A record at 3004.8 Hz whose time column is written with `decimals` decimals, dt_s in the header
+/// `header_dt` (3 s), optionally without row `skip`.
+std::string AtRate(int decimals, double header_dt, std::size_t skip = 0) {
+  const double dt = 1.0 / 3004.8;
+  std::string s = fmt::format("# rths rig record v1\n# dt_s: {:.12g}\nt_s,u_mm,y_mm,f_kN,i_A\n", header_dt);
+  for (std::size_t k = 0; k < 9015; ++k) {
+    if (skip != 0 && k == skip) continue;
+    const double t = k * dt;
+    s += fmt::format("{:.{}f},{},{},{},0\n", t, decimals, std::sin(t), 0.9 * std::sin(t), 0.5);
+  }
+  return s;
+}
+std::string MessageOf(const std::string& text, rths::io::TimeAxis axis) {
+  try {
+    rths::io::ParseRigRecord(text, "r.csv", axis);
+  } catch (const rths::Error& e) {
+    return e.what();
+  }
+  return "";
+}
+}  // namespace
+
+TEST_CASE("rig record: a rounded time column, a header dt slightly off, and dt from the header") {
+  using rths::io::TimeAxis;
+  const double dt = 1.0 / 3004.8;
+  // Rounded to 0.1 ms: steps of 0.3 and 0.4 ms. Refused by default, with the way out named.
+  const std::string rounded = AtRate(4, dt);
+  const std::string m = MessageOf(rounded, TimeAxis::kColumn);
+  CAPTURE(m);
+  CHECK(m.find("non-uniform time") != std::string::npos);
+  CHECK(m.find("--time-from-header") != std::string::npos);
+  CHECK(m.find("gap") == std::string::npos);
+  // From the header: read, the step is the header's, the deviation reported.
+  const RigRecord r = rths::io::ParseRigRecord(rounded, "r.csv", TimeAxis::kHeader);
+  CHECK(r.dt_s == doctest::Approx(dt).epsilon(1e-11));
+  CHECK(r.t_s[9000] == doctest::Approx(9000 * dt).epsilon(1e-12));
+  REQUIRE(!r.warnings.empty());
+  CHECK(r.warnings.back().find("time taken from the header") != std::string::npos);
+  // A precise column with a header 0.16 % off: refused on the dt_s line (line 2), the gap stated.
+  const std::string off = MessageOf(AtRate(9, dt * 1.0016), TimeAxis::kColumn);
+  CAPTURE(off);
+  CHECK(off.find("r.csv:2") == 0);
+  CHECK(off.find("disagrees with the time column's mean step") != std::string::npos);
+  CHECK(off.find("-0.16 %") != std::string::npos);
+  // ... and the same column and a correct header pass.
+  CHECK(MessageOf(AtRate(9, dt), TimeAxis::kColumn).empty());
+  // From the header, a missing row is still found (more than half a step off from there on).
+  const std::string missing = MessageOf(AtRate(4, dt, 4000), TimeAxis::kHeader);
+  CAPTURE(missing);
+  CHECK(missing.find("more than half a step") != std::string::npos);
+  CHECK(missing.find("r.csv:4004:") == 0);  // row k = 4000 (holding the t of k = 4001) is on line 4 + k
+}

@@ -36,6 +36,10 @@ int main(int argc, char** argv) {
   app.add_flag("--detrend", o.detrend, "remove each record's mean of u, y and f first");
   app.add_option("--none-ratio", o.none_ratio, "residual/noise-floor power ratio at or below which a channel is noise");
   app.add_option("--smooth-hz", o.smooth_hz, "zero-phase smoothing of the y residual for the force channel's motion [Hz] (default 20)");
+  bool time_from_header = false;
+  app.add_flag("--time-from-header", time_from_header,
+               "take the step from the record's '# dt_s' line; the time column need only lie within half a step "
+               "of t_0 + k dt_s (for a rounded time column)");
   app.add_flag("--brief", brief, "print only the verdict and each channel's shrink (the files are the same)");
   try {
     app.parse(argc, argv);
@@ -45,9 +49,10 @@ int main(int argc, char** argv) {
   }
   std::vector<rths::io::RigRecord> tr, te;
   rths::diagnosis::NominalModel model;
+  const auto axis = time_from_header ? rths::io::TimeAxis::kHeader : rths::io::TimeAxis::kColumn;
   try {
-    for (const auto& p : train) tr.push_back(rths::io::ReadRecordAny(p));
-    for (const auto& p : test) te.push_back(rths::io::ReadRecordAny(p));
+    for (const auto& p : train) tr.push_back(rths::io::ReadRecordAny(p, axis));
+    for (const auto& p : test) te.push_back(rths::io::ReadRecordAny(p, axis));
     model = model_file.empty() ? rths::diagnosis::PaperModel() : rths::diagnosis::LoadModel(model_file);
     if (!(o.none_ratio >= 1.0)) throw rths::Error("--none-ratio", fmt::format("{}: must be >= 1", o.none_ratio));
   } catch (const std::exception& e) {

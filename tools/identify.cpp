@@ -255,6 +255,10 @@ int main(int argc, char** argv) {
                  "CSV rig record or LCM run log (log.lcm) of ours; with --damper one or more damper tests (also UTFSM "
                  "damper files)")
       ->required();
+  bool time_from_header = false;
+  app.add_flag("--time-from-header", time_from_header,
+               "take the step from the record's '# dt_s' line; the time column need only lie within half a step "
+               "of t_0 + k dt_s (for a rounded time column)");
   app.add_flag("--damper", damper, "fit the Spencer MR damper model (Eqs. 32-34) at one current instead");
   app.add_option("--current", current_A, "--damper: the current of the records [A] (required)");
   app.add_option("--check", checks, "--damper: held-out records to score the fitted model on");
@@ -302,7 +306,8 @@ int main(int argc, char** argv) {
     std::string why;
     if (!o.fit.IsValid(&why)) throw Error("--poles/--band", why);
 
-    const auto rec = rths::io::ReadRecordAny(record);
+    const auto axis = time_from_header ? rths::io::TimeAxis::kHeader : rths::io::TimeAxis::kColumn;
+    const auto rec = rths::io::ReadRecordAny(record, axis);
     for (const auto& w : rec.warnings) std::fprintf(stderr, "rths identify: warning: %s\n", w.c_str());
 
     // The model as the paper fits it (continuous, Eq. 15) and the one whose ZOH simulation at the

@@ -73,32 +73,79 @@ double Median(std::vector<double> v) {
   return v[v.size() / 2];
 }
 
-/// Time-axis checks shared by the CSV reader and ValidateRigRecord. `line_of(k)` names sample k.
+/// Largest |t_k - (t_0 + k dt)| [s].
+double GridDeviation(const std::vector<double>& t, double dt) {
+  double dev = 0.0;
+  for (std::size_t k = 0; k < t.size(); ++k) dev = std::max(dev, std::abs(t[k] - (t[0] + static_cast<double>(k) * dt)));
+  return dev;
+}
+
+/// Time-axis checks shared by the CSV reader and ValidateRigRecord (TimeAxis::kColumn). `line_of(k)`
+/// names sample k.
 template <class LineOf>
 void CheckTime(const std::vector<double>& t, double dt_header, const std::string& dt_where, LineOf line_of) {
   if (t.size() < 2) return;  // too short: reported by the duration check
   std::vector<double> steps(t.size() - 1);
   for (std::size_t k = 1; k < t.size(); ++k) steps[k - 1] = t[k] - t[k - 1];
   const double med = Median(steps);
+  const double n1 = static_cast<double>(t.size() - 1);
+  // A column rounded to a coarse resolution (steps of 0.3 and 0.4 ms for 0.3328 ms) is uniform
+  // on the header's grid: say so instead of calling it non-uniform.
+  const bool on_header_grid = GridDeviation(t, dt_header) <= 0.5 * dt_header;
+  const std::string rounded_hint =
+      on_header_grid ? fmt::format("; every t_s is within half a step of t_0 + k dt_s ({} s): if the column is "
+                                   "rounded, take dt from the header (--time-from-header)",
+                                   dt_header)
+                     : "";
   for (std::size_t k = 1; k < t.size(); ++k) {
     const double d = steps[k - 1];
     if (!(d > 0.0)) {
       throw Error(line_of(k), fmt::format("time t_s = {} does not increase (previous {})", t[k], t[k - 1]));
     }
     if (med > 0.0 && std::abs(d - med) > 0.01 * med) {
-      if (d > 1.5 * med) {
+      if (d > 1.5 * med && !on_header_grid) {
         throw Error(line_of(k), fmt::format("gap in time: t_s jumps from {} to {} ({:.6g} s, {:.3g} steps of {:.6g} s; "
                                             "missing rows?)",
                                             t[k - 1], t[k], d, d / med, med));
       }
       throw Error(line_of(k), fmt::format("non-uniform time: step {:.6g} s from t_s = {} differs from the record's "
-                                          "step {:.6g} s by more than 1 %",
-                                          d, t[k - 1], med));
+                                          "step {:.6g} s by more than 1 %{}",
+                                          d, t[k - 1], med, rounded_hint));
     }
   }
-  if (std::abs(med - dt_header) > 0.01 * dt_header) {
-    throw Error(dt_where, fmt::format("dt_s = {} disagrees with the time column's step {:.6g} s", dt_header, med));
+  // The mean step over the whole record (rounding averages out) against the header, within
+  // kDtAgreement: a header 0.16 % off would misplace the last sample of 20 s by 32 ms.
+  const double mean = (t.back() - t.front()) / n1;
+  if (std::abs(mean - dt_header) > kDtAgreement * dt_header) {
+    throw Error(dt_where, fmt::format("dt_s = {} disagrees with the time column's mean step {:.9g} s ({:+.3g} %, "
+                                      "allowed {:g} %; {:.6g} Hz vs {:.6g} Hz)",
+                                      dt_header, mean, 100.0 * (mean - dt_header) / dt_header, 100.0 * kDtAgreement,
+                                      1.0 / dt_header, 1.0 / mean));
   }
+}
+
+/// TimeAxis::kHeader: dt is the header's; every t_k must lie within half a step of t_0 + k dt
+/// (no row missing or extra); the largest deviation is a warning; t_s becomes t_0 + k dt.
+template <class LineOf>
+void TimeFromHeader(RigRecord* rec, LineOf line_of) {
+  auto& t = rec->t_s;
+  if (t.size() < 2) return;
+  const double dt = rec->dt_s;
+  double dev = 0.0;
+  for (std::size_t k = 0; k < t.size(); ++k) {
+    const double place = t[0] + static_cast<double>(k) * dt;
+    const double d = std::abs(t[k] - place);
+    if (d > 0.5 * dt) {  // the first sample off its place: where a row went missing or extra
+      throw Error(line_of(k), fmt::format("t_s = {} is {:.6g} s from its place t_0 + k dt_s = {} (k = {}): more "
+                                          "than half a step (dt_s = {} s from the header); a row missing or extra?",
+                                          t[k], t[k] - place, place, k, dt));
+    }
+    dev = std::max(dev, d);
+  }
+  rec->warnings.push_back(fmt::format("{}: time taken from the header (dt_s = {} s); the time column deviates from "
+                                      "t_0 + k dt_s by at most {:.3g} s ({:.3g} steps, allowed 0.5)",
+                                      rec->source, dt, dev, dev / dt));
+  for (std::size_t k = 0; k < t.size(); ++k) t[k] = t[0] + static_cast<double>(k) * dt;
 }
 
 void CheckDuration(std::size_t n, double dt, const std::string& where) {
@@ -117,15 +164,15 @@ std::string RigRecord::Meta(const std::string& key) const {
   return "";
 }
 
-RigRecord ReadRigRecord(const std::string& path) {
+RigRecord ReadRigRecord(const std::string& path, TimeAxis time) {
   std::ifstream file(path, std::ios::binary);
   if (!file) throw Error(path, "cannot open the rig record");
   const std::string text((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
   if (file.bad()) throw Error(path, "cannot read the rig record");
-  return ParseRigRecord(text, path);
+  return ParseRigRecord(text, path, time);
 }
 
-RigRecord ParseRigRecord(std::string_view text, const std::string& path) {
+RigRecord ParseRigRecord(std::string_view text, const std::string& path, TimeAxis time) {
   std::istringstream in{std::string(text)};
   RigRecord rec;
   rec.source = path;
@@ -207,7 +254,15 @@ RigRecord ParseRigRecord(std::string_view text, const std::string& path) {
     }
     row_line.push_back(ln);
   }
-  CheckTime(rec.t_s, rec.dt_s, Where(path, dt_line), [&](std::size_t k) { return Where(path, row_line[k]); });
+  const auto line_of = [&](std::size_t k) { return Where(path, row_line[k]); };
+  if (time == TimeAxis::kHeader) {
+    for (std::size_t k = 1; k < rec.t_s.size(); ++k)
+      if (!(rec.t_s[k] > rec.t_s[k - 1]))
+        throw Error(line_of(k), fmt::format("time t_s = {} does not increase (previous {})", rec.t_s[k], rec.t_s[k - 1]));
+    TimeFromHeader(&rec, line_of);
+  } else {
+    CheckTime(rec.t_s, rec.dt_s, Where(path, dt_line), line_of);
+  }
   CheckDuration(rec.size(), rec.dt_s, Where(path, row_line.empty() ? ln : row_line.back()));
   return rec;
 }
@@ -284,9 +339,9 @@ bool IsLcmLog(const std::string& path) {
   return b[0] == 0xED && b[1] == 0xA1 && b[2] == 0xDA && b[3] == 0x01;
 }
 
-RigRecord ReadRecordAny(const std::string& path) {
+RigRecord ReadRecordAny(const std::string& path, TimeAxis time) {
   if (IsLcmLog(path)) return RigRecordFromRunLog(ReadRunLog(path), path);
-  return ReadRigRecord(path);
+  return ReadRigRecord(path, time);
 }
 
 }  // namespace rths::io

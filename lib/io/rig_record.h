@@ -61,18 +61,33 @@ inline constexpr double kMaxAbsTimeS = 1e10;          ///< |t_s| [s] (Unix times
 /// The range of dt_s [s]: 1 MHz to 1 Hz sampling.
 inline constexpr double kMinDtS = 1e-6, kMaxDtS = 1.0;
 
+/// How a CSV reader takes the step dt.
+enum class TimeAxis {
+  /// From the time column, checked: uniform (each step within 1 % of the median step, a gap if
+  /// above 1.5 steps), and its mean step (t_last - t_0) / (n - 1) equal to '# dt_s' within
+  /// kDtAgreement. A rounded column fails with a hint to use kHeader.
+  kColumn,
+  /// From '# dt_s' (--time-from-header): the time column only has to increase and lie within half
+  /// a step of t_0 + k dt_s (no row missing or extra; a column rounded to 0.1 ms at 3 kHz passes);
+  /// its largest deviation is a warning, and t_s becomes t_0 + k dt_s.
+  kHeader,
+};
+/// Relative agreement required between '# dt_s' and the time column's mean step (TimeAxis::kColumn).
+inline constexpr double kDtAgreement = 1e-4;
+
 /// Reads a CSV rig record. Throws rths::Error with where = "path:line" (line 1-based, of the
 /// offending line; or "path" if it cannot be opened) for: a missing or wrong first line, a
 /// missing or bad '# dt_s:' line (a number in [kMinDtS, kMaxDtS]), a missing or duplicated column,
 /// a row with the wrong number of fields, a field that is not a finite number (NaN, inf, 1e999,
 /// text) or is out of its column's bounds (kMaxAbsDisplacementMm, kMaxAbsForceKN, kMaxAbsCurrentA,
 /// kMaxAbsTimeS), a non-increasing time, a non-uniform step or a gap (a step off the median step
-/// by more than 1 %; a gap if it exceeds 1.5 steps), a median step that disagrees with dt_s by
-/// more than 1 % (where = the dt_s line), and fewer than 2 s of data (where = the last line).
-RigRecord ReadRigRecord(const std::string& path);
+/// by more than 1 %; a gap if it exceeds 1.5 steps), a mean step that disagrees with dt_s by
+/// more than kDtAgreement (where = the dt_s line), and fewer than 2 s of data (where = the last
+/// line); `time` says where dt comes from (TimeAxis).
+RigRecord ReadRigRecord(const std::string& path, TimeAxis time = TimeAxis::kColumn);
 
 /// ReadRigRecord on the text of a record (`path` names it in messages and becomes its source).
-RigRecord ParseRigRecord(std::string_view text, const std::string& path);
+RigRecord ParseRigRecord(std::string_view text, const std::string& path, TimeAxis time = TimeAxis::kColumn);
 
 /// Writes `rec` as a CSV rig record (format above; t_s, u_mm, y_mm, f_kN, i_A[, r_mm]; numbers
 /// with 10 significant digits). Throws rths::Error if the file cannot be written or the vectors
@@ -96,6 +111,6 @@ RigRecord RigRecordFromRunLog(const RunLog& log, const std::string& source);
 bool IsLcmLog(const std::string& path);
 
 /// Reads `path` as an LCM run log of ours (IsLcmLog) or else as a CSV rig record.
-RigRecord ReadRecordAny(const std::string& path);
+RigRecord ReadRecordAny(const std::string& path, TimeAxis time = TimeAxis::kColumn);
 
 }  // namespace rths::io
