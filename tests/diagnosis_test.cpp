@@ -255,6 +255,43 @@ TEST_CASE("the block generator solves the same-sample load coupling: finite, and
   CHECK(std::sqrt(ef / nf) < 0.01);
 }
 
+TEST_CASE("a state condition that covers most samples is reported as uninformative, not as localisation") {
+  // The current switches every 50-100 ms: current_switching (100 ms after a change) covers
+  // most samples of the test record (88 %).
+  Truth t;
+  t.effects.sensor_noise = m::SensorNoise{0.01, 0.2};
+  t.effects.damper_scale = m::DamperScale{1.2};
+  Excitation tr;
+  tr.duration_s = 6.0;
+  tr.band_hz = 25.0;
+  tr.seed = 3;
+  tr.hold_min_s = 0.05;
+  tr.hold_max_s = 0.1;
+  Excitation te = tr;
+  te.band_hz = 8.0;
+  te.seed = 1003;
+  Truth t2 = t;
+  t2.noise_seed += 5;
+  const auto r = Diagnose({MakeRecordBlocks(tr, t, "train")}, {MakeRecordBlocks(te, t2, "test")}, PaperModel(), Options{});
+  bool seen = false;
+  for (const auto& c : r.conditions) {
+    CAPTURE(c.name);
+    CAPTURE(c.samples_pct);
+    CHECK(c.informative == (c.samples_pct > 0.0 && c.samples_pct <= Options{}.max_condition_samples_pct));
+    if (c.name == "current_switching" && c.channel == "f") {
+      seen = true;
+      CHECK(c.samples_pct > 80.0);
+      CHECK_FALSE(c.informative);
+    }
+  }
+  CHECK(seen);
+  const auto j = ToJson(r);
+  for (const auto& c : j["where"]["conditions"]) CHECK(c.contains("informative"));
+  const std::string text = Summary(r);
+  CHECK(text.find("uninformative: ") != std::string::npos);
+  CHECK(text.find("current_switching holds") == std::string::npos);
+}
+
 TEST_CASE("a record with sensor noise only: verdict none, noise floors measured") {
   const auto [tr, te] = Records(Noisy());
   const auto r = Diagnose({tr}, {te}, PaperModel(), Options{});
@@ -541,7 +578,7 @@ TEST_CASE("options: the ones used are written into the JSON, every field") {
   CHECK(j["refit_rounds"] == 5);
   CHECK(j["min_test_shrink_pct"] == 30.0);
   CHECK(j["detrend"] == false);
-  CHECK(j.size() == 37);  // one per field of Options
+  CHECK(j.size() == 38);  // one per field of Options
 }
 
 TEST_CASE("Summary: the brief report is the verdict and each channel's shrink; the full one is unchanged") {

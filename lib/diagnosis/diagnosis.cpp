@@ -93,7 +93,8 @@ bool Options::IsValid(std::string* error) const {
          real("refit_rel_tol", refit_rel_tol, 0.0, 1.0, false, true) &&
          integer("trial_refit_rounds", trial_refit_rounds, 1, 1000) &&
          integer("refit_rounds", refit_rounds, 1, 1000) &&
-         integer("prune_refit_rounds", prune_refit_rounds, 1, 1000);
+         integer("prune_refit_rounds", prune_refit_rounds, 1, 1000) &&
+         real("max_condition_samples_pct", max_condition_samples_pct, 0.0, 100.0, true, false);
 }
 
 // ------------------------------------------------------------------------------------------
@@ -1045,7 +1046,14 @@ void LocaliseAndTrace(const std::vector<ChannelState>& st, const std::vector<Dat
       in.i = d.i;
       li.push_back(in);
     }
-    if (res->channels[c].diagnosed) Localise(std::string(1, s.ch), li, &res->bands, &res->conditions, &res->time);
+    if (res->channels[c].diagnosed) {
+      const std::size_t first_condition = res->conditions.size();
+      Localise(std::string(1, s.ch), li, &res->bands, &res->conditions, &res->time);
+      for (std::size_t j = first_condition; j < res->conditions.size(); ++j) {
+        Condition& cond = res->conditions[j];
+        cond.informative = cond.samples_pct > 0.0 && cond.samples_pct <= o.max_condition_samples_pct;
+      }
+    }
     if (traces && c == 0) {
       traces->test.clear();
       for (std::size_t r = 0; r < test.size(); ++r) {
@@ -1187,7 +1195,8 @@ nlohmann::json ToJson(const Options& o) {
           {"refit_rel_tol", o.refit_rel_tol},
           {"trial_refit_rounds", o.trial_refit_rounds},
           {"refit_rounds", o.refit_rounds},
-          {"prune_refit_rounds", o.prune_refit_rounds}};
+          {"prune_refit_rounds", o.prune_refit_rounds},
+          {"max_condition_samples_pct", o.max_condition_samples_pct}};
 }
 
 nlohmann::json ToJson(const Result& r) {
@@ -1213,7 +1222,7 @@ nlohmann::json ToJson(const Result& r) {
   where["conditions"] = json::array();
   for (const auto& c : r.conditions)
     where["conditions"].push_back({{"channel", c.channel}, {"name", c.name}, {"share_pct", num(c.share_pct)},
-                                   {"samples_pct", num(c.samples_pct)}});
+                                   {"samples_pct", num(c.samples_pct)}, {"informative", c.informative}});
   where["time"] = json::array();
   for (const auto& t : r.time)
     where["time"].push_back({{"channel", t.channel}, {"record", t.record}, {"t0_s", t.t0_s}, {"t1_s", t.t1_s},
@@ -1307,9 +1316,17 @@ std::string Summary(const Result& r, SummaryDetail detail) {
       if (b.channel == ch && (!top || b.share_pct > top->share_pct)) top = &b;
     if (top) s += fmt::format("where ({}): {:.0f}-{:.0f} Hz holds {:.1f} % of the residual", ch, top->lo_hz, top->hi_hz, top->share_pct);
     const Condition* tc = nullptr;
-    for (const auto& c : r.conditions)
-      if (c.channel == ch && c.samples_pct > 0 && (!tc || c.share_pct / c.samples_pct > tc->share_pct / tc->samples_pct)) tc = &c;
+    std::string uninformative;
+    for (const auto& c : r.conditions) {
+      if (c.channel != ch) continue;
+      if (!c.informative) {
+        uninformative += fmt::format("{}{} ({:.0f} % of the samples)", uninformative.empty() ? "" : ", ", c.name, c.samples_pct);
+        continue;
+      }
+      if (!tc || c.share_pct / c.samples_pct > tc->share_pct / tc->samples_pct) tc = &c;
+    }
     if (tc) s += fmt::format("; {} holds {:.1f} % of it in {:.1f} % of the samples", tc->name, tc->share_pct, tc->samples_pct);
+    if (top && !uninformative.empty()) s += fmt::format("; uninformative: {}", uninformative);
     if (top) s += "\n";
   }
   s += "effects (test NRMSE after, shrink):\n";

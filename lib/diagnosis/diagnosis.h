@@ -105,6 +105,9 @@ struct Options {
   double refit_rel_tol = 1e-4;
   int trial_refit_rounds = 2;          ///< coordinate rounds refitting a candidate's trial set, [1, 1000]
   int refit_rounds = 6;                ///< ... after an addition, a swap or a held-out drop, [1, 1000]
+  /// A state condition holding in more than this share of the samples [%] localises nothing (a
+  /// current switching every 0.1 s covers 99.9 % of them): reported as uninformative; (0, 100].
+  double max_condition_samples_pct = 50.0;
   int prune_refit_rounds = 2;          ///< ... of the set without an effect, when pruning, [1, 1000]
 
   /// True if every field is in its range; else false and a message naming the field and its
@@ -129,6 +132,9 @@ struct Condition {
   std::string name;          ///< velocity_reversal | high_velocity | high_force | current_switching
   double share_pct = 0;      ///< share of the channel's residual energy in the condition's samples
   double samples_pct = 0;    ///< share of the samples in the condition
+  /// false if the condition holds in more than Options::max_condition_samples_pct of the samples
+  /// (or in none): it singles out no state, so its share says nothing about where the residual is.
+  bool informative = true;
 };
 /// A residual localised in time.
 struct TimeWindow {

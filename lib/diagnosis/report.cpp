@@ -252,10 +252,14 @@ void WriteReport(const Result& r, const Traces& traces, const fs::path& dir) {
                      b.coherence >= 0 ? fmt::format("{:.2f}", b.phase_diff_deg) : "");
   }
   h += "</table>\n<h2>Where: state conditions</h2>\n<table><tr><th>channel</th><th>condition</th><th>residual share [%]</th>"
-       "<th>sample share [%]</th><th>ratio</th></tr>\n";
+       "<th>sample share [%]</th><th>ratio</th><th>informative</th></tr>\n";
   for (const auto& c : r.conditions)
-    h += fmt::format("<tr><td class=l>{}</td><td class=l>{}</td><td>{:.1f}</td><td>{:.1f}</td><td>{:.2f}</td></tr>\n", c.channel,
-                     c.name, c.share_pct, c.samples_pct, c.samples_pct > 0 ? c.share_pct / c.samples_pct : 0.0);
+    h += fmt::format("<tr><td class=l>{}</td><td class=l>{}</td><td>{:.1f}</td><td>{:.1f}</td><td>{:.2f}</td><td class=l>{}</td></tr>\n",
+                     c.channel, c.name, c.share_pct, c.samples_pct, c.samples_pct > 0 ? c.share_pct / c.samples_pct : 0.0,
+                     c.informative         ? std::string("yes")
+                     : c.samples_pct <= 0.0 ? std::string("no: holds in no sample")
+                                            : fmt::format("no: holds in {:.0f} % of the samples (more than {:.0f} %)",
+                                                          c.samples_pct, r.options.max_condition_samples_pct));
   h += "</table>\n<h2>Where: time windows (largest shares)</h2>\n<table><tr><th>channel</th><th>record</th><th>t0 [s]</th>"
        "<th>t1 [s]</th><th>share [%]</th></tr>\n";
   for (const auto& t : r.time)
