@@ -292,6 +292,28 @@ TEST_CASE("a state condition that covers most samples is reported as uninformati
   CHECK(text.find("current_switching holds") == std::string::npos);
 }
 
+TEST_CASE("a stuck sensor (y flat for 0.8 s while the rig moves) is flagged as a sensor fault") {
+  auto [tr, te] = Records(Noisy());
+  const auto a = static_cast<std::size_t>(std::lround(2.0 / te.dt_s)), b = static_cast<std::size_t>(std::lround(2.8 / te.dt_s));
+  for (std::size_t k = a; k < b; ++k) te.y_mm[k] = te.y_mm[a];
+  const auto faults = FindFlatSensors(te, Options{}.sensor_flat_s);
+  REQUIRE(faults.size() == 1);
+  CHECK(faults[0].channel == "y");
+  CHECK(faults[0].t0_s == doctest::Approx(2.0));
+  CHECK(faults[0].t1_s == doctest::Approx(2.8 - te.dt_s));
+  CHECK(FindFlatSensors(tr, Options{}.sensor_flat_s).empty());  // a noisy sensor is never flat
+  const auto r = Diagnose({tr}, {te}, PaperModel(), Options{});
+  REQUIRE(r.sensor_faults.size() == 1);
+  CHECK(ToJson(r)["sensor_faults"].size() == 1);
+  bool warned = false;
+  for (const auto& w : r.warnings) warned |= w.find("stuck or clipped sensor") != std::string::npos;
+  CHECK(warned);
+  // A force column of zeros (no force sensor) is not a stuck sensor.
+  auto z = te;
+  std::fill(z.f_kN.begin(), z.f_kN.end(), 0.0);
+  for (const auto& f : FindFlatSensors(z, 0.25)) CHECK(f.channel != "f");
+}
+
 TEST_CASE("a record with sensor noise only: verdict none, noise floors measured") {
   const auto [tr, te] = Records(Noisy());
   const auto r = Diagnose({tr}, {te}, PaperModel(), Options{});
@@ -578,7 +600,7 @@ TEST_CASE("options: the ones used are written into the JSON, every field") {
   CHECK(j["refit_rounds"] == 5);
   CHECK(j["min_test_shrink_pct"] == 30.0);
   CHECK(j["detrend"] == false);
-  CHECK(j.size() == 38);  // one per field of Options
+  CHECK(j.size() == 39);  // one per field of Options
 }
 
 TEST_CASE("Summary: the brief report is the verdict and each channel's shrink; the full one is unchanged") {

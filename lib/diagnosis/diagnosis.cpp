@@ -94,7 +94,8 @@ bool Options::IsValid(std::string* error) const {
          integer("trial_refit_rounds", trial_refit_rounds, 1, 1000) &&
          integer("refit_rounds", refit_rounds, 1, 1000) &&
          integer("prune_refit_rounds", prune_refit_rounds, 1, 1000) &&
-         real("max_condition_samples_pct", max_condition_samples_pct, 0.0, 100.0, true, false);
+         real("max_condition_samples_pct", max_condition_samples_pct, 0.0, 100.0, true, false) &&
+         real("sensor_flat_s", sensor_flat_s, 0.0, inf, true, true);
 }
 
 // ------------------------------------------------------------------------------------------
@@ -1103,6 +1104,14 @@ Result Diagnose(const std::vector<io::RigRecord>& train_in, const std::vector<io
   for (const auto& d : train) res.train.push_back(d.source);
   for (const auto& d : test) res.test.push_back(d.source);
   res.samples = stages::Count(train) + stages::Count(test);
+  for (const auto* set : {&train_in, &test_in})
+    for (const auto& r : *set)
+      for (const SensorFault& sf : FindFlatSensors(r, o.sensor_flat_s)) {
+        res.warnings.push_back(fmt::format("{}: {} holds exactly {} from {:.3f} s to {:.3f} s while the rig moves: a "
+                                           "stuck or clipped sensor? (its residual there is not a model error)",
+                                           sf.record, sf.channel, sf.value, sf.t0_s, sf.t1_s));
+        res.sensor_faults.push_back(sf);
+      }
 
   const auto servo = models::LinearServo::Make(model.actuator, dt);
   std::optional<ForcePredictor> fp;
@@ -1158,6 +1167,29 @@ Result Diagnose(const std::vector<io::RigRecord>& train_in, const std::vector<io
 
 // ------------------------------------------------------------------------------------------
 
+std::vector<SensorFault> FindFlatSensors(const io::RigRecord& r, double min_s) {
+  std::vector<SensorFault> out;
+  const std::size_t n = r.size();
+  const auto min_n = static_cast<std::size_t>(std::ceil(min_s / r.dt_s));
+  auto scan = [&](const char* channel, const std::vector<double>& x, const std::vector<double>& drive) {
+    // A channel constant throughout was not connected (a force column of zeros): said elsewhere.
+    if (n == 0 || std::all_of(x.begin(), x.end(), [&](double v) { return v == x[0]; })) return;
+    std::size_t a = 0;
+    for (std::size_t k = 1; k <= n; ++k) {
+      if (k < n && x[k] == x[a]) continue;
+      if (k - a >= min_n && k - a >= 2) {  // x[a .. k-1] all equal: does the drive move meanwhile?
+        const auto [lo, hi] = std::minmax_element(drive.begin() + static_cast<std::ptrdiff_t>(a),
+                                                  drive.begin() + static_cast<std::ptrdiff_t>(k));
+        if (*hi > *lo) out.push_back({r.source, channel, r.t_s[a], r.t_s[k - 1], x[a]});
+      }
+      a = k;
+    }
+  };
+  if (r.y_mm.size() == n && r.u_mm.size() == n) scan("y", r.y_mm, r.u_mm);
+  if (r.f_kN.size() == n && r.y_mm.size() == n) scan("f", r.f_kN, r.y_mm);
+  return out;
+}
+
 nlohmann::json ToJson(const Options& o) {
   return {{"warmup_s", o.warmup_s},
           {"detrend", o.detrend},
@@ -1196,7 +1228,8 @@ nlohmann::json ToJson(const Options& o) {
           {"trial_refit_rounds", o.trial_refit_rounds},
           {"refit_rounds", o.refit_rounds},
           {"prune_refit_rounds", o.prune_refit_rounds},
-          {"max_condition_samples_pct", o.max_condition_samples_pct}};
+          {"max_condition_samples_pct", o.max_condition_samples_pct},
+          {"sensor_flat_s", o.sensor_flat_s}};
 }
 
 nlohmann::json ToJson(const Result& r) {
@@ -1272,6 +1305,10 @@ nlohmann::json ToJson(const Result& r) {
   j["samples"] = r.samples;
   j["runtime_s"] = r.runtime_s;
   j["warnings"] = r.warnings;
+  j["sensor_faults"] = json::array();
+  for (const auto& sf : r.sensor_faults)
+    j["sensor_faults"].push_back({{"record", sf.record}, {"channel", sf.channel}, {"t0_s", sf.t0_s},
+                                  {"t1_s", sf.t1_s}, {"value", sf.value}});
   j["options"] = ToJson(r.options);
   return j;
 }

@@ -108,6 +108,8 @@ struct Options {
   /// A state condition holding in more than this share of the samples [%] localises nothing (a
   /// current switching every 0.1 s covers 99.9 % of them): reported as uninformative; (0, 100].
   double max_condition_samples_pct = 50.0;
+  /// A channel exactly flat for this long [s] while the rig moves is a sensor fault; > 0.
+  double sensor_flat_s = 0.25;
   int prune_refit_rounds = 2;          ///< ... of the set without an effect, when pruning, [1, 1000]
 
   /// True if every field is in its range; else false and a message naming the field and its
@@ -172,6 +174,20 @@ struct ChannelSummary {
   std::string status;                     ///< "noise" | "explained" | "unexplained" | "not diagnosed"
 };
 
+/// A stretch where a sensor channel holds one value while the rig moves: a stuck or clipped
+/// sensor, not a model error (FindFlatSensors).
+struct SensorFault {
+  std::string record;        ///< source of the record
+  std::string channel;       ///< "y" or "f"
+  double t0_s = 0, t1_s = 0; ///< the stretch [s]
+  double value = 0;          ///< the value held [mm or kN]
+};
+
+/// Stretches of at least `min_s` [s] where y (or f) repeats one value exactly while the command u
+/// (for f: y) does not: a real sensor always shows some noise, so an exactly flat channel under
+/// motion is a stuck or clipped sensor.
+std::vector<SensorFault> FindFlatSensors(const io::RigRecord& r, double min_s);
+
 struct Result {
   std::vector<std::string> train, test;   ///< record sources
   std::string model_source;
@@ -182,6 +198,7 @@ struct Result {
   std::vector<EffectResult> effects;      ///< ranked: selected in order, then by shrink
   std::vector<std::string> verdict;
   std::vector<std::string> warnings;
+  std::vector<SensorFault> sensor_faults;  ///< stuck or clipped sensor stretches (also warnings)
   double runtime_s = 0;
   double dt_s = 0;
   std::size_t samples = 0;                ///< all samples, train + test
