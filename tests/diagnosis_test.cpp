@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <numbers>
 #include <set>
 #include <string>
@@ -37,21 +38,25 @@ fs::path TempDir(const std::string& name) {
   return p;
 }
 
-/// Short training (BLWN 0-25 Hz) and test (BLWN 0-8 Hz) records from the effect blocks.
-std::pair<rths::io::RigRecord, rths::io::RigRecord> Records(const Truth& truth, double duration_s = 6.0,
-                                                             std::uint64_t seed = 3) {
+/// Short training (BLWN 0-25 Hz) and test (BLWN 0-8 Hz) records from the effect blocks (or from
+/// `make`); `edit` changes the training excitation before the test one is derived from it.
+std::pair<rths::io::RigRecord, rths::io::RigRecord> Records(
+    const Truth& truth, double duration_s = 6.0, std::uint64_t seed = 3,
+    const std::function<void(Excitation*)>& edit = {},
+    rths::io::RigRecord (*make)(const Excitation&, const Truth&, const std::string&) = &MakeRecordBlocks) {
   Excitation tr;
   tr.duration_s = duration_s;
   tr.band_hz = 25.0;
   tr.rms_mm = 4.0;
   tr.seed = seed;
+  if (edit) edit(&tr);
   Excitation te = tr;
   te.band_hz = 8.0;
   te.rms_mm = 5.0;
   te.seed = seed + 1000;
   Truth t2 = truth;
   t2.noise_seed += 17;
-  return {MakeRecordBlocks(tr, truth, "train"), MakeRecordBlocks(te, t2, "test")};
+  return {make(tr, truth, "train"), make(te, t2, "test")};
 }
 
 Truth Noisy() {
@@ -214,20 +219,12 @@ TEST_CASE("the displacement prediction's velocity is the servo's exact one, not 
 }
 
 TEST_CASE("nominal records sit at the noise floor whatever the excitation band (none, not unknown)") {
-  // Training BLWN up to 40 Hz with a staircase current, test to 12 Hz, white noise 0.002 mm and
+  // Training BLWN up to 40 Hz with a staircase current, test to 8 Hz, white noise 0.002 mm and
   // 0.05 kN: the force prediction must not carry its own error above the floor.
   Truth t;
   t.effects.sensor_noise = m::SensorNoise{0.002, 0.05};
-  Excitation tr;
-  tr.duration_s = 6.0;
-  tr.band_hz = 40.0;
-  tr.seed = 3;
-  Excitation te = tr;
-  te.band_hz = 12.0;
-  te.seed = 1003;
-  Truth t2 = t;
-  t2.noise_seed += 5;
-  const auto r = Diagnose({MakeRecordRig(tr, t, "train")}, {MakeRecordRig(te, t2, "test")}, PaperModel(), Options{});
+  const auto [tr, te] = Records(t, 6.0, 3, [](Excitation* e) { e->band_hz = 40.0; }, &MakeRecordRig);
+  const auto r = Diagnose({tr}, {te}, PaperModel(), Options{});
   INFO(Summary(r));
   CHECK(r.verdict == std::vector<std::string>{"none"});
   CHECK(r.Channel("f")->floor_ratio <= Options{}.none_ratio);
@@ -258,21 +255,10 @@ TEST_CASE("the block generator solves the same-sample load coupling: finite, and
 TEST_CASE("a state condition that covers most samples is reported as uninformative, not as localisation") {
   // The current switches every 50-100 ms: current_switching (100 ms after a change) covers
   // most samples of the test record (88 %).
-  Truth t;
-  t.effects.sensor_noise = m::SensorNoise{0.01, 0.2};
+  Truth t = Noisy();
   t.effects.damper_scale = m::DamperScale{1.2};
-  Excitation tr;
-  tr.duration_s = 6.0;
-  tr.band_hz = 25.0;
-  tr.seed = 3;
-  tr.hold_min_s = 0.05;
-  tr.hold_max_s = 0.1;
-  Excitation te = tr;
-  te.band_hz = 8.0;
-  te.seed = 1003;
-  Truth t2 = t;
-  t2.noise_seed += 5;
-  const auto r = Diagnose({MakeRecordBlocks(tr, t, "train")}, {MakeRecordBlocks(te, t2, "test")}, PaperModel(), Options{});
+  const auto [tr, te] = Records(t, 6.0, 3, [](Excitation* e) { e->hold_min_s = 0.05, e->hold_max_s = 0.1; });
+  const auto r = Diagnose({tr}, {te}, PaperModel(), Options{});
   bool seen = false;
   for (const auto& c : r.conditions) {
     CAPTURE(c.name);

@@ -1,6 +1,7 @@
 #include "diagnosis/synthetic.h"
 
 #include <cmath>
+#include <utility>
 
 #include <fmt/format.h>
 
@@ -82,10 +83,10 @@ io::RigRecord MakeRecordBlocks(const Excitation& ex, const Truth& truth, const s
   // load_coupling sees the force of the same sample, as in the rig mode: a fixed point solved
   // by models::SolveCoupledForce, each trial re-integrating the step from the saved state.
   double x_prev = 0.0, xd_prev = 0.0, d_prev = 0.0, f_prev = 0.0, f_prev2 = 0.0;
+  models::DisplacementEffects dfx_try = dfx;  // a trial's copy: same sizes, assigned without allocating
   for (std::size_t k = 0; k < n; ++k) {
     const double x = models::Output(servo, xs), xd = models::OutputVelocity(servo, xs);
-    // One trial: the output effects (a copy, committed by the caller) fed the force f_in.
-    models::DisplacementEffects dfx_try = dfx;
+    // One trial: the output effects and the damper from the step's start, fed the force f_in.
     models::MrDamperState ds_try = ds;
     double y = 0.0, f = 0.0;
     auto trial = [&](double f_in) {
@@ -138,7 +139,7 @@ io::RigRecord MakeRecordBlocks(const Excitation& ex, const Truth& truth, const s
     } else {
       trial(f_prev);
     }
-    dfx = dfx_try;
+    std::swap(dfx, dfx_try);  // the accepted trial's state
     ds = ds_try;
     if (k > 0) models::Advance(driver, &cs);
     const double d = y - x;

@@ -89,20 +89,20 @@ void CheckTime(const std::vector<double>& t, double dt_header, const std::string
   for (std::size_t k = 1; k < t.size(); ++k) steps[k - 1] = t[k] - t[k - 1];
   const double med = Median(steps);
   const double n1 = static_cast<double>(t.size() - 1);
-  // A column rounded to a coarse resolution (steps of 0.3 and 0.4 ms for 0.3328 ms) is uniform
-  // on the header's grid: say so instead of calling it non-uniform.
-  const bool on_header_grid = GridDeviation(t, dt_header) <= 0.5 * dt_header;
-  const std::string rounded_hint =
-      on_header_grid ? fmt::format("; every t_s is within half a step of t_0 + k dt_s ({} s): if the column is "
-                                   "rounded, take dt from the header (--time-from-header)",
-                                   dt_header)
-                     : "";
   for (std::size_t k = 1; k < t.size(); ++k) {
     const double d = steps[k - 1];
     if (!(d > 0.0)) {
       throw Error(line_of(k), fmt::format("time t_s = {} does not increase (previous {})", t[k], t[k - 1]));
     }
     if (med > 0.0 && std::abs(d - med) > 0.01 * med) {
+      // A column rounded to a coarse resolution (steps of 0.3 and 0.4 ms for 0.3328 ms) is
+      // uniform on the header's grid: say so instead of calling it non-uniform or a gap.
+      const bool on_header_grid = GridDeviation(t, dt_header) <= 0.5 * dt_header;
+      const std::string rounded_hint =
+          on_header_grid ? fmt::format("; every t_s is within half a step of t_0 + k dt_s ({} s): if the column is "
+                                       "rounded, take dt from the header (--time-from-header)",
+                                       dt_header)
+                         : "";
       if (d > 1.5 * med && !on_header_grid) {
         throw Error(line_of(k), fmt::format("gap in time: t_s jumps from {} to {} ({:.6g} s, {:.3g} steps of {:.6g} s; "
                                             "missing rows?)",
@@ -124,8 +124,8 @@ void CheckTime(const std::vector<double>& t, double dt_header, const std::string
   }
 }
 
-/// TimeAxis::kHeader: dt is the header's; every t_k must lie within half a step of t_0 + k dt
-/// (no row missing or extra); the largest deviation is a warning; t_s becomes t_0 + k dt.
+/// TimeAxis::kHeader: dt is the header's; t must increase and every t_k lie within half a step of
+/// t_0 + k dt (no row missing or extra); the largest deviation is a warning; t_s becomes t_0 + k dt.
 template <class LineOf>
 void TimeFromHeader(RigRecord* rec, LineOf line_of) {
   auto& t = rec->t_s;
@@ -133,6 +133,9 @@ void TimeFromHeader(RigRecord* rec, LineOf line_of) {
   const double dt = rec->dt_s;
   double dev = 0.0;
   for (std::size_t k = 0; k < t.size(); ++k) {
+    if (k > 0 && !(t[k] > t[k - 1])) {
+      throw Error(line_of(k), fmt::format("time t_s = {} does not increase (previous {})", t[k], t[k - 1]));
+    }
     const double place = t[0] + static_cast<double>(k) * dt;
     const double d = std::abs(t[k] - place);
     if (d > 0.5 * dt) {  // the first sample off its place: where a row went missing or extra
@@ -256,9 +259,6 @@ RigRecord ParseRigRecord(std::string_view text, const std::string& path, TimeAxi
   }
   const auto line_of = [&](std::size_t k) { return Where(path, row_line[k]); };
   if (time == TimeAxis::kHeader) {
-    for (std::size_t k = 1; k < rec.t_s.size(); ++k)
-      if (!(rec.t_s[k] > rec.t_s[k - 1]))
-        throw Error(line_of(k), fmt::format("time t_s = {} does not increase (previous {})", rec.t_s[k], rec.t_s[k - 1]));
     TimeFromHeader(&rec, line_of);
   } else {
     CheckTime(rec.t_s, rec.dt_s, Where(path, dt_line), line_of);
