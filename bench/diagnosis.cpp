@@ -1,4 +1,4 @@
-// bench-diagnosis [--seeds N] [--duration S] [--blocks] [--noise-y MM] [--noise-f KN] [--verbose] [--no-pairs] [--only KIND ...] [--runtime-only]
+// bench-diagnosis [--seeds N] [--first-seed S] [--duration S] [--blocks | --independent] [--noise-y MM] [--noise-f KN] [--verbose] [--no-pairs] [--only KIND ...] [--runtime-only]
 // The diagnosis's validation harness (lib/diagnosis/harness.h, docs/diagnosis.md "Harness"):
 // records with known effects, diagnosed without the truth; prints one line per case, the
 // confusion table (true effect vs verdict), the held-out shrink per effect and the scores against
@@ -19,9 +19,14 @@ int main(int argc, char** argv) {
   bool no_pairs = false, runtime_only = false;
   app.add_option("--seeds", o.seeds, "seeds per case kind (default 5)");
   app.add_option("--duration", o.duration_s, "record length [s] (default 20)");
-  bool blocks = false;
+  bool blocks = false, independent = false;
+  app.add_option("--first-seed", o.first_seed, "first seed (default 1): seeds first .. first + N - 1");
   app.add_flag("--blocks", blocks, "make the records with the effect blocks (diagnosis::MakeRecordBlocks) instead of the "
                                    "plant's rig mode (models::MakeRig, the default)");
+  app.add_flag("--independent", independent,
+               "make the records with the independently written generator (diagnosis::MakeIndependentRecord: "
+               "continuous RK4, its own effect forms, excitation families and anti-aliased noise)")
+      ->excludes("--blocks");
   app.add_flag("--no-pairs", no_pairs, "leave out the two-effect cases");
   app.add_option("--only", o.only, "case kinds to run");
   app.add_option("--noise-y", o.noise_y_mm, "sensor noise rms on y [mm] (default 0.01)");
@@ -30,13 +35,17 @@ int main(int argc, char** argv) {
   app.add_flag("--runtime-only", runtime_only, "only the 60 s runtime measurement");
   CLI11_PARSE(app, argc, argv);
   o.pairs = !no_pairs;
-  o.use_rig = !blocks;
+  o.generator = independent ? rths::diagnosis::Generator::kIndependent
+                : blocks      ? rths::diagnosis::Generator::kBlocks
+                              : rths::diagnosis::Generator::kRig;
   try {
     if (!runtime_only) {
       std::printf("harness: %d seeds per case, %.0f s records, generator %s\n", o.seeds, o.duration_s,
-                  o.use_rig ? "rig mode (models::MakeRig)" : "effect blocks");
+                  independent ? "independent (diagnosis::MakeIndependentRecord)"
+                  : blocks    ? "effect blocks"
+                              : "rig mode (models::MakeRig)");
       const auto cases = rths::diagnosis::RunHarness(o, [](const rths::diagnosis::HarnessCase& c) {
-        std::printf("%-40s seed %2llu %-5s verdict %-40s shrink %6.1f %%  %5.2f s  [%s]\n", c.kind.c_str(),
+        std::printf("%-38s seed %2llu %-5s verdict %-44s shrink %6.1f %%  %5.2f s  [%s]\n", c.kind.c_str(),
                     static_cast<unsigned long long>(c.seed), c.right ? "RIGHT" : "wrong",
                     fmt::format("{}", fmt::join(c.verdict, ",")).c_str(), c.shrink_pct, c.runtime_s, c.params.c_str());
         std::fflush(stdout);

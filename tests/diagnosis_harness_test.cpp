@@ -16,7 +16,7 @@ TEST_CASE("harness (rig mode): confusion table and held-out shrink meet the harn
   HarnessOptions o;
   o.seeds = 2;
   o.duration_s = 6.0;
-  o.use_rig = true;
+  o.generator = Generator::kRig;
   o.pairs = true;
   std::string lines;
   const auto cases = RunHarness(o, [&](const HarnessCase& c) {

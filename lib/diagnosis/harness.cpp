@@ -40,6 +40,12 @@ std::vector<std::string> Split(const std::string& s) {
   return out;
 }
 
+// The independent generator's pairs: two the issue found failing (load_coupling+gain_error,
+// backlash+oil_column_resonance) and four more across both channels.
+const std::vector<std::string> kIndependentPairs = {
+    "load_coupling+gain_error", "backlash+oil_column_resonance",         "pure_delay+damper_scale",
+    "gain_error+current_lag",   "oil_column_resonance+coulomb_friction", "servovalve_saturation+current_lag"};
+
 }  // namespace
 
 std::vector<std::string> HarnessCaseKinds(bool pairs) {
@@ -49,6 +55,117 @@ std::vector<std::string> HarnessCaseKinds(bool pairs) {
   k.push_back("unknown_ripple");
   k.push_back("unknown_stiffness");
   return k;
+}
+
+std::vector<std::string> IndependentCaseKinds(bool pairs) {
+  std::vector<std::string> k = kSingles;
+  if (pairs) k.insert(k.end(), kIndependentPairs.begin(), kIndependentPairs.end());
+  for (const char* s : {"none", "none_white", "unknown_ripple", "unknown_cubic", "unknown_asymmetric"}) k.emplace_back(s);
+  return k;
+}
+
+std::vector<std::string> CaseKinds(Generator g, bool pairs) {
+  return g == Generator::kIndependent ? IndependentCaseKinds(pairs) : HarnessCaseKinds(pairs);
+}
+
+IndependentCase IndependentHarnessCase(const std::string& kind, std::uint64_t seed, double duration_s,
+                                       double noise_y_mm, double noise_f_kN) {
+  IndependentCase c;
+  IndependentTruth& t = c.truth;
+  // A stream of its own (not HarnessTruth's): another draw for the same seed.
+  auto g = signal::MakeGaussian(seed * 0x94D049BB133111EBULL + std::hash<std::string>{}(kind) % 1000003 + 17);
+  auto U = [&](double a, double b) { return a + (b - a) * signal::NextUniform(&g); };
+  auto side = [&](double a, double b, double c, double d) { return signal::NextUniform(&g) < 0.5 ? U(a, b) : U(c, d); };
+  auto pick = [&](int n) { return std::min(n - 1, static_cast<int>(std::floor(n * signal::NextUniform(&g)))); };
+  t.noise_y_mm = noise_y_mm;
+  t.noise_f_kN = noise_f_kN;
+  t.noise_seed = seed * 7727 + 3;
+  t.colour = NoiseColour::kAntiAliased;
+  t.drift_fraction = 0.5;
+  std::string txt;
+  for (const auto& e : Split(kind)) {
+    if (e == "pure_delay") {
+      t.delay_ms = U(1.0, 8.0);
+      txt += fmt::format("delay_ms={:.3f} ", t.delay_ms);
+    } else if (e == "gain_error") {
+      t.gain = side(0.85, 0.95, 1.05, 1.2);
+      txt += fmt::format("gain={:.3g} ", t.gain);
+    } else if (e == "load_coupling") {
+      t.compliance_mm_per_kN = U(0.0003, 0.003);
+      txt += fmt::format("compliance_mm_per_kN={:.3g} ", t.compliance_mm_per_kN);
+    } else if (e == "oil_column_resonance") {
+      t.oil_f_hz = U(15.0, 40.0);
+      t.oil_zeta = U(0.05, 0.3);
+      txt += fmt::format("f_hz={:.3g} zeta={:.3g} ", t.oil_f_hz, t.oil_zeta);
+    } else if (e == "coulomb_friction") {
+      t.friction_loss_mm = U(0.05, 0.3);
+      txt += fmt::format("loss_mm={:.3g} ", t.friction_loss_mm);
+    } else if (e == "backlash") {
+      t.backlash_gap_mm = U(0.1, 0.6);
+      txt += fmt::format("gap_mm={:.3g} ", t.backlash_gap_mm);
+    } else if (e == "servovalve_saturation") {
+      t.vmax_mm_per_s = U(150.0, 300.0);
+      txt += fmt::format("vmax_mm_per_s={:.4g} ", t.vmax_mm_per_s);
+    } else if (e == "current_lag") {
+      t.current_lag_ms = U(20.0, 150.0);
+      txt += fmt::format("lag_ms={:.3g} ", t.current_lag_ms);
+    } else if (e == "damper_scale") {
+      t.damper_scale = side(0.75, 0.9, 1.1, 1.3);
+      txt += fmt::format("scale={:.3g} ", t.damper_scale);
+    } else if (e == "none") {
+    } else if (e == "none_white") {
+      t.colour = NoiseColour::kWhite;
+      t.drift_fraction = 0.0;
+      txt += "white noise ";
+    } else if (e == "unknown_ripple") {
+      t.ripple_mm = U(0.05, 0.2);
+      t.ripple_hz = U(11.0, 17.0);
+      txt += fmt::format("ripple_mm={:.3g} ripple_hz={:.3g} ", t.ripple_mm, t.ripple_hz);
+    } else if (e == "unknown_cubic") {
+      t.cubic_kN_per_mm3 = U(0.005, 0.02);
+      txt += fmt::format("cubic_kN_per_mm3={:.3g} ", t.cubic_kN_per_mm3);
+    } else if (e == "unknown_asymmetric") {
+      t.asymmetric_gain = U(0.05, 0.12);
+      txt += fmt::format("asymmetric_gain={:.3g} ", t.asymmetric_gain);
+    } else {
+      throw Error("harness", "unknown independent case kind " + kind);
+    }
+  }
+  // Training: a broad family (band noise to 40 Hz, a chirp 0.5-40 Hz or a multisine 0.5-30 Hz)
+  // with a varying current; test: another family, narrower (band noise to 12 Hz, a multisine
+  // 0.3-10 Hz, a chirp 0.3-10 Hz or an SDOF under El Centro), another varying current.
+  IndependentExcitation& tr = c.train;
+  tr.duration_s = duration_s;
+  tr.seed = seed * 2 + 1;
+  const CommandFamily train_families[] = {CommandFamily::kBandNoise, CommandFamily::kChirp, CommandFamily::kMultisine};
+  tr.command = train_families[pick(3)];
+  tr.rms_mm = 4.0;
+  if (tr.command == CommandFamily::kBandNoise) tr.lo_hz = 0.0, tr.hi_hz = 40.0;
+  else if (tr.command == CommandFamily::kChirp) tr.lo_hz = 0.5, tr.hi_hz = 40.0;
+  else tr.lo_hz = 0.5, tr.hi_hz = 30.0;
+  const CurrentPattern varying[] = {CurrentPattern::kPulsed, CurrentPattern::kStaircase, CurrentPattern::kTelegraph};
+  tr.current = varying[pick(3)];
+  tr.current_period_s = tr.current == CurrentPattern::kStaircase ? U(0.2, 0.5) : U(0.5, 1.5);
+  IndependentExcitation& te = c.test;
+  te.duration_s = duration_s;
+  te.seed = seed * 2 + 1000003;
+  std::vector<CommandFamily> test_families;
+  for (auto f : {CommandFamily::kBandNoise, CommandFamily::kMultisine, CommandFamily::kChirp, CommandFamily::kEarthquake})
+    if (f != tr.command) test_families.push_back(f);
+  te.command = test_families[static_cast<std::size_t>(pick(static_cast<int>(test_families.size())))];
+  te.rms_mm = 5.0;
+  if (te.command == CommandFamily::kBandNoise) te.lo_hz = 0.0, te.hi_hz = 12.0;
+  else if (te.command == CommandFamily::kEarthquake) te.lo_hz = U(1.5, 4.0), te.rms_mm = 8.0;
+  else te.lo_hz = 0.3, te.hi_hz = 10.0;
+  te.current = varying[pick(3)];
+  te.current_period_s = te.current == CurrentPattern::kStaircase ? U(0.3, 0.8) : U(0.6, 2.0);
+  auto ex_text = [](const IndependentExcitation& x) {
+    return x.command == CommandFamily::kEarthquake
+               ? fmt::format("{} fn={:.2g}Hz/{}", Name(x.command), x.lo_hz, Name(x.current))
+               : fmt::format("{} {:.3g}-{:.3g}Hz/{}", Name(x.command), x.lo_hz, x.hi_hz, Name(x.current));
+  };
+  c.text = txt + fmt::format("| train {} | test {}", ex_text(tr), ex_text(te));
+  return c;
 }
 
 Truth HarnessTruth(const std::string& kind, std::uint64_t seed, double noise_y_mm, double noise_f_kN,
@@ -110,32 +227,42 @@ HarnessCase RunHarnessCase(const std::string& kind, std::uint64_t seed, const Ha
   HarnessCase c;
   c.kind = kind;
   c.seed = seed;
-  const Truth truth = HarnessTruth(kind, seed, o.noise_y_mm, o.noise_f_kN, &c.params);
-  if (kind == "none") c.truth = {"none"};
+  if (kind.rfind("none", 0) == 0) c.truth = {"none"};
   else if (kind.rfind("unknown", 0) == 0) c.truth = {"unknown"};
   else c.truth = Split(kind);
   std::sort(c.truth.begin(), c.truth.end());
-  Excitation tr;
-  tr.duration_s = o.duration_s;
-  tr.band_hz = 25.0;
-  tr.rms_mm = 4.0;
-  tr.seed = seed * 2 + 1;
-  Excitation te = tr;
-  te.band_hz = 8.0;
-  te.rms_mm = 5.0;
-  te.seed = seed * 2 + 1000003;
-  te.hold_min_s = 0.3;
-  te.hold_max_s = 1.5;
-  Truth ttr = truth, tte = truth;
-  tte.noise_seed = truth.noise_seed + 99991;
-  const auto make = o.use_rig ? &MakeRecordRig : &MakeRecordBlocks;
-  const auto rtr = make(tr, ttr, fmt::format("{}-s{}-train", kind, seed));
-  const auto rte = make(te, tte, fmt::format("{}-s{}-test", kind, seed));
+  io::RigRecord rtr, rte;
+  if (o.generator == Generator::kIndependent) {
+    const IndependentCase ic = IndependentHarnessCase(kind, seed, o.duration_s, o.noise_y_mm, o.noise_f_kN);
+    c.params = ic.text;
+    IndependentTruth ttr = ic.truth, tte = ic.truth;
+    tte.noise_seed = ic.truth.noise_seed + 99991;
+    rtr = MakeIndependentRecord(ic.train, ttr, fmt::format("{}-s{}-train", kind, seed));
+    rte = MakeIndependentRecord(ic.test, tte, fmt::format("{}-s{}-test", kind, seed));
+  } else {
+    const Truth truth = HarnessTruth(kind, seed, o.noise_y_mm, o.noise_f_kN, &c.params);
+    Excitation tr;
+    tr.duration_s = o.duration_s;
+    tr.band_hz = 25.0;
+    tr.rms_mm = 4.0;
+    tr.seed = seed * 2 + 1;
+    Excitation te = tr;
+    te.band_hz = 8.0;
+    te.rms_mm = 5.0;
+    te.seed = seed * 2 + 1000003;
+    te.hold_min_s = 0.3;
+    te.hold_max_s = 1.5;
+    Truth ttr = truth, tte = truth;
+    tte.noise_seed = truth.noise_seed + 99991;
+    const auto make = o.generator == Generator::kRig ? &MakeRecordRig : &MakeRecordBlocks;
+    rtr = make(tr, ttr, fmt::format("{}-s{}-train", kind, seed));
+    rte = make(te, tte, fmt::format("{}-s{}-test", kind, seed));
+  }
   const auto t0 = std::chrono::steady_clock::now();
   const Result r = Diagnose({rtr}, {rte}, PaperModel(), Options{});
   c.runtime_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   c.verdict = r.verdict;
-  if (o.verbose) std::printf("--- %s seed %llu\n%s", kind.c_str(), static_cast<unsigned long long>(seed), Summary(r).c_str());
+  if (o.verbose) std::printf("--- %s seed %llu [%s]\n%s", kind.c_str(), static_cast<unsigned long long>(seed), c.params.c_str(), Summary(r).c_str());
   auto v = r.verdict;
   std::sort(v.begin(), v.end());
   c.right = v == c.truth;
@@ -155,10 +282,10 @@ HarnessCase RunHarnessCase(const std::string& kind, std::uint64_t seed, const Ha
 
 std::vector<HarnessCase> RunHarness(const HarnessOptions& o, const std::function<void(const HarnessCase&)>& progress) {
   std::vector<HarnessCase> out;
-  for (const auto& kind : HarnessCaseKinds(o.pairs)) {
+  for (const auto& kind : CaseKinds(o.generator, o.pairs)) {
     if (!o.only.empty() && std::find(o.only.begin(), o.only.end(), kind) == o.only.end()) continue;
-    for (int s = 1; s <= o.seeds; ++s) {
-      out.push_back(RunHarnessCase(kind, static_cast<std::uint64_t>(s), o));
+    for (int s = 0; s < o.seeds; ++s) {
+      out.push_back(RunHarnessCase(kind, o.first_seed + static_cast<std::uint64_t>(s), o));
       if (progress) progress(out.back());
     }
   }

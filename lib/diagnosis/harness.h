@@ -10,19 +10,30 @@
 /// seed and staircase); sensor noise 0.01 mm and 0.2 kN rms on every record.
 /// Right verdict: the set of effects named equals the truth (order free); none -> ["none"];
 /// outside the library -> ["unknown"].
+#include <cstdint>
 #include <functional>
 #include <string>
 #include <vector>
 
 #include "diagnosis/diagnosis.h"
+#include "diagnosis/independent_rig.h"
 #include "diagnosis/synthetic.h"
 
 namespace rths::diagnosis {
 
+/// Which generator makes the harness's records.
+enum class Generator {
+  kRig,          ///< the plant's rig mode (MakeRecordRig)
+  kBlocks,       ///< the effect blocks (MakeRecordBlocks)
+  kIndependent,  ///< the independently written continuous rig (MakeIndependentRecord), its own
+                 ///< effect forms, excitation families and coloured noise (IndependentCaseKinds)
+};
+
 struct HarnessOptions {
   int seeds = 5;                 ///< seeds per case kind
+  std::uint64_t first_seed = 1;  ///< seeds first_seed .. first_seed + seeds - 1
   double duration_s = 20.0;      ///< each record's length [s]
-  bool use_rig = false;          ///< records from the plant's rig mode (MakeRecordRig), else the blocks
+  Generator generator = Generator::kBlocks;
   std::vector<std::string> only; ///< case kinds to run (empty: all)
   bool pairs = true;             ///< include the two-effect cases
   double noise_y_mm = 0.01, noise_f_kN = 0.2;
@@ -40,8 +51,31 @@ struct HarnessCase {
   double runtime_s = 0;
 };
 
-/// The case kinds: 9 single effects, pairs, "none", "unknown_ripple", "unknown_stiffness".
+/// The case kinds of the rig and blocks generators: 9 single effects, pairs, "none",
+/// "unknown_ripple", "unknown_stiffness".
 std::vector<std::string> HarnessCaseKinds(bool pairs);
+
+/// The case kinds of the independent generator: the 9 single effects (its own forms), pairs
+/// (load_coupling+gain_error, backlash+oil_column_resonance, pure_delay+damper_scale,
+/// gain_error+current_lag, oil_column_resonance+coulomb_friction, servovalve_saturation+current_lag),
+/// "none" (anti-aliased noise with drift), "none_white" (white noise, no drift), and outside the
+/// library "unknown_ripple" (amplitude-modulated, 11-17 Hz), "unknown_cubic" (F += k3 y^3),
+/// "unknown_asymmetric" (valve gain 1 +- a).
+std::vector<std::string> IndependentCaseKinds(bool pairs);
+
+/// The case kinds of a generator.
+std::vector<std::string> CaseKinds(Generator g, bool pairs);
+
+/// One independent case's truth (parameters drawn from the seed; ranges in docs/diagnosis.md)
+/// and its training and test excitations (families drawn from the seed, the test's always another
+/// family than the training's). Throws rths::Error for an unknown kind.
+struct IndependentCase {
+  IndependentTruth truth;
+  IndependentExcitation train, test;
+  std::string text;  ///< parameters and excitations, as text
+};
+IndependentCase IndependentHarnessCase(const std::string& kind, std::uint64_t seed, double duration_s,
+                                       double noise_y_mm, double noise_f_kN);
 
 /// Draws the truth of a case kind for a seed (parameters in documented ranges).
 Truth HarnessTruth(const std::string& kind, std::uint64_t seed, double noise_y_mm, double noise_f_kN,
@@ -50,7 +84,7 @@ Truth HarnessTruth(const std::string& kind, std::uint64_t seed, double noise_y_m
 /// Runs one case. progress (may be empty) is called after it.
 HarnessCase RunHarnessCase(const std::string& kind, std::uint64_t seed, const HarnessOptions& o);
 
-/// Runs every case of o; calls progress after each.
+/// Runs every case of o (CaseKinds(o.generator, o.pairs), seeds first_seed ..); calls progress after each.
 std::vector<HarnessCase> RunHarness(const HarnessOptions& o, const std::function<void(const HarnessCase&)>& progress = {});
 
 /// Scores: fractions right per class and the mean held-out shrink of correctly identified singles.
