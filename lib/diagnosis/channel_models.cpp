@@ -30,6 +30,7 @@ NominalModel LoadModel(const std::string& path) {
   m.actuator = s.plant.actuator;
   m.damper = s.plant.damper;
   m.current_dynamics = s.plant.current_dynamics;
+  m.current_driver = s.plant.current_driver;
   m.has_damper = !actuator_only && s.plant.specimen == models::Specimen::kMrDamper;
   m.source = fmt::format("{}: [plant] actuator K={:.6g} p={:.6g} b={:.6g} c={:.6g}", path, m.actuator.K,
                          m.actuator.p, m.actuator.b, m.actuator.c);
@@ -42,7 +43,10 @@ NominalModel LoadModel(const std::string& path) {
                                   NameOf(models::kSpecimenNames, s.plant.specimen)));
   } else {
     m.source += fmt::format("; Spencer damper from [plant.damper]; current dynamics {}",
-                            m.current_dynamics ? "Eq. 40 + 75 Hz" : "off");
+                            !m.current_dynamics ? "off"
+                            : m.current_driver.kind == models::CurrentFilter::kFirstOrder
+                                ? fmt::format("first order, eta = {:g} 1/s", m.current_driver.eta_1_s)
+                                : std::string("Eq. 40 + 75 Hz"));
   }
   if (s.plant.kind != models::PlantKind::kLinear)
     m.notes.push_back(fmt::format("{}: plant.kind = \"{}\": the diagnosis uses the 3-pole [plant] actuator "
@@ -102,13 +106,19 @@ SmoothedMotion SmoothMotion(std::span<const double> y_mm, double dt_s, double sm
 }
 
 SmoothedMotion ModelAidedMotion(std::span<const double> y_mm, std::span<const double> yhat_mm,
-                                std::span<const double> vhat_mm_s, double dt_s, double smooth_hz) {
+                                std::span<const double> vhat_mm_s, double dt_s, double smooth_hz,
+                                std::span<const double> ahat_mm_s2) {
   const std::size_t n = y_mm.size();
-  if (yhat_mm.size() != n || (!vhat_mm_s.empty() && vhat_mm_s.size() != n))
+  if (yhat_mm.size() != n || (!vhat_mm_s.empty() && vhat_mm_s.size() != n) ||
+      (!ahat_mm_s2.empty() && (ahat_mm_s2.size() != n || vhat_mm_s.empty())))
     throw Error("ModelAidedMotion", "lengths differ");
   std::vector<double> res(n);
   for (std::size_t k = 0; k < n; ++k) res[k] = y_mm[k] - yhat_mm[k];
   SmoothedMotion m = SmoothMotion(res, dt_s, smooth_hz);  // x = S(res), v = its derivative
+  if (!ahat_mm_s2.empty()) {
+    Differentiate(m.v_mm_s, dt_s, &m.a_mm_s2);  // d^2/dt^2 S(res)
+    for (std::size_t k = 0; k < n; ++k) m.a_mm_s2[k] += ahat_mm_s2[k];
+  }
   for (std::size_t k = 0; k < n; ++k) m.x_mm[k] += yhat_mm[k];
   if (vhat_mm_s.empty()) {
     Differentiate(m.x_mm, dt_s, &m.v_mm_s);
@@ -120,14 +130,16 @@ SmoothedMotion ModelAidedMotion(std::span<const double> y_mm, std::span<const do
 
 std::vector<double> PredictDisplacement(const models::LinearServo& servo, const models::EffectSet& effects,
                                         std::span<const double> u_mm, std::span<const double> f_kN,
-                                        std::vector<double>* v_mm_s) {
+                                        std::vector<double>* v_mm_s, std::vector<double>* a_mm_s2) {
   const std::size_t n = u_mm.size();
   std::vector<double> y(n);
-  std::vector<double> servo_v;  // the servo's exact velocity z1 at t_k (phase variables)
+  std::vector<double> servo_v, servo_a;  // the servo's exact velocity z1 and acceleration z2 at t_k
+  if (a_mm_s2 != nullptr && v_mm_s == nullptr) throw Error("PredictDisplacement", "an acceleration needs the velocity");
   if (v_mm_s != nullptr) {
     servo_v.resize(n);
     v_mm_s->resize(n);
   }
+  if (a_mm_s2 != nullptr) servo_a.resize(n);
   models::DisplacementEffects fx(effects, servo.dt_s);
   // Plain 3x3 arithmetic (this is the inner loop of every fit).
   const Eigen::Matrix3d& P = servo.Phi;
@@ -141,6 +153,7 @@ std::vector<double> PredictDisplacement(const models::LinearServo& servo, const 
       servo_v[k] = z1;
       (*v_mm_s)[k] = y[k] - z0;  // the output effects' share, differentiated below
     }
+    if (a_mm_s2 != nullptr) servo_a[k] = z2;
     const double ua = fx.Pre(u_mm[k]);
     const double n0 = P(0, 0) * z0 + P(0, 1) * z1 + P(0, 2) * z2 + G(0) * ua;
     const double n1 = P(1, 0) * z0 + P(1, 1) * z1 + P(1, 2) * z2 + G(1) * ua;
@@ -151,13 +164,18 @@ std::vector<double> PredictDisplacement(const models::LinearServo& servo, const 
     std::vector<double> post_v;
     Differentiate(*v_mm_s, servo.dt_s, &post_v);
     for (std::size_t k = 0; k < n; ++k) (*v_mm_s)[k] = servo_v[k] + post_v[k];
+    if (a_mm_s2 != nullptr) {
+      Differentiate(post_v, servo.dt_s, a_mm_s2);
+      for (std::size_t k = 0; k < n; ++k) (*a_mm_s2)[k] += servo_a[k];
+    }
   }
   return y;
 }
 
-ForcePredictor::ForcePredictor(const models::MrDamperParams& damper, bool current_dynamics, double dt_s)
+ForcePredictor::ForcePredictor(const models::MrDamperParams& damper, bool current_dynamics, double dt_s,
+                               const models::CurrentDriverParams& driver)
     : damper_(damper), current_dynamics_(current_dynamics), dt_s_(dt_s),
-      driver_(models::CurrentDriver::Make({}, dt_s)) {
+      driver_(models::CurrentDriver::Make(driver, dt_s)) {
   damper_.Validate();
 }
 
@@ -215,6 +233,7 @@ std::vector<double> ForcePredictor::PredictUnscaled(const SmoothedMotion& motion
   double half1 = 1.0;
   std::complex<double> half{1.0, 0.0};
   std::vector<double> ic(2 * 256 + 1);
+  const bool quintic = motion.a_mm_s2.size() == n;
   for (std::size_t k = 0; k < n; ++k) {
     const double ic_k = current_dynamics_ ? models::EffectiveCurrentA(driver_, cs) : cs.held_A;
     f[k] = models::DamperForceKn(coef_at(ic_k), s, motion.x_mm[k], motion.v_mm_s[k]);
@@ -228,6 +247,7 @@ std::vector<double> ForcePredictor::PredictUnscaled(const SmoothedMotion& motion
     const bool constant = !current_dynamics_ || models::AtSteadyState(cs);
     const double x0 = motion.x_mm[k], x1 = motion.x_mm[k + 1];
     const double v0 = motion.v_mm_s[k], v1 = motion.v_mm_s[k + 1];
+    const double a0 = quintic ? motion.a_mm_s2[k] : 0.0, a1 = quintic ? motion.a_mm_s2[k + 1] : 0.0;
     // Substeps from the size of the local Jacobian at the start of the step (file comment).
     const models::MrDamperCoefficients c0 = coef_at(constant ? cs.held_A : models::EffectiveCurrentAt(driver_, cs, 0.0));
     const double vmax = std::max(std::abs(v0), std::abs(v1));
@@ -235,7 +255,18 @@ std::vector<double> ForcePredictor::PredictUnscaled(const SmoothedMotion& motion
     const double zpow = c0.n == 2.0 ? zabs : std::pow(zabs, c0.n - 1.0);
     const double lam = (c0.beta + c0.gamma) * c0.n * zpow * vmax + c0.A * c0.alpha / (c0.c0 + c0.c1) +
                        c0.k0 / (c0.c0 + c0.c1);
-    const int m = std::clamp(static_cast<int>(std::ceil(dt * lam / kRk4StepLambda)), 1, 256);
+    int m = std::clamp(static_cast<int>(std::ceil(dt * lam / kRk4StepLambda)), 1, 256);
+    // A reversal of the relative velocity r = x' - y' inside the step: Eq. 33 has a kink there
+    // (|r|), which RK4 integrates with an error of about A alpha |r'| h^2 / 8 in alpha z (its
+    // slope jumps by up to A), whatever the Jacobian's size. Substeps so that it stays below
+    // kKinkForceTolKn.
+    const double r0 = v0 - models::DamperRates(c0, s, x0, v0).ydot_mm_s;
+    const double r1 = v1 - models::DamperRates(c0, s, x1, v1).ydot_mm_s;
+    const double dr = std::abs(v1 - v0);
+    if (r0 * r1 <= 0.0 || std::min(std::abs(r0), std::abs(r1)) < dr) {
+      const double kink = c0.A * c0.alpha * dr / dt / 8.0;  // [kN / s^2]
+      if (kink > 0) m = std::clamp(static_cast<int>(std::ceil(dt * std::sqrt(kink / kKinkForceTolKn))), m, 256);
+    }
     const double h = dt / m;
     if (!constant) {
       if (m != cached_m) {
@@ -254,6 +285,17 @@ std::vector<double> ForcePredictor::PredictUnscaled(const SmoothedMotion& motion
     auto motion_at = [&](double tau, double* x, double* xd) {
       const double t = tau / dt;
       const double t2 = t * t, t3 = t2 * t;
+      if (quintic) {  // Hermite through (x, v, a) at both ends
+        const double t4 = t3 * t, t5 = t4 * t, d2 = dt * dt;
+        *x = (1 - 10 * t3 + 15 * t4 - 6 * t5) * x0 + (t - 6 * t3 + 8 * t4 - 3 * t5) * dt * v0 +
+             0.5 * (t2 - 3 * t3 + 3 * t4 - t5) * d2 * a0 + (10 * t3 - 15 * t4 + 6 * t5) * x1 +
+             (-4 * t3 + 7 * t4 - 3 * t5) * dt * v1 + 0.5 * (t3 - 2 * t4 + t5) * d2 * a1;
+        *xd = ((-30 * t2 + 60 * t3 - 30 * t4) * x0 + (1 - 18 * t2 + 32 * t3 - 15 * t4) * dt * v0 +
+               0.5 * (2 * t - 9 * t2 + 12 * t3 - 5 * t4) * d2 * a0 + (30 * t2 - 60 * t3 + 30 * t4) * x1 +
+               (-12 * t2 + 28 * t3 - 15 * t4) * dt * v1 + 0.5 * (3 * t2 - 8 * t3 + 5 * t4) * d2 * a1) /
+              dt;
+        return;
+      }
       *x = (2 * t3 - 3 * t2 + 1) * x0 + (t3 - 2 * t2 + t) * dt * v0 + (-2 * t3 + 3 * t2) * x1 + (t3 - t2) * dt * v1;
       *xd = ((6 * t2 - 6 * t) * x0 + (3 * t2 - 4 * t + 1) * dt * v0 + (-6 * t2 + 6 * t) * x1 + (3 * t2 - 2 * t) * dt * v1) / dt;
     };

@@ -28,9 +28,14 @@
 ///   3. The Spencer damper (Eqs. 32-33) is integrated by classical Runge-Kutta (RK4) with
 ///      m substeps per sample, m = ceil(dt lambda / kRk4StepLambda), lambda the size of the local
 ///      Jacobian, (beta + gamma) n |z|^(n-1) max(|v_k|, |v_{k+1}|) + A alpha / (c0 + c1) +
-///      k0 / (c0 + c1) (so h lambda <= 0.8, inside RK4's stability interval [-2.78, 0] and
-///      accurate: R(-0.8) = 0.4493 vs e^-0.8 = 0.4493; checked against CVODE at 1e-8 in
-///      tests/diagnosis_test.cpp). Eqs. 35-39 come from a 1 mA table (linear interpolation) and
+///      k0 / (c0 + c1) (so h lambda <= 0.4, inside RK4's stability interval [-2.78, 0]; at 0.8
+///      the saturating Bouc-Wen phase near peak velocity left 0.01-0.02 kN at 80 Hz and 2.5 A;
+///      checked against CVODE at 1e-8 in tests/diagnosis_test.cpp). Where x' - y' may change sign inside the step (a reversal),
+///      Eq. 33's right-hand side has a kink (its |x' - y'|) and RK4's error there is
+///      about A alpha |x''| h^2 / 8 in the force, not bounded by h lambda: the step then takes
+///      m >= dt sqrt(A alpha |x''| / (8 kKinkForceTolKn)) substeps (at 80 Hz excitation and 2.5 A one
+///      substep across a reversal left 0.1 kN in alpha z that decayed over many samples).
+///      Eqs. 35-39 come from a 1 mA table (linear interpolation) and
 ///      i_c at the substep times from the driver's closed form advanced by multiplication.
 ///      Deterministic, about a microsecond per sample.
 ///   4. fhat_k = Force(Eq. 34 at (ys_k, v_k), i_c(t_k)) (damper_scale).
@@ -48,7 +53,10 @@
 namespace rths::diagnosis {
 
 /// RK4 step size bound h lambda of the force predictor (file comment, step 3).
-inline constexpr double kRk4StepLambda = 0.8;
+inline constexpr double kRk4StepLambda = 0.4;
+/// Where the relative velocity may reverse inside a step, RK4 substeps h with
+/// A alpha |x''| h^2 / 8 <= this force [kN] (the kink of Eq. 33 at x' = y'; file comment, step 3).
+inline constexpr double kKinkForceTolKn = 1e-3;
 
 /// The nominal model: what the lab believes its rig is.
 struct NominalModel {
@@ -56,6 +64,7 @@ struct NominalModel {
   bool has_damper = true;                  ///< false: the force channel is not diagnosed
   models::MrDamperParams damper{};         ///< Spencer model (default Table 3)
   bool current_dynamics = true;            ///< Eq. 40 + 75 Hz low-pass on the current
+  models::CurrentDriverParams current_driver{};  ///< their form ([plant.current_driver])
   std::string source = "paper: Eq. 30 (ZOH), Spencer damper with Table 3, Eq. 40 + 75 Hz low-pass";
   std::vector<std::string> notes;          ///< what was read and how (for the report)
 };
@@ -75,6 +84,9 @@ NominalModel LoadModel(const std::string& path);
 struct SmoothedMotion {
   std::vector<double> x_mm;     ///< smoothed displacement [mm]
   std::vector<double> v_mm_s;   ///< velocity [mm/s]
+  /// Acceleration [mm/s^2], or empty. With it, the motion inside a step is the quintic Hermite
+  /// through (x, v, a) at both ends, else the cubic through (x, v) (ForcePredictor).
+  std::vector<double> a_mm_s2;
 };
 /// Throws rths::Error unless smooth_hz is in (0, 0.5/dt_s) and y has at least 4 samples.
 SmoothedMotion SmoothMotion(std::span<const double> y_mm, double dt_s, double smooth_hz);
@@ -87,22 +99,31 @@ SmoothedMotion SmoothMotion(std::span<const double> y_mm, double dt_s, double sm
 /// it. The model's velocity matters: a servo driven by a held command has a jump of its third
 /// derivative at every sample, so a difference quotient of sampled y errs by O(dt^2 K du)
 /// however smooth the data (a 40 Hz excitation at 2 kHz: a force error 15 times the noise floor).
+/// With ahat_mm_s2 (the model's own acceleration, same length as vhat) the motion also carries
+/// a = ahat + d^2/dt^2 S(y - yhat), and the force predictor interpolates it by a quintic inside a
+/// step: a servo driven by a held command is smooth inside the step (only its jerk jumps at the
+/// samples), so the quintic through (x, v, a) errs by O(dt^6) where the cubic errs by O(dt^4 x^(4)).
 SmoothedMotion ModelAidedMotion(std::span<const double> y_mm, std::span<const double> yhat_mm,
-                                std::span<const double> vhat_mm_s, double dt_s, double smooth_hz);
+                                std::span<const double> vhat_mm_s, double dt_s, double smooth_hz,
+                                std::span<const double> ahat_mm_s2 = {});
 
 /// Displacement channel prediction yhat_k for one record (file comment). `effects` may hold
 /// any effects; only the displacement ones act. f_kN: the measured force f_k (load_coupling).
 /// v_mm_s (optional): the prediction's velocity [mm/s] at t_k: the servo's exact velocity (its
 /// state y-dot) plus the difference quotient of what the output effects add to its displacement.
+/// a_mm_s2 (optional, with v_mm_s): its acceleration [mm/s^2], the servo's exact y'' plus the
+/// difference quotient of the effects' velocity share.
 std::vector<double> PredictDisplacement(const models::LinearServo& servo,
                                         const models::EffectSet& effects,
                                         std::span<const double> u_mm, std::span<const double> f_kN,
-                                        std::vector<double>* v_mm_s = nullptr);
+                                        std::vector<double>* v_mm_s = nullptr,
+                                        std::vector<double>* a_mm_s2 = nullptr);
 
 /// Force channel predictor: an immutable description (damper, current dynamics, dt).
 class ForcePredictor {
  public:
-  ForcePredictor(const models::MrDamperParams& damper, bool current_dynamics, double dt_s);
+  ForcePredictor(const models::MrDamperParams& damper, bool current_dynamics, double dt_s,
+                 const models::CurrentDriverParams& driver = {});
   /// fhat_k for one record (file comment, steps 2-4): the smoothed motion and the current
   /// commands i_A (same length). Only the force effects of `effects` act.
   std::vector<double> Predict(const SmoothedMotion& motion, std::span<const double> i_A,

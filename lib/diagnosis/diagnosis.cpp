@@ -64,7 +64,8 @@ bool Options::IsValid(std::string* error) const {
          real("displacement_only_smooth_factor", displacement_only_smooth_factor, 0.0, inf, true, true) &&
          real("vmax_search_factor", vmax_search_factor, 1.0, inf, false, true) &&
          real("noise_band_lo", noise_band_lo, 0.0, 1.0, false, true) &&
-         real("noise_band_hi", noise_band_hi, noise_band_lo, 1.0, true, false) &&
+         real("noise_band_split", noise_band_split, noise_band_lo, 1.0, true, true) &&
+         real("noise_band_hi", noise_band_hi, noise_band_split, 1.0, true, false) &&
          integer("noise_psd_segment", noise_psd_segment, 8, 1 << 20) &&
          integer("whiteness_lags", whiteness_lags, 1, 10000) &&
          integer("correlation_max_lag", correlation_max_lag, 1, imax - 1) &&
@@ -73,6 +74,7 @@ bool Options::IsValid(std::string* error) const {
          real("min_excess_reduction", min_excess_reduction, 0.0, 1.0, true, true) &&
          real("min_floor_gain", min_floor_gain, 0.0, inf, false, true) &&
          integer("max_effects_per_channel", max_effects_per_channel, 1, imax) &&
+         real("min_delay_samples", min_delay_samples, 0.0, inf, false, true) &&
          real("at_bound_fraction", at_bound_fraction, 0.0, 0.5, false, true) &&
          integer("swap_passes", swap_passes, 0, 100) &&
          real("swap_min_gain", swap_min_gain, 0.0, 1.0, false, true) &&
@@ -146,6 +148,15 @@ bool AtBound(const CandidateSpec& spec, const std::vector<double>& v, double fra
   return false;
 }
 
+/// true if the set holds pure_delay beside another effect and its tau is shorter than
+/// o.min_delay_samples dt: a delay below a sample is a timing convention (a ZOH lags by dt/2, a
+/// discrete block and a continuous effect differ by a fraction of a sample), which a sub-sample
+/// delay added to the other effect only compensates; it is not a transport delay of its own.
+bool SubSampleDelayBeside(const Params& p, double dt, const Options& o) {
+  const auto it = p.find("pure_delay");
+  return it != p.end() && p.size() >= 2 && 1e-3 * it->second[0] < o.min_delay_samples * dt;
+}
+
 /// The damper scale fitted on the training records, if the set has one: on the test records it is
 /// held at that value (not refitted in closed form).
 std::optional<double> FittedScale(const Params& p) {
@@ -198,7 +209,7 @@ Data Prepare(const io::RigRecord& r, const Options& o) {
   d.u = r.u_mm;
   d.y = r.y_mm;
   d.f = r.f_kN;
-  d.i = r.i_A;
+  d.i = r.Command();  // the current, or the voltage of a record without one
   if (o.detrend) {
     for (auto* v : {&d.u, &d.y, &d.f}) {
       const double m = std::accumulate(v->begin(), v->end(), 0.0) / static_cast<double>(v->size());
@@ -536,9 +547,12 @@ double IntegratedCorrelationTime(const Channel& ch, const std::vector<std::vecto
   return tau;
 }
 
-/// Noise floor of a residual set: sigma^2 = median PSD over [o.noise_band_lo, o.noise_band_hi]
-/// f_Nyq x f_Nyq, PSDs (Welch, segments of o.noise_psd_segment samples) of the records averaged
-/// with weights by their length.
+/// Noise floor of a residual set: the level of the residual PSD's plateau above the excitation,
+/// sigma^2 = f_Nyq x max(median PSD over [lo, split] f_Nyq, median PSD over [split, hi] f_Nyq)
+/// (o.noise_band_lo, o.noise_band_split, o.noise_band_hi), PSDs (Welch, segments of
+/// o.noise_psd_segment samples) of the records averaged with weights by their length. For white
+/// noise both medians estimate the same level; a sensor's anti-alias filter lowers the upper band
+/// (a 4th-order Butterworth at 0.8 f_Nyq: its median to 70 % of the plateau), never the lower one.
 double NoiseFloorVar(const Channel& ch, const std::vector<std::vector<double>>& pred, const Options& o) {
   std::vector<double> psd;
   double wsum = 0;
@@ -559,15 +573,18 @@ double NoiseFloorVar(const Channel& ch, const std::vector<std::vector<double>>& 
     wsum += static_cast<double>(n);
   }
   if (psd.empty() || wsum <= 0) return 0.0;
-  std::vector<double> top;
   const double df = 2.0 * nyq / static_cast<double>(L);
-  for (std::size_t j = 0; j < psd.size(); ++j) {
-    const double f = static_cast<double>(j) * df;
-    if (f >= o.noise_band_lo * nyq && f <= o.noise_band_hi * nyq) top.push_back(psd[j] / wsum);
-  }
-  if (top.empty()) return 0.0;
-  std::nth_element(top.begin(), top.begin() + static_cast<std::ptrdiff_t>(top.size() / 2), top.end());
-  return top[top.size() / 2] * nyq;
+  auto median = [&](double lo, double hi) {
+    std::vector<double> band;
+    for (std::size_t j = 0; j < psd.size(); ++j) {
+      const double f = static_cast<double>(j) * df;
+      if (f >= lo * nyq && f <= hi * nyq) band.push_back(psd[j] / wsum);
+    }
+    if (band.empty()) return 0.0;
+    std::nth_element(band.begin(), band.begin() + static_cast<std::ptrdiff_t>(band.size() / 2), band.end());
+    return band[band.size() / 2];
+  };
+  return nyq * std::max(median(o.noise_band_lo, o.noise_band_split), median(o.noise_band_split, o.noise_band_hi));
 }
 
 /// n sum_{l=1..L} r_l^2 of the residual, L = o.whiteness_lags (records pooled by summing
@@ -663,6 +680,7 @@ void MarkNotDiagnosed(ChannelState* s) {
 
 void SelectEffects(ChannelState* sp, const std::vector<CandidateSpec>& specs, const Options& o) {
   ChannelState& s = *sp;
+  const double dt = s.train.recs().front().dt;
   for (;;) {
     std::optional<Trial> best;
     const double tau = IntegratedCorrelationTime(s.train, s.pred_train, o);
@@ -691,7 +709,8 @@ void SelectEffects(ChannelState* sp, const std::vector<CandidateSpec>& specs, co
                t.marginal_red >= o.min_excess_reduction &&
                (sse_wo - sse) >= o.min_floor_gain * static_cast<double>(s.n_train) * s.var_floor &&
                static_cast<int>(s.order.size()) < o.max_effects_per_channel &&
-               !AtBound(spec, t.params.at(spec.name), o.at_bound_fraction);
+               !AtBound(spec, t.params.at(spec.name), o.at_bound_fraction) &&
+               !(spec.name == "pure_delay" && SubSampleDelayBeside(t.params, dt, o));
       s.last_trial[spec.name] = t;
       if (t.pass && (!best || t.excess_red > best->excess_red)) best = t;
     }
@@ -738,6 +757,16 @@ void SwapEffects(ChannelState* sp, const std::vector<CandidateSpec>& specs, cons
 void PruneEffects(ChannelState* sp, const std::vector<CandidateSpec>& specs, const Options& o,
                   std::vector<std::string>* warnings) {
   ChannelState& s = *sp;
+  // A delay that the refits shrank below a sample beside another effect is that effect's form
+  // mismatch, not a delay (SubSampleDelayBeside): removed, the rest refitted.
+  if (SubSampleDelayBeside(s.sel, s.train.recs().front().dt, o)) {
+    warnings->push_back(fmt::format("channel {}: pure_delay of {:.3g} ms beside {} removed (shorter than {:g} sample: a "
+                                    "form or timing mismatch of the other effect, not a delay)",
+                                    s.summary.channel, s.sel.at("pure_delay")[0], s.order.size() - 1, o.min_delay_samples));
+    s.sel.erase("pure_delay");
+    s.order.erase(std::find(s.order.begin(), s.order.end(), "pure_delay"));
+    s.sse = RefitAll(s.train, specs, &s.sel, s.train.Sse(s.train.Predict(ToSet(specs, s.sel))), o.refit_rounds, o);
+  }
   for (bool pruned = true; pruned && s.order.size() > 1;) {
     pruned = false;
     double least = o.min_excess_reduction;
@@ -970,11 +999,12 @@ void SetForceMotion(std::vector<Data>* train, std::vector<Data>* test, const Cha
     for (auto& d : *test) d.motion = SmoothMotion(d.y, dt, fc);
     return;
   }
-  // The final model's own velocity (exact for the servo) under the smoothed residual's.
+  // The final model's own velocity and acceleration (exact for the servo) under the smoothed
+  // residual's.
   auto motion = [&](const Data& d) {
-    std::vector<double> vhat;
-    const std::vector<double> yhat = PredictDisplacement(servo, y.fin_set, d.u, d.f, &vhat);
-    return ModelAidedMotion(d.y, yhat, vhat, dt, MotionCutoffHz(o, dt));
+    std::vector<double> vhat, ahat;
+    const std::vector<double> yhat = PredictDisplacement(servo, y.fin_set, d.u, d.f, &vhat, &ahat);
+    return ModelAidedMotion(d.y, yhat, vhat, dt, MotionCutoffHz(o, dt), ahat);
   };
   for (auto& d : *train) d.motion = motion(d);
   for (auto& d : *test) d.motion = motion(d);
@@ -1115,7 +1145,7 @@ Result Diagnose(const std::vector<io::RigRecord>& train_in, const std::vector<io
 
   const auto servo = models::LinearServo::Make(model.actuator, dt);
   std::optional<ForcePredictor> fp;
-  if (model.has_damper) fp.emplace(model.damper, model.current_dynamics, dt);
+  if (model.has_damper) fp.emplace(model.damper, model.current_dynamics, dt, model.current_driver);
   const ForcePredictor* fpp = fp ? &*fp : nullptr;
   // A force channel that is all zeros cannot be diagnosed either.
   const bool force_ok = ForceChannelUsable(model, train, &res.warnings);
@@ -1198,6 +1228,7 @@ nlohmann::json ToJson(const Options& o) {
           {"displacement_only_smooth_factor", o.displacement_only_smooth_factor},
           {"vmax_search_factor", o.vmax_search_factor},
           {"noise_band_lo", o.noise_band_lo},
+          {"noise_band_split", o.noise_band_split},
           {"noise_band_hi", o.noise_band_hi},
           {"noise_psd_segment", o.noise_psd_segment},
           {"whiteness_lags", o.whiteness_lags},
@@ -1207,6 +1238,7 @@ nlohmann::json ToJson(const Options& o) {
           {"min_excess_reduction", o.min_excess_reduction},
           {"min_floor_gain", o.min_floor_gain},
           {"max_effects_per_channel", o.max_effects_per_channel},
+          {"min_delay_samples", o.min_delay_samples},
           {"at_bound_fraction", o.at_bound_fraction},
           {"swap_passes", o.swap_passes},
           {"swap_min_gain", o.swap_min_gain},

@@ -7,8 +7,9 @@
 ///   residual     e_k = meas_k - pred_k, over the samples k >= warmup_s / dt of every record;
 ///   NRMSE        100 sqrt( sum e_k^2 / sum meas_k^2 ), sums over all records of a set (Eq. 31);
 ///   shrink       100 (1 - NRMSE_after / NRMSE_before) on the test records;
-///   noise floor  sigma_c^2 = median over f in [0.5, 0.95] f_Nyquist of the residual's Welch PSD,
-///                times f_Nyquist (white noise of variance sigma^2 has PSD sigma^2 / f_Nyq);
+///   noise floor  sigma_c^2 = f_Nyquist x the larger of the medians of the residual's Welch PSD over
+///                [0.25, 0.5] and [0.5, 0.95] f_Nyquist (white noise of variance sigma^2 has PSD
+///                sigma^2 / f_Nyq; an anti-alias filter lowers only the upper band);
 ///   floor ratio  rho_c = mean e_k^2 / sigma_c^2 (1 for a residual that is only white noise).
 /// Selection (training records only), greedy: a candidate is fitted with the channel's selected
 /// effects held, then all of the channel's effects are refitted coordinate-wise; it is added if
@@ -64,8 +65,12 @@ struct Options {
   double vmax_search_factor = 2.0;
 
   // --- noise floor and residual statistics
-  double noise_band_lo = 0.5;          ///< noise floor: median PSD from this fraction of f_Nyquist, [0, 1)
-  double noise_band_hi = 0.95;         ///< ... up to this fraction of f_Nyquist, (noise_band_lo, 1]
+  /// Noise floor: the larger of the median PSDs over [noise_band_lo, noise_band_split] and
+  /// [noise_band_split, noise_band_hi] (fractions of f_Nyquist), the plateau of the residual's
+  /// spectrum whether the sensor noise is white or anti-alias filtered. lo in [0, 1).
+  double noise_band_lo = 0.25;
+  double noise_band_split = 0.5;       ///< (noise_band_lo, 1)
+  double noise_band_hi = 0.95;         ///< (noise_band_split, 1]
   int noise_psd_segment = 256;         ///< Welch segment length of the noise floor [samples], [8, 1048576]
   int whiteness_lags = 20;             ///< lags l = 1 .. this of the whiteness number, [1, 10000]
   int correlation_max_lag = 2000;      ///< tau_int sums the autocorrelation up to this lag [samples], >= 1
@@ -76,6 +81,12 @@ struct Options {
   double min_excess_reduction = 0.25;  ///< rule (b) above (also the pruning threshold), in (0, 1)
   double min_floor_gain = 0.5;         ///< rule (c) above: the SSE removed, in units of n sigma^2, >= 0
   int max_effects_per_channel = 3;     ///< greedy stops after this many on one channel, >= 1
+  /// A pure_delay beside another effect of its channel must be at least this many samples long
+  /// (tau >= min_delay_samples dt), else it is not added and a refit that shrinks it below is
+  /// undone: a sub-sample delay next to another effect compensates that effect's form or timing
+  /// mismatch (a ZOH's half sample, a continuous vs. a discrete block), it is no transport delay.
+  /// Alone it may be shorter. >= 0.
+  double min_delay_samples = 1.0;
   /// A fitted parameter within this fraction of its search range of either end (in log space for
   /// log parameters) is "at a bound": the candidate is not an explanation; in [0, 0.5).
   double at_bound_fraction = 1e-3;
