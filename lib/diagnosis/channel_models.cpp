@@ -256,14 +256,14 @@ std::vector<double> ForcePredictor::PredictUnscaled(const SmoothedMotion& motion
     const double lam = (c0.beta + c0.gamma) * c0.n * zpow * vmax + c0.A * c0.alpha / (c0.c0 + c0.c1) +
                        c0.k0 / (c0.c0 + c0.c1);
     int m = std::clamp(static_cast<int>(std::ceil(dt * lam / kRk4StepLambda)), 1, 256);
-    // A reversal of the relative velocity r = x' - y' inside the step: Eq. 33 has a kink there
-    // (|r|), which RK4 integrates with an error of about A alpha |r'| h^2 / 8 in alpha z (its
-    // slope jumps by up to A), whatever the Jacobian's size. Substeps so that it stays below
-    // kKinkForceTolKn.
+    // A reversal of the relative velocity r = x' - y' inside the step (r changes sign between its
+    // ends, the end's taken with the state at the start): Eq. 33 has a kink there (|r|), which
+    // RK4 integrates with an error of about A alpha |r'| h^2 / 8 in alpha z (its slope jumps by up
+    // to A), whatever the Jacobian's size. Substeps so that it stays below kKinkForceTolKn.
     const double r0 = v0 - models::DamperRates(c0, s, x0, v0).ydot_mm_s;
     const double r1 = v1 - models::DamperRates(c0, s, x1, v1).ydot_mm_s;
     const double dr = std::abs(v1 - v0);
-    if (r0 * r1 <= 0.0 || std::min(std::abs(r0), std::abs(r1)) < dr) {
+    if (r0 * r1 <= 0.0) {
       const double kink = c0.A * c0.alpha * dr / dt / 8.0;  // [kN / s^2]
       if (kink > 0) m = std::clamp(static_cast<int>(std::ceil(dt * std::sqrt(kink / kKinkForceTolKn))), m, 256);
     }

@@ -22,7 +22,8 @@
 ///      2 pi sigma sqrt(smooth_hz^3 dt / 3) rms) while the motion below ~0.6 smooth_hz passes
 ///      unchanged in amplitude and phase.
 ///   2. Within a step the motion is the cubic Hermite interpolant of (ys_k, v_k), (ys_{k+1},
-///      v_{k+1}); the current command i_k, through ForceEffects::Current (current_lag), is held
+///      v_{k+1}) (the quintic through the accelerations too, when the motion carries them);
+///      the current command i_k, through ForceEffects::Current (current_lag), is held
 ///      over [t_k, t_{k+1}) by Eq. 40 and the 75 Hz low-pass (models/current_driver.h, whose
 ///      closed form gives i_c(t) inside the step), starting at the steady state of i_0.
 ///   3. The Spencer damper (Eqs. 32-33) is integrated by classical Runge-Kutta (RK4) with
@@ -30,11 +31,12 @@
 ///      Jacobian, (beta + gamma) n |z|^(n-1) max(|v_k|, |v_{k+1}|) + A alpha / (c0 + c1) +
 ///      k0 / (c0 + c1) (so h lambda <= 0.4, inside RK4's stability interval [-2.78, 0]; at 0.8
 ///      the saturating Bouc-Wen phase near peak velocity left 0.01-0.02 kN at 80 Hz and 2.5 A;
-///      checked against CVODE at 1e-8 in tests/diagnosis_test.cpp). Where x' - y' may change sign inside the step (a reversal),
-///      Eq. 33's right-hand side has a kink (its |x' - y'|) and RK4's error there is
+///      checked against CVODE at 1e-8 in tests/diagnosis_test.cpp). Where x' - y' changes sign
+///      over the step (a reversal; its value at the end taken with the damper state at the
+///      start), Eq. 33's right-hand side has a kink (its |x' - y'|) and RK4's error there is
 ///      about A alpha |x''| h^2 / 8 in the force, not bounded by h lambda: the step then takes
-///      m >= dt sqrt(A alpha |x''| / (8 kKinkForceTolKn)) substeps (at 80 Hz excitation and 2.5 A one
-///      substep across a reversal left 0.1 kN in alpha z that decayed over many samples).
+///      m >= dt sqrt(A alpha |x''| / (8 kKinkForceTolKn)) substeps (at 80 Hz excitation and
+///      2.5 A one substep across a reversal left 0.1 kN in alpha z, decaying over many samples).
 ///      Eqs. 35-39 come from a 1 mA table (linear interpolation) and
 ///      i_c at the substep times from the driver's closed form advanced by multiplication.
 ///      Deterministic, about a microsecond per sample.
