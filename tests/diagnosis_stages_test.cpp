@@ -139,6 +139,41 @@ TEST_CASE("PruneEffects: an effect that explains nothing is removed, two needed 
   }
 }
 
+TEST_CASE("PruneEffects: a pure_delay shorter than a sample beside another effect is removed; one longer is kept") {
+  const Options o;
+  m::EffectSet oil;
+  oil.oil_column_resonance = m::OilColumnResonance{25.0, 0.1};
+  YChannel y(oil);
+  st::ScoreNominal(&y.s(), o);
+  const double dt_ms = 1e3 * y.train.front().dt;
+  // Half a sample of delay beside the right mode: a timing convention, not a transport delay.
+  y.Select({{"oil_column_resonance", {25.0, 0.1}}, {"pure_delay", {0.5 * dt_ms}}}, {"oil_column_resonance", "pure_delay"});
+  std::vector<std::string> warnings;
+  st::PruneEffects(&y.s(), y.specs, o, &warnings);
+  CHECK(y.s().order == std::vector<std::string>{"oil_column_resonance"});
+  CHECK(y.s().sel.count("pure_delay") == 0);
+  CHECK(Mentions(warnings, "pure_delay", "shorter than"));
+  // The same with the rule off (min_delay_samples = 0) keeps it unless its share is too small.
+  Options off = o;
+  off.min_delay_samples = 0.0;
+  y.Select({{"oil_column_resonance", {25.0, 0.1}}, {"pure_delay", {0.5 * dt_ms}}}, {"oil_column_resonance", "pure_delay"});
+  warnings.clear();
+  st::PruneEffects(&y.s(), y.specs, off, &warnings);
+  CHECK_FALSE(Mentions(warnings, "pure_delay", "shorter than"));
+
+  // A real delay of several samples beside a gain error stays.
+  m::EffectSet both;
+  both.pure_delay = m::PureDelay{4.0};
+  both.gain_error = m::GainError{1.1};
+  YChannel z(both);
+  st::ScoreNominal(&z.s(), o);
+  z.Select({{"pure_delay", {4.0}}, {"gain_error", {1.1}}}, {"pure_delay", "gain_error"});
+  warnings.clear();
+  st::PruneEffects(&z.s(), z.specs, o, &warnings);
+  CHECK(z.s().order == std::vector<std::string>{"pure_delay", "gain_error"});
+  CHECK(warnings.empty());
+}
+
 TEST_CASE("RetainOnTest: an effect that raises the held-out NRMSE is dropped, the rest refitted") {
   Options o;
   m::EffectSet delay;
