@@ -1,8 +1,10 @@
 // The diagnosis's validation harness, CI size (lib/diagnosis/harness.h; the full one is
 // bench/diagnosis.cpp): records with known effects made by the plant's RIG MODE
-// (models::MakeRig with plant.effects / plant.unmodelled), diagnosed without the truth, scored
-// against the harness targets (docs/diagnosis.md "Validation harness"). Fewer and shorter records than the bench (2 seeds, 6 s), the same
-// targets on what it runs.
+// (models::MakeRig with plant.effects / plant.unmodelled) and, one seed, by the effect BLOCKS
+// (MakeRecordBlocks), diagnosed without the truth, scored against the harness targets
+// (docs/diagnosis.md "Validation harness"). Fewer and shorter records than the bench (2 seeds,
+// 6 s), the same targets on what it runs. The independent generator's harness is
+// tests/diagnosis_independent_test.cpp.
 #include <cstdio>
 
 #include <doctest/doctest.h>
@@ -34,5 +36,30 @@ TEST_CASE("harness (rig mode): confusion table and held-out shrink meet the harn
   CHECK(sc.pair_right >= 0.75 * sc.pair_n);
   CHECK(sc.none_as_effect == 0);
   CHECK(sc.unknown_as_effect == 0);
+  CHECK(sc.single_shrink_mean >= 70.0);
+}
+
+TEST_CASE("harness (effect blocks, one seed): confusion table and held-out shrink meet the harness targets") {
+  HarnessOptions o;
+  o.seeds = 1;
+  o.first_seed = 3;
+  o.duration_s = 6.0;
+  o.generator = Generator::kBlocks;
+  o.pairs = true;
+  std::string lines;
+  const auto cases = RunHarness(o, [&](const HarnessCase& c) {
+    lines += fmt::format("{:<40} seed {} {:<5} verdict {:<40} shrink {:5.1f} %  [{}]\n", c.kind, c.seed,
+                         c.right ? "RIGHT" : "wrong", fmt::format("{}", fmt::join(c.verdict, ",")), c.shrink_pct, c.params);
+  });
+  const auto sc = ScoreHarness(cases);
+  const std::string report = lines + sc.table;
+  MESSAGE(report);
+  REQUIRE(sc.single_n == 9);
+  REQUIRE(sc.none_n == 1);
+  REQUIRE(sc.unknown_n == 2);
+  CHECK(sc.single_right >= 0.9 * sc.single_n);
+  CHECK(sc.pair_right >= 0.75 * sc.pair_n);
+  CHECK(sc.none_right == sc.none_n);
+  CHECK(sc.unknown_right == sc.unknown_n);
   CHECK(sc.single_shrink_mean >= 70.0);
 }
