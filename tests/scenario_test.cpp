@@ -449,6 +449,7 @@ Scenario EveryFieldChanged(const fs::path& dir, bool rig_mode) {
   p.physical = {0.03, 21e6, 9e-3, 160.0, 10.0, 71.0, 0.6, 1.1e-2, 330.0, 1.2e9, 3e-11};
   p.specimen = m::Specimen::kNone;
   p.current_dynamics = false;
+  p.current_driver = {m::CurrentFilter::kFirstOrder, 150.0, 3.0, 27.0, 70.0, 0.6};
   p.noise_y_mm_rms = 0.01;
   p.noise_f_kN_rms = 0.02;
   p.noise_seed = 9;
@@ -476,7 +477,7 @@ Scenario EveryFieldChanged(const fs::path& dir, bool rig_mode) {
     p.load_coupling_same_sample = false;
     p.unmodelled = {0.01, 30.0, 0.5};
   }
-  s.semiactive = {c::SemiactiveMode::kConstant, 1.0, 2.0, 1.0, 0.3, 0.02, 20.0, 150.0};
+  s.semiactive = {c::SemiactiveMode::kConstant, 1.0, 2.0, 1.0, 0.3, 4, 0.02, 20.0, 150.0};
   s.safety = {false, 100.0, 400.0, 20.0, 0.5, 1.5, 5, 0.7};
   s.lockstep = {50.0, 20.0, 5.0};
   s.realtime = {true, 5, false, 50, false};

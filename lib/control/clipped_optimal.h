@@ -32,12 +32,13 @@
 namespace rths::control {
 
 /// How the semiactive participant sets the damper current (SemiactiveConfig::mode).
-enum class SemiactiveMode { kPassiveOff, kPassiveOn, kConstant, kPulse, kClippedOptimal };
-inline constexpr std::array<Named<SemiactiveMode>, 5> kSemiactiveModeNames = {
+enum class SemiactiveMode { kPassiveOff, kPassiveOn, kConstant, kPulse, kRandomPulse, kClippedOptimal };
+inline constexpr std::array<Named<SemiactiveMode>, 6> kSemiactiveModeNames = {
     {{SemiactiveMode::kPassiveOff, "passive_off"},
      {SemiactiveMode::kPassiveOn, "passive_on"},
      {SemiactiveMode::kConstant, "constant"},
      {SemiactiveMode::kPulse, "pulse"},
+     {SemiactiveMode::kRandomPulse, "random_pulse"},
      {SemiactiveMode::kClippedOptimal, "clipped_optimal"}}};
 
 /// Semiactive current (procs/semiactive): constant modes, the 0.5 Hz pulse of Table 2, or
@@ -45,12 +46,15 @@ inline constexpr std::array<Named<SemiactiveMode>, 5> kSemiactiveModeNames = {
 struct SemiactiveConfig {
   /// "passive_off" (0 A) | "passive_on" (max_current_A) | "constant" (current_A) |
   /// "pulse" (max_current_A for the first pulse_duty of every period 1/pulse_hz, then 0 A) |
+  /// "random_pulse" (as "pulse", each pulse at its own level uniform in [0, max_current_A],
+  /// drawn from pulse_seed: a record for identifying the current laws, Eqs. 35-39) |
   /// "clipped_optimal" (needs structure.mode = "rths").
   SemiactiveMode mode = SemiactiveMode::kPassiveOff;
   double current_A = 0.0;            ///< for "constant": [0, max_current_A]
   double max_current_A = 2.5;        ///< (0, 5]
   double pulse_hz = 0.5;             ///< "pulse": frequency [Hz], (0, 0.25/dt)
   double pulse_duty = 0.5;           ///< "pulse": fraction of the period at max current, (0, 1)
+  std::uint64_t pulse_seed = 1;      ///< "random_pulse": seed of the levels
   // "clipped_optimal" (Dyke et al. 1996; docs/semiactive.md): an H2/LQG nominal controller on the
   // structure, i = max_current_A when (f_c - f) f > 0, else 0.
   double r_weight = 1e-2;            ///< weight on the force (in units of capacity), (0, 1e6]

@@ -46,6 +46,14 @@ bool ParseFinite(const std::string& s, double* v) {
   return end == s.c_str() + s.size() && std::isfinite(*v);
 }
 
+/// Every optional-length column is empty or as long as t_s.
+bool SizesOk(const RigRecord& rec) {
+  const std::size_t n = rec.size();
+  for (const auto* v : {&rec.i_A, &rec.r_mm, &rec.v_V})
+    if (!v->empty() && v->size() != n) return false;
+  return true;
+}
+
 std::string Where(const std::string& path, std::size_t line) { return fmt::format("{}:{}", path, line); }
 
 /// The bound on |value| of a column and its unit (0 if the column is not one of ours).
@@ -54,6 +62,7 @@ std::pair<double, const char*> BoundOf(std::string_view column) {
   if (column == "u_mm" || column == "y_mm" || column == "r_mm") return {kMaxAbsDisplacementMm, "mm"};
   if (column == "f_kN") return {kMaxAbsForceKN, "kN"};
   if (column == "i_A") return {kMaxAbsCurrentA, "A"};
+  if (column == "v_V") return {kMaxAbsVoltageV, "V"};
   return {0.0, ""};
 }
 
@@ -212,30 +221,36 @@ RigRecord ParseRigRecord(std::string_view text, const std::string& path, TimeAxi
     break;
   }
   if (header_line == 0) throw Error(Where(path, ln), "no column header line (t_s,u_mm,y_mm,f_kN,i_A)");
+  static constexpr const char* kColumns = "required: t_s,u_mm,y_mm,f_kN and i_A or v_V (or both); optional r_mm";
   if (dt_line == 0) throw Error(Where(path, header_line), "missing the '# dt_s: <step in s>' line before the columns");
 
   // Column map.
-  static const std::vector<std::string> kRequired{"t_s", "u_mm", "y_mm", "f_kN", "i_A"};
+  static const std::vector<std::string> kRequired{"t_s", "u_mm", "y_mm", "f_kN"};
   std::map<std::string, std::size_t> index;
   for (std::size_t c = 0; c < cols.size(); ++c) {
     if (index.count(cols[c]))
       throw Error(Where(path, header_line), fmt::format("column \"{}\" appears twice", cols[c]));
     index[cols[c]] = c;
-    const bool known = cols[c] == "r_mm" || std::find(kRequired.begin(), kRequired.end(), cols[c]) != kRequired.end();
+    const bool known = cols[c] == "r_mm" || cols[c] == "i_A" || cols[c] == "v_V" || std::find(kRequired.begin(), kRequired.end(), cols[c]) != kRequired.end();
     if (!known)
       rec.warnings.push_back(fmt::format("{}: unknown column \"{}\" ignored", Where(path, header_line), cols[c]));
   }
   for (const auto& name : kRequired) {
     if (!index.count(name)) {
       throw Error(Where(path, header_line),
-                  fmt::format("missing column \"{}\" (required: t_s,u_mm,y_mm,f_kN,i_A; optional r_mm)", name));
+                  fmt::format("missing column \"{}\" ({})", name, kColumns));
     }
   }
+  if (!index.count("i_A") && !index.count("v_V"))
+    throw Error(Where(path, header_line),
+                fmt::format("missing the damper command: a column \"i_A\" (current) or \"v_V\" (voltage) ({})", kColumns));
   const bool has_r = index.count("r_mm") > 0;
   std::vector<std::pair<std::vector<double>*, std::size_t>> targets{
       {&rec.t_s, index["t_s"]}, {&rec.u_mm, index["u_mm"]}, {&rec.y_mm, index["y_mm"]},
-      {&rec.f_kN, index["f_kN"]}, {&rec.i_A, index["i_A"]}};
+      {&rec.f_kN, index["f_kN"]}};
+  if (index.count("i_A")) targets.emplace_back(&rec.i_A, index["i_A"]);
   if (has_r) targets.emplace_back(&rec.r_mm, index["r_mm"]);
+  if (index.count("v_V")) targets.emplace_back(&rec.v_V, index["v_V"]);
 
   std::vector<std::size_t> row_line;
   while (std::getline(in, line)) {
@@ -269,14 +284,14 @@ RigRecord ParseRigRecord(std::string_view text, const std::string& path, TimeAxi
 
 void ValidateRigRecord(const RigRecord& rec, const std::string& where) {
   const std::size_t n = rec.t_s.size();
-  if (rec.u_mm.size() != n || rec.y_mm.size() != n || rec.f_kN.size() != n || rec.i_A.size() != n ||
-      (rec.has_r() && rec.r_mm.size() != n))
+  if (rec.u_mm.size() != n || rec.y_mm.size() != n || rec.f_kN.size() != n || !SizesOk(rec))
     throw Error(where, "the record's columns differ in length");
+  if (rec.i_A.empty() && rec.v_V.empty()) throw Error(where, "the record has no damper command (i_A or v_V)");
   if (!DtInRange(rec.dt_s))
     throw Error(where, fmt::format("dt_s must be in [{:g}, {:g}] s (got {})", kMinDtS, kMaxDtS, rec.dt_s));
   const std::vector<std::pair<const char*, const std::vector<double>*>> cols{
       {"t_s", &rec.t_s}, {"u_mm", &rec.u_mm}, {"y_mm", &rec.y_mm}, {"f_kN", &rec.f_kN}, {"i_A", &rec.i_A},
-      {"r_mm", &rec.r_mm}};
+      {"r_mm", &rec.r_mm}, {"v_V", &rec.v_V}};
   for (const auto& [name, v] : cols)
     for (std::size_t k = 0; k < v->size(); ++k)
       if (!std::isfinite((*v)[k])) {
@@ -290,18 +305,23 @@ void ValidateRigRecord(const RigRecord& rec, const std::string& where) {
 
 void WriteRigRecord(const RigRecord& rec, const std::string& path) {
   const std::size_t n = rec.size();
-  if (rec.u_mm.size() != n || rec.y_mm.size() != n || rec.f_kN.size() != n || rec.i_A.size() != n ||
-      (rec.has_r() && rec.r_mm.size() != n))
-    throw Error(path, "the record's columns differ in length");
+  if (rec.u_mm.size() != n || rec.y_mm.size() != n || rec.f_kN.size() != n || !SizesOk(rec) ||
+      (rec.i_A.empty() && rec.v_V.empty()))
+    throw Error(path, "the record's columns differ in length or it has no damper command (i_A or v_V)");
   std::FILE* f = std::fopen(path.c_str(), "w");
   if (!f) throw Error(path, "cannot write the rig record");
   std::string out = fmt::format("{}\n# dt_s: {}\n", kMagic, rec.dt_s);
   for (const auto& [k, v] : rec.metadata) out += fmt::format("# {}: {}\n", k, v);
-  out += rec.has_r() ? "t_s,u_mm,y_mm,f_kN,i_A,r_mm\n" : "t_s,u_mm,y_mm,f_kN,i_A\n";
+  const bool has_i = !rec.i_A.empty();
+  out += "t_s,u_mm,y_mm,f_kN";
+  out += has_i ? ",i_A" : "";
+  out += rec.has_r() ? ",r_mm" : "";
+  out += rec.has_v() ? ",v_V\n" : "\n";
   for (std::size_t k = 0; k < n; ++k) {
-    out += fmt::format("{:.10g},{:.10g},{:.10g},{:.10g},{:.10g}", rec.t_s[k], rec.u_mm[k], rec.y_mm[k], rec.f_kN[k],
-                       rec.i_A[k]);
+    out += fmt::format("{:.10g},{:.10g},{:.10g},{:.10g}", rec.t_s[k], rec.u_mm[k], rec.y_mm[k], rec.f_kN[k]);
+    if (has_i) out += fmt::format(",{:.10g}", rec.i_A[k]);
     if (rec.has_r()) out += fmt::format(",{:.10g}", rec.r_mm[k]);
+    if (rec.has_v()) out += fmt::format(",{:.10g}", rec.v_V[k]);
     out += '\n';
   }
   const bool ok = std::fwrite(out.data(), 1, out.size(), f) == out.size();

@@ -31,8 +31,11 @@ struct RigRecord {
   std::vector<double> u_mm;          ///< command u_k [mm]
   std::vector<double> y_mm;          ///< measured displacement y_k [mm]
   std::vector<double> f_kN;          ///< measured force f_k [kN]
-  std::vector<double> i_A;           ///< damper current command i_k [A]
+  std::vector<double> i_A;           ///< damper current command i_k [A]; empty if the record has v_V only
   std::vector<double> r_mm;          ///< desired displacement r_k [mm]; empty if the record has none
+  /// damper voltage command v_k [V] (a voltage-driven damper); empty if the record has none.
+  /// A record has i_A, v_V or both.
+  std::vector<double> v_V;
   /// '# key: value' metadata other than dt_s, in file order.
   std::vector<std::pair<std::string, std::string>> metadata;
   /// Non-fatal findings while reading (e.g. unknown columns), each "file:line: message".
@@ -42,6 +45,9 @@ struct RigRecord {
 
   std::size_t size() const { return t_s.size(); }
   bool has_r() const { return !r_mm.empty(); }
+  bool has_v() const { return !v_V.empty(); }
+  /// The damper command the models are driven with: i_A, or v_V for a record without i_A.
+  const std::vector<double>& Command() const { return i_A.empty() ? v_V : i_A; }
   /// size() x dt_s [s].
   double DurationS() const { return static_cast<double>(size()) * dt_s; }
   /// The value of metadata `key`, or "" if absent.
@@ -57,6 +63,7 @@ inline constexpr double kMinRecordS = 2.0;
 inline constexpr double kMaxAbsDisplacementMm = 1e4;  ///< |u_mm|, |y_mm|, |r_mm| [mm] (10 m)
 inline constexpr double kMaxAbsForceKN = 1e5;         ///< |f_kN| [kN] (100 MN)
 inline constexpr double kMaxAbsCurrentA = 100.0;      ///< |i_A| [A]
+inline constexpr double kMaxAbsVoltageV = 100.0;      ///< |v_V| [V]
 inline constexpr double kMaxAbsTimeS = 1e10;          ///< |t_s| [s] (Unix times fit)
 /// The range of dt_s [s]: 1 MHz to 1 Hz sampling.
 inline constexpr double kMinDtS = 1e-6, kMaxDtS = 1.0;

@@ -216,13 +216,13 @@ RigRecord ReadUtfsm(const std::string& path) {
   return ReadUtfsmDamper(path);
 }
 
-RigRecord ReadRecordOrUtfsm(const std::string& path) {
-  if (IsLcmLog(path)) return ReadRecordAny(path);
+RigRecord ReadRecordOrUtfsm(const std::string& path, TimeAxis time) {
+  if (IsLcmLog(path)) return ReadRecordAny(path, time);
   std::ifstream in(path);
   if (!in) throw Error(path, "cannot open");
   std::string first;
   std::getline(in, first);
-  if (Trim(first).rfind("# rths rig record", 0) == 0) return ReadRecordAny(path);
+  if (Trim(first).rfind("# rths rig record", 0) == 0) return ReadRecordAny(path, time);
   return ReadUtfsm(path);
 }
 
@@ -247,8 +247,9 @@ RigRecord CutRigRecord(const RigRecord& rec, double from_s, double to_s) {
       out.u_mm.push_back(rec.u_mm[k]);
       out.y_mm.push_back(rec.y_mm[k]);
       out.f_kN.push_back(rec.f_kN[k]);
-      out.i_A.push_back(rec.i_A[k]);
+      if (!rec.i_A.empty()) out.i_A.push_back(rec.i_A[k]);
       if (rec.has_r()) out.r_mm.push_back(rec.r_mm[k]);
+      if (rec.has_v()) out.v_V.push_back(rec.v_V[k]);
     }
   }
   if (out.size() == 0)

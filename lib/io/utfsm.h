@@ -49,7 +49,8 @@ RigRecord ReadUtfsm(const std::string& path);
 
 /// Any record a tool takes, by content: an LCM run log of ours (IsLcmLog) or a CSV rig record
 /// (first line "# rths rig record ...") through ReadRecordAny, anything else through ReadUtfsm.
-RigRecord ReadRecordOrUtfsm(const std::string& path);
+/// `time` is how a CSV rig record takes its step (ReadRigRecord).
+RigRecord ReadRecordOrUtfsm(const std::string& path, TimeAxis time = TimeAxis::kColumn);
 
 /// The samples of `rec` with from_s <= t_k - t_0 < to_s (times relative to the record's first
 /// sample, so the second half of a record starts at its own t = 0 as well), time restarted at 0

@@ -17,6 +17,22 @@ CurrentDriver CurrentDriver::Make(const CurrentDriverParams& p, double dt_s) {
                  fmt::format("must be finite and {} (got {})", range, v));
   };
   const auto positive = [](double v) { return std::isfinite(v) && v > 0.0; };
+  if (p.kind == CurrentFilter::kFirstOrder) {
+    if (!positive(p.eta_1_s)) throw bad("eta_1_s", p.eta_1_s, "> 0");
+    if (!positive(dt_s)) throw bad("dt_s", dt_s, "> 0");
+    // H(s) = eta / (s + eta): the real mode alone; the complex pair is kept with residue 0 (and a
+    // pole of its own, so Hold()'s division stays defined) and so never reaches i_c.
+    CurrentDriver d;
+    d.params = p;
+    d.dt_s = dt_s;
+    d.pole1 = -p.eta_1_s;
+    d.residue1 = p.eta_1_s;
+    d.pole = cd(-p.eta_1_s, p.eta_1_s);
+    d.residue = cd(0.0, 0.0);
+    d.phi1 = std::exp(-p.eta_1_s * dt_s);
+    d.phi = std::exp(d.pole * dt_s);
+    return d;
+  }
   if (!positive(p.lag_pole_rad_s)) throw bad("lag_pole_rad_s", p.lag_pole_rad_s, "> 0");
   if (!positive(p.lag_zero_rad_s) || p.lag_zero_rad_s == p.lag_pole_rad_s)
     throw bad("lag_zero_rad_s", p.lag_zero_rad_s, "> 0 and != lag_pole_rad_s");
@@ -97,6 +113,7 @@ double EffectiveCurrentA(const CurrentDriver& d, const CurrentDriverState& s) {
 }
 
 double DriverOutputA(const CurrentDriver& d, const CurrentDriverState& s) {
+  if (d.params.kind == CurrentFilter::kFirstOrder) return EffectiveCurrentA(d, s);
   const double a = d.params.lag_pole_rad_s, b = d.params.lag_zero_rad_s;
   return s.held_A + a * (1.0 - a / b) * s.e1_A_s;
 }

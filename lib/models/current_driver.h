@@ -30,16 +30,31 @@
 /// At steady state e = 0 exactly, so a constant current stays exactly constant (bit for bit),
 /// and the within-step closed form lets a damper ODE use i_c(t) as a continuous function of time
 /// without carrying the filter in the ODE's state.
+#include <array>
 #include <complex>
+
+#include "core/names.h"
 
 namespace rths::models {
 
+/// The form of H(s) (CurrentDriverParams::kind).
+///  - kEq40: the paper's Eq. 40 times the second-order low-pass (file comment);
+///  - kFirstOrder: the control-input filter of Spencer et al. (1997), u' = -eta (u - v), i.e.
+///    H(s) = eta / (s + eta): one real mode, pole -eta, residue eta (the complex pair has
+///    residue 0). The command v may be a current [A] or a voltage [V]; u has the same unit.
+enum class CurrentFilter { kEq40, kFirstOrder };
+inline constexpr std::array<Named<CurrentFilter>, 2> kCurrentFilterNames = {
+    {{CurrentFilter::kEq40, "eq40"}, {CurrentFilter::kFirstOrder, "first_order"}}};
+
 /// Parameters of H(s). Defaults: the paper's Eq. 40 and a 75 Hz Butterworth.
 struct CurrentDriverParams {
+  CurrentFilter kind = CurrentFilter::kEq40;  ///< `[plant.current_driver] kind`
+  double eta_1_s = 190.0;  ///< kFirstOrder: eta [1/s], > 0 (Spencer et al. 1997 fitted 190 1/s)
   double lag_pole_rad_s = 3.141592653589793;   ///< Eq. 40's pole a = pi [rad/s], > 0
   double lag_zero_rad_s = 28.274333882308138;  ///< Eq. 40's zero b = 9 pi [rad/s], > 0
   double lowpass_hz = 75.0;                   ///< low-pass natural frequency w_n / 2 pi [Hz], > 0
   double lowpass_zeta = 0.7071067811865476;   ///< low-pass damping, (0, 1) (1/sqrt(2): Butterworth)
+  bool operator==(const CurrentDriverParams&) const = default;
 };
 
 /// Immutable description: modal coefficients and the per-step transition factors.
@@ -53,8 +68,8 @@ struct CurrentDriver {
   double phi1 = 0.0;              ///< e^{lambda_1 dt}
   std::complex<double> phi;       ///< e^{lambda dt}
 
-  /// Throws rths::Error naming a bad parameter (0 < a, a != b, b > 0, 0 < lowpass_hz,
-  /// zeta in (0, 1), dt_s > 0, all finite).
+  /// Throws rths::Error naming a bad parameter (kEq40: 0 < a, a != b, b > 0, 0 < lowpass_hz,
+  /// zeta in (0, 1); kFirstOrder: eta_1_s > 0; dt_s > 0, all finite).
   static CurrentDriver Make(const CurrentDriverParams& p, double dt_s);
   /// H(j 2 pi f_hz) (continuous, [A/A]).
   std::complex<double> FrequencyResponse(double f_hz) const;

@@ -49,7 +49,8 @@ EffectRigModel EffectRigModel::Make(const models::PlantConfig& plant, double dt_
     throw Error("plant.unmodelled.stiffness_kN_per_mm",
                 fmt::format("{} is out of range [-100, 100]", u.stiffness_kN_per_mm));
   EffectRigModel m;
-  m.rig = LinearRig::Make(plant.actuator, dt_s, damper, plant.damper, plant.cvode_rtol, plant.current_dynamics);
+  m.rig = LinearRig::Make(plant.actuator, dt_s, damper, plant.damper, plant.cvode_rtol, plant.current_dynamics,
+                          plant.current_driver);
   m.effects = plant.effects;
   m.unmodelled = plant.unmodelled;
   m.noise_seed = plant.noise_seed;

@@ -10,7 +10,8 @@
 namespace rths::models {
 
 LinearRig LinearRig::Make(const models::ServoModel3& actuator, double dt_s, bool has_damper,
-                          const MrDamperParams& damper, double rtol, bool current_dynamics) {
+                          const MrDamperParams& damper, double rtol, bool current_dynamics,
+                          const CurrentDriverParams& driver) {
   if (!(rtol > 0.0 && rtol <= 1e-2))
     throw Error("LinearRig: rtol", fmt::format("must be in (0, 1e-2] (got {})", rtol));
   damper.Validate();
@@ -20,7 +21,7 @@ LinearRig LinearRig::Make(const models::ServoModel3& actuator, double dt_s, bool
   r.has_damper = has_damper;
   r.rtol = rtol;
   r.current_dynamics = current_dynamics;
-  r.driver = CurrentDriver::Make({}, dt_s);
+  r.driver = CurrentDriver::Make(driver, dt_s);
   return r;
 }
 

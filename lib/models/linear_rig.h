@@ -35,7 +35,8 @@ struct LinearRig {
   /// Validates everything (rths::Error on a bad value).
   static LinearRig Make(const models::ServoModel3& actuator, double dt_s, bool has_damper,
                         const MrDamperParams& damper = MrDamperParams::Table3(),
-                        double rtol = 1e-8, bool current_dynamics = false);
+                        double rtol = 1e-8, bool current_dynamics = false,
+                        const CurrentDriverParams& driver = {});
 };
 
 /// Per-step state at sample k.

@@ -41,12 +41,13 @@ using PhysicalRigAdapter = RigAdapter<PhysicalRig, PhysicalRigStepper, PhysicalR
 // itself, x(t) linear between samples; y_k = r_k bit for bit.
 class IdealRig final : public Rig {
  public:
-  IdealRig(const MrDamperParams& params, bool damper, bool current_dynamics, double dt_s, double rtol)
+  IdealRig(const MrDamperParams& params, bool damper, bool current_dynamics, double dt_s, double rtol,
+           const CurrentDriverParams& driver)
       : params_(params),
         damper_(damper),
         current_dynamics_(current_dynamics),
         dt_(dt_s),
-        driver_(CurrentDriver::Make({}, dt_s)),
+        driver_(CurrentDriver::Make(driver, dt_s)),
         ode_(2, rtol, rtol * 0.01, &IdealRig::Rhs, this) {
     params_.Validate();
   }
@@ -129,17 +130,18 @@ std::unique_ptr<Rig> MakeRig(const models::PlantConfig& plant, double dt_s) {
       return std::make_unique<LinearRigAdapter>(LinearRig::Make(plant.actuator, dt_s, damper,
                                                                 plant.damper,
                                                                 plant.cvode_rtol,
-                                                                plant.current_dynamics));
+                                                                plant.current_dynamics,
+                                                                plant.current_driver));
     case PlantKind::kPhysical:
       return std::make_unique<PhysicalRigAdapter>(
           PhysicalRig::Make(plant.physical, dt_s, damper ? RigLoad::kMrDamper : RigLoad::kNone,
                             plant.current_dynamics, plant.damper, {},
-                            plant.cvode_rtol));
+                            plant.cvode_rtol, plant.current_driver));
     case PlantKind::kIdeal:
       if (!(plant.cvode_rtol > 0.0 && plant.cvode_rtol <= 1e-2))
         throw Error("plant.cvode_rtol", fmt::format("must be in (0, 1e-2] (got {})", plant.cvode_rtol));
       return std::make_unique<IdealRig>(plant.damper, damper, plant.current_dynamics, dt_s,
-                                        plant.cvode_rtol);
+                                        plant.cvode_rtol, plant.current_driver);
   }
   throw Error("plant.kind", "unknown loading system");
 }

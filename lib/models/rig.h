@@ -14,6 +14,7 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include "models/current_driver.h"
 #include "models/mr_damper.h"
 #include "models/rig_effects.h"
 #include "models/servo_linear.h"
@@ -46,6 +47,9 @@ struct PlantConfig {
   /// Damper current dynamics: the driver lag of Eq. 40 and a 75 Hz second-order Butterworth
   /// low-pass between the commanded and the effective current. false: effective = commanded.
   bool current_dynamics = true;
+  /// The form of those dynamics, `[plant.current_driver]` (models/current_driver.h): Eq. 40 + the
+  /// low-pass (default) or the first-order filter of Spencer et al. (1997) with its eta.
+  CurrentDriverParams current_driver{};
   double noise_y_mm_rms = 0.0;         ///< Gaussian sensor noise on y [mm], [0, 10]
   double noise_f_kN_rms = 0.0;         ///< Gaussian sensor noise on f [kN], [0, 100]
   std::uint64_t noise_seed = 7;

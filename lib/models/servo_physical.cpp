@@ -94,7 +94,8 @@ std::complex<double> SmallSignalResponse(const PhysicalActuator& a, const Spring
 
 PhysicalRig PhysicalRig::Make(const models::PhysicalActuatorConfig& actuator, double dt_s,
                               RigLoad load, bool current_dynamics, const MrDamperParams& damper,
-                              const SpringDashpot& spring, double rtol) {
+                              const SpringDashpot& spring, double rtol,
+                              const CurrentDriverParams& driver) {
   PhysicalRig r;
   r.actuator = PhysicalActuator::Make(actuator);
   if (!(std::isfinite(dt_s) && dt_s > 0.0))
@@ -111,7 +112,7 @@ PhysicalRig PhysicalRig::Make(const models::PhysicalActuatorConfig& actuator, do
   r.damper = damper;
   r.spring = spring;
   r.current_dynamics = current_dynamics;
-  r.driver = CurrentDriver::Make({}, dt_s);
+  r.driver = CurrentDriver::Make(driver, dt_s);
   r.dt_s = dt_s;
   r.rtol = rtol;
   return r;

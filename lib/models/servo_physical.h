@@ -152,7 +152,8 @@ struct PhysicalRig {
   static PhysicalRig Make(const models::PhysicalActuatorConfig& actuator, double dt_s,
                           RigLoad load, bool current_dynamics,
                           const MrDamperParams& damper = MrDamperParams::Table3(),
-                          const SpringDashpot& spring = {}, double rtol = 1e-8);
+                          const SpringDashpot& spring = {}, double rtol = 1e-8,
+                          const CurrentDriverParams& driver = {});
 };
 
 /// Per-step state at sample k.

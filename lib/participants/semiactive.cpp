@@ -16,18 +16,31 @@ CurrentSchedule::CurrentSchedule(const control::SemiactiveConfig& cfg, double dt
     on_A_ = cfg.max_current_A;
   } else if (cfg.mode == control::SemiactiveMode::kConstant) {
     on_A_ = cfg.current_A;
-  } else if (cfg.mode == control::SemiactiveMode::kPulse) {
+  } else if (cfg.mode == control::SemiactiveMode::kPulse || cfg.mode == control::SemiactiveMode::kRandomPulse) {
     on_A_ = cfg.max_current_A;
+    random_ = cfg.mode == control::SemiactiveMode::kRandomPulse;
+    seed_ = cfg.pulse_seed;
     period_ = std::max<std::int64_t>(2, std::llround(1.0 / (cfg.pulse_hz * dt_s)));
     on_steps_ = std::llround(cfg.pulse_duty * static_cast<double>(period_));
   } else {
     throw Error("semiactive.mode", "'" + std::string(NameOf(control::kSemiactiveModeNames, cfg.mode)) +
-                                       "' is not a schedule (allowed: passive_off, passive_on, constant, pulse)");
+                                       "' is not a schedule (allowed: passive_off, passive_on, constant, pulse, random_pulse)");
   }
-  if (cfg.mode != control::SemiactiveMode::kPulse) on_steps_ = period_;
+  if (cfg.mode != control::SemiactiveMode::kPulse && cfg.mode != control::SemiactiveMode::kRandomPulse)
+    on_steps_ = period_;
 }
 
-double CurrentSchedule::At(std::int64_t k) const { return k % period_ < on_steps_ ? on_A_ : 0.0; }
+double CurrentSchedule::At(std::int64_t k) const {
+  if (k % period_ >= on_steps_) return 0.0;
+  if (!random_) return on_A_;
+  // splitmix64 of (seed, pulse index): a pure function of k, so every participant and replay
+  // agrees without carrying generator state.
+  std::uint64_t z = seed_ + 0x9E3779B97F4A7C15ull * static_cast<std::uint64_t>(k / period_ + 1);
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+  z ^= z >> 31;
+  return on_A_ * static_cast<double>(z >> 11) * 0x1.0p-53;
+}
 
 Semiactive::Semiactive(const scenario::Scenario& s, lockstep::RunIdentity id, lcm::LCM* lcm,
                        lockstep::Faults faults)

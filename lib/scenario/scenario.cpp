@@ -457,6 +457,15 @@ void PlantFields(V& v, PlantConfig& p, const Context& cx) {
   v.Number("cvode_rtol", p.cvode_rtol, OpenClosed(0.0, 1e-2));
   v.Table("physical", [&](V& t) { PhysicalFields(t, p.physical); });
   v.Table("damper", [&](V& t) { DamperFields(t, p.damper); });
+  v.Table("current_driver", [&](V& t) {
+    models::CurrentDriverParams& d = p.current_driver;
+    t.Choice("kind", d.kind, models::kCurrentFilterNames);
+    t.Number("eta_1_s", d.eta_1_s, OpenClosed(0.0, 1e6));
+    t.Number("lag_pole_rad_s", d.lag_pole_rad_s, OpenClosed(0.0, 1e6));
+    t.Number("lag_zero_rad_s", d.lag_zero_rad_s, OpenClosed(0.0, 1e6));
+    t.Number("lowpass_hz", d.lowpass_hz, OpenClosed(0.0, 1e6));
+    t.Number("lowpass_zeta", d.lowpass_zeta, {0.0, 1.0, true, true});
+  });
   v.Table("unmodelled", [&](V& t) {
     UnmodelledConfig& u = p.unmodelled;
     t.Number("ripple_mm", u.ripple_mm, Closed(0.0, 10.0));
@@ -477,6 +486,7 @@ void SemiactiveFields(V& v, SemiactiveConfig& s, const Context& cx) {
   v.Number("pulse_hz", s.pulse_hz,
            {0.0, 0.25 / cx.dt_s, true, true, "at least four steps per period: below 0.25/run.dt_s"});
   v.Number("pulse_duty", s.pulse_duty, Open(0.0, 1.0));
+  v.Integer("pulse_seed", s.pulse_seed);
   v.Number("r_weight", s.r_weight, OpenClosed(0.0, 1e6));
   v.Number("noise_ratio", s.noise_ratio, OpenClosed(0.0, 1e6));
   v.Number("capacity_kN", s.capacity_kN, OpenClosed(0.0, 1e6));
@@ -823,6 +833,11 @@ void ValidatePlant(const PlantConfig& p, const Check& check) {
     const std::size_t colon = w.rfind(": ");
     check.Fail(fmt::format("plant.damper.{}", colon == std::string::npos ? w : w.substr(colon + 2)), e.problem());
   }
+  if (p.current_driver.kind == models::CurrentFilter::kEq40 &&
+      p.current_driver.lag_zero_rad_s == p.current_driver.lag_pole_rad_s)
+    check.Fail("plant.current_driver.lag_zero_rad_s",
+               fmt::format("{} equals lag_pole_rad_s: Eq. 40 needs a zero apart from its pole",
+                           p.current_driver.lag_zero_rad_s));
   if (p.RigMode() && p.kind != models::PlantKind::kLinear) {
     check.Fail(p.effects.Empty() ? "plant.unmodelled" : "plant.effects",
                fmt::format("rig mode needs plant.kind = \"linear\" (got \"{}\"): the effects act around the "
