@@ -28,6 +28,7 @@
 
 #include "core/error.h"
 #include "ident/damper_fit.h"
+#include "ident/spencer_fit.h"
 #include "ident/identify.h"
 #include "io/rig_record.h"
 #include "io/utfsm.h"
@@ -155,10 +156,18 @@ std::string GnuplotSafe(const std::string& s) {
   return o;
 }
 
+/// One record of the --damper plot: the record, whether it was fitted, the model's force [kN],
+/// the smoothed velocity [mm/s] and Eq. 31 on f [%].
+struct DamperPlotRecord {
+  const rths::io::RigRecord* rec;
+  bool fitted;
+  std::vector<double> F_kN, v_mm_s;
+  double nrmse_f_pct;
+};
+
 /// --damper plot: per record (training, then held-out), force against velocity and against
 /// displacement, measured and model, over the record's last 60 % (the steady cycles).
-void PlotDamper(const std::string& png, const std::vector<std::pair<const rths::io::RigRecord*, bool>>& recs,
-                const rths::models::MrDamperCoefficients& coef, double cutoff_hz, double current_A) {
+void PlotDamper(const std::string& png, const std::vector<DamperPlotRecord>& recs, const std::string& what) {
   const fs::path dir = fs::temp_directory_path() / fmt::format("rths_identify_damper_{}", ::getpid());
   fs::create_directories(dir);
   const fs::path script = dir / "plot.gp";
@@ -166,21 +175,18 @@ void PlotDamper(const std::string& png, const std::vector<std::pair<const rths::
   const std::size_t rows = recs.size();
   o << fmt::format("set terminal pngcairo size 1000,{} font 'Sans,9'\n", 60 + 260 * rows);
   o << "set output '" << png << "'\n";
-  o << fmt::format("set multiplot layout {},2 title 'MR damper at {} A: measured (blue) and fitted model (red)'\n", rows,
-                   current_A);
+  o << fmt::format("set multiplot layout {},2 title 'MR damper {}: measured (blue) and fitted model (red)'\n", rows,
+                   GnuplotSafe(what));
   o << "set grid\nset key top left\n";
   for (std::size_t i = 0; i < rows; ++i) {
-    const auto& rec = *recs[i].first;
-    const auto v = rths::ident::SmoothVelocity(rec.y_mm, rec.dt_s, cutoff_hz);
-    const auto F = rths::ident::SimulateDamperForce(coef, rec.y_mm, v, rec.dt_s);
-    const auto score = rths::ident::ScoreDamper(coef, rec, cutoff_hz);
+    const auto& rec = *recs[i].rec;
     const fs::path dat = dir / fmt::format("r{}.dat", i);
     std::ofstream d(dat);
     for (std::size_t k = rec.size() * 2 / 5; k < rec.size(); ++k)
-      d << fmt::format("{:.6g} {:.6g} {:.6g} {:.6g}\n", rec.y_mm[k], v[k], rec.f_kN[k], F[k]);
+      d << fmt::format("{:.6g} {:.6g} {:.6g} {:.6g}\n", rec.y_mm[k], recs[i].v_mm_s[k], rec.f_kN[k], recs[i].F_kN[k]);
     const std::string name = GnuplotSafe(fs::path(rec.source).filename().string());
-    const std::string title = fmt::format("{} ({}, Eq. 31 on f {:.1f} %)", name, recs[i].second ? "fitted" : "held out",
-                                          score.nrmse_f_pct);
+    const std::string title = fmt::format("{} ({}, Eq. 31 on f {:.1f} %)", name, recs[i].fitted ? "fitted" : "held out",
+                                          recs[i].nrmse_f_pct);
     o << fmt::format("set title '{}'\nset xlabel 'velocity [mm/s]'\nset ylabel 'force [kN]'\n", title);
     o << "plot '" << dat.string() << "' u 2:3 w l lw 1.5 lc rgb '#1f77b4' t 'measured', '' u 2:4 w l lw 1.5 lc rgb '#d62728' t 'model'\n";
     o << "set xlabel 'displacement [mm]'\n";
@@ -199,22 +205,45 @@ void PlotDamper(const std::string& png, const std::vector<std::pair<const rths::
   if (rc != 0) throw Error(png, fmt::format("gnuplot failed ({}); is gnuplot-nox installed? {}", rc, err));
 }
 
-/// The --damper mode (file comment).
-int RunDamper(const std::vector<std::string>& records, double current_A, const std::vector<std::string>& checks,
-              const rths::ident::DamperFitOptions& o, const std::string& out, const std::string& plot) {
+/// Options of the --damper mode beyond the fits' own.
+struct DamperCli {
+  std::vector<std::string> records, checks;
+  double current_A = -1.0;          ///< >= 0: the one-current fit
+  std::string input;                ///< "current" | "voltage" | "" (current if the records have i_A)
+  std::string out, plot;
+  rths::io::TimeAxis time = rths::io::TimeAxis::kColumn;
+};
+
+std::vector<rths::io::RigRecord> ReadDamperRecords(const std::vector<std::string>& paths, rths::io::TimeAxis time) {
   std::vector<rths::io::RigRecord> recs;
-  for (const auto& path : records) {
-    recs.push_back(rths::io::ReadRecordOrUtfsm(path));
+  for (const auto& path : paths) {
+    recs.push_back(rths::io::ReadRecordOrUtfsm(path, time));
     for (const auto& w : recs.back().warnings) std::fprintf(stderr, "rths identify: warning: %s\n", w.c_str());
   }
-  std::vector<rths::io::RigRecord> held;
-  for (const auto& path : checks) held.push_back(rths::io::ReadRecordOrUtfsm(path));
-  const auto fit = rths::ident::FitDamper(recs, current_A, o);
-  std::printf("rths identify --damper: %zu record(s) at %g A\n%s", recs.size(), current_A, fit.Report().c_str());
+  return recs;
+}
+
+void WriteModel(const std::string& toml, const std::string& out) {
+  std::printf("\n%s", toml.c_str());
+  if (!out.empty()) {
+    std::ofstream f(out);
+    if (!(f << toml)) throw Error(out, "cannot write the model file");
+    std::printf("\nwrote %s\n", out.c_str());
+  }
+}
+
+std::string Names(const std::vector<std::string>& paths) {
   std::string names;
-  for (const auto& r : records) names += (names.empty() ? "" : " ") + fs::path(r).filename().string();
-  std::string title = fmt::format("rths identify --damper {} --current {}", names, current_A);
-  auto fit_out = fit;
+  for (const auto& r : paths) names += (names.empty() ? "" : " ") + fs::path(r).filename().string();
+  return names;
+}
+
+/// The --damper mode at one current (file comment).
+int RunDamper(const DamperCli& c, const rths::ident::DamperFitOptions& o) {
+  const auto recs = ReadDamperRecords(c.records, c.time);
+  const auto held = ReadDamperRecords(c.checks, c.time);
+  const auto fit = rths::ident::FitDamper(recs, c.current_A, o);
+  std::printf("rths identify --damper: %zu record(s) at %g A\n%s", recs.size(), c.current_A, fit.Report().c_str());
   if (!held.empty()) {
     std::printf("  held-out force error (Eq. 31 on f), same model:\n");
     for (const auto& h : held) {
@@ -223,19 +252,57 @@ int RunDamper(const std::vector<std::string>& records, double current_A, const s
                   sc.peak_force_kN, sc.nrmse_f_pct);
     }
   }
-  const std::string toml = rths::ident::DamperTomlFragment(fit_out, title);
-  std::printf("\n%s", toml.c_str());
-  if (!out.empty()) {
-    std::ofstream f(out);
-    if (!(f << toml)) throw Error(out, "cannot write the model file");
-    std::printf("\nwrote %s\n", out.c_str());
+  WriteModel(rths::ident::DamperTomlFragment(
+                 fit, fmt::format("rths identify --damper {} --current {}", Names(c.records), c.current_A)),
+             c.out);
+  if (!c.plot.empty()) {
+    std::vector<DamperPlotRecord> all;
+    auto add = [&](const rths::io::RigRecord& r, bool fitted) {
+      const double cutoff = o.velocity_cutoff_hz > 0.0 ? o.velocity_cutoff_hz : rths::ident::VelocityCutoffHz(r);
+      auto v = rths::ident::SmoothVelocity(r.y_mm, r.dt_s, cutoff);
+      auto F = rths::ident::SimulateDamperForce(fit.coef, r.y_mm, v, r.dt_s);
+      all.push_back({&r, fitted, std::move(F), std::move(v), rths::ident::ScoreDamper(fit.coef, r, cutoff).nrmse_f_pct});
+    };
+    for (const auto& r : recs) add(r, true);
+    for (const auto& r : held) add(r, false);
+    PlotDamper(c.plot, all, fmt::format("at {} A", c.current_A));
+    std::printf("wrote %s\n", c.plot.c_str());
   }
-  if (!plot.empty()) {
-    std::vector<std::pair<const rths::io::RigRecord*, bool>> all;
-    for (const auto& r : recs) all.emplace_back(&r, true);
-    for (const auto& r : held) all.emplace_back(&r, false);
-    PlotDamper(plot, all, fit.coef, o.velocity_cutoff_hz, current_A);
-    std::printf("wrote %s\n", plot.c_str());
+  return 0;
+}
+
+/// The --damper mode with any input history: Eqs. 32-39 with the control filter.
+int RunSpencer(const DamperCli& c, const rths::ident::SpencerFitOptions& o) {
+  const auto recs = ReadDamperRecords(c.records, c.time);
+  const auto held = ReadDamperRecords(c.checks, c.time);
+  bool voltage = c.input == "voltage";
+  if (c.input.empty()) voltage = !recs.empty() && recs[0].i_A.empty();
+  const auto fit = rths::ident::FitSpencer(recs, voltage, o);
+  std::printf("rths identify --damper: %zu record(s), %s input %g to %g %s\n%s", recs.size(),
+              voltage ? "voltage" : "current", fit.input_min, fit.input_max, voltage ? "V" : "A", fit.Report().c_str());
+  if (!held.empty()) {
+    std::printf("  held-out force error (Eq. 31 on f), same model:\n");
+    for (const auto& h : held) {
+      const auto sc = rths::ident::ScoreSpencer(fit.params, fit.driver, fit.filter, h, voltage, o.velocity_cutoff_hz);
+      std::printf("    %-40s %7zu samples at %g s, peak %.4g kN: %.3f %%\n", sc.source.c_str(), sc.samples, sc.dt_s,
+                  sc.peak_force_kN, sc.nrmse_f_pct);
+    }
+  }
+  WriteModel(rths::ident::SpencerModelToml(fit, fmt::format("rths identify --damper {} ({} input)", Names(c.records),
+                                                            voltage ? "voltage" : "current")),
+             c.out);
+  if (!c.plot.empty()) {
+    std::vector<DamperPlotRecord> all;
+    auto add = [&](const rths::io::RigRecord& r, bool fitted) {
+      const double cutoff = o.velocity_cutoff_hz > 0.0 ? o.velocity_cutoff_hz : rths::ident::VelocityCutoffHz(r);
+      auto F = rths::ident::PredictSpencerForce(fit.params, fit.driver, fit.filter, r, voltage, cutoff);
+      const auto sc = rths::ident::ScoreSpencer(fit.params, fit.driver, fit.filter, r, voltage, cutoff);
+      all.push_back({&r, fitted, std::move(F), rths::ident::SmoothVelocity(r.y_mm, r.dt_s, cutoff), sc.nrmse_f_pct});
+    };
+    for (const auto& r : recs) add(r, true);
+    for (const auto& r : held) add(r, false);
+    PlotDamper(c.plot, all, voltage ? "(voltage input)" : "(current input)");
+    std::printf("wrote %s\n", c.plot.c_str());
   }
   return 0;
 }
@@ -249,8 +316,12 @@ int main(int argc, char** argv) {
   int poles = 3;
   double segment_s = 0.0;
   bool damper = false;
-  double current_A = -1.0;
+  DamperCli dc;
+  double& current_A = dc.current_A;
   rths::ident::DamperFitOptions damper_options;
+  rths::ident::SpencerFitOptions spencer_options;
+  std::string filter = "first_order";
+  bool no_offset = false;
   app.add_option("record", records,
                  "CSV rig record or LCM run log (log.lcm) of ours; with --damper one or more damper tests (also UTFSM "
                  "damper files)")
@@ -259,12 +330,26 @@ int main(int argc, char** argv) {
   app.add_flag("--time-from-header", time_from_header,
                "take the step from the record's '# dt_s' line; the time column need only lie within half a step "
                "of t_0 + k dt_s (for a rounded time column)");
-  app.add_flag("--damper", damper, "fit the Spencer MR damper model (Eqs. 32-34) at one current instead");
-  app.add_option("--current", current_A, "--damper: the current of the records [A] (required)");
+  app.add_flag("--damper", damper,
+               "fit the Spencer MR damper model instead: at one current (--current) or, without it, its current- or "
+               "voltage-dependent form (Eqs. 32-39) with a control filter, from records with any input history");
+  app.add_option("--current", current_A, "--damper: fit at this one current [A] (the records' constant current)");
   app.add_option("--check", checks, "--damper: held-out records to score the fitted model on");
   app.add_option("--A", damper_options.A, "--damper: Bouc-Wen A, held fixed (default 300, Table 3)");
   app.add_option("--velocity-cutoff-hz", damper_options.velocity_cutoff_hz,
-                 "--damper: cutoff of the zero-phase smoothing differentiator [Hz] (default 50)");
+                 "--damper: cutoff of the zero-phase smoothing differentiator [Hz] (default 0: 1.5 x the band edge of "
+                 "each record's displacement, at least 50 Hz, at most 0.45 / dt)");
+  app.add_option("--input", dc.input,
+                 "--damper without --current: the control input, current (column i_A) or voltage (column v_V) "
+                 "(default: current if the records have i_A)")
+      ->check(CLI::IsMember({"current", "voltage"}));
+  app.add_option("--filter", filter,
+                 "--damper without --current: control filter between command and parameters: first_order "
+                 "(u' = -eta (u - v), eta fitted; default), eq40 (the paper's Eq. 40 + 75 Hz low-pass, fixed), none")
+      ->check(CLI::IsMember({"first_order", "eq40", "none"}));
+  app.add_flag("--no-offset", no_offset, "--damper without --current: hold k1 = x0 = 0 (no accumulator force)");
+  app.add_option("--threads", spencer_options.threads,
+                 "--damper without --current: threads for the Jacobian (default 0: one per core)");
   app.add_option("--band", band, "frequency band fitted, LO-HI [Hz] (default 0.5-40, the paper's range)");
   app.add_option("--poles", poles, "number of poles N of Eq. 15 (default 3)");
   app.add_option("--segment-s", segment_s, "Welch segment length [s] (default min(4 s, 2/9 of the record))");
@@ -282,10 +367,24 @@ int main(int argc, char** argv) {
 
   try {
     if (damper) {
-      if (current_A < 0.0) throw Error("--current", "--damper needs --current A (>= 0), the current of the records");
-      return RunDamper(records, current_A, checks, damper_options, out, plot);
+      dc.records = records;
+      dc.checks = checks;
+      dc.out = out;
+      dc.plot = plot;
+      dc.time = time_from_header ? rths::io::TimeAxis::kHeader : rths::io::TimeAxis::kColumn;
+      if (app.count("--current") > 0) {
+        if (!(current_A >= 0.0)) throw Error("--current", fmt::format("{} A: must be >= 0", current_A));
+        if (!dc.input.empty() || app.count("--filter") > 0 || no_offset)
+          throw Error("--input/--filter/--no-offset", "only for the fit with any input history (without --current)");
+        return RunDamper(dc, damper_options);
+      }
+      spencer_options.A = damper_options.A;
+      spencer_options.velocity_cutoff_hz = damper_options.velocity_cutoff_hz;
+      spencer_options.filter = *rths::ValueOf(rths::ident::kControlFilterNames, filter);
+      spencer_options.accumulator = !no_offset;
+      return RunSpencer(dc, spencer_options);
     }
-    if (current_A >= 0.0 || !checks.empty()) throw Error("--current/--check", "only with --damper");
+    if (app.count("--current") > 0 || !checks.empty()) throw Error("--current/--check", "only with --damper");
     if (records.size() != 1)
       throw Error("record", fmt::format("{} records given: the actuator fit takes one (or use --damper)", records.size()));
     record = records[0];

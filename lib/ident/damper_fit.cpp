@@ -10,6 +10,7 @@
 
 #include "core/error.h"
 #include "signal/butterworth.h"
+#include "signal/spectral.h"
 
 namespace rths::ident {
 
@@ -182,8 +183,8 @@ bool DamperFitOptions::IsValid(std::string* error) const {
     return false;
   };
   if (!(A > 0.0) || !std::isfinite(A)) return fail(fmt::format("A = {}: must be > 0", A));
-  if (!(velocity_cutoff_hz > 0.0) || !std::isfinite(velocity_cutoff_hz))
-    return fail(fmt::format("velocity_cutoff_hz = {}: must be > 0", velocity_cutoff_hz));
+  if (!(velocity_cutoff_hz >= 0.0) || !std::isfinite(velocity_cutoff_hz))
+    return fail(fmt::format("velocity_cutoff_hz = {}: must be >= 0 (0: from the record's band)", velocity_cutoff_hz));
   if (start_iterations < 1) return fail(fmt::format("start_iterations = {}: must be >= 1", start_iterations));
   if (max_iterations < 1) return fail(fmt::format("max_iterations = {}: must be >= 1", max_iterations));
   if (!(current_tolerance_A >= 0.0))
@@ -219,6 +220,37 @@ std::vector<double> SmoothVelocity(std::span<const double> x, double dt, double 
   run(ext.begin(), ext.end());
   run(ext.rbegin(), ext.rend());
   return {ext.begin() + static_cast<std::ptrdiff_t>(pad), ext.begin() + static_cast<std::ptrdiff_t>(pad + n)};
+}
+
+double VelocityCutoffHz(const io::RigRecord& rec) {
+  const double fs = 1.0 / rec.dt_s, top = 0.45 * fs;
+  const std::size_t n = rec.size();
+  if (n < 64) return std::min(50.0, top);
+  std::size_t L = 1;
+  while (L * 2 <= std::min<std::size_t>(n / 4, static_cast<std::size_t>(2.0 * fs))) L *= 2;
+  L = std::max<std::size_t>(L, 32);
+  const auto psd = signal::WelchPsd(rec.y_mm, rec.dt_s, L);
+  const std::size_t m = psd.size();
+  std::vector<double> hi(psd.begin() + static_cast<std::ptrdiff_t>(m * 4 / 5), psd.end());
+  std::nth_element(hi.begin(), hi.begin() + static_cast<std::ptrdiff_t>(hi.size() / 2), hi.end());
+  const double floor = hi.empty() ? 0.0 : hi[hi.size() / 2];
+  // Velocity density of the signal: (2 pi f)^2 (S_y - floor) where S_y stands clear of the floor
+  // (10 x: a Welch estimate of noise alone scatters by far less), 0 elsewhere; the constant
+  // factor drops out.
+  auto vel = [&](std::size_t i) {
+    return psd[i] > 10.0 * floor ? static_cast<double>(i) * static_cast<double>(i) * (psd[i] - floor) : 0.0;
+  };
+  double total = 0.0;
+  for (std::size_t i = 1; i < m; ++i) total += vel(i);
+  double edge = 0.0, cum = 0.0;
+  for (std::size_t i = 1; i < m && total > 0.0; ++i) {
+    cum += vel(i);
+    if (cum >= 0.999 * total) {
+      edge = static_cast<double>(i) * fs / static_cast<double>(L);
+      break;
+    }
+  }
+  return std::clamp(4.0 * edge, std::min(50.0, top), top);
 }
 
 int DamperSubsteps(const models::MrDamperCoefficients& k, double dt, double vmax) {
@@ -277,7 +309,8 @@ DamperRecordScore ScoreDamper(const models::MrDamperCoefficients& coef, const io
   s.source = rec.source;
   s.samples = rec.size();
   s.dt_s = rec.dt_s;
-  const auto v = SmoothVelocity(rec.y_mm, rec.dt_s, velocity_cutoff_hz);
+  const double cutoff = velocity_cutoff_hz > 0.0 ? velocity_cutoff_hz : VelocityCutoffHz(rec);
+  const auto v = SmoothVelocity(rec.y_mm, rec.dt_s, cutoff);
   const auto F = SimulateDamperForce(coef, rec.y_mm, v, rec.dt_s);
   double se = 0.0, sf = 0.0;
   for (std::size_t k = 0; k < rec.size(); ++k) {
@@ -304,14 +337,16 @@ DamperFitResult FitDamper(const std::vector<io::RigRecord>& records, double curr
     const std::string where = rec.source.empty() ? "record" : rec.source;
     if (rec.size() < 3 || rec.f_kN.size() != rec.size() || rec.y_mm.size() != rec.size())
       throw Error(where, "too few samples or columns of different lengths");
-    for (std::size_t k = 0; k < rec.i_A.size(); ++k) {
-      if (std::abs(rec.i_A[k] - current_A) > o.current_tolerance_A)
+    const auto& command = rec.Command();  // i_A, or v_V of a voltage-only record
+    for (std::size_t k = 0; k < command.size(); ++k) {
+      if (std::abs(command[k] - current_A) > o.current_tolerance_A)
         throw Error(where, fmt::format("sample {} (t = {} s): current i_A = {} A differs from --current {} A by "
                                        "more than {} A: the fit is at one current",
-                                       k + 1, k < rec.t_s.size() ? rec.t_s[k] : 0.0, rec.i_A[k], current_A,
+                                       k + 1, k < rec.t_s.size() ? rec.t_s[k] : 0.0, command[k], current_A,
                                        o.current_tolerance_A));
     }
-    Prepared p{&rec, SmoothVelocity(rec.y_mm, rec.dt_s, o.velocity_cutoff_hz), 0.0, 0.0};
+    const double cutoff = o.velocity_cutoff_hz > 0.0 ? o.velocity_cutoff_hz : VelocityCutoffHz(rec);
+    Prepared p{&rec, SmoothVelocity(rec.y_mm, rec.dt_s, cutoff), 0.0, 0.0};
     double sf = 0.0;
     for (std::size_t k = 0; k < rec.size(); ++k) {
       sf += rec.f_kN[k] * rec.f_kN[k];

@@ -7,7 +7,8 @@
 ///     z'    = -gamma |x' - y'| z |z| - beta (x' - y') z^2 + A (x' - y')           (Eq. 33)
 ///     F     = alpha z + c0 (x' - y') + k0 (x - y) + k1 (x - x0)                    (Eq. 34)
 /// driven by the measured displacement x_k = y_mm of the record and a velocity v_k estimated
-/// from it offline by SmoothVelocity (a zero-phase smoothing differentiator), from rest
+/// from it offline by SmoothVelocity (a zero-phase smoothing differentiator at the cut-off of
+/// VelocityCutoffHz unless one is given), from rest
 /// (y = x_0, z = 0) at the record's first sample.
 ///
 /// Scale redundancy: z -> z / s with alpha -> s alpha, beta -> s beta, gamma -> s gamma,
@@ -46,6 +47,16 @@ namespace rths::ident {
 /// 0.45 / dt_s. Throws rths::Error for fewer than 3 samples, dt_s <= 0 or cutoff_hz <= 0.
 std::vector<double> SmoothVelocity(std::span<const double> x_mm, double dt_s, double cutoff_hz);
 
+/// The velocity cut-off [Hz] for a record's displacement: 4 x the band edge f_e of its velocity
+/// (the frequency below which 99.9 % of f^2 (S_y(f) - floor) lies, over the frequencies where
+/// S_y > 10 floor; S_y a Welch PSD of y_mm, the floor the median density over the top fifth of
+/// the frequencies), at least 50 Hz (the former
+/// fixed default, right for slow tests) and at most 0.45 / dt_s. Why 4 x: the smoothing's
+/// amplitude error is (f / f_c)^8 (SmoothVelocity), 1.5e-5 at f_e; at 1.5 x it is 4 %, and the
+/// damper force, which integrates x' - y' through the stiff Bouc-Wen state, shows it (a 15 Hz
+/// BLWN record: force error 0.6 % at 50 Hz, 0.04 % at 100 Hz, with the true model).
+double VelocityCutoffHz(const io::RigRecord& record);
+
 /// Substeps per sample of SimulateDamperForce for these coefficients (file comment), given the
 /// largest |v| [mm/s] of the motion; at least 1, at most 4000.
 int DamperSubsteps(const models::MrDamperCoefficients& k, double dt_s, double vmax_mm_s);
@@ -60,7 +71,7 @@ std::vector<double> SimulateDamperForce(const models::MrDamperCoefficients& k, s
 /// Options of FitDamper; defaults are those of `rths identify --damper`.
 struct DamperFitOptions {
   double A = 300.0;                  ///< Bouc-Wen A, held fixed (file comment), > 0
-  double velocity_cutoff_hz = 50.0;  ///< SmoothVelocity cutoff [Hz], > 0
+  double velocity_cutoff_hz = 0.0;   ///< SmoothVelocity cutoff [Hz], >= 0; 0 = VelocityCutoffHz per record
   int start_iterations = 6;          ///< Levenberg-Marquardt iterations per start, >= 1
   int max_iterations = 200;          ///< for the best start, >= 1
   /// Largest |i_k - current| [A] accepted in a record (the fit is at one current), >= 0.
@@ -100,9 +111,9 @@ DamperFitResult FitDamper(const std::vector<io::RigRecord>& records, double curr
                           const DamperFitOptions& options = {});
 
 /// Eq. 31 on force of `coef` on a record (held-out check), with the velocity of
-/// SmoothVelocity(y_mm, dt_s, velocity_cutoff_hz).
+/// SmoothVelocity(y_mm, dt_s, velocity_cutoff_hz); 0 = VelocityCutoffHz(record).
 DamperRecordScore ScoreDamper(const models::MrDamperCoefficients& coef, const io::RigRecord& record,
-                              double velocity_cutoff_hz = 50.0);
+                              double velocity_cutoff_hz = 0.0);
 
 /// The coefficients as current-independent MrDamperParams: p_a = p_b = the value, p_c = 0
 /// (Eqs. 35-39 then give the value at every current).

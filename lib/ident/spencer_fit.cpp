@@ -1,0 +1,627 @@
+#include "ident/spencer_fit.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <thread>
+
+#include <Eigen/Dense>
+#include <fmt/format.h>
+
+#include "core/error.h"
+#include "ident/damper_fit.h"
+
+namespace rths::ident {
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+// theta layout (file comment of spencer_fit.h): 5 laws x (a, b, c), then k0, then eta.
+constexpr int kLaws = 5;  // alpha, c0, c1, beta, gamma
+constexpr int kK0 = 3 * kLaws;
+constexpr int kEta = kK0 + 1;
+
+// Bounds of each law's ends a, b (natural units) and of the rates [1/A or 1/V].
+constexpr double kEndLo[kLaws] = {1e-7, 1e-7, 1e-7, 1e-9, 1e-9};
+constexpr double kEndHi[kLaws] = {1e3, 1e4, 1e4, 1e4, 1e4};
+constexpr double kRateLo = 1e-4, kRateHi = 1e3;
+constexpr double kK0Lo = 1e-8, kK0Hi = 1e2;
+constexpr double kEtaLo = 1.0, kEtaHi = 1e5;
+// The starts' share of every record (and its least length [s]).
+constexpr double kStartShare = 0.25, kStartMinS = 3.0;
+
+int Dim(ControlFilter f) { return f == ControlFilter::kFirstOrder ? kEta + 1 : kK0 + 1; }
+
+double LoBound(int i) {
+  if (i < kK0) return i % 3 == 2 ? kRateLo : kEndLo[i / 3];
+  return i == kK0 ? kK0Lo : kEtaLo;
+}
+double HiBound(int i) {
+  if (i < kK0) return i % 3 == 2 ? kRateHi : kEndHi[i / 3];
+  return i == kK0 ? kK0Hi : kEtaHi;
+}
+
+Eigen::VectorXd Clamp(Eigen::VectorXd th) {
+  for (Eigen::Index i = 0; i < th.size(); ++i)
+    th[i] = std::clamp(th[i], std::log(LoBound(static_cast<int>(i))), std::log(HiBound(static_cast<int>(i))));
+  return th;
+}
+
+models::MrDamperParams ParamsOf(const Eigen::VectorXd& th, double A) {
+  models::MrDamperParams p;
+  double* ends[kLaws][3] = {{&p.alpha_a, &p.alpha_b, &p.alpha_c},
+                            {&p.c0_a, &p.c0_b, &p.c0_c},
+                            {&p.c1_a, &p.c1_b, &p.c1_c},
+                            {&p.beta_a, &p.beta_b, &p.beta_c},
+                            {&p.gamma_a, &p.gamma_b, &p.gamma_c}};
+  for (int l = 0; l < kLaws; ++l)
+    for (int j = 0; j < 3; ++j) *ends[l][j] = std::exp(th[3 * l + j]);
+  p.A = A;
+  p.n = 2.0;
+  p.k0 = std::exp(th[kK0]);
+  p.k1 = 0.0;
+  p.x0 = 0.0;
+  return p;
+}
+
+models::CurrentDriverParams DriverOf(const Eigen::VectorXd& th, ControlFilter f) {
+  models::CurrentDriverParams d;
+  if (f == ControlFilter::kFirstOrder) {
+    d.kind = models::CurrentFilter::kFirstOrder;
+    d.eta_1_s = std::exp(th[kEta]);
+  }
+  return d;
+}
+
+// The filtered input u_k at the sample times (file comment), from u_0 = v_0.
+void FilteredInput(std::span<const double> v, double dt, ControlFilter f, const models::CurrentDriverParams& d,
+                   std::vector<double>* u) {
+  const std::size_t n = v.size();
+  u->resize(n);
+  if (n == 0) return;
+  if (f == ControlFilter::kNone) {
+    std::copy(v.begin(), v.end(), u->begin());
+    return;
+  }
+  const auto driver = models::CurrentDriver::Make(d, dt);
+  auto st = models::SteadyState(v[0]);
+  for (std::size_t k = 0; k < n; ++k) {
+    (*u)[k] = models::EffectiveCurrentA(driver, st);
+    models::Step(driver, &st, v[k]);
+  }
+}
+
+// One record prepared for the fit.
+struct Prepared {
+  const io::RigRecord* rec = nullptr;
+  std::span<const double> v;  // the command
+  std::vector<double> xdot;   // smoothed velocity [mm/s]
+  double cutoff_hz = 0.0;
+  double weight = 0.0;        // 1 / sum f^2
+  double vmax = 0.0;          // max |x'|
+  std::size_t n = 0;          // samples used: all, or the first part for the starts
+};
+
+// Substeps of sample step j -> j+1 from the local rate bound (damper_fit.h, lambda with the
+// coefficients and |x'| of both ends); kMaxSpencerSubsteps + 1 if too stiff.
+int LocalSubsteps(const models::MrDamperCoefficients& c0, const models::MrDamperCoefficients& c1, double A, double k0,
+                  double v0, double v1, double dt) {
+  const double bg = std::max(c0.beta + c0.gamma, c1.beta + c1.gamma);
+  const double slow = std::max((A * c0.alpha + k0) / (c0.c0 + c0.c1), (A * c1.alpha + k0) / (c1.c0 + c1.c1));
+  const double lambda = 2.0 * std::sqrt(A * bg) * std::max(std::abs(v0), std::abs(v1)) + slow;
+  if (!(lambda < 1e300)) return kMaxSpencerSubsteps + 1;
+  const double m = std::ceil(dt * lambda / 0.8);
+  return m > kMaxSpencerSubsteps ? kMaxSpencerSubsteps + 1 : std::max(1, static_cast<int>(m));
+}
+
+// Nonlinear part of the force, F_nl = alpha z + c0 (x' - y') + k0 (x - y), at the first d.n
+// samples of a record, into out; false if a step is too stiff for kMaxSpencerSubsteps or the
+// state stops being finite. `m` holds the substeps per sample step: chosen here (LocalSubsteps)
+// if `choose`, else given (the Jacobian's columns keep the base point's, so that the finite
+// differences see a smooth function).
+struct Workspace {
+  std::vector<double> u;
+  std::vector<models::MrDamperCoefficients> c;
+};
+
+bool SimulateNonlinear(const models::MrDamperParams& p, const models::CurrentDriverParams& drv, ControlFilter filter,
+                       const Prepared& d, bool choose, std::vector<std::uint8_t>* msteps, Workspace* w, double* out) {
+  const auto& rec = *d.rec;
+  const std::size_t n = d.n;
+  const double dt = rec.dt_s;
+  FilteredInput(d.v.subspan(0, n), dt, filter, drv, &w->u);
+  w->c.resize(n);
+  for (std::size_t k = 0; k < n; ++k) w->c[k] = models::CoefficientsAt(p, w->u[k]);
+  if (choose) msteps->assign(n, 1);
+  const double A = p.A, k0 = p.k0;
+  const auto& x = rec.y_mm;
+  const auto& xd = d.xdot;
+  double y = x[0], z = 0.0;
+  // Rates at fraction s in [0, 1] of sample step j -> j+1 (x, x', coefficients linear in s).
+  auto rates = [&](std::size_t j, double s, double ys, double zs, double* dy, double* dz) {
+    const auto& c0 = w->c[j];
+    const auto& c1 = w->c[j + 1];
+    const double xs = x[j] + s * (x[j + 1] - x[j]), vs = xd[j] + s * (xd[j + 1] - xd[j]);
+    const double alpha = c0.alpha + s * (c1.alpha - c0.alpha), cc0 = c0.c0 + s * (c1.c0 - c0.c0),
+                 cc1 = c0.c1 + s * (c1.c1 - c0.c1), beta = c0.beta + s * (c1.beta - c0.beta),
+                 gamma = c0.gamma + s * (c1.gamma - c0.gamma);
+    *dy = (alpha * zs + k0 * (xs - ys) + cc0 * vs) / (cc0 + cc1);
+    const double rel = vs - *dy;
+    *dz = -gamma * std::abs(rel) * zs * std::abs(zs) - beta * rel * zs * zs + A * rel;
+  };
+  for (std::size_t j = 0; j < n; ++j) {
+    const auto& c = w->c[j];
+    const double ydot = (c.alpha * z + k0 * (x[j] - y) + c.c0 * xd[j]) / (c.c0 + c.c1);
+    out[j] = c.alpha * z + c.c0 * (xd[j] - ydot) + k0 * (x[j] - y);
+    if (!std::isfinite(out[j])) return false;
+    if (j + 1 == n) break;
+    if (choose) {
+      const int mj = LocalSubsteps(w->c[j], w->c[j + 1], A, k0, xd[j], xd[j + 1], dt);
+      if (mj > kMaxSpencerSubsteps) return false;
+      (*msteps)[j] = static_cast<std::uint8_t>(mj);
+    }
+    const int m = (*msteps)[j];
+    const double h = dt / m;
+    for (int i = 0; i < m; ++i) {
+      const double s0 = static_cast<double>(i) / m, s1 = (i + 0.5) / m, s2 = static_cast<double>(i + 1) / m;
+      double dy1, dz1, dy2, dz2, dy3, dz3, dy4, dz4;
+      rates(j, s0, y, z, &dy1, &dz1);
+      rates(j, s1, y + 0.5 * h * dy1, z + 0.5 * h * dz1, &dy2, &dz2);
+      rates(j, s1, y + 0.5 * h * dy2, z + 0.5 * h * dz2, &dy3, &dz3);
+      rates(j, s2, y + h * dy3, z + h * dz3, &dy4, &dz4);
+      y += h / 6.0 * (dy1 + 2.0 * dy2 + 2.0 * dy3 + dy4);
+      z += h / 6.0 * (dz1 + 2.0 * dz2 + 2.0 * dz3 + dz4);
+    }
+  }
+  return true;
+}
+
+struct Evaluation {
+  Eigen::VectorXd r;
+  double cost = kInf;
+  double k1 = 0.0, x0 = 0.0;
+  std::vector<std::vector<std::uint8_t>> substeps;  // per record, per sample step
+};
+
+class Problem {
+ public:
+  Problem(const std::vector<Prepared>& data, const SpencerFitOptions& o) : data_(data), o_(o) {
+    for (const auto& d : data_) total_ += d.n;
+  }
+  int dim() const { return Dim(o_.filter); }
+
+  // fixed: substeps of a base evaluation to keep (nullptr: choose them here).
+  Evaluation Evaluate(const Eigen::VectorXd& th, const Evaluation* fixed, Workspace* w,
+                      std::vector<double>* fnl) const {
+    Evaluation ev;
+    const auto p = ParamsOf(th, o_.A);
+    const auto drv = DriverOf(th, o_.filter);
+    fnl->resize(total_);
+    ev.substeps.resize(data_.size());
+    std::size_t off = 0;
+    for (std::size_t i = 0; i < data_.size(); ++i) {
+      const auto& d = data_[i];
+      if (fixed != nullptr) ev.substeps[i] = fixed->substeps[i];
+      if (!SimulateNonlinear(p, drv, o_.filter, d, fixed == nullptr, &ev.substeps[i], w, fnl->data() + off))
+        return ev;  // cost inf
+      off += d.n;
+    }
+    double k1 = 0.0, b = 0.0;
+    if (o_.accumulator) {
+      double sxx = 0, sx = 0, s1 = 0, sxe = 0, se = 0;
+      off = 0;
+      for (const auto& d : data_) {
+        for (std::size_t j = 0; j < d.n; ++j) {
+          const double x = d.rec->y_mm[j], e = d.rec->f_kN[j] - (*fnl)[off + j];
+          sxx += d.weight * x * x;
+          sx += d.weight * x;
+          s1 += d.weight;
+          sxe += d.weight * x * e;
+          se += d.weight * e;
+        }
+        off += d.n;
+      }
+      const double det = sxx * s1 - sx * sx;
+      if (det > 1e-12 * sxx * s1) {
+        k1 = (sxe * s1 - sx * se) / det;
+        b = (sxx * se - sx * sxe) / det;
+      }
+      if (!(k1 > 0.0)) k1 = b = 0.0;  // k1 (x - x0) needs k1 > 0 to carry an offset
+    }
+    ev.k1 = k1;
+    ev.x0 = k1 > 0.0 ? -b / k1 : 0.0;
+    ev.r.resize(static_cast<Eigen::Index>(total_));
+    off = 0;
+    for (const auto& d : data_) {
+      const double sw = std::sqrt(d.weight);
+      for (std::size_t j = 0; j < d.n; ++j)
+        ev.r[static_cast<Eigen::Index>(off + j)] = sw * (d.rec->f_kN[j] - (*fnl)[off + j] - k1 * d.rec->y_mm[j] - b);
+      off += d.n;
+    }
+    ev.cost = ev.r.squaredNorm();
+    if (!std::isfinite(ev.cost)) ev.cost = kInf;
+    return ev;
+  }
+
+ private:
+  const std::vector<Prepared>& data_;
+  const SpencerFitOptions& o_;
+  std::size_t total_ = 0;
+};
+
+struct LmState {
+  Eigen::VectorXd theta;
+  Evaluation ev;
+  double mu = 1e-3;
+  int iterations = 0;
+  bool converged = false;
+};
+
+void Iterate(LmState* s, const Problem& pb, int iterations, int threads) {
+  const int P = pb.dim();
+  std::vector<Workspace> ws(static_cast<std::size_t>(threads));
+  std::vector<std::vector<double>> fnl(static_cast<std::size_t>(threads));
+  for (int it = 0; it < iterations && !s->converged; ++it) {
+    const Evaluation base = pb.Evaluate(s->theta, nullptr, &ws[0], &fnl[0]);
+    if (!std::isfinite(base.cost)) {
+      s->converged = true;
+      return;
+    }
+    Eigen::MatrixXd J(base.r.size(), P);
+    auto column = [&](int i, int t) {
+      Eigen::VectorXd th = s->theta;
+      double h = 1e-5;
+      if (th[i] + h > std::log(HiBound(i))) h = -h;
+      th[i] += h;
+      const Evaluation e = pb.Evaluate(th, &base, &ws[static_cast<std::size_t>(t)], &fnl[static_cast<std::size_t>(t)]);
+      if (std::isfinite(e.cost))
+        J.col(i) = (e.r - base.r) / h;
+      else
+        J.col(i).setZero();
+    };
+    if (threads <= 1) {
+      for (int i = 0; i < P; ++i) column(i, 0);
+    } else {
+      std::vector<std::thread> pool;
+      for (int t = 0; t < threads; ++t)
+        pool.emplace_back([&, t] {
+          for (int i = t; i < P; i += threads) column(i, t);
+        });
+      for (auto& th : pool) th.join();
+    }
+    const Eigen::MatrixXd H = J.transpose() * J;
+    const Eigen::VectorXd g = J.transpose() * base.r;
+    ++s->iterations;
+    bool accepted = false;
+    while (s->mu < 1e12) {
+      Eigen::MatrixXd Hd = H;
+      for (int i = 0; i < P; ++i) Hd(i, i) += s->mu * std::max(H(i, i), 1e-12);
+      const Eigen::VectorXd trial = Clamp(s->theta + Hd.ldlt().solve(-g));
+      const Evaluation e = pb.Evaluate(trial, nullptr, &ws[0], &fnl[0]);
+      if (std::isfinite(e.cost) && e.cost < s->ev.cost) {
+        const double rel = (s->ev.cost - e.cost) / std::max(s->ev.cost, 1e-300);
+        const double dstep = (trial - s->theta).norm();
+        s->theta = trial;
+        s->ev = e;
+        s->mu = std::max(s->mu / 3.0, 1e-9);
+        accepted = true;
+        if (rel < 1e-9 || dstep < 1e-7) s->converged = true;
+        break;
+      }
+      s->mu *= 4.0;
+    }
+    if (!accepted) s->converged = true;
+  }
+}
+
+// Rough f ~ F_y sgn(x') + c x' + k x + b on the samples with `use`, weighted per record.
+struct Rough {
+  double Fy = 0.0, c = 0.0;
+  std::size_t n = 0;
+};
+Rough RoughFit(const std::vector<Prepared>& data, const std::vector<std::vector<char>>& use) {
+  Eigen::Matrix4d N = Eigen::Matrix4d::Zero();
+  Eigen::Vector4d rhs = Eigen::Vector4d::Zero();
+  Rough r;
+  for (std::size_t i = 0; i < data.size(); ++i) {
+    const auto& d = data[i];
+    for (std::size_t k = 0; k < d.n; ++k) {
+      if (!use[i][k]) continue;
+      const double v = d.xdot[k];
+      Eigen::Vector4d a(v > 0.0 ? 1.0 : (v < 0.0 ? -1.0 : 0.0), v, d.rec->y_mm[k], 1.0);
+      N += d.weight * a * a.transpose();
+      rhs += d.weight * d.rec->f_kN[k] * a;
+      ++r.n;
+    }
+  }
+  if (r.n < 8) return r;
+  const Eigen::Vector4d sol = N.ldlt().solve(rhs);
+  r.Fy = sol[0];
+  r.c = sol[1];
+  return r;
+}
+
+}  // namespace
+
+bool SpencerFitOptions::IsValid(std::string* error) const {
+  auto fail = [&](const std::string& m) {
+    if (error) *error = m;
+    return false;
+  };
+  if (!(A > 0.0) || !std::isfinite(A)) return fail(fmt::format("A = {}: must be > 0", A));
+  if (!(velocity_cutoff_hz >= 0.0) || !std::isfinite(velocity_cutoff_hz))
+    return fail(fmt::format("velocity_cutoff_hz = {}: must be >= 0 (0: from the record's band)", velocity_cutoff_hz));
+  if (!(eta_start_1_s > 0.0) || !std::isfinite(eta_start_1_s))
+    return fail(fmt::format("eta_start_1_s = {}: must be > 0", eta_start_1_s));
+  if (start_iterations < 1) return fail(fmt::format("start_iterations = {}: must be >= 1", start_iterations));
+  if (max_iterations < 1) return fail(fmt::format("max_iterations = {}: must be >= 1", max_iterations));
+  if (threads < 0) return fail(fmt::format("threads = {}: must be >= 0", threads));
+  return true;
+}
+
+std::span<const double> ControlInput(const io::RigRecord& rec, bool voltage) {
+  const std::string where = rec.source.empty() ? "record" : rec.source;
+  if (voltage) {
+    if (rec.v_V.size() != rec.size())
+      throw Error(where, "no voltage column v_V (the fit was asked for a voltage input)");
+    return rec.v_V;
+  }
+  if (rec.i_A.size() != rec.size())
+    throw Error(where, "no current column i_A (use the voltage input for a record with v_V only)");
+  return rec.i_A;
+}
+
+std::vector<double> PredictSpencerForce(const models::MrDamperParams& params, const models::CurrentDriverParams& driver,
+                                        ControlFilter filter, const io::RigRecord& rec, bool voltage,
+                                        double cutoff_hz) {
+  params.Validate();
+  Prepared d;
+  d.rec = &rec;
+  d.v = ControlInput(rec, voltage);
+  d.cutoff_hz = cutoff_hz > 0.0 ? cutoff_hz : VelocityCutoffHz(rec);
+  d.xdot = SmoothVelocity(rec.y_mm, rec.dt_s, d.cutoff_hz);
+  for (double v : d.xdot) d.vmax = std::max(d.vmax, std::abs(v));
+  std::vector<double> f(rec.size(), kNaN);
+  Workspace w;
+  d.n = rec.size();
+  std::vector<std::uint8_t> msteps;
+  if (!SimulateNonlinear(params, driver, filter, d, true, &msteps, &w, f.data())) {
+    for (std::size_t k = 0; k < f.size(); ++k)
+      if (!std::isfinite(f[k])) {
+        std::fill(f.begin() + static_cast<std::ptrdiff_t>(k), f.end(), kNaN);
+        break;
+      }
+  }
+  for (std::size_t k = 0; k < f.size(); ++k) f[k] += params.k1 * (rec.y_mm[k] - params.x0);
+  return f;
+}
+
+SpencerRecordScore ScoreSpencer(const models::MrDamperParams& params, const models::CurrentDriverParams& driver,
+                                ControlFilter filter, const io::RigRecord& rec, bool voltage, double cutoff_hz) {
+  SpencerRecordScore s;
+  s.source = rec.source;
+  s.samples = rec.size();
+  s.dt_s = rec.dt_s;
+  s.velocity_cutoff_hz = cutoff_hz > 0.0 ? cutoff_hz : VelocityCutoffHz(rec);
+  const auto F = PredictSpencerForce(params, driver, filter, rec, voltage, s.velocity_cutoff_hz);
+  double se = 0.0, sf = 0.0;
+  for (std::size_t k = 0; k < rec.size(); ++k) {
+    se += (rec.f_kN[k] - F[k]) * (rec.f_kN[k] - F[k]);
+    sf += rec.f_kN[k] * rec.f_kN[k];
+    s.peak_force_kN = std::max(s.peak_force_kN, std::abs(rec.f_kN[k]));
+  }
+  s.nrmse_f_pct = sf > 0.0 ? std::sqrt(se / sf) * 100.0 : kNaN;
+  if (!std::isfinite(se)) s.nrmse_f_pct = kInf;
+  return s;
+}
+
+SpencerFitResult FitSpencer(const std::vector<io::RigRecord>& records, bool voltage, const SpencerFitOptions& o) {
+  const auto t0 = std::chrono::steady_clock::now();
+  std::string why;
+  if (!o.IsValid(&why)) throw Error("SpencerFitOptions", why);
+  if (records.empty()) throw Error("FitSpencer", "no records");
+  std::vector<Prepared> data;
+  double xmax = 0.0, vmax_all = 0.0, in_lo = kInf, in_hi = -kInf;
+  for (const auto& rec : records) {
+    const std::string where = rec.source.empty() ? "record" : rec.source;
+    if (rec.size() < 3 || rec.f_kN.size() != rec.size() || rec.y_mm.size() != rec.size())
+      throw Error(where, "too few samples or columns of different lengths");
+    Prepared p;
+    p.rec = &rec;
+    p.v = ControlInput(rec, voltage);
+    p.cutoff_hz = o.velocity_cutoff_hz > 0.0 ? o.velocity_cutoff_hz : VelocityCutoffHz(rec);
+    p.xdot = SmoothVelocity(rec.y_mm, rec.dt_s, p.cutoff_hz);
+    double sf = 0.0;
+    for (std::size_t k = 0; k < rec.size(); ++k) {
+      sf += rec.f_kN[k] * rec.f_kN[k];
+      p.vmax = std::max(p.vmax, std::abs(p.xdot[k]));
+      xmax = std::max(xmax, std::abs(rec.y_mm[k]));
+      in_lo = std::min(in_lo, p.v[k]);
+      in_hi = std::max(in_hi, p.v[k]);
+    }
+    if (!(sf > 0.0)) throw Error(where, "the force f_kN is zero throughout: nothing to fit");
+    p.weight = 1.0 / sf;
+    p.n = rec.size();
+    vmax_all = std::max(vmax_all, p.vmax);
+    data.push_back(std::move(p));
+  }
+  if (!(vmax_all > 0.0)) throw Error("FitSpencer", "the displacement never moves: nothing to fit");
+  const char* unit = voltage ? "V" : "A";
+  if (!(in_hi - in_lo > 1e-6))
+    throw Error("FitSpencer", fmt::format("the control input is constant ({} {}): its laws (Eqs. 35-39) cannot be "
+                                          "fitted; fit at one current instead (--current)",
+                                          in_lo, unit));
+  if (in_lo < 0.0)
+    throw Error("FitSpencer", fmt::format("the control input goes negative ({} {}): Eqs. 35-39 take an input >= 0",
+                                          in_lo, unit));
+  const int threads = o.threads > 0 ? o.threads : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+
+  // Rough ends: samples whose filtered input (eta of the starts) is in the lowest / highest tenth.
+  models::CurrentDriverParams d0;
+  if (o.filter == ControlFilter::kFirstOrder) {
+    d0.kind = models::CurrentFilter::kFirstOrder;
+    d0.eta_1_s = o.eta_start_1_s;
+  }
+  std::vector<std::vector<char>> low(data.size()), high(data.size());
+  std::vector<double> u;
+  for (std::size_t i = 0; i < data.size(); ++i) {
+    FilteredInput(data[i].v, data[i].rec->dt_s, o.filter, d0, &u);
+    low[i].resize(u.size());
+    high[i].resize(u.size());
+    for (std::size_t k = 0; k < u.size(); ++k) {
+      low[i][k] = u[k] <= in_lo + 0.1 * (in_hi - in_lo);
+      high[i][k] = u[k] >= in_hi - 0.1 * (in_hi - in_lo);
+    }
+  }
+  double fpeak = 0.0;
+  for (const auto& rec : records)
+    for (double f : rec.f_kN) fpeak = std::max(fpeak, std::abs(f));
+  auto sane = [&](Rough r) {
+    if (!(r.Fy > 0.0)) r.Fy = 0.25 * fpeak;
+    if (!(r.c > 0.0)) r.c = 0.1 * fpeak / vmax_all;
+    return r;
+  };
+  const Rough ra = sane(RoughFit(data, low)), rb = sane(RoughFit(data, high));
+
+  // Starts (file comment) on the first part of every record (kStartShare of it, at least
+  // kStartMinS): pre-yield travel at each end of the input range x c1/c0.
+  std::vector<Prepared> part = data;
+  for (auto& d : part)
+    d.n = std::min(d.rec->size(), std::max(static_cast<std::size_t>(kStartShare * static_cast<double>(d.rec->size())),
+                                           static_cast<std::size_t>(kStartMinS / d.rec->dt_s)));
+  const Problem pb_part(part, o), pb(data, o);
+  const int P = pb.dim();
+  std::vector<LmState> starts;
+  const std::pair<double, double> travels[] = {{0.1, 0.1}, {0.1, 0.5}, {0.5, 0.5}, {0.5, 2.0}, {2.0, 2.0}};
+  for (const auto& [delta_a, delta_b] : travels) {
+    for (double ratio : {1.0, 10.0}) {
+      LmState s;
+      s.theta.resize(P);
+      const double rate = 2.0 / std::max(in_hi, 1e-6);
+      const Rough* ends[2] = {&ra, &rb};
+      for (int j = 0; j < 2; ++j) {
+        const double delta = j == 0 ? delta_a : delta_b;
+        const double zmax = o.A * delta, bg = 1.0 / (o.A * delta * delta);
+        const double c0 = ends[j]->c * (1.0 + ratio) / ratio, c1 = ratio * c0;
+        const double alpha = ends[j]->Fy / zmax * (c0 + c1) / c1;
+        s.theta[0 + j] = std::log(alpha);
+        s.theta[3 + j] = std::log(c0);
+        s.theta[6 + j] = std::log(c1);
+        s.theta[9 + j] = std::log(0.5 * bg);
+        s.theta[12 + j] = std::log(0.5 * bg);
+      }
+      for (int l = 0; l < kLaws; ++l) s.theta[3 * l + 2] = std::log(rate);
+      s.theta[kK0] = std::log(0.01 * rb.Fy / std::max(xmax, 1e-3));
+      if (o.filter == ControlFilter::kFirstOrder) s.theta[kEta] = std::log(o.eta_start_1_s);
+      s.theta = Clamp(s.theta);
+      Workspace w;
+      std::vector<double> f;
+      s.ev = pb_part.Evaluate(s.theta, nullptr, &w, &f);
+      starts.push_back(std::move(s));
+    }
+  }
+  SpencerFitResult res;
+  res.filter = o.filter;
+  res.voltage = voltage;
+  res.input_min = in_lo;
+  res.input_max = in_hi;
+  int best = -1;
+  for (std::size_t i = 0; i < starts.size(); ++i) {
+    if (std::isfinite(starts[i].ev.cost)) Iterate(&starts[i], pb_part, o.start_iterations, threads);
+    res.start_costs.push_back(starts[i].ev.cost);
+    if (std::isfinite(starts[i].ev.cost) &&
+        (best < 0 || starts[i].ev.cost < starts[static_cast<std::size_t>(best)].ev.cost))
+      best = static_cast<int>(i);
+  }
+  if (best < 0) throw Error("FitSpencer", "no start gives a finite force prediction");
+  LmState& s = starts[static_cast<std::size_t>(best)];
+  s.converged = false;
+  {
+    Workspace w;
+    std::vector<double> f;
+    s.ev = pb.Evaluate(s.theta, nullptr, &w, &f);  // on all the data now
+  }
+  Iterate(&s, pb, o.max_iterations, threads);
+  res.best_start = best;
+  res.iterations = s.iterations;
+  res.converged = s.converged;
+  res.cost = s.ev.cost;
+  res.params = ParamsOf(s.theta, o.A);
+  res.params.k1 = s.ev.k1;
+  res.params.x0 = s.ev.x0;
+  res.driver = DriverOf(s.theta, o.filter);
+  for (const auto& d : data)
+    res.records.push_back(ScoreSpencer(res.params, res.driver, o.filter, *d.rec, voltage, d.cutoff_hz));
+  res.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return res;
+}
+
+std::string SpencerFitResult::Report() const {
+  const char* unit = voltage ? "V" : "A";
+  const auto& p = params;
+  std::string o = fmt::format("Spencer MR damper model, current-dependent (Eqs. 32-39, n = 2, A held at {}), input in {}:\n",
+                              p.A, voltage ? "volts" : "amperes");
+  if (filter == ControlFilter::kFirstOrder)
+    o += fmt::format("  control filter u' = -eta (u - v): eta = {:.5g} 1/s (time constant {:.4g} ms)\n", driver.eta_1_s,
+                     1000.0 / driver.eta_1_s);
+  else
+    o += fmt::format("  control filter: {}\n", filter == ControlFilter::kEq40 ? "Eq. 40 + 75 Hz low-pass (fixed)"
+                                                                              : "none (the command is the input)");
+  o += fmt::format("  p(u) = p_b + (p_a - p_b) exp(-p_c u):        p_a            p_b            p_c [1/{}]\n", unit);
+  const std::pair<const char*, const double*> laws[] = {{"alpha [kN/mm]", &p.alpha_a}, {"c0 [kN s/mm]", &p.c0_a},
+                                                        {"c1 [kN s/mm]", &p.c1_a},     {"beta [1/mm^2]", &p.beta_a},
+                                                        {"gamma [1/mm^2]", &p.gamma_a}};
+  for (const auto& [name, v] : laws)
+    o += fmt::format("    {:<40} {:<14.6g} {:<14.6g} {:.6g}\n", name, v[0], v[1], v[2]);
+  o += fmt::format("  k0 = {:.6g} kN/mm   k1 = {:.6g} kN/mm   x0 = {:.6g} mm\n", p.k0, p.k1, p.x0);
+  for (double in : {input_min, input_max}) {
+    const auto c = models::CoefficientsAt(p, in);
+    o += fmt::format("  at {:.4g} {}: alpha {:.4g}, c0 {:.4g}, c1 {:.4g}, beta {:.4g}, gamma {:.4g}\n", in, unit, c.alpha,
+                     c.c0, c.c1, c.beta, c.gamma);
+  }
+  o += fmt::format("  Levenberg-Marquardt: start {} of {} won, {} iterations, {}; cost J = {:.6g}; {:.1f} s\n",
+                   best_start + 1, start_costs.size(), iterations, converged ? "converged" : "not converged (iteration limit)",
+                   cost, seconds);
+  o += "  force error per record (Eq. 31 on f):\n";
+  for (const auto& r : records)
+    o += fmt::format("    {:<40} {:7d} samples at {:g} s, velocity cut-off {:.0f} Hz, peak {:.4g} kN: {:.3f} %\n",
+                     r.source, r.samples, r.dt_s, r.velocity_cutoff_hz, r.peak_force_kN, r.nrmse_f_pct);
+  return o;
+}
+
+std::string SpencerModelToml(const SpencerFitResult& fit, const std::string& title) {
+  const auto& p = fit.params;
+  std::string o = fmt::format("# {}\n", title);
+  o += fmt::format("# Spencer MR damper (Eqs. 32-39, n = 2) fitted on inputs {:g} to {:g} {}{}.\n", fit.input_min,
+                   fit.input_max, fit.voltage ? "V" : "A",
+                   fit.voltage ? " (a VOLTAGE: the rates p_c are per V, and the damper command of a run is in V)" : "");
+  o += "# Force error (Eq. 31 on f) per training record:\n";
+  for (const auto& r : fit.records) o += fmt::format("#   {}: {:.3f} %\n", r.source, r.nrmse_f_pct);
+  auto num = [](double v) {
+    std::string s = fmt::format("{:.10g}", v);  // a TOML float: keep a '.' or an exponent
+    if (s.find_first_of(".e") == std::string::npos) s += ".0";
+    return s;
+  };
+  o += fmt::format("\n[plant]\ncurrent_dynamics = {}\n", fit.filter == ControlFilter::kNone ? "false" : "true");
+  o += "\n[plant.damper]\n";
+  const std::pair<const char*, double> fields[] = {
+      {"alpha_a", p.alpha_a}, {"alpha_b", p.alpha_b}, {"alpha_c", p.alpha_c}, {"c0_a", p.c0_a},
+      {"c0_b", p.c0_b},       {"c0_c", p.c0_c},       {"c1_a", p.c1_a},       {"c1_b", p.c1_b},
+      {"c1_c", p.c1_c},       {"beta_a", p.beta_a},   {"beta_b", p.beta_b},   {"beta_c", p.beta_c},
+      {"gamma_a", p.gamma_a}, {"gamma_b", p.gamma_b}, {"gamma_c", p.gamma_c}, {"A", p.A},
+      {"n", p.n},             {"k0", p.k0},           {"k1", p.k1},           {"x0", p.x0}};
+  for (const auto& [key, v] : fields) o += fmt::format("{} = {}\n", key, num(v));
+  if (fit.filter != ControlFilter::kNone) {
+    o += "\n[plant.current_driver]\n";
+    if (fit.filter == ControlFilter::kFirstOrder)
+      o += fmt::format("kind = \"first_order\"\neta_1_s = {}\n", num(fit.driver.eta_1_s));
+    else
+      o += "kind = \"eq40\"\n";
+  }
+  return o;
+}
+
+}  // namespace rths::ident

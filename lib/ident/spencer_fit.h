@@ -1,0 +1,125 @@
+#pragma once
+/// @file Least-squares fit of the current-dependent Spencer MR damper model (Eqs. 32-39) to
+/// damper tests with any control history: a current or a voltage, constant, pulsed, switched
+/// (`rths identify --damper` without `--current`; docs/identification.md "The MR damper, any
+/// input"). Units: mm, kN, s; the control input in A (current) or V (voltage).
+///
+/// Model. The command v_k of the record (held over [t_k, t_{k+1})) passes through the control
+/// filter, then sets the parameters, then drives Eqs. 32-34 with the measured motion:
+///
+///     u' = -eta (u - v)                     first-order filter of Spencer et al. (1997), or
+///                                           the paper's Eq. 40 + 75 Hz low-pass (fixed), or none
+///     p(u) = p_b + (p_a - p_b) exp(-p_c u)  for p in {alpha, c0, c1, beta, gamma}  (Eqs. 35-39)
+///     c1 y' = alpha z + k0 (x - y) + c0 (x' - y')                                  (Eq. 32)
+///     z'    = -gamma |x' - y'| z |z| - beta (x' - y') z^2 + A (x' - y')           (Eq. 33)
+///     F     = alpha z + c0 (x' - y') + k0 (x - y) + k1 (x - x0)                    (Eq. 34)
+///
+/// with x_k = y_mm and x'_k from SmoothVelocity (damper_fit.h) at a cut-off chosen from the
+/// record's band (VelocityCutoffHz), from rest (y = x_0, z = 0, u = v_0).
+///
+/// Fit: minimise J = sum_r sum_k (f_rk - F_rk)^2 / sum_k f_rk^2 (each record weighs the same)
+/// over theta = ln [alpha_a, alpha_b, alpha_c, c0_a, c0_b, c0_c, c1_a, c1_b, c1_c, beta_a,
+/// beta_b, beta_c, gamma_a, gamma_b, gamma_c, k0, eta] (eta only for the first-order filter),
+/// in a box, by Levenberg-Marquardt with a forward-difference Jacobian (its columns computed in
+/// parallel; the result does not depend on the number of threads); k1 and b = -k1 x0 enter
+/// linearly and are solved at every theta (variable projection), or held at 0 without the
+/// accumulator. A is held (scale redundancy, damper_fit.h). Starts: rough yield-force /
+/// viscous fits of the samples at the lowest and at the highest filtered input give p_a and
+/// p_b; pre-yield travels (at the low, high end) in {(0.1, 0.1), (0.1, 0.5), (0.5, 0.5),
+/// (0.5, 2), (2, 2)} mm x c1/c0 in {1, 10}; every start runs a few iterations on the first
+/// quarter of each record (at least 3 s), the best continues on all the data to convergence.
+///
+/// Integration: per sample, the coefficients at the sample times t_k (5 exponentials each),
+/// linear in between; RK4 on (y, z) with x, x' and the coefficients interpolated linearly,
+/// m_k substeps over step k -> k+1 with h lambda_k <= 0.8, lambda_k the rate bound of
+/// damper_fit.h with the coefficients and |x'| of the step's two ends (at most
+/// kMaxSpencerSubsteps: beyond that a trial is refused as too stiff; a prediction gives NaN).
+/// The Jacobian's columns keep the base point's m_k.
+#include <span>
+#include <string>
+#include <vector>
+
+#include "io/rig_record.h"
+#include "models/current_driver.h"
+#include "models/mr_damper.h"
+
+namespace rths::ident {
+
+/// The control filter between the record's command and the parameters' input.
+enum class ControlFilter { kFirstOrder, kEq40, kNone };
+inline constexpr std::array<Named<ControlFilter>, 3> kControlFilterNames = {
+    {{ControlFilter::kFirstOrder, "first_order"}, {ControlFilter::kEq40, "eq40"}, {ControlFilter::kNone, "none"}}};
+
+/// Most substeps per sample the fit integrates with (file comment).
+inline constexpr int kMaxSpencerSubsteps = 64;
+
+/// Options of FitSpencer; defaults are those of `rths identify --damper` with a varying input.
+struct SpencerFitOptions {
+  double A = 300.0;                 ///< Bouc-Wen A, held fixed, > 0
+  double velocity_cutoff_hz = 0.0;  ///< SmoothVelocity cut-off [Hz]; 0 = VelocityCutoffHz per record
+  ControlFilter filter = ControlFilter::kFirstOrder;
+  double eta_start_1_s = 100.0;     ///< first-order filter: eta of the starts [1/s], > 0
+  bool accumulator = true;          ///< fit k1 and x0 (the force offset); false: k1 = x0 = 0
+  int start_iterations = 8;         ///< LM iterations per start (on a quarter of the data), >= 1
+  int max_iterations = 150;         ///< for the best start, >= 1
+  int threads = 0;                  ///< Jacobian threads; 0 = the machine's cores
+  /// True if every field is in range; else false and a message naming the field.
+  bool IsValid(std::string* error) const;
+};
+
+/// One record's score: Eq. 31 on force.
+struct SpencerRecordScore {
+  std::string source;
+  std::size_t samples = 0;
+  double dt_s = 0.0;
+  double velocity_cutoff_hz = 0.0;
+  double peak_force_kN = 0.0;
+  double nrmse_f_pct = 0.0;
+};
+
+/// The fitted model and how well it fits.
+struct SpencerFitResult {
+  models::MrDamperParams params{};          ///< Eqs. 32-39 (rates per A or per V)
+  models::CurrentDriverParams driver{};     ///< the filter (kFirstOrder: the fitted eta)
+  ControlFilter filter = ControlFilter::kFirstOrder;
+  bool voltage = false;                     ///< the input is a voltage [V] (else a current [A])
+  double input_min = 0.0, input_max = 0.0;  ///< range of the commands fitted [A or V]
+  std::vector<SpencerRecordScore> records;  ///< per training record
+  double cost = 0.0;
+  int best_start = 0;
+  int iterations = 0;
+  bool converged = false;
+  std::vector<double> start_costs;
+  double seconds = 0.0;                     ///< wall time of the fit [s]
+  /// Multi-line text: the parameters at the ends of the input range, eta, the errors.
+  std::string Report() const;
+};
+
+/// The command the model is driven with: the record's v_V if voltage (throws if it has none),
+/// else its i_A (throws if it has none).
+std::span<const double> ControlInput(const io::RigRecord& record, bool voltage);
+
+/// Fits the model to the records (file comment). voltage: drive it with each record's v_V
+/// column instead of i_A. Throws rths::Error (where = the record's source) for a record without
+/// that column, too short, or with zero force; (where = "SpencerFitOptions") for bad options;
+/// if no start gives a finite cost.
+SpencerFitResult FitSpencer(const std::vector<io::RigRecord>& records, bool voltage,
+                            const SpencerFitOptions& options = {});
+
+/// Force prediction F_k [kN] of the model on a record's motion and command (NaN from the first
+/// non-finite sample). velocity_cutoff_hz 0 = VelocityCutoffHz(record).
+std::vector<double> PredictSpencerForce(const models::MrDamperParams& params, const models::CurrentDriverParams& driver,
+                                        ControlFilter filter, const io::RigRecord& record, bool voltage,
+                                        double velocity_cutoff_hz = 0.0);
+
+/// Eq. 31 on force of the model on a record (held-out check).
+SpencerRecordScore ScoreSpencer(const models::MrDamperParams& params, const models::CurrentDriverParams& driver,
+                                ControlFilter filter, const io::RigRecord& record, bool voltage,
+                                double velocity_cutoff_hz = 0.0);
+
+/// The model as a model file `rths run`, `design` and `diagnose --model` read: '#' comments
+/// (title, input unit, errors), then [plant] current_dynamics, [plant.damper] (every
+/// MrDamperParams field) and [plant.current_driver] (the filter).
+std::string SpencerModelToml(const SpencerFitResult& fit, const std::string& title);
+
+}  // namespace rths::ident

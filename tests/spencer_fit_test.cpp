@@ -1,0 +1,258 @@
+// The current-dependent MR damper fit (ident/spencer_fit.h) and what it needs: the first-order
+// control filter of the current driver, the random_pulse current schedule, voltage records, the
+// velocity cut-off from the record's band, and the model file read back by the scenario parser
+// and by the diagnosis. The recovery test fits a record made by the plant's rig mode (models::
+// MakeRig with the sensor_noise effect) with a pulsed current of random levels.
+#include <cmath>
+#include <fstream>
+#include <numbers>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <doctest/doctest.h>
+#include <fmt/format.h>
+
+#include "core/error.h"
+#include "diagnosis/channel_models.h"
+#include "ident/damper_fit.h"
+#include "ident/spencer_fit.h"
+#include "io/rig_record.h"
+#include "models/current_driver.h"
+#include "models/rig.h"
+#include "participants/semiactive.h"
+#include "scenario/scenario.h"
+#include "signal/blwn.h"
+#include "test_support.h"
+
+namespace {
+
+namespace m = rths::models;
+using rths::ident::ControlFilter;
+
+/// A rig-mode record: the linear plant ("avg"), the Table 3 damper, the first-order current
+/// filter with eta, sensor noise as a rig-mode effect, u = BLWN, i = random pulses.
+rths::io::RigRecord RigModeRecord(double eta_1_s, double dt, double duration_s, double band_hz, double rms_mm,
+                                  std::uint64_t seed, const std::string& name, double noise_y_mm = 0.001,
+                                  double noise_f_kN = 0.02) {
+  m::PlantConfig plant;
+  plant.kind = m::PlantKind::kLinear;
+  plant.current_driver.kind = m::CurrentFilter::kFirstOrder;
+  plant.current_driver.eta_1_s = eta_1_s;
+  plant.effects.sensor_noise = m::SensorNoise{noise_y_mm, noise_f_kN};
+  plant.noise_seed = seed + 100;
+  auto rig = m::MakeRig(plant, dt);
+  rths::control::SemiactiveConfig sa;
+  sa.mode = rths::control::SemiactiveMode::kRandomPulse;
+  sa.pulse_hz = 2.0;
+  sa.pulse_duty = 0.6;
+  sa.pulse_seed = seed;
+  const rths::participants::CurrentSchedule schedule(sa, dt);
+  const auto n = static_cast<std::size_t>(std::llround(duration_s / dt));
+  const auto u = rths::signal::Blwn(band_hz, rms_mm, dt, n, seed, 1.0);
+  rths::io::RigRecord rec;
+  rec.dt_s = dt;
+  rec.source = name;
+  for (std::size_t k = 0; k < n; ++k) {
+    const double i = schedule.At(static_cast<std::int64_t>(k));
+    rec.t_s.push_back(static_cast<double>(k) * dt);
+    rec.u_mm.push_back(u[k]);
+    rec.y_mm.push_back(rig->y_mm());
+    rec.f_kN.push_back(rig->f_kN());
+    rec.i_A.push_back(i);
+    rig->Step(u[k], i);
+  }
+  return rec;
+}
+
+}  // namespace
+
+TEST_CASE("first-order current filter: H(s) = eta / (s + eta), exact step response, continuous on a jump") {
+  m::CurrentDriverParams p;
+  p.kind = m::CurrentFilter::kFirstOrder;
+  p.eta_1_s = 150.0;
+  const double dt = 1.0 / 3000.0;
+  const auto d = m::CurrentDriver::Make(p, dt);
+  CHECK(d.DcGain() == doctest::Approx(1.0).epsilon(1e-14));
+  const auto h = d.FrequencyResponse(150.0 / (2.0 * std::numbers::pi));  // at the corner: 1 / (1 + j)
+  CHECK(std::abs(h) == doctest::Approx(1.0 / std::sqrt(2.0)).epsilon(1e-12));
+  auto s = m::SteadyState(0.0);
+  for (int k = 0; k < 30; ++k) {
+    CHECK(m::EffectiveCurrentA(d, s) == doctest::Approx(2.0 * (1.0 - std::exp(-150.0 * k * dt))).epsilon(1e-12));
+    m::Step(d, &s, 2.0);
+  }
+  // Closed form inside a step, and the same as DriverOutputA (no separate Eq. 40 stage).
+  CHECK(m::EffectiveCurrentAt(d, s, 0.5 * dt) ==
+        doctest::Approx(2.0 * (1.0 - std::exp(-150.0 * 30.5 * dt))).epsilon(1e-12));
+  CHECK(m::DriverOutputA(d, s) == m::EffectiveCurrentA(d, s));
+  p.eta_1_s = 0.0;
+  CHECK_THROWS_AS(m::CurrentDriver::Make(p, dt), rths::Error);
+}
+
+TEST_CASE("random_pulse: a pure function of k, levels spread over [0, max], off between pulses") {
+  rths::control::SemiactiveConfig sa;
+  sa.mode = rths::control::SemiactiveMode::kRandomPulse;
+  sa.max_current_A = 2.5;
+  sa.pulse_hz = 2.0;
+  sa.pulse_duty = 0.5;
+  const double dt = 0.001;
+  const rths::participants::CurrentSchedule a(sa, dt), b(sa, dt);
+  double lo = 9, hi = -9;
+  for (std::int64_t k = 0; k < 20000; ++k) {
+    const double i = a.At(k);
+    REQUIRE(i == b.At(k));
+    CHECK(i >= 0.0);
+    CHECK(i < 2.5);
+    if (k % 500 >= 250) CHECK(i == 0.0);
+    if (k % 500 == 0) lo = std::min(lo, i), hi = std::max(hi, i);
+    if (k % 500 > 0 && k % 500 < 250) CHECK(i == a.At(k - 1));  // one level per pulse
+  }
+  CHECK(lo < 0.5);
+  CHECK(hi > 2.0);
+  sa.pulse_seed = 2;
+  CHECK(rths::participants::CurrentSchedule(sa, dt).At(0) != a.At(0));
+}
+
+TEST_CASE("[plant.current_driver] and random_pulse are read, written back and range-checked") {
+  const auto dir = rths_test::TempDir("spencer_scenario");
+  const auto sc = rths::scenario::LoadScenario(
+      rths_test::WriteScenario(dir, "[run]\nduration_s = 0.5\n[plant.current_driver]\nkind = \"first_order\"\n"
+                                    "eta_1_s = 120.0\n[semiactive]\nmode = \"random_pulse\"\npulse_seed = 9\n")
+          .string());
+  CHECK(sc.plant.current_driver.kind == m::CurrentFilter::kFirstOrder);
+  CHECK(sc.plant.current_driver.eta_1_s == 120.0);
+  CHECK(sc.semiactive.mode == rths::control::SemiactiveMode::kRandomPulse);
+  CHECK(sc.semiactive.pulse_seed == 9u);
+  const auto again = rths::scenario::LoadScenario(rths_test::WriteScenario(dir, rths::scenario::ToToml(sc)).string());
+  CHECK(again.plant.current_driver == sc.plant.current_driver);
+  CHECK(again.semiactive == sc.semiactive);
+  try {
+    rths::scenario::LoadScenario(
+        rths_test::WriteScenario(dir, "[plant.current_driver]\nkind = \"first_order\"\neta_1_s = -3.0\n").string());
+    FAIL("a negative eta was accepted");
+  } catch (const rths::Error& e) {
+    CHECK(std::string(e.what()).find("plant.current_driver.eta_1_s") != std::string::npos);
+  }
+}
+
+TEST_CASE("v_V: a voltage column is read, written back, and drives the fit's input") {
+  rths::io::RigRecord rec;
+  rec.dt_s = 0.001;
+  for (int k = 0; k < 2500; ++k) {
+    rec.t_s.push_back(k * 0.001);
+    rec.u_mm.push_back(std::sin(k * 0.01));
+    rec.y_mm.push_back(std::sin(k * 0.01));
+    rec.f_kN.push_back(0.1 * std::cos(k * 0.01));
+    rec.v_V.push_back(k % 500 < 250 ? 5.0 : 0.0);
+  }
+  const auto dir = rths_test::TempDir("spencer_vV");
+  const auto path = (dir / "v.csv").string();
+  rths::io::WriteRigRecord(rec, path);
+  const auto back = rths::io::ReadRigRecord(path);
+  CHECK(back.i_A.empty());
+  REQUIRE(back.v_V.size() == rec.size());
+  CHECK(back.v_V[0] == 5.0);
+  CHECK(back.Command() == back.v_V);
+  CHECK(rths::ident::ControlInput(back, true)[300] == 0.0);
+  CHECK_THROWS_AS(rths::ident::ControlInput(back, false), rths::Error);
+  // Neither i_A nor v_V: refused, naming both.
+  { std::ofstream(path) << "# rths rig record v1\n# dt_s: 0.001\nt_s,u_mm,y_mm,f_kN\n0,0,0,0\n"; }
+  try {
+    rths::io::ReadRigRecord(path);
+    FAIL("a record without a damper command was accepted");
+  } catch (const rths::Error& e) {
+    CHECK(std::string(e.what()).find("v_V") != std::string::npos);
+  }
+}
+
+TEST_CASE("VelocityCutoffHz follows the displacement's band: 50 Hz for slow tests, higher for wide-band ones") {
+  const double dt = 1.0 / 3000.0;
+  const std::size_t n = 3 * 3000 * 4;
+  rths::io::RigRecord slow, wide;
+  slow.dt_s = wide.dt_s = dt;
+  std::mt19937_64 gen(5);
+  std::normal_distribution<double> noise(0.0, 0.002);  // sensor noise [mm]
+  const auto a = rths::signal::Blwn(5.0, 2.0, dt, n, 3, 1.0);
+  const auto b = rths::signal::Blwn(50.0, 2.0, dt, n, 4, 1.0);
+  for (std::size_t k = 0; k < n; ++k) {
+    slow.t_s.push_back(k * dt);
+    wide.t_s.push_back(k * dt);
+    slow.y_mm.push_back(a[k] + noise(gen));
+    wide.y_mm.push_back(b[k] + noise(gen));
+  }
+  CHECK(rths::ident::VelocityCutoffHz(slow) == doctest::Approx(50.0));
+  const double fw = rths::ident::VelocityCutoffHz(wide);
+  CHECK(fw > 150.0);  // 4 x a velocity band edge of about 50-60 Hz
+  CHECK(fw < 400.0);
+}
+
+TEST_CASE("FitSpencer recovers Eqs. 35-39 and eta from a rig-mode record with a pulsed current") {
+  const double eta = 120.0, dt = 1.0 / 3000.0;
+  const std::vector<rths::io::RigRecord> train = {RigModeRecord(eta, dt, 20.0, 20.0, 8.0, 5, "train")};
+  const auto test = RigModeRecord(eta, dt, 6.0, 8.0, 4.0, 6, "test");
+  rths::ident::SpencerFitOptions o;
+  const auto fit = rths::ident::FitSpencer(train, false, o);
+  MESSAGE(fit.Report());
+  const auto t = m::MrDamperParams::Table3();
+  const auto& p = fit.params;
+  const std::pair<double, double> pairs[] = {{p.alpha_a, t.alpha_a}, {p.alpha_b, t.alpha_b}, {p.alpha_c, t.alpha_c},
+                                             {p.c0_a, t.c0_a},       {p.c0_b, t.c0_b},       {p.c0_c, t.c0_c},
+                                             {p.c1_a, t.c1_a},       {p.c1_b, t.c1_b},       {p.c1_c, t.c1_c},
+                                             {p.beta_a, t.beta_a},   {p.beta_b, t.beta_b},   {p.beta_c, t.beta_c},
+                                             {p.gamma_a, t.gamma_a}, {p.gamma_b, t.gamma_b}, {p.gamma_c, t.gamma_c}};
+  int i = 0;
+  for (const auto& [got, want] : pairs) {
+    CAPTURE(i++);
+    CHECK(got == doctest::Approx(want).epsilon(0.03));
+  }
+  CHECK(fit.driver.kind == m::CurrentFilter::kFirstOrder);
+  CHECK(fit.driver.eta_1_s == doctest::Approx(eta).epsilon(0.03));
+  CHECK(fit.records[0].nrmse_f_pct < 2.0);
+  const auto held = rths::ident::ScoreSpencer(fit.params, fit.driver, fit.filter, test, false);
+  CHECK(held.nrmse_f_pct < 2.0);
+
+  // Without the filter the same record fits worse: the filter is a real part of the model.
+  o.filter = ControlFilter::kNone;
+  o.max_iterations = 40;
+  const auto none = rths::ident::FitSpencer(train, false, o);
+  CHECK(none.records[0].nrmse_f_pct > fit.records[0].nrmse_f_pct);
+
+  // The model file: the scenario parser and the diagnosis read the same model back.
+  const auto dir = rths_test::TempDir("spencer_model");
+  const std::string toml = rths::ident::SpencerModelToml(fit, "test");
+  const auto path = (dir / "damper.toml").string();
+  { std::ofstream(path) << toml; }
+  const auto sc = rths::scenario::LoadScenario(path);
+  CHECK(sc.plant.damper.c1_c == doctest::Approx(p.c1_c).epsilon(1e-9));
+  CHECK(sc.plant.current_driver.kind == m::CurrentFilter::kFirstOrder);
+  CHECK(sc.plant.current_driver.eta_1_s == doctest::Approx(fit.driver.eta_1_s).epsilon(1e-9));
+  CHECK(sc.plant.current_dynamics);
+  const auto model = rths::diagnosis::LoadModel(path);
+  CHECK(model.current_driver == sc.plant.current_driver);
+  CHECK(model.damper == sc.plant.damper);
+}
+
+TEST_CASE("FitSpencer: bad input is refused with the reason") {
+  const double dt = 0.001;
+  rths::io::RigRecord rec;
+  rec.dt_s = dt;
+  rec.source = "constant.csv";
+  for (int k = 0; k < 3000; ++k) {
+    rec.t_s.push_back(k * dt);
+    rec.u_mm.push_back(std::sin(k * 0.01));
+    rec.y_mm.push_back(std::sin(k * 0.01));
+    rec.f_kN.push_back(std::cos(k * 0.01));
+    rec.i_A.push_back(1.0);
+  }
+  try {
+    rths::ident::FitSpencer({rec}, false);
+    FAIL("a constant current was accepted");
+  } catch (const rths::Error& e) {
+    CHECK(std::string(e.what()).find("--current") != std::string::npos);
+  }
+  CHECK_THROWS_AS(rths::ident::FitSpencer({rec}, true), rths::Error);  // no v_V column
+  rths::ident::SpencerFitOptions o;
+  o.threads = -1;
+  CHECK_THROWS_AS(rths::ident::FitSpencer({rec}, false, o), rths::Error);
+}
+
