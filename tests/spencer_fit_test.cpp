@@ -256,3 +256,24 @@ TEST_CASE("FitSpencer: bad input is refused with the reason") {
   CHECK_THROWS_AS(rths::ident::FitSpencer({rec}, false, o), rths::Error);
 }
 
+
+TEST_CASE("rths identify --damper without --current: the fit from a CSV record, a model file that loads") {
+  const auto dir = rths_test::TempDir("spencer_cli");
+  const auto rec = RigModeRecord(150.0, 0.0005, 8.0, 12.0, 5.0, 11, "cli");
+  const auto csv = (dir / "rec.csv").string(), model = (dir / "model.toml").string(),
+             log = (dir / "out.txt").string();
+  rths::io::WriteRigRecord(rec, csv);
+  const std::string cmd =
+      fmt::format("{}/rths-identify --damper {} --out {} > {} 2>&1", RTHS_BIN_DIR, csv, model, log);
+  const int status = std::system(cmd.c_str());
+  REQUIRE(WIFEXITED(status));
+  CHECK(WEXITSTATUS(status) == 0);
+  const auto sc = rths::scenario::LoadScenario(model);
+  CHECK(sc.plant.current_driver.kind == m::CurrentFilter::kFirstOrder);
+  CHECK(sc.plant.current_driver.eta_1_s == doctest::Approx(150.0).epsilon(0.03));
+  CHECK(sc.plant.damper.alpha_b == doctest::Approx(0.55).epsilon(0.03));
+  // --current on a record whose current varies is refused (exit 2), naming the record.
+  const int bad = std::system(
+      fmt::format("{}/rths-identify --damper {} --current 1.0 > {} 2>&1", RTHS_BIN_DIR, csv, log).c_str());
+  CHECK(WEXITSTATUS(bad) == 2);
+}

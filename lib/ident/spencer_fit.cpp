@@ -537,13 +537,26 @@ SpencerFitResult FitSpencer(const std::vector<io::RigRecord>& records, bool volt
       best = static_cast<int>(i);
   }
   if (best < 0) throw Error("FitSpencer", "no start gives a finite force prediction");
-  LmState& s = starts[static_cast<std::size_t>(best)];
-  s.converged = false;
-  {
+  // On all the data now: the best start by its cost on the first part whose cost on all of it
+  // is finite (a start may meet a stiffer stretch later in the records).
+  std::vector<std::size_t> order(starts.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::size_t a, std::size_t b) { return starts[a].ev.cost < starts[b].ev.cost; });
+  best = -1;
+  for (std::size_t i : order) {
+    if (!std::isfinite(starts[i].ev.cost)) break;
     Workspace w;
     std::vector<double> f;
-    s.ev = pb.Evaluate(s.theta, nullptr, &w, &f);  // on all the data now
+    starts[i].ev = pb.Evaluate(starts[i].theta, nullptr, &w, &f);
+    if (std::isfinite(starts[i].ev.cost)) {
+      best = static_cast<int>(i);
+      break;
+    }
   }
+  if (best < 0) throw Error("FitSpencer", "no start gives a finite force prediction on all the data");
+  LmState& s = starts[static_cast<std::size_t>(best)];
+  s.converged = false;
   Iterate(&s, pb, o.max_iterations, threads);
   res.best_start = best;
   res.iterations = s.iterations;
