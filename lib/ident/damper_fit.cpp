@@ -18,6 +18,8 @@ namespace {
 
 constexpr int kNonlinear = 6;  // ln alpha, ln c0, ln c1, ln k0, ln beta, ln gamma
 constexpr double kInf = std::numeric_limits<double>::infinity();
+// Most substeps per sample a trial of the fit may need (Evaluate); the search refuses stiffer ones.
+constexpr int kMaxFitSubsteps = 64;
 
 // Bounds of the nonlinear parameters (natural units: kN/mm, kN s/mm, kN s/mm, kN/mm, 1/mm^2,
 // 1/mm^2), in the order of theta.
@@ -71,6 +73,9 @@ Evaluation Evaluate(const Theta& th, const std::vector<Prepared>& data, double A
   for (std::size_t i = 0; i < data.size(); ++i) {
     const auto& d = data[i];
     const int m = substeps_fixed > 0 ? substeps_fixed : DamperSubsteps(k, d.rec->dt_s, d.vmax);
+    // A trial this stiff is refused rather than integrated (it cost minutes at 3 kHz: thousands of
+    // substeps per sample for a step the search rejects anyway).
+    if (m > kMaxFitSubsteps) return ev;  // cost = inf
     fnl[i] = SimulateDamperForce(k, d.rec->y_mm, d.v, d.rec->dt_s, m);
     for (double f : fnl[i])
       if (!std::isfinite(f)) return ev;  // cost = inf
