@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 
 #include "core/error.h"
+#include "ident/lm.h"
 #include "signal/butterworth.h"
 #include "signal/spectral.h"
 
@@ -157,26 +158,8 @@ void Iterate(LmState* s, const std::vector<Prepared>& data, double A, int iterat
     const Eigen::MatrixXd H = J.transpose() * J;
     const Eigen::VectorXd g = J.transpose() * base.r;
     ++s->iterations;
-    bool accepted = false;
-    while (s->mu < 1e12) {
-      Eigen::MatrixXd Hd = H;
-      for (int i = 0; i < kNonlinear; ++i) Hd(i, i) += s->mu * std::max(H(i, i), 1e-12);
-      const Theta step = Hd.ldlt().solve(-g);
-      const Theta trial = Clamp(s->theta + step);
-      const Evaluation e = Evaluate(trial, data, A, 0);
-      if (std::isfinite(e.cost) && e.cost < s->ev.cost) {
-        const double rel = (s->ev.cost - e.cost) / std::max(s->ev.cost, 1e-300);
-        const double dstep = (trial - s->theta).norm();
-        s->theta = trial;
-        s->ev = e;
-        s->mu = std::max(s->mu / 3.0, 1e-9);
-        accepted = true;
-        if (rel < 1e-7 || dstep < 1e-6) s->converged = true;
-        break;
-      }
-      s->mu *= 4.0;
-    }
-    if (!accepted) s->converged = true;
+    DampedStep(H, g, &s->theta, &s->ev, &s->mu, [&](const Theta& t) { return Evaluate(t, data, A, 0); }, Clamp,
+               1e-7, 1e-6, &s->converged);
   }
 }
 

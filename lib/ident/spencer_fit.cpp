@@ -11,6 +11,7 @@
 
 #include "core/error.h"
 #include "ident/damper_fit.h"
+#include "ident/lm.h"
 
 namespace rths::ident {
 
@@ -295,25 +296,9 @@ void Iterate(LmState* s, const Problem& pb, int iterations, int threads) {
     const Eigen::MatrixXd H = J.transpose() * J;
     const Eigen::VectorXd g = J.transpose() * base.r;
     ++s->iterations;
-    bool accepted = false;
-    while (s->mu < 1e12) {
-      Eigen::MatrixXd Hd = H;
-      for (int i = 0; i < P; ++i) Hd(i, i) += s->mu * std::max(H(i, i), 1e-12);
-      const Eigen::VectorXd trial = Clamp(s->theta + Hd.ldlt().solve(-g));
-      const Evaluation e = pb.Evaluate(trial, nullptr, &ws[0], &fnl[0]);
-      if (std::isfinite(e.cost) && e.cost < s->ev.cost) {
-        const double rel = (s->ev.cost - e.cost) / std::max(s->ev.cost, 1e-300);
-        const double dstep = (trial - s->theta).norm();
-        s->theta = trial;
-        s->ev = e;
-        s->mu = std::max(s->mu / 3.0, 1e-9);
-        accepted = true;
-        if (rel < 1e-9 || dstep < 1e-7) s->converged = true;
-        break;
-      }
-      s->mu *= 4.0;
-    }
-    if (!accepted) s->converged = true;
+    DampedStep(
+        H, g, &s->theta, &s->ev, &s->mu, [&](const Eigen::VectorXd& t) { return pb.Evaluate(t, nullptr, &ws[0], &fnl[0]); },
+        Clamp, 1e-9, 1e-7, &s->converged);
   }
 }
 
