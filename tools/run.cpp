@@ -152,7 +152,7 @@ struct ExternalRoles {
   }
 };
 
-std::vector<Outcome> RunUdpm(const std::string& scenario_path, const rths::scenario::Scenario& s,
+std::vector<Outcome> RunUdpm(const std::string& scenario_path, const rths::scenario::Scenario& /*s*/,
                              std::int64_t run_id, const fs::path& out, const fs::path& bin_dir,
                              const std::string& url, const ExternalRoles& external,
                              const std::vector<std::string>& role_args, Clock::time_point* noticed) {

@@ -27,7 +27,10 @@ lockstep::RunIdentity IdentityOf(const scenario::Scenario& s, std::int64_t run_i
 }
 
 lockstep::Timing TimingOf(const scenario::Scenario& s) {
-  lockstep::Timing t{s.lockstep.rerequest_ms, s.lockstep.stall_budget_s, s.lockstep.handshake_timeout_s};
+  lockstep::Timing t;
+  t.rerequest_ms = s.lockstep.rerequest_ms;
+  t.stall_budget_s = s.lockstep.stall_budget_s;
+  t.handshake_timeout_s = s.lockstep.handshake_timeout_s;
   t.pacing = {s.realtime.enabled, s.run.dt_s, s.realtime.max_consecutive_misses};
   return t;
 }
