@@ -45,9 +45,7 @@ int main(int argc, char** argv) {
                   : blocks    ? "effect blocks"
                               : "rig mode (models::MakeRig)");
       const auto cases = rths::diagnosis::RunHarness(o, [](const rths::diagnosis::HarnessCase& c) {
-        std::printf("%-38s seed %2llu %-5s verdict %-44s shrink %6.1f %%  %5.2f s  [%s]\n", c.kind.c_str(),
-                    static_cast<unsigned long long>(c.seed), c.right ? "RIGHT" : "wrong",
-                    fmt::format("{}", fmt::join(c.verdict, ",")).c_str(), c.shrink_pct, c.runtime_s, c.params.c_str());
+        std::fputs(rths::diagnosis::FormatCase(c).c_str(), stdout);
         std::fflush(stdout);
       });
       const auto sc = rths::diagnosis::ScoreHarness(cases);

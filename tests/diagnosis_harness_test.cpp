@@ -21,10 +21,7 @@ TEST_CASE("harness (rig mode): confusion table and held-out shrink meet the harn
   o.generator = Generator::kRig;
   o.pairs = true;
   std::string lines;
-  const auto cases = RunHarness(o, [&](const HarnessCase& c) {
-    lines += fmt::format("{:<40} seed {} {:<5} verdict {:<40} shrink {:5.1f} %  [{}]\n", c.kind, c.seed,
-                         c.right ? "RIGHT" : "wrong", fmt::format("{}", fmt::join(c.verdict, ",")), c.shrink_pct, c.params);
-  });
+  const auto cases = RunHarness(o, [&](const HarnessCase& c) { lines += FormatCase(c); });
   const auto sc = ScoreHarness(cases);
   const std::string report = lines + sc.table;
   MESSAGE(report);
@@ -47,10 +44,7 @@ TEST_CASE("harness (effect blocks, one seed): confusion table and held-out shrin
   o.generator = Generator::kBlocks;
   o.pairs = true;
   std::string lines;
-  const auto cases = RunHarness(o, [&](const HarnessCase& c) {
-    lines += fmt::format("{:<40} seed {} {:<5} verdict {:<40} shrink {:5.1f} %  [{}]\n", c.kind, c.seed,
-                         c.right ? "RIGHT" : "wrong", fmt::format("{}", fmt::join(c.verdict, ",")), c.shrink_pct, c.params);
-  });
+  const auto cases = RunHarness(o, [&](const HarnessCase& c) { lines += FormatCase(c); });
   const auto sc = ScoreHarness(cases);
   const std::string report = lines + sc.table;
   MESSAGE(report);

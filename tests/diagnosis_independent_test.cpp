@@ -135,10 +135,7 @@ TEST_CASE("harness (independent generator): confusion table and held-out shrink 
   o.generator = Generator::kIndependent;
   o.pairs = true;
   std::string lines;
-  const auto cases = RunHarness(o, [&](const HarnessCase& c) {
-    lines += fmt::format("{:<38} seed {} {:<5} verdict {:<44} shrink {:5.1f} %  [{}]\n", c.kind, c.seed,
-                         c.right ? "RIGHT" : "wrong", fmt::format("{}", fmt::join(c.verdict, ",")), c.shrink_pct, c.params);
-  });
+  const auto cases = RunHarness(o, [&](const HarnessCase& c) { lines += FormatCase(c); });
   const auto sc = ScoreHarness(cases);
   const std::string report = lines + sc.table;
   MESSAGE(report);

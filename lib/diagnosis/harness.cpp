@@ -346,4 +346,10 @@ HarnessScore ScoreHarness(const std::vector<HarnessCase>& cases) {
   return sc;
 }
 
+std::string FormatCase(const HarnessCase& c) {
+  return fmt::format("{:<38} seed {:2} {:<5} verdict {:<44} shrink {:6.1f} %  {:5.2f} s  [{}]\n", c.kind, c.seed,
+                     c.right ? "RIGHT" : "wrong", fmt::format("{}", fmt::join(c.verdict, ",")), c.shrink_pct,
+                     c.runtime_s, c.params);
+}
+
 }  // namespace rths::diagnosis

@@ -84,6 +84,9 @@ Truth HarnessTruth(const std::string& kind, std::uint64_t seed, double noise_y_m
 /// Runs one case. progress (may be empty) is called after it.
 HarnessCase RunHarnessCase(const std::string& kind, std::uint64_t seed, const HarnessOptions& o);
 
+/// One line per case: kind, seed, RIGHT/wrong, verdict, held-out shrink, runtime, true parameters.
+std::string FormatCase(const HarnessCase& c);
+
 /// Runs every case of o (CaseKinds(o.generator, o.pairs), seeds first_seed ..); calls progress after each.
 std::vector<HarnessCase> RunHarness(const HarnessOptions& o, const std::function<void(const HarnessCase&)>& progress = {});
 
