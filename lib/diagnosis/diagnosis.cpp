@@ -1402,8 +1402,11 @@ std::string Summary(const Result& r, SummaryDetail detail) {
   for (const auto& e : r.effects) {
     std::string ps;
     for (const auto& [k, v] : e.params) ps += fmt::format(" {}={:.4g}", k, v);
-    s += fmt::format("  {} {:<22} [{}]{}: {:.3f} %, shrink {:.1f} % (train: excess -{:.0f} %)\n", e.selected ? "*" : " ", e.name,
-                     e.channel, ps, e.test_nrmse_after, e.shrink_pct, 100.0 * e.excess_reduction);
+    // "excess": the training residual's sum of squares above the noise floor (rule (b)).
+    const double red_pct = 100.0 * e.excess_reduction;
+    s += fmt::format("  {} {:<22} [{}]{}: {:.3f} %, shrink {:.1f} % (training: {} {:.0f} % of the residual above noise)\n",
+                     e.selected ? "*" : " ", e.name, e.channel, ps, e.test_nrmse_after, e.shrink_pct,
+                     red_pct >= 0.0 ? "removes" : "adds", std::abs(red_pct));
   }
   s += fmt::format("verdict: {}\n", fmt::join(r.verdict, ", "));
   for (const auto& w : r.warnings) s += "warning: " + w + "\n";
