@@ -261,7 +261,8 @@ int RunDamper(const DamperCli& c, const rths::ident::DamperFitOptions& o) {
       const double cutoff = o.velocity_cutoff_hz > 0.0 ? o.velocity_cutoff_hz : rths::ident::VelocityCutoffHz(r);
       auto v = rths::ident::SmoothVelocity(r.y_mm, r.dt_s, cutoff);
       auto F = rths::ident::SimulateDamperForce(fit.coef, r.y_mm, v, r.dt_s);
-      all.push_back({&r, fitted, std::move(F), std::move(v), rths::ident::ScoreDamper(fit.coef, r, cutoff).nrmse_f_pct});
+      const double pct = rths::ident::ScoreForce(r, F, cutoff).nrmse_f_pct;
+      all.push_back({&r, fitted, std::move(F), std::move(v), pct});
     };
     for (const auto& r : recs) add(r, true);
     for (const auto& r : held) add(r, false);
@@ -296,8 +297,8 @@ int RunSpencer(const DamperCli& c, const rths::ident::SpencerFitOptions& o) {
     auto add = [&](const rths::io::RigRecord& r, bool fitted) {
       const double cutoff = o.velocity_cutoff_hz > 0.0 ? o.velocity_cutoff_hz : rths::ident::VelocityCutoffHz(r);
       auto F = rths::ident::PredictSpencerForce(fit.params, fit.driver, fit.filter, r, voltage, cutoff);
-      const auto sc = rths::ident::ScoreSpencer(fit.params, fit.driver, fit.filter, r, voltage, cutoff);
-      all.push_back({&r, fitted, std::move(F), rths::ident::SmoothVelocity(r.y_mm, r.dt_s, cutoff), sc.nrmse_f_pct});
+      const double pct = rths::ident::ScoreForce(r, F, cutoff).nrmse_f_pct;
+      all.push_back({&r, fitted, std::move(F), rths::ident::SmoothVelocity(r.y_mm, r.dt_s, cutoff), pct});
     };
     for (const auto& r : recs) add(r, true);
     for (const auto& r : held) add(r, false);

@@ -241,6 +241,12 @@ double VelocityCutoffHz(const io::RigRecord& rec) {
   return std::clamp(4.0 * edge, std::min(50.0, top), top);
 }
 
+std::string TomlFloat(double v) {
+  std::string s = fmt::format("{:.10g}", v);
+  if (s.find_first_of(".e") == std::string::npos) s += ".0";
+  return s;
+}
+
 int DamperSubsteps(const models::MrDamperCoefficients& k, double dt, double vmax) {
   const double lambda = 2.0 * std::sqrt(k.A * std::max(k.beta + k.gamma, 0.0)) * std::abs(vmax) +
                         (k.A * k.alpha + k.k0) / (k.c0 + k.c1);
@@ -291,15 +297,12 @@ std::vector<double> SimulateDamperForce(const models::MrDamperCoefficients& k, s
   return f;
 }
 
-DamperRecordScore ScoreDamper(const models::MrDamperCoefficients& coef, const io::RigRecord& rec,
-                              double velocity_cutoff_hz) {
+DamperRecordScore ScoreForce(const io::RigRecord& rec, std::span<const double> F, double velocity_cutoff_hz) {
   DamperRecordScore s;
   s.source = rec.source;
   s.samples = rec.size();
   s.dt_s = rec.dt_s;
-  const double cutoff = velocity_cutoff_hz > 0.0 ? velocity_cutoff_hz : VelocityCutoffHz(rec);
-  const auto v = SmoothVelocity(rec.y_mm, rec.dt_s, cutoff);
-  const auto F = SimulateDamperForce(coef, rec.y_mm, v, rec.dt_s);
+  s.velocity_cutoff_hz = velocity_cutoff_hz;
   double se = 0.0, sf = 0.0;
   for (std::size_t k = 0; k < rec.size(); ++k) {
     se += (rec.f_kN[k] - F[k]) * (rec.f_kN[k] - F[k]);
@@ -309,6 +312,13 @@ DamperRecordScore ScoreDamper(const models::MrDamperCoefficients& coef, const io
   s.nrmse_f_pct = sf > 0.0 ? std::sqrt(se / sf) * 100.0 : std::numeric_limits<double>::quiet_NaN();
   if (!std::isfinite(se)) s.nrmse_f_pct = std::numeric_limits<double>::infinity();
   return s;
+}
+
+DamperRecordScore ScoreDamper(const models::MrDamperCoefficients& coef, const io::RigRecord& rec,
+                              double velocity_cutoff_hz) {
+  const double cutoff = velocity_cutoff_hz > 0.0 ? velocity_cutoff_hz : VelocityCutoffHz(rec);
+  const auto v = SmoothVelocity(rec.y_mm, rec.dt_s, cutoff);
+  return ScoreForce(rec, SimulateDamperForce(coef, rec.y_mm, v, rec.dt_s), cutoff);
 }
 
 DamperFitResult FitDamper(const std::vector<io::RigRecord>& records, double current_A,
@@ -439,6 +449,18 @@ models::MrDamperParams ParamsAtOneCurrent(const models::MrDamperCoefficients& k)
   return p;
 }
 
+std::string DamperTable(const models::MrDamperParams& p) {
+  std::string o = "[plant.damper]\n";
+  const std::pair<const char*, double> fields[] = {
+      {"alpha_a", p.alpha_a}, {"alpha_b", p.alpha_b}, {"alpha_c", p.alpha_c}, {"c0_a", p.c0_a},
+      {"c0_b", p.c0_b},       {"c0_c", p.c0_c},       {"c1_a", p.c1_a},       {"c1_b", p.c1_b},
+      {"c1_c", p.c1_c},       {"beta_a", p.beta_a},   {"beta_b", p.beta_b},   {"beta_c", p.beta_c},
+      {"gamma_a", p.gamma_a}, {"gamma_b", p.gamma_b}, {"gamma_c", p.gamma_c}, {"A", p.A},
+      {"n", p.n},             {"k0", p.k0},           {"k1", p.k1},           {"x0", p.x0}};
+  for (const auto& [key, v] : fields) o += fmt::format("{} = {}\n", key, TomlFloat(v));
+  return o;
+}
+
 std::string DamperTomlFragment(const DamperFitResult& fit, const std::string& title) {
   const auto p = ParamsAtOneCurrent(fit.coef);
   std::string o = fmt::format("# {}\n", title);
@@ -447,18 +469,7 @@ std::string DamperTomlFragment(const DamperFitResult& fit, const std::string& ti
       "# so it holds at {} A only. Force error (Eq. 31 on f) per training record:\n",
       fit.current_A, fit.current_A);
   for (const auto& r : fit.records) o += fmt::format("#   {}: {:.3f} %\n", r.source, r.nrmse_f_pct);
-  o += "\n[plant.damper]\n";
-  const std::pair<const char*, double> fields[] = {
-      {"alpha_a", p.alpha_a}, {"alpha_b", p.alpha_b}, {"alpha_c", p.alpha_c}, {"c0_a", p.c0_a},
-      {"c0_b", p.c0_b},       {"c0_c", p.c0_c},       {"c1_a", p.c1_a},       {"c1_b", p.c1_b},
-      {"c1_c", p.c1_c},       {"beta_a", p.beta_a},   {"beta_b", p.beta_b},   {"beta_c", p.beta_c},
-      {"gamma_a", p.gamma_a}, {"gamma_b", p.gamma_b}, {"gamma_c", p.gamma_c}, {"A", p.A},
-      {"n", p.n},             {"k0", p.k0},           {"k1", p.k1},           {"x0", p.x0}};
-  for (const auto& [key, v] : fields) {
-    std::string num = fmt::format("{:.10g}", v);  // a TOML float: keep a '.' or an exponent
-    if (num.find_first_of(".e") == std::string::npos) num += ".0";
-    o += fmt::format("{} = {}\n", key, num);
-  }
+  o += "\n" + DamperTable(p);
   return o;
 }
 

@@ -85,9 +85,14 @@ struct DamperRecordScore {
   std::string source;     ///< the record's path
   std::size_t samples = 0;
   double dt_s = 0.0;
+  double velocity_cutoff_hz = 0.0;  ///< of the velocity the prediction was driven with [Hz]
   double peak_force_kN = 0.0;   ///< max |f|
-  double nrmse_f_pct = 0.0;     ///< of the fitted (or given) model
+  double nrmse_f_pct = 0.0;     ///< of the fitted (or given) model; inf if F is not finite
 };
+
+/// The score of a force prediction F_kN [kN] of `record` (one value per sample), made with a
+/// velocity smoothed at velocity_cutoff_hz [Hz].
+DamperRecordScore ScoreForce(const io::RigRecord& record, std::span<const double> F_kN, double velocity_cutoff_hz);
 
 /// The fitted model at one current and how well it fits.
 struct DamperFitResult {
@@ -114,6 +119,12 @@ DamperFitResult FitDamper(const std::vector<io::RigRecord>& records, double curr
 /// SmoothVelocity(y_mm, dt_s, velocity_cutoff_hz); 0 = VelocityCutoffHz(record).
 DamperRecordScore ScoreDamper(const models::MrDamperCoefficients& coef, const io::RigRecord& record,
                               double velocity_cutoff_hz = 0.0);
+
+/// v as a TOML float (10 significant digits, always with a '.' or an exponent).
+std::string TomlFloat(double v);
+
+/// A [plant.damper] table with every MrDamperParams field, one per line (a TOML float each).
+std::string DamperTable(const models::MrDamperParams& params);
 
 /// The coefficients as current-independent MrDamperParams: p_a = p_b = the value, p_c = 0
 /// (Eqs. 35-39 then give the value at every current).

@@ -102,7 +102,6 @@ struct Prepared {
   std::vector<double> xdot;   // smoothed velocity [mm/s]
   double cutoff_hz = 0.0;
   double weight = 0.0;        // 1 / sum f^2
-  double vmax = 0.0;          // max |x'|
   std::size_t n = 0;          // samples used: all, or the first part for the starts
 };
 
@@ -368,7 +367,6 @@ std::vector<double> PredictSpencerForce(const models::MrDamperParams& params, co
   d.v = ControlInput(rec, voltage);
   d.cutoff_hz = cutoff_hz > 0.0 ? cutoff_hz : VelocityCutoffHz(rec);
   d.xdot = SmoothVelocity(rec.y_mm, rec.dt_s, d.cutoff_hz);
-  for (double v : d.xdot) d.vmax = std::max(d.vmax, std::abs(v));
   std::vector<double> f(rec.size(), kNaN);
   Workspace w;
   d.n = rec.size();
@@ -384,23 +382,10 @@ std::vector<double> PredictSpencerForce(const models::MrDamperParams& params, co
   return f;
 }
 
-SpencerRecordScore ScoreSpencer(const models::MrDamperParams& params, const models::CurrentDriverParams& driver,
-                                ControlFilter filter, const io::RigRecord& rec, bool voltage, double cutoff_hz) {
-  SpencerRecordScore s;
-  s.source = rec.source;
-  s.samples = rec.size();
-  s.dt_s = rec.dt_s;
-  s.velocity_cutoff_hz = cutoff_hz > 0.0 ? cutoff_hz : VelocityCutoffHz(rec);
-  const auto F = PredictSpencerForce(params, driver, filter, rec, voltage, s.velocity_cutoff_hz);
-  double se = 0.0, sf = 0.0;
-  for (std::size_t k = 0; k < rec.size(); ++k) {
-    se += (rec.f_kN[k] - F[k]) * (rec.f_kN[k] - F[k]);
-    sf += rec.f_kN[k] * rec.f_kN[k];
-    s.peak_force_kN = std::max(s.peak_force_kN, std::abs(rec.f_kN[k]));
-  }
-  s.nrmse_f_pct = sf > 0.0 ? std::sqrt(se / sf) * 100.0 : kNaN;
-  if (!std::isfinite(se)) s.nrmse_f_pct = kInf;
-  return s;
+DamperRecordScore ScoreSpencer(const models::MrDamperParams& params, const models::CurrentDriverParams& driver,
+                               ControlFilter filter, const io::RigRecord& rec, bool voltage, double cutoff_hz) {
+  const double cutoff = cutoff_hz > 0.0 ? cutoff_hz : VelocityCutoffHz(rec);
+  return ScoreForce(rec, PredictSpencerForce(params, driver, filter, rec, voltage, cutoff), cutoff);
 }
 
 SpencerFitResult FitSpencer(const std::vector<io::RigRecord>& records, bool voltage, const SpencerFitOptions& o) {
@@ -422,7 +407,7 @@ SpencerFitResult FitSpencer(const std::vector<io::RigRecord>& records, bool volt
     double sf = 0.0;
     for (std::size_t k = 0; k < rec.size(); ++k) {
       sf += rec.f_kN[k] * rec.f_kN[k];
-      p.vmax = std::max(p.vmax, std::abs(p.xdot[k]));
+      vmax_all = std::max(vmax_all, std::abs(p.xdot[k]));
       xmax = std::max(xmax, std::abs(rec.y_mm[k]));
       in_lo = std::min(in_lo, p.v[k]);
       in_hi = std::max(in_hi, p.v[k]);
@@ -430,7 +415,6 @@ SpencerFitResult FitSpencer(const std::vector<io::RigRecord>& records, bool volt
     if (!(sf > 0.0)) throw Error(where, "the force f_kN is zero throughout: nothing to fit");
     p.weight = 1.0 / sf;
     p.n = rec.size();
-    vmax_all = std::max(vmax_all, p.vmax);
     data.push_back(std::move(p));
   }
   if (!(vmax_all > 0.0)) throw Error("FitSpencer", "the displacement never moves: nothing to fit");
@@ -598,24 +582,12 @@ std::string SpencerModelToml(const SpencerFitResult& fit, const std::string& tit
                    fit.voltage ? " (a VOLTAGE: the rates p_c are per V, and the damper command of a run is in V)" : "");
   o += "# Force error (Eq. 31 on f) per training record:\n";
   for (const auto& r : fit.records) o += fmt::format("#   {}: {:.3f} %\n", r.source, r.nrmse_f_pct);
-  auto num = [](double v) {
-    std::string s = fmt::format("{:.10g}", v);  // a TOML float: keep a '.' or an exponent
-    if (s.find_first_of(".e") == std::string::npos) s += ".0";
-    return s;
-  };
   o += fmt::format("\n[plant]\ncurrent_dynamics = {}\n", fit.filter == ControlFilter::kNone ? "false" : "true");
-  o += "\n[plant.damper]\n";
-  const std::pair<const char*, double> fields[] = {
-      {"alpha_a", p.alpha_a}, {"alpha_b", p.alpha_b}, {"alpha_c", p.alpha_c}, {"c0_a", p.c0_a},
-      {"c0_b", p.c0_b},       {"c0_c", p.c0_c},       {"c1_a", p.c1_a},       {"c1_b", p.c1_b},
-      {"c1_c", p.c1_c},       {"beta_a", p.beta_a},   {"beta_b", p.beta_b},   {"beta_c", p.beta_c},
-      {"gamma_a", p.gamma_a}, {"gamma_b", p.gamma_b}, {"gamma_c", p.gamma_c}, {"A", p.A},
-      {"n", p.n},             {"k0", p.k0},           {"k1", p.k1},           {"x0", p.x0}};
-  for (const auto& [key, v] : fields) o += fmt::format("{} = {}\n", key, num(v));
+  o += "\n" + DamperTable(p);
   if (fit.filter != ControlFilter::kNone) {
     o += "\n[plant.current_driver]\n";
     if (fit.filter == ControlFilter::kFirstOrder)
-      o += fmt::format("kind = \"first_order\"\neta_1_s = {}\n", num(fit.driver.eta_1_s));
+      o += fmt::format("kind = \"first_order\"\neta_1_s = {}\n", TomlFloat(fit.driver.eta_1_s));
     else
       o += "kind = \"eq40\"\n";
   }

@@ -39,6 +39,7 @@
 #include <string>
 #include <vector>
 
+#include "ident/damper_fit.h"
 #include "io/rig_record.h"
 #include "models/current_driver.h"
 #include "models/mr_damper.h"
@@ -67,16 +68,6 @@ struct SpencerFitOptions {
   bool IsValid(std::string* error) const;
 };
 
-/// One record's score: Eq. 31 on force.
-struct SpencerRecordScore {
-  std::string source;
-  std::size_t samples = 0;
-  double dt_s = 0.0;
-  double velocity_cutoff_hz = 0.0;
-  double peak_force_kN = 0.0;
-  double nrmse_f_pct = 0.0;
-};
-
 /// The fitted model and how well it fits.
 struct SpencerFitResult {
   models::MrDamperParams params{};          ///< Eqs. 32-39 (rates per A or per V)
@@ -84,7 +75,7 @@ struct SpencerFitResult {
   ControlFilter filter = ControlFilter::kFirstOrder;
   bool voltage = false;                     ///< the input is a voltage [V] (else a current [A])
   double input_min = 0.0, input_max = 0.0;  ///< range of the commands fitted [A or V]
-  std::vector<SpencerRecordScore> records;  ///< per training record
+  std::vector<DamperRecordScore> records;   ///< per training record
   double cost = 0.0;
   int best_start = 0;
   int iterations = 0;
@@ -113,9 +104,9 @@ std::vector<double> PredictSpencerForce(const models::MrDamperParams& params, co
                                         double velocity_cutoff_hz = 0.0);
 
 /// Eq. 31 on force of the model on a record (held-out check).
-SpencerRecordScore ScoreSpencer(const models::MrDamperParams& params, const models::CurrentDriverParams& driver,
-                                ControlFilter filter, const io::RigRecord& record, bool voltage,
-                                double velocity_cutoff_hz = 0.0);
+DamperRecordScore ScoreSpencer(const models::MrDamperParams& params, const models::CurrentDriverParams& driver,
+                               ControlFilter filter, const io::RigRecord& record, bool voltage,
+                               double velocity_cutoff_hz = 0.0);
 
 /// The model as a model file `rths run`, `design` and `diagnose --model` read: '#' comments
 /// (title, input unit, errors), then [plant] current_dynamics, [plant.damper] (every
