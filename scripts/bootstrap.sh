@@ -16,6 +16,9 @@ packages=(
   gnuplot-nox                      # figures (PNG via pngcairo)
   default-jdk-headless liblcm-java # the Java types jar (lcm-spy, MATLAB) and examples/java_plant
   clang-14 libclang-rt-14-dev      # libFuzzer + ASan/UBSan for the fuzz targets (fuzz/, build-fuzz/)
+  libmatio-dev                     # .mat export (rths export): MATLAB v5, and v7.3 through HDF5
+  octave                           # the test that loads an exported .mat in GNU Octave
+  chromium                         # the test that screenshots a run report headless
 )
 missing=()
 for p in "${packages[@]}"; do
