@@ -1,0 +1,116 @@
+#include "io/run_signals.h"
+
+#include <cmath>
+#include <cstdint>
+
+#include <fmt/format.h>
+
+#include "core/error.h"
+
+namespace rths::io {
+
+std::size_t RunSignals::steps() const { return columns.empty() ? 0 : columns.front().values.size(); }
+
+const SignalColumn* RunSignals::Find(std::string_view name) const {
+  for (const auto& c : columns)
+    if (c.name == name) return &c;
+  return nullptr;
+}
+
+const SignalColumn& RunSignals::At(std::string_view name) const {
+  if (const auto* c = Find(name)) return *c;
+  std::string names;
+  for (const auto& c : columns) names += (names.empty() ? "" : ", ") + c.name;
+  throw Error("run signals", fmt::format("no column '{}' (columns: {})", name, names));
+}
+
+namespace {
+
+/// Appends an empty column with room for `n` values; returns its index.
+std::size_t AddColumn(RunSignals* s, std::string name, std::string unit, std::string description, std::size_t n) {
+  s->columns.push_back({std::move(name), std::move(unit), std::move(description), {}});
+  s->columns.back().values.reserve(n);
+  return s->columns.size() - 1;
+}
+
+}  // namespace
+
+RunSignals SignalsFromRunLog(const RunLog& log, double dt_s) {
+  if (!std::isfinite(dt_s) || dt_s <= 0.0)
+    throw Error(log.source, fmt::format("dt_s = {} is not a step (must be finite and > 0 s)", dt_s));
+  RunSignals s;
+  s.dt_s = dt_s;
+  const std::int64_t n_steps = log.CompleteSteps();
+  const std::size_t n = static_cast<std::size_t>(n_steps > 0 ? n_steps : 0);
+  const int n_dof = n > 0 ? log.desired[0].n_dof : 0;
+
+  // Column layout: fixed columns by index, then the per-DOF blocks.
+  const auto k = AddColumn(&s, "k", "", "step index k (t_k = k dt)", n);
+  const auto t = AddColumn(&s, "t_s", "s", "time of sample k, t_k = k dt", n);
+  const auto r = AddColumn(&s, "r_mm", "mm",
+                           "desired actuator displacement r_k (Eq. 20-22 predictions in rd/rdd/rddd)", n);
+  const auto rd = AddColumn(&s, "rd_mm_s", "mm/s", "predicted desired velocity r'_k (Eq. 21)", n);
+  const auto rdd = AddColumn(&s, "rdd_mm_s2", "mm/s^2", "extrapolated desired acceleration r''_k (Eq. 20)", n);
+  const auto rddd = AddColumn(&s, "rddd_mm_s3", "mm/s^3", "predicted desired jerk r'''_k (Eq. 22)", n);
+  const auto acc_prev = AddColumn(&s, "acc_prev_mm_s2", "mm/s^2",
+                                  "central-difference acceleration one step back a_{k-1}", n);
+  const auto vel_prev = AddColumn(&s, "vel_prev_mm_s", "mm/s",
+                                  "central-difference velocity one step back v_{k-1}", n);
+  const auto ground = AddColumn(&s, "ground_acc_mm_s2", "mm/s^2",
+                                "ground acceleration at sample k (0 in predefined mode)", n);
+  const std::size_t x0 = s.columns.size();
+  for (int i = 1; i <= n_dof; ++i)
+    AddColumn(&s, fmt::format("x{}_mm", i), "mm",
+              fmt::format("structure displacement of DOF {} relative to ground at sample k", i), n);
+  const std::size_t a0 = s.columns.size();
+  for (int i = 1; i <= n_dof; ++i)
+    AddColumn(&s, fmt::format("abs_acc{}_mm_s2", i), "mm/s^2",
+              fmt::format("absolute acceleration of DOF {} at sample k-1", i), n);
+  const auto u = AddColumn(&s, "u_mm", "mm", "actuator command u_k = u_FF + u_FB (held over [t_k, t_k+1))", n);
+  const auto u_ff = AddColumn(&s, "u_ff_mm", "mm", "feedforward part of the command u_FF", n);
+  const auto u_fb = AddColumn(&s, "u_fb_mm", "mm", "feedback part of the command u_FB", n);
+  const auto y = AddColumn(&s, "y_mm", "mm", "measured actuator displacement y_k (with sensor noise, if any)", n);
+  const auto e = AddColumn(&s, "e_mm", "mm", "tracking error e_k = r_k - y_k", n);
+  const auto f = AddColumn(&s, "f_kN", "kN", "measured specimen (damper) force f_k (with sensor noise, if any)", n);
+  const auto i_eff = AddColumn(&s, "i_eff_A", "A", "effective damper current at t_k (measured_t.current_A)", n);
+  const auto i_cmd = AddColumn(&s, "i_cmd_A", "A", "damper current command i_k (held over [t_k, t_k+1))", n);
+  const auto f_des = AddColumn(&s, "f_desired_kN", "kN",
+                               "clipped-optimal nominal force for one damper (0 for other modes)", n);
+
+  for (std::size_t j = 0; j < n; ++j) {
+    const auto& d = log.desired[j];
+    const auto& c = log.command[j];
+    const auto& m = log.measured[j];
+    const auto& i = log.current[j];
+    if (d.n_dof != n_dof || static_cast<int>(d.x_mm.size()) != n_dof ||
+        static_cast<int>(d.abs_acc_mm_s2.size()) != n_dof)
+      throw Error(log.source, fmt::format("RTHS_DESIRED k = {}: n_dof = {}, but step 0 has n_dof = {}", j,
+                                          d.n_dof, n_dof));
+    const auto put = [&](std::size_t col, double v) { s.columns[col].values.push_back(v); };
+    put(k, static_cast<double>(j));
+    put(t, static_cast<double>(j) * dt_s);
+    put(r, d.r_mm);
+    put(rd, d.rd_mm_s);
+    put(rdd, d.rdd_mm_s2);
+    put(rddd, d.rddd_mm_s3);
+    put(acc_prev, d.acc_prev_mm_s2);
+    put(vel_prev, d.vel_prev_mm_s);
+    put(ground, d.ground_acc_mm_s2);
+    for (int q = 0; q < n_dof; ++q) {
+      put(x0 + static_cast<std::size_t>(q), d.x_mm[static_cast<std::size_t>(q)]);
+      put(a0 + static_cast<std::size_t>(q), d.abs_acc_mm_s2[static_cast<std::size_t>(q)]);
+    }
+    put(u, c.u_mm);
+    put(u_ff, c.u_ff_mm);
+    put(u_fb, c.u_fb_mm);
+    put(y, m.y_mm);
+    put(e, d.r_mm - m.y_mm);
+    put(f, m.f_kN);
+    put(i_eff, m.current_A);
+    put(i_cmd, i.i_cmd_A);
+    put(f_des, i.f_desired_kN);
+  }
+  return s;
+}
+
+}  // namespace rths::io
