@@ -1,0 +1,147 @@
+// rths-export: a run's per-step signals, with their units, as a MATLAB file (matio; v5 by
+// default, v7.3/HDF5 on request) and/or a CSV table, for users without LCM (docs/export.md).
+//   rths export RUN_DIR [--mat FILE.mat] [--csv FILE.csv] [--mat-version 5|7.3]
+// Without --mat and --csv it writes RUN_DIR/export.mat. The signals are decoded from
+// RUN_DIR/log.lcm (io::ReadRunLog: every event checked) over its complete steps; dt comes from the
+// log's handshake (what ran), else from RUN_DIR/scenario.toml.
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+
+#include "core/error.h"
+#include "io/mat_export.h"
+#include "io/run_log.h"
+#include "io/run_signals.h"
+#include "scenario/scenario.h"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+/// Exit codes (also in the --help footer).
+enum Exit : int { kOk = 0, kInternal = 1, kBadInput = 2, kTruncated = 3 };
+
+constexpr const char* kExitHelp =
+    "Layout of the .mat file (docs/export.md): one struct 'rths' with rths.signals.<name> (n x 1 double\n"
+    "per signal), rths.units.<name>, rths.descriptions.<name>, rths.names (comma-separated, column order) and\n"
+    "rths.meta (run_id, dt_s, steps, planned_steps, complete, status, scenario, scenario_sha256,\n"
+    "source_log, rths_version, matio_version). MATLAB/Octave: d = load('export.mat'); d.rths.signals.y_mm\n"
+    "The CSV has one row per step; its header names carry the units (y_mm, f_kN, t_s; k = step index).\n"
+    "\n"
+    "Exit codes:\n"
+    "  0  exported every step of a finished run\n"
+    "  1  internal failure\n"
+    "  2  bad input: RUN_DIR is not a folder or has no log.lcm, the log is not an LCM event log of a run\n"
+    "     (the message names the file and the byte offset), it has no complete step, an output cannot be\n"
+    "     written (named; no half-written file is left), this matio cannot write v7.3; or a usage error\n"
+    "  3  the log is truncated (the run did not finish): its complete steps were exported";
+
+/// The whole file, or "" if it cannot be read.
+std::string ReadText(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+/// The step of the run: a handshake's dt_s (what ran), else the run's scenario.toml.
+double StepOfRun(const rths::io::RunLog& log, const fs::path& scenario) {
+  for (const auto& h : log.handshakes)
+    if (h.dt_s > 0.0) return h.dt_s;
+  if (!fs::exists(scenario))
+    throw rths::Error(log.source, fmt::format("no handshake says the step dt and there is no {}", scenario.string()));
+  return rths::scenario::LoadScenario(scenario.string()).run.dt_s;
+}
+
+/// The scenario hash the participants agreed on ("" if no handshake says).
+std::string ScenarioHash(const rths::io::RunLog& log) {
+  for (const auto& h : log.handshakes)
+    if (!h.scenario_sha256.empty()) return h.scenario_sha256;
+  return "";
+}
+
+std::string SizeText(const fs::path& p) {
+  std::error_code ec;
+  const auto bytes = fs::file_size(p, ec);
+  if (ec) return "?";
+  return bytes >= 10 * 1024 * 1024 ? fmt::format("{:.1f} MB", bytes / (1024.0 * 1024.0))
+                                   : fmt::format("{:.1f} kB", bytes / 1024.0);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"rths export: a run's per-step signals with units as a MATLAB file (matio) and/or CSV"};
+  app.footer(kExitHelp);
+  std::string run_dir, mat_path, csv_path, mat_version = "5";
+  app.add_option("run_dir", run_dir, "run folder (with log.lcm, as written by rths run or rths replay)")->required();
+  app.add_option("--mat", mat_path,
+                 "MATLAB file to write (default: RUN_DIR/export.mat when neither --mat nor --csv is given)");
+  app.add_option("--csv", csv_path, "CSV file to write: one row per step, units in the header names");
+  app.add_option("--mat-version", mat_version, "MATLAB file format: 5 (MATLAB 5+, Octave, SciPy) or 7.3 (HDF5)")
+      ->check(CLI::IsMember({"5", "7.3"}))
+      ->capture_default_str();
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e);
+    return code == 0 ? kOk : kBadInput;
+  }
+  try {
+    const fs::path dir(run_dir);
+    if (!fs::is_directory(dir)) throw rths::Error(run_dir, "not a folder (give a run folder with log.lcm)");
+    const fs::path log_path = dir / "log.lcm";
+    if (!fs::exists(log_path))
+      throw rths::Error(run_dir, "no log.lcm in this folder (a run folder of rths run holds log.lcm, "
+                                 "scenario.toml, signals.csv and summary.json)");
+    if (mat_path.empty() && csv_path.empty()) mat_path = (dir / "export.mat").string();
+
+    const auto log = rths::io::ReadRunLog(log_path.string());
+    const std::int64_t steps = log.CompleteSteps();
+    if (steps <= 0)
+      throw rths::Error(log_path.string(), fmt::format("no complete step to export ({})",
+                                                       log.Complete() ? "empty run" : log.TruncationReason()));
+    const fs::path scenario_path = dir / "scenario.toml";
+    const auto signals = rths::io::SignalsFromRunLog(log, StepOfRun(log, scenario_path));
+
+    rths::io::ExportMeta meta;
+    meta.run_id = log.run_id;
+    meta.planned_steps = log.n_steps;
+    meta.complete = log.Complete();
+    meta.status = log.Complete() ? "finished" : log.TruncationReason();
+    meta.scenario_toml = ReadText(scenario_path);
+    meta.scenario_sha256 = ScenarioHash(log);
+    meta.source_log = fs::absolute(log_path).lexically_normal().string();
+
+    std::printf("rths export: %s: %lld steps of %g s, %zu signals (run %lld, %s)\n", log_path.c_str(),
+                static_cast<long long>(steps), signals.dt_s, signals.columns.size(),
+                static_cast<long long>(log.run_id), log.Complete() ? "finished" : "truncated");
+    if (!mat_path.empty()) {
+      const auto version = mat_version == "7.3" ? rths::io::MatVersion::kV73 : rths::io::MatVersion::kV5;
+      rths::io::WriteMat(mat_path, signals, meta, version);
+      std::printf("  wrote %s (MATLAB v%s, %s)\n", mat_path.c_str(), mat_version.c_str(), SizeText(mat_path).c_str());
+    }
+    if (!csv_path.empty()) {
+      rths::io::WriteSignalsCsv(csv_path, signals);
+      std::printf("  wrote %s (CSV, %s)\n", csv_path.c_str(), SizeText(csv_path).c_str());
+    }
+    if (!log.Complete()) {
+      std::fprintf(stderr, "rths export: note: %s: %s; exported its %lld complete steps (k = 0..%lld)\n",
+                   log_path.c_str(), log.TruncationReason().c_str(), static_cast<long long>(steps),
+                   static_cast<long long>(steps - 1));
+      return kTruncated;
+    }
+    return kOk;
+  } catch (const rths::Error& e) {
+    std::fprintf(stderr, "rths export: %s\n", e.what());
+    return kBadInput;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "rths export: internal failure: %s\n", e.what());
+    return kInternal;
+  }
+}
