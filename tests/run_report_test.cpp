@@ -1,0 +1,332 @@
+// lib/report/run_report + rths-report (docs/report.md): the report of a short memq run has every
+// figure, each a real picture (decoded by Octave: pixel variance), the page names them and quotes
+// summary.json's Eq. 31 value, and a headless Chromium renders it to a non-blank screenshot with
+// the figures in it. Also: a truncated log, a safety stop, no gnuplot, the tool's exit codes.
+#include <doctest/doctest.h>
+
+#include <sys/wait.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "core/error.h"
+#include "report/run_report.h"
+#include "test_support.h"
+
+namespace fs = std::filesystem;
+using rths_test::RunCli;
+using rths_test::TempDir;
+using rths_test::WriteScenario;
+
+namespace {
+
+/// 4 s of the default SDOF (8000 steps at 2 kHz), the damper at 1 A for the first 2 s, then at 0 A.
+const char* kScenario = R"(
+[run]
+name = "report_test"
+dt_s = 0.0005
+duration_s = 4.0
+[structure]
+mass_kg = 20000.0
+frequency_hz = 5.0
+damping_ratio = 0.02
+[structure.ground]
+kind = "blwn"
+band_hz = 30.0
+rms_mm_s2 = 1500.0
+seed = 3
+[controller]
+kind = "ff"
+[plant]
+actuator = "avg"
+[semiactive]
+mode = "pulse"
+pulse_hz = 0.25
+max_current_A = 1.0
+[lockstep]
+stall_budget_s = 5.0
+handshake_timeout_s = 10.0
+)";
+
+std::string Slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+nlohmann::json ReadJson(const fs::path& p) { return nlohmann::json::parse(Slurp(p)); }
+
+/// Runs a shell command; its stdout and stderr into *output; returns its exit code.
+int Shell(const std::string& cmd, std::string* output) {
+  const fs::path txt = fs::temp_directory_path() / ("rths_report_sh_" + std::to_string(::getpid()) + ".txt");
+  const int status = std::system((cmd + " > '" + txt.string() + "' 2>&1").c_str());
+  *output = Slurp(txt);
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+bool OnPath(const std::string& program) {
+  std::string out;
+  return Shell("command -v " + program, &out) == 0;
+}
+
+/// A run of kScenario (+ extra TOML) by `rths-run --transport memq` into dir/run; its exit code.
+int MakeRun(const fs::path& dir, const std::string& extra = "") {
+  const fs::path scenario = WriteScenario(dir, std::string(kScenario) + extra);
+  std::string out;
+  const int code = RunCli(scenario.string() + " --transport memq --out " + (dir / "run").string(), &out);
+  INFO(out);
+  CHECK(fs::exists(dir / "run" / "log.lcm"));
+  return code;
+}
+
+/// The number in the page's <td id="ID">NUMBER ...</td>.
+double CellNumber(const std::string& html, const std::string& id) {
+  const std::string tag = "<td id=\"" + id + "\">";
+  const auto p = html.find(tag);
+  REQUIRE(p != std::string::npos);
+  return std::stod(html.substr(p + tag.size()));
+}
+
+/// Per image, from Octave's imread: the standard deviation of every pixel value (0-255 scale), the
+/// fraction of pixels that are not near-white, and the pixels near #1f77b4 (the blue of u).
+struct ImageStats {
+  double stddev = 0.0, ink_fraction = 0.0;
+  long blue_pixels = 0;
+};
+std::map<std::string, ImageStats> OctaveImageStats(const std::vector<fs::path>& images) {
+  std::string script;
+  for (const auto& p : images)
+    script += "x = double(imread('" + p.string() + "')); if size(x, 3) == 1, x = repmat(x, [1 1 3]); end; "
+              "x = x(:, :, 1:3); s = std(x(:)); ink = mean(min(x, [], 3)(:) < 200); "
+              "b = abs(x(:,:,1) - 31) < 30 & abs(x(:,:,2) - 119) < 30 & abs(x(:,:,3) - 180) < 30; "
+              "printf('IMG %s %.6g %.6g %d\\n', '" + p.filename().string() + "', s, ink, sum(b(:))); ";
+  std::string out;
+  const int code = Shell("octave-cli --no-gui --norc --quiet --eval \"" + script + "\"", &out);
+  INFO(out);
+  CHECK(out.find("IMG") != std::string::npos);
+  (void)code;  // octave may complain on exit after printing; the lines are what count
+  std::map<std::string, ImageStats> stats;
+  std::istringstream in(out);
+  std::string word;
+  while (in >> word) {
+    if (word != "IMG") continue;
+    std::string name;
+    ImageStats s;
+    in >> name >> s.stddev >> s.ink_fraction >> s.blue_pixels;
+    stats[name] = s;
+  }
+  return stats;
+}
+
+const std::vector<std::string> kFigures = {"time_histories", "tracking_error", "loops", "spectra", "gyr"};
+
+}  // namespace
+
+TEST_CASE("MinMaxDecimate keeps every peak, in time order; CentralDifference; HtmlEscape") {
+  std::vector<double> x(10000);
+  for (std::size_t i = 0; i < x.size(); ++i) x[i] = std::sin(0.01 * static_cast<double>(i));
+  x[1234] = 50.0;
+  x[8765] = -40.0;
+  const auto idx = rths::report::MinMaxDecimate(x, 400);
+  CHECK(idx.size() <= 400);
+  CHECK(idx.size() >= 300);
+  for (std::size_t i = 1; i < idx.size(); ++i) CHECK(idx[i] > idx[i - 1]);
+  CHECK(std::find(idx.begin(), idx.end(), 1234u) != idx.end());
+  CHECK(std::find(idx.begin(), idx.end(), 8765u) != idx.end());
+  CHECK(rths::report::MinMaxDecimate(std::vector<double>(50, 1.0), 400).size() == 50);
+
+  // A parabola: the central difference is exact inside, one-sided at the ends.
+  std::vector<double> y;
+  for (int k = 0; k < 5; ++k) y.push_back(3.0 * (0.1 * k) * (0.1 * k));
+  const auto v = rths::report::CentralDifference(y, 0.1);
+  CHECK(v[2] == doctest::Approx(6.0 * 0.2));
+  CHECK(v[1] == doctest::Approx(6.0 * 0.1));
+  CHECK(v[0] == doctest::Approx((y[1] - y[0]) / 0.1));
+  CHECK(rths::report::HtmlEscape("a<b & \"c\"") == "a&lt;b &amp; &quot;c&quot;");
+}
+
+TEST_CASE("the report of a run: five real figures, the Eq. 31 value of summary.json, a page Chromium renders") {
+  const auto dir = TempDir("report_full");
+  REQUIRE(MakeRun(dir) == 0);
+  const fs::path run = dir / "run";
+  const auto files = rths::report::WriteRunReport(run);
+  CHECK(files.html == run / "report.html");
+  CHECK(files.complete);
+  CHECK(files.steps == 8000);
+  CHECK(files.steps_planned == 8000);
+  CHECK(files.warnings.empty());
+  REQUIRE(files.figures.size() == kFigures.size());
+
+  const std::string html = Slurp(files.html);
+  CHECK(html.find("class=\"banner ok\"") != std::string::npos);
+  for (std::size_t i = 0; i < kFigures.size(); ++i) {
+    CAPTURE(kFigures[i]);
+    CHECK(files.figures[i] == run / "figures" / (kFigures[i] + ".png"));
+    const std::string png = Slurp(files.figures[i]);
+    CHECK(png.size() > 10000);
+    CHECK(png.substr(0, 8) == std::string("\x89PNG\r\n\x1a\n", 8));
+    CHECK(html.find("src=\"figures/" + kFigures[i] + ".png\"") != std::string::npos);
+  }
+  // The page quotes what summary.json says (4 significant digits), and the scenario.
+  const auto summary = ReadJson(run / "summary.json");
+  const double nrmse = summary.at("tracking_nrmse_pct").get<double>();
+  CHECK(nrmse > 0.0);
+  CHECK(CellNumber(html, "tracking_nrmse_pct") == doctest::Approx(nrmse).epsilon(1e-3));
+  CHECK(CellNumber(html, "peak_force_kN") == doctest::Approx(summary.at("peak_force_kN").get<double>()).epsilon(1e-3));
+  CHECK(html.find("completed (exit code 0)") != std::string::npos);
+  CHECK(html.find("<details><summary>scenario.toml") != std::string::npos);
+  CHECK(html.find("name = &quot;report_test&quot;") != std::string::npos);
+  CHECK(html.find("pulse, max 1 A") != std::string::npos);
+  CHECK(html.find("<script") == std::string::npos);
+  CHECK(html.find("http") == std::string::npos);  // nothing from the network
+
+  // Each PNG is a picture, not an empty frame: its pixels vary and some are ink.
+  if (!OnPath("octave-cli")) {
+    MESSAGE("octave-cli is not installed: the PNGs and the screenshot are not decoded");
+    return;
+  }
+  const auto stats = OctaveImageStats(files.figures);
+  for (const auto& name : kFigures) {
+    CAPTURE(name);
+    REQUIRE(stats.count(name + ".png") == 1);
+    const auto& s = stats.at(name + ".png");
+    CHECK(s.stddev > 10.0);
+    CHECK(s.ink_fraction > 0.01);
+  }
+  CHECK(stats.at("time_histories.png").blue_pixels > 500);  // u is drawn
+  CHECK(stats.at("gyr.png").blue_pixels > 100);              // the coherence is drawn
+
+  // The page in a headless browser: not blank, and the figures load (their blue is on screen).
+  if (!OnPath("chromium")) {
+    MESSAGE("chromium is not installed: the page is not rendered");
+    return;
+  }
+  const fs::path shot = dir / "screenshot.png";
+  std::string out;
+  const int code = Shell("timeout 120 chromium --headless --no-sandbox --disable-gpu --user-data-dir='" +
+                             (dir / "chromium").string() + "' --screenshot='" + shot.string() +
+                             "' --window-size=1200,2000 'file://" + fs::absolute(files.html).string() + "'",
+                         &out);
+  INFO(out);
+  CHECK(code == 0);
+  REQUIRE(fs::exists(shot));
+  const auto page = OctaveImageStats({shot});
+  REQUIRE(page.count("screenshot.png") == 1);
+  CHECK(page.at("screenshot.png").stddev > 10.0);
+  CHECK(page.at("screenshot.png").ink_fraction > 0.01);
+  CHECK(page.at("screenshot.png").blue_pixels > 200);
+}
+
+TEST_CASE("a truncated log without summary.json: its complete steps, and the page says the run did not finish") {
+  const auto dir = TempDir("report_truncated");
+  REQUIRE(MakeRun(dir) == 0);
+  const fs::path run = dir / "run";
+  fs::remove(run / "summary.json");
+  const auto size = fs::file_size(run / "log.lcm");
+  fs::resize_file(run / "log.lcm", size / 2 + 7);  // cut in the middle of an event
+  rths::report::RunReportOptions o;
+  o.out_dir = dir / "report";
+  const auto files = rths::report::WriteRunReport(run, o);
+  CHECK(files.html == dir / "report" / "report.html");
+  CHECK_FALSE(files.complete);
+  CHECK(files.steps > 1000);
+  CHECK(files.steps < 8000);
+  CHECK(files.steps_planned == 8000);
+  CHECK(files.figures.size() == kFigures.size());
+  const std::string html = Slurp(files.html);
+  CHECK(html.find("class=\"banner failed\"") != std::string::npos);
+  CHECK(html.find("<p><strong>This run did not finish (log.lcm: truncated") != std::string::npos);
+  CHECK(html.find("Its log holds " + std::to_string(files.steps) + " complete step(s) of 8000 planned") !=
+        std::string::npos);
+  CHECK(html.find("no summary.json") != std::string::npos);
+  CHECK(!fs::exists(run / "report.html"));  // --out: nothing in the run folder
+  // The Eq. 31 value is the log's over its complete steps.
+  const auto data = rths::report::LoadRunData(run);
+  CHECK(CellNumber(html, "tracking_nrmse_pct") == doctest::Approx(data.metrics.tracking_nrmse_pct).epsilon(1e-3));
+}
+
+TEST_CASE("a run stopped by the safety monitor: status, exit code 6 and the reason on top") {
+  const auto dir = TempDir("report_safety");
+  REQUIRE(MakeRun(dir, "[safety]\nmax_error_mm = 0.01\n") == 6);
+  const auto files = rths::report::WriteRunReport(dir / "run");
+  CHECK_FALSE(files.complete);
+  const std::string html = Slurp(files.html);
+  CHECK(html.find("class=\"banner failed\"") != std::string::npos);
+  CHECK(html.find("<p><strong>This run did not finish: stopped by the safety monitor (exit code 6): ") !=
+        std::string::npos);
+  CHECK(html.find("(safety.max_error_mm)") != std::string::npos);
+  CHECK(html.find("<td id=\"status\">stopped by the safety monitor (exit code 6)") != std::string::npos);
+  CHECK(files.steps < 8000);
+  CHECK(files.figures.size() == kFigures.size());  // the steps before the stop are drawn
+}
+
+TEST_CASE("a paced run: the real-time figures of summary.json on the page") {
+  const auto dir = TempDir("report_realtime");
+  // 0.25 s paced at 2 kHz (the 4 s of kScenario would be long for a test).
+  std::string text = std::string(kScenario) + "[realtime]\nenabled = true\n";
+  text.replace(text.find("duration_s = 4.0"), std::string("duration_s = 4.0").size(), "duration_s = 0.25");
+  const fs::path scenario = WriteScenario(dir, text);
+  std::string out;
+  REQUIRE(RunCli(scenario.string() + " --transport memq --out " + (dir / "run").string(), &out) == 0);
+  const auto files = rths::report::WriteRunReport(dir / "run");
+  const std::string html = Slurp(files.html);
+  const auto rt = ReadJson(dir / "run" / "summary.json").at("realtime");
+  CHECK(html.find("<h2 id=\"realtime\">Real time</h2>") != std::string::npos);
+  CHECK(html.find("paced at</th><td>2000 Hz") != std::string::npos);
+  CHECK(html.find(fmt::format("<td id=\"latency\">p50 {:.0f} us", rt.at("latency_p50_us").get<double>())) !=
+        std::string::npos);
+  CHECK(html.find(fmt::format("<td id=\"deadline_misses\">{} of {} steps", rt.at("deadline_misses").get<long>(),
+                              rt.at("steps").get<long>())) != std::string::npos);
+}
+
+TEST_CASE("no gnuplot: a clear error, and nothing written") {
+  const auto dir = TempDir("report_nognuplot");
+  REQUIRE(MakeRun(dir) == 0);
+  rths::report::RunReportOptions o;
+  o.gnuplot = "rths-no-such-gnuplot";
+  o.out_dir = dir / "report";
+  CHECK_THROWS_WITH_AS(rths::report::WriteRunReport(dir / "run", o),
+                       doctest::Contains("gnuplot is not installed (no 'rths-no-such-gnuplot' on PATH): install it"),
+                       rths::Error);
+  CHECK_FALSE(fs::exists(dir / "report"));
+  o.gnuplot = "gnuplot";
+  o.min_coherence = 1.5;
+  CHECK_THROWS_WITH_AS(rths::report::WriteRunReport(dir / "run", o), doctest::Contains("[0, 1]"), rths::Error);
+}
+
+TEST_CASE("rths report: exit codes, help, the output line") {
+  const auto dir = TempDir("report_cli");
+  const std::string tool = std::string(RTHS_BIN_DIR) + "/rths-report";
+  std::string out;
+  CHECK(Shell(tool + " " + (dir / "no_such_run").string(), &out) == 2);
+  CHECK(out.find("rths report: ") != std::string::npos);
+  CHECK(out.find("no such run folder") != std::string::npos);
+  CHECK(Shell(tool + " " + dir.string(), &out) == 2);
+  CHECK(out.find("no log.lcm") != std::string::npos);
+  CHECK(Shell(tool, &out) == 2);
+  CHECK(Shell(tool + " --help", &out) == 0);
+  for (const char* opt : {"--out", "--max-plot-points", "--welch-segment-s", "--min-coherence", "--band-db", "--gnuplot"})
+    CHECK(out.find(opt) != std::string::npos);
+  CHECK(out.find("0.9") != std::string::npos);  // defaults shown
+
+  REQUIRE(MakeRun(dir) == 0);
+  CHECK(Shell(tool + " " + (dir / "run").string() + " --min-coherence 2", &out) == 2);
+  CHECK(Shell(tool + " " + (dir / "run").string() + " --gnuplot rths-no-such-gnuplot", &out) == 1);
+  CHECK(out.find("rths report: ") != std::string::npos);
+  CHECK(out.find("gnuplot is not installed") != std::string::npos);
+  CHECK(Shell(tool + " " + (dir / "run").string() + " --out " + (dir / "rep").string(), &out) == 0);
+  INFO(out);
+  CHECK(out.find("8000 of 8000 steps -> " + (dir / "rep" / "report.html").string() + " (5 figures)") !=
+        std::string::npos);
+  CHECK(fs::exists(dir / "rep" / "figures" / "gyr.png"));
+}
