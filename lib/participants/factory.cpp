@@ -56,7 +56,7 @@ std::unique_ptr<lockstep::Participant> MakeParticipant(std::string_view role, co
   if (role == "semiactive") return std::make_unique<Semiactive>(s, id, lcm, std::move(faults));
   if (role == "logger") {
     return std::make_unique<Logger>(id, TimingOf(s), lcm, out_dir + "/log.lcm", out_dir + "/signals.csv",
-                                    std::move(faults));
+                                    std::move(faults), s.run.csv_every);
   }
   throw Error("", fmt::format("unknown participant role '{}'", role));
 }

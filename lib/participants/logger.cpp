@@ -30,7 +30,9 @@ int CreateFile(const std::string& path, const char* what) {
 }
 }  // namespace
 
-std::int64_t StoredBytesPerStep(int n_dof) {
+std::int64_t StoredBytesPerStep(int n_dof) { return LogBytesPerStep(n_dof) + static_cast<std::int64_t>(kCsvRowMaxBytes); }
+
+std::int64_t LogBytesPerStep(int n_dof) {
   // desired_t: 8 hash + 2x8 (run_id, k) + 7x8 doubles + 4 (n_dof) + 2 n_dof x8; the others are
   // fixed (hash, run_id, k and their doubles); ack_t is not logged.
   const std::int64_t desired = 8 + 16 + 7 * 8 + 4 + 16 * static_cast<std::int64_t>(n_dof);
@@ -38,23 +40,26 @@ std::int64_t StoredBytesPerStep(int n_dof) {
   const std::int64_t events = static_cast<std::int64_t>(
       io::EventBytes(lockstep::kChDesired, desired) + io::EventBytes(lockstep::kChCommand, command) +
       io::EventBytes(lockstep::kChMeasured, measured) + io::EventBytes(lockstep::kChCurrent, current));
-  return events + static_cast<std::int64_t>(kCsvRowMaxBytes);
+  return events;
 }
 
 Logger::Logger(lockstep::RunIdentity id, lockstep::Timing timing, lcm::LCM* lcm, const std::string& log_path,
-               const std::string& csv_path, lockstep::Faults faults)
+               const std::string& csv_path, lockstep::Faults faults, int csv_every)
     : Participant("logger", std::move(id), timing, lcm, std::move(faults)),
       log_path_(log_path),
-      csv_path_(csv_path) {
+      csv_path_(csv_path),
+      csv_every_(csv_every) {
+  if (csv_every_ < 0) throw Error(csv_path_, fmt::format("csv_every = {}: must be >= 0", csv_every_));
   log_fd_ = CreateFile(log_path_, "event log");
   try {
-    csv_fd_ = CreateFile(csv_path_, "signals CSV");
+    if (csv_every_ > 0) csv_fd_ = CreateFile(csv_path_, "signals CSV");
   } catch (...) {
     ::close(log_fd_);
     throw;
   }
-  if (const std::string why = Append(csv_fd_, csv_path_, reinterpret_cast<const std::uint8_t*>(kCsvHeader),
-                                     std::strlen(kCsvHeader), &csv_end_);
+  if (const std::string why = csv_fd_ < 0 ? std::string()
+                                          : Append(csv_fd_, csv_path_, reinterpret_cast<const std::uint8_t*>(kCsvHeader),
+                                                   std::strlen(kCsvHeader), &csv_end_);
       !why.empty()) {
     ::close(log_fd_);
     ::close(csv_fd_);
@@ -107,7 +112,7 @@ std::string Logger::Append(int fd, const std::string& path, const std::uint8_t* 
 void Logger::FailWrite(const std::string& why, std::int64_t k) {
   // Both files end on the last acknowledged step (the other file may hold part of step k).
   const bool cut_log = ::ftruncate(log_fd_, static_cast<off_t>(log_acked_)) == 0;
-  const bool cut_csv = ::ftruncate(csv_fd_, static_cast<off_t>(csv_acked_)) == 0;
+  const bool cut_csv = csv_fd_ < 0 || ::ftruncate(csv_fd_, static_cast<off_t>(csv_acked_)) == 0;
   std::string reason = fmt::format("{} (at step {}; the log and signals.csv end on step {}, the last "
                                    "acknowledged one{})",
                                    why, k, next_ - 1, cut_log && cut_csv ? "" : "; cutting them back failed");
@@ -179,6 +184,11 @@ void Logger::TryAck() {
       FailWrite(why, k);
       return;
     }
+    if (csv_fd_ < 0 || k % csv_every_ != 0) {  // this step has no row of signals.csv
+      log_acked_ = log_end_;
+      Acknowledge(k);
+      continue;
+    }
     char row[kCsvRowMaxBytes + 1];
     const int n = std::snprintf(row, sizeof row,
                                 "%" PRId64 ",%.6f,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n",
@@ -197,12 +207,16 @@ void Logger::TryAck() {
     }
     log_acked_ = log_end_;
     csv_acked_ = csv_end_;
-    ack_.run_id = id_.run_id;
-    ack_.k = k;
-    ack_.participant = name_;
-    Answer(lockstep::kChAck, &ack_cache_, k, ack_);
-    ++next_;
+    Acknowledge(k);
   }
+}
+
+void Logger::Acknowledge(std::int64_t k) {
+  ack_.run_id = id_.run_id;
+  ack_.k = k;
+  ack_.participant = name_;
+  Answer(lockstep::kChAck, &ack_cache_, k, ack_);
+  ++next_;
 }
 
 }  // namespace rths::participants

@@ -37,12 +37,17 @@ namespace rths::participants {
 /// events of log.lcm and the signals.csv row (an upper bound for the row). The supervisor uses
 /// it to check the free disk space before a run.
 std::int64_t StoredBytesPerStep(int n_dof);
+/// Bytes of log.lcm per step (its four events) for `n_dof` degrees of freedom: the log's size
+/// divided by this is about the steps written (progress displays).
+std::int64_t LogBytesPerStep(int n_dof);
 
 class Logger : public lockstep::Participant {
  public:
-  /// Creates `log_path` (LCM event log) and `csv_path` (signals); throws rths::Error.
+  /// Creates `log_path` (LCM event log) and `csv_path` (signals: a row for every `csv_every`-th
+  /// step, k = 0, N, 2N, ...; csv_every = 0: no CSV file at all; scenario key run.csv_every);
+  /// throws rths::Error.
   Logger(lockstep::RunIdentity id, lockstep::Timing timing, lcm::LCM* lcm, const std::string& log_path,
-         const std::string& csv_path, lockstep::Faults faults = {});
+         const std::string& csv_path, lockstep::Faults faults = {}, int csv_every = 1);
   ~Logger() override;
 
   /// Steps acknowledged so far.
@@ -64,6 +69,8 @@ class Logger : public lockstep::Participant {
                      const lcm::ReceiveBuffer* rbuf);
   void OnHandshakeSeen(const lcm::ReceiveBuffer* rbuf, const rths::handshake_t& msg) override;
   void TryAck();
+  /// Publishes ack_t k (step k is stored) and moves on to k + 1.
+  void Acknowledge(std::int64_t k);
   /// Appends `bytes` to the file `fd` (every byte, or none: on failure the file is cut back to
   /// `*good_end`); advances `*good_end`. Returns "" or the error, naming the file.
   std::string Append(int fd, const std::string& path, const std::uint8_t* data, std::size_t size,
@@ -72,6 +79,7 @@ class Logger : public lockstep::Participant {
   void FailWrite(const std::string& why, std::int64_t k);
 
   std::string log_path_, csv_path_;
+  int csv_every_ = 1;  ///< signals.csv row every this many steps; 0: no signals.csv
   int log_fd_ = -1, csv_fd_ = -1;
   std::int64_t log_end_ = 0, csv_end_ = 0;      ///< bytes written, each ending on a whole event / row
   std::int64_t log_acked_ = 0, csv_acked_ = 0;  ///< ... at the last acknowledged step

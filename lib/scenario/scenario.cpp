@@ -369,6 +369,7 @@ void RunFields(V& v, RunConfig& r, const Context&) {
   v.String("name", r.name);
   v.Number("dt_s", r.dt_s, Closed(1e-5, 0.01));
   v.Number("duration_s", r.duration_s, OpenClosed(0.0, 36000.0));
+  v.Integer("csv_every", r.csv_every, Closed(0.0, 1e9));
 }
 
 template <typename V>
@@ -949,6 +950,120 @@ Scenario LoadScenario(const std::string& path) {
   Scenario s = ParseScenario(bytes, path);
   s.sha256 = Sha256Hex(bytes);
   return s;
+}
+
+namespace {
+
+/// "run.duration_s" -> {"run", "duration_s"}; quoted parts are not supported (no scenario key needs them).
+std::vector<std::string> SplitDotted(const std::string& key) {
+  std::vector<std::string> parts;
+  std::string part;
+  for (char c : key) {
+    if (c == '.') {
+      parts.push_back(part);
+      part.clear();
+    } else {
+      part += c;
+    }
+  }
+  parts.push_back(part);
+  return parts;
+}
+
+std::string Trim(std::string_view s) {
+  const auto b = s.find_first_not_of(" \t");
+  if (b == std::string_view::npos) return "";
+  const auto e = s.find_last_not_of(" \t");
+  return std::string(s.substr(b, e - b + 1));
+}
+
+/// Rethrows a validation error about a key that --set changed with the --set argument named.
+[[noreturn]] void RethrowWithSet(const Error& e, const std::vector<std::string>& sets) {
+  for (const auto& set : sets) {
+    const std::string key = Trim(std::string_view(set).substr(0, set.find('=')));
+    if (!key.empty() && e.where().find(key) != std::string::npos) {
+      throw Error(e.where(), e.problem() + " (set by --set " + set + ")");
+    }
+  }
+  throw e;
+}
+
+}  // namespace
+
+std::string ApplyOverrides(std::string_view toml_text, const std::vector<std::string>& sets, const std::string& path) {
+  toml::table root;
+  try {
+    root = toml::parse(toml_text, path);
+  } catch (const toml::parse_error& e) {
+    const toml::source_position& at = e.source().begin;
+    throw Error(fmt::format("{}:{}:{}", DisplayName(path), at.line, at.column),
+                fmt::format("TOML syntax error at line {}, column {}: {}", at.line, at.column, e.description()));
+  }
+  for (const auto& set : sets) {
+    const auto eq = set.find('=');
+    const std::string key = eq == std::string::npos ? "" : Trim(std::string_view(set).substr(0, eq));
+    if (eq == std::string::npos || key.empty()) {
+      throw Error("--set " + set, "expected KEY=VALUE with a dotted scenario key, e.g. --set run.duration_s=5 "
+                                  "(every key: docs/scenarios.md)");
+    }
+    const std::string text = Trim(std::string_view(set).substr(eq + 1));
+    toml::table value_table;
+    try {
+      value_table = toml::parse("v = " + text);
+    } catch (const toml::parse_error&) {
+      // Not a TOML value: a bare word is a string (--set controller.kind=ff_lqg).
+      value_table = toml::table{{"v", text}};
+    }
+    const std::vector<std::string> parts = SplitDotted(key);
+    toml::table* t = &root;
+    std::string walked;
+    for (std::size_t i = 0; i + 1 < parts.size(); ++i) {
+      if (parts[i].empty()) throw Error("--set " + set, fmt::format("\"{}\": empty part in the dotted key", key));
+      walked += (walked.empty() ? "" : ".") + parts[i];
+      toml::node* next = t->get(parts[i]);
+      if (next == nullptr) {
+        t = t->insert_or_assign(parts[i], toml::table{}).first->second.as_table();
+      } else if (next->is_table()) {
+        t = next->as_table();
+      } else {
+        throw Error("--set " + set, fmt::format("{} is a value in the scenario, not a table, so {} cannot be set",
+                                                walked, key));
+      }
+    }
+    if (parts.back().empty()) throw Error("--set " + set, fmt::format("\"{}\": empty part in the dotted key", key));
+    value_table.get("v")->visit([&](auto&& v) { t->insert_or_assign(parts.back(), v); });
+  }
+  std::ostringstream out;
+  out << root << "\n";
+  return out.str();
+}
+
+Scenario LoadScenario(const std::string& path, const std::vector<std::string>& sets) {
+  if (sets.empty()) return LoadScenario(path);
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw Error(path, "cannot open scenario file");
+  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (in.bad()) throw Error(path, "cannot read scenario file");
+  const std::string text = ApplyOverrides(bytes, sets, path);
+  try {
+    Scenario s = ParseScenario(text, path);
+    s.sha256 = Sha256Hex(text);
+    return s;
+  } catch (const Error& e) {
+    RethrowWithSet(e, sets);
+  }
+}
+
+Scenario WithOverrides(const Scenario& s, const std::vector<std::string>& sets) {
+  if (sets.empty()) return s;
+  const std::string text = ApplyOverrides(ToToml(s), sets, s.path);
+  try {
+    Scenario out = ParseScenario(text, s.path);
+    out.sha256 = Sha256Hex(text);
+    return out;
+  } catch (const Error& e) {
+    RethrowWithSet(e, sets);
+  }
 }
 
 }  // namespace rths::scenario

@@ -26,6 +26,9 @@ struct RunConfig {
   std::string name = "run";
   double dt_s = 0.0005;       ///< lockstep step [s], [1e-5, 0.01]
   double duration_s = 20.0;   ///< simulated time [s], (0, 36000]
+  /// signals.csv gets a row every csv_every steps (1: every step; 10: every 10th; 0: no
+  /// signals.csv). log.lcm always holds every step (`rths export` makes a full CSV or .mat of it).
+  int csv_every = 1;
   bool operator==(const RunConfig&) const = default;
 };
 
@@ -60,6 +63,22 @@ void ValidateScenario(const Scenario& s);
 /// The scenario as TOML text with every key written out (ParseScenario of it gives back the same
 /// scenario). Used to store programmatic variants as files, so every run has a real file and hash.
 std::string ToToml(const Scenario& s);
+/// Applies command-line overrides to scenario TOML text (`--set KEY=VALUE`, issue 13): KEY is a
+/// dotted key ("run.duration_s", "controller.kind", "plant.damper.c0a"), created if absent (tables
+/// too); VALUE is a TOML value ("5", "2.5e-4", "true", "[1, 2]", "\"ff\""), and a bare word that
+/// is not one ("ff_lqg") is taken as a string. Returns the text with the keys replaced (comments
+/// are not kept). Throws rths::Error naming the --set argument when it has no '=', an empty key,
+/// or a key that runs through a value that is not a table. Ranges and unknown keys are checked
+/// afterwards, by ParseScenario, exactly as for the file.
+std::string ApplyOverrides(std::string_view toml_text, const std::vector<std::string>& sets,
+                           const std::string& path);
+/// LoadScenario(path) with `sets` applied (ApplyOverrides) before parsing and validation; the
+/// hash is that of the overridden text. Without sets: LoadScenario(path). Errors of the
+/// validation that concern a set key say so ("(set by --set KEY=VALUE)").
+Scenario LoadScenario(const std::string& path, const std::vector<std::string>& sets);
+/// A scenario with `sets` applied: ToToml(s), ApplyOverrides, ParseScenario (paths resolved as
+/// in s.path). For scenarios built in code (the reproductions' runs).
+Scenario WithOverrides(const Scenario& s, const std::vector<std::string>& sets);
 /// Hex SHA-256 of a byte string.
 std::string Sha256Hex(std::string_view bytes);
 
