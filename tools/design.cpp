@@ -7,25 +7,25 @@
 #include <exception>
 #include <fstream>
 #include <string>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 
 #include "control/design.h"
 #include "scenario/scenario.h"
+#include "cli.h"
 
 int main(int argc, char** argv) {
   CLI::App app{"rths design: design the controller a scenario names, from its models, and analyse it"};
   std::string scenario_path, out;
   app.add_option("scenario", scenario_path, "scenario file (TOML)")->required();
   app.add_option("--out", out, "also write the summary as JSON to this file");
+  std::vector<std::string> sets;
+  rths::tools::AddSetOption(app, &sets);
+  rths::tools::NameCommand(app, "design");
+  if (const int code = rths::tools::ParseCommandLine(app, argc, argv); code >= 0) return code;
   try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    const int code = app.exit(e);
-    return code == 0 ? 0 : 2;
-  }
-  try {
-    const rths::scenario::Scenario s = rths::scenario::LoadScenario(scenario_path);
+    const rths::scenario::Scenario s = rths::scenario::LoadScenario(scenario_path, sets);
     const rths::control::DesignSummary d = rths::control::DesignController(s.controller, s.run.dt_s);
     std::fputs(d.Report().c_str(), stdout);
     if (!out.empty()) {

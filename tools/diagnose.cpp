@@ -14,8 +14,10 @@
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
+#include "cli.h"
 #include "core/error.h"
 #include "diagnosis/diagnosis.h"
+#include "diagnosis/model_file.h"
 #include "diagnosis/report.h"
 #include "io/output_folder.h"
 #include "io/rig_record.h"
@@ -34,19 +36,17 @@ int main(int argc, char** argv) {
                                         "(default: the paper's Eq. 30, Table 3, Eq. 40 + 75 Hz)");
   app.add_option("--out", out, "output folder (default: a new folder under runs/)");
   app.add_flag("--detrend", o.detrend, "remove each record's mean of u, y and f first");
-  app.add_option("--none-ratio", o.none_ratio, "residual/noise-floor power ratio at or below which a channel is noise");
-  app.add_option("--smooth-hz", o.smooth_hz, "zero-phase smoothing of the y residual for the force channel's motion [Hz] (default 20)");
+  app.add_option("--none-ratio", o.none_ratio, "residual/noise-floor power ratio [-] at or below which a channel is noise (>= 1)")
+      ->capture_default_str();
+  app.add_option("--smooth-hz", o.smooth_hz, "zero-phase smoothing of the y residual for the force channel's motion [Hz]")
+      ->capture_default_str();
   bool time_from_header = false;
   app.add_flag("--time-from-header", time_from_header,
                "take the step from the record's '# dt_s' line; the time column need only lie within half a step "
                "of t_0 + k dt_s (for a rounded time column)");
   app.add_flag("--brief", brief, "print only the verdict and each channel's shrink (the files are the same)");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    const int code = app.exit(e);
-    return code == 0 ? 0 : 2;
-  }
+  rths::tools::NameCommand(app, "diagnose");
+  if (const int code = rths::tools::ParseCommandLine(app, argc, argv); code >= 0) return code;
   std::vector<rths::io::RigRecord> tr, te;
   rths::diagnosis::NominalModel model;
   const auto axis = time_from_header ? rths::io::TimeAxis::kHeader : rths::io::TimeAxis::kColumn;
@@ -75,8 +75,19 @@ int main(int argc, char** argv) {
     } catch (const std::exception& e) {
       report_note = fmt::format("warning: report.html: {}\n", e.what());
     }
+    std::string model_note;
+    try {
+      const fs::path model_path = dir / "fitted_model.toml";
+      std::ofstream f(model_path);
+      if (!(f << rths::diagnosis::FittedModelToml(model, r))) throw rths::Error(model_path.string(), "cannot write");
+      model_note = fmt::format("fitted model: {} (nominal + selected effects; rths run / design take it)\n",
+                               model_path.string());
+    } catch (const std::exception& e) {
+      model_note = fmt::format("warning: fitted_model.toml: {}\n", e.what());
+    }
     const auto detail = brief ? rths::diagnosis::SummaryDetail::kBrief : rths::diagnosis::SummaryDetail::kFull;
-    std::printf("rths diagnose\n%s%s", rths::diagnosis::Summary(r, detail).c_str(), report_note.c_str());
+    std::printf("rths diagnose\n%s%s%s", rths::diagnosis::Summary(r, detail).c_str(), report_note.c_str(),
+                model_note.c_str());
     std::printf("output: %s\n", dir.string().c_str());
   } catch (const rths::Error& e) {
     std::fprintf(stderr, "rths diagnose: %s\n", e.what());

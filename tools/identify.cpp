@@ -26,6 +26,7 @@
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
+#include "cli.h"
 #include "core/error.h"
 #include "ident/damper_fit.h"
 #include "ident/spencer_fit.h"
@@ -336,10 +337,11 @@ int main(int argc, char** argv) {
                "voltage-dependent form (Eqs. 32-39) with a control filter, from records with any input history");
   app.add_option("--current", current_A, "--damper: fit at this one current [A] (the records' constant current)");
   app.add_option("--check", checks, "--damper: held-out records to score the fitted model on");
-  app.add_option("--A", damper_options.A, "--damper: Bouc-Wen A, held fixed (default 300, Table 3)");
+  app.add_option("--A", damper_options.A, "--damper: Bouc-Wen A [-], held fixed (Table 3)")->capture_default_str();
   app.add_option("--velocity-cutoff-hz", damper_options.velocity_cutoff_hz,
-                 "--damper: cutoff of the zero-phase smoothing differentiator [Hz] (default 0: 1.5 x the band edge of "
-                 "each record's displacement, at least 50 Hz, at most 0.45 / dt)");
+                 "--damper: cutoff of the zero-phase smoothing differentiator [Hz] (0: 4 x the band edge of each "
+                 "record's velocity, at least 50 Hz, at most 0.45 / dt)")
+      ->capture_default_str();
   app.add_option("--input", dc.input,
                  "--damper without --current: the control input, current (column i_A) or voltage (column v_V) "
                  "(default: current if the records have i_A)")
@@ -350,21 +352,21 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"first_order", "eq40", "none"}));
   app.add_flag("--no-offset", no_offset, "--damper without --current: hold k1 = x0 = 0 (no accumulator force)");
   app.add_option("--threads", spencer_options.threads,
-                 "--damper without --current: threads for the Jacobian (default 0: one per core)");
-  app.add_option("--band", band, "frequency band fitted, LO-HI [Hz] (default 0.5-40, the paper's range)");
-  app.add_option("--poles", poles, "number of poles N of Eq. 15 (default 3)");
-  app.add_option("--segment-s", segment_s, "Welch segment length [s] (default min(4 s, 2/9 of the record))");
-  app.add_option("--weights", weights, "frequency weights: inverse-variance (default), coherence, uniform");
+                 "--damper without --current: threads for the Jacobian (0: one per core)")
+      ->capture_default_str();
+  app.add_option("--band", band, "frequency band fitted, LO-HI [Hz] (the paper's range)")->capture_default_str();
+  app.add_option("--poles", poles, "number of poles N of Eq. 15")->capture_default_str();
+  app.add_option("--segment-s", segment_s, "Welch segment length [s] (0: min(4 s, 2/9 of the record))")
+      ->capture_default_str();
+  app.add_option("--weights", weights, "frequency weights")
+      ->check(CLI::IsMember({"inverse-variance", "coherence", "uniform"}))
+      ->capture_default_str();
   app.add_option("--out", out, "write the scenario fragment ([plant] actuator, [controller] model) here");
   app.add_option("--plot", plot,
-                 "Bode plot PNG (default: beside --out, else identify.png); with --damper: force against velocity and "
-                 "displacement per record (only if given)");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    const int code = app.exit(e);
-    return code == 0 ? 0 : 2;
-  }
+                 "Bode plot PNG (default: beside --out with the extension .png; none without --out); with --damper: "
+                 "force against velocity and displacement per record (only if given)");
+  rths::tools::NameCommand(app, "identify");
+  if (const int code = rths::tools::ParseCommandLine(app, argc, argv); code >= 0) return code;
 
   try {
     if (damper) {
@@ -433,7 +435,12 @@ int main(int argc, char** argv) {
       if (!(f << toml)) throw Error(out, "cannot write the model file");
       std::printf("\nwrote %s\n", out.c_str());
     }
-    if (plot.empty()) plot = out.empty() ? "identify.png" : fs::path(out).replace_extension(".png").string();
+    // Plots go only where the user said: --plot, or beside --out.
+    if (plot.empty() && !out.empty()) plot = fs::path(out).replace_extension(".png").string();
+    if (plot.empty()) {
+      std::printf("(no plot: give --plot FILE.png or --out FILE.toml for a Bode plot beside it)\n");
+      return 0;
+    }
     std::string name;  // enhanced-text safe
     const fs::path rp(record);
     const std::string shown = rp.filename() == "log.lcm" && !rp.parent_path().filename().empty()

@@ -1,4 +1,4 @@
-// rths-record RUN_DIR [--out FILE.csv]
+// rths record RUN_DIR [--out FILE.csv]
 // Writes a run's plant-side signals as a CSV rig record (docs/rig_record.md "Rig record,
 // CSV"; io/rig_record.h): t_s, u_mm (command_t), y_mm and f_kN (measured_t, as the plant published
 // them: with its sensor noise), i_A (current_t, the commanded current), r_mm (desired_t), over the
@@ -11,31 +11,28 @@
 
 #include <CLI/CLI.hpp>
 
+#include "cli.h"
 #include "io/rig_record.h"
 #include "io/run_log.h"
 
 namespace fs = std::filesystem;
 
 int main(int argc, char** argv) {
-  CLI::App app{"rths-record: a run's plant-side signals (u, y, f, i, r) as a CSV rig record"};
+  CLI::App app{"rths record: a run's plant-side signals (u, y, f, i, r) as a CSV rig record"};
   std::string run_dir, out;
   app.add_option("run_dir", run_dir, "run folder written by `rths run` (holds log.lcm)")->required();
   app.add_option("--out", out, "output CSV (default: RUN_DIR/record.csv)");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    const int code = app.exit(e);
-    return code == 0 ? 0 : 2;
-  }
+  rths::tools::NameCommand(app, "record");
+  if (const int code = rths::tools::ParseCommandLine(app, argc, argv); code >= 0) return code;
   std::error_code ec;
   if (!fs::is_directory(run_dir, ec)) {
-    std::fprintf(stderr, "rths-record: %s: no such run folder (give the folder `rths run` printed, e.g. "
+    std::fprintf(stderr, "rths record: %s: no such run folder (give the folder `rths run` printed, e.g. "
                          "runs/<time>-<name>)\n", run_dir.c_str());
     return 2;
   }
   const fs::path log_path = fs::path(run_dir) / "log.lcm";
   if (!fs::is_regular_file(log_path, ec)) {
-    std::fprintf(stderr, "rths-record: %s: no log.lcm in this folder (not a run folder of `rths run`?)\n",
+    std::fprintf(stderr, "rths record: %s: no log.lcm in this folder (not a run folder of `rths run`?)\n",
                  run_dir.c_str());
     return 2;
   }
@@ -55,9 +52,9 @@ int main(int argc, char** argv) {
     if (!reason.empty()) {
       std::printf("  note: the run stopped early (%s); the record holds its complete steps\n", reason.c_str());
     }
-    for (const auto& w : rec.warnings) std::fprintf(stderr, "rths-record: warning: %s\n", w.c_str());
+    for (const auto& w : rec.warnings) std::fprintf(stderr, "rths record: warning: %s\n", w.c_str());
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "rths-record: %s\n", e.what());
+    std::fprintf(stderr, "rths record: %s\n", e.what());
     return 2;
   }
   return 0;

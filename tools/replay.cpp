@@ -19,6 +19,7 @@
 #include <fmt/core.h>
 #include <nlohmann/json.hpp>
 
+#include "cli.h"
 #include "core/error.h"
 #include "io/log_compare.h"
 #include "io/output_folder.h"
@@ -64,7 +65,8 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(std::int64_t{1}, std::int64_t{1} << 40));
   app.footer("Exit codes: 0 the live outputs are identical to the recording; 1 they differ (first differing step, "
              "RMS and peak per field); 2 bad input (nothing ran); 3-7 the replay run failed (as rths run).");
-  CLI11_PARSE(app, argc, argv);
+  rths::tools::NameCommand(app, "replay");
+  if (const int code = rths::tools::ParseCommandLine(app, argc, argv); code >= 0) return code;
   std::signal(SIGINT, OnSignal);
   std::signal(SIGTERM, OnSignal);
 

@@ -20,6 +20,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <condition_variable>
 #include <cmath>
 #include <csignal>
 #include <cstdio>
@@ -27,8 +28,10 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <mutex>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <CLI/CLI.hpp>
@@ -36,6 +39,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/error.h"
+#include "core/progress.h"
 #include "io/output_folder.h"
 #include "io/reserved_file.h"
 #include "io/run_log.h"
@@ -47,6 +51,7 @@
 #include "participants/logger.h"
 #include "participants/run_summary.h"
 #include "scenario/scenario.h"
+#include "cli.h"
 
 namespace fs = std::filesystem;
 using rths::participants::Outcome;
@@ -93,16 +98,68 @@ int FreeUdpPort() {
 
 std::string Megabytes(double bytes) { return fmt::format("{:.1f} MB", bytes / 1e6); }
 
-/// Output the run will write [bytes]: its steps, the reserved summary and some slack for the
-/// copied scenario and the participants' own logs.
-double EstimateOutputBytes(const rths::scenario::Scenario& s) {
-  int n_dof = 1;
-  if (s.structure.mode != rths::models::StructureMode::kPredefined) {
-    n_dof = static_cast<int>(rths::models::StructureFromScenario(s.structure, s.path).M.rows());
-  }
-  return static_cast<double>(s.steps()) * static_cast<double>(rths::participants::StoredBytesPerStep(n_dof)) +
-         static_cast<double>(kSummaryReserve) + 256.0 * 1024.0;
+int DegreesOfFreedom(const rths::scenario::Scenario& s) {
+  if (s.structure.mode == rths::models::StructureMode::kPredefined) return 1;
+  return static_cast<int>(rths::models::StructureFromScenario(s.structure, s.path).M.rows());
 }
+
+/// Output the run will write [bytes]: log.lcm (every step), signals.csv (every csv_every-th step,
+/// an upper bound per row), the reserved summary and some slack for the copied scenario and the
+/// participants' own logs.
+struct OutputEstimate {
+  double log_bytes = 0.0, csv_bytes = 0.0, total_bytes = 0.0;
+};
+OutputEstimate EstimateOutput(const rths::scenario::Scenario& s) {
+  const int n_dof = DegreesOfFreedom(s);
+  const double steps = static_cast<double>(s.steps());
+  const double log_step = static_cast<double>(rths::participants::LogBytesPerStep(n_dof));
+  const double row = static_cast<double>(rths::participants::StoredBytesPerStep(n_dof)) - log_step;
+  OutputEstimate e;
+  e.log_bytes = steps * log_step;
+  e.csv_bytes = s.run.csv_every > 0 ? std::ceil(steps / s.run.csv_every) * row : 0.0;
+  e.total_bytes = e.log_bytes + e.csv_bytes + static_cast<double>(kSummaryReserve) + 256.0 * 1024.0;
+  return e;
+}
+
+/// On a terminal: the run's progress (steps written, from the size of log.lcm) with an ETA,
+/// redrawn four times a second until `stop`. Nothing when stderr is not a terminal.
+class RunProgress {
+ public:
+  RunProgress(const fs::path& log, std::int64_t steps, std::int64_t log_bytes_per_step)
+      : line_("rths run") {
+    if (!line_.enabled() || steps <= 0) return;
+    thread_ = std::thread([this, log, steps, log_bytes_per_step] {
+      std::unique_lock<std::mutex> lock(mutex_);
+      while (!stop_) {
+        std::error_code ec;
+        const auto bytes = fs::file_size(log, ec);
+        if (!ec) {
+          const double done = std::min<double>(static_cast<double>(bytes) / static_cast<double>(log_bytes_per_step),
+                                               static_cast<double>(steps));
+          line_.Update(done, static_cast<double>(steps),
+                       fmt::format("step {} of {}", static_cast<long long>(done), static_cast<long long>(steps)));
+        }
+        cv_.wait_for(lock, std::chrono::milliseconds(250));
+      }
+    });
+  }
+  ~RunProgress() {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      stop_ = true;
+    }
+    cv_.notify_all();
+    if (thread_.joinable()) thread_.join();
+    line_.Finish();
+  }
+
+ private:
+  rths::ProgressLine line_;
+  std::thread thread_;
+  std::mutex mutex_;
+  std::condition_variable cv_;
+  bool stop_ = false;
+};
 
 /// Free bytes for an unprivileged writer on the file system that will hold `dir`.
 double FreeBytes(fs::path dir) {
@@ -346,9 +403,21 @@ int main(int argc, char** argv) {
              "answering (named); 4 stopped by an abort; 5 a participant's computation failed; 6 stopped "
              "by the safety monitor; 7 the output could not be written (disk full); 8 real-time mode: too many "
              "consecutive deadline misses; 128+N a participant was killed by signal N; 130 interrupted.");
-  CLI11_PARSE(app, argc, argv);
+  std::vector<std::string> sets;
+  rths::tools::AddSetOption(app, &sets);
+  bool compact = false;
+  app.add_flag("--compact", compact,
+               "no signals.csv (as --set run.csv_every=0): log.lcm alone holds every step; `rths export` makes "
+               "a CSV or .mat of it when needed");
+  bool report = false;
+  app.add_flag("--report", report, "at the end, write RUN_DIR/report.html with figures (as `rths report RUN_DIR`)");
+  rths::tools::NameCommand(app, "run");
+  if (const int code = rths::tools::ParseCommandLine(app, argc, argv); code >= 0) return code;
 
   if (scenario_path.empty()) scenario_path = default_scenario;
+  if (compact) sets.push_back("run.csv_every=0");
+  std::string shown_scenario = scenario_path;  // as the user named it, with the overrides
+  for (const auto& set : sets) shown_scenario += " --set " + set;
   ExternalRoles external;
   {
     std::stringstream ss(external_arg);
@@ -394,9 +463,10 @@ int main(int argc, char** argv) {
   rths::scenario::Scenario s;
   fs::path out;
   double estimate = 0.0;
+  OutputEstimate sizes;
   std::string url = "memq://";
   try {
-    s = rths::scenario::LoadScenario(scenario_path);
+    s = rths::scenario::LoadScenario(scenario_path, sets);
     if (realtime) s.realtime.enabled = true;
     rths::participants::CheckBuildable(s);
     const rths::lockstep::ProcessFault kind = s.faults.process_kind;
@@ -421,7 +491,8 @@ int main(int argc, char** argv) {
       throw rths::Error(out.string(), "output folder exists and is not empty; refusing to overwrite "
                                       "a previous run (choose another --out)");
     }
-    estimate = EstimateOutputBytes(s);
+    sizes = EstimateOutput(s);
+    estimate = sizes.total_bytes;
     const double free_bytes = FreeBytes(out);
     if (!skip_space_check && free_bytes >= 0 && estimate > free_bytes) {
       throw rths::Error(out.string(),
@@ -444,7 +515,24 @@ int main(int argc, char** argv) {
   const bool created_out = !fs::exists(out);
   try {
     fs::create_directories(out);
-    fs::copy_file(scenario_path, out / "scenario.toml");
+    if (sets.empty()) {
+      fs::copy_file(scenario_path, out / "scenario.toml");
+    } else {
+      // The scenario that runs is the file with the overrides: written out in full (file paths
+      // absolute), loaded back so its hash is the file's, and given to every participant.
+      std::string header = fmt::format("# {} with", scenario_path);
+      for (const auto& set : sets) header += " --set " + set;
+      const fs::path effective = out / "scenario.toml";
+      std::ofstream file(effective, std::ios::binary);
+      if (!(file << header << "\n" << rths::scenario::ToToml(s)) || !file.flush()) {
+        throw rths::Error(effective.string(), "cannot write the scenario (disk full?)");
+      }
+      file.close();
+      const bool paced = s.realtime.enabled;
+      s = rths::scenario::LoadScenario(effective.string());
+      s.realtime.enabled = paced;
+      scenario_path = effective.string();
+    }
     if (!rths::io::ReserveFile((out / "summary.json").string(), kSummaryReserve, "{\"status\": \"running\"}\n")) {
       throw rths::Error((out / "summary.json").string(), "cannot reserve the summary (disk full?)");
     }
@@ -463,10 +551,17 @@ int main(int argc, char** argv) {
   Clock::time_point noticed{};
   try {
     if (!quiet) {
-      std::printf("rths run: %s (%lld steps of %g s), transport %s\n", scenario_path.c_str(),
+      std::printf("rths run: %s (%lld steps of %g s), transport %s\n", shown_scenario.c_str(),
                   static_cast<long long>(s.steps()), s.run.dt_s, transport.c_str());
+      std::printf("  output           about %s: log.lcm %s, %s\n", Megabytes(sizes.total_bytes).c_str(),
+                  Megabytes(sizes.log_bytes).c_str(),
+                  s.run.csv_every == 0 ? "no signals.csv (--compact)"
+                  : s.run.csv_every == 1
+                      ? fmt::format("signals.csv {} (--compact: none)", Megabytes(sizes.csv_bytes)).c_str()
+                      : fmt::format("signals.csv {} (every {} steps)", Megabytes(sizes.csv_bytes), s.run.csv_every).c_str());
       std::fflush(stdout);
     }
+    const RunProgress progress(out / "log.lcm", s.steps(), rths::participants::LogBytesPerStep(DegreesOfFreedom(s)));
     if (!external.roles.empty()) {
       // Always printed (also with --quiet): what the user's participants need to join.
       std::string roles;

@@ -8,6 +8,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "cli.h"
 #include "models/structure_file.h"
 
 int main(int argc, char** argv) {
@@ -26,7 +27,8 @@ int main(int argc, char** argv) {
   shear->add_option("--damping", zeta, "damping ratio in every mode")->capture_default_str();
   shear->add_option("--comment", comment, "comment written after the header");
   shear->add_option("--out", out, "file to write")->required();
-  CLI11_PARSE(app, argc, argv);
+  rths::tools::NameCommand(app, "structure");
+  if (const int code = rths::tools::ParseCommandLine(app, argc, argv); code >= 0) return code;
   try {
     rths::models::StructureMatrices m;
     if (*shear) {

@@ -1,4 +1,4 @@
-// rths-utfsm-convert INPUT [--out FILE.csv] [--from-s S] [--to-s S]
+// rths utfsm-convert INPUT [--out FILE.csv] [--from-s S] [--to-s S]
 // Converts a UTFSM measured record (data/utfsm/: the actuator DAQ export chirp_0A.txt or an MR
 // damper file <amp>mm<freq>Hz<current>A.txt) into a CSV rig record (io/rig_record.h,
 // io/utfsm.h for the conversions, offsets and trimming). INPUT may also be a CSV rig record or
@@ -13,26 +13,23 @@
 
 #include <CLI/CLI.hpp>
 
+#include "cli.h"
 #include "core/error.h"
 #include "io/rig_record.h"
 #include "io/utfsm.h"
 
 int main(int argc, char** argv) {
-  CLI::App app{"rths-utfsm-convert: a UTFSM measured record (data/utfsm/) as a CSV rig record"};
+  CLI::App app{"rths utfsm-convert: a UTFSM measured record (data/utfsm/) as a CSV rig record"};
   std::string input, out;
   double from_s = 0.0, to_s = std::numeric_limits<double>::infinity();
   app.add_option("input", input,
                  "data/utfsm/actuator/chirp_0A.txt, data/utfsm/mr_damper/*.txt, or a rig record / LCM log to cut")
       ->required();
   app.add_option("--out", out, "output CSV (default: the input's name with .csv, here)");
-  app.add_option("--from-s", from_s, "keep samples from this time on [s] (relative to the first sample; default 0)");
+  app.add_option("--from-s", from_s, "keep samples from this time on [s] (relative to the first sample)")->capture_default_str();
   app.add_option("--to-s", to_s, "keep samples before this time [s] (default: to the end)");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    const int code = app.exit(e);
-    return code == 0 ? 0 : 2;
-  }
+  rths::tools::NameCommand(app, "utfsm-convert");
+  if (const int code = rths::tools::ParseCommandLine(app, argc, argv); code >= 0) return code;
   try {
     auto rec = rths::io::ReadRecordOrUtfsm(input);
     if (from_s != 0.0 || to_s != std::numeric_limits<double>::infinity())
@@ -45,7 +42,7 @@ int main(int argc, char** argv) {
                 rec.DurationS(), out.c_str());
     for (const auto& [k, v] : rec.metadata) std::printf("  %s: %s\n", k.c_str(), v.c_str());
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "rths-utfsm-convert: %s\n", e.what());
+    std::fprintf(stderr, "rths utfsm-convert: %s\n", e.what());
     return 2;
   }
   return 0;

@@ -919,6 +919,8 @@ void ScoreCandidates(ChannelState* sp, const std::vector<CandidateSpec>& specs, 
     e.shrink_pct = ShrinkPct(before, e.test_nrmse_after);
     e.excess_reduction = t.excess_red;
     e.delta_bic = t.dbic;
+    for (const auto& spec : specs)
+      if (spec.name == name) e.at_bound = AtBound(spec, t.params.at(name), o.at_bound_fraction);
     (*er)[name] = e;
   }
 }
@@ -1304,6 +1306,7 @@ nlohmann::json ToJson(const Result& r) {
     o["nrmse_" + e.channel + "_pct_after"] = num(e.test_nrmse_after);
     o["shrink_pct"] = num(e.shrink_pct);
     o["selected"] = e.selected;
+    o["at_bound"] = e.at_bound;
     o["train_nrmse_" + e.channel + "_pct_after"] = num(e.train_nrmse_after);
     if (e.name != "sensor_noise") {
       o["excess_reduction_pct"] = num(100.0 * e.excess_reduction);
@@ -1399,7 +1402,12 @@ std::string Summary(const Result& r, SummaryDetail detail) {
     if (top) s += "\n";
   }
   s += "effects (test NRMSE after, shrink):\n";
+  std::vector<std::string> pinned;
   for (const auto& e : r.effects) {
+    if (e.at_bound && !e.selected) {
+      pinned.push_back(e.name);
+      continue;
+    }
     std::string ps;
     for (const auto& [k, v] : e.params) ps += fmt::format(" {}={:.4g}", k, v);
     // "excess": the training residual's sum of squares above the noise floor (rule (b)).
@@ -1407,6 +1415,11 @@ std::string Summary(const Result& r, SummaryDetail detail) {
     s += fmt::format("  {} {:<22} [{}]{}: {:.3f} %, shrink {:.1f} % (training: {} {:.0f} % of the residual above noise)\n",
                      e.selected ? "*" : " ", e.name, e.channel, ps, e.test_nrmse_after, e.shrink_pct,
                      red_pct >= 0.0 ? "removes" : "adds", std::abs(red_pct));
+  }
+  if (!pinned.empty()) {
+    s += fmt::format("  (not shown: {} fitted to an end of the search range, so not a description of the residual; "
+                     "diagnosis.json has them)\n",
+                     fmt::join(pinned, ", "));
   }
   s += fmt::format("verdict: {}\n", fmt::join(r.verdict, ", "));
   for (const auto& w : r.warnings) s += "warning: " + w + "\n";

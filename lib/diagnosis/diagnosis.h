@@ -168,6 +168,10 @@ struct EffectResult {
   double excess_reduction = 0;            ///< rule (b)'s fraction when it was last tried
   double delta_bic = 0;                   ///< rule (a)'s value when it was last tried
   bool selected = false;
+  /// A fitted parameter sits at an end of its search range (Options::at_bound_fraction): the
+  /// fit did not find the effect, it ran out of range; never selected, and left out of the
+  /// terminal summary (diagnosis.json keeps it).
+  bool at_bound = false;
   int order = -1;                         ///< position in the verdict (selected only)
 };
 

@@ -1,0 +1,149 @@
+// The command-line convention of every `rths <sub>` (tools/cli.h, README "Commands"): usage errors
+// exit 2, --help exits 0 and names the command as the user types it, options show their defaults;
+// --set overrides scenario keys (checked like the file); --compact and run.csv_every shrink the
+// output; identify writes plots only where told.
+#include <sys/wait.h>
+
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include <doctest/doctest.h>
+
+#include "io/run_log.h"
+#include "scenario/scenario.h"
+#include "test_support.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using rths_test::TempDir;
+
+/// Runs `cd CWD && RTHS_BIN_DIR/rths-TOOL ARGS`, stdout and stderr into *output; returns the exit code.
+int RunTool(const std::string& tool, const std::string& args, std::string* output, const fs::path& cwd = {}) {
+  const fs::path txt = fs::temp_directory_path() / ("rths_cli_" + std::to_string(::getpid()) + ".txt");
+  std::string cmd = std::string(RTHS_BIN_DIR) + "/rths-" + tool + " " + args + " > " + txt.string() + " 2>&1";
+  if (!cwd.empty()) cmd = "cd '" + cwd.string() + "' && " + cmd;
+  const int status = std::system(cmd.c_str());
+  std::ifstream in(txt);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  *output = ss.str();
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+std::string Scenario(const std::string& name) { return std::string(RTHS_SOURCE_DIR) + "/scenarios/" + name; }
+
+long Lines(const fs::path& file) {
+  std::ifstream in(file);
+  long n = 0;
+  for (std::string line; std::getline(in, line);) ++n;
+  return n;
+}
+
+const char* const kTools[] = {"run",    "design", "identify", "reproduce", "diagnose",      "record",
+                              "replay", "structure", "log",   "utfsm-convert"};
+
+}  // namespace
+
+TEST_CASE("every command: a usage error exits 2, --help exits 0 and shows `rths <sub>`") {
+  for (const char* tool : kTools) {
+    CAPTURE(tool);
+    std::string out;
+    CHECK(RunTool(tool, "--no-such-option", &out) == 2);
+    CHECK(out.find("Run with --help") != std::string::npos);
+    CHECK(RunTool(tool, "--help", &out) == 0);
+    CHECK(out.find(std::string("rths ") + tool) != std::string::npos);
+    CHECK(out.find("bin/rths-") == std::string::npos);  // not the build path
+  }
+}
+
+TEST_CASE("options show their defaults and units") {
+  std::string out;
+  REQUIRE(RunTool("diagnose", "--help", &out) == 0);
+  const auto at = out.find("--none-ratio");
+  REQUIRE(at != std::string::npos);
+  CHECK(out.find("=1.6", at) < out.find("--smooth-hz", at));  // the default, on its own line
+  REQUIRE(RunTool("identify", "--help", &out) == 0);
+  CHECK(out.find("--band TEXT=0.5-40") != std::string::npos);
+  CHECK(out.find("}=inverse-variance") != std::string::npos);
+  REQUIRE(RunTool("reproduce", "--help", &out) == 0);
+  CHECK(out.find("--jobs") != std::string::npos);
+  CHECK(out.find("--set") != std::string::npos);
+}
+
+TEST_CASE("scenario::ApplyOverrides: dotted keys, TOML values, bare words, new tables") {
+  const std::string text = "[run]\nname = \"x\"\nduration_s = 1.0\n";
+  const std::string out = rths::scenario::ApplyOverrides(
+      text, {"run.duration_s=5", "controller.kind=ff_lqg", "plant.noise_y_mm_rms = 0.01", "run.name=\"y.z\""}, "t.toml");
+  const auto s = rths::scenario::ParseScenario(out, "t.toml");
+  CHECK(s.run.duration_s == 5.0);
+  CHECK(s.run.name == "y.z");
+  CHECK(s.controller.kind == rths::control::ControllerKind::kFfLqg);
+  CHECK(s.plant.noise_y_mm_rms == 0.01);
+  CHECK_THROWS_WITH_AS(rths::scenario::ApplyOverrides(text, {"run.duration_s"}, "t.toml"),
+                       doctest::Contains("expected KEY=VALUE"), rths::Error);
+  CHECK_THROWS_WITH_AS(rths::scenario::ApplyOverrides(text, {"run.name.first=1"}, "t.toml"),
+                       doctest::Contains("not a table"), rths::Error);
+  CHECK_THROWS_WITH_AS(rths::scenario::ApplyOverrides(text, {"run..x=1"}, "t.toml"),
+                       doctest::Contains("empty part"), rths::Error);
+}
+
+TEST_CASE("--set is checked like the file and names itself in the error") {
+  std::string out;
+  CHECK(RunTool("design", Scenario("default.toml") + " --set controller.kind=ff_lqg", &out) == 0);
+  CHECK(out.find("controller: ff_lqg") != std::string::npos);
+  CHECK(RunTool("design", Scenario("default.toml") + " --set run.dt_s=-1", &out) == 2);
+  CHECK(out.find("run.dt_s") != std::string::npos);
+  CHECK(out.find("(set by --set run.dt_s=-1)") != std::string::npos);
+  CHECK(RunTool("design", Scenario("default.toml") + " --set controller.kindd=ff", &out) == 2);
+  CHECK(out.find("unknown key") != std::string::npos);
+}
+
+TEST_CASE("rths run --set and --compact: the scenario that ran is in the folder; no signals.csv") {
+  const fs::path dir = TempDir("cli_compact");
+  std::string out;
+  const int code = RunTool("run", Scenario("default.toml") + " --transport memq --skip-space-check --compact --set run.duration_s=0.25 --out " +
+                                      (dir / "run").string(),
+                           &out);
+  INFO(out);
+  REQUIRE(code == 0);
+  CHECK(out.find("output           about") != std::string::npos);  // the size, said up front
+  CHECK(out.find("no signals.csv") != std::string::npos);
+  CHECK_FALSE(fs::exists(dir / "run" / "signals.csv"));
+  const auto log = rths::io::ReadRunLog((dir / "run" / "log.lcm").string());
+  CHECK(log.Complete());
+  CHECK(log.CompleteSteps() == 500);  // 0.25 s at 0.5 ms
+  // The folder's scenario.toml is the one that ran: the overrides are in it.
+  const auto s = rths::scenario::LoadScenario((dir / "run" / "scenario.toml").string());
+  CHECK(s.run.duration_s == 0.25);
+  CHECK(s.run.csv_every == 0);
+
+  // run.csv_every = 10: a row for k = 0, 10, ..., 490 after the header.
+  REQUIRE(RunTool("run", Scenario("default.toml") + " --transport memq --skip-space-check --set run.duration_s=0.25 --set run.csv_every=10 --out " +
+                             (dir / "every10").string(),
+                  &out) == 0);
+  CHECK(Lines(dir / "every10" / "signals.csv") == 1 + 50);
+  CHECK(rths::io::ReadRunLog((dir / "every10" / "log.lcm").string()).CompleteSteps() == 500);
+}
+
+TEST_CASE("identify writes a plot only where told") {
+  const fs::path dir = TempDir("cli_identify");
+  std::string out;
+  REQUIRE(RunTool("run", Scenario("default.toml") + " --transport memq --skip-space-check --compact --set run.duration_s=3 --out " +
+                             (dir / "run").string(),
+                  &out) == 0);
+  REQUIRE(RunTool("record", (dir / "run").string(), &out) == 0);
+  const fs::path cwd = dir / "cwd";
+  fs::create_directories(cwd);
+  const int code = RunTool("identify", (dir / "run" / "record.csv").string() + " --band 0.5-20", &out, cwd);
+  INFO(out);
+  CHECK(code == 0);
+  CHECK(fs::is_empty(cwd));  // no identify.png dropped into the current folder
+  CHECK(out.find("no plot") != std::string::npos);
+  REQUIRE(RunTool("identify", (dir / "run" / "record.csv").string() + " --band 0.5-20 --out " + (dir / "model.toml").string(),
+                  &out, cwd) == 0);
+  CHECK(fs::file_size(dir / "model.png") > 10000);  // beside --out
+  CHECK(fs::is_empty(cwd));
+}
