@@ -714,9 +714,9 @@ RunData LoadRunData(const fs::path& run_dir) {
 ReportFiles WriteRunReport(const RunData& d, const RunReportOptions& o) {
   CheckOptions(o);
   if (!io::GnuplotAvailable(o.gnuplot))
-    throw Error("run report", fmt::format("gnuplot is not installed (no '{}' on PATH): install it with `apt-get "
-                                          "install gnuplot-nox` and run again (nothing was written)",
-                                          o.gnuplot));
+    throw Error("", fmt::format("gnuplot is not installed (no '{}' on PATH): install it with `apt-get install "
+                                "gnuplot-nox` and run again (nothing was written)",
+                                o.gnuplot));
   const fs::path out = o.out_dir.empty() ? d.run_dir : o.out_dir;
   const fs::path fig_dir = out / "figures";
   std::error_code ec;
@@ -754,6 +754,12 @@ ReportFiles WriteRunReport(const RunData& d, const RunReportOptions& o) {
     } else {
       figure_notes.push_back(fmt::format("no figure {}: a panel has no finite value (the run diverged?)", pf.figure.name));
     }
+  }
+  // An earlier report's figure that this one does not draw would stay beside the page: remove it.
+  for (const char* stale : {"time_histories", "tracking_error", "loops", "spectra", "gyr"}) {
+    if (std::any_of(drawn.begin(), drawn.end(), [&](const PageFigure& pf) { return pf.figure.name == stale; }))
+      continue;
+    for (const char* ext : {".png", ".dat", ".gp"}) fs::remove(fig_dir / (std::string(stale) + ext), ec);
   }
   // One gnuplot process per figure, all at once (each writes its own files).
   std::vector<std::future<io::PlotFiles>> jobs;
