@@ -20,6 +20,7 @@
 #include "io/run_log.h"
 #include "io/run_signals.h"
 #include "scenario/scenario.h"
+#include "signal/metrics.h"
 #include "test_support.h"
 
 namespace fs = std::filesystem;
@@ -190,6 +191,35 @@ TEST_CASE("SignalsFromRunLog: every column, in order, equal to the decoded log a
   }
 }
 
+TEST_CASE("SignalsFromRunLog: a 9-story structure has x1..x9 and abs_acc1..abs_acc9, in DOF order") {
+  const fs::path dir = TempDir("export_mdof");
+  const auto sc = rths::scenario::LoadScenario(WriteScenario(dir, R"(
+[run]
+duration_s = 0.05
+[structure]
+kind = "file"
+file = ")" + std::string(RTHS_SOURCE_DIR) + R"(/data/buildings/ohtori9_ns.txt"
+actuator_dof = 1
+specimen_count = 18.0
+)").string());
+  REQUIRE(RunMemq({sc}, dir).code == 0);
+  const auto log = rths::io::ReadRunLog((dir / "log.lcm").string());
+  const auto s = rths::io::SignalsFromRunLog(log, sc.run.dt_s);
+  REQUIRE(s.steps() == 100);
+  std::vector<std::string> names;
+  for (const auto& c : s.columns) names.push_back(c.name);
+  const auto at = [&](const std::string& n) { return std::find(names.begin(), names.end(), n) - names.begin(); };
+  CHECK(at("ground_acc_mm_s2") + 1 == at("x1_mm"));
+  CHECK(at("x9_mm") + 1 == at("abs_acc1_mm_s2"));
+  CHECK(at("abs_acc9_mm_s2") + 1 == at("u_mm"));
+  CHECK(s.Find("x10_mm") == nullptr);
+  for (std::size_t k = 0; k < s.steps(); ++k) {
+    CHECK(s.At("x9_mm").values[k] == log.desired[k].x_mm[8]);
+    CHECK(s.At("abs_acc5_mm_s2").values[k] == log.desired[k].abs_acc_mm_s2[4]);
+  }
+  CHECK(MaxAbs(s.At("abs_acc9_mm_s2").values) > 0.0);
+}
+
 TEST_CASE("SignalsFromRunLog: a log without a complete step gives empty columns") {
   rths::io::RunLog empty;
   empty.source = "empty.lcm";
@@ -274,6 +304,20 @@ TEST_CASE("rths export: .mat v5 and v7.3 read back by GNU Octave, and CSV, equal
     CHECK(kv.at("sha").size() == 64);
     CHECK(kv.at("scenario_has_name") == "1");
   }
+
+  // The MATLAB/Octave example examples/matlab/rths_run_summary.m: Eq. 31 as rths computes it.
+  const std::string call = "addpath('" + std::string(RTHS_SOURCE_DIR) + "/examples/matlab'); s = rths_run_summary('" +
+                           mat5.string() + "'); printf('nrmse %.17g\\npeak_f %.17g\\nend ok\\n', "
+                           "s.tracking_nrmse_pct, s.peak_force_kN);";
+  const auto o = Shell("octave-cli --no-gui --norc --eval \"" + call + "\"");
+  INFO(o.out, o.err);
+  REQUIRE(o.code == 0);
+  const auto kv = KeyValues(o.out);
+  REQUIRE(kv.count("end"));
+  const double nrmse = rths::signal::RmsErrorPercent(s.At("r_mm").values, s.At("y_mm").values);
+  CHECK(std::stod(kv.at("nrmse")) == doctest::Approx(nrmse).epsilon(1e-12));
+  CHECK(std::stod(kv.at("peak_f")) == MaxAbs(s.At("f_kN").values));
+  CHECK(o.out.find("tracking error") != std::string::npos);
 }
 
 TEST_CASE("rths export: errors name the folder or file; a truncated log exports its complete steps") {
@@ -394,6 +438,29 @@ TEST_CASE("Java types jar: built with the tree, and buildable in a tree configur
   const auto list = Shell("unzip -l " + jar.string());
   CHECK(list.out.find("rths/desired_t.class") != std::string::npos);
   CHECK(list.out.find("rths/handshake_t.class") != std::string::npos);
+
+  // MATLAB's way of decoding a log with the jar (docs/export.md), in Octave's JVM.
+  if (HaveProgram("octave-cli")) {
+    const fs::path& run = RecordedRun();
+    const std::string script =
+        "if ~usejava('jvm'); printf('nojvm\\n'); exit(0); end; javaaddpath('/usr/share/java/lcm.jar'); "
+        "javaaddpath('" + jar.string() + "'); log = javaObject('lcm.logging.Log', '" + (run / "log.lcm").string() +
+        "', 'r'); f = []; while true; try; ev = log.readNext(); catch; break; end; "
+        "if strcmp(char(ev.channel), 'RTHS_MEASURED'); m = javaObject('rths.measured_t', ev.data); "
+        "f(end+1) = m.f_kN; end; end; log.close(); printf('n %d\\nsum_f %.17g\\nend ok\\n', numel(f), sum(f));";
+    const auto o = Shell("octave-cli --no-gui --norc --eval \"" + script + "\"");
+    INFO(o.out, o.err);
+    if (o.out.find("nojvm") != std::string::npos) {
+      MESSAGE("Octave has no JVM: the jar is not tried from Octave");
+    } else {
+      REQUIRE(o.code == 0);
+      const auto kv = KeyValues(o.out);
+      REQUIRE(kv.count("end"));
+      CHECK(std::stoll(kv.at("n")) == kSteps);
+      const auto& s = RecordedSignals();
+      CHECK(std::stod(kv.at("sum_f")) == doctest::Approx(Sum(s.At("f_kN").values)).epsilon(1e-12));
+    }
+  }
 
   // A tree configured as if javac were absent (JAVAC=OFF): the target exists all the same and
   // finds javac when it runs.
