@@ -13,6 +13,7 @@
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
+#include "cli.h"
 #include "core/error.h"
 #include "io/mat_export.h"
 #include "io/run_log.h"
@@ -77,6 +78,7 @@ std::string SizeText(const fs::path& p) {
 
 int main(int argc, char** argv) {
   CLI::App app{"rths export: a run's per-step signals with units as a MATLAB file (matio) and/or CSV"};
+  rths::tools::NameCommand(app, "export");
   app.footer(kExitHelp);
   std::string run_dir, mat_path, csv_path, mat_version = "5";
   app.add_option("run_dir", run_dir, "run folder (with log.lcm, as written by rths run or rths replay)")->required();
@@ -86,12 +88,7 @@ int main(int argc, char** argv) {
   app.add_option("--mat-version", mat_version, "MATLAB file format: 5 (MATLAB 5+, Octave, SciPy) or 7.3 (HDF5)")
       ->check(CLI::IsMember({"5", "7.3"}))
       ->capture_default_str();
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    const int code = app.exit(e);
-    return code == 0 ? kOk : kBadInput;
-  }
+  if (const int code = rths::tools::ParseCommandLine(app, argc, argv); code >= 0) return code;
   try {
     const fs::path dir(run_dir);
     if (!fs::is_directory(dir)) throw rths::Error(run_dir, "not a folder (give a run folder with log.lcm)");

@@ -18,6 +18,7 @@
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
+#include "cli.h"
 #include "core/error.h"
 #include "io/csv.h"
 #include "io/event_log.h"
@@ -227,6 +228,7 @@ std::int64_t Dump(const std::string& path, const rths::io::RunLog& log, const st
 
 int main(int argc, char** argv) {
   CLI::App app{"rths log: inspect and compare run logs (log.lcm) by decoded payload per (channel, k)"};
+  rths::tools::NameCommand(app, "log");
   app.footer(kExitHelp);
   app.require_subcommand(1);
   std::vector<std::string> files;
@@ -246,12 +248,7 @@ int main(int argc, char** argv) {
                    "RTHS_MEASURED, RTHS_CURRENT, RTHS_HANDSHAKE, or desired, command, measured, current, "
                    "handshake (default: every channel, all their fields, other channels' cells empty)");
   dump->add_option("--csv", dump_csv, "write the CSV to this file (default: standard output)");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    const int code = app.exit(e);
-    return code == 0 ? kOk : kBadInput;
-  }
+  if (const int code = rths::tools::ParseCommandLine(app, argc, argv); code >= 0) return code;
   try {
     if (*dump) {
       const std::string channel = dump_channel.empty() ? "" : DumpChannelName(dump_channel);
