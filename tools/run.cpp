@@ -50,6 +50,7 @@
 #include "participants/group.h"
 #include "participants/logger.h"
 #include "participants/run_summary.h"
+#include "report/run_report.h"
 #include "scenario/scenario.h"
 #include "cli.h"
 
@@ -652,6 +653,16 @@ int main(int argc, char** argv) {
   const int code = sum.exit_code;
   const std::string what = sum.failure ? sum.failure->what : "";
   const std::int64_t steps = sum.steps;
+  if (report && steps > 0) {
+    // The report of what was logged (also of a run that stopped: its complete steps). A report
+    // that cannot be made is a warning; the run's exit code stays the run's.
+    try {
+      const auto files = rths::report::WriteRunReport(out);
+      std::printf("report: %s (%zu figures)\n", files.html.string().c_str(), files.figures.size());
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "rths run: warning: no report: %s\n", e.what());
+    }
+  }
   if (code == 0) {
     std::printf("output: %s\n", out.string().c_str());
     return 0;
