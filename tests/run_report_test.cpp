@@ -314,7 +314,11 @@ TEST_CASE("rths report: exit codes, help, the output line") {
   CHECK(Shell(tool + " " + dir.string(), &out) == 2);
   CHECK(out.find("no log.lcm") != std::string::npos);
   CHECK(Shell(tool, &out) == 2);
+  CHECK(Shell(tool + " --no-such-option", &out) == 2);
+  CHECK(out.find("Run with --help") != std::string::npos);
   CHECK(Shell(tool + " --help", &out) == 0);
+  CHECK(out.find("rths report") != std::string::npos);  // tools/cli.h: the command as the user types it
+  CHECK(out.find("bin/rths-") == std::string::npos);
   for (const char* opt : {"--out", "--max-plot-points", "--welch-segment-s", "--min-coherence", "--band-db", "--gnuplot"})
     CHECK(out.find(opt) != std::string::npos);
   CHECK(out.find("0.9") != std::string::npos);  // defaults shown

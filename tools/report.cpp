@@ -12,6 +12,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "cli.h"
 #include "report/run_report.h"
 
 namespace fs = std::filesystem;
@@ -39,12 +40,8 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1e-6, 200.0))
       ->capture_default_str();
   app.add_option("--gnuplot", o.gnuplot, "plotting program (a name on PATH or a path)")->capture_default_str();
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    const int code = app.exit(e);
-    return code == 0 ? 0 : 2;
-  }
+  rths::tools::NameCommand(app, "report");
+  if (const int code = rths::tools::ParseCommandLine(app, argc, argv); code >= 0) return code;
   o.out_dir = out;
 
   rths::report::RunData data;
@@ -52,7 +49,7 @@ int main(int argc, char** argv) {
     data = rths::report::LoadRunData(run_dir);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "rths report: %s\n", e.what());
-    return 2;
+    return rths::tools::kExitUsage;
   }
   try {
     const rths::report::ReportFiles files = rths::report::WriteRunReport(data, o);

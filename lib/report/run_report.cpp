@@ -656,15 +656,6 @@ RunData LoadRunData(const fs::path& run_dir) {
   RunData d;
   d.run_dir = run_dir;
 
-  const fs::path scenario_path = run_dir / "scenario.toml";
-  if (fs::is_regular_file(scenario_path, ec)) {
-    d.scenario_toml = Slurp(scenario_path);
-    try {
-      d.scenario = scenario::LoadScenario(scenario_path.string());
-    } catch (const std::exception& e) {
-      d.scenario_error = e.what();
-    }
-  }
   const fs::path summary_path = run_dir / "summary.json";
   if (fs::is_regular_file(summary_path, ec)) {
     try {
@@ -676,6 +667,26 @@ RunData LoadRunData(const fs::path& run_dir) {
     }
   } else {
     d.summary_error = "no summary.json in the run folder (the supervisor did not write it)";
+  }
+  // scenario.toml holds the bytes that ran; files it names are relative to the folder of the file
+  // that ran (summary.json's "scenario"), so it is parsed as that file if it does not load here.
+  const fs::path scenario_path = run_dir / "scenario.toml";
+  if (fs::is_regular_file(scenario_path, ec)) {
+    d.scenario_toml = Slurp(scenario_path);
+    try {
+      d.scenario = scenario::LoadScenario(scenario_path.string());
+    } catch (const std::exception& e) {
+      d.scenario_error = e.what();
+      const std::string ran = JsonText(d.summary, "scenario");
+      if (!ran.empty()) {
+        try {
+          d.scenario = scenario::ParseScenario(d.scenario_toml, ran);
+          d.scenario_error.clear();
+        } catch (const std::exception&) {
+          // keep the first error: it names the run folder's file
+        }
+      }
+    }
   }
 
   const io::RunLog log = io::ReadRunLog(log_path.string());
