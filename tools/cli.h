@@ -35,7 +35,7 @@ inline CLI::Option* AddSetOption(CLI::App& app, std::vector<std::string>* sets) 
   return app
       .add_option("--set", *sets,
                   "KEY=VALUE: override a scenario key (dotted, e.g. run.duration_s=5, controller.kind=ff_lqg, "
-                  "plant.damper.c0a=21); repeatable; checked like the file (docs/scenarios.md)")
+                  "plant.damper.c0_a=21); repeatable; checked like the file (docs/scenarios.md)")
       ->type_name("KEY=VALUE")
       ->allow_extra_args(false);
 }
