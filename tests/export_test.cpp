@@ -347,6 +347,32 @@ TEST_CASE("rths export: errors name the folder or file; a truncated log exports 
   CHECK(r.err.find((dir / "nowhere" / "x.mat").string()) != std::string::npos);
   CHECK(r.err.find("No such file or directory") != std::string::npos);
 
+  // A full disk (a file size limit: the writes fail part way, EFBIG): exit 2 naming the file,
+  // nothing left behind. matio does not check its writes; rths export does.
+  for (const std::string& out : {"--mat " + (dir / "full.mat").string(),
+                                 "--mat " + (dir / "full.mat").string() + " --mat-version 7.3",
+                                 "--csv " + (dir / "full.csv").string()}) {
+    CAPTURE(out);
+    r = Shell("bash -c \"trap '' XFSZ; ulimit -f 40; " + std::string(RTHS_BIN_DIR) + "/rths-export " + run.string() +
+              " " + out + "\"");
+    CHECK(r.code == 2);
+    CHECK(r.err.find((dir / "full.").string()) != std::string::npos);
+    CHECK(r.err.find("write failed") != std::string::npos);
+  }
+  r = Shell("bash -c \"trap '' XFSZ; ulimit -f 40; " + std::string(RTHS_BIN_DIR) + "/rths-log dump " +
+            (run / "log.lcm").string() + " --csv " + (dir / "full_dump.csv").string() + "\"");
+  CHECK(r.code == 2);
+  CHECK(r.err.find("full_dump.csv: write failed") != std::string::npos);
+  for (const auto& e : fs::directory_iterator(dir)) CHECK(e.path().filename().string().find("full") == std::string::npos);
+  // A device that is full: written in place (never replaced by a file), the failure reported.
+  if (fs::is_character_file("/dev/full")) {
+    r = Tool("export", run.string() + " --csv /dev/full");
+    CHECK(r.code == 2);
+    CHECK(r.err.find("/dev/full: write failed: No space left on device") != std::string::npos);
+    CHECK(Tool("export", run.string() + " --mat /dev/full").code == 2);
+    CHECK(fs::is_character_file("/dev/full"));
+  }
+
   // A truncated log: the first 60 % of its bytes.
   const fs::path cut = dir / "cut";
   fs::create_directories(cut);

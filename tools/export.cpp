@@ -5,6 +5,7 @@
 // RUN_DIR/log.lcm (io::ReadRunLog: every event checked) over its complete steps; dt comes from the
 // log's handshake (what ran), else from RUN_DIR/scenario.toml.
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -66,12 +67,21 @@ std::string ScenarioHash(const rths::io::RunLog& log) {
   return "";
 }
 
+/// ", 40.8 kB" for a regular file; "" for a device or FIFO.
 std::string SizeText(const fs::path& p) {
   std::error_code ec;
+  if (!fs::is_regular_file(p, ec)) return "";
   const auto bytes = fs::file_size(p, ec);
-  if (ec) return "?";
-  return bytes >= 10 * 1024 * 1024 ? fmt::format("{:.1f} MB", bytes / (1024.0 * 1024.0))
-                                   : fmt::format("{:.1f} kB", bytes / 1024.0);
+  if (ec) return "";
+  return bytes >= 10 * 1024 * 1024 ? fmt::format(", {:.1f} MB", bytes / (1024.0 * 1024.0))
+                                   : fmt::format(", {:.1f} kB", bytes / 1024.0);
+}
+
+/// Exits at once after a failure: HDF5 (under matio's v7.3 writer) crashes in its exit handlers
+/// when a write failed with its objects still open, which would turn exit 2 into a SIGSEGV.
+[[noreturn]] int ExitNow(int code) {
+  std::fflush(nullptr);
+  std::_Exit(code);
 }
 
 }  // namespace
@@ -121,11 +131,11 @@ int main(int argc, char** argv) {
     if (!mat_path.empty()) {
       const auto version = mat_version == "7.3" ? rths::io::MatVersion::kV73 : rths::io::MatVersion::kV5;
       rths::io::WriteMat(mat_path, signals, meta, version);
-      std::printf("  wrote %s (MATLAB v%s, %s)\n", mat_path.c_str(), mat_version.c_str(), SizeText(mat_path).c_str());
+      std::printf("  wrote %s (MATLAB v%s%s)\n", mat_path.c_str(), mat_version.c_str(), SizeText(mat_path).c_str());
     }
     if (!csv_path.empty()) {
       rths::io::WriteSignalsCsv(csv_path, signals);
-      std::printf("  wrote %s (CSV, %s)\n", csv_path.c_str(), SizeText(csv_path).c_str());
+      std::printf("  wrote %s (CSV%s)\n", csv_path.c_str(), SizeText(csv_path).c_str());
     }
     if (!log.Complete()) {
       std::fprintf(stderr, "rths export: note: %s: %s; exported its %lld complete steps (k = 0..%lld)\n",
@@ -136,9 +146,9 @@ int main(int argc, char** argv) {
     return kOk;
   } catch (const rths::Error& e) {
     std::fprintf(stderr, "rths export: %s\n", e.what());
-    return kBadInput;
+    return ExitNow(kBadInput);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "rths export: internal failure: %s\n", e.what());
-    return kInternal;
+    return ExitNow(kInternal);
   }
 }

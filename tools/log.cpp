@@ -10,6 +10,7 @@
 #include <cctype>
 #include <cerrno>
 #include <cstring>
+#include <filesystem>
 #include <cstdio>
 #include <memory>
 #include <string>
@@ -181,7 +182,7 @@ bool DecodeRow(const rths::io::LogEvent& e, int n_dof, std::vector<std::string>*
 /// else that channel's messages only. Returns the rows written; *skipped counts the events on
 /// channels it leaves out.
 std::int64_t Dump(const std::string& path, const rths::io::RunLog& log, const std::string& channel, std::FILE* out,
-                  std::int64_t* skipped) {
+                  const std::string& out_name, std::int64_t* skipped) {
   int n_dof = 0;
   for (const auto& d : log.desired) n_dof = std::max(n_dof, static_cast<int>(d.n_dof));
   // Where each channel's fields start in a row (after channel, k, run_id when dumping all).
@@ -198,7 +199,7 @@ std::int64_t Dump(const std::string& path, const rths::io::RunLog& log, const st
   const auto write = [&](const std::vector<std::string>& fields) {
     const std::string rec = rths::io::CsvRecord(fields);
     if (std::fwrite(rec.data(), 1, rec.size(), out) != rec.size())
-      throw rths::Error("dump output", "write failed (disk full or closed pipe?)");
+      throw rths::Error(out_name, fmt::format("write failed: {}", std::strerror(errno)));
   };
   write(header);
   rths::io::EventLogReader reader(path);
@@ -260,10 +261,20 @@ int main(int argc, char** argv) {
         if (!file) throw rths::Error(dump_csv, fmt::format("cannot write the file: {}", std::strerror(errno)));
         out = file.get();
       }
-      std::int64_t skipped = 0;
-      const std::int64_t rows = Dump(files[0], log, channel, out, &skipped);
-      if (std::fflush(out) != 0 || (file && std::fclose(file.release()) != 0))
-        throw rths::Error(dump_csv.empty() ? "standard output" : dump_csv, "write failed (disk full?)");
+      std::int64_t skipped = 0, rows = 0;
+      const std::string out_name = dump_csv.empty() ? "standard output" : dump_csv;
+      try {
+        rows = Dump(files[0], log, channel, out, out_name, &skipped);
+        if (std::fflush(out) != 0 || (file && std::fclose(file.release()) != 0))
+          throw rths::Error(out_name, fmt::format("write failed: {}", std::strerror(errno)));
+      } catch (...) {
+        // No half-written file is left behind (a device or FIFO is left alone).
+        std::error_code ec;
+        file.reset();
+        if (!dump_csv.empty() && std::filesystem::is_regular_file(std::filesystem::symlink_status(dump_csv, ec)))
+          std::filesystem::remove(dump_csv, ec);
+        throw;
+      }
       if (!dump_csv.empty())
         std::fprintf(stderr, "rths log: %s: %lld messages to %s\n", files[0].c_str(), static_cast<long long>(rows),
                      dump_csv.c_str());

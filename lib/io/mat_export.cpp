@@ -6,6 +6,7 @@
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
+#include <fstream>
 #include <memory>
 #include <string_view>
 #include <system_error>
@@ -55,45 +56,127 @@ void ResetMatioMessages() {
   (void)installed;
   MatioMessages().clear();
 }
-std::string MatioSaid() { return MatioMessages().empty() ? "" : " (matio: " + MatioMessages() + ")"; }
+/// What matio said first, on one line (HDF5's error stacks run to dozens of lines).
+std::string MatioSaid() {
+  std::string m = MatioMessages();
+  if (m.empty()) return "";
+  m = m.substr(0, m.find('\n'));
+  if (m.size() > 300) m = m.substr(0, 300) + "...";
+  return " (matio: " + m + ")";
+}
 
-// --- temporary file beside the target, renamed into place -----------------------------------
-/// A writable, empty temporary file beside `path`; removed on destruction unless Commit()ed.
-class TempBeside {
- public:
-  explicit TempBeside(const fs::path& path) : path_(path) {
-    tmp_ = path.parent_path() / fmt::format(".{}.tmp-{}", path.filename().string(), ::getpid());
-    std::FILE* f = std::fopen(tmp_.c_str(), "wb");
-    if (!f) throw Error(path.string(), fmt::format("cannot write the file: {}", std::strerror(errno)));
-    std::fclose(f);
-  }
-  ~TempBeside() {
-    if (!committed_) {
-      std::error_code ec;
-      fs::remove(tmp_, ec);
-    }
-  }
-  TempBeside(const TempBeside&) = delete;
-  TempBeside& operator=(const TempBeside&) = delete;
-  const fs::path& tmp() const { return tmp_; }
-  /// Renames the temporary file to the target.
-  void Commit() {
-    if (std::rename(tmp_.c_str(), path_.c_str()) != 0)
-      throw Error(path_.string(), fmt::format("cannot rename {} to it: {}", tmp_.string(), std::strerror(errno)));
-    committed_ = true;
-  }
-
- private:
-  fs::path path_, tmp_;
-  bool committed_ = false;
-};
-
-// --- matio variables ------------------------------------------------------------------------
+/// A matio variable, freed with Mat_VarFree.
 struct VarFree {
   void operator()(matvar_t* v) const { Mat_VarFree(v); }
 };
 using Var = std::unique_ptr<matvar_t, VarFree>;
 
+// --- outputs: written under a temporary name, checked, then put in place -----------------------
+/// An output file. A new or regular file is written beside the target under a temporary name and
+/// renamed into place by Commit(). Anything else that is not a folder (a device such as
+/// /dev/stdout, a FIFO, a symbolic link) is written to a temporary file in the system's temp
+/// folder and copied into the target by Commit(), with every write checked. The temporary file is
+/// removed unless it was renamed.
+class Output {
+ public:
+  explicit Output(const fs::path& path) : path_(path) {
+    std::error_code ec;
+    if (fs::is_directory(fs::status(path, ec))) throw Error(path.string(), "is a folder, not a file");
+    const auto status = fs::symlink_status(path, ec);
+    copy_ = fs::exists(status) && !fs::is_regular_file(status);
+    const std::string name = fmt::format(".{}.tmp-{}", path.filename().string(), ::getpid());
+    tmp_ = copy_ ? fs::temp_directory_path() / name : path.parent_path() / name;
+    // Can the target be written at all? (Says why not, before anything is computed.)
+    std::FILE* f = std::fopen(copy_ ? path.c_str() : tmp_.c_str(), copy_ ? "ab" : "wb");
+    if (!f) throw Error(path.string(), fmt::format("cannot write the file: {}", std::strerror(errno)));
+    std::fclose(f);
+  }
+  ~Output() {
+    std::error_code ec;
+    if (!renamed_) fs::remove(tmp_, ec);
+  }
+  Output(const Output&) = delete;
+  Output& operator=(const Output&) = delete;
+  /// The file to write.
+  const fs::path& tmp() const { return tmp_; }
+  /// Puts the written file in place: renamed, or copied into a device / FIFO / link.
+  void Commit() {
+    if (!copy_) {
+      if (std::rename(tmp_.c_str(), path_.c_str()) != 0)
+        throw Error(path_.string(), fmt::format("cannot rename {} to it: {}", tmp_.string(), std::strerror(errno)));
+      renamed_ = true;
+      return;
+    }
+    std::unique_ptr<std::FILE, int (*)(std::FILE*)> in(std::fopen(tmp_.c_str(), "rb"), std::fclose);
+    std::FILE* out = std::fopen(path_.c_str(), "wb");
+    if (!in || !out) {
+      if (out) std::fclose(out);
+      throw Error(path_.string(), fmt::format("cannot write the file: {}", std::strerror(errno)));
+    }
+    std::vector<char> buf(1 << 16);
+    bool ok = true;
+    while (ok) {
+      const std::size_t n = std::fread(buf.data(), 1, buf.size(), in.get());
+      if (n == 0) break;
+      ok = std::fwrite(buf.data(), 1, n, out) == n;
+    }
+    const int saved = errno;
+    ok = std::fflush(out) == 0 && ok;
+    const int flush_errno = errno;
+    ok = std::fclose(out) == 0 && ok;
+    if (!ok) throw Error(path_.string(), fmt::format("write failed: {}", std::strerror(saved ? saved : flush_errno)));
+  }
+
+ private:
+  fs::path path_, tmp_;
+  bool copy_ = false, renamed_ = false;
+};
+
+/// Checks that a MATLAB v5 file holds every byte its data elements announce (matio does not check
+/// its writes: a full disk leaves a short file, which matio itself cannot read back safely).
+void CheckV5Complete(const fs::path& file, const fs::path& target) {
+  std::ifstream in(file, std::ios::binary);
+  std::error_code ec;
+  const std::uint64_t size = fs::file_size(file, ec);
+  char header[128];
+  if (ec || !in.read(header, sizeof header))
+    throw Error(target.string(), "write failed: the file is shorter than a MAT-file header (disk full?)");
+  const bool swap = header[126] == 'M' && header[127] == 'I';  // written big-endian
+  const auto u32 = [swap](const unsigned char* b) {
+    return swap ? (std::uint32_t{b[0]} << 24) | (std::uint32_t{b[1]} << 16) | (std::uint32_t{b[2]} << 8) | b[3]
+                : (std::uint32_t{b[3]} << 24) | (std::uint32_t{b[2]} << 16) | (std::uint32_t{b[1]} << 8) | b[0];
+  };
+  std::uint64_t at = 128;
+  while (at < size) {
+    unsigned char tag[8];
+    in.seekg(static_cast<std::streamoff>(at));
+    if (!in.read(reinterpret_cast<char*>(tag), sizeof tag)) break;
+    const std::uint32_t type = u32(tag), bytes = u32(tag + 4);
+    std::uint64_t next = at + 8 + bytes;
+    if (type != 15 /* miCOMPRESSED: not padded */) next = (next + 7) / 8 * 8;
+    at = next;
+  }
+  if (at != size)
+    throw Error(target.string(), fmt::format("write failed: the file written is cut short at byte {}, inside a data "
+                                             "element (disk full?)",
+                                             size));
+}
+
+/// Reads `file` back with matio: the struct `rths` with `steps` values in its last signal.
+void CheckReadBack(const fs::path& file, const fs::path& target, const RunSignals& s) {
+  mat_t* mat = Mat_Open(file.c_str(), MAT_ACC_RDONLY);
+  if (!mat) throw Error(target.string(), fmt::format("the file written cannot be opened again{}", MatioSaid()));
+  Var v(Mat_VarRead(mat, "rths"));
+  Mat_Close(mat);
+  matvar_t* signals = v ? Mat_VarGetStructFieldByName(v.get(), "signals", 0) : nullptr;
+  matvar_t* last = signals && !s.columns.empty()
+                       ? Mat_VarGetStructFieldByName(signals, s.columns.back().name.c_str(), 0)
+                       : nullptr;
+  if (!last || last->rank != 2 || last->dims[0] != s.steps() || (s.steps() > 0 && !last->data))
+    throw Error(target.string(), fmt::format("the file written does not read back whole (disk full?){}", MatioSaid()));
+}
+
+// --- matio variables ------------------------------------------------------------------------
 /// Throws if matio could not create a variable (out of memory); `name` may be null (a field).
 Var Checked(matvar_t* v, const char* name) {
   if (!v) throw Error("matio", fmt::format("cannot create a variable {}{}", name ? name : "(field)", MatioSaid()));
@@ -229,15 +312,11 @@ Var BuildRthsVar(const fs::path& path, const RunSignals& s, const ExportMeta& me
   return top;
 }
 
-struct MatClose {
-  void operator()(mat_t* m) const { Mat_Close(m); }
-};
-
 }  // namespace
 
 void WriteMat(const fs::path& path, const RunSignals& signals, const ExportMeta& meta, MatVersion version) {
   Var rths_var = BuildRthsVar(path, signals, meta);
-  TempBeside tmp(path);
+  Output tmp(path);
   ResetMatioMessages();
   const std::string header =
       fmt::format("MATLAB {} MAT-file, written by {} (matio {}), run {}", version == MatVersion::kV73 ? "7.3" : "5.0",
@@ -255,16 +334,18 @@ void WriteMat(const fs::path& path, const RunSignals& signals, const ExportMeta&
   const int wrote = Mat_VarWrite(mat, rths_var.get(), MAT_COMPRESSION_ZLIB);
   const int closed = Mat_Close(mat);
   if (wrote != 0 || closed != 0)
-    throw Error(path.string(), fmt::format("matio could not write the data (error {}){}", wrote != 0 ? wrote : closed,
+    throw Error(path.string(), fmt::format("write failed: matio error {} (disk full?){}", wrote != 0 ? wrote : closed,
                                            MatioSaid()));
+  if (version == MatVersion::kV5) CheckV5Complete(tmp.tmp(), path);
+  CheckReadBack(tmp.tmp(), path, signals);
   tmp.Commit();
 }
 
 void WriteSignalsCsv(const fs::path& path, const RunSignals& signals) {
-  TempBeside tmp(path);
+  Output tmp(path);
   std::vector<std::string> header;
   for (const auto& c : signals.columns) header.push_back(c.name);
-  {
+  try {
     CsvWriter w(tmp.tmp(), header);
     std::vector<std::string> row(header.size());
     for (std::size_t k = 0; k < signals.steps(); ++k) {
@@ -272,11 +353,10 @@ void WriteSignalsCsv(const fs::path& path, const RunSignals& signals) {
       for (std::size_t j = 0; j < signals.columns.size(); ++j) row[j] = fmt::format("{}", signals.columns[j].values[k]);
       w.Row(row);
     }
-    try {
-      w.Close();
-    } catch (const Error& e) {
-      throw Error(path.string(), e.problem());
-    }
+    w.Close();
+  } catch (const Error& e) {
+    // CsvWriter names the temporary file; the user named the target.
+    throw Error(path.string(), e.problem() + " (disk full?)");
   }
   tmp.Commit();
 }

@@ -37,9 +37,10 @@ std::string RthsVersion();
 /// The matio library's version ("1.5.23").
 std::string MatioVersion();
 
-/// Writes `signals` and `meta` to `path` in the layout above. The file is written beside `path`
-/// under a temporary name and renamed into place, so a failure never leaves a half-written file
-/// (an existing file at `path` is replaced). Throws rths::Error naming `path` if it cannot be
+/// Writes `signals` and `meta` to `path` in the layout above. A new or regular file is written
+/// beside `path` under a temporary name and renamed into place, so a failure never leaves a
+/// half-written file (an existing file at `path` is replaced); a device, FIFO or symbolic link
+/// at `path` is written in place. Throws rths::Error naming `path` if it cannot be
 /// written (with the system's reason), if this matio cannot write v7.3 (built without HDF5), or
 /// if a signal name is not a valid MATLAB field name (letters, digits, '_', starting with a
 /// letter, at most 63 characters).
