@@ -2,9 +2,11 @@
 // with the labels and legend entries, clear errors).
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <limits>
+#include <set>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -12,6 +14,7 @@
 #include "core/error.h"
 #include "io/csv.h"
 #include "io/plot.h"
+#include "report/figures.h"
 #include "test_support.h"
 
 using namespace rths::io;
@@ -137,4 +140,166 @@ TEST_CASE("plot errors are clear") {
   fig.gnuplot = "gnuplot";
   fig.name = "bad name";
   CHECK_THROWS_AS(Plot(fig, dir), rths::Error);
+}
+
+// --- Figure conventions (io/plot.h, report/figures.h) --------------------------------------
+
+namespace {
+// Every "[unit]" of the axis labels of a figure.
+std::vector<std::string> Units(const Figure& fig) {
+  std::vector<std::string> units;
+  for (const auto& p : fig.panels) {
+    for (const std::string& label : {p.xlabel, p.ylabel}) {
+      const auto a = label.rfind('['), b = label.rfind(']');
+      if (a != std::string::npos && b != std::string::npos && b > a) units.push_back(label.substr(a + 1, b - a - 1));
+    }
+  }
+  return units;
+}
+const std::set<std::string> kFigureUnits{"mm", "kN", "s", "ms", "Hz", "mm/s", "mm/s^2", "%", "deg", "mm/mm", "-"};
+}  // namespace
+
+TEST_CASE("the readable palette: distinct #rrggbb colours, none paler than 3:1 against white") {
+  CHECK(RelativeLuminance("#000000") == 0.0);
+  CHECK(RelativeLuminance("#FFFFFF") == doctest::Approx(1.0));
+  CHECK(RelativeLuminance("#f0e442") > kMaxReadableLuminance);  // Okabe-Ito yellow: too pale
+  CHECK(RelativeLuminance("#56B4E9") > kMaxReadableLuminance);  // Okabe-Ito sky blue: too pale
+  CHECK_THROWS_AS(RelativeLuminance("red"), rths::Error);
+  CHECK_THROWS_AS(RelativeLuminance("#12345g"), rths::Error);
+  const auto& colors = ReadableColors();
+  CHECK(colors.size() >= 6);
+  CHECK(std::set<std::string>(colors.begin(), colors.end()).size() == colors.size());
+  for (const auto& c : colors) {
+    CAPTURE(c);
+    CHECK(RelativeLuminance(c) <= kMaxReadableLuminance);
+  }
+}
+
+TEST_CASE("a plot's colour cycle is the readable palette; margins and a legend beside the axes reach the script") {
+  const auto dir = TempDir("plot_cycle");
+  Figure fig;
+  fig.name = "cycle";
+  Panel p = MakePanel("", "Time [s]", "Displacement [mm]");
+  p.key = "outside right top";
+  p.left_margin_chars = 10;
+  p.right_margin_chars = 30;
+  Series s = MakeSeries("a");
+  s.x = {0, 1};
+  s.y = {0, 1};
+  p.series = {s};
+  fig.panels = {p};
+  CHECK(KeyMarginChars({&p}) == 12);  // the shortest entries still get a sample line and a box
+  Panel wide = p;
+  wide.series[0].title = std::string(40, 'w');
+  CHECK(KeyMarginChars({&p, &wide}) == 44);
+  const std::string gp = Slurp(Plot(fig, dir).gp);
+  CHECK(gp.find("set linetype 1 lc rgb '" + ReadableColors()[0] + "'") != std::string::npos);
+  CHECK(gp.find("set linetype cycle " + std::to_string(ReadableColors().size())) != std::string::npos);
+  CHECK(gp.find("set key on outside right top") != std::string::npos);
+  CHECK(gp.find("set lmargin 10") != std::string::npos);
+  CHECK(gp.find("set rmargin 30") != std::string::npos);
+}
+
+TEST_CASE("a bar panel: filled boxes side by side over named categories") {
+  Series a = MakeSeries("share of the residual", "#D55E00"), b = MakeSeries("share of the samples", "#0072B2");
+  a.y = {30, 50, 20};
+  b.y = {10, 15, 88};
+  const Panel p = MakeBarPanel("conditions", "Share [%]", {"velocity_reversal", "high_velocity", "high_force"}, {a, b});
+  REQUIRE(p.series.size() == 2);
+  CHECK(p.series[0].with == "boxes");
+  CHECK(p.x_tics.size() == 3);
+  CHECK(p.x_tics[1] == std::make_pair(2.0, std::string("high_velocity")));
+  CHECK(p.box_width == doctest::Approx(0.4));
+  // The two bars of a category side by side around it, not overlapping.
+  CHECK(p.series[0].x[1] == doctest::Approx(1.8));
+  CHECK(p.series[1].x[1] == doctest::Approx(2.2));
+  CHECK(p.x_range == std::make_optional(std::make_pair(0.5, 3.5)));
+  b.y.pop_back();
+  CHECK_THROWS_WITH_AS(MakeBarPanel("c", "[%]", {"a", "b", "c"}, {a, b}), doctest::Contains("2 values for 3 categories"),
+                       rths::Error);
+
+  const auto dir = TempDir("plot_bars");
+  Figure fig;
+  fig.name = "bars";
+  fig.panels = {p};
+  const std::string gp = Slurp(Plot(fig, dir).gp);
+  CHECK(gp.find("with boxes") != std::string::npos);
+  CHECK(gp.find("set xtics ('velocity_reversal' 1, 'high_velocity' 2, 'high_force' 3)") != std::string::npos);
+  CHECK(gp.find("set boxwidth 0.4 absolute") != std::string::npos);
+}
+
+TEST_CASE("fig9's figure: every controller a distinct readable colour, the proposed G_FF,0.0A the most prominent") {
+  rths::report::Fig9Result res;
+  double v = 0.1;
+  for (double f : rths::report::Fig9FrequenciesHz()) {
+    for (const auto& c : rths::report::Fig9Controllers()) {
+      rths::report::Fig9Row row;
+      row.f_hz = f;
+      row.controller = c.name;
+      row.rms_pct = v *= 1.1;
+      if (f == 30.0 && c.name == "None") row.stopped = "stroke limit";
+      res.rows.push_back(row);
+    }
+  }
+  const Figure fig = rths::report::Fig9Figure(res, "physical", true);
+  REQUIRE(fig.panels.size() == 1);
+  const Panel& p = fig.panels[0];
+  std::set<std::string> colors;
+  double widest_other = 0.0, proposed = 0.0;
+  std::size_t curves = 0;
+  for (const auto& s : p.series) {
+    if (s.title == "stopped by the safety monitor") continue;
+    ++curves;
+    CAPTURE(s.title);
+    CAPTURE(s.color);
+    REQUIRE(s.color.size() == 7);
+    CHECK(RelativeLuminance(s.color) <= kMaxReadableLuminance);
+    colors.insert(s.color);
+    CHECK(s.x.size() == 6);
+    if (s.title == "G_FF,0.0A") {
+      proposed = s.width;
+    } else {
+      widest_other = std::max(widest_other, s.width);
+    }
+  }
+  CHECK(curves == 6);
+  CHECK(colors.size() == 6);
+  CHECK(proposed > widest_other);
+  CHECK(p.series.back().title == "stopped by the safety monitor");
+  CHECK(p.series.back().x == std::vector<double>{30.0});
+  CHECK(p.key.rfind("outside", 0) == 0);
+  for (const auto& u : Units(fig)) CHECK(kFigureUnits.count(u) == 1);
+}
+
+TEST_CASE("fig11's stories figure: one legend beside the axes, accelerations in mm/s^2 like the logs") {
+  rths::report::Fig11Result res;
+  for (const auto& mode : rths::report::Fig11SemiactiveModes()) {
+    rths::report::Fig11Run n;
+    n.controller = "Numerical";
+    n.semiactive = mode;
+    for (int i = 0; i < 9; ++i) {
+      n.peak_drift_mm.push_back(10.0 + i);
+      n.peak_abs_accel_mps2.push_back(1.5 + 0.1 * i);
+    }
+    res.numerical.push_back(n);
+    for (const auto& c : rths::report::Fig11Controllers()) {
+      rths::report::Fig11Run r = n;
+      r.controller = c.name;
+      res.runs.push_back(r);
+    }
+  }
+  const Figure fig = rths::report::Fig11StoriesFigure(res);
+  REQUIRE(fig.panels.size() == 2);
+  const Panel& drift = fig.panels[0];
+  const Panel& acc = fig.panels[1];
+  // The curves cover the story-1 corner of both panels: the legend goes beside the right one.
+  CHECK(drift.key == "off");
+  CHECK(acc.key.rfind("outside right", 0) == 0);
+  CHECK(acc.right_margin_chars == KeyMarginChars({&acc}));  // room for the legend's longest entry
+  REQUIRE(acc.series.size() == 6);  // 3 modes x (numerical, RTHS G_FF,avgA + LQG)
+  CHECK(acc.xlabel == "Peak acceleration [mm/s^2]");
+  CHECK(acc.series[0].x[0] == doctest::Approx(1500.0));
+  CHECK(acc.series[0].x[8] == doctest::Approx(2300.0));
+  for (const auto& u : Units(fig)) CHECK(kFigureUnits.count(u) == 1);
+  for (const auto& s : acc.series) CHECK(RelativeLuminance(s.color) <= kMaxReadableLuminance);
 }

@@ -3,6 +3,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -103,6 +104,60 @@ std::string GnuplotQuote(const std::string& s) {
   return out;
 }
 
+const std::vector<std::string>& ReadableColors() {
+  static const std::vector<std::string> colors{"#0072B2", "#D55E00", "#009E73", "#CC79A7",
+                                               "#000000", "#882255", "#666666"};
+  return colors;
+}
+
+double RelativeLuminance(const std::string& hex_color) {
+  auto hex = [&](std::size_t i) {
+    const char c = hex_color[i];
+    if (c >= '0' && c <= '9') return c - '0';
+    if (c >= 'a' && c <= 'f') return c - 'a' + 10;
+    if (c >= 'A' && c <= 'F') return c - 'A' + 10;
+    return -1;
+  };
+  bool ok = hex_color.size() == 7 && hex_color[0] == '#';
+  for (std::size_t i = 1; ok && i < 7; ++i) ok = hex(i) >= 0;
+  if (!ok) throw Error("RelativeLuminance", fmt::format("colour '{}' is not of the form #rrggbb", hex_color));
+  auto linear = [&](std::size_t i) {  // sRGB channel -> linear light
+    const double c = (16 * hex(i) + hex(i + 1)) / 255.0;
+    return c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4);
+  };
+  return 0.2126 * linear(1) + 0.7152 * linear(3) + 0.0722 * linear(5);
+}
+
+Panel MakeBarPanel(std::string title, std::string ylabel, const std::vector<std::string>& categories,
+                   std::vector<Series> series) {
+  Panel p = MakePanel(std::move(title), "", std::move(ylabel));
+  const double n = static_cast<double>(std::max<std::size_t>(series.size(), 1));
+  p.box_width = 0.8 / n;
+  for (std::size_t j = 0; j < series.size(); ++j) {
+    Series& s = series[j];
+    if (s.y.size() != categories.size()) {
+      throw Error("MakeBarPanel", fmt::format("series '{}' has {} values for {} categories", s.title, s.y.size(),
+                                              categories.size()));
+    }
+    s.with = "boxes";
+    s.x.clear();
+    const double offset = (static_cast<double>(j) - 0.5 * (n - 1.0)) * p.box_width;
+    for (std::size_t i = 0; i < categories.size(); ++i) s.x.push_back(static_cast<double>(i + 1) + offset);
+  }
+  for (std::size_t i = 0; i < categories.size(); ++i) p.x_tics.emplace_back(static_cast<double>(i + 1), categories[i]);
+  p.x_range = std::make_pair(0.5, static_cast<double>(categories.size()) + 0.5);
+  p.series = std::move(series);
+  return p;
+}
+
+int KeyMarginChars(const std::vector<const Panel*>& panels) {
+  std::size_t longest = 2;
+  for (const Panel* p : panels) {
+    for (const auto& s : p->series) longest = std::max(longest, s.title.size());
+  }
+  return std::max(12, static_cast<int>(longest - longest / 10) + 8);
+}
+
 bool GnuplotAvailable(const std::string& program) { return !FindOnPath(program).empty(); }
 
 PlotFiles Plot(const Figure& fig, const fs::path& dir) {
@@ -174,6 +229,10 @@ PlotFiles Plot(const Figure& fig, const fs::path& dir) {
                     GnuplotQuote(fig.font))
      << "set output " << GnuplotQuote(fig.name + ".png") << "\n"
      << "set encoding utf8\n";
+  // The colour cycle of curves without a colour: readable on white, colour-blind safe.
+  const auto& cycle = ReadableColors();
+  for (std::size_t i = 0; i < cycle.size(); ++i) gp << fmt::format("set linetype {} lc rgb '{}'\n", i + 1, cycle[i]);
+  gp << "set linetype cycle " << cycle.size() << "\n";
   if (fig.panels.size() > 1 || !fig.title.empty()) {
     gp << fmt::format("set multiplot layout {},{}", rows, fig.columns);
     if (!fig.title.empty()) gp << " title " << GnuplotQuote(fig.title);
@@ -188,14 +247,38 @@ PlotFiles Plot(const Figure& fig, const fs::path& dir) {
        << "set ylabel " << GnuplotQuote(panel.ylabel) << "\n";
     if (panel.log_x) gp << "set logscale x\n";
     if (panel.log_y) gp << "set logscale y\n";
+    // Log axes: plain tick labels (1e-06, 0.001, 100), not gnuplot's fixed "0.0000010".
+    gp << "set format x " << (panel.log_x ? "'%g'" : "'% h'") << "\nset format y " << (panel.log_y ? "'%g'" : "'% h'")
+       << "\n";
     gp << (panel.x_range ? fmt::format("set xrange [{}:{}]\n", Num(panel.x_range->first), Num(panel.x_range->second))
                          : std::string("set xrange [*:*]\n"));
     gp << (panel.y_range ? fmt::format("set yrange [{}:{}]\n", Num(panel.y_range->first), Num(panel.y_range->second))
                          : std::string("set yrange [*:*]\n"));
+    gp << fmt::format("set lmargin {}\nset rmargin {}\n", panel.left_margin_chars < 0 ? -1 : panel.left_margin_chars,
+                      panel.right_margin_chars < 0 ? -1 : panel.right_margin_chars);
+    if (panel.x_tics.empty()) {
+      gp << "set xtics autofreq\n";
+    } else {
+      gp << "set xtics (";
+      for (std::size_t i = 0; i < panel.x_tics.size(); ++i) {
+        gp << (i ? ", " : "") << GnuplotQuote(panel.x_tics[i].second) << " " << Num(panel.x_tics[i].first);
+      }
+      gp << ")\n";
+    }
+    gp << fmt::format("set boxwidth {} absolute\nset style fill solid 0.85 border -1\n", Num(panel.box_width));
+    gp << "set key default\n";  // nothing of the previous panel's key (outside, width) carries over
     if (panel.key == "off") {
       gp << "set key off\n";
     } else {
-      gp << "set key on " << panel.key << " box opaque spacing 1.2\n";
+      gp << "set key on " << panel.key << " box opaque spacing 1.2";
+      if (panel.key.find("outside") != std::string::npos && panel.key.find("width") == std::string::npos) {
+        // gnuplot sizes the box for its wide-letter character width; titles take about 0.8 of
+        // it. Narrow the box by a tenth (the room KeyMarginChars leaves beside the axes).
+        std::size_t longest = 0;
+        for (const auto& s : panel.series) longest = std::max(longest, s.title.size());
+        gp << " width " << -static_cast<int>(longest / 10);
+      }
+      gp << "\n";
     }
     gp << "plot ";
     bool first = true;

@@ -7,6 +7,11 @@
 ///   <name>.gp   the script, runnable again by hand: cd dir && gnuplot <name>.gp
 ///   <name>.png  the figure: one or more panels, stacked (Figs. 6-8) or side by side (Fig. 5).
 /// Titles and labels are written literally (noenhanced), so "G_FF,0.0A + LP" stays as it is.
+///
+/// Figure conventions (every figure of rths): units as docs/units.md (mm, kN, s, Hz, mm/s,
+/// mm/s^2) written "Quantity [unit]"; colours from ReadableColors() (also gnuplot's colour cycle for
+/// a curve without a colour), none paler than kMaxReadableLuminance; a legend never over data
+/// (Panel::key "outside ..." with Panel::right_margin_chars, or a corner the data leave empty).
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -19,7 +24,8 @@ namespace rths::io {
 struct Series {
   std::string title;            ///< legend entry; "" = no entry
   std::vector<double> x, y;     ///< same length; NaN/inf points are left out (the line breaks)
-  std::string with = "lines";   ///< gnuplot style: "lines", "points", "linespoints"
+  std::string with = "lines";   ///< gnuplot style: "lines", "points", "linespoints", or "boxes"
+                                ///< (filled bars from y = 0, Panel::box_width wide; MakeBarPanel)
   std::string color;            ///< "" = gnuplot's colour cycle; else a name or "#rrggbb"
   int dash = 1;                 ///< gnuplot dashtype: 1 solid, 2 dashed, 3 dotted, ...
   double width = 1.5;           ///< line width
@@ -31,8 +37,16 @@ struct Panel {
   std::string xlabel, ylabel;                      ///< with units, e.g. "Frequency [Hz]"
   bool log_x = false, log_y = false;
   std::optional<std::pair<double, double>> x_range, y_range;  ///< unset = autoscale
-  std::string key = "top right";                   ///< legend position (gnuplot `set key`), "off"
+  std::string key = "top right";                   ///< legend position (gnuplot `set key`), "off";
+                                                   ///< "outside right top" puts it beside the axes
   std::vector<Series> series;
+  /// Margins of the plot area in character widths (gnuplot `set lmargin` / `set rmargin`);
+  /// -1 = automatic. Give stacked panels the same values and their axes line up; a key
+  /// "outside right" needs right_margin_chars wide enough for its longest entry + ~8.
+  int left_margin_chars = -1, right_margin_chars = -1;
+  /// Labelled x ticks (x, label), e.g. categories of a bar chart; empty = numeric ticks.
+  std::vector<std::pair<double, std::string>> x_tics;
+  double box_width = 0.8;                          ///< width of "boxes" bars [x units]
 };
 
 struct Figure {
@@ -62,6 +76,34 @@ inline Series MakeSeries(std::string title, std::string color = "", int dash = 1
   s.dash = dash;
   return s;
 }
+
+/// Bars over named categories: category i at x = i + 1, series j of n offset so the n bars of a
+/// category sit side by side (together 0.8 wide). Each series gives its title, colour and one y
+/// per category (y.size() == categories.size(), else rths::Error); its x and `with` are set here.
+/// The x ticks are the category names.
+Panel MakeBarPanel(std::string title, std::string ylabel, const std::vector<std::string>& categories,
+                   std::vector<Series> series);
+
+/// Okabe & Ito's colour-blind-safe palette (2008) without the three of its colours that are too
+/// pale on white (orange, sky blue, yellow), in order: blue #0072B2, vermillion #D55E00, bluish
+/// green #009E73, reddish purple #CC79A7, black #000000; then Tol's wine #882255 and a grey
+/// #666666. gnuplot's colour cycle in every figure (curves without a colour).
+const std::vector<std::string>& ReadableColors();
+
+/// Relative luminance (WCAG 2.1) of a "#rrggbb" colour, in [0, 1] (black 0, white 1). Throws
+/// rths::Error for anything else (names like "red" included).
+double RelativeLuminance(const std::string& hex_color);
+
+/// The palest a curve may be on the white background: luminance 0.30 is a contrast of 3:1 with
+/// white ((1 + 0.05) / (0.30 + 0.05)), WCAG 2.1's minimum for graphical objects.
+inline constexpr double kMaxReadableLuminance = 0.30;
+
+/// The right margin [characters] a key "outside right" needs for the legend entries of `panels`:
+/// the longest title less 1/10 (gnuplot's character width is that of a wide letter; titles
+/// average about 0.8 of it) + 8 (the sample line, spacing and box), at least 12. Plot narrows
+/// the box of a key "outside" to match (`set key ... width -N`, N = 1/10 of its panel's longest
+/// title).
+int KeyMarginChars(const std::vector<const Panel*>& panels);
 
 struct PlotFiles {
   std::filesystem::path dat, gp, png;

@@ -15,6 +15,7 @@
 #include "io/csv.h"
 #include "io/plot.h"
 #include "io/source_tree.h"
+#include "report/figures.h"
 #include "report/studies.h"
 #include "signal/metrics.h"
 
@@ -34,6 +35,8 @@ namespace {
 
 
 constexpr const char* kNumerical = "Numerical";
+// The paper's controller for the building (the stories figure shows its RTHS runs).
+constexpr const char* kFig11Proposed = "G_FF,avgA + LQG";
 
 // Per-run signals for the figures and the summary.
 struct Fig11Trace {
@@ -107,6 +110,49 @@ Series Thin(Series s, const std::vector<double>& x, const std::vector<double>& y
 }
 
 }  // namespace
+
+Figure Fig11StoriesFigure(const Fig11Result& res) {
+  Figure fig;
+  fig.name = "fig11_stories";
+  fig.title = "Fig. 11: peak story drifts and absolute floor accelerations (El Centro NS x 0.5)";
+  fig.columns = 2;
+  fig.width_px = 1600;
+  fig.panel_height_px = 600;
+  Panel drift = MakePanel("Peak story drift", "Peak drift [mm]", "Story");
+  Panel acc = MakePanel("Peak absolute acceleration", "Peak acceleration [mm/s^2]", "Floor");
+  // One legend, beside the right panel: the curves fill both panels.
+  drift.key = "off";
+  acc.key = "outside right top";
+  drift.y_range = acc.y_range = std::make_pair(0.5, 9.5);
+  const auto modes = Fig11SemiactiveModes();
+  const std::vector<std::string> mode_colors = {"#0072B2", "#D55E00", "#009E73"};
+  const std::vector<int> mode_points = {7, 5, 9};
+  std::vector<double> story(9);
+  for (int i = 0; i < 9; ++i) story[i] = i + 1;
+  for (std::size_t m = 0; m < modes.size(); ++m) {
+    for (const auto* set : {&res.numerical, &res.runs}) {
+      for (const auto& r : *set) {
+        if (r.semiactive != modes[m]) continue;
+        const bool num = r.controller == kNumerical;
+        if (!num && r.controller != kFig11Proposed) continue;
+        const std::string title = fmt::format("{}, {}", modes[m], num ? "numerical" : std::string("RTHS ") + kFig11Proposed);
+        Series sd = MakeSeries(title, mode_colors[m % mode_colors.size()], num ? 2 : 1);
+        sd.with = fmt::format("linespoints pt {} ps 1.3", num ? 6 : mode_points[m % mode_points.size()]);
+        sd.width = num ? 2.0 : 1.5;
+        sd.x = r.peak_drift_mm;
+        sd.y = story;
+        drift.series.push_back(sd);
+        Series sa = sd;
+        sa.x.clear();
+        for (double a_mps2 : r.peak_abs_accel_mps2) sa.x.push_back(1000.0 * a_mps2);  // m/s^2 -> mm/s^2
+        acc.series.push_back(sa);
+      }
+    }
+  }
+  acc.right_margin_chars = io::KeyMarginChars({&acc});
+  fig.panels = {drift, acc};
+  return fig;
+}
 
 std::vector<Fig11Controller> Fig11Controllers() {
   control::ControllerConfig poly = ControllerKind("poly3");
@@ -210,7 +256,6 @@ Fig11Result ReproduceFig11(const ReproduceOptions& opts) {
 
   // Figures.
   if (GnuplotAvailable(opts.gnuplot)) {
-    const std::vector<std::string> colors = {"black", "#1f77b4", "#2ca02c", "#d62728"};
     const std::size_t stride = opts.quick ? 2 : 4;
     for (const auto& mode : modes) {
       Figure fig;
@@ -219,65 +264,40 @@ Fig11Result ReproduceFig11(const ReproduceOptions& opts) {
       fig.title = fmt::format("Fig. 11: damper at the first story, semiactive {} (RTHS on the {} plant vs numerical)",
                               mode, opts.plant);
       fig.columns = 2;
-      fig.width_px = 1400;
+      fig.width_px = 1600;
       fig.panel_height_px = 420;
       Panel disp = MakePanel("Damper displacement", "Time [s]", "Displacement [mm]");
       Panel force = MakePanel("Damper force (one of 18)", "Time [s]", "Force [kN]");
       Panel fd = MakePanel("Force-displacement", "Displacement [mm]", "Force [kN]");
       Panel fv = MakePanel("Force-velocity", "Velocity [mm/s]", "Force [kN]");
-      for (Panel* p : {&disp, &force, &fd, &fv}) p->key = "top left";
-      int ci = 0;
+      // One legend, beside the top right panel; the right column keeps the same margin.
+      for (Panel* p : {&disp, &force, &fd, &fv}) p->key = "off";
+      force.key = "outside right top";
+      // RTHS first, the numerical reference last (dashed, on top).
+      std::vector<std::size_t> order;
       for (std::size_t j = 0; j < items.size(); ++j) {
-        if (items[j].mode != mode) continue;
+        if (items[j].mode == mode && items[j].controller != kNumerical) order.push_back(j);
+      }
+      for (std::size_t j = 0; j < items.size(); ++j) {
+        if (items[j].mode == mode && items[j].controller == kNumerical) order.push_back(j);
+      }
+      for (std::size_t j : order) {
         const bool num = items[j].controller == kNumerical;
         const std::string title = num ? "Numerical (ideal tracking)" : "RTHS " + items[j].controller;
-        const std::string color = colors[ci++ % colors.size()];
-        const int dash = num ? 2 : 1;
+        const Series style = StyledSeries(title, ControllerStyle(items[j].controller));
         const auto& tr = traces[j];
-        disp.series.push_back(Thin(MakeSeries(title, color, dash), tr.t, tr.y_mm, stride));
-        force.series.push_back(Thin(MakeSeries(title, color, dash), tr.t, tr.f_kN, stride));
-        fd.series.push_back(Thin(MakeSeries(title, color, dash), tr.y_mm, tr.f_kN, stride));
-        fv.series.push_back(Thin(MakeSeries(title, color, dash), tr.v_mm_s, tr.f_kN, stride));
+        disp.series.push_back(Thin(style, tr.t, tr.y_mm, stride));
+        force.series.push_back(Thin(style, tr.t, tr.f_kN, stride));
+        fd.series.push_back(Thin(style, tr.y_mm, tr.f_kN, stride));
+        fv.series.push_back(Thin(style, tr.v_mm_s, tr.f_kN, stride));
       }
+      force.right_margin_chars = fv.right_margin_chars = io::KeyMarginChars({&force});
       fig.panels = {disp, force, fd, fv};
       Plot(fig, opts.out_dir);
     }
-    {
-      Figure fig;
-      fig.name = "fig11_stories";
-      fig.gnuplot = opts.gnuplot;
-      fig.title = "Fig. 11: peak story drifts and absolute floor accelerations (El Centro NS x 0.5)";
-      fig.columns = 2;
-      fig.width_px = 1400;
-      fig.panel_height_px = 600;
-      Panel drift = MakePanel("Peak story drift", "Peak drift [mm]", "Story");
-      Panel acc = MakePanel("Peak absolute acceleration", "Peak acceleration [m/s^2]", "Floor");
-      drift.key = acc.key = "bottom right";
-      drift.y_range = acc.y_range = std::make_pair(0.5, 9.5);
-      const std::vector<std::string> mode_colors = {"#1f77b4", "#d62728", "#2ca02c"};
-      std::vector<double> story(9);
-      for (int i = 0; i < 9; ++i) story[i] = i + 1;
-      for (std::size_t m = 0; m < modes.size(); ++m) {
-        for (const auto* set : {&res.numerical, &res.runs}) {
-          for (const auto& r : *set) {
-            if (r.semiactive != modes[m]) continue;
-            const bool num = r.controller == kNumerical;
-            if (!num && r.controller != "G_FF,avgA + LQG") continue;
-            const std::string title = fmt::format("{} {}", modes[m], num ? "numerical" : "RTHS FF avg + LQG");
-            Series sd = MakeSeries(title, mode_colors[m], num ? 2 : 1);
-            sd.with = "linespoints";
-            sd.x = r.peak_drift_mm;
-            sd.y = story;
-            drift.series.push_back(sd);
-            Series sa = sd;
-            sa.x = r.peak_abs_accel_mps2;
-            acc.series.push_back(sa);
-          }
-        }
-      }
-      fig.panels = {drift, acc};
-      Plot(fig, opts.out_dir);
-    }
+    Figure stories = Fig11StoriesFigure(res);
+    stories.gnuplot = opts.gnuplot;
+    Plot(stories, opts.out_dir);
   } else if (opts.log) {
     opts.log("fig11: gnuplot not found, no PNGs (apt-get install gnuplot-nox)");
   }

@@ -122,10 +122,14 @@ Fig5Result ReproduceFig5(const ReproduceOptions& opts) {
   Panel fv = MakePanel("Force-velocity", "Velocity [mm/s]", "Force [kN]");
   ft.key = fx.key = "off";
   fv.key = "top left";  // negative velocity, positive force: empty in every loop
+  // io::ReadableColors() in an order that makes neighbouring currents (whose curves lie close
+  // together) differ most in hue.
+  const std::vector<std::string> colors = {"#666666", "#CC79A7", "#009E73", "#D55E00", "#0072B2", "#000000"};
   for (std::size_t j = 0; j < loops.size(); ++j) {
     const Loop& l = loops[j];
     const std::string name = fmt::format("{:.1f} A", res.current_A[j]);
-    Series a = MakeSeries(name), b = MakeSeries(name), c = MakeSeries(name);
+    const std::string& color = colors[j % colors.size()];
+    Series a = MakeSeries(name, color), b = MakeSeries(name, color), c = MakeSeries(name, color);
     for (std::size_t k = 0; k < l.t_s.size(); k += 2) {
       a.x.push_back(l.t_s[k]);
       a.y.push_back(l.f_kN[k]);

@@ -12,6 +12,7 @@
 #include "io/csv.h"
 #include "io/plot.h"
 #include "io/source_tree.h"
+#include "report/figures.h"
 #include "report/studies.h"
 
 namespace rths::report {
@@ -43,6 +44,9 @@ namespace {
 
 
 std::string FreqText(double f) { return FormatSig(f, 3); }
+
+// The controller the paper proposes for this study, drawn prominently.
+constexpr const char* kFig9Proposed = "G_FF,0.0A";
 
 }  // namespace
 
@@ -77,6 +81,49 @@ scenario::Scenario Fig9Scenario(const scenario::Scenario& base, double f_hz, con
   s.plant.actuator = models::ServoPreset("0.0A");
   s.semiactive.mode = control::SemiactiveMode::kPassiveOff;
   return s;
+}
+
+Figure Fig9Figure(const Fig9Result& res, const std::string& plant, bool quick) {
+  Figure fig;
+  fig.name = "fig9";
+  fig.panel_height_px = 600;
+  Panel p = MakePanel(fmt::format("Fig. 9: RTHS tracking error, SDOF with the MR damper at 0.0 A ({} plant{})", plant,
+                                  quick ? ", --quick" : ""),
+                      "Natural frequency [Hz]", "RMS error, Eq. 31 [%]");
+  p.log_x = true;
+  p.log_y = true;
+  p.key = "outside right top";  // beside the axes, never over a curve
+  fig.width_px = 1200;
+  p.x_range = std::make_pair(0.4, 40.0);
+  Series stopped;
+  stopped.title = "stopped by the safety monitor";
+  stopped.with = "points pt 6 ps 3";
+  stopped.color = "#D55E00";
+  // The proposed controller last, so it is drawn over the others.
+  std::vector<Fig9Controller> order;
+  for (const auto& c : Fig9Controllers()) {
+    if (c.name != kFig9Proposed) order.push_back(c);
+  }
+  for (const auto& c : Fig9Controllers()) {
+    if (c.name == kFig9Proposed) order.push_back(c);
+  }
+  for (const auto& c : order) {
+    Series s = StyledSeries(c.name, ControllerStyle(c.name, c.name == kFig9Proposed), "linespoints");
+    for (const auto& r : res.rows) {
+      if (r.controller != c.name) continue;
+      s.x.push_back(r.f_hz);
+      s.y.push_back(r.rms_pct > 0 ? r.rms_pct : std::nan(""));
+      if (r.stopped != "no") {
+        stopped.x.push_back(r.f_hz);
+        stopped.y.push_back(r.rms_pct > 0 ? r.rms_pct : std::nan(""));
+      }
+    }
+    p.series.push_back(s);
+  }
+  if (!stopped.x.empty()) p.series.push_back(stopped);
+  p.right_margin_chars = io::KeyMarginChars({&p});
+  fig.panels.push_back(p);
+  return fig;
 }
 
 Fig9Result ReproduceFig9(const ReproduceOptions& opts) {
@@ -133,44 +180,12 @@ Fig9Result ReproduceFig9(const ReproduceOptions& opts) {
   }
 
   // Figure: one curve per controller, stopped pairs marked.
-  {
-    Figure fig;
-    fig.name = "fig9";
+  if (GnuplotAvailable(opts.gnuplot)) {
+    Figure fig = Fig9Figure(res, opts.plant, opts.quick);
     fig.gnuplot = opts.gnuplot;
-    fig.panel_height_px = 600;
-    Panel p = MakePanel(fmt::format("Fig. 9: RTHS tracking error, SDOF with the MR damper at 0.0 A ({} plant{})",
-                                    opts.plant, opts.quick ? ", --quick" : ""),
-                        "Natural frequency [Hz]", "RMS error, Eq. 31 [%]");
-    p.log_x = true;
-    p.log_y = true;
-    p.key = "top left";
-    p.x_range = std::make_pair(0.4, 40.0);
-    Series stopped;
-    stopped.title = "stopped by the safety monitor";
-    stopped.with = "points pt 6 ps 3";
-    stopped.color = "red";
-    for (const auto& c : Fig9Controllers()) {
-      Series s;
-      s.title = c.name;
-      s.with = "linespoints";
-      for (const auto& r : res.rows) {
-        if (r.controller != c.name) continue;
-        s.x.push_back(r.f_hz);
-        s.y.push_back(r.rms_pct > 0 ? r.rms_pct : std::nan(""));
-        if (r.stopped != "no") {
-          stopped.x.push_back(r.f_hz);
-          stopped.y.push_back(r.rms_pct > 0 ? r.rms_pct : std::nan(""));
-        }
-      }
-      p.series.push_back(s);
-    }
-    if (!stopped.x.empty()) p.series.push_back(stopped);
-    fig.panels.push_back(p);
-    if (GnuplotAvailable(opts.gnuplot)) {
-      Plot(fig, opts.out_dir);
-    } else if (opts.log) {
-      opts.log("fig9: gnuplot not found, no fig9.png (apt-get install gnuplot-nox)");
-    }
+    Plot(fig, opts.out_dir);
+  } else if (opts.log) {
+    opts.log("fig9: gnuplot not found, no fig9.png (apt-get install gnuplot-nox)");
   }
 
   res.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

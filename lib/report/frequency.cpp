@@ -16,6 +16,7 @@
 #include "ident/identify.h"
 #include "io/csv.h"
 #include "io/plot.h"
+#include "report/figures.h"
 #include "report/reproduce.h"
 
 namespace rths::report {
@@ -71,21 +72,26 @@ std::vector<RunResult> RunAll(const std::vector<RunSpec>& specs, const Reproduce
   return results;
 }
 
-// Three stacked panels (magnitude, phase, time lag) for a set of curves.
+// Three stacked panels (magnitude, phase, time lag) for a set of curves: `solid` in their
+// controller's style (report/figures.h; `proposed` drawn prominent, other names in palette
+// order), then `styled` as given. One legend, beside the magnitude panel; the same margins in
+// all three panels so their frequency axes line up.
 Figure BodeFigure(const std::string& name, const std::string& title, const std::vector<BodeCurve>& solid,
-                  const std::vector<std::pair<BodeCurve, Series>>& styled, const std::string& lag_key) {
+                  const std::vector<std::pair<BodeCurve, Series>>& styled, const std::string& proposed = "") {
   Figure fig;
   fig.name = name;
   fig.title = title;
-  fig.width_px = 1000;
+  fig.width_px = 1200;
   fig.panel_height_px = 330;
   Panel mag = MakePanel("", "Frequency [Hz]", "Magnitude [mm/mm]");
   Panel ph = MakePanel("", "Frequency [Hz]", "Phase [deg]");
   Panel lag = MakePanel("", "Frequency [Hz]", "Time lag [ms]");
-  for (Panel* p : {&mag, &ph, &lag}) p->x_range = std::make_pair(0.0, kPlotMaxHz);
-  mag.key = "top left";
-  ph.key = "off";
-  lag.key = lag_key;
+  for (Panel* p : {&mag, &ph, &lag}) {
+    p->x_range = std::make_pair(0.0, kPlotMaxHz);
+    p->left_margin_chars = 10;
+    p->key = "off";
+  }
+  mag.key = "outside right top";
   auto add = [&](const BodeCurve& c, Series style) {
     Series m = style, p = style, l = style;
     m.x = p.x = l.x = c.f_hz;
@@ -96,8 +102,25 @@ Figure BodeFigure(const std::string& name, const std::string& title, const std::
     ph.series.push_back(p);
     lag.series.push_back(l);
   };
-  for (const auto& c : solid) add(c, MakeSeries(c.name));
+  for (std::size_t i = 0; i < solid.size(); ++i) {
+    const BodeCurve& c = solid[i];
+    add(c, StyledSeries(c.name, ControllerStyle(c.name, !proposed.empty() && c.name == proposed, i)));
+  }
   for (const auto& [c, style] : styled) add(c, style);
+  // Time lag: the range of the curves from 2 Hz up. Below, -phase / (2 pi f) divides the
+  // estimate's phase noise by a small f and would squeeze the rest into a few pixels.
+  double lo = 1e300, hi = -1e300;
+  for (const auto& s : lag.series) {
+    for (std::size_t i = 0; i < s.x.size(); ++i) {
+      if (s.x[i] >= 2.0 && std::isfinite(s.y[i])) lo = std::min(lo, s.y[i]), hi = std::max(hi, s.y[i]);
+    }
+  }
+  if (lo <= hi) {
+    const double pad = std::max(0.5, 0.1 * (hi - lo));
+    lag.y_range = std::make_pair(std::floor(lo - pad), std::ceil(hi + pad));
+  }
+  const int key_margin = io::KeyMarginChars({&mag});
+  for (Panel* p : {&mag, &ph, &lag}) p->right_margin_chars = key_margin;
   fig.panels = {mag, ph, lag};
   return fig;
 }
@@ -298,13 +321,15 @@ Fig6Result ReproduceFig6(const ReproduceOptions& opts) {
                         MakeSeries(j == 0 ? "fitted 3-pole models" : "", "black", 2)});
   }
   for (std::size_t j = 0; j < 2; ++j) {
+    Series paper = MakeSeries(j == 0 ? "Eqs. 28-29 (paper)" : "", "#666666", 3);
+    paper.width = 2.0;  // dotted: a little wider to read as a line
     overlays.push_back({BodeFromModel("Eqs. 28-29 (paper)",
                                       ident::PoleModel::FromServoModel3(res.models[j].paper), res.measured[j].f_hz, kDt),
-                        MakeSeries(j == 0 ? "Eqs. 28-29 (paper)" : "", "#808080", 3)});
+                        paper});
   }
   Figure fig = BodeFigure(
       "fig6", fmt::format("Fig. 6: measured G_yu ({} plant, no controller) with fitted models (ZOH at 2 kHz)", opts.plant),
-      res.measured, overlays, "off");
+      res.measured, overlays);
   fig.gnuplot = opts.gnuplot;
   Plot(fig, opts.out_dir);
   {
@@ -467,7 +492,7 @@ Fig78Result ReproduceFig78(const ReproduceOptions& opts, const std::string& figu
   Figure fig = BodeFigure(figure,
                           fmt::format("Fig. {}: G_yr with {} in the damper ({} plant)", figure == "fig7" ? 7 : 8,
                                       cond_text, opts.plant),
-                          res.curves, {}, "off");
+                          res.curves, {}, res.condition == "0.0A" ? "G_FF,0.0A" : "G_FF,2.5A");
   fig.panels[0].y_range = std::make_pair(0.0, 2.5);     // the polynomial and the lead grow fast near 50 Hz
   fig.panels[2].y_range = std::make_pair(-5.0, 12.0);   // ms
   fig.gnuplot = opts.gnuplot;
