@@ -20,10 +20,12 @@
 
 #include "core/error.h"
 #include "diagnosis/diagnosis.h"
+#include "diagnosis/report_figures.h"
 #include "diagnosis/synthetic.h"
 #include "io/rig_record.h"
 #include "models/mr_damper.h"
 #include "models/servo_linear.h"
+#include "signal/blwn.h"
 
 namespace fs = std::filesystem;
 using namespace rths::diagnosis;
@@ -606,4 +608,133 @@ TEST_CASE("Summary: the brief report is the verdict and each channel's shrink; t
   CHECK(brief.find("channel f: noise") != std::string::npos);
   CHECK(std::count(brief.begin(), brief.end(), '\n') <= 4);
   CHECK(brief.size() < full.size() / 2);
+}
+
+// --- The report's figures (diagnosis/report_figures.h) ------------------------------------
+
+namespace {
+Traces::Record BandRecord(const std::vector<double>& u, const std::vector<double>& noise, double dt_s) {
+  Traces::Record t;
+  t.source = "synthetic.csv";
+  t.dt_s = dt_s;
+  t.u = u;
+  // y: u through a 4 ms delay (8 samples), measured with `noise`; both models exact.
+  t.y_nom.assign(u.size(), 0.0);
+  for (std::size_t k = 8; k < u.size(); ++k) t.y_nom[k] = u[k - 8];
+  t.y_fin = t.y_nom;
+  t.y_meas = t.y_nom;
+  for (std::size_t k = 0; k < u.size(); ++k) t.y_meas[k] += noise[k];
+  return t;
+}
+}  // namespace
+
+TEST_CASE("report figures: the FRF's frequency axis is the input's excited band, not up to Nyquist") {
+  const double dt = 0.0005;
+  const std::size_t n = 40000;  // 20 s
+  const auto u = rths::signal::Blwn(15.0, 2.0, dt, n, 5, 2.0);
+  const auto fig = FrfFigure(BandRecord(u, std::vector<double>(n, 0.0), dt), 0);
+  REQUIRE(fig.panels.size() == 3);
+  for (const auto& p : fig.panels) {
+    REQUIRE(p.x_range.has_value());
+    CHECK(p.x_range->first == 0.0);
+    // 99 % of a 0-15 Hz BLWN's energy (8th-order Butterworth) lies below about 18 Hz.
+    CHECK(p.x_range->second >= 15.0);
+    CHECK(p.x_range->second <= 20.0);
+    for (const auto& s : p.series) {
+      for (double x : s.x) CHECK(x <= p.x_range->second);
+    }
+  }
+  CHECK(fig.title.find("99 % energy band") != std::string::npos);
+
+  // An input from 8 to 20 Hz (a linear chirp): the axis starts near 8 Hz.
+  std::vector<double> chirp(n);
+  const double T = static_cast<double>(n) * dt;
+  for (std::size_t k = 0; k < n; ++k) {
+    const double t = static_cast<double>(k) * dt;
+    chirp[k] = std::sin(2.0 * std::numbers::pi * (8.0 * t + 0.5 * (20.0 - 8.0) / T * t * t));
+  }
+  const auto band = FrfFigure(BandRecord(chirp, std::vector<double>(n, 0.0), dt), 0).panels[0].x_range;
+  REQUIRE(band.has_value());
+  CHECK(band->first >= 7.5);
+  CHECK(band->first <= 8.5);
+  CHECK(band->second >= 19.5);
+  CHECK(band->second <= 21.0);
+  CHECK_THROWS_AS(EnergyBand({0.0, 1.0}, {0.0, 0.0}, 0.99), rths::Error);
+}
+
+TEST_CASE("report figures: the FRF leaves out the points whose coherence is below 0.5") {
+  const double dt = 0.0005;
+  const std::size_t n = 40000;
+  const auto u = rths::signal::Blwn(15.0, 2.0, dt, n, 5, 2.0);
+  // Sensor noise as strong as the response near the band edge: coherence falls below 0.5 there.
+  const auto noise = rths::signal::Blwn(900.0, 8.0, dt, n, 6, 0.0);
+  const auto fig = FrfFigure(BandRecord(u, noise, dt), 0);
+  REQUIRE(fig.panels.size() == 3);
+  const auto& mag = fig.panels[0].series;
+  const auto& coh = fig.panels[2].series[0];
+  REQUIRE(mag.size() == 3);
+  std::size_t kept = 0, left_out = 0;
+  for (const auto& s : mag) {
+    REQUIRE(s.x.size() == coh.x.size());
+    for (std::size_t i = 0; i < s.x.size(); ++i) {
+      CHECK(s.x[i] == coh.x[i]);
+      if (std::isfinite(s.y[i])) {
+        ++kept;
+        CHECK(coh.y[i] >= kFrfMinCoherence);
+      } else {
+        ++left_out;
+        CHECK(coh.y[i] < kFrfMinCoherence);
+      }
+    }
+  }
+  CHECK(kept > 0);
+  CHECK(left_out > 0);
+  CHECK(fig.title.find("coherence < 0.5 left out") != std::string::npos);
+}
+
+TEST_CASE("report figures: the state conditions are bars over the named conditions") {
+  Result r;
+  r.conditions = {{"y", "velocity_reversal", 30.0, 10.0, true},
+                  {"y", "high_velocity", 55.0, 15.0, true},
+                  {"f", "current_switching", 20.0, 88.0, false}};
+  const auto fig = ConditionFigure(r);
+  REQUIRE(fig.panels.size() == 2);
+  for (const auto& p : fig.panels) {
+    REQUIRE(p.series.size() == 2);
+    for (const auto& s : p.series) CHECK(s.with == "boxes");
+    CHECK(p.key.rfind("outside", 0) == 0);
+  }
+  REQUIRE(fig.panels[0].x_tics.size() == 2);
+  CHECK(fig.panels[0].x_tics[1].second == "high_velocity");
+  CHECK(fig.panels[0].series[0].y == std::vector<double>{30.0, 55.0});
+  REQUIRE(fig.panels[1].x_tics.size() == 1);
+  CHECK(fig.panels[1].x_tics[0].second == "current_switching (uninformative)");
+  CHECK(ConditionFigure(Result{}).panels.empty());
+}
+
+TEST_CASE("report figures: axis units are docs/units.md's, and every legend sits beside the axes") {
+  const auto [tr, te] = Records(Noisy());
+  Traces traces;
+  const auto r = Diagnose({tr}, {te}, PaperModel(), Options{}, &traces);
+  REQUIRE(traces.test.size() == 1);
+  const auto& t = traces.test[0];
+  const std::set<std::string> units{"mm", "kN", "s", "Hz", "mm/mm", "deg", "-", "%", "mm^2/Hz", "kN^2/Hz"};
+  for (const auto& fig : {SpectrumFigure(t, "y", 0), SpectrumFigure(t, "f", 0), FrfFigure(t, 0), ConditionFigure(r),
+                          TraceFigure(t, "y"), TraceFigure(t, "f")}) {
+    CAPTURE(fig.name);
+    for (const auto& p : fig.panels) {
+      CHECK((p.key == "off" || p.key.rfind("outside", 0) == 0));
+      for (const auto& [label, categorical] : {std::pair{p.xlabel, !p.x_tics.empty()}, std::pair{p.ylabel, false}}) {
+        CAPTURE(label);
+        const auto a = label.rfind('['), b = label.rfind(']');
+        if (a == std::string::npos && categorical) continue;  // named categories have no unit
+        REQUIRE(a != std::string::npos);
+        REQUIRE(b > a);
+        CHECK(units.count(label.substr(a + 1, b - a - 1)) == 1);
+      }
+      for (const auto& s : p.series) {
+        if (!s.color.empty() && s.color[0] == '#') CHECK(rths::io::RelativeLuminance(s.color) <= rths::io::kMaxReadableLuminance);
+      }
+    }
+  }
 }

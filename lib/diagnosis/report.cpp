@@ -1,4 +1,5 @@
 #include "diagnosis/report.h"
+#include "diagnosis/report_figures.h"
 
 #include <algorithm>
 #include <cmath>
@@ -34,7 +35,53 @@ std::vector<double> Residual(const std::vector<double>& m, const std::vector<dou
   return e;
 }
 
-/// Spectra of one channel (first test record): measured, nominal residual, final residual.
+// Legend beside the axes (never over the data), the same margins in every panel so stacked
+// axes line up.
+constexpr int kLeftMarginChars = 12;
+void KeyOutside(io::Figure* fig) {
+  std::vector<const io::Panel*> panels;
+  for (const auto& p : fig->panels) panels.push_back(&p);
+  const int right = io::KeyMarginChars(panels);
+  fig->width_px = 1200;  // the plot keeps about 1000 px beside the legend
+  for (auto& p : fig->panels) {
+    p.left_margin_chars = kLeftMarginChars;
+    p.right_margin_chars = right;
+    if (p.key != "off") p.key = "outside right top";
+  }
+}
+
+const std::string kMeasuredColor = "#0072B2", kNominalColor = "#D55E00", kFinalColor = "#009E73";
+
+std::string ChannelQuantity(const std::string& ch) { return ch == "y" ? "Displacement y [mm]" : "Force f [kN]"; }
+
+}  // namespace
+
+std::pair<double, double> EnergyBand(const std::vector<double>& f_hz, const std::vector<double>& psd, double fraction) {
+  if (f_hz.size() != psd.size() || f_hz.size() < 2) {
+    throw Error("EnergyBand", fmt::format("{} frequencies for {} densities (need the same number, >= 2)", f_hz.size(),
+                                          psd.size()));
+  }
+  if (!(fraction > 0.0 && fraction <= 1.0)) throw Error("EnergyBand", fmt::format("fraction {} (allowed: (0, 1])", fraction));
+  double total = 0.0;
+  for (std::size_t j = 1; j < psd.size(); ++j) total += std::isfinite(psd[j]) && psd[j] > 0 ? psd[j] : 0.0;
+  if (!(total > 0.0)) throw Error("EnergyBand", "the spectrum holds no energy");
+  const double lo_at = 0.5 * (1.0 - fraction) * total, hi_at = 0.5 * (1.0 + fraction) * total;
+  double lo = f_hz[1], hi = f_hz.back(), sum = 0.0;
+  bool lo_found = false;
+  for (std::size_t j = 1; j < psd.size(); ++j) {
+    sum += std::isfinite(psd[j]) && psd[j] > 0 ? psd[j] : 0.0;
+    if (!lo_found && sum >= lo_at) {
+      lo = f_hz[j];
+      lo_found = true;
+    }
+    if (sum >= hi_at) {
+      hi = f_hz[j];
+      break;
+    }
+  }
+  return {lo, hi};
+}
+
 io::Figure SpectrumFigure(const Traces::Record& t, const std::string& ch, std::size_t first) {
   const auto& m = ch == "y" ? t.y_meas : t.f_meas;
   const auto& pn = ch == "y" ? t.y_nom : t.f_nom;
@@ -51,12 +98,12 @@ io::Figure SpectrumFigure(const Traces::Record& t, const std::string& ch, std::s
   const std::string shown = src.filename() == "log.lcm" && !src.parent_path().filename().empty()
                                 ? (src.parent_path().filename() / src.filename()).string()
                                 : src.filename().string();
-  auto p = io::MakePanel(fmt::format("channel {}: spectra (test record {})", ch, shown),
-                             "frequency [Hz]", "PSD [" + unit + "]");
+  auto p = io::MakePanel(fmt::format("channel {}: spectra (test record {})", ch, shown), "Frequency [Hz]",
+                         fmt::format("PSD of {} [{}]", ch, unit));
   p.log_x = p.log_y = true;
-  auto s1 = io::MakeSeries("measured", "#1f77b4");
-  auto s2 = io::MakeSeries("residual, nominal model", "#d62728");
-  auto s3 = io::MakeSeries("residual, with the verdict's effects", "#2ca02c");
+  auto s1 = io::MakeSeries("measured", kMeasuredColor);
+  auto s2 = io::MakeSeries("residual, nominal model", kNominalColor);
+  auto s3 = io::MakeSeries("residual, with the verdict's effects", kFinalColor);
   for (std::size_t j = 1; j < sm.size(); ++j) {
     const double f = static_cast<double>(j) / (t.dt_s * static_cast<double>(L));
     s1.x.push_back(f), s1.y.push_back(sm[j] > 0 ? sm[j] : NAN);
@@ -65,6 +112,7 @@ io::Figure SpectrumFigure(const Traces::Record& t, const std::string& ch, std::s
   }
   p.series = {s1, s2, s3};
   fig.panels.push_back(p);
+  KeyOutside(&fig);
   return fig;
 }
 
@@ -74,71 +122,91 @@ io::Figure FrfFigure(const Traces::Record& t, std::size_t first) {
   std::vector<double> yn(t.y_nom.begin() + static_cast<std::ptrdiff_t>(first), t.y_nom.end());
   std::vector<double> yf(t.y_fin.begin() + static_cast<std::ptrdiff_t>(first), t.y_fin.end());
   const std::size_t L = std::max<std::size_t>(64, std::min<std::size_t>(static_cast<std::size_t>(std::lround(2.0 / t.dt_s)), u.size() / 8));
-  const auto hm = signal::H1Estimate(u, ym, t.dt_s, L);
+  const auto sm = signal::WelchCrossSpectra(u, ym, t.dt_s, L);
+  const auto hm = signal::H1FromSpectra(sm);
   const auto hn = signal::H1Estimate(u, yn, t.dt_s, L);
   const auto hf = signal::H1Estimate(u, yf, t.dt_s, L);
   const auto phm = signal::UnwrapPhase(hm.h), phn = signal::UnwrapPhase(hn.h), phf = signal::UnwrapPhase(hf.h);
+
+  // The frequency axis: the input's excited band (from 0 Hz unless it starts well above).
+  auto [lo, hi] = EnergyBand(sm.f_hz, sm.s_uu, kFrfEnergyFraction);
+  if (lo < 0.25 * hi) lo = 0.0;
+  // Reliable points: coherence u -> y_meas at least kFrfMinCoherence.
+  std::size_t reliable = 0;
+  for (std::size_t j = 1; j < hm.f_hz.size(); ++j) {
+    if (hm.f_hz[j] >= lo && hm.f_hz[j] <= hi && hm.coherence[j] >= kFrfMinCoherence) ++reliable;
+  }
+  const bool mask = reliable >= 2;
   io::Figure fig;
   fig.name = "frf_y";
-  fig.title = "u -> y: measured vs model (H1, test record)";
-  auto pm = io::MakePanel("", "frequency [Hz]", "|G_yu| [mm/mm]");
-  auto pp = io::MakePanel("", "frequency [Hz]", "phase [deg]");
-  auto pc = io::MakePanel("", "frequency [Hz]", "coherence u -> y_meas");
-  // Up to twice the highest frequency where the test excitation is coherent (gamma^2 > 0.5).
-  double fcoh = 5.0;
-  for (std::size_t j = 1; j < hm.f_hz.size(); ++j)
-    if (hm.coherence[j] > 0.5) fcoh = std::max(fcoh, hm.f_hz[j]);
-  const double fmax = std::min({2.0 * fcoh, 100.0, 0.5 / t.dt_s});
-  for (auto* p : {&pm, &pp, &pc}) p->x_range = std::make_pair(0.0, fmax);
-  auto a1 = io::MakeSeries("measured", "#1f77b4"), a2 = io::MakeSeries("nominal model", "#d62728", 2),
-       a3 = io::MakeSeries("with the verdict's effects", "#2ca02c", 3);
+  fig.title = fmt::format("u -> y: measured vs model (H1, test record), over the input's {:g} % energy band {:.3g}-{:.3g} Hz; {}",
+                          100 * kFrfEnergyFraction, lo, hi,
+                          mask ? fmt::format("points with coherence < {:g} left out", kFrfMinCoherence)
+                               : fmt::format("coherence < {:g} everywhere: nothing left out", kFrfMinCoherence));
+  auto pm = io::MakePanel("", "Frequency [Hz]", "|G_yu| [mm/mm]");
+  auto pp = io::MakePanel("", "Frequency [Hz]", "Phase [deg]");
+  auto pc = io::MakePanel("", "Frequency [Hz]", "Coherence u -> y_meas [-]");
+  for (auto* p : {&pm, &pp, &pc}) p->x_range = std::make_pair(lo, hi);
+  auto a1 = io::MakeSeries("measured", kMeasuredColor), a2 = io::MakeSeries("nominal model", kNominalColor, 2),
+       a3 = io::MakeSeries("with the verdict's effects", kFinalColor, 3);
+  a1.width = 2.0;
+  a3.width = 2.5;  // on top of the measured curve it follows
   auto b1 = a1, b2 = a2, b3 = a3;
-  auto c1 = io::MakeSeries("", "#1f77b4");
-  for (std::size_t j = 1; j < hm.f_hz.size() && hm.f_hz[j] <= fmax; ++j) {
+  auto c1 = io::MakeSeries("coherence", kMeasuredColor);
+  auto c2 = io::MakeSeries(fmt::format("{:g}: the points below are left out", kFrfMinCoherence), "#666666", 2);
+  for (std::size_t j = 1; j < hm.f_hz.size(); ++j) {
     const double f = hm.f_hz[j];
-    a1.x.push_back(f), a1.y.push_back(std::abs(hm.h[j]));
-    a2.x.push_back(f), a2.y.push_back(std::abs(hn.h[j]));
-    a3.x.push_back(f), a3.y.push_back(std::abs(hf.h[j]));
-    b1.x.push_back(f), b1.y.push_back(phm[j] * 180 / M_PI);
-    b2.x.push_back(f), b2.y.push_back(phn[j] * 180 / M_PI);
-    b3.x.push_back(f), b3.y.push_back(phf[j] * 180 / M_PI);
+    if (f < lo || f > hi) continue;
+    const bool keep = !mask || hm.coherence[j] >= kFrfMinCoherence;
+    auto put = [&](io::Series& s, double v) {
+      s.x.push_back(f);
+      s.y.push_back(keep ? v : NAN);
+    };
+    put(a1, std::abs(hm.h[j]));
+    put(a2, std::abs(hn.h[j]));
+    put(a3, std::abs(hf.h[j]));
+    put(b1, phm[j] * 180 / M_PI);
+    put(b2, phn[j] * 180 / M_PI);
+    put(b3, phf[j] * 180 / M_PI);
     c1.x.push_back(f), c1.y.push_back(hm.coherence[j]);
   }
+  c2.x = {lo, hi};
+  c2.y = {kFrfMinCoherence, kFrfMinCoherence};
   pm.series = {a1, a2, a3};
   pp.series = {b1, b2, b3};
-  pc.series = {c1};
-  pc.key = "off";
+  pp.key = "off";
+  pc.series = {c1, c2};
   pc.y_range = std::make_pair(0.0, 1.05);
   fig.panels = {pm, pp, pc};
   fig.panel_height_px = 260;
+  KeyOutside(&fig);
   return fig;
 }
 
-/// RMS residual (nominal) inside vs outside each condition, as bars drawn with boxes-like lines.
 io::Figure ConditionFigure(const Result& r) {
   io::Figure fig;
   fig.name = "conditions";
   for (const std::string ch : {"y", "f"}) {
-    auto p = io::MakePanel(fmt::format("channel {}: share of residual energy vs share of samples", ch), "condition #",
-                               "[%]");
-    auto s1 = io::MakeSeries("share of residual energy", "#d62728");
-    auto s2 = io::MakeSeries("share of samples", "#1f77b4");
-    s1.with = s2.with = "linespoints";
-    std::string names;
-    int j = 0;
+    std::vector<std::string> names;
+    auto s1 = io::MakeSeries("share of the residual energy", kNominalColor);
+    auto s2 = io::MakeSeries("share of the samples", kMeasuredColor);
     for (const auto& c : r.conditions) {
       if (c.channel != ch) continue;
-      ++j;
-      s1.x.push_back(j), s1.y.push_back(c.share_pct);
-      s2.x.push_back(j), s2.y.push_back(c.samples_pct);
-      names += fmt::format("{}{}={}", names.empty() ? "" : ", ", j, c.name);
+      names.push_back(c.informative ? c.name : c.name + " (uninformative)");
+      s1.y.push_back(c.share_pct);
+      s2.y.push_back(c.samples_pct);
     }
-    if (j == 0) continue;
-    p.xlabel = names;
-    p.x_range = std::make_pair(0.5, j + 0.5);
-    p.series = {s1, s2};
+    if (names.empty()) continue;
+    auto p = io::MakeBarPanel(fmt::format("channel {}: nominal residual by state condition (test records)", ch),
+                              "Share [%]", names, {s1, s2});
+    p.xlabel = "State condition";
+    double top = 0.0;
+    for (double v : s1.y) top = std::max(top, v);
+    for (double v : s2.y) top = std::max(top, v);
+    p.y_range = std::make_pair(0.0, std::max(10.0, 1.1 * top));
     fig.panels.push_back(p);
   }
+  KeyOutside(&fig);
   return fig;
 }
 
@@ -159,11 +227,11 @@ io::Figure TraceFigure(const Traces::Record& t, const std::string& ch) {
   }
   const std::size_t b = std::min(m.size(), best + w);
   const std::string unit = ch == "y" ? "mm" : "kN";
-  auto p1 = io::MakePanel(fmt::format("channel {}: measured and predicted", ch), "t [s]", ch + " [" + unit + "]");
-  auto p2 = io::MakePanel("residual", "t [s]", "[" + unit + "]");
-  auto s1 = io::MakeSeries("measured", "#1f77b4"), s2 = io::MakeSeries("nominal", "#d62728", 2),
-       s3 = io::MakeSeries("with the verdict's effects", "#2ca02c", 3);
-  auto r1 = io::MakeSeries("nominal", "#d62728"), r2 = io::MakeSeries("with the verdict's effects", "#2ca02c");
+  auto p1 = io::MakePanel(fmt::format("channel {}: measured and predicted", ch), "Time [s]", ChannelQuantity(ch));
+  auto p2 = io::MakePanel("residual: measured - predicted", "Time [s]", fmt::format("Residual {} [{}]", ch, unit));
+  auto s1 = io::MakeSeries("measured", kMeasuredColor), s2 = io::MakeSeries("nominal", kNominalColor, 2),
+       s3 = io::MakeSeries("with the verdict's effects", kFinalColor, 3);
+  auto r1 = io::MakeSeries("nominal", kNominalColor), r2 = io::MakeSeries("with the verdict's effects", kFinalColor);
   for (std::size_t k = best; k < b; ++k) {
     const double tt = static_cast<double>(k) * t.dt_s;
     s1.x.push_back(tt), s1.y.push_back(m[k]);
@@ -176,10 +244,9 @@ io::Figure TraceFigure(const Traces::Record& t, const std::string& ch) {
   p2.series = {r1, r2};
   fig.panels = {p1, p2};
   fig.panel_height_px = 280;
+  KeyOutside(&fig);
   return fig;
 }
-
-}  // namespace
 
 void WriteReport(const Result& r, const Traces& traces, const fs::path& dir) {
   std::vector<std::string> pngs;
