@@ -42,8 +42,8 @@ long Lines(const fs::path& file) {
   return n;
 }
 
-const char* const kTools[] = {"run",    "design", "identify", "reproduce", "diagnose",      "record",
-                              "replay", "structure", "log",   "utfsm-convert"};
+const char* const kTools[] = {"run",    "design",    "identify", "reproduce",     "diagnose", "record",
+                              "replay", "structure", "log",      "utfsm-convert", "export",   "report"};
 
 }  // namespace
 

@@ -91,6 +91,13 @@ void Preflight(const std::vector<RunSpec>& specs) {
   throw Error("reproduce", msg);
 }
 
+void Preflight(std::vector<RunSpec>* specs, const std::vector<std::string>& overrides) {
+  if (!overrides.empty()) {
+    for (auto& spec : *specs) spec.scenario = scenario::WithOverrides(spec.scenario, overrides);
+  }
+  Preflight(*specs);
+}
+
 namespace {
 
 RunResult RunOne(const RunSpec& spec) {
@@ -156,11 +163,15 @@ RunResult RunOne(const RunSpec& spec) {
 
 }  // namespace
 
-std::vector<RunResult> RunBatch(const std::vector<RunSpec>& specs, int jobs, const Progress& progress) {
+std::vector<RunResult> RunBatch(const std::vector<RunSpec>& specs, int jobs, ProgressLine* line,
+                                const Progress& progress) {
   if (jobs < 1) throw Error("reproduce", "--jobs must be >= 1");
   std::vector<RunResult> results(specs.size());
   std::atomic<std::size_t> next{0};
   std::size_t done = 0;
+  // Progress by simulated steps of the finished runs (runs differ in length).
+  double total_steps = 0.0, done_steps = 0.0;
+  for (const auto& spec : specs) total_steps += static_cast<double>(spec.scenario.steps());
   std::mutex m;
   auto worker = [&] {
     for (;;) {
@@ -170,7 +181,9 @@ std::vector<RunResult> RunBatch(const std::vector<RunSpec>& specs, int jobs, con
       std::lock_guard<std::mutex> lock(m);
       results[i] = r;
       ++done;
+      done_steps += static_cast<double>(specs[i].scenario.steps());
       if (progress) progress(done, specs.size(), results[i]);
+      if (line) line->Update(done_steps, total_steps, fmt::format("{} of {} runs", done, specs.size()));
     }
   };
   const int n = std::min<int>(jobs, static_cast<int>(std::max<std::size_t>(specs.size(), 1)));

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "core/progress.h"
 #include "scenario/scenario.h"
 
 namespace rths::report {
@@ -52,13 +53,18 @@ scenario::Scenario WriteScenarioFile(const RunSpec& spec);
 /// running, and throws one rths::Error listing every run that cannot be built (e.g. a
 /// controller kind or plant that is not implemented yet) with the component's own message.
 void Preflight(const std::vector<RunSpec>& specs);
+/// Applies `overrides` (`--set KEY=VALUE`, scenario::WithOverrides) to every spec's scenario,
+/// then Preflight. An override that does not check out throws rths::Error naming the --set.
+void Preflight(std::vector<RunSpec>* specs, const std::vector<std::string>& overrides);
 
 /// Called after each run (from the worker threads, serialised): done so far, total, the result.
 using Progress = std::function<void(std::size_t done, std::size_t total, const RunResult&)>;
 
 /// Runs every spec, `jobs` at a time (>= 1), and returns the results in spec order. A failed
 /// run is reported in its RunResult (and its summary.json), not thrown.
-std::vector<RunResult> RunBatch(const std::vector<RunSpec>& specs, int jobs, const Progress& progress = {});
+/// `line`: if not null, shows the batch's progress with an ETA (by simulated steps done).
+std::vector<RunResult> RunBatch(const std::vector<RunSpec>& specs, int jobs, ProgressLine* line = nullptr,
+                                const Progress& progress = {});
 
 /// A folder-name-safe form of a label: lower case, runs of other characters -> '-'
 /// ("G_FF,0.0A + LP" -> "g_ff-0.0a-lp").

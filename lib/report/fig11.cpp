@@ -206,13 +206,13 @@ Fig11Result ReproduceFig11(const ReproduceOptions& opts) {
       items.push_back({c.name, mode});
     }
   }
-  Preflight(specs);
+  Preflight(&specs, opts.overrides);
   if (opts.log) {
     opts.log(fmt::format("fig11: {} lockstep runs of {:g} s (9 RTHS on the {} plant + 3 numerical), {} at a time "
                          "(base {})",
                          specs.size(), duration, opts.plant, opts.jobs, base_file.string()));
   }
-  const auto results = RunBatch(specs, opts.jobs, [&](std::size_t done, std::size_t total, const RunResult& r) {
+  const auto results = RunBatch(specs, opts.jobs, opts.progress, [&](std::size_t done, std::size_t total, const RunResult& r) {
     if (!opts.log) return;
     opts.log(fmt::format("  [{:2}/{}] {:<36} peak f {:7.2f} kN ({:.1f} s){}", done, total, r.label, r.peak_force_kN,
                          r.wall_s, r.ok ? "" : "  STOPPED: " + StoppedText(r)));

@@ -147,12 +147,12 @@ Fig9Result ReproduceFig9(const ReproduceOptions& opts) {
       res.rows.push_back(row);
     }
   }
-  Preflight(specs);
+  Preflight(&specs, opts.overrides);
   if (opts.log) {
     opts.log(fmt::format("fig9: {} lockstep runs of {:g} s on the {} plant, {} at a time (base {})", specs.size(),
                          duration, opts.plant, opts.jobs, base_file.string()));
   }
-  const auto results = RunBatch(specs, opts.jobs, [&](std::size_t done, std::size_t total, const RunResult& r) {
+  const auto results = RunBatch(specs, opts.jobs, opts.progress, [&](std::size_t done, std::size_t total, const RunResult& r) {
     if (!opts.log) return;
     opts.log(fmt::format("  [{:2}/{}] {:<28} {:9.3f} %  ({:.1f} s){}", done, total, r.label, r.tracking_pct, r.wall_s,
                          r.ok ? "" : "  STOPPED: " + StoppedText(r)));

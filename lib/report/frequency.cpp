@@ -54,12 +54,12 @@ std::string Stamp() {
 std::string Sig(double v) { return std::isfinite(v) ? fmt::format("{:#.4g}", v) : FormatSig(v); }
 
 // Runs the specs (preflight first), logging progress; throws if any failed.
-std::vector<RunResult> RunAll(const std::vector<RunSpec>& specs, const ReproduceOptions& opts, const std::string& what) {
-  Preflight(specs);
+std::vector<RunResult> RunAll(std::vector<RunSpec> specs, const ReproduceOptions& opts, const std::string& what) {
+  Preflight(&specs, opts.overrides);
   if (opts.log) {
     opts.log(fmt::format("{}: {} lockstep runs on the {} plant, {} at a time", what, specs.size(), opts.plant, opts.jobs));
   }
-  const auto results = RunBatch(specs, opts.jobs, [&](std::size_t done, std::size_t total, const RunResult& r) {
+  const auto results = RunBatch(specs, opts.jobs, opts.progress, [&](std::size_t done, std::size_t total, const RunResult& r) {
     if (!opts.log) return;
     opts.log(r.ok ? fmt::format("  [{:2}/{}] {:<28} done ({:.1f} s)", done, total, r.label, r.wall_s)
                   : fmt::format("  [{:2}/{}] {:<28} FAILED: {}", done, total, r.label, r.error));

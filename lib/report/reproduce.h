@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "ident/fit.h"
+#include "core/progress.h"
 #include "report/batch.h"
 #include "scenario/scenario.h"
 #include "signal/spectral.h"
@@ -27,6 +28,11 @@ struct ReproduceOptions {
   int jobs = 2;                           ///< lockstep groups run at the same time (threads)
   std::function<void(std::string_view)> log;  ///< progress lines ("" = silent)
   std::string gnuplot = "gnuplot";        ///< plotting program
+  /// `--set KEY=VALUE` overrides applied to every lockstep run's scenario after the study set its
+  /// own keys (scenario::WithOverrides, in Preflight); checked like a file.
+  std::vector<std::string> overrides;
+  /// Progress with an ETA of the lockstep batches (null: none); the main program decides.
+  ProgressLine* progress = nullptr;
 };
 
 /// Creates `dir`, or accepts it if it exists and is empty; throws rths::Error if it holds

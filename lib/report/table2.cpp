@@ -289,12 +289,12 @@ Table2Result ReproduceTable2(const ReproduceOptions& opts) {
   std::vector<RunSpec> ordered;
   for (std::size_t i : order) ordered.push_back(specs[i]);
 
-  Preflight(ordered);
+  Preflight(&ordered, opts.overrides);
   if (opts.log) {
     opts.log(fmt::format("table2: {} lockstep runs on the {} plant, {} at a time", ordered.size(), opts.plant,
                          opts.jobs));
   }
-  const auto results = RunBatch(ordered, opts.jobs, [&](std::size_t done, std::size_t total, const RunResult& r) {
+  const auto results = RunBatch(ordered, opts.jobs, opts.progress, [&](std::size_t done, std::size_t total, const RunResult& r) {
     if (!opts.log) return;
     opts.log(r.ok ? fmt::format("  [{:2}/{}] {:<32} {:8.3f} %  ({:.1f} s)", done, total, r.label, r.tracking_pct,
                                 r.wall_s)
