@@ -1,0 +1,121 @@
+// The README's "First steps" walk, run line by line as a new user would (after the install line,
+// which CI has just run): a run with its report, an export to .mat, the .mat in GNU Octave, and a
+// variant with --set and --compact. The lines are read from README.md, so the README cannot drift
+// from what works.
+#include <sys/wait.h>
+
+#include <cstdlib>
+#include <fstream>
+#include <regex>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <doctest/doctest.h>
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "scenario/scenario.h"
+#include "test_support.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string Slurp(const fs::path& p) {
+  std::ifstream in(p);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+/// The command lines of the README's walk block (between the walk markers, inside ```sh), with
+/// their trailing comments removed.
+std::vector<std::string> WalkLines() {
+  const std::string readme = Slurp(fs::path(RTHS_SOURCE_DIR) / "README.md");
+  const auto begin = readme.find("<!-- walk:begin");
+  const auto end = readme.find("<!-- walk:end -->");
+  REQUIRE(begin != std::string::npos);
+  REQUIRE(end != std::string::npos);
+  std::istringstream block(readme.substr(begin, end - begin));
+  std::vector<std::string> lines;
+  for (std::string line; std::getline(block, line);) {
+    if (line.rfind("```", 0) == 0 || line.rfind("<!--", 0) == 0 || line.empty()) continue;
+    if (const auto c = line.find("  # "); c != std::string::npos) line = line.substr(0, c);
+    while (!line.empty() && line.back() == ' ') line.pop_back();
+    lines.push_back(line);
+  }
+  return lines;
+}
+
+/// Runs `line` in `cwd` with ./rths and examples/ pointing into the source tree; output in *out.
+int RunLine(std::string line, const fs::path& cwd, std::string* out) {
+  const std::string src = RTHS_SOURCE_DIR;
+  line = std::regex_replace(line, std::regex(R"(\./rths )"), src + "/rths ");
+  line = std::regex_replace(line, std::regex("'examples/"), "'" + src + "/examples/");
+  const fs::path txt = cwd / "out.txt";
+  const std::string cmd = "cd '" + cwd.string() + "' && RTHS_BIN_DIR='" + RTHS_BIN_DIR + "' " + line + " > " +
+                          txt.string() + " 2>&1";
+  const int status = std::system(cmd.c_str());
+  *out = Slurp(txt);
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+bool OnPath(const std::string& program) { return std::system(("command -v " + program + " >/dev/null 2>&1").c_str()) == 0; }
+
+}  // namespace
+
+TEST_CASE("README first steps: run + report, export, Octave, a --set variant") {
+  const std::vector<std::string> lines = WalkLines();
+  REQUIRE(lines.size() == 5);
+  CHECK(lines[0] == "bash scripts/bootstrap.sh");  // the install, which CI has run already
+  if (!rths_test::UdpmAvailable()) {
+    MESSAGE("no multicast route: the walk's udpm runs are skipped (bootstrap adds the route as root)");
+    return;
+  }
+  const fs::path cwd = rths_test::TempDir("readme_walk");
+  std::string out;
+
+  // 2. The default scenario with its report.
+  INFO(lines[1]);
+  REQUIRE_MESSAGE(RunLine(lines[1], cwd, &out) == 0, out);
+  const fs::path first = cwd / "runs" / "first";
+  CHECK(out.find("report: ") != std::string::npos);
+  const std::string html = Slurp(first / "report.html");
+  const auto summary = nlohmann::json::parse(Slurp(first / "summary.json"));
+  const double nrmse = summary["tracking_nrmse_pct"].get<double>();
+  CHECK(html.find(fmt::format("{:.4g}", nrmse)) != std::string::npos);
+  int figures = 0;
+  for (const auto& e : fs::directory_iterator(first / "figures")) {
+    if (e.path().extension() == ".png") {
+      ++figures;
+      CHECK(fs::file_size(e.path()) > 10000);
+    }
+  }
+  CHECK(figures >= 5);
+
+  // 3. The export.
+  INFO(lines[2]);
+  REQUIRE_MESSAGE(RunLine(lines[2], cwd, &out) == 0, out);
+  CHECK(fs::file_size(first / "export.mat") > 100000);
+
+  // 4. The .mat in Octave: the example prints Eq. 31 as rths run does.
+  if (OnPath("octave-cli")) {
+    INFO(lines[3]);
+    CHECK_MESSAGE(RunLine(lines[3], cwd, &out) == 0, out);
+    CHECK_MESSAGE(out.find(fmt::format("tracking error     {:.3f} %", nrmse)) != std::string::npos, out);
+  } else {
+    MESSAGE("octave-cli is not installed (bootstrap installs it): the Octave line is skipped");
+  }
+
+  // 5. The variant: --set takes, --compact leaves out signals.csv, and no compensation tracks worse.
+  INFO(lines[4]);
+  REQUIRE_MESSAGE(RunLine(lines[4], cwd, &out) == 0, out);
+  const fs::path none = cwd / "runs" / "none";
+  CHECK(fs::exists(none / "report.html"));
+  CHECK_FALSE(fs::exists(none / "signals.csv"));
+  CHECK(rths::scenario::LoadScenario((none / "scenario.toml").string()).controller.kind ==
+        rths::control::ControllerKind::kNone);
+  const auto summary_none = nlohmann::json::parse(Slurp(none / "summary.json"));
+  CHECK(summary_none["tracking_nrmse_pct"].get<double>() > 5 * nrmse);
+}
