@@ -11,6 +11,7 @@
 
 #include <doctest/doctest.h>
 
+#include "core/progress.h"
 #include "io/run_log.h"
 #include "scenario/scenario.h"
 #include "test_support.h"
@@ -146,4 +147,34 @@ TEST_CASE("identify writes a plot only where told") {
                   &out, cwd) == 0);
   CHECK(fs::file_size(dir / "model.png") > 10000);  // beside --out
   CHECK(fs::is_empty(cwd));
+}
+
+TEST_CASE("progress: drawn with an ETA on a terminal, nothing when the output is not one") {
+  CHECK(rths::ProgressLine::FormatSeconds(3.25) == "3.2 s");
+  CHECK(rths::ProgressLine::FormatSeconds(42) == "42 s");
+  CHECK(rths::ProgressLine::FormatSeconds(185) == "3 min 05 s");
+  CHECK(rths::ProgressLine::FormatSeconds(3725) == "1 h 02 min");
+  const fs::path dir = TempDir("cli_progress");
+  const std::string run = std::string(RTHS_BIN_DIR) + "/rths-run " + Scenario("default.toml") +
+                          " --transport memq --skip-space-check --compact --set run.duration_s=10 --out ";
+  std::string out;
+  REQUIRE(RunTool("run", Scenario("default.toml") + " --transport memq --skip-space-check --compact --set run.duration_s=10 --out " +
+                             (dir / "pipe").string(),
+                  &out) == 0);
+  CHECK(out.find("\033[K") == std::string::npos);  // not a terminal: no progress line
+  // On a terminal (a pseudo-terminal from script(1)): the line, redrawn in place, with the step.
+  if (std::system("command -v script >/dev/null 2>&1") != 0) {
+    MESSAGE("script(1) is not installed: the terminal case is skipped");
+    return;
+  }
+  const fs::path txt = dir / "tty.txt";
+  const std::string cmd = "env -u RTHS_NO_PROGRESS script -qc \"" + run + (dir / "tty").string() + "\" /dev/null > " + txt.string();
+  REQUIRE(std::system(cmd.c_str()) == 0);
+  std::ifstream in(txt);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  const std::string tty = ss.str();
+  CHECK(tty.find("\r\033[Krths run ") != std::string::npos);
+  CHECK(tty.find(" of 20000") != std::string::npos);
+  CHECK(tty.find("tracking error") != std::string::npos);  // the summary after it, on a clean line
 }

@@ -16,6 +16,7 @@
 
 #include "cli.h"
 #include "core/error.h"
+#include "core/progress.h"
 #include "diagnosis/diagnosis.h"
 #include "diagnosis/model_file.h"
 #include "diagnosis/report.h"
@@ -61,7 +62,12 @@ int main(int argc, char** argv) {
   }
   try {
     rths::diagnosis::Traces traces;
+    rths::ProgressLine progress("rths diagnose");
+    if (progress.enabled()) {
+      o.progress = [&progress](double done, double total, std::string_view what) { progress.Update(done, total, what); };
+    }
     const auto r = rths::diagnosis::Diagnose(tr, te, model, o, &traces);
+    progress.Finish();
     const fs::path dir = out.empty() ? rths::io::NewOutputFolder("diagnose") : fs::path(out);
     fs::create_directories(dir);
     {

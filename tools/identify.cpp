@@ -28,6 +28,7 @@
 
 #include "cli.h"
 #include "core/error.h"
+#include "core/progress.h"
 #include "ident/damper_fit.h"
 #include "ident/spencer_fit.h"
 #include "ident/identify.h"
@@ -279,7 +280,13 @@ int RunSpencer(const DamperCli& c, const rths::ident::SpencerFitOptions& o) {
   const auto held = ReadDamperRecords(c.checks, c.time);
   bool voltage = c.input == "voltage";
   if (c.input.empty()) voltage = !recs.empty() && recs[0].i_A.empty();
-  const auto fit = rths::ident::FitSpencer(recs, voltage, o);
+  rths::ProgressLine progress("rths identify --damper");
+  rths::ident::SpencerFitOptions opts = o;
+  if (progress.enabled()) {
+    opts.progress = [&progress](double done, double total, std::string_view what) { progress.Update(done, total, what); };
+  }
+  const auto fit = rths::ident::FitSpencer(recs, voltage, opts);
+  progress.Finish();
   std::printf("rths identify --damper: %zu record(s), %s input %g to %g %s\n%s", recs.size(),
               voltage ? "voltage" : "current", fit.input_min, fit.input_max, voltage ? "V" : "A", fit.Report().c_str());
   if (!held.empty()) {

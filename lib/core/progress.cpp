@@ -23,6 +23,7 @@ bool ProgressLine::StderrIsTerminal() {
 
 std::string ProgressLine::FormatSeconds(double s) {
   if (!(s >= 0.0) || !std::isfinite(s)) return "?";
+  if (s < 9.95) return fmt::format("{:.1f} s", s);
   const long long t = std::llround(s);
   if (t < 60) return fmt::format("{} s", t);
   if (t < 3600) return fmt::format("{} min {:02d} s", t / 60, t % 60);

@@ -4,11 +4,17 @@
 /// times a second; when stderr is not a terminal (a pipe, a file, CI) it prints nothing at all, so
 /// logs and test output stay as they were. Thread-safe: batch workers may report concurrently.
 #include <chrono>
+#include <functional>
 #include <mutex>
 #include <string>
 #include <string_view>
 
 namespace rths {
+
+/// How a long computation reports how far it is: `done` of `total` units of work and what it is
+/// doing. Libraries take one in their options (empty: nobody listens); a main program passes
+/// ProgressLine::Update.
+using ProgressFn = std::function<void(double done, double total, std::string_view what)>;
 
 class ProgressLine {
  public:

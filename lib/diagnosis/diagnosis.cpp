@@ -1172,12 +1172,20 @@ Result Diagnose(const std::vector<io::RigRecord>& train_in, const std::vector<io
       res.channels.push_back(s.summary);
       continue;
     }
+    // Progress: selection is most of a channel's time; the other stages share the rest.
+    const double base = 10.0 * static_cast<double>(st.size() - 1);  // this channel's index
+    const double total = 10.0 * static_cast<double>(chans.size());
+    const std::string ch(1, chan);
+    if (o.progress) o.progress(base, total, "channel " + ch + ": fitting and selecting effects");
     stages::SelectEffects(&s, specs, o);
+    if (o.progress) o.progress(base + 6, total, "channel " + ch + ": swaps and pruning");
     stages::SwapEffects(&s, specs, o, &res.warnings);
     stages::PruneEffects(&s, specs, o, &res.warnings);
+    if (o.progress) o.progress(base + 8, total, "channel " + ch + ": held-out test");
     stages::RetainOnTest(&s, specs, o, &res.warnings);
     stages::ScoreSelected(s, specs, &er);
     stages::ApplyShrinkRule(&s, specs, o, &res.warnings, &er);
+    if (o.progress) o.progress(base + 9, total, "channel " + ch + ": scoring the other candidates");
     if (s.retained)
       for (const auto& n : s.order) verdict.push_back(n);
     stages::ScoreCandidates(&s, specs, o, &er);

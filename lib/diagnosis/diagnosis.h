@@ -41,6 +41,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "core/progress.h"
 #include "diagnosis/channel_models.h"
 #include "io/rig_record.h"
 #include "models/rig_effects.h"
@@ -97,6 +98,9 @@ struct Options {
   // --- held-out checks on the test records
   double min_test_shrink_pct = 30.0;   ///< the contract's 30 % on the test records, [0, 100]
   double max_test_worsening = 0.02;    ///< an effect raising the test NRMSE by more than this (relative) is dropped, >= 0
+
+  /// Progress by stage (channel x stage), for a terminal display; empty: none. Not in ToJson.
+  ProgressFn progress;
 
   // --- parameter search (one effect) and joint refits (coordinate-wise)
   int golden_iters_y = 24;             ///< golden-section iterations after the full-range grid, y effects, [0, 200]

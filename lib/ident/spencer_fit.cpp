@@ -1,6 +1,7 @@
 #include "ident/spencer_fit.h"
 
 #include <algorithm>
+#include <functional>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -260,7 +261,9 @@ struct LmState {
   bool converged = false;
 };
 
-void Iterate(LmState* s, const Problem& pb, int iterations, int threads) {
+/// `on_iteration`: called after each iteration (may be empty).
+void Iterate(LmState* s, const Problem& pb, int iterations, int threads,
+             const std::function<void()>& on_iteration = {}) {
   const int P = pb.dim();
   std::vector<Workspace> ws(static_cast<std::size_t>(threads));
   std::vector<std::vector<double>> fnl(static_cast<std::size_t>(threads));
@@ -298,6 +301,7 @@ void Iterate(LmState* s, const Problem& pb, int iterations, int threads) {
     DampedStep(
         H, g, &s->theta, &s->ev, &s->mu, [&](const Eigen::VectorXd& t) { return pb.Evaluate(t, nullptr, &ws[0], &fnl[0]); },
         Clamp, 1e-9, 1e-7, &s->converged);
+    if (on_iteration) on_iteration();
   }
 }
 
@@ -498,8 +502,17 @@ SpencerFitResult FitSpencer(const std::vector<io::RigRecord>& records, bool volt
   res.input_min = in_lo;
   res.input_max = in_hi;
   int best = -1;
+  // Progress (SpencerFitOptions::progress): whole-record iterations, a start's counting a quarter.
+  const double work = 0.25 * static_cast<double>(starts.size() * static_cast<std::size_t>(o.start_iterations)) +
+                      static_cast<double>(o.max_iterations);
+  double done = 0.0;
+  auto step = [&](double units, std::string_view what) {
+    done += units;
+    if (o.progress) o.progress(done, work, what);
+  };
   for (std::size_t i = 0; i < starts.size(); ++i) {
-    if (std::isfinite(starts[i].ev.cost)) Iterate(&starts[i], pb_part, o.start_iterations, threads);
+    if (std::isfinite(starts[i].ev.cost))
+      Iterate(&starts[i], pb_part, o.start_iterations, threads, [&] { step(0.25, "starts"); });
     res.start_costs.push_back(starts[i].ev.cost);
     if (std::isfinite(starts[i].ev.cost) &&
         (best < 0 || starts[i].ev.cost < starts[static_cast<std::size_t>(best)].ev.cost))
@@ -526,7 +539,9 @@ SpencerFitResult FitSpencer(const std::vector<io::RigRecord>& records, bool volt
   if (best < 0) throw Error("FitSpencer", "no start gives a finite force prediction on all the data");
   LmState& s = starts[static_cast<std::size_t>(best)];
   s.converged = false;
-  Iterate(&s, pb, o.max_iterations, threads);
+  done = 0.25 * static_cast<double>(starts.size() * static_cast<std::size_t>(o.start_iterations));
+  Iterate(&s, pb, o.max_iterations, threads, [&] { step(1.0, "least squares on the whole record"); });
+  if (o.progress) o.progress(work, work, "done");
   res.best_start = best;
   res.iterations = s.iterations;
   res.converged = s.converged;

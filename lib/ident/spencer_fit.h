@@ -39,6 +39,7 @@
 #include <string>
 #include <vector>
 
+#include "core/progress.h"
 #include "ident/damper_fit.h"
 #include "io/rig_record.h"
 #include "models/current_driver.h"
@@ -64,6 +65,9 @@ struct SpencerFitOptions {
   int start_iterations = 8;         ///< LM iterations per start (on a quarter of the data), >= 1
   int max_iterations = 150;         ///< for the best start, >= 1
   int threads = 0;                  ///< Jacobian threads; 0 = the machine's cores
+  /// Progress in LM iterations on the whole record (a start's iteration on a quarter counts a
+  /// quarter; the final fit counts max_iterations until it converges): empty = none.
+  ProgressFn progress;
   /// True if every field is in range; else false and a message naming the field.
   bool IsValid(std::string* error) const;
 };
