@@ -104,22 +104,14 @@ int DegreesOfFreedom(const rths::scenario::Scenario& s) {
   return static_cast<int>(rths::models::StructureFromScenario(s.structure, s.path).M.rows());
 }
 
-/// Output the run will write [bytes]: log.lcm (every step), signals.csv (every csv_every-th step,
-/// an upper bound per row), the reserved summary and some slack for the copied scenario and the
-/// participants' own logs.
+/// Output the run will write [bytes]: log.lcm, signals.csv, the reserved summary and some slack
+/// for the copied scenario and the participants' own logs.
 struct OutputEstimate {
   double log_bytes = 0.0, csv_bytes = 0.0, total_bytes = 0.0;
 };
 OutputEstimate EstimateOutput(const rths::scenario::Scenario& s) {
-  const int n_dof = DegreesOfFreedom(s);
-  const double steps = static_cast<double>(s.steps());
-  const double log_step = static_cast<double>(rths::participants::LogBytesPerStep(n_dof));
-  const double row = static_cast<double>(rths::participants::StoredBytesPerStep(n_dof)) - log_step;
-  OutputEstimate e;
-  e.log_bytes = steps * log_step;
-  e.csv_bytes = s.run.csv_every > 0 ? std::ceil(steps / s.run.csv_every) * row : 0.0;
-  e.total_bytes = e.log_bytes + e.csv_bytes + static_cast<double>(kSummaryReserve) + 256.0 * 1024.0;
-  return e;
+  const auto b = rths::participants::EstimateOutputBytes(s);
+  return {b.log, b.csv, b.total() + static_cast<double>(kSummaryReserve) + 256.0 * 1024.0};
 }
 
 /// On a terminal: the run's progress (steps written, from the size of log.lcm) with an ETA,

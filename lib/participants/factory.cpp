@@ -1,5 +1,6 @@
 #include "participants/factory.h"
 
+#include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
@@ -45,6 +46,19 @@ lockstep::Faults FaultsOf(const scenario::Scenario& s, std::string_view role) {
     f.stop_s = c.process_stop_s;
   }
   return f;
+}
+
+OutputBytes EstimateOutputBytes(const scenario::Scenario& s) {
+  const int n_dof = s.structure.mode == models::StructureMode::kPredefined
+                        ? 1
+                        : static_cast<int>(models::StructureFromScenario(s.structure, s.path).M.rows());
+  const double steps = static_cast<double>(s.steps());
+  const double log_step = static_cast<double>(LogBytesPerStep(n_dof));
+  const double row = static_cast<double>(StoredBytesPerStep(n_dof)) - log_step;
+  OutputBytes b;
+  b.log = steps * log_step;
+  b.csv = s.run.csv_every > 0 ? std::ceil(steps / s.run.csv_every) * row : 0.0;
+  return b;
 }
 
 std::unique_ptr<lockstep::Participant> MakeParticipant(std::string_view role, const scenario::Scenario& s,

@@ -38,6 +38,14 @@ std::unique_ptr<lockstep::Participant> MakeParticipant(std::string_view role, co
 /// any process starts. Throws rths::Error.
 void CheckBuildable(const scenario::Scenario& s);
 
+/// What a run of `s` stores [bytes]: log.lcm (every step) and signals.csv (every run.csv_every-th
+/// step; an upper bound per row). For the disk-space check and the size said before a run.
+struct OutputBytes {
+  double log = 0.0, csv = 0.0;
+  double total() const { return log + csv; }
+};
+OutputBytes EstimateOutputBytes(const scenario::Scenario& s);
+
 /// main() of procs/<role>: `--scenario FILE --lcm-url URL --run-id N [--out DIR]`.
 /// Exit codes: lockstep::ExitCode. At exit it writes `DIR/logs/<role>.json` (its outcome and
 /// link statistics, participants::OutcomeToJson) for the supervisor.

@@ -91,11 +91,22 @@ void Preflight(const std::vector<RunSpec>& specs) {
   throw Error("reproduce", msg);
 }
 
-void Preflight(std::vector<RunSpec>* specs, const std::vector<std::string>& overrides) {
+void Preflight(std::vector<RunSpec>* specs, const std::vector<std::string>& overrides,
+               const std::function<void(std::string_view)>& log) {
   if (!overrides.empty()) {
     for (auto& spec : *specs) spec.scenario = scenario::WithOverrides(spec.scenario, overrides);
   }
   Preflight(*specs);
+  if (!log) return;
+  participants::OutputBytes sum;
+  for (const auto& spec : *specs) {
+    const auto b = participants::EstimateOutputBytes(spec.scenario);
+    sum.log += b.log;
+    sum.csv += b.csv;
+  }
+  log(fmt::format("{} runs will write about {:.0f} MB: log.lcm {:.0f} MB, signals.csv {}", specs->size(),
+                  sum.total() / 1e6, sum.log / 1e6,
+                  sum.csv > 0 ? fmt::format("{:.0f} MB (--compact: none)", sum.csv / 1e6) : std::string("none")));
 }
 
 namespace {

@@ -54,8 +54,10 @@ scenario::Scenario WriteScenarioFile(const RunSpec& spec);
 /// controller kind or plant that is not implemented yet) with the component's own message.
 void Preflight(const std::vector<RunSpec>& specs);
 /// Applies `overrides` (`--set KEY=VALUE`, scenario::WithOverrides) to every spec's scenario,
-/// then Preflight. An override that does not check out throws rths::Error naming the --set.
-void Preflight(std::vector<RunSpec>* specs, const std::vector<std::string>& overrides);
+/// then Preflight, then says through `log` (if set) how much the runs will write. An override
+/// that does not check out throws rths::Error naming the --set.
+void Preflight(std::vector<RunSpec>* specs, const std::vector<std::string>& overrides,
+               const std::function<void(std::string_view)>& log = {});
 
 /// Called after each run (from the worker threads, serialised): done so far, total, the result.
 using Progress = std::function<void(std::size_t done, std::size_t total, const RunResult&)>;

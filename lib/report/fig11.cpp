@@ -206,7 +206,7 @@ Fig11Result ReproduceFig11(const ReproduceOptions& opts) {
       items.push_back({c.name, mode});
     }
   }
-  Preflight(&specs, opts.overrides);
+  Preflight(&specs, opts.overrides, opts.log);
   if (opts.log) {
     opts.log(fmt::format("fig11: {} lockstep runs of {:g} s (9 RTHS on the {} plant + 3 numerical), {} at a time "
                          "(base {})",

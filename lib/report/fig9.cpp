@@ -147,7 +147,7 @@ Fig9Result ReproduceFig9(const ReproduceOptions& opts) {
       res.rows.push_back(row);
     }
   }
-  Preflight(&specs, opts.overrides);
+  Preflight(&specs, opts.overrides, opts.log);
   if (opts.log) {
     opts.log(fmt::format("fig9: {} lockstep runs of {:g} s on the {} plant, {} at a time (base {})", specs.size(),
                          duration, opts.plant, opts.jobs, base_file.string()));

@@ -55,7 +55,7 @@ std::string Sig(double v) { return std::isfinite(v) ? fmt::format("{:#.4g}", v) 
 
 // Runs the specs (preflight first), logging progress; throws if any failed.
 std::vector<RunResult> RunAll(std::vector<RunSpec> specs, const ReproduceOptions& opts, const std::string& what) {
-  Preflight(&specs, opts.overrides);
+  Preflight(&specs, opts.overrides, opts.log);
   if (opts.log) {
     opts.log(fmt::format("{}: {} lockstep runs on the {} plant, {} at a time", what, specs.size(), opts.plant, opts.jobs));
   }

@@ -289,7 +289,7 @@ Table2Result ReproduceTable2(const ReproduceOptions& opts) {
   std::vector<RunSpec> ordered;
   for (std::size_t i : order) ordered.push_back(specs[i]);
 
-  Preflight(&ordered, opts.overrides);
+  Preflight(&ordered, opts.overrides, opts.log);
   if (opts.log) {
     opts.log(fmt::format("table2: {} lockstep runs on the {} plant, {} at a time", ordered.size(), opts.plant,
                          opts.jobs));
