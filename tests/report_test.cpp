@@ -191,13 +191,33 @@ TEST_CASE("a plot's colour cycle is the readable palette; margins and a legend b
   CHECK(KeyMarginChars({&p}) == 12);  // the shortest entries still get a sample line and a box
   Panel wide = p;
   wide.series[0].title = std::string(40, 'w');
-  CHECK(KeyMarginChars({&p, &wide}) == 44);
+  CHECK(KeyMarginChars({&p, &wide}) == 50);
   const std::string gp = Slurp(Plot(fig, dir).gp);
   CHECK(gp.find("set linetype 1 lc rgb '" + ReadableColors()[0] + "'") != std::string::npos);
   CHECK(gp.find("set linetype cycle " + std::to_string(ReadableColors().size())) != std::string::npos);
-  CHECK(gp.find("set key on outside right top") != std::string::npos);
+  CHECK(gp.find("set key on outside right top box opaque spacing 1.2 width 1") != std::string::npos);
   CHECK(gp.find("set lmargin 10") != std::string::npos);
   CHECK(gp.find("set rmargin 30") != std::string::npos);
+}
+
+TEST_CASE("a run of non-finite points breaks a curve once and never ends its data block") {
+  const auto dir = TempDir("plot_gaps");
+  Figure fig;
+  fig.name = "gaps";
+  Panel p = MakePanel("", "Frequency [Hz]", "Magnitude [mm/mm]");
+  Series a = MakeSeries("masked"), b = MakeSeries("after");
+  a.x = {1, 2, 3, 4, 5};
+  a.y = {1, NAN, NAN, NAN, 2};
+  b.x = {1, 2};
+  b.y = {7, 8};
+  p.series = {a, b};
+  fig.panels = {p};
+  const std::string dat = Slurp(Plot(fig, dir).dat);
+  CHECK(dat.find("\n1 1\n\n5 2\n") != std::string::npos);  // one blank line: the curve breaks
+  std::size_t blocks = 0;
+  for (auto at = dat.find("\n\n\n"); at != std::string::npos; at = dat.find("\n\n\n", at + 1)) ++blocks;
+  CHECK(blocks == 1);  // two blank lines only between the two curves: `index 1` is "after"
+  CHECK(dat.find("2\n\n\n# index 1") != std::string::npos);
 }
 
 TEST_CASE("a bar panel: filled boxes side by side over named categories") {

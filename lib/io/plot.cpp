@@ -155,7 +155,7 @@ int KeyMarginChars(const std::vector<const Panel*>& panels) {
   for (const Panel* p : panels) {
     for (const auto& s : p->series) longest = std::max(longest, s.title.size());
   }
-  return std::max(12, static_cast<int>(longest - longest / 10) + 8);
+  return std::max(12, static_cast<int>(longest) + 10);
 }
 
 bool GnuplotAvailable(const std::string& program) { return !FindOnPath(program).empty(); }
@@ -202,11 +202,17 @@ PlotFiles Plot(const Figure& fig, const fs::path& dir) {
       if (next_index > 0) dat << "\n\n";
       dat << fmt::format("# index {}: panel {} curve \"{}\"\n# x: {}   y: {}\n", next_index, p + 1,
                          ser.title, panel.xlabel, panel.ylabel);
+      // One blank line breaks the curve at a run of non-finite points; never two in a row (two
+      // blank lines end the block for gnuplot's `index`, shifting every later curve).
+      bool written = false, gap = false;
       for (std::size_t i = 0; i < ser.x.size(); ++i) {
         if (std::isfinite(ser.x[i]) && std::isfinite(ser.y[i])) {
+          if (gap && written) dat << '\n';
           dat << Num(ser.x[i]) << ' ' << Num(ser.y[i]) << '\n';
+          written = true;
+          gap = false;
         } else {
-          dat << '\n';  // a blank line breaks the curve
+          gap = true;
         }
       }
       index[p].push_back(next_index++);
@@ -271,13 +277,9 @@ PlotFiles Plot(const Figure& fig, const fs::path& dir) {
       gp << "set key off\n";
     } else {
       gp << "set key on " << panel.key << " box opaque spacing 1.2";
-      if (panel.key.find("outside") != std::string::npos && panel.key.find("width") == std::string::npos) {
-        // gnuplot sizes the box for its wide-letter character width; titles take about 0.8 of
-        // it. Narrow the box by a tenth (the room KeyMarginChars leaves beside the axes).
-        std::size_t longest = 0;
-        for (const auto& s : panel.series) longest = std::max(longest, s.title.size());
-        gp << " width " << -static_cast<int>(longest / 10);
-      }
+      // Beside the axes: one character more than gnuplot's estimate of the titles, whose capitals
+      // run wider ("G_FF,avgA + LQG" would start left of its box).
+      if (panel.key.find("outside") != std::string::npos && panel.key.find("width") == std::string::npos) gp << " width 1";
       gp << "\n";
     }
     gp << "plot ";

@@ -99,10 +99,9 @@ double RelativeLuminance(const std::string& hex_color);
 inline constexpr double kMaxReadableLuminance = 0.30;
 
 /// The right margin [characters] a key "outside right" needs for the legend entries of `panels`:
-/// the longest title less 1/10 (gnuplot's character width is that of a wide letter; titles
-/// average about 0.8 of it) + 8 (the sample line, spacing and box), at least 12. Plot narrows
-/// the box of a key "outside" to match (`set key ... width -N`, N = 1/10 of its panel's longest
-/// title).
+/// the longest title + 10, at least 12. (gnuplot draws the box as wide as the title + about 7
+/// characters for the sample line, padding and Plot's `width 1`, ~1 character from the figure's
+/// edge; the rest is the gap to the axes. Measured with sans 11 on pngcairo.)
 int KeyMarginChars(const std::vector<const Panel*>& panels);
 
 struct PlotFiles {
