@@ -101,6 +101,7 @@ io::Figure SpectrumFigure(const Traces::Record& t, const std::string& ch, std::s
   auto p = io::MakePanel(fmt::format("channel {}: spectra (test record {})", ch, shown), "Frequency [Hz]",
                          fmt::format("PSD of {} [{}]", ch, unit));
   p.log_x = p.log_y = true;
+  p.x_range = std::make_pair(1.0 / (t.dt_s * static_cast<double>(L)), 0.5 / t.dt_s);  // first bin to Nyquist
   auto s1 = io::MakeSeries("measured", kMeasuredColor);
   auto s2 = io::MakeSeries("residual, nominal model", kNominalColor);
   auto s3 = io::MakeSeries("residual, with the verdict's effects", kFinalColor);
@@ -129,7 +130,17 @@ io::Figure FrfFigure(const Traces::Record& t, std::size_t first) {
   const auto phm = signal::UnwrapPhase(hm.h), phn = signal::UnwrapPhase(hn.h), phf = signal::UnwrapPhase(hf.h);
 
   // The frequency axis: the input's excited band (from 0 Hz unless it starts well above).
-  auto [lo, hi] = EnergyBand(sm.f_hz, sm.s_uu, kFrfEnergyFraction);
+  double peak = 0.0;
+  for (std::size_t j = 1; j < sm.s_uu.size(); ++j) peak = std::max(peak, sm.s_uu[j]);
+  std::vector<double> strong(sm.s_uu.size(), 0.0), excited(sm.s_uu.size(), 0.0);
+  bool coherent = false;
+  for (std::size_t j = 1; j < sm.s_uu.size(); ++j) {
+    if (sm.s_uu[j] < kFrfInputFloor * peak) continue;
+    strong[j] = sm.s_uu[j];
+    if (hm.coherence[j] >= kFrfMinCoherence) excited[j] = sm.s_uu[j], coherent = true;
+  }
+  auto [lo, hi] = peak > 0.0 ? EnergyBand(sm.f_hz, coherent ? excited : strong, kFrfEnergyFraction)
+                             : std::make_pair(0.0, sm.f_hz.back());  // no input: the whole axis
   if (lo < 0.25 * hi) lo = 0.0;
   // Reliable points: coherence u -> y_meas at least kFrfMinCoherence.
   std::size_t reliable = 0;
@@ -188,16 +199,22 @@ io::Figure ConditionFigure(const Result& r) {
   fig.name = "conditions";
   for (const std::string ch : {"y", "f"}) {
     std::vector<std::string> names;
+    bool starred = false;
     auto s1 = io::MakeSeries("share of the residual energy", kNominalColor);
     auto s2 = io::MakeSeries("share of the samples", kMeasuredColor);
     for (const auto& c : r.conditions) {
       if (c.channel != ch) continue;
-      names.push_back(c.informative ? c.name : c.name + " (uninformative)");
+      names.push_back(c.informative ? c.name : c.name + "*");
+      starred = starred || !c.informative;
       s1.y.push_back(c.share_pct);
       s2.y.push_back(c.samples_pct);
     }
     if (names.empty()) continue;
-    auto p = io::MakeBarPanel(fmt::format("channel {}: nominal residual by state condition (test records)", ch),
+    auto p = io::MakeBarPanel(fmt::format("channel {}: nominal residual by state condition (test records){}", ch,
+                                          starred ? fmt::format("; * uninformative: holds in none or more than {:g} % "
+                                                                "of the samples",
+                                                                r.options.max_condition_samples_pct)
+                                                  : ""),
                               "Share [%]", names, {s1, s2});
     p.xlabel = "State condition";
     double top = 0.0;
