@@ -316,7 +316,8 @@ TEST_CASE("fig11's stories figure: one legend beside the axes, accelerations in 
   CHECK(drift.key == "off");
   CHECK(acc.key.rfind("outside right", 0) == 0);
   CHECK(acc.right_margin_chars == KeyMarginChars({&acc}));  // room for the legend's longest entry
-  REQUIRE(acc.series.size() == 6);  // 3 modes x (numerical, RTHS G_FF,avgA + LQG)
+  REQUIRE(acc.series.size() == 6);  // 3 modes x (numerical, RTHS with G_FF,avgA + LQG)
+  CHECK(fig.title.find("G_FF,avgA + LQG") != std::string::npos);
   CHECK(acc.xlabel == "Peak acceleration [mm/s^2]");
   CHECK(acc.series[0].x[0] == doctest::Approx(1500.0));
   CHECK(acc.series[0].x[8] == doctest::Approx(2300.0));

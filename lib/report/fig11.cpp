@@ -114,7 +114,9 @@ Series Thin(Series s, const std::vector<double>& x, const std::vector<double>& y
 Figure Fig11StoriesFigure(const Fig11Result& res) {
   Figure fig;
   fig.name = "fig11_stories";
-  fig.title = "Fig. 11: peak story drifts and absolute floor accelerations (El Centro NS x 0.5)";
+  fig.title = fmt::format("Fig. 11: peak story drifts and absolute floor accelerations (El Centro NS x 0.5): RTHS with "
+                          "{} (solid) vs numerical (dashed)",
+                          kFig11Proposed);
   fig.columns = 2;
   fig.width_px = 1600;
   fig.panel_height_px = 600;
@@ -135,7 +137,7 @@ Figure Fig11StoriesFigure(const Fig11Result& res) {
         if (r.semiactive != modes[m]) continue;
         const bool num = r.controller == kNumerical;
         if (!num && r.controller != kFig11Proposed) continue;
-        const std::string title = fmt::format("{}, {}", modes[m], num ? "numerical" : std::string("RTHS ") + kFig11Proposed);
+        const std::string title = fmt::format("{}, {}", modes[m], num ? "numerical" : "RTHS");
         Series sd = MakeSeries(title, mode_colors[m % mode_colors.size()], num ? 2 : 1);
         sd.with = fmt::format("linespoints pt {} ps 1.3", num ? 6 : mode_points[m % mode_points.size()]);
         sd.width = num ? 2.0 : 1.5;
@@ -261,7 +263,8 @@ Fig11Result ReproduceFig11(const ReproduceOptions& opts) {
       Figure fig;
       fig.name = "fig11_damper_" + mode;
       fig.gnuplot = opts.gnuplot;
-      fig.title = fmt::format("Fig. 11: damper at the first story, semiactive {} (RTHS on the {} plant vs numerical)",
+      fig.title = fmt::format("Fig. 11: damper at the first story, semiactive {}: RTHS with each controller on the {} "
+                              "plant vs the numerical simulation (ideal tracking)",
                               mode, opts.plant);
       fig.columns = 2;
       fig.width_px = 1600;
@@ -283,7 +286,7 @@ Fig11Result ReproduceFig11(const ReproduceOptions& opts) {
       }
       for (std::size_t j : order) {
         const bool num = items[j].controller == kNumerical;
-        const std::string title = num ? "Numerical (ideal tracking)" : "RTHS " + items[j].controller;
+        const std::string title = num ? "Numerical (ideal)" : items[j].controller;
         const Series style = StyledSeries(title, ControllerStyle(items[j].controller));
         const auto& tr = traces[j];
         disp.series.push_back(Thin(style, tr.t, tr.y_mm, stride));
