@@ -100,6 +100,13 @@ TEST_CASE("--set is checked like the file and names itself in the error") {
   CHECK(out.find("(set by --set run.dt_s=-1)") != std::string::npos);
   CHECK(RunTool("design", Scenario("default.toml") + " --set controller.kindd=ff", &out) == 2);
   CHECK(out.find("unknown key") != std::string::npos);
+  // reproduce: checked on every run of the study before any runs, naming the run.
+  const fs::path dir = TempDir("cli_reproduce_set");
+  CHECK(RunTool("reproduce", "fig7 --quick --plant linear --set run.dt_s=0.3 --out " + (dir / "f7").string(), &out) == 2);
+  CHECK(out.find("fig7 None: run.dt_s: 0.3 is out of range") != std::string::npos);
+  CHECK(out.find("(set by --set run.dt_s=0.3)") != std::string::npos);
+  CHECK_FALSE(fs::exists(dir / "f7" / "runs"));
+  CHECK(RunTool("reproduce", "fig5 --set run.dt_s=0.001 --out " + (dir / "f5").string(), &out) == 2);
 }
 
 TEST_CASE("rths run --set and --compact: the scenario that ran is in the folder; no signals.csv") {

@@ -94,7 +94,16 @@ void Preflight(const std::vector<RunSpec>& specs) {
 void Preflight(std::vector<RunSpec>* specs, const std::vector<std::string>& overrides,
                const std::function<void(std::string_view)>& log) {
   if (!overrides.empty()) {
-    for (auto& spec : *specs) spec.scenario = scenario::WithOverrides(spec.scenario, overrides);
+    for (auto& spec : *specs) {
+      try {
+        spec.scenario = scenario::WithOverrides(spec.scenario, overrides);
+      } catch (const Error& e) {  // a scenario built in code has no file: name the run instead
+        std::string where = e.where();
+        if (const std::string text = "<scenario text>"; where.rfind(text, 0) == 0) where.erase(0, text.size());
+        if (where.rfind(": ", 0) == 0) where.erase(0, 2);
+        throw Error(spec.label, where.empty() ? e.problem() : where + ": " + e.problem());
+      }
+    }
   }
   Preflight(*specs);
   if (!log) return;
