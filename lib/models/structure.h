@@ -24,7 +24,10 @@ struct LinearStructure {
   Eigen::MatrixXd M;             ///< mass [kN s^2/mm], n x n, symmetric positive definite
   Eigen::MatrixXd C;             ///< damping [kN s/mm], n x n
   Eigen::MatrixXd K;             ///< stiffness [kN/mm], n x n, symmetric positive semidefinite
-  Eigen::VectorXd iota;          ///< ground influence vector (ones for a shear building)
+  /// Ground influence vector [-]: the ground load is -M iota a_g, the absolute accelerations
+  /// x'' + iota a_g (ones for a shear building; Make sets ones, StructureFromScenario a structure
+  /// file's iota line: models/structure_file.h).
+  Eigen::VectorXd iota;
   Eigen::VectorXd specimen_dir;  ///< force location: unit vector at actuator_dof x specimen count
   int actuator_dof = 0;          ///< DOF the actuator (specimen) is attached to
 

@@ -103,7 +103,15 @@ StructureMatrices LoadStructureFile(const std::string& path) {
   m.K = Matrix(path, &t, n, "K");
   Expect(path, &t, "C", "kN*s/mm");
   m.C = Matrix(path, &t, n, "C");
-  if (t.next != t.words.size()) throw Error(Where(path, t), "unexpected text after the C matrix");
+  if (t.next < t.words.size() && t.words[t.next] == "iota") {
+    ++t.next;
+    m.iota.resize(n);
+    for (int i = 0; i < n; ++i) m.iota(i) = Number(path, &t, "iota");
+  }
+  if (t.next != t.words.size()) {
+    throw Error(Where(path, t), m.iota.size() ? "unexpected text after iota"
+                                              : "unexpected text after the C matrix (only an \"iota\" line may follow)");
+  }
   CheckSymmetric(path, m.M, "M");
   CheckSymmetric(path, m.K, "K");
   CheckSymmetric(path, m.C, "C");
@@ -131,6 +139,24 @@ void WriteStructureFile(const std::string& path, const StructureMatrices& m, con
   write("M kg", m.M, 1.0 / kKgToProject);
   write("K kN/mm", m.K, 1.0);
   write("C kN*s/mm", m.C, 1.0);
+  if (m.iota.size() == n && (m.iota.array() != 1.0).any()) {
+    out << "iota\n";
+    for (int i = 0; i < n; ++i) out << fmt::format("{}{:.17g}", i ? " " : "", m.iota(i));
+    out << "\n";
+  }
+  if (!out.flush()) throw Error(path, "cannot write the structure file");
+}
+
+Eigen::VectorXd StructureMatrices::IotaOrOnes() const {
+  return iota.size() ? iota : Eigen::VectorXd::Ones(M.rows());
+}
+
+Eigen::MatrixXd ModalDampingMatrix(const Eigen::MatrixXd& M, const Eigen::MatrixXd& K, double zeta) {
+  Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> eig(K, M);
+  const Eigen::MatrixXd& phi = eig.eigenvectors();  // mass-normalised: phi^T M phi = I
+  const Eigen::VectorXd w = eig.eigenvalues().cwiseMax(0.0).cwiseSqrt();
+  Eigen::MatrixXd C = M * phi * (2.0 * zeta * w).asDiagonal() * phi.transpose() * M;
+  return 0.5 * (C + C.transpose());
 }
 
 StructureMatrices ShearBuilding(const std::vector<double>& floor_masses_kg,
@@ -152,11 +178,7 @@ StructureMatrices ShearBuilding(const std::vector<double>& floor_masses_kg,
       m.K(i, i - 1) -= k;
     }
   }
-  Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> eig(m.K, m.M);
-  const Eigen::MatrixXd& phi = eig.eigenvectors();  // mass-normalised: phi^T M phi = I
-  const Eigen::VectorXd w = eig.eigenvalues().cwiseSqrt();
-  m.C = m.M * phi * (2.0 * zeta * w).asDiagonal() * phi.transpose() * m.M;
-  m.C = 0.5 * (m.C + m.C.transpose()).eval();
+  m.C = ModalDampingMatrix(m.M, m.K, zeta);
   return m;
 }
 
@@ -182,7 +204,9 @@ LinearStructure StructureFromScenario(const models::StructureConfig& st, const s
                 fmt::format("{} is out of range [1, {}] ({} has {} DOFs)", st.actuator_dof, m.M.rows(), st.file,
                             m.M.rows()));
   }
-  return LinearStructure::Make(m.M, m.C, m.K, st.actuator_dof - 1, st.specimen_count);
+  LinearStructure s = LinearStructure::Make(m.M, m.C, m.K, st.actuator_dof - 1, st.specimen_count);
+  if (m.iota.size()) s.iota = m.iota;  // the file's ground influence (default ones, from Make)
+  return s;
 }
 
 }  // namespace rths::models

@@ -8,7 +8,16 @@
 ///     M kg              then n rows of n values: mass matrix [kg]
 ///     K kN/mm           then n rows of n values: stiffness [kN/mm]
 ///     C kN*s/mm         then n rows of n values: damping [kN s/mm]
+///     iota              optional, then n values: ground influence vector [-] (default: ones)
 /// The loader converts M to project units (kN s^2/mm = kg * 1e-6).
+///
+/// iota enters the equation of motion as the ground load -M iota a_g (structure.h). A shear
+/// building has iota = 1. A partitioned numerical substructure may need another: when the
+/// measured force carries only the specimen's relative inertia m_e x''_1 (its actuator reacts
+/// against the ground), the specimen mass's ground inertia -m_e a_g stays on the numerical side, so
+/// M_n iota = M_ref 1 (the benchmark partition, data/buildings/silva3_numerical_case1.txt:
+/// iota_1 = M_ref,11 / M_n,11). Note that CentralDifference also reports the absolute
+/// accelerations as x'' + iota a_g.
 #include <string>
 #include <vector>
 
@@ -40,6 +49,11 @@ struct StructureConfig {
   /// structure file: docs/structures.md; e.g. data/buildings/ohtori9_ns.txt).
   StructureKind kind = StructureKind::kSdof;
   std::string file;           ///< kind = "file": path, relative to the scenario file's folder
+  /// mode = "rths", kind = "file", optional: the monolithic reference structure of a partitioned
+  /// test (a structure file with as many DOFs as `file`; e.g. data/buildings/silva3_reference.txt),
+  /// integrated offline under the run's ground acceleration for the benchmark criteria J1-J9
+  /// (io/benchmark_run.h). "" for none. Relative to the scenario file's folder.
+  std::string reference_file;
   int actuator_dof = 1;       ///< kind = "file": DOF the specimen acts on, 1-based (1 = first story)
   // kind = "sdof":
   double mass_kg = 20000.0;          ///< (0, 1e9]
@@ -55,16 +69,27 @@ struct StructureConfig {
   bool operator==(const StructureConfig&) const = default;
 };
 
-/// M [kN s^2/mm], K [kN/mm], C [kN s/mm].
+/// M [kN s^2/mm], K [kN/mm], C [kN s/mm], and the ground influence vector iota [-] (empty: ones).
 struct StructureMatrices {
   Eigen::MatrixXd M, K, C;
+  Eigen::VectorXd iota;  ///< n entries, or empty for ones (a shear building)
+  /// iota if it is set, else ones (n = M.rows()).
+  Eigen::VectorXd IotaOrOnes() const;
 };
 
 /// Reads a structure file; throws rths::Error naming the file, line and problem (missing or
-/// malformed matrix, wrong size, non-symmetric M or K, M not positive definite).
+/// malformed matrix, wrong size, non-symmetric M or K, M not positive definite, an iota line
+/// without n values). iota is left empty when the file has no iota line.
 StructureMatrices LoadStructureFile(const std::string& path);
-/// Writes a structure file (masses back in kg), with `comment` lines after the header.
+/// Writes a structure file (masses back in kg), with `comment` lines after the header; the iota
+/// line only if m.iota is set and not all ones.
 void WriteStructureFile(const std::string& path, const StructureMatrices& m, const std::string& comment);
+
+/// Damping matrix with the ratio zeta in every mode of (M, K):
+/// C = M Phi diag(2 zeta w_i) Phi^T M, Phi the mass-normalised modes (Phi^T M Phi = I), w_i their
+/// natural circular frequencies [rad/s]; symmetrised. Units follow M and K (kN s^2/mm, kN/mm ->
+/// kN s/mm).
+Eigen::MatrixXd ModalDampingMatrix(const Eigen::MatrixXd& M, const Eigen::MatrixXd& K, double zeta);
 
 /// A lumped-mass shear building: floor masses [kg] (floor 1 first), story stiffnesses [kN/mm]
 /// (story 1 between the ground and floor 1), and damping ratio zeta in every mode:
@@ -81,8 +106,9 @@ struct Modes {
 Modes ModalAnalysis(const StructureMatrices& m);
 
 /// The numerical substructure a scenario describes: the SDOF of [structure], or the matrices of
-/// structure.file with the specimen on structure.actuator_dof (1-based). Throws rths::Error naming
-/// the scenario key or the structure file's line.
+/// structure.file (and its iota, carried into LinearStructure::iota) with the specimen on
+/// structure.actuator_dof (1-based). Throws rths::Error naming the scenario key or the structure
+/// file's line.
 LinearStructure StructureFromScenario(const models::StructureConfig& st, const std::string& scenario_path);
 
 }  // namespace rths::models

@@ -1,0 +1,61 @@
+#pragma once
+/// @file The structure of the RTHS benchmark problem (Silva, Gomez, Maghareh, Dyke & Spencer,
+/// Mech. Syst. Signal Process. 2020; docs/benchmark.md) and its partition into a numerical and an
+/// experimental substructure (case 1), as structure matrices in project units (mm, kN, s; mass
+/// kN s^2/mm = kg * 1e-6). The benchmark's constants are SI: they are converted here, once.
+///
+/// Reference (monolithic) structure, 3 stories, SI:
+///
+///     M_ref = 1000 I3 kg
+///     K_ref = 1e7 [[2.6055, -2.3134, 0.5937], [-2.3134, 3.2561, -1.4420], [0.5937, -1.4420, 0.9267]] N/m
+///     C_ref = M Phi diag(2 zeta w_i) Phi^T M,  zeta = 0.05 in every mode (Phi mass-normalised)
+///
+/// 1 N/m = 1e-6 kN/mm, so K_ref = 10 [[...]] kN/mm. The experimental substructure (case 1) sits at
+/// floor 1: m_e = 29.13 kg, k_e = 1.19e6 N/m, zeta_e = 0.0097, c_e = 2 zeta_e sqrt(m_e k_e). The
+/// numerical substructure is the reference minus it at DOF 1:
+///
+///     M_n = M_ref - m_e e1 e1^T,  C_n = C_ref - c_e e1 e1^T,  K_n = K_ref - k_e e1 e1^T.
+///
+/// Ground inertia: the reference is loaded by -M_ref 1 a_g. The measured force carries only the
+/// specimen's relative motion, f = m_e x''_1 + c_e x'_1 + k_e x_1 (the actuator reacts against the
+/// ground), so the numerical side keeps the specimen's ground inertia: M_n iota = M_ref 1, i.e.
+/// iota_i = (M_ref 1)_i / M_n,ii for the diagonal masses here (iota_1 = 1000 / 970.87).
+/// Then M_n x'' + C_n x' + K_n x + e1 f = -M_n iota a_g is the reference's equation of motion.
+#include <string>
+
+#include "models/structure_file.h"
+
+namespace rths::models {
+
+/// The experimental substructure of the benchmark, case 1 (SI, the benchmark's nominal values).
+struct BenchmarkSpecimen {
+  double m_e_kg = 29.13;         ///< mass [kg] (> 0)
+  double k_e_N_per_m = 1.19e6;   ///< stiffness [N/m] (> 0)
+  double zeta_e = 0.0097;        ///< damping ratio [-] (>= 0)
+  /// c_e = 2 zeta_e sqrt(m_e k_e) [N s/m].
+  double c_e_N_s_per_m() const;
+};
+
+/// Modal damping ratio of the benchmark's reference structure, every mode.
+inline constexpr double kSilva3ModalDamping = 0.05;
+
+/// The benchmark's reference structure and its partition, in project units.
+struct BenchmarkStructures {
+  StructureMatrices reference;     ///< M_ref, K_ref, C_ref; iota empty (ones)
+  StructureMatrices experimental;  ///< m_e, c_e, k_e at (0, 0), zeros elsewhere; iota empty
+  StructureMatrices numerical;     ///< reference - experimental; iota with M_n iota = M_ref 1
+  int actuator_dof = 1;            ///< the experimental substructure's floor (1-based)
+};
+
+/// The benchmark's 3-story reference structure and its case-1 partition (the formulas of the file
+/// comment) for the experimental substructure `e`. Throws rths::Error if e's values are out of
+/// range (m_e, k_e > 0, zeta_e >= 0, all finite) or leave M_n or K_n not positive definite.
+BenchmarkStructures Silva3Structures(const BenchmarkSpecimen& e = {});
+
+/// Writes `dir`/silva3_reference.txt and `dir`/silva3_numerical_case1.txt from Silva3Structures(),
+/// each with comments saying where every number comes from (the repository's copies are in
+/// data/buildings/; tests/benchmark_structures_test.cpp checks them against this function).
+/// Throws rths::Error if a file cannot be written.
+void WriteSilva3StructureFiles(const std::string& dir);
+
+}  // namespace rths::models
