@@ -110,6 +110,26 @@ class IdealRig final : public Rig {
   OdeStepper ode_;
 };
 
+// The RTHS benchmark's plant (plant.kind = "benchmark"): no damper, no current.
+class BenchmarkRigAdapter final : public Rig {
+ public:
+  explicit BenchmarkRigAdapter(BenchmarkRig rig) : rig_(std::move(rig)) {}
+  void Step(double u_mm, double /*i_cmd_A: no damper*/) override {
+    models::Step(rig_, &state_, u_mm);
+    ++k_;
+  }
+  double y_mm() const override { return MeasuredDisplacementMm(rig_, state_); }
+  double MeasuredYMm(double noise_mm) const override { return MeasuredDisplacementMm(rig_, state_, noise_mm); }
+  double f_kN() const override { return MeasuredForceKn(rig_, state_); }
+  double current_A() const override { return 0.0; }
+  std::int64_t k() const override { return k_; }
+
+ private:
+  const BenchmarkRig rig_;
+  BenchmarkRigState state_{};
+  std::int64_t k_ = 0;
+};
+
 }  // namespace
 
 bool HasDamper(const models::PlantConfig& plant) { return plant.specimen == Specimen::kMrDamper; }
@@ -142,6 +162,8 @@ std::unique_ptr<Rig> MakeRig(const models::PlantConfig& plant, double dt_s) {
         throw Error("plant.cvode_rtol", fmt::format("must be in (0, 1e-2] (got {})", plant.cvode_rtol));
       return std::make_unique<IdealRig>(plant.damper, damper, plant.current_dynamics, dt_s,
                                         plant.cvode_rtol, plant.current_driver);
+    case PlantKind::kBenchmark:  // the specimen is the benchmark's experimental substructure, inside Gp
+      return std::make_unique<BenchmarkRigAdapter>(BenchmarkRig::Make(plant.benchmark, dt_s));
   }
   throw Error("plant.kind", "unknown loading system");
 }

@@ -2,7 +2,8 @@
 /// @file One interface for the plant participant's loading system + specimen: the linear rig
 /// (Eqs. 28-30 with the MR damper, lib/models/linear_rig.h) or the physics-based rig (docs/models.md
 /// section 5, lib/models/servo_physical.h), both with the optional current dynamics (Eq. 40 and
-/// the 75 Hz low-pass, lib/models/current_driver.h). Units: mm, kN, A, s (docs/units.md).
+/// the 75 Hz low-pass, lib/models/current_driver.h), or the control plant of the RTHS benchmark
+/// problem (lib/models/benchmark_rig.h). Units: mm, kN, A, s (docs/units.md).
 ///
 /// Step indices (docs/lockstep.md): after k calls of Step() the rig is at sample k; y_mm(),
 /// f_kN() and current_A() are the sensor readings at t_k, made from the state after holding
@@ -14,6 +15,7 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include "models/benchmark_rig.h"
 #include "models/current_driver.h"
 #include "models/mr_damper.h"
 #include "models/rig_effects.h"
@@ -24,10 +26,13 @@
 namespace rths::models {
 
 /// The loading system (PlantConfig::kind): the linear three-pole model, the servovalve / oil
-/// column / piston model ("physical" in files: docs/models.md section 5), or ideal tracking.
-enum class PlantKind { kLinear, kPhysical, kIdeal };
-inline constexpr std::array<Named<PlantKind>, 3> kPlantKindNames = {
-    {{PlantKind::kLinear, "linear"}, {PlantKind::kPhysical, "physical"}, {PlantKind::kIdeal, "ideal"}}};
+/// column / piston model ("physical" in files: docs/models.md section 5), ideal tracking, or the
+/// RTHS benchmark's control plant ("benchmark": docs/benchmark.md).
+enum class PlantKind { kLinear, kPhysical, kIdeal, kBenchmark };
+inline constexpr std::array<Named<PlantKind>, 4> kPlantKindNames = {{{PlantKind::kLinear, "linear"},
+                                                                     {PlantKind::kPhysical, "physical"},
+                                                                     {PlantKind::kIdeal, "ideal"},
+                                                                     {PlantKind::kBenchmark, "benchmark"}}};
 /// The specimen on the actuator (PlantConfig::specimen).
 enum class Specimen { kMrDamper, kNone };
 inline constexpr std::array<Named<Specimen>, 2> kSpecimenNames = {
@@ -39,7 +44,10 @@ struct PlantConfig {
   /// specimen; "physical": the servovalve / oil column / piston model of docs/models.md section 5
   /// loaded by the damper force (control-structure interaction); "ideal": the pure numerical
   /// simulation, a loading system that tracks perfectly (y_k = r_k, the damper driven by the
-  /// desired motion; answers measured_t k from desired_t k: docs/lockstep.md, footnote).
+  /// desired motion; answers measured_t k from desired_t k: docs/lockstep.md, footnote);
+  /// "benchmark": the fifth-order control plant Gp of the RTHS benchmark problem (Silva et al.
+  /// 2020) with its experimental substructure as the specimen, `benchmark` below
+  /// (lib/models/benchmark_rig.h; specimen, damper and current settings do not apply).
   PlantKind kind = PlantKind::kLinear;
   ServoModel3 actuator{};              ///< "linear": servohydraulic model
   PhysicalActuatorConfig physical{};   ///< "physical": its parameters
@@ -50,6 +58,8 @@ struct PlantConfig {
   /// The form of those dynamics, `[plant.current_driver]` (models/current_driver.h): Eq. 40 + the
   /// low-pass (default) or the first-order filter of Spencer et al. (1997) with its eta.
   CurrentDriverParams current_driver{};
+  /// "benchmark": the plant's constants (SI) and DAQ, `[plant.benchmark]` and `[plant.benchmark.daq]`.
+  BenchmarkRigConfig benchmark{};
   double noise_y_mm_rms = 0.0;         ///< Gaussian sensor noise on y [mm], [0, 10]
   double noise_f_kN_rms = 0.0;         ///< Gaussian sensor noise on f [kN], [0, 100]
   std::uint64_t noise_seed = 7;
@@ -80,6 +90,9 @@ class Rig {
   virtual void Step(double u_mm, double i_cmd_A) = 0;
   /// Measured actuator displacement y_k [mm].
   virtual double y_mm() const = 0;
+  /// The displacement reading y_k [mm] with the sensor noise noise_mm [mm] added where the sensor
+  /// adds it: y_mm() + noise_mm, or for "benchmark" with its DAQ on, before the A/D converter.
+  virtual double MeasuredYMm(double noise_mm) const { return y_mm() + noise_mm; }
   /// Measured specimen force f_k [kN] (0 without a specimen).
   virtual double f_kN() const = 0;
   /// Effective damper current i_c(t_k) [A] (after Eq. 40 and the low-pass if they are on).
@@ -101,7 +114,9 @@ class Rig {
 /// (x = r_k, x' = that velocity).
 ///
 /// The rig that `plant` describes ("linear" | "physical" | "ideal"; specimen "mr_damper" | "none";
-/// current_dynamics; cvode_rtol; the damper parameters plant.damper), stepping at dt_s [s].
+/// current_dynamics; cvode_rtol; the damper parameters plant.damper), stepping at dt_s [s];
+/// "benchmark": the benchmark's plant of plant.benchmark (specimen, damper and current settings
+/// ignored; current_A() is 0).
 /// With effects or unmodelled disturbances on (plant.RigMode()), the rig mode of
 /// lib/models/effect_rig.h, which needs kind "linear"; otherwise the nominal rigs, unchanged.
 /// Throws rths::Error for a bad kind or value.

@@ -40,7 +40,7 @@ void Plant::Publish(std::int64_t k) {
   const double nf = noise_f_kN_ > 0.0 ? noise_f_kN_ * signal::NextGaussian(&noise_) : 0.0;
   out_.run_id = id_.run_id;
   out_.k = k;
-  out_.y_mm = rig_->y_mm() + ny;
+  out_.y_mm = rig_->MeasuredYMm(ny);  // y_mm() + ny; "benchmark" with its DAQ: noise before the A/D
   out_.f_kN = rig_->f_kN() + nf;
   out_.current_A = rig_->current_A();  // effective current at t_k
   Answer(lockstep::kChMeasured, &cache_, k, out_);

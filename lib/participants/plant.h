@@ -11,9 +11,10 @@
 /// footnote).
 ///
 /// The rig is plant.kind's (models::MakeRig: "linear", Eqs. 28-30; "physical", docs/models.md
-/// section 5; docs/plant.md). measured_t k carries y_k [mm], f_k [kN] (plus the scenario's sensor
-/// noise) and current_A = the effective damper current i_c(t_k) [A] (after Eq. 40 and the 75 Hz
-/// low-pass when plant.current_dynamics; 0 at k = 0).
+/// section 5; "benchmark", docs/benchmark.md; docs/plant.md). measured_t k carries y_k [mm], f_k
+/// [kN] (plus the scenario's sensor noise, plant.noise_*_rms: on y before the benchmark's A/D
+/// converter when its DAQ is on) and current_A = the effective damper current i_c(t_k) [A] (after
+/// Eq. 40 and the 75 Hz low-pass when plant.current_dynamics; 0 at k = 0; always 0 for "benchmark").
 #include <memory>
 #include <optional>
 

@@ -446,6 +446,28 @@ void DamperFields(V& v, models::MrDamperParams& d) {
   }
 }
 
+/// `[plant.benchmark]`: the benchmark's plant constants (SI, models::BenchmarkPlantParams) and
+/// its DAQ. Per-key ranges here; Gp's stability is ValidatePlant's (ValidateBenchmarkParams).
+template <typename V>
+void BenchmarkFields(V& v, models::BenchmarkRigConfig& b) {
+  models::BenchmarkPlantParams& p = b.params;
+  v.Number("gain", p.gain, Open(0.0, kInf));
+  v.Number("a1b0", p.a1b0, Open(0.0, kInf));
+  v.Number("a2", p.a2, ClosedOpen(0.0, kInf));
+  v.Number("a3", p.a3, {-kInf, kInf, true, true, "any finite value; Gp must stay stable"});
+  v.Number("b1", p.b1, Open(0.0, kInf));
+  v.Number("b2", p.b2, Open(0.0, kInf));
+  v.Number("m_e_kg", p.m_e_kg, Open(0.0, kInf));
+  v.Number("k_e_N_per_m", p.k_e_N_per_m, Open(0.0, kInf));
+  v.Number("zeta_e", p.zeta_e, ClosedOpen(0.0, kInf));
+  v.Table("daq", [&](V& t) {
+    t.Bool("enabled", b.daq.enabled);
+    t.Number("volts_per_m", b.daq.volts_per_m, Open(0.0, kInf));
+    t.Number("saturation_V", b.daq.saturation_V, Open(0.0, kInf));
+    t.Integer("bits", b.daq.bits, Closed(2, 32));
+  });
+}
+
 template <typename V>
 void PlantFields(V& v, PlantConfig& p, const Context& cx) {
   v.Choice("kind", p.kind, models::kPlantKindNames);
@@ -457,6 +479,7 @@ void PlantFields(V& v, PlantConfig& p, const Context& cx) {
   v.Integer("noise_seed", p.noise_seed);
   v.Number("cvode_rtol", p.cvode_rtol, OpenClosed(0.0, 1e-2));
   v.Table("physical", [&](V& t) { PhysicalFields(t, p.physical); });
+  v.Table("benchmark", [&](V& t) { BenchmarkFields(t, p.benchmark); });
   v.Table("damper", [&](V& t) { DamperFields(t, p.damper); });
   v.Table("current_driver", [&](V& t) {
     models::CurrentDriverParams& d = p.current_driver;
@@ -834,6 +857,10 @@ void ValidatePlant(const PlantConfig& p, const Check& check) {
     const std::size_t colon = w.rfind(": ");
     check.Fail(fmt::format("plant.damper.{}", colon == std::string::npos ? w : w.substr(colon + 2)), e.problem());
   }
+  // The benchmark plant's stability (its keys' ranges are checked already): every kind, like
+  // plant.damper, so a table that cannot run is refused even while another kind is chosen.
+  models::ValidateBenchmarkParams(p.benchmark.params, fmt::format("{}: plant.benchmark", check.file()));
+  models::ValidateBenchmarkDaq(p.benchmark.daq, fmt::format("{}: plant.benchmark.daq", check.file()));
   if (p.current_driver.kind == models::CurrentFilter::kEq40 &&
       p.current_driver.lag_zero_rad_s == p.current_driver.lag_pole_rad_s)
     check.Fail("plant.current_driver.lag_zero_rad_s",
