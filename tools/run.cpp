@@ -603,7 +603,7 @@ int main(int argc, char** argv) {
   sum.steps_expected = s.steps();
   sum.wall_s = wall_s;
   sum.output_estimate_bytes = estimate;
-  rths::participants::ReadLog((out / "log.lcm").string(), &sum);
+  rths::participants::ReadLog((out / "log.lcm").string(), s, &sum);  // + J1-J9 with a reference_file
   rths::participants::SetOutcomes(outcomes, &sum);
   rths::participants::SetVerdict(verdict, g_interrupted != 0, &sum);
   if (sum.failure && noticed != Clock::time_point{}) {

@@ -5,6 +5,8 @@
 
 #include <fmt/format.h>
 
+#include "io/benchmark_run.h"
+
 namespace rths::participants {
 
 double RunSummary::steps_per_s() const {
@@ -34,6 +36,17 @@ nlohmann::json RunSummary::ToJson() const {
     j["duplicates_logged"] = duplicates_logged;
   }
   if (!log_error.empty()) j["log_error"] = log_error;
+  if (benchmark_criteria) {
+    const signal::BenchmarkCriteria& c = *benchmark_criteria;
+    nlohmann::json b = {{"J1_ms", c.J1_ms},   {"J2_pct", c.J2_pct}, {"J3_pct", c.J3_pct},
+                        {"J4_pct", c.J4_pct}, {"J5_pct", c.J5_pct}, {"J6_pct", c.J6_pct},
+                        {"J7_pct", c.J7_pct}, {"J8_pct", c.J8_pct}, {"J9_pct", c.J9_pct},
+                        {"lag_samples", c.lag_samples}};
+    b["floors"] = nlohmann::json::array();  // which floors J6-J9 are (every floor but the actuator's)
+    for (const auto& f : c.floors) b["floors"].push_back({{"floor", f.floor}, {"std_pct", f.std_pct}, {"max_pct", f.max_pct}});
+    j["benchmark_criteria"] = b;
+  }
+  if (!benchmark_error.empty()) j["benchmark_criteria_error"] = benchmark_error;
   j["status"] = status;
   j["exit_code"] = exit_code;
   j["stopped"] = stopped;
@@ -63,6 +76,8 @@ std::string RunSummary::Report(double dt_s) const {
     o += fmt::format("  rate               {:.0f} steps/s ({:.2f}x real time)\n", steps_per_s(),
                      steps_per_s() * dt_s);
   }
+  if (benchmark_criteria) o += "  benchmark          " + benchmark_criteria->Format() + "\n";
+  if (!benchmark_error.empty()) o += "  benchmark          no J1-J9: " + benchmark_error + "\n";
   if (realtime.is_object() && realtime.contains("steps")) {
     const auto& rt = realtime;
     const double period_us = rt["period_us"].get<double>();
@@ -89,15 +104,43 @@ std::string RunSummary::Report(double dt_s) const {
   return o;
 }
 
+namespace {
+/// steps, metrics and duplicates_logged from a log that was read. Throws what ComputeMetrics throws.
+void ReadLog(const io::RunLog& log, RunSummary* s) {
+  const io::RunMetrics m = io::ComputeMetrics(log);
+  s->steps = m.steps;
+  s->metrics = m;
+  s->duplicates_logged = 0;
+  for (const auto& [channel, n] : log.duplicates) s->duplicates_logged += n;
+  s->log_error.clear();
+}
+}  // namespace
+
 void ReadLog(const std::string& log_path, RunSummary* s) {
   try {
+    ReadLog(io::ReadRunLog(log_path), s);
+  } catch (const std::exception& e) {
+    s->steps = 0;
+    s->metrics.reset();
+    s->log_error = e.what();
+  }
+}
+
+void ReadLog(const std::string& log_path, const scenario::Scenario& scenario, RunSummary* s) {
+  s->benchmark_criteria.reset();
+  s->benchmark_error.clear();
+  if (scenario.structure.reference_file.empty()) {
+    ReadLog(log_path, s);
+    return;
+  }
+  try {
     const io::RunLog log = io::ReadRunLog(log_path);
-    const io::RunMetrics m = io::ComputeMetrics(log);
-    s->steps = m.steps;
-    s->metrics = m;
-    s->duplicates_logged = 0;
-    for (const auto& [channel, n] : log.duplicates) s->duplicates_logged += n;
-    s->log_error.clear();
+    ReadLog(log, s);
+    try {
+      s->benchmark_criteria = io::BenchmarkCriteriaOfRun(log, scenario);
+    } catch (const std::exception& e) {
+      s->benchmark_error = e.what();
+    }
   } catch (const std::exception& e) {
     s->steps = 0;
     s->metrics.reset();

@@ -12,6 +12,8 @@
 #include "io/run_log.h"
 #include "lockstep/runtime.h"
 #include "participants/group.h"
+#include "scenario/scenario.h"
+#include "signal/benchmark_criteria.h"
 
 namespace rths::participants {
 
@@ -31,6 +33,10 @@ struct RunSummary {
   std::optional<io::RunMetrics> metrics;  ///< Eq. 31 error, peaks, extrapolation errors (if the log was read)
   std::int64_t duplicates_logged = 0;     ///< duplicate events in the log, all channels
   std::string log_error;          ///< why the log could not be read ("" if it could)
+  /// The RTHS benchmark's J1-J9 over the logged steps (raw values), when the scenario has a
+  /// structure.reference_file (ReadLog with the scenario; io/benchmark_run.h).
+  std::optional<signal::BenchmarkCriteria> benchmark_criteria;
+  std::string benchmark_error;    ///< why they could not be computed ("" if they were or were not asked for)
 
   // From the outcomes (SetOutcomes, SetVerdict).
   double stepping_s = 0.0;        ///< [s] the clock's GO to its last committed step
@@ -55,14 +61,19 @@ struct RunSummary {
   /// Steps per second of the clock's stepping time (0 if unknown).
   double steps_per_s() const;
   nlohmann::json ToJson() const;
-  /// The terminal lines after a run (steps, Eq. 31 error, peak force, rate, real-time figures,
-  /// link repairs); dt_s [s] turns the rate into a multiple of real time.
+  /// The terminal lines after a run (steps, Eq. 31 error, peak force, rate, the benchmark's J1-J9
+  /// if computed, real-time figures, link repairs); dt_s [s] turns the rate into a multiple of real
+  /// time.
   std::string Report(double dt_s) const;
 };
 
 /// Sets steps, metrics and duplicates_logged from the run's log at `log_path`, or log_error
 /// (steps 0) if it cannot be read.
 void ReadLog(const std::string& log_path, RunSummary* s);
+/// ReadLog, then, if `scenario` has a structure.reference_file, the benchmark's J1-J9 over the
+/// log's complete steps (io::BenchmarkCriteriaOfRun) into benchmark_criteria, or why not into
+/// benchmark_error (too few steps, a diverged run, ...; never thrown).
+void ReadLog(const std::string& log_path, const scenario::Scenario& scenario, RunSummary* s);
 
 /// Sets participants, stepping_s (the clock's) and link (summed over the participants whose
 /// statistics are known).

@@ -145,7 +145,7 @@ RunResult RunOne(const RunSpec& spec) {
       error = fmt::format("{} exited with code {}: {}", culprit->role, culprit->exit_code, culprit->message);
     }
     sum.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    participants::ReadLog((spec.dir / "log.lcm").string(), &sum);
+    participants::ReadLog((spec.dir / "log.lcm").string(), s, &sum);  // + J1-J9 with a reference_file
     participants::SetVerdict(participants::Judge(outcomes), false, &sum);
     if (error.empty() && !sum.log_error.empty()) error = sum.log_error;
     if (error.empty() && sum.steps != s.steps()) {

@@ -12,7 +12,9 @@
 
 #include "core/error.h"
 #include "core/names.h"
+#include "io/benchmark_run.h"
 #include "io/plot.h"
+#include "signal/benchmark_criteria.h"
 #include "signal/spectral.h"
 
 namespace rths::report {
@@ -342,6 +344,114 @@ FrequencyFigures Frequency(const io::RunSignals& s, const RunReportOptions& o) {
       "-phase/(2&pi;f) median {:.3g} ms</td></tr>\n",
       f_lo, f_hi, *std::min_element(mags.begin(), mags.end()), *std::max_element(mags.begin(), mags.end()),
       sorted[sorted.size() / 2]);
+  return out;
+}
+
+/// The RTHS benchmark's criteria and their figure (scenarios with structure.reference_file).
+struct BenchmarkSection {
+  std::optional<PageFigure> figure;
+  std::string table_html;  ///< the J1-J9 table ("" if none)
+  std::string note;        ///< why there are no criteria ("" if there are)
+};
+
+BenchmarkSection Benchmark(const RunData& d, const RunReportOptions& o) {
+  BenchmarkSection out;
+  if (!d.scenario || d.scenario->structure.reference_file.empty()) return out;
+  signal::BenchmarkSignals b;
+  signal::BenchmarkCriteria c;
+  try {
+    b = io::BenchmarkSignalsFromRun(d.signals, *d.scenario);
+    c = signal::BenchmarkCriteriaFrom(b);
+  } catch (const std::exception& e) {
+    out.note = std::string("no benchmark criteria J1-J9: ") + e.what();
+    return out;
+  }
+  const signal::BenchmarkCriteria r = c.Rounded();
+  const int a = b.actuator_floor;
+  auto pct = [](double v) { return std::isfinite(v) ? fmt::format("{:.2f} %", v) : std::string("n/a"); };
+  std::string h = "<table id=\"benchmark_criteria\">\n<tr><th>criterion</th><th>value</th><th>what</th></tr>\n";
+  auto row = [&](const std::string& name, const std::string& value, const std::string& what) {
+    std::string id = name;
+    std::replace(id.begin(), id.end(), ' ', '_');
+    h += fmt::format("<tr><th>{}</th><td id=\"{}\">{}</td><td>{}</td></tr>\n", name, id, value, what);
+  };
+  row("J1", std::isfinite(r.J1_ms) ? fmt::format("{:.1f} ms", r.J1_ms) : "n/a",
+      fmt::format("time delay of x<sub>m</sub> behind x<sub>t</sub>: the lag in 0-49 steps of largest correlation "
+                  "({} steps)",
+                  c.lag_samples));
+  row("J2", pct(r.J2_pct), "std(x<sub>m</sub> - x<sub>t</sub>) / std(x<sub>t</sub>): tracking error");
+  row("J3", pct(r.J3_pct), "max|x<sub>m</sub> - x<sub>t</sub>| / max|x<sub>t</sub>|: peak tracking error");
+  row("J4", pct(r.J4_pct), fmt::format("std(x<sub>m</sub> - x<sub>r,{0}</sub>) / std(x<sub>r,{0}</sub>): against the "
+                                       "reference structure",
+                                       a));
+  row("J5", pct(r.J5_pct), fmt::format("max|x<sub>m</sub> - x<sub>r,{0}</sub>| / max|x<sub>r,{0}</sub>|", a));
+  // J6, J7: std ratios of the first two other floors; J8, J9: their max ratios (in that order).
+  const std::size_t named = std::min<std::size_t>(2, r.floors.size());
+  const double std_values[2] = {r.J6_pct, r.J7_pct}, max_values[2] = {r.J8_pct, r.J9_pct};
+  for (std::size_t i = 0; i < named; ++i)
+    row(i == 0 ? "J6" : "J7", pct(std_values[i]),
+        fmt::format("std(x<sub>n,{0}</sub> - x<sub>r,{0}</sub>) / std(x<sub>r,{0}</sub>): floor {0}", r.floors[i].floor));
+  for (std::size_t i = 0; i < named; ++i)
+    row(i == 0 ? "J8" : "J9", pct(max_values[i]),
+        fmt::format("max|x<sub>n,{0}</sub> - x<sub>r,{0}</sub>| / max|x<sub>r,{0}</sub>|: floor {0}", r.floors[i].floor));
+  for (std::size_t i = named; i < r.floors.size(); ++i)
+    row(fmt::format("floor {}", r.floors[i].floor), fmt::format("{} / {}", pct(r.floors[i].std_pct), pct(r.floors[i].max_pct)),
+        "std / max ratios as J6 / J8, for this floor");
+  h += "</table>\n<p class=\"where\">RTHS benchmark (Silva et al. 2020; docs/benchmark.md), over the " +
+       std::to_string(b.x_m.size()) + " logged steps: x<sub>m</sub> = y (measured), x<sub>t</sub> = r (the numerical "
+       "substructure's floor " + std::to_string(a) + "), x<sub>n,i</sub> its floors, x<sub>r,i</sub> the reference "
+       "structure (" + HtmlEscape(d.scenario->structure.reference_file) +
+       ") integrated offline under the logged ground acceleration. J1 to 0.1 ms, the others to 0.01 %.</p>\n";
+  out.table_html = h;
+
+  const std::vector<double>& t = d.signals.At("t_s").values;
+  const std::size_t m = o.max_plot_points;
+  const std::size_t ai = static_cast<std::size_t>(a - 1);
+  Panel act = MakePanel(fmt::format("Actuator floor {}", a), "t [s]", "displacement [mm]");
+  Series sxr = History(fmt::format("x_r,{} (reference)", a), "black", t, b.x_r[ai], m);
+  sxr.dash = 2;
+  act.series = {History("x_t = r (target)", kColorU, t, b.x_t, m), History("x_m = y (measured)", kColorY, t, b.x_m, m),
+                sxr};
+  std::vector<double> e_t(b.x_m.size()), e_r(b.x_m.size());
+  for (std::size_t k = 0; k < e_t.size(); ++k) {
+    e_t[k] = b.x_m[k] - b.x_t[k];
+    e_r[k] = b.x_m[k] - b.x_r[ai][k];
+  }
+  Panel err = MakePanel("Errors of the measured displacement", "t [s]", "error [mm]");
+  err.series = {History("x_m - x_t (J2, J3)", kColorE, t, e_t, m),
+                History(fmt::format("x_m - x_r,{} (J4, J5)", a), kColorF, t, e_r, m)};
+  PageFigure pf{NewFigure("benchmark", o), "Benchmark: measured, target and reference", ""};
+  pf.figure.panels = {act, err};
+  // The other floors: numerical against reference (J6-J9), at most 6 panels (the lowest 5 and the top).
+  std::vector<int> floors;
+  for (const auto& f : c.floors) floors.push_back(f.floor);
+  if (floors.size() > 6) floors.erase(floors.begin() + 5, floors.end() - 1);
+  for (int f : floors) {
+    const std::size_t fi = static_cast<std::size_t>(f - 1);
+    Panel p = MakePanel(fmt::format("Floor {}", f), "t [s]", "displacement [mm]");
+    Series r_i = History(fmt::format("x_r,{} (reference)", f), "black", t, b.x_r[fi], m);
+    r_i.dash = 2;
+    p.series = {History(fmt::format("x_n,{} (numerical)", f), kColorU, t, b.x_n[fi], m), r_i};
+    pf.figure.panels.push_back(p);
+  }
+  pf.figure.panel_height_px = 260;
+  // Legends beside the axes (the curves fill the panels), equal margins so the time axes line up.
+  std::vector<const Panel*> panels;
+  for (const Panel& p : pf.figure.panels) panels.push_back(&p);
+  const int right = io::KeyMarginChars(panels);
+  pf.figure.width_px = 1200;
+  for (Panel& p : pf.figure.panels) {
+    p.key = "outside right top";
+    p.left_margin_chars = 10;
+    p.right_margin_chars = right;
+  }
+  pf.caption_html = fmt::format(
+      "Top: the target x<sub>t</sub> = r, the measured x<sub>m</sub> = y and the reference structure's floor {0} "
+      "x<sub>r,{0}</sub> [mm]; then the errors x<sub>m</sub> - x<sub>t</sub> and x<sub>m</sub> - x<sub>r,{0}</sub> "
+      "[mm]; then each other floor of the numerical substructure x<sub>n,i</sub> against the reference "
+      "x<sub>r,i</sub> [mm] (J6-J9){1}.",
+      a, c.floors.size() > floors.size() ? fmt::format(", {} of {} floors shown", floors.size(), c.floors.size()) : "");
+  out.figure = pf;
   return out;
 }
 
@@ -746,6 +856,7 @@ ReportFiles WriteRunReport(const RunData& d, const RunReportOptions& o) {
   std::vector<PageFigure> figures;
   std::vector<std::string> figure_notes;
   std::string frequency_summary;
+  std::string benchmark_html;  // the J1-J9 table (scenarios with structure.reference_file)
   if (d.signals.steps() >= 2) {
     figures.push_back(TimeHistories(d.signals, o));
     figures.push_back(TrackingError(d.signals, o));
@@ -755,6 +866,10 @@ ReportFiles WriteRunReport(const RunData& d, const RunReportOptions& o) {
     if (ff.gyr) figures.push_back(*ff.gyr);
     frequency_summary = ff.summary_html;
     figure_notes = ff.notes;
+    BenchmarkSection bs = Benchmark(d, o);
+    if (bs.figure) figures.push_back(*bs.figure);
+    benchmark_html = bs.table_html;
+    if (!bs.note.empty()) figure_notes.push_back(bs.note);
   } else {
     figure_notes.push_back(fmt::format("no figures: the log holds {} complete step(s)", d.signals.steps()));
   }
@@ -767,7 +882,7 @@ ReportFiles WriteRunReport(const RunData& d, const RunReportOptions& o) {
     }
   }
   // An earlier report's figure that this one does not draw would stay beside the page: remove it.
-  for (const char* stale : {"time_histories", "tracking_error", "loops", "spectra", "gyr"}) {
+  for (const char* stale : {"time_histories", "tracking_error", "loops", "spectra", "gyr", "benchmark"}) {
     if (std::any_of(drawn.begin(), drawn.end(), [&](const PageFigure& pf) { return pf.figure.name == stale; }))
       continue;
     for (const char* ext : {".png", ".dat", ".gp"}) fs::remove(fig_dir / (std::string(stale) + ext), ec);
@@ -796,6 +911,7 @@ ReportFiles WriteRunReport(const RunData& d, const RunReportOptions& o) {
     h += "</div>\n";
   }
   h += "<h2 id=\"results\">Results</h2>\n<table>\n" + MetricsTable(d) + frequency_summary + "</table>\n";
+  if (!benchmark_html.empty()) h += "<h2 id=\"criteria\">Benchmark criteria J1-J9</h2>\n" + benchmark_html;
   h += RealtimeTable(d.summary);
   h += "<h2 id=\"scenario\">Scenario</h2>\n<table>\n" + ScenarioTable(d) + "</table>\n";
   if (!d.scenario_toml.empty()) {

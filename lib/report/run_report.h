@@ -16,6 +16,10 @@
 ///   spectra.png         Welch PSDs of r, y, e [mm^2/Hz] (signal/spectral.h)
 ///   gyr.png             G_yr = Y/R by H1: magnitude [-], phase [deg] and coherence [-], limited to
 ///                       the excited band of r, points of low coherence masked
+///   benchmark.png       scenarios with structure.reference_file (the RTHS benchmark, docs/benchmark.md):
+///                       x_t = r, x_m = y and the reference's actuator floor x_r,a; x_m - x_t and
+///                       x_m - x_r,a; each other floor x_n,i against x_r,i [mm] against t [s]. The page
+///                       then also has the table of J1-J9 (io/benchmark_run.h).
 #include <cstdint>
 #include <filesystem>
 #include <optional>

@@ -384,6 +384,7 @@ void StructureFields(V& v, StructureConfig& st, const Context& cx) {
   v.Choice("derivatives", st.derivatives, models::kDerivativesNames);
   v.Choice("kind", st.kind, models::kStructureKindNames);
   v.String("file", st.file);
+  v.String("reference_file", st.reference_file);  // ValidateStructure: only with kind = "file"
   v.Integer("actuator_dof", st.actuator_dof);  // ValidateStructure: when kind = "file"
   v.Table("ground", [&](V& t) { SignalFields(t, st.ground, "rms_mm_s2", cx); });
   v.Table("desired", [&](V& t) { SignalFields(t, st.desired, "rms_mm", cx); });
@@ -837,6 +838,33 @@ void ValidateSignal(const SignalSpec& s, std::string_view prefix, const std::str
   }
 }
 
+/// structure.reference_file (the benchmark criteria's monolithic reference, io/benchmark_run.h):
+/// only beside a structure file, loadable, with as many DOFs as structure.file.
+void ValidateReferenceFile(const StructureConfig& st, const std::string& scenario_path, const Check& check) {
+  const char* key = "structure.reference_file";
+  if (st.mode != models::StructureMode::kRths || st.kind != models::StructureKind::kFile) {
+    check.Fail(key, fmt::format("needs structure.mode = \"rths\" and structure.kind = \"file\" (got \"{}\", \"{}\"): "
+                                "the reference is compared with a structure file's floors; leave it \"\" otherwise",
+                                NameOf(models::kStructureModeNames, st.mode), NameOf(models::kStructureKindNames, st.kind)));
+  }
+  CheckFileExists(check, key, scenario_path, st.reference_file);
+  models::StructureMatrices ref, run;
+  try {
+    ref = models::LoadStructureFile(ResolveSignalFile(scenario_path, st.reference_file).string());
+  } catch (const Error& e) {
+    check.Fail(key, e.what());
+  }
+  try {
+    run = models::LoadStructureFile(ResolveSignalFile(scenario_path, st.file).string());
+  } catch (const Error&) {
+    return;  // structure.file's own problem, reported where the structure is built
+  }
+  if (ref.M.rows() != run.M.rows()) {
+    check.Fail(key, fmt::format("{} has {} DOFs but structure.file ({}) has {}: they must match",
+                                st.reference_file, ref.M.rows(), st.file, run.M.rows()));
+  }
+}
+
 void ValidateStructure(const StructureConfig& st, const std::string& scenario_path, const Check& check) {
   if (st.mode == models::StructureMode::kRths && st.kind == models::StructureKind::kFile) {
     if (st.file.empty()) check.Fail("structure.file", "missing: kind = \"file\" needs a structure file");
@@ -844,6 +872,7 @@ void ValidateStructure(const StructureConfig& st, const std::string& scenario_pa
     check.InRange("structure.actuator_dof", st.actuator_dof,
                   {1, 10000, false, false, "1-based; at most the structure's number of DOFs"});
   }
+  if (!st.reference_file.empty()) ValidateReferenceFile(st, scenario_path, check);
   ValidateSignal(st.ground, "structure.ground", scenario_path, check);
   ValidateSignal(st.desired, "structure.desired", scenario_path, check);
 }
@@ -959,6 +988,8 @@ Scenario ParseScenario(std::string_view toml_text, const std::string& path) {
     if (signal->kind == signal::SignalKind::kFile) signal->file = ResolveSignalFile(path, signal->file).string();
   }
   if (!s.structure.file.empty()) s.structure.file = ResolveSignalFile(path, s.structure.file).string();
+  if (!s.structure.reference_file.empty())
+    s.structure.reference_file = ResolveSignalFile(path, s.structure.reference_file).string();
   return s;
 }
 

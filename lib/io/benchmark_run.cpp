@@ -1,0 +1,75 @@
+#include "io/benchmark_run.h"
+
+#include <fmt/format.h>
+
+#include "core/error.h"
+#include "models/structure_file.h"
+
+namespace rths::io {
+
+std::vector<std::vector<double>> ReferenceResponse(const models::LinearStructure& reference, double dt_s,
+                                                   std::span<const double> ground_acc_mm_s2) {
+  const models::CentralDifference cd = models::CentralDifference::Make(reference, dt_s);
+  models::StructureState st = models::MakeState(cd);
+  const std::size_t n = ground_acc_mm_s2.size();
+  std::vector<std::vector<double>> x(static_cast<std::size_t>(cd.dofs()), std::vector<double>(n, 0.0));
+  for (std::size_t k = 0; k < n; ++k) {
+    if (k > 0) models::Advance(cd, &st, ground_acc_mm_s2[k - 1], 0.0);  // x_k from a_g,k-1 (as the integrator)
+    for (int i = 0; i < cd.dofs(); ++i) x[static_cast<std::size_t>(i)][k] = st.x[i];
+  }
+  return x;
+}
+
+models::LinearStructure ReferenceStructure(const scenario::Scenario& s, int run_dofs) {
+  const std::string where = fmt::format("{}: structure.reference_file", s.path.empty() ? "<scenario text>" : s.path);
+  const models::StructureConfig& st = s.structure;
+  if (st.reference_file.empty()) throw Error(where, "not set: the criteria need a reference structure");
+  models::StructureMatrices m;
+  try {
+    m = models::LoadStructureFile(st.reference_file);
+  } catch (const Error& e) {
+    throw Error(where, e.what());
+  }
+  if (m.M.rows() != run_dofs)
+    throw Error(where, fmt::format("{} has {} DOFs but the run's structure has {}: they must match", st.reference_file,
+                                   m.M.rows(), run_dofs));
+  if (st.actuator_dof < 1 || st.actuator_dof > run_dofs)
+    throw Error(fmt::format("{}: structure.actuator_dof", s.path),
+                fmt::format("{} is out of range [1, {}]", st.actuator_dof, run_dofs));
+  models::LinearStructure ref = models::LinearStructure::Make(m.M, m.C, m.K, st.actuator_dof - 1, 1.0);
+  if (m.iota.size()) ref.iota = m.iota;
+  return ref;
+}
+
+signal::BenchmarkSignals BenchmarkSignalsFromRun(const RunSignals& signals, const scenario::Scenario& s) {
+  int dofs = 0;
+  while (signals.Find(fmt::format("x{}_mm", dofs + 1))) ++dofs;
+  if (dofs == 0) throw Error("benchmark criteria", "the run's signals have no structure displacement (x1_mm)");
+  const models::LinearStructure ref = ReferenceStructure(s, dofs);
+  signal::BenchmarkSignals b;
+  b.dt_s = signals.dt_s;
+  b.actuator_floor = s.structure.actuator_dof;
+  b.x_m = signals.At("y_mm").values;
+  b.x_t = signals.At("r_mm").values;
+  for (int i = 1; i <= dofs; ++i) b.x_n.push_back(signals.At(fmt::format("x{}_mm", i)).values);
+  try {
+    b.x_r = ReferenceResponse(ref, signals.dt_s, signals.At("ground_acc_mm_s2").values);
+  } catch (const Error& e) {
+    throw Error(fmt::format("{}: structure.reference_file", s.path), e.what());
+  }
+  return b;
+}
+
+signal::BenchmarkCriteria BenchmarkCriteriaFromRun(const RunSignals& signals, const scenario::Scenario& s) {
+  return signal::BenchmarkCriteriaFrom(BenchmarkSignalsFromRun(signals, s));
+}
+
+signal::BenchmarkCriteria BenchmarkCriteriaOfRun(const RunLog& log, const scenario::Scenario& s) {
+  return BenchmarkCriteriaFromRun(SignalsFromRunLog(log, s.run.dt_s), s);
+}
+
+signal::BenchmarkCriteria BenchmarkCriteriaOfRun(const std::string& log_path, const scenario::Scenario& s) {
+  return BenchmarkCriteriaOfRun(ReadRunLog(log_path), s);
+}
+
+}  // namespace rths::io
