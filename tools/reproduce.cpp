@@ -17,6 +17,7 @@
 #include "core/error.h"
 #include "io/output_folder.h"
 #include "report/reproduce.h"
+#include "report/benchmark_study.h"
 #include "report/studies.h"
 
 namespace fs = std::filesystem;
@@ -55,10 +56,13 @@ int main(int argc, char** argv) {
   int jobs = 2;
   app.add_option("name", name, "what to reproduce")
       ->required()
-      ->check(CLI::IsMember({"fig5", "fig6", "fig7", "fig8", "fig9", "fig11", "table2"}));
+      ->check(CLI::IsMember({"fig5", "fig6", "fig7", "fig8", "fig9", "fig11", "table2", "benchmark"}));
   app.add_option("--out", out_arg, "output folder (default: a new folder under runs/); never overwritten");
   app.add_flag("--quick", quick, "shorter records (for tests; numbers are noisier)");
-  app.add_option("--plant", plant, "plant for the lockstep runs")
+  bool keep_logs = false;
+  app.add_flag("--keep-logs", keep_logs,
+               "benchmark: keep every perturbed run's log.lcm (default: removed once scored; about 50 MB per full run)");
+  app.add_option("--plant", plant, "plant for the lockstep runs (not benchmark: it has its own plant)")
       ->check(CLI::IsMember({"physical", "linear"}))
       ->capture_default_str();
   app.add_option("--jobs", jobs, "lockstep groups run at the same time")->check(CLI::Range(1, 64))->capture_default_str();
@@ -120,6 +124,20 @@ int main(int argc, char** argv) {
       const auto r = rths::report::ReproduceFig11(opts);  // report/studies.h; table in fig11.md
       std::printf("fig11: %zu RTHS + %zu numerical runs in %.1f s; fig11_summary.json, fig11.md, PNGs\n",
                   r.runs.size(), r.numerical.size(), r.wall_s);
+    } else if (name == "benchmark") {
+      const auto r = rths::report::ReproduceBenchmark(opts, keep_logs);  // report/benchmark_study.h
+      const auto names = rths::report::BenchmarkControllerNames();
+      std::printf("\nnominal plant (J1 [ms], J2-J9 [%%]; benchmark.md has the perturbed runs' spread)\n%-8s", "");
+      for (int j = 1; j <= 9; ++j) std::printf(" %8s", fmt::format("J{}", j).c_str());
+      std::printf("\n");
+      for (const auto& row : r.rows) {
+        if (row.run != "nominal") continue;
+        const auto& j = row.j;
+        std::printf("%-8s %8.1f %8.2f %8.2f %8.2f %8.2f %8.2f %8.2f %8.2f %8.2f%s\n", row.controller.c_str(), j.J1_ms,
+                    j.J2_pct, j.J3_pct, j.J4_pct, j.J5_pct, j.J6_pct, j.J7_pct, j.J8_pct, j.J9_pct,
+                    row.stopped == "no" ? "" : "  (stopped)");
+      }
+      std::printf("\n%zu runs in %.1f s; benchmark.csv, benchmark.md, benchmark.png\n", r.rows.size(), r.wall_s);
     } else if (name == "fig6") {
       const auto r = rths::report::ReproduceFig6(opts);
       std::printf("\n%-5s %-3s %12s %12s %8s\n", "cond", "", "paper", "ours", "diff");
