@@ -497,7 +497,13 @@ std::string ScenarioTable(const RunData& d) {
   const auto& p = s.plant;
   std::string plant(NameOf(models::kPlantKindNames, p.kind));
   if (p.kind == models::PlantKind::kLinear) plant += ", actuator " + p.actuator.name;
-  plant += ", specimen " + std::string(NameOf(models::kSpecimenNames, p.specimen));
+  if (p.kind == models::PlantKind::kBenchmark) {  // the specimen is inside Gp: the experimental substructure
+    const auto& b = p.benchmark.params;
+    plant += fmt::format(", experimental substructure m_e {:g} kg, k_e {:g} N/m, zeta_e {:g}{}", b.m_e_kg, b.k_e_N_per_m,
+                         b.zeta_e, p.benchmark.daq.enabled ? ", DAQ on" : "");
+  } else {
+    plant += ", specimen " + std::string(NameOf(models::kSpecimenNames, p.specimen));
+  }
   if (p.RigMode()) plant += ", rig mode (effects on)";
   if (p.noise_y_mm_rms > 0 || p.noise_f_kN_rms > 0)
     plant += fmt::format(", sensor noise {:g} mm / {:g} kN RMS", p.noise_y_mm_rms, p.noise_f_kN_rms);
