@@ -1,21 +1,39 @@
-// bench-lockstep: LCM ping-pong round trips/s, lockstep steps/s on udpm and memq, and the
-// lockstep rate as a fraction of the ping-pong limit for its hops — all measured in one run,
-// side by side, because absolute times drift on shared machines.
+// bench-lockstep: what one udpm delivery and one send cost in CPU, the bound that puts on a
+// lockstep run of five processes on this machine's cores, and the lockstep rate on one port, on
+// a port per channel and on memq, as a fraction of that bound. Everything is measured in one run,
+// side by side, repeated (medians printed), because absolute times drift on shared machines.
 //
-//   build/bin/bench-lockstep [--seconds S] [--scenario FILE]
+//   build/bin/bench-lockstep [--seconds S] [--repeat N] [--round-trips N] [--scenario FILE]
 //
-// The lockstep step's critical path is three messages (desired_t -> command_t -> ack_t ->
-// next desired_t; docs/lockstep.md), so its limit is 2/3 of the round trips per second.
+// The bound. A step is CPU-bound, not latency-bound: its five messages (desired_t, command_t,
+// measured_t, current_t, ack_t) are each sent once and delivered to sockets. On one port (LCM's
+// udpm) every message reaches every socket of the run, the sender's included: 5 x 5 = 25
+// deliveries, 15 of them to a subscriber (handled) and 10 to a process that drops them (ignored).
+// With a port per channel (lockstep/transport.h) a message reaches only its subscribers: 15
+// handled deliveries, on our own sockets read in the event loop's thread (no LCM receive thread).
+// Ping-pongs between two processes, with idle or subscribed listeners added, give the CPU (user +
+// system, getrusage of every process) of one send s, one handled delivery h and one ignored
+// delivery i:
+//   one port:          C(L idle, S subscribed) per round trip = 2 s + 2 (1 + S) h + 2 (1 + L) i
+//   port per channel:  C(S subscribed)                       = 2 s + 2 (1 + S) h
+// A step then costs 5 s + 15 h + 10 i (one port) or 5 s + 15 h (port per channel) of CPU, and
+// the bound is cores / that: the rate if the participants computed and logged for free.
 #include <signal.h>
 #include <sys/prctl.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <memory>
+#include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <CLI/CLI.hpp>
@@ -24,109 +42,263 @@
 #include <nlohmann/json.hpp>
 
 #include "lockstep/runtime.h"
+#include "lockstep/transport.h"
 
 namespace fs = std::filesystem;
+namespace ls = rths::lockstep;
 
 namespace {
 
-/// Round trips per second between two processes on one udpm URL (payload of `bytes` bytes).
-double PingPong(const std::string& url, int round_trips, int bytes) {
-  const pid_t pid = ::fork();
-  if (pid == 0) {
-    ::prctl(PR_SET_PDEATHSIG, SIGTERM);
-    lcm::LCM lcm(url);
-    struct Echo {
-      lcm::LCM* lcm;
-      void On(const lcm::ReceiveBuffer* rb, const std::string&) {
-        lcm->publish("PONG", rb->data, rb->data_size);
-      }
-    } echo{&lcm};
-    lcm.subscribe("PING", &Echo::On, &echo);
-    for (;;) lcm.handle();
-  }
-  lcm::LCM lcm(url);
-  struct Counter {
-    int n = 0;
-    void On(const lcm::ReceiveBuffer*, const std::string&) { ++n; }
-  } counter;
-  lcm.subscribe("PONG", &Counter::On, &counter);
-  std::vector<std::uint8_t> payload(bytes, 0x5a);
-  // Warm up until the echo process is subscribed.
-  while (counter.n == 0) {
-    lcm.publish("PING", payload.data(), bytes);
-    lcm.handleTimeout(20);
-  }
-  counter.n = 0;
-  const auto t0 = std::chrono::steady_clock::now();
-  for (int i = 0; i < round_trips; ++i) {
-    lcm.publish("PING", payload.data(), bytes);
-    const int before = counter.n;
-    while (counter.n == before) {
-      if (lcm.handleTimeout(1000) <= 0) break;  // a lost datagram: count it as slow
-    }
-  }
-  const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  ::kill(pid, SIGTERM);
-  ::waitpid(pid, nullptr, 0);
-  return round_trips / s;
+/// Handled deliveries per step: the subscribers of each step channel (docs/lockstep.md):
+/// desired_t: controller, semiactive, plant, logger; command_t: integrator, plant, logger;
+/// measured_t: integrator, controller, semiactive, logger; current_t: integrator, plant, logger;
+/// ack_t: integrator.
+constexpr int kSendsPerStep = 5;
+constexpr int kHandledPerStep = 4 + 3 + 4 + 3 + 1;
+constexpr int kProcesses = 5;
+constexpr int kIgnoredPerStepOnePort = kSendsPerStep * kProcesses - kHandledPerStep;
+
+double CpuSeconds(int who) {
+  rusage u{};
+  ::getrusage(who, &u);
+  return u.ru_utime.tv_sec + u.ru_utime.tv_usec * 1e-6 + u.ru_stime.tv_sec + u.ru_stime.tv_usec * 1e-6;
 }
 
-double LockstepRate(const fs::path& bin, const fs::path& scenario, const std::string& transport,
-                    const fs::path& out) {
+/// The two channels of the ping-pong (run channels, so a per-channel transport carries them).
+constexpr const char* kPing = ls::kChDesired;
+constexpr const char* kPong = ls::kChCommand;
+
+/// A process that receives on one transport: echoes PING as PONG, or (a listener) only handles
+/// what it subscribed to. `subscribe`: 0 nothing (an idle LCM listener: subscribed to a channel no
+/// one sends), 1 PING (echo), 2 PING and PONG (a subscribed listener).
+[[noreturn]] void Child(const std::string& url, bool per_channel, int subscribe) {
+  ::prctl(PR_SET_PDEATHSIG, SIGTERM);
+  struct Ctx {
+    lcm::LCM* lcm = nullptr;
+    ls::UdpmChannels* ch = nullptr;
+    bool echo = false;
+  } ctx;
+  ctx.echo = subscribe == 1;
+  auto on = [](void* c, const lcm::ReceiveBuffer* rb) {
+    auto* x = static_cast<Ctx*>(c);
+    if (!x->echo) return;
+    if (x->ch) x->ch->Publish(kPong, rb->data, rb->data_size);
+    else x->lcm->publish(kPong, rb->data, rb->data_size);
+  };
+  if (per_channel) {
+    ls::UdpmChannels ch(*ls::UdpmUrl::Parse(url));
+    ctx.ch = &ch;
+    if (subscribe >= 1) ch.Subscribe(kPing, on, &ctx);
+    if (subscribe == 2) ch.Subscribe(kPong, on, &ctx);
+    for (;;) ch.HandleTimeout(1000);
+  }
+  lcm::LCM lcm(url);
+  ctx.lcm = &lcm;
+  struct Sub {
+    void (*f)(void*, const lcm::ReceiveBuffer*);
+    Ctx* c;
+    void On(const lcm::ReceiveBuffer* rb, const std::string&) { f(c, rb); }
+  } sub{on, &ctx};
+  if (subscribe == 0) lcm.subscribe("BENCH_NOTHING", &Sub::On, &sub);
+  if (subscribe >= 1) lcm.subscribe(kPing, &Sub::On, &sub);
+  if (subscribe == 2) lcm.subscribe(kPong, &Sub::On, &sub);
+  for (;;) lcm.handle();
+}
+
+/// CPU of one round trip [s], all processes together, with `idle` idle and `subscribed`
+/// subscribed listeners besides the echo, `round_trips` of a 160-byte payload.
+double PingPongCpu(const std::string& url, bool per_channel, int idle, int subscribed, int round_trips) {
+  std::vector<pid_t> kids;
+  auto spawn = [&](int subscribe) {
+    const pid_t pid = ::fork();
+    if (pid == 0) Child(url, per_channel, subscribe);
+    kids.push_back(pid);
+  };
+  spawn(1);
+  for (int i = 0; i < idle; ++i) spawn(0);
+  for (int i = 0; i < subscribed; ++i) spawn(2);
+  std::vector<std::uint8_t> payload(160, 0x5a);
+  int got = 0;
+  auto on = [](void* c, const lcm::ReceiveBuffer*) { ++*static_cast<int*>(c); };
+  std::unique_ptr<ls::UdpmChannels> ch;
+  std::unique_ptr<lcm::LCM> lcm;
+  struct Sub {
+    int* n;
+    void On(const lcm::ReceiveBuffer*, const std::string&) { ++*n; }
+  } sub{&got};
+  if (per_channel) {
+    ch = std::make_unique<ls::UdpmChannels>(*ls::UdpmUrl::Parse(url));
+    ch->Subscribe(kPong, on, &got);
+  } else {
+    lcm = std::make_unique<lcm::LCM>(url);
+    lcm->subscribe(kPong, &Sub::On, &sub);
+  }
+  auto publish = [&] { ch ? ch->Publish(kPing, payload.data(), 160) : lcm->publish(kPing, payload.data(), 160); };
+  auto handle = [&](int ms) { return ch ? ch->HandleTimeout(ms) : lcm->handleTimeout(ms); };
+  // Warm up until the echo answers, and the listeners have had time to join.
+  while (got == 0) {
+    publish();
+    handle(20);
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  while (handle(0) > 0) {
+  }
+  const double self0 = CpuSeconds(RUSAGE_SELF);
+  // The children's CPU so far: from their own clock, read through /proc before and after.
+  auto kids_cpu = [&] {
+    double total = 0;
+    const double tick = static_cast<double>(::sysconf(_SC_CLK_TCK));
+    for (const pid_t pid : kids) {
+      std::ifstream in(fmt::format("/proc/{}/stat", pid));
+      std::string all((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+      std::istringstream ss(all.substr(all.rfind(')') + 2));
+      std::string field;
+      unsigned long long ut = 0, st = 0;
+      for (int f = 3; f <= 15 && ss >> field; ++f) {
+        if (f == 14) ut = std::stoull(field);
+        if (f == 15) st = std::stoull(field);
+      }
+      total += (ut + st) / tick;
+    }
+    return total;
+  };
+  const double before = kids_cpu();
+  for (int i = 0; i < round_trips; ++i) {
+    const int want = got + 1;
+    publish();
+    while (got < want) {
+      if (handle(1000) <= 0) break;  // a lost datagram: count it as slow
+    }
+  }
+  const double self = CpuSeconds(RUSAGE_SELF) - self0;
+  const double children = kids_cpu() - before;
+  for (const pid_t pid : kids) ::kill(pid, SIGTERM);
+  for (const pid_t pid : kids) ::waitpid(pid, nullptr, 0);
+  return (self + children) / round_trips;
+}
+
+struct Run {
+  double steps_per_s = 0, cpu_per_step_s = 0;
+};
+
+Run LockstepRun(const fs::path& bin, const fs::path& scenario, const std::string& transport_args,
+                const fs::path& out, std::int64_t steps) {
   fs::remove_all(out);
-  const std::string cmd = fmt::format("{}/rths-run {} --transport {} --out {} --quiet > /dev/null",
-                                      bin.string(), scenario.string(), transport, out.string());
+  const std::string cmd = fmt::format("{}/rths-run {} {} --out {} --quiet > /dev/null", bin.string(),
+                                      scenario.string(), transport_args, out.string());
+  const double cpu0 = CpuSeconds(RUSAGE_CHILDREN);
   if (std::system(cmd.c_str()) != 0) {
     std::fprintf(stderr, "bench: %s failed\n", cmd.c_str());
-    return 0.0;
+    return {};
   }
   const auto j = nlohmann::json::parse(std::ifstream(out / "summary.json"));
-  return j["steps_per_s"].get<double>();
+  return {j["steps_per_s"].get<double>(), (CpuSeconds(RUSAGE_CHILDREN) - cpu0) / static_cast<double>(steps)};
+}
+
+double Median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v.empty() ? 0.0 : v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"bench-lockstep: LCM ping-pong vs lockstep steps/s on udpm and memq, one run"};
+  CLI::App app{"bench-lockstep: udpm delivery and send CPU, the bound it sets, and lockstep steps/s on one "
+               "port, a port per channel and memq, side by side"};
   double seconds = 5.0;
+  int repeat = 3, round_trips = 10000;
   std::string scenario;
   app.add_option("--seconds", seconds, "simulated seconds per lockstep run")->capture_default_str();
+  app.add_option("--repeat", repeat, "measurements of each kind (medians printed)")->capture_default_str();
+  app.add_option("--round-trips", round_trips, "round trips per ping-pong")->capture_default_str();
   app.add_option("--scenario", scenario, "base scenario (default: scenarios/default.toml)");
   CLI11_PARSE(app, argc, argv);
 
   const fs::path bin = fs::read_symlink("/proc/self/exe").parent_path();
   if (scenario.empty()) scenario = (bin / "../../scenarios/default.toml").lexically_normal().string();
-  if (const auto hint = rths::lockstep::CheckMulticastRoute(); !hint.empty()) {
+  if (const auto hint = ls::CheckMulticastRoute(); !hint.empty()) {
     std::fprintf(stderr, "bench: %s\n", hint.c_str());
     return 3;
   }
+  const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
   const fs::path tmp = fs::temp_directory_path() / fmt::format("rths_bench_{}", ::getpid());
   fs::create_directories(tmp);
-  // The default scenario, shortened.
   std::string text;
+  double dt = 0.0005;
   {
     std::ifstream in(scenario);
     std::string line;
     while (std::getline(in, line)) {
       if (line.rfind("duration_s", 0) == 0) line = fmt::format("duration_s = {}", seconds);
+      if (line.rfind("dt_s", 0) == 0) dt = std::stod(line.substr(line.find('=') + 1));
       text += line + "\n";
     }
   }
+  const auto steps = static_cast<std::int64_t>(std::llround(seconds / dt));
   const fs::path scen = tmp / "bench.toml";
   std::ofstream(scen) << text;
 
-  const int port = 7600 + ::getpid() % 300;
-  const std::string url = fmt::format("udpm://239.255.76.67:{}?ttl=0", port);
-  const double rt = PingPong(url, 20000, 160);
-  const double udpm = LockstepRate(bin, scen, "udpm", tmp / "udpm");
-  const double memq = LockstepRate(bin, scen, "memq", tmp / "memq");
-  const double limit = rt * 2.0 / 3.0;
-  std::printf("LCM udpm ping-pong            %10.0f round trips/s (160-byte payload)\n", rt);
-  std::printf("lockstep limit (3 hops/step)  %10.0f steps/s\n", limit);
-  std::printf("lockstep udpm (5 processes)   %10.0f steps/s  = %.2f x limit, %.2f x real time\n", udpm,
-              udpm / limit, udpm * 0.0005);
-  std::printf("lockstep memq (1 process)     %10.0f steps/s  = %.2f x udpm\n", memq, memq / udpm);
-  std::printf("target >= 4096 steps/s on udpm: %s\n", udpm >= 4096 ? "met" : "NOT met");
+  const int port = 17600 + ::getpid() % 2000 * 8;
+  const std::string one = fmt::format("udpm://239.255.76.67:{}?ttl=0", port);
+  const std::string per = fmt::format("udpm://239.255.76.67:{}?ttl=0&port_per_channel=1", port);
+  std::vector<double> c00, c10, c30, c01, p00, p01, r_one, r_per, r_memq, cpu_one, cpu_per, cpu_memq, gain;
+  for (int r = 0; r < repeat; ++r) {
+    c00.push_back(PingPongCpu(one, false, 0, 0, round_trips));
+    c10.push_back(PingPongCpu(one, false, 1, 0, round_trips));
+    c30.push_back(PingPongCpu(one, false, 3, 0, round_trips));
+    c01.push_back(PingPongCpu(one, false, 0, 1, round_trips));
+    p00.push_back(PingPongCpu(per, true, 0, 0, round_trips));
+    p01.push_back(PingPongCpu(per, true, 0, 1, round_trips));
+    const Run a = LockstepRun(bin, scen, "--transport udpm", tmp / "one", steps);
+    const Run b = LockstepRun(bin, scen, "--transport udpm --port-per-channel", tmp / "per", steps);
+    const Run m = LockstepRun(bin, scen, "--transport memq", tmp / "memq", steps);
+    r_one.push_back(a.steps_per_s);
+    r_per.push_back(b.steps_per_s);
+    r_memq.push_back(m.steps_per_s);
+    cpu_one.push_back(a.cpu_per_step_s);
+    cpu_per.push_back(b.cpu_per_step_s);
+    cpu_memq.push_back(m.cpu_per_step_s);
+    gain.push_back(a.steps_per_s > 0 ? b.steps_per_s / a.steps_per_s : 0.0);
+  }
+  // One port: C(L, S) = 2 s + 2 (1 + S) h + 2 (1 + L) i.
+  const double C00 = Median(c00), C10 = Median(c10), C30 = Median(c30), C01 = Median(c01);
+  const double i = ((C10 - C00) + (C30 - C00) / 3.0) / 2.0 / 2.0;  // per message per idle listener
+  const double h = (C01 - C00) / 2.0;
+  const double s = (C00 - 2 * h - 2 * i) / 2.0;
+  const double step_one = kSendsPerStep * s + kHandledPerStep * h + kIgnoredPerStepOnePort * i;
+  // Port per channel: C(S) = 2 s' + 2 (1 + S) h'.
+  const double P00 = Median(p00), P01 = Median(p01);
+  const double hp = (P01 - P00) / 2.0, sp = (P00 - 2 * hp) / 2.0;
+  const double step_per = kSendsPerStep * sp + kHandledPerStep * hp;
+  const double bound_one = cores / step_one, bound_per = cores / step_per;
+  const double one_rate = Median(r_one), per_rate = Median(r_per), memq_rate = Median(r_memq);
+  auto us = [](double x) { return x * 1e6; };
+
+  std::printf("bench-lockstep: %d repeats, medians; %u cores; %lld steps per lockstep run\n", repeat, cores,
+              static_cast<long long>(steps));
+  std::printf("ping-pong CPU per round trip (all processes, user + system), 160-byte payload:\n");
+  std::printf("  LCM, one port: no listener %6.1f us, 1 idle %6.1f us, 3 idle %6.1f us, 1 subscribed %6.1f us\n",
+              us(C00), us(C10), us(C30), us(C01));
+  std::printf("  port per channel:          %6.1f us,                          1 subscribed %6.1f us\n", us(P00),
+              us(P01));
+  std::printf("cost of one          send     handled delivery   ignored delivery\n");
+  std::printf("  LCM, one port      %6.1f us   %6.1f us          %6.1f us\n", us(s), us(h), us(i));
+  std::printf("  port per channel   %6.1f us   %6.1f us               -\n", us(sp), us(hp));
+  std::printf("per step: %d sends; one port %d deliveries (%d handled, %d ignored); port per channel %d\n",
+              kSendsPerStep, kSendsPerStep * kProcesses, kHandledPerStep, kIgnoredPerStepOnePort, kHandledPerStep);
+  std::printf("transport CPU per step: one port %6.1f us, port per channel %6.1f us\n", us(step_one), us(step_per));
+  std::printf("bound (%u cores / transport CPU per step): one port %8.0f steps/s, port per channel %8.0f steps/s\n",
+              cores, bound_one, bound_per);
+  std::printf("lockstep udpm, one port          %8.0f steps/s = %.2f of its bound; CPU %6.1f us/step (all processes)\n",
+              one_rate, one_rate / bound_one, us(Median(cpu_one)));
+  std::printf("lockstep udpm, port per channel  %8.0f steps/s = %.2f of its bound; CPU %6.1f us/step; %.2f x one port "
+              "(median of per-repeat ratios)\n",
+              per_rate, per_rate / bound_per, us(Median(cpu_per)), Median(gain));
+  std::printf("lockstep memq (1 process)        %8.0f steps/s = %.2f x port per channel; CPU %6.1f us/step\n", memq_rate,
+              per_rate > 0 ? memq_rate / per_rate : 0.0, us(Median(cpu_memq)));
+  std::printf("per repeat (one port / port per channel / memq steps/s):");
+  for (int r = 0; r < repeat; ++r) std::printf(" %.0f/%.0f/%.0f", r_one[r], r_per[r], r_memq[r]);
+  std::printf("\ntarget >= 8000 steps/s on udpm with a port per channel: %s\n", per_rate >= 8000 ? "met" : "NOT met");
   fs::remove_all(tmp);
   return 0;
 }

@@ -45,6 +45,7 @@
 #include "io/run_log.h"
 #include "lockstep/realtime.h"
 #include "lockstep/runtime.h"
+#include "lockstep/transport.h"
 #include "models/structure_file.h"
 #include "participants/factory.h"
 #include "participants/group.h"
@@ -95,6 +96,28 @@ int FreeUdpPort() {
   }
   ::close(fd);
   return ntohs(a.sin_port);
+}
+
+/// A base port P with P .. P+n-1 all free for UDP (each bound once, then released), picked by
+/// the kernel's ephemeral allocator and checked.
+int FreeUdpPorts(int n) {
+  for (int attempt = 0; attempt < 64; ++attempt) {
+    const int base = FreeUdpPort();
+    if (base + n - 1 > 65535) continue;
+    bool free = true;
+    for (int i = 1; i < n && free; ++i) {
+      const int fd = ::socket(AF_INET, SOCK_DGRAM, 0);
+      if (fd < 0) throw rths::Error("", "cannot create a UDP socket to pick a port");
+      sockaddr_in a{};
+      a.sin_family = AF_INET;
+      a.sin_addr.s_addr = htonl(INADDR_ANY);
+      a.sin_port = htons(static_cast<std::uint16_t>(base + i));
+      free = ::bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0;
+      ::close(fd);
+    }
+    if (free) return base;
+  }
+  throw rths::Error("", fmt::format("cannot find {} consecutive free UDP ports", n));
 }
 
 std::string Megabytes(double bytes) { return fmt::format("{:.1f} MB", bytes / 1e6); }
@@ -173,7 +196,9 @@ char ProcessState(pid_t pid) {
 
 /// Tells every participant of the run to stop: ABORT on the run's URL, from "supervisor".
 void BroadcastAbort(const std::string& url, std::int64_t run_id, const std::string& reason) {
-  lcm::LCM lcm(url);
+  // A run with a port per channel hears handshakes on the handshake channel's port.
+  const auto parsed = rths::lockstep::UdpmUrl::Parse(url);
+  lcm::LCM lcm(parsed ? parsed->ChannelUrl(rths::lockstep::kChHandshake) : url);
   if (!lcm.good()) return;
   rths::handshake_t h{};
   h.run_id = run_id;
@@ -377,6 +402,12 @@ int main(int argc, char** argv) {
   app.add_option("--lcm-url", url_arg,
                  "udpm URL of the run (default: udpm://239.255.76.67:<a free port>?ttl=0); ttl=1 to reach "
                  "participants on other hosts of the LAN (docs/participant.md)");
+  bool port_per_channel = false;
+  app.add_flag("--port-per-channel", port_per_channel,
+               "udpm: carry each channel on its own UDP port (the run's port + 0..6), so each process "
+               "receives only the channels it reads: fewer deliveries per step, a faster run; the same "
+               "payloads (as --lcm-url 'udpm://239.255.76.67:PORT?ttl=0&port_per_channel=1'; "
+               "docs/lockstep.md, Transports)");
   app.add_option("--run-id", run_id_arg, "run id every participant must use (default: random)")
       ->check(CLI::Range(std::int64_t{1}, std::int64_t{0x3fffffffffffffff}));
   app.add_option("--external", external_arg,
@@ -448,6 +479,22 @@ int main(int argc, char** argv) {
                    url_arg.c_str());
       return rths::lockstep::kExitUsage;
     }
+    if (port_per_channel && transport != "udpm") {
+      std::fprintf(stderr, "rths run: --port-per-channel needs the udpm transport\n");
+      return rths::lockstep::kExitUsage;
+    }
+    if (!url_arg.empty()) {
+      std::string why;
+      auto parsed = rths::lockstep::UdpmUrl::Parse(url_arg, &why);
+      if (!parsed) {
+        std::fprintf(stderr, "rths run: --lcm-url %s\n", why.c_str());
+        return rths::lockstep::kExitUsage;
+      }
+      if (port_per_channel && !parsed->port_per_channel) {
+        parsed->port_per_channel = true;
+        url_arg = parsed->ToString();
+      }
+    }
   }
   std::signal(SIGINT, OnSignal);
   std::signal(SIGTERM, OnSignal);
@@ -473,7 +520,10 @@ int main(int argc, char** argv) {
       if (const std::string hint = rths::lockstep::CheckMulticastRoute(); !hint.empty()) {
         throw rths::Error("", hint);
       }
-      url = url_arg.empty() ? fmt::format("udpm://239.255.76.67:{}?ttl=0", FreeUdpPort()) : url_arg;
+      url = !url_arg.empty()     ? url_arg
+            : port_per_channel ? fmt::format("udpm://239.255.76.67:{}?ttl=0&port_per_channel=1",
+                                             FreeUdpPorts(static_cast<int>(rths::lockstep::kPortChannels.size())))
+                               : fmt::format("udpm://239.255.76.67:{}?ttl=0", FreeUdpPort());
       if (s.faults.recv_buf_bytes > 0) {
         url += fmt::format("{}recv_buf_size={}", url.find('?') == std::string::npos ? "?" : "&",
                            s.faults.recv_buf_bytes);

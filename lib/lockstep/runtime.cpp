@@ -1,5 +1,7 @@
 #include "lockstep/runtime.h"
 
+#include "lockstep/transport.h"
+
 #include <signal.h>
 #include <time.h>
 #include <sys/types.h>
@@ -79,6 +81,10 @@ struct Participant::Route {
   std::string channel;
   Handler handler;
   void OnMessage(const lcm::ReceiveBuffer* rbuf, const std::string&) { self->Deliver(this, rbuf); }
+  static void OnChannelMessage(void* route, const lcm::ReceiveBuffer* rbuf) {
+    auto* r = static_cast<Route*>(route);
+    r->self->Deliver(r, rbuf);
+  }
 };
 
 Participant::Participant(std::string name, RunIdentity id, Timing timing, lcm::LCM* lcm, Faults faults)
@@ -99,7 +105,28 @@ Participant::~Participant() = default;
 
 void Participant::Subscribe(const char* channel, Handler handler) {
   routes_.push_back(std::make_unique<Route>(Route{this, channel, std::move(handler)}));
-  lcm_->subscribe(channel, &Route::OnMessage, routes_.back().get());
+  if (channels_) {
+    if (!channels_->Subscribe(channel, &Route::OnChannelMessage, routes_.back().get())) {
+      throw std::runtime_error(fmt::format("{}: {}", name_, channels_->error()));
+    }
+  } else if (lcm_) {
+    lcm_->subscribe(channel, &Route::OnMessage, routes_.back().get());
+  }
+}
+
+void Participant::Attach(UdpmChannels* channels) {
+  if (lcm_) throw std::runtime_error(name_ + ": Attach: already subscribed on an LCM instance");
+  channels_ = channels;
+  for (auto& r : routes_) {
+    if (!channels_->Subscribe(r->channel.c_str(), &Route::OnChannelMessage, r.get())) {
+      throw std::runtime_error(fmt::format("{}: {}", name_, channels_->error()));
+    }
+  }
+}
+
+int Participant::Send(const char* channel, const std::uint8_t* data, std::size_t size) {
+  if (channels_) return channels_->Publish(channel, data, static_cast<unsigned int>(size));
+  return lcm_->publish(channel, data, static_cast<unsigned int>(size));
 }
 
 void Participant::SetAnswerChannel(Channel channel, const AnswerCache* cache) {
@@ -175,7 +202,7 @@ SteadyClock::time_point Participant::NextDeadline() const {
 }
 
 void Participant::PublishBytes(const char* channel, const Bytes& bytes) {
-  if (lcm_->publish(channel, bytes.data(), static_cast<unsigned int>(bytes.size())) != 0) {
+  if (Send(channel, bytes.data(), bytes.size()) != 0) {
     Fail(kExitLockstep, fmt::format("could not publish on {}", channel), false);
   }
 }
@@ -238,7 +265,7 @@ void Participant::SendHandshake(Phase phase, std::int64_t k, const std::string& 
   Encode(hs_out_, &hs_bytes_);
   const int copies = (phase == kAbort || phase == kGo || phase == kClose) ? kControlCopies : 1;
   for (int i = 0; i < copies; ++i) {
-    lcm_->publish(kChHandshake, hs_bytes_.data(), static_cast<unsigned int>(hs_bytes_.size()));
+    Send(kChHandshake, hs_bytes_.data(), hs_bytes_.size());
   }
 }
 
@@ -426,6 +453,11 @@ void Participant::Interrupt(const std::string& reason) {
 }
 
 int RunLoop(lcm::LCM* lcm, const std::vector<Participant*>& participants, const volatile std::sig_atomic_t* stop) {
+  return RunLoopWith([lcm](int timeout_ms) { return lcm->handleTimeout(timeout_ms); }, participants, stop);
+}
+
+int RunLoopWith(const std::function<int(int)>& handle, const std::vector<Participant*>& participants,
+                const volatile std::sig_atomic_t* stop) {
   constexpr int kPollMs = 5;
   for (;;) {
     if (stop && *stop) {
@@ -440,7 +472,7 @@ int RunLoop(lcm::LCM* lcm, const std::vector<Participant*>& participants, const 
     for (const Participant* p : participants) release = std::min(release, p->ReleaseAt());
     if (release != SteadyClock::time_point::max()) {
       int handled = 0;
-      while (handled < 64 && lcm->handleTimeout(0) > 0) {
+      while (handled < 64 && handle(0) > 0) {
         ++handled;
         const auto now = SteadyClock::now();
         for (Participant* p : participants) p->Tick(now, false);
@@ -460,7 +492,7 @@ int RunLoop(lcm::LCM* lcm, const std::vector<Participant*>& participants, const 
     for (const Participant* p : participants) deadline = std::min(deadline, p->NextDeadline());
     const auto wait = std::chrono::ceil<std::chrono::milliseconds>(deadline - SteadyClock::now()).count();
     errno = 0;
-    int r = lcm->handleTimeout(static_cast<int>(std::clamp<std::int64_t>(wait, 0, kPollMs)));
+    int r = handle(static_cast<int>(std::clamp<std::int64_t>(wait, 0, kPollMs)));
     if (r < 0 && errno == EINTR) r = 0;  // a signal (e.g. SIGTERM: handled through `stop`)
     if (r < 0) {
       for (Participant* p : participants) {

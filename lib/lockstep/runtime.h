@@ -5,8 +5,9 @@
 /// participant's doc comment points there.
 ///
 /// The same participant objects run as separate processes, each with its own LCM instance on
-/// `udpm://` (one UDP port per run), or all in one process sharing one `memq://` instance
-/// (memq queues belong to one lcm_t, so in that mode LCM dispatches from one thread).
+/// `udpm://` (one UDP port per run), or each with the sockets of a per-channel run (UdpmChannels,
+/// lockstep/transport.h: one UDP port per channel), or all in one process sharing one `memq://`
+/// instance (memq queues belong to one lcm_t, so in that mode LCM dispatches from one thread).
 #include <array>
 #include <chrono>
 #include <csignal>
@@ -25,6 +26,8 @@
 #include "rths/repair_t.hpp"
 
 namespace rths::lockstep {
+
+class UdpmChannels;
 
 /// Lockstep runtime knobs (docs/lockstep.md).
 struct LockstepConfig {
@@ -220,6 +223,8 @@ class WantList {
 /// what it lacks for a step, and implements the step.
 class Participant {
  public:
+  /// `lcm`: the LCM instance to subscribe and publish on, or nullptr for a participant that is
+  /// then attached to a per-channel transport (Attach) before it runs.
   Participant(std::string name, RunIdentity id, Timing timing, lcm::LCM* lcm, Faults faults = {});
   virtual ~Participant();
   Participant(const Participant&) = delete;
@@ -253,6 +258,11 @@ class Participant {
   /// message: a lost input stops its answers there.
   void Follow(double idle_exit_s);
 
+  /// Moves every subscription, and every publication from now on, to `channels` (a per-channel
+  /// udpm run). For a participant built with lcm = nullptr, before RunLoop; `channels` must
+  /// outlive it. Throws std::runtime_error if a channel cannot be opened.
+  void Attach(UdpmChannels* channels);
+
   /// Called by the event loop after every handled message and on every poll timeout: delivers
   /// held (delayed) messages that are due, then Poll(). `idle` is true when no message was
   /// waiting: only then may a participant conclude that someone has gone silent.
@@ -283,6 +293,8 @@ class Participant {
   /// k, or for the plant measured_t k). Called when the clock re-requests step k.
   virtual void ListMissing(std::int64_t /*k*/, WantList* /*out*/) const {}
 
+  /// Publishes raw bytes on a channel (LCM or the attached channels); 0 on success.
+  int Send(const char* channel, const std::uint8_t* data, std::size_t size);
   /// Publishes raw bytes on a channel.
   void PublishBytes(const char* channel, const Bytes& bytes);
   /// Encodes an answer for step k into the cache, then publishes it.
@@ -343,6 +355,7 @@ class Participant {
   const RunIdentity id_;
   const Timing timing_;
   lcm::LCM* const lcm_;
+  UdpmChannels* channels_ = nullptr;  ///< set by Attach (then lcm_ is unused)
   bool is_clock_ = false;
   LinkStats stats_;
   double stepping_s_ = 0;
@@ -402,6 +415,10 @@ class Participant {
 /// kExitPeerAbort, "interrupted"), its committed output flushed.
 int RunLoop(lcm::LCM* lcm, const std::vector<Participant*>& participants,
             const volatile std::sig_atomic_t* stop = nullptr);
+/// RunLoop over any transport: `handle(timeout_ms)` waits at most that long and handles what
+/// came in, returning as lcm::LCM::handleTimeout does (> 0 handled, 0 timed out, < 0 error).
+int RunLoopWith(const std::function<int(int)>& handle, const std::vector<Participant*>& participants,
+                const volatile std::sig_atomic_t* stop = nullptr);
 
 /// Checks the host can do LCM multicast on loopback (`udpm`); returns "" if fine, or a message
 /// telling the user how to fix it (ip route add 224.0.0.0/4 dev lo).

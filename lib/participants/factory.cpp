@@ -12,6 +12,7 @@
 
 #include "core/error.h"
 #include "io/reserved_file.h"
+#include "lockstep/transport.h"
 #include "participants/controller.h"
 #include "participants/group.h"
 #include "participants/integrator.h"
@@ -149,8 +150,32 @@ int RoleMain(std::string_view role, int argc, char** argv) {
       o.realtime_setup = lockstep::EnterRealtime(s.realtime.sched_fifo, s.realtime.priority, s.realtime.lock_memory);
       if (!o.realtime_setup.note.empty()) std::fprintf(stderr, "%s: %s\n", name.c_str(), o.realtime_setup.note.c_str());
     }
-    lcm::LCM lcm(url);
-    if (!lcm.good()) {
+    if (lockstep::IsPortPerChannel(url)) {
+      // One UDP port per channel (lockstep/transport.h): this process receives only its channels.
+      lockstep::UdpmChannels channels(*lockstep::UdpmUrl::Parse(url));
+      auto p = MakeParticipant(role, s, IdentityOf(s, run_id), nullptr, out_dir);
+      std::string why = channels.error();
+      if (why.empty()) {
+        try {
+          p->Attach(&channels);
+        } catch (const std::runtime_error& e) {
+          why = e.what();
+        }
+      }
+      if (!why.empty()) {
+        const std::string hint = lockstep::CheckMulticastRoute();
+        o.exit_code = lockstep::kExitLockstep;
+        o.message = fmt::format("cannot open the channels of {}: {}{}{}", url, why, hint.empty() ? "" : "\n", hint);
+      } else {
+        if (follow) {
+          if (role == "integrator") throw Error("--follow", "the integrator is the clock: it cannot follow");
+          p->Follow(follow_idle_s);
+        }
+        const int rc = lockstep::RunLoop(&channels, {p.get()}, &g_stop);
+        o = OutcomeOf(*p, o);
+        if (o.exit_code == 0) o.exit_code = rc;
+      }
+    } else if (lcm::LCM lcm(url); !lcm.good()) {
       std::string hint = lockstep::CheckMulticastRoute();
       o.exit_code = lockstep::kExitLockstep;
       o.message = fmt::format("cannot open LCM at {}{}{}", url, hint.empty() ? "" : "\n", hint);

@@ -1,0 +1,255 @@
+#include "lockstep/transport.h"
+
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <poll.h>
+#include <sys/socket.h>
+#include <sys/uio.h>
+#include <time.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+
+#include <fmt/core.h>
+
+namespace rths::lockstep {
+
+namespace {
+/// LCM's small-message datagram: uint32 magic "LC02", uint32 sequence number (both big-endian),
+/// the channel and its NUL, then the payload (LCM 1.3.1, lcm_udpm.c).
+constexpr std::uint32_t kShortMagic = 0x4c433032;
+/// The largest datagram LCM sends unfragmented.
+constexpr std::size_t kMaxShortDatagram = 65499;
+
+std::int64_t WallUtime() {
+  timespec ts{};
+  ::clock_gettime(CLOCK_REALTIME, &ts);
+  return static_cast<std::int64_t>(ts.tv_sec) * 1000000 + ts.tv_nsec / 1000;
+}
+}  // namespace
+
+int PortOffset(std::string_view channel) {
+  for (std::size_t i = 0; i < kPortChannels.size(); ++i) {
+    if (channel == kPortChannels[i]) return static_cast<int>(i);
+  }
+  return -1;
+}
+
+std::optional<UdpmUrl> UdpmUrl::Parse(const std::string& url, std::string* error) {
+  auto fail = [&](const std::string& why) -> std::optional<UdpmUrl> {
+    if (error) *error = fmt::format("{}: {} (expected udpm://GROUP:PORT?ttl=0[&port_per_channel=1])", url, why);
+    return std::nullopt;
+  };
+  constexpr std::string_view kScheme = "udpm://";
+  if (url.rfind(kScheme, 0) != 0) return fail("not a udpm:// URL");
+  const std::string rest = url.substr(kScheme.size());
+  const std::size_t q = rest.find('?');
+  const std::string host = rest.substr(0, q);
+  const std::string query = q == std::string::npos ? "" : rest.substr(q + 1);
+  UdpmUrl u;
+  const std::size_t colon = host.find(':');
+  u.group = host.substr(0, colon);
+  if (u.group.empty()) u.group = "239.255.76.67";
+  in_addr a{};
+  if (::inet_pton(AF_INET, u.group.c_str(), &a) != 1) return fail("the group is not an IPv4 address");
+  if (colon != std::string::npos) {
+    try {
+      std::size_t used = 0;
+      u.port = std::stoi(host.substr(colon + 1), &used);
+      if (used != host.size() - colon - 1) return fail("bad port");
+    } catch (const std::exception&) {
+      return fail("bad port");
+    }
+  }
+  std::size_t start = 0;
+  while (start < query.size()) {
+    std::size_t amp = query.find('&', start);
+    if (amp == std::string::npos) amp = query.size();
+    const std::string opt = query.substr(start, amp - start);
+    start = amp + 1;
+    if (opt.empty()) continue;
+    const std::size_t eq = opt.find('=');
+    const std::string key = opt.substr(0, eq), value = eq == std::string::npos ? "" : opt.substr(eq + 1);
+    auto number = [&](int* out) {
+      try {
+        std::size_t used = 0;
+        *out = std::stoi(value, &used);
+        return used == value.size();
+      } catch (const std::exception&) {
+        return false;
+      }
+    };
+    if (key == "ttl") {
+      if (!number(&u.ttl) || u.ttl < 0 || u.ttl > 255) return fail("ttl must be in [0, 255]");
+    } else if (key == "recv_buf_size") {
+      if (!number(&u.recv_buf_size) || u.recv_buf_size < 0) return fail("recv_buf_size must be >= 0");
+    } else if (key == "port_per_channel") {
+      if (value != "0" && value != "1" && value != "true" && value != "false") {
+        return fail("port_per_channel must be 1 or 0");
+      }
+      u.port_per_channel = value == "1" || value == "true";
+    } else {
+      u.other_options += (u.other_options.empty() ? "" : "&") + opt;
+    }
+  }
+  const int last = u.port + (u.port_per_channel ? static_cast<int>(kPortChannels.size()) - 1 : 0);
+  if (u.port < 1 || last > 65535) {
+    return fail(u.port_per_channel ? "ports PORT .. PORT+6 must be in [1, 65535]" : "port must be in [1, 65535]");
+  }
+  return u;
+}
+
+std::string UdpmUrl::ChannelUrl(std::string_view channel) const {
+  const int offset = port_per_channel ? std::max(0, PortOffset(channel)) : 0;
+  std::string s = fmt::format("udpm://{}:{}?ttl={}", group, port + offset, ttl);
+  if (recv_buf_size > 0) s += fmt::format("&recv_buf_size={}", recv_buf_size);
+  if (!other_options.empty()) s += "&" + other_options;
+  return s;
+}
+
+std::string UdpmUrl::ToString() const {
+  std::string s = fmt::format("udpm://{}:{}?ttl={}", group, port, ttl);
+  if (recv_buf_size > 0) s += fmt::format("&recv_buf_size={}", recv_buf_size);
+  if (port_per_channel) s += "&port_per_channel=1";
+  if (!other_options.empty()) s += "&" + other_options;
+  return s;
+}
+
+bool IsPortPerChannel(const std::string& url) {
+  const auto u = UdpmUrl::Parse(url);
+  return u && u->port_per_channel;
+}
+
+UdpmChannels::UdpmChannels(const UdpmUrl& url) : url_(url) {
+  for (std::size_t i = 0; i < kPortChannels.size(); ++i) sockets_[i].channel = kPortChannels[i];
+  if (!url_.port_per_channel) {
+    error_ = "UdpmChannels needs a URL with port_per_channel=1";
+    return;
+  }
+  send_fd_ = ::socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC, 0);
+  if (send_fd_ < 0) {
+    error_ = fmt::format("cannot create a UDP socket: {}", std::strerror(errno));
+    return;
+  }
+  const unsigned char ttl = static_cast<unsigned char>(url_.ttl), loop = 1;
+  if (::setsockopt(send_fd_, IPPROTO_IP, IP_MULTICAST_TTL, &ttl, sizeof ttl) != 0 ||
+      ::setsockopt(send_fd_, IPPROTO_IP, IP_MULTICAST_LOOP, &loop, sizeof loop) != 0) {
+    error_ = fmt::format("cannot set the multicast TTL / loopback: {}", std::strerror(errno));
+  }
+}
+
+UdpmChannels::~UdpmChannels() {
+  if (send_fd_ >= 0) ::close(send_fd_);
+  for (auto& s : sockets_) {
+    if (s.fd >= 0) ::close(s.fd);
+  }
+}
+
+bool UdpmChannels::Subscribe(const char* channel, Callback callback, void* context) {
+  const int i = PortOffset(channel);
+  if (i < 0) {
+    error_ = fmt::format("channel {} has no port of its own (not a run channel)", channel);
+    return false;
+  }
+  Socket& s = sockets_[i];
+  if (s.fd < 0) {
+    const int port = url_.port + i;
+    const int fd = ::socket(AF_INET, SOCK_DGRAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
+    if (fd < 0) {
+      error_ = fmt::format("cannot create a UDP socket: {}", std::strerror(errno));
+      return false;
+    }
+    const int one = 1;
+    sockaddr_in a{};
+    a.sin_family = AF_INET;
+    a.sin_addr.s_addr = htonl(INADDR_ANY);
+    a.sin_port = htons(static_cast<std::uint16_t>(port));
+    ip_mreq m{};
+    ::inet_pton(AF_INET, url_.group.c_str(), &m.imr_multiaddr);
+    m.imr_interface.s_addr = htonl(INADDR_ANY);
+    std::string why;
+    // As LCM does: SO_REUSEADDR, so every process of the run (and lcm-spy) binds the same port.
+    if (::setsockopt(fd, SOL_SOCKET, SO_REUSEADDR, &one, sizeof one) != 0) {
+      why = "SO_REUSEADDR";
+    } else if (url_.recv_buf_size > 0 &&
+               ::setsockopt(fd, SOL_SOCKET, SO_RCVBUF, &url_.recv_buf_size, sizeof url_.recv_buf_size) != 0) {
+      why = "SO_RCVBUF";
+    } else if (::bind(fd, reinterpret_cast<const sockaddr*>(&a), sizeof a) != 0) {
+      why = fmt::format("bind to port {}", port);
+    } else if (::setsockopt(fd, IPPROTO_IP, IP_ADD_MEMBERSHIP, &m, sizeof m) != 0) {
+      why = fmt::format("join {}", url_.group);
+    }
+    if (!why.empty()) {
+      error_ = fmt::format("{} ({}): {}", why, channel, std::strerror(errno));
+      ::close(fd);
+      return false;
+    }
+    s.fd = fd;
+    poll_order_.push_back(i);
+  }
+  s.callbacks.emplace_back(callback, context);
+  return true;
+}
+
+int UdpmChannels::Publish(const char* channel, const void* data, unsigned size) {
+  const int i = PortOffset(channel);
+  if (i < 0 || send_fd_ < 0) return -1;
+  const std::size_t channel_len = std::strlen(channel) + 1;
+  if (8 + channel_len + size > kMaxShortDatagram) return -1;  // LCM would fragment: not needed here
+  const std::uint32_t header[2] = {htonl(kShortMagic), htonl(seqno_++)};
+  iovec iov[3] = {{const_cast<std::uint32_t*>(header), sizeof header},
+                  {const_cast<char*>(channel), channel_len},
+                  {const_cast<void*>(data), size}};
+  sockaddr_in to{};
+  to.sin_family = AF_INET;
+  ::inet_pton(AF_INET, url_.group.c_str(), &to.sin_addr);
+  to.sin_port = htons(static_cast<std::uint16_t>(url_.port + i));
+  msghdr msg{};
+  msg.msg_name = &to;
+  msg.msg_namelen = sizeof to;
+  msg.msg_iov = iov;
+  msg.msg_iovlen = 3;
+  if (::sendmsg(send_fd_, &msg, 0) < 0) return -1;
+  ++sent_;
+  return 0;
+}
+
+bool UdpmChannels::Dispatch(Socket* s) {
+  const ssize_t n = ::recv(s->fd, buffer_.data(), buffer_.size(), 0);
+  if (n < 0) return false;  // EAGAIN: another reader took it, or nothing after all
+  ++received_;
+  const auto size = static_cast<std::size_t>(n);
+  if (size < 9) return true;
+  std::uint32_t magic = 0;
+  std::memcpy(&magic, buffer_.data(), 4);
+  if (ntohl(magic) != kShortMagic) return true;  // a fragment of a large message: none of ours
+  const auto* channel = reinterpret_cast<const char*>(buffer_.data() + 8);
+  const auto* end = static_cast<const char*>(std::memchr(channel, '\0', size - 8));
+  if (!end || std::strcmp(channel, s->channel) != 0) return true;  // another channel on our port
+  const std::size_t header = 8 + static_cast<std::size_t>(end - channel) + 1;
+  lcm::ReceiveBuffer rb{buffer_.data() + header, static_cast<std::uint32_t>(size - header), WallUtime()};
+  for (const auto& [callback, context] : s->callbacks) callback(context, &rb);
+  return true;
+}
+
+int UdpmChannels::HandleTimeout(int timeout_ms) {
+  std::array<pollfd, kPortChannels.size()> fds{};
+  const std::size_t n = poll_order_.size();
+  for (std::size_t j = 0; j < n; ++j) fds[j] = {sockets_[poll_order_[j]].fd, POLLIN, 0};
+  const int r = ::poll(fds.data(), n, timeout_ms);
+  if (r <= 0) return r;
+  int handled = 0;
+  for (std::size_t j = 0; j < n; ++j) {
+    if ((fds[j].revents & POLLIN) && Dispatch(&sockets_[poll_order_[j]])) ++handled;
+  }
+  return handled;
+}
+
+int RunLoop(UdpmChannels* channels, const std::vector<Participant*>& participants,
+            const volatile std::sig_atomic_t* stop) {
+  return RunLoopWith([channels](int timeout_ms) { return channels->HandleTimeout(timeout_ms); }, participants,
+                     stop);
+}
+
+}  // namespace rths::lockstep
