@@ -189,3 +189,32 @@ TEST_CASE("rths run --port-per-channel needs udpm; a bad --lcm-url is a usage er
   CHECK(RunCli("--lcm-url 'udpm://239.255.76.67:65533?port_per_channel=1'", &output) == 2);
   CHECK(output.find("PORT+6") != std::string::npos);
 }
+
+TEST_CASE("a port per channel: 5 % of every fault on every channel and a small receive buffer, still bit-identical") {
+  const std::string tiny = "[run]\nname = \"transport_faults\"\nduration_s = 0.25\n[lockstep]\nrerequest_ms = 10.0\n"
+                           "stall_budget_s = 5.0\nhandshake_timeout_s = 5.0\n";
+  const auto base = TempDir("faults_clean");
+  const auto clean = rths::scenario::LoadScenario(WriteScenario(base, tiny).string());
+  REQUIRE(RunMemq({clean}, base).code == 0);
+  const std::string reference = rths::io::PayloadDigest(rths::io::ReadRunLog((base / "log.lcm").string()));
+  if (!UdpmAvailable()) FAIL("udpm cannot run on this host: " << ls::CheckMulticastRoute());
+  // Faults are injected on every receive path (as on one port); recv_buf_bytes shrinks every one
+  // of the per-channel sockets (SO_RCVBUF, from the URL's recv_buf_size).
+  for (const std::string faults : {"[faults]\ndrop = 0.05\nduplicate = 0.05\ndelay = 0.05\nreorder = 0.05\n"
+                                   "delay_ms = 15.0\nseed = 11\n",
+                                   "[faults]\nrecv_buf_bytes = 2048\n"}) {
+    CAPTURE(faults);
+    const auto dir = TempDir("faults_per_channel");
+    const auto scen = WriteScenario(dir, tiny + faults);
+    std::string output;
+    const int code = RunCli(scen.string() + " --port-per-channel --out " + (dir / "run").string(), &output);
+    CAPTURE(output);
+    REQUIRE(code == 0);
+    CHECK(rths::io::PayloadDigest(rths::io::ReadRunLog((dir / "run" / "log.lcm").string())) == reference);
+    const auto summary = nlohmann::json::parse(std::ifstream(dir / "run" / "summary.json"));
+    if (faults.find("drop") != std::string::npos) CHECK(summary["link"]["repaired"].get<std::int64_t>() > 0);
+    if (faults.find("recv_buf") != std::string::npos) {
+      CHECK(summary["lcm_url"].get<std::string>().find("recv_buf_size=2048") != std::string::npos);
+    }
+  }
+}
