@@ -4,6 +4,7 @@
 
 #include <unistd.h>
 
+#include <array>
 #include <chrono>
 #include <csignal>
 #include <filesystem>
@@ -15,6 +16,7 @@
 #include <lcm/lcm-cpp.hpp>
 #include <nlohmann/json.hpp>
 
+#include "alloc_counter.h"
 #include "io/run_log.h"
 #include "lockstep/transport.h"
 #include "test_support.h"
@@ -217,4 +219,27 @@ TEST_CASE("a port per channel: 5 % of every fault on every channel and a small r
       CHECK(summary["lcm_url"].get<std::string>().find("recv_buf_size=2048") != std::string::npos);
     }
   }
+}
+
+TEST_CASE("UdpmChannels: sending and receiving a message allocates nothing") {
+  if (!UdpmAvailable()) FAIL("udpm cannot run on this host: " << ls::CheckMulticastRoute());
+  const auto url = *ls::UdpmUrl::Parse(fmt::format("udpm://239.255.76.67:{}?ttl=0&port_per_channel=1", TestPort(3)));
+  ls::UdpmChannels ch(url);
+  struct Count {
+    int n = 0;
+    static void On(void* self, const lcm::ReceiveBuffer*) { ++static_cast<Count*>(self)->n; }
+  } count;
+  REQUIRE(ch.Subscribe(ls::kChMeasured, &Count::On, &count));
+  const std::array<std::uint8_t, 200> payload{};
+  REQUIRE(ch.Publish(ls::kChMeasured, payload.data(), payload.size()) == 0);
+  Pump(&ch, &count.n, 1);
+  REQUIRE(count.n == 1);
+  const long before = rths_test::AllocationCount();
+  for (int i = 0; i < 100; ++i) {
+    ch.Publish(ls::kChMeasured, payload.data(), payload.size());
+    ch.HandleTimeout(100);
+  }
+  const long allocations = rths_test::AllocationCount() - before;
+  CHECK(count.n == 101);
+  CHECK(allocations == 0);
 }
