@@ -151,21 +151,33 @@ TEST_CASE("OdeStepper: closed form, stop time, and errors") {
     xdot[1] = std::cos(t);
     return 0;
   };
-  OdeStepper ode(2, 1e-10, 1e-14, rhs, nullptr);
+  OdeStepper ode(2, 1e-10, 1e-14, rhs, nullptr, OdeMethod::kBdf);  // stiff: BDF
   double x[2] = {1.0, 0.0};
   ode.Advance(0.0, 1e-4, x);
   CHECK(x[0] == doctest::Approx(std::exp(-10.0)).epsilon(1e-6));
   ode.Advance(1e-4, 1.0, x);
   CHECK(x[1] == doctest::Approx(std::sin(1.0)).epsilon(1e-8));
   CHECK_THROWS_AS(ode.Advance(1.0, 1.0, x), rths::Error);
+  // The explicit default on the same closed form over a step where it is not stiff
+  // (|h lambda| <= 1 for h = 1e-5 s); a stiff interval it cannot cross, and says so.
+  OdeStepper erk(2, 1e-10, 1e-14, rhs, nullptr);
+  CHECK(erk.method() == OdeMethod::kErk);
+  double e[2] = {1.0, 0.0};
+  erk.Advance(0.0, 1e-5, e);
+  CHECK(e[0] == doctest::Approx(std::exp(-1.0)).epsilon(1e-8));
+  CHECK(e[1] == doctest::Approx(std::sin(1e-5)).epsilon(1e-8));
+  CHECK_THROWS_WITH_AS(erk.Advance(1e-4, 1.0, e), doctest::Contains("ERKStep failed"), rths::Error);
 
   auto failing = [](double t, const double*, double* xdot, void*) {
     xdot[0] = 1.0;
     return t > 0.5 ? -1 : 0;
   };
-  OdeStepper bad(1, 1e-8, 1e-10, failing, nullptr);
+  OdeStepper bad(1, 1e-8, 1e-10, failing, nullptr, OdeMethod::kBdf);
   double z[1] = {0.0};
   CHECK_THROWS_WITH_AS(bad.Advance(0.0, 1.0, z), doctest::Contains("CV_RHSFUNC_FAIL"), rths::Error);
+  OdeStepper bad_erk(1, 1e-8, 1e-10, failing, nullptr);
+  z[0] = 0.0;
+  CHECK_THROWS_WITH_AS(bad_erk.Advance(0.0, 1.0, z), doctest::Contains("RHSFUNC_FAIL"), rths::Error);
   CHECK_THROWS_AS(OdeStepper(0, 1e-8, 1e-10, rhs, nullptr), rths::Error);
   CHECK_THROWS_AS(OdeStepper(2, -1.0, 1e-10, rhs, nullptr), rths::Error);
 }

@@ -93,11 +93,11 @@ const MrDamperParams& Validated(const MrDamperParams& p) {
 }  // namespace
 
 MrDamperStepper::MrDamperStepper(const MrDamperParams& params, Motion motion, void* motion_ctx,
-                                 double rtol)
+                                 double rtol, OdeMethod method)
     : params_(Validated(params)),
       motion_(motion),
       motion_ctx_(motion_ctx),
-      ode_(2, rtol, rtol * 0.01, &MrDamperStepper::Rhs, this) {
+      ode_(2, rtol, rtol * 0.01, &MrDamperStepper::Rhs, this, method) {
   if (motion == nullptr) throw Error("MrDamperStepper", "motion is null");
 }
 

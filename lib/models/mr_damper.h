@@ -65,16 +65,17 @@ double DamperForceKn(const MrDamperCoefficients& k, const MrDamperState& s, doub
                      double xdot_mm_s);
 
 /// Advances the damper over one step for a prescribed motion x(t), x'(t) at a constant current.
-/// Owns its CVODE workspace; allocates nothing per step.
+/// Owns its integrator workspace (OdeStepper: ARKODE's Dormand-Prince 5(4) by default, CVODE's BDF
+/// on request); allocates nothing per step.
 class MrDamperStepper {
  public:
   /// Prescribed motion: writes x(t) [mm] and x'(t) [mm/s] at t_s [s].
   using Motion = void (*)(double t_s, void* ctx, double* x_mm, double* xdot_mm_s);
 
   /// params are validated (throws rths::Error); motion_ctx must outlive the stepper; rtol is
-  /// CVODE's relative tolerance, the absolute one is rtol * 0.01 mm.
+  /// the integrator's relative tolerance, the absolute one is rtol * 0.01 mm.
   MrDamperStepper(const MrDamperParams& params, Motion motion, void* motion_ctx,
-                  double rtol = 1e-8);
+                  double rtol = 1e-8, OdeMethod method = OdeMethod::kErk);
   MrDamperStepper(const MrDamperStepper&) = delete;
   MrDamperStepper& operator=(const MrDamperStepper&) = delete;
 

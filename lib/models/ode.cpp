@@ -5,6 +5,7 @@
 #include <cstdlib>
 #include <vector>
 
+#include <arkode/arkode_erkstep.h>
 #include <cvode/cvode.h>
 #include <fmt/format.h>
 #include <nvector/nvector_serial.h>
@@ -26,8 +27,9 @@ void Check(bool ok, const char* call) {
 
 }  // namespace
 
-OdeStepper::OdeStepper(int n, double rtol, std::span<const double> atol, OdeRhs rhs, void* ctx)
-    : n_(n), rhs_(rhs), ctx_(ctx) {
+OdeStepper::OdeStepper(int n, double rtol, std::span<const double> atol, OdeRhs rhs, void* ctx,
+                       OdeMethod method)
+    : n_(n), method_(method), rhs_(rhs), ctx_(ctx) {
   if (n <= 0) throw Error("OdeStepper", fmt::format("state size must be > 0 (got {})", n));
   if (!(rtol > 0.0) || !std::isfinite(rtol))
     throw Error("OdeStepper", fmt::format("rtol must be finite and > 0 (got {})", rtol));
@@ -45,9 +47,9 @@ OdeStepper::OdeStepper(int n, double rtol, std::span<const double> atol, OdeRhs 
   }
 }
 
-OdeStepper::OdeStepper(int n, double rtol, double atol, OdeRhs rhs, void* ctx)
+OdeStepper::OdeStepper(int n, double rtol, double atol, OdeRhs rhs, void* ctx, OdeMethod method)
     : OdeStepper(n, rtol, std::span<const double>(std::vector<double>(n > 0 ? n : 0, atol)), rhs,
-                 ctx) {}
+                 ctx, method) {}
 
 void OdeStepper::Init(double rtol, std::span<const double> atol) {
   Check(SUNContext_Create(nullptr, &sunctx_) == 0, "SUNContext_Create");
@@ -58,6 +60,10 @@ void OdeStepper::Init(double rtol, std::span<const double> atol) {
   N_VConst(0.0, x_);
   double* a = N_VGetArrayPointer(atol_);
   for (int i = 0; i < n_; ++i) a[i] = atol[i];
+  if (method_ == OdeMethod::kErk) {
+    InitErk(rtol);
+    return;
+  }
 
   cvode_ = CVodeCreate(CV_BDF, sunctx_);
   Check(cvode_ != nullptr, "CVodeCreate");
@@ -88,17 +94,48 @@ void OdeStepper::Init(double rtol, std::span<const double> atol) {
   rhs_ = user_rhs, ctx_ = user_ctx;
 }
 
+void OdeStepper::InitErk(double rtol) {
+  arkode_ = ERKStepCreate(&OdeStepper::ErkRhs, 0.0, x_, sunctx_);
+  Check(arkode_ != nullptr, "ERKStepCreate");
+  Check(ERKStepSetErrHandlerFn(arkode_, &OdeStepper::ErrHandler, this) == ARK_SUCCESS,
+        "ERKStepSetErrHandlerFn");
+  Check(ERKStepSVtolerances(arkode_, rtol, atol_) == ARK_SUCCESS, "ERKStepSVtolerances");
+  Check(ERKStepSetUserData(arkode_, this) == ARK_SUCCESS, "ERKStepSetUserData");
+  Check(ERKStepSetTableNum(arkode_, ARKODE_DORMAND_PRINCE_7_4_5) == ARK_SUCCESS,
+        "ERKStepSetTableNum");
+  Check(ERKStepSetMaxNumSteps(arkode_, kMaxStepsPerAdvance) == ARK_SUCCESS,
+        "ERKStepSetMaxNumSteps");
+  // One warm-up step of x' = 0, as for CVODE: whatever ARKODE sets up lazily is set up here.
+  const OdeRhs user_rhs = rhs_;
+  rhs_ = [](double, const double*, double* xdot, void* ctx) {
+    for (int i = 0, n = *static_cast<const int*>(ctx); i < n; ++i) xdot[i] = 0.0;
+    return 0;
+  };
+  void* user_ctx = ctx_;
+  ctx_ = &n_;
+  std::vector<double> x0(n_, 0.0);
+  Advance(0.0, 1.0, x0.data());
+  rhs_ = user_rhs, ctx_ = user_ctx;
+}
+
 OdeStepper::~OdeStepper() { Free(); }
 
 void OdeStepper::Free() {
   if (cvode_) CVodeFree(&cvode_);
+  if (arkode_) ERKStepFree(&arkode_);
   if (ls_) SUNLinSolFree(ls_);
   if (jac_) SUNMatDestroy(jac_);
   if (ewt_) N_VDestroy(ewt_);
   if (atol_) N_VDestroy(atol_);
   if (x_) N_VDestroy(x_);
   if (sunctx_) SUNContext_Free(&sunctx_);
-  cvode_ = nullptr, ls_ = nullptr, jac_ = nullptr, ewt_ = nullptr, atol_ = nullptr, x_ = nullptr;
+  cvode_ = nullptr, arkode_ = nullptr, ls_ = nullptr, jac_ = nullptr, ewt_ = nullptr, atol_ = nullptr, x_ = nullptr;
+}
+
+int OdeStepper::ErkRhs(double t, N_Vector x, N_Vector xdot, void* self) {
+  // ARKODE takes any nonzero return as a failure (no recoverable retry in ERKStep).
+  auto* me = static_cast<OdeStepper*>(self);
+  return me->rhs_(t, N_VGetArrayPointer(x), N_VGetArrayPointer(xdot), me->ctx_);
 }
 
 int OdeStepper::Rhs(double t, N_Vector x, N_Vector xdot, void* self) {
@@ -127,6 +164,7 @@ int OdeStepper::Jac(double t, N_Vector x, N_Vector fx, SUNMatrix jac, void* self
     const double inc = std::max(srur * std::abs(xj), min_inc / ewt[j]);
     xv[j] = xj + inc;
     const int flag = me->rhs_(t, xv, N_VGetArrayPointer(tmp1), me->ctx_);
+    ++me->jac_rhs_evals_;
     xv[j] = xj;
     if (flag != 0) return flag;
     double* col = SUNDenseMatrix_Column(jac, j);
@@ -144,6 +182,25 @@ void OdeStepper::Advance(double t0, double t1, double* x_inout) {
     throw Error("OdeStepper", fmt::format("Advance needs t1 > t0 (got {} -> {})", t0, t1));
   double* x = N_VGetArrayPointer(x_);
   for (int i = 0; i < n_; ++i) x[i] = x_inout[i];
+  if (method_ == OdeMethod::kErk) {
+    // ReInit (not ERKStepReset, which keeps the step-size history): a function of (t0, t1, x).
+    int flag = ERKStepReInit(arkode_, &OdeStepper::ErkRhs, t0, x_);
+    if (flag == ARK_SUCCESS) flag = ERKStepSetInitStep(arkode_, t1 - t0);
+    if (flag == ARK_SUCCESS) flag = ERKStepSetStopTime(arkode_, t1);
+    double t_reached = t0;
+    if (flag == ARK_SUCCESS) flag = ERKStepEvolve(arkode_, t1, x_, &t_reached, ARK_NORMAL);
+    if (flag < 0) {
+      char* name = ERKStepGetReturnFlagName(flag);
+      const std::string what =
+          fmt::format("ARKODE ERKStep failed over [{}, {}] s with {} ({}) at t = {}: {}", t0, t1,
+                      name ? name : "?", flag, t_reached, last_message_);
+      std::free(name);
+      throw Error("OdeStepper", what);
+    }
+    for (int i = 0; i < n_; ++i) x_inout[i] = x[i];
+    return;
+  }
+  jac_rhs_evals_ = 0;
   int flag = CVodeReInit(cvode_, t0, x_);
   if (flag == CV_SUCCESS) flag = CVodeSetStopTime(cvode_, t1);
   double t_reached = t0;
@@ -160,8 +217,16 @@ void OdeStepper::Advance(double t0, double t1, double* x_inout) {
 
 long OdeStepper::last_steps() const {
   long steps = 0;
-  CVodeGetNumSteps(cvode_, &steps);
+  if (arkode_) ERKStepGetNumSteps(arkode_, &steps);
+  if (cvode_) CVodeGetNumSteps(cvode_, &steps);
   return steps;
+}
+
+long OdeStepper::last_rhs_evals() const {
+  long evals = 0;
+  if (arkode_) ERKStepGetNumRhsEvals(arkode_, &evals);
+  if (cvode_) CVodeGetNumRhsEvals(cvode_, &evals), evals += jac_rhs_evals_;
+  return evals;
 }
 
 }  // namespace rths::models
