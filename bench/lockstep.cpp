@@ -11,11 +11,11 @@
 // deliveries, 15 of them to a subscriber (handled) and 10 to a process that drops them (ignored).
 // With a port per channel (lockstep/transport.h) a message reaches only its subscribers: 15
 // handled deliveries, on our own sockets read in the event loop's thread (no LCM receive thread).
-// Ping-pongs between two processes, with idle or subscribed listeners added, give the CPU (user +
-// system, getrusage of every process) of one send s, one handled delivery h and one ignored
-// delivery i:
-//   one port:          C(L idle, S subscribed) per round trip = 2 s + 2 (1 + S) h + 2 (1 + L) i
-//   port per channel:  C(S subscribed)                       = 2 s + 2 (1 + S) h
+// A loop of sends with no socket on the port gives the CPU of one send s; ping-pongs between two
+// processes, with 0, 1 and 3 idle listeners added, the CPU (user + system, of every process) of
+// one round trip, hence one handled delivery h and one ignored delivery i:
+//   one port:          C(L idle listeners) per round trip = 2 s + 2 h + 2 (1 + L) i
+//   port per channel:  C per round trip                   = 2 s + 2 h
 // A step then costs 5 s + 15 h + 10 i (one port) or 5 s + 15 h (port per channel) of CPU, and
 // the bound is cores / that: the rate if the participants computed and logged for free.
 #include <signal.h>
@@ -177,6 +177,21 @@ double PingPongCpu(const std::string& url, bool per_channel, int idle, int subsc
   return (self + children) / round_trips;
 }
 
+/// CPU of one send [s] with no socket on the port: `sends` publications of a 160-byte payload.
+double SendCpu(const std::string& url, bool per_channel, int sends) {
+  std::vector<std::uint8_t> payload(160, 0x5a);
+  std::unique_ptr<ls::UdpmChannels> ch;
+  std::unique_ptr<lcm::LCM> lcm;
+  if (per_channel) ch = std::make_unique<ls::UdpmChannels>(*ls::UdpmUrl::Parse(url));
+  else lcm = std::make_unique<lcm::LCM>(url);
+  const double t0 = CpuSeconds(RUSAGE_SELF);
+  for (int i = 0; i < sends; ++i) {
+    if (ch) ch->Publish(kPing, payload.data(), 160);
+    else lcm->publish(kPing, payload.data(), 160);
+  }
+  return (CpuSeconds(RUSAGE_SELF) - t0) / sends;
+}
+
 struct Run {
   double steps_per_s = 0, cpu_per_step_s = 0;
 };
@@ -241,14 +256,14 @@ int main(int argc, char** argv) {
   const int port = 17600 + ::getpid() % 2000 * 8;
   const std::string one = fmt::format("udpm://239.255.76.67:{}?ttl=0", port);
   const std::string per = fmt::format("udpm://239.255.76.67:{}?ttl=0&port_per_channel=1", port);
-  std::vector<double> c00, c10, c30, c01, p00, p01, r_one, r_per, r_memq, cpu_one, cpu_per, cpu_memq, gain;
+  std::vector<double> c00, c10, c30, s_one, s_per, p00, r_one, r_per, r_memq, cpu_one, cpu_per, cpu_memq, gain;
   for (int r = 0; r < repeat; ++r) {
     c00.push_back(PingPongCpu(one, false, 0, 0, round_trips));
     c10.push_back(PingPongCpu(one, false, 1, 0, round_trips));
     c30.push_back(PingPongCpu(one, false, 3, 0, round_trips));
-    c01.push_back(PingPongCpu(one, false, 0, 1, round_trips));
+    s_one.push_back(SendCpu(one, false, 4 * round_trips));
     p00.push_back(PingPongCpu(per, true, 0, 0, round_trips));
-    p01.push_back(PingPongCpu(per, true, 0, 1, round_trips));
+    s_per.push_back(SendCpu(per, true, 4 * round_trips));
     const Run a = LockstepRun(bin, scen, "--transport udpm", tmp / "one", steps);
     const Run b = LockstepRun(bin, scen, "--transport udpm --port-per-channel", tmp / "per", steps);
     const Run m = LockstepRun(bin, scen, "--transport memq", tmp / "memq", steps);
@@ -260,15 +275,15 @@ int main(int argc, char** argv) {
     cpu_memq.push_back(m.cpu_per_step_s);
     gain.push_back(a.steps_per_s > 0 ? b.steps_per_s / a.steps_per_s : 0.0);
   }
-  // One port: C(L, S) = 2 s + 2 (1 + S) h + 2 (1 + L) i.
-  const double C00 = Median(c00), C10 = Median(c10), C30 = Median(c30), C01 = Median(c01);
+  // One port: C(L) = 2 s + 2 h + 2 (1 + L) i.
+  const double C00 = Median(c00), C10 = Median(c10), C30 = Median(c30);
   const double i = ((C10 - C00) + (C30 - C00) / 3.0) / 2.0 / 2.0;  // per message per idle listener
-  const double h = (C01 - C00) / 2.0;
-  const double s = (C00 - 2 * h - 2 * i) / 2.0;
+  const double s = Median(s_one);
+  const double h = (C00 - 2 * s - 2 * i) / 2.0;
   const double step_one = kSendsPerStep * s + kHandledPerStep * h + kIgnoredPerStepOnePort * i;
-  // Port per channel: C(S) = 2 s' + 2 (1 + S) h'.
-  const double P00 = Median(p00), P01 = Median(p01);
-  const double hp = (P01 - P00) / 2.0, sp = (P00 - 2 * hp) / 2.0;
+  // Port per channel: C = 2 s' + 2 h'.
+  const double P00 = Median(p00);
+  const double sp = Median(s_per), hp = (P00 - 2 * sp) / 2.0;
   const double step_per = kSendsPerStep * sp + kHandledPerStep * hp;
   const double bound_one = cores / step_one, bound_per = cores / step_per;
   const double one_rate = Median(r_one), per_rate = Median(r_per), memq_rate = Median(r_memq);
@@ -277,10 +292,9 @@ int main(int argc, char** argv) {
   std::printf("bench-lockstep: %d repeats, medians; %u cores; %lld steps per lockstep run\n", repeat, cores,
               static_cast<long long>(steps));
   std::printf("ping-pong CPU per round trip (all processes, user + system), 160-byte payload:\n");
-  std::printf("  LCM, one port: no listener %6.1f us, 1 idle %6.1f us, 3 idle %6.1f us, 1 subscribed %6.1f us\n",
-              us(C00), us(C10), us(C30), us(C01));
-  std::printf("  port per channel:          %6.1f us,                          1 subscribed %6.1f us\n", us(P00),
-              us(P01));
+  std::printf("  LCM, one port: no listener %6.1f us, 1 idle listener %6.1f us, 3 idle listeners %6.1f us\n", us(C00),
+              us(C10), us(C30));
+  std::printf("  port per channel:          %6.1f us\n", us(P00));
   std::printf("cost of one          send     handled delivery   ignored delivery\n");
   std::printf("  LCM, one port      %6.1f us   %6.1f us          %6.1f us\n", us(s), us(h), us(i));
   std::printf("  port per channel   %6.1f us   %6.1f us               -\n", us(sp), us(hp));
