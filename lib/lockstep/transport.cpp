@@ -240,8 +240,25 @@ int UdpmChannels::HandleTimeout(int timeout_ms) {
   const int r = ::poll(fds.data(), n, timeout_ms);
   if (r <= 0) return r;
   int handled = 0;
+  Socket* handshake = nullptr;
   for (std::size_t j = 0; j < n; ++j) {
-    if ((fds[j].revents & POLLIN) && Dispatch(&sockets_[poll_order_[j]])) ++handled;
+    if (!(fds[j].revents & POLLIN)) continue;
+    Socket* s = &sockets_[poll_order_[j]];
+    if (s->channel == kPortChannels[0]) {
+      handshake = s;
+    } else if (Dispatch(s)) {
+      ++handled;
+    }
+  }
+  if (handshake) {
+    // Across ports there is no order: an ABORT may be ready before step messages sent earlier.
+    // Loopback delivery is done within the sender's send call, so whatever was sent before this
+    // handshake message is queued by now: hand it all over first, as one port's FIFO would.
+    for (const int i : poll_order_) {
+      if (&sockets_[i] == handshake) continue;
+      for (int m = 0; m < 256 && Dispatch(&sockets_[i]); ++m) ++handled;  // bounded under a flood
+    }
+    if (Dispatch(handshake)) ++handled;
   }
   return handled;
 }

@@ -78,7 +78,8 @@ class UdpmChannels {
   /// -1 on failure (an unknown channel, a message too large for one datagram, a send error).
   int Publish(const char* channel, const void* data, unsigned size);
   /// Waits at most `timeout_ms` for a message on any subscribed channel, then hands at most one
-  /// waiting message per channel to its callbacks. Returns how many it handled (> 0), 0 if none
+  /// waiting message per channel to its callbacks; before a handshake message (an ABORT, DONE) it
+  /// hands over every message waiting on the other channels, sent before it, as on one port. Returns how many it handled (> 0), 0 if none
   /// came in time, < 0 on a receive error (errno set; EINTR: a signal).
   int HandleTimeout(int timeout_ms);
 
