@@ -228,7 +228,13 @@ role = ")") + role + "\"\n");
     const auto log = ReadRunLog((dir / "run" / "log.lcm").string());
     CHECK(log.CompleteSteps() == 300);
     CHECK_FALSE(log.truncated_tail);
-    CHECK(CsvLines(dir / "run" / "signals.csv") == 301);
+    // signals.csv is buffered (docs/lockstep.md "Logging"): a killed logger cannot write the rows
+    // it held, so its CSV ends earlier, on a whole row; anyone else's death lets it write them all.
+    if (std::string(role) == "logger") {
+      CHECK(CsvLines(dir / "run" / "signals.csv") <= 301);
+    } else {
+      CHECK(CsvLines(dir / "run" / "signals.csv") == 301);
+    }
     const auto j = Summary(dir / "run");
     CHECK(j["status"] == "failed");
     CHECK(j["failure"]["participant"] == role);

@@ -65,8 +65,16 @@ Logger::Logger(lockstep::RunIdentity id, lockstep::Timing timing, lcm::LCM* lcm,
     ::close(csv_fd_);
     throw Error(csv_path_, why);
   }
-  csv_acked_ = csv_end_;
   step_bytes_.reserve(4096);
+  if (csv_fd_ >= 0) {
+    csv_buf_.reserve(kCsvFlushBytes + kCsvRowMaxBytes);
+    csv_reserved_end_ = csv_end_;
+    if (const std::string why = FlushCsv(); !why.empty()) {  // reserves the first stretch
+      ::close(log_fd_);
+      ::close(csv_fd_);
+      throw Error(csv_path_, why);
+    }
+  }
   SetAnswerChannel(lockstep::kAck, &ack_cache_);
   Subscribe(lockstep::kChDesired, [this](const lcm::ReceiveBuffer* rbuf) {
     OnStepMessage(&desired_, &raw_desired_, lockstep::kDesired, rbuf);
@@ -83,6 +91,7 @@ Logger::Logger(lockstep::RunIdentity id, lockstep::Timing timing, lcm::LCM* lcm,
 }
 
 Logger::~Logger() {
+  if (csv_fd_ >= 0) CloseCsv();  // after a stop without OnStop (an exception): keep the rows
   if (log_fd_ >= 0) ::close(log_fd_);
   if (csv_fd_ >= 0) ::close(csv_fd_);
 }
@@ -91,6 +100,7 @@ std::string Logger::Append(int fd, const std::string& path, const std::uint8_t* 
                            std::int64_t* good_end) {
   std::size_t done = 0;
   while (done < size) {
+    ++write_calls_;
     const ssize_t n = ::pwrite(fd, data + done, size - done, static_cast<off_t>(*good_end + done));
     if (n > 0) {
       done += static_cast<std::size_t>(n);
@@ -110,14 +120,60 @@ std::string Logger::Append(int fd, const std::string& path, const std::uint8_t* 
 }
 
 void Logger::FailWrite(const std::string& why, std::int64_t k) {
-  // Both files end on the last acknowledged step (the other file may hold part of step k).
+  // log.lcm ends on the last acknowledged step (it may hold part of step k); the buffered rows
+  // are all of acknowledged steps: write them (a failed write cuts signals.csv to a whole row).
   const bool cut_log = ::ftruncate(log_fd_, static_cast<off_t>(log_acked_)) == 0;
-  const bool cut_csv = csv_fd_ < 0 || ::ftruncate(csv_fd_, static_cast<off_t>(csv_acked_)) == 0;
+  const bool csv_ok = csv_fd_ < 0 || CloseCsv().empty();
   std::string reason = fmt::format("{} (at step {}; the log and signals.csv end on step {}, the last "
                                    "acknowledged one{})",
-                                   why, k, next_ - 1, cut_log && cut_csv ? "" : "; cutting them back failed");
+                                   why, k, next_ - 1,
+                                   !cut_log ? "; cutting the log back failed"
+                                   : !csv_ok ? "; signals.csv ends earlier, on a whole row"
+                                             : "");
   Fail(lockstep::kExitOutput, "logger: " + reason, true, k);
 }
+
+std::string Logger::AddCsvRow(const char* row, std::size_t size) {
+  if (!csv_buffered_) return Append(csv_fd_, csv_path_, reinterpret_cast<const std::uint8_t*>(row), size, &csv_end_);
+  csv_buf_.append(row, size);
+  return csv_buf_.size() >= kCsvFlushBytes ? FlushCsv() : std::string();
+}
+
+std::string Logger::FlushCsv() {
+  if (!csv_buf_.empty()) {
+    const std::string why = Append(csv_fd_, csv_path_, reinterpret_cast<const std::uint8_t*>(csv_buf_.data()),
+                                   csv_buf_.size(), &csv_end_);
+    csv_buf_.clear();
+    if (!why.empty()) return why;
+  }
+  // Reserve what the next flush writes (it may exceed kCsvFlushBytes by one row), so that a full
+  // disk fails the log's write, never a flush of rows already acknowledged.
+  if (csv_reserved_end_ < csv_end_ + static_cast<std::int64_t>(kCsvFlushBytes + kCsvRowMaxBytes)) {
+    ++write_calls_;
+    const off_t len = static_cast<off_t>(2 * kCsvFlushBytes);
+    csv_buffered_ = ::fallocate(csv_fd_, FALLOC_FL_KEEP_SIZE, static_cast<off_t>(csv_end_), len) == 0;
+    csv_reserved_end_ = csv_buffered_ ? csv_end_ + len : csv_end_;
+  }
+  return {};
+}
+
+std::string Logger::CloseCsv() {
+  if (csv_closed_ || csv_fd_ < 0) return {};
+  csv_closed_ = true;
+  std::string why = FlushCsv();
+  csv_buffered_ = false;
+  if (csv_reserved_end_ > csv_end_) {  // give back the reserved blocks past the last row
+    ++write_calls_;
+    ::fallocate(csv_fd_, FALLOC_FL_PUNCH_HOLE | FALLOC_FL_KEEP_SIZE, static_cast<off_t>(csv_end_),
+                static_cast<off_t>(csv_reserved_end_ - csv_end_));
+    csv_reserved_end_ = csv_end_;
+  }
+  return why;
+}
+
+std::string Logger::OnDone() { return CloseCsv(); }  // every step is in log.lcm before its ack
+
+void Logger::OnStop() { CloseCsv(); }
 
 template <class Msg>
 void Logger::OnStepMessage(lockstep::StepMailbox<Msg>* box, RawRing* raw, lockstep::Channel channel,
@@ -184,7 +240,7 @@ void Logger::TryAck() {
       FailWrite(why, k);
       return;
     }
-    if (csv_fd_ < 0 || k % csv_every_ != 0) {  // this step has no row of signals.csv
+    if (csv_fd_ < 0 || csv_closed_ || k % csv_every_ != 0) {  // this step has no row of signals.csv
       log_acked_ = log_end_;
       Acknowledge(k);
       continue;
@@ -199,14 +255,11 @@ void Logger::TryAck() {
       FailWrite(fmt::format("formatting row {} of {} failed", k, csv_path_), k);
       return;
     }
-    if (const std::string why = Append(csv_fd_, csv_path_, reinterpret_cast<const std::uint8_t*>(row),
-                                       static_cast<std::size_t>(n), &csv_end_);
-        !why.empty()) {
+    if (const std::string why = AddCsvRow(row, static_cast<std::size_t>(n)); !why.empty()) {
       FailWrite(why, k);
       return;
     }
     log_acked_ = log_end_;
-    csv_acked_ = csv_end_;
     Acknowledge(k);
   }
 }

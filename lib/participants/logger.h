@@ -6,19 +6,28 @@
 ///   desired_t k, command_t k, measured_t k, current_t k  ->  ack_t k
 /// The first copy of every (channel, k) is kept; re-sent duplicates are ignored. Once all four
 /// messages of step k are in, they are appended to log.lcm (a standard LCM event log, readable by
-/// lcm-logplayer and lcm-spy) in channel order with one write(2), the row k of signals.csv with
-/// another, and only then is ack_t k published: the clock cannot advance past a step the logger
-/// has not handed to the kernel. The handshake is logged on its own channel as it arrives (first
-/// copy per participant and phase).
+/// lcm-logplayer and lcm-spy) in channel order with one pwrite(2), and only then is ack_t k
+/// published: the clock cannot advance past a step the logger has not handed to the kernel. The
+/// handshake is logged on its own channel as it arrives (first copy per participant and phase).
+///
+/// signals.csv is a derived copy of the log (every column comes from the four messages), so its
+/// rows are buffered and written kCsvFlushBytes at a time, into space reserved ahead with
+/// fallocate(2) (so a full disk cannot fail a flush); where the file system cannot reserve space,
+/// each row is written with the step as before. The buffer is flushed when DONE arrives, when the
+/// run stops (ABORT, an interrupt, a write error) and when the logger is destroyed: signals.csv
+/// then ends on the last acknowledged step, like log.lcm. Only if the logger process itself is
+/// killed (SIGKILL) may signals.csv end earlier, on a whole row; log.lcm is complete regardless.
+/// One write system call per step, instead of two (bench/memq.cpp counts them).
 ///
 /// Event timestamps are simulated time: the wall-clock time at which the logger started stepping
 /// (GO) plus k dt for the events of step k, so `lcm-logplayer --speed 1` replays a run at the pace
 /// it represents, whatever pace it ran at. Handshake events before GO carry their receive time,
 /// later ones the current step's time.
 ///
-/// A failed or short write (disk full, I/O error) stops the run: both files are cut back to the
-/// end of the last acknowledged step (so they end on a whole event and a whole row), ABORT is
-/// broadcast naming the file and the error, and the logger exits with kExitOutput.
+/// A failed or short write (disk full, I/O error) stops the run: log.lcm is cut back to the end of
+/// the last acknowledged step, the buffered rows (all of acknowledged steps) are written to
+/// signals.csv (cut back to its last whole row if that fails too), ABORT is broadcast naming the
+/// file and the error, and the logger exits with kExitOutput.
 #include <cstdint>
 #include <set>
 #include <string>
@@ -50,11 +59,17 @@ class Logger : public lockstep::Participant {
          const std::string& csv_path, lockstep::Faults faults = {}, int csv_every = 1);
   ~Logger() override;
 
+  /// Bytes of signals.csv rows buffered before one write (and reserved ahead on disk).
+  static constexpr std::size_t kCsvFlushBytes = 64 * 1024;
+
   /// Steps acknowledged so far.
   std::int64_t steps_written() const { return next_; }
+  /// Write system calls (pwrite, ftruncate, fallocate) made so far, handshake included.
+  std::int64_t write_calls() const { return write_calls_; }
 
  protected:
-  std::string OnDone() override { return {}; }  // every step was written before its ack
+  std::string OnDone() override;  // writes the buffered rows of signals.csv
+  void OnStop() override;         // the same, on an abnormal stop
   void OnGo() override;
   void ListMissing(std::int64_t k, lockstep::WantList* out) const override;
 
@@ -77,12 +92,25 @@ class Logger : public lockstep::Participant {
                      std::int64_t* good_end);
   /// Cuts both files back to the last acknowledged step and stops the run (kExitOutput).
   void FailWrite(const std::string& why, std::int64_t k);
+  /// Adds a row to signals.csv: to the buffer (written once it holds kCsvFlushBytes) or, where no
+  /// space can be reserved, straight to the file. Returns "" or the error.
+  std::string AddCsvRow(const char* row, std::size_t size);
+  /// Writes the buffered rows, then reserves the next 2 kCsvFlushBytes (fallocate, keeping the
+  /// size); if that fails, rows are written one by one from then on. Returns "" or the error.
+  std::string FlushCsv();
+  /// FlushCsv() once at the end of the run, then frees the reserved space past the last row.
+  std::string CloseCsv();
 
   std::string log_path_, csv_path_;
   int csv_every_ = 1;  ///< signals.csv row every this many steps; 0: no signals.csv
   int log_fd_ = -1, csv_fd_ = -1;
   std::int64_t log_end_ = 0, csv_end_ = 0;      ///< bytes written, each ending on a whole event / row
-  std::int64_t log_acked_ = 0, csv_acked_ = 0;  ///< ... at the last acknowledged step
+  std::int64_t log_acked_ = 0;                  ///< log bytes at the last acknowledged step
+  std::string csv_buf_;                         ///< rows of acknowledged steps not yet written
+  bool csv_buffered_ = false;                   ///< space is reserved ahead: rows are buffered
+  bool csv_closed_ = false;                     ///< final flush done (or failed): no more rows
+  std::int64_t csv_reserved_end_ = 0;           ///< end of the space reserved with fallocate
+  std::int64_t write_calls_ = 0;
   std::int64_t event_number_ = 0;
   std::int64_t start_utime_ = -1;  ///< wall-clock time of GO [us since the epoch]; -1 before
   std::int64_t next_ = 0;  ///< next step to acknowledge
