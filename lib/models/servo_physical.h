@@ -131,7 +131,8 @@ enum class RigLoad {
 
 /// How a step is integrated.
 enum class RigIntegrator {
-  kCvode,  ///< CVODE (BDF, Newton, dense DQ Jacobian) over [t_k, t_{k+1}) at rtol (default)
+  kCvode,  ///< OdeStepper's adaptive, error-controlled integrator (ARKODE Dormand-Prince 5(4);
+           ///< the name is historical) over [t_k, t_{k+1}) at rtol (default)
   kRk4,    ///< classical Runge-Kutta, rk4_substeps fixed steps per dt (for comparison)
 };
 
@@ -144,7 +145,7 @@ struct PhysicalRig {
   bool current_dynamics = true;   ///< Eq. 40 + 75 Hz low-pass; false: i_c = commanded current
   CurrentDriver driver;           ///< used if current_dynamics
   double dt_s = 0.0;              ///< lockstep step [s]
-  double rtol = 1e-8;             ///< CVODE relative tolerance, (0, 1e-2]
+  double rtol = 1e-8;             ///< the integrator's relative tolerance, (0, 1e-2]
   RigIntegrator integrator = RigIntegrator::kCvode;
   int rk4_substeps = 4;           ///< kRk4: fixed steps per dt, [1, 1000]
 
@@ -171,9 +172,9 @@ double EffectiveCurrentA(const PhysicalRig& rig, const PhysicalRigState& s);
 /// effective current; 0 without a specimen.
 double MeasuredForceKn(const PhysicalRig& rig, const PhysicalRigState& s);
 
-/// Advances a PhysicalRigState by one step. Holds a copy of the rig and its CVODE workspace,
+/// Advances a PhysicalRigState by one step. Holds a copy of the rig and its integrator workspace,
 /// created once; Step() allocates nothing and depends only on (state, u, i). Non-copyable,
-/// non-movable (CVODE keeps a pointer to it).
+/// non-movable (the integrator keeps a pointer to it).
 ///
 /// ODE state w = [x, x', p_L, x_v, x_v'] (SI) plus [y_d, z_bw] (mm) with the MR damper; the
 /// effective current i_c(t) inside the step is CurrentDriver's closed form (not an ODE state).
@@ -187,7 +188,7 @@ class PhysicalRigStepper {
   /// [t_k, t_{k+1}).
   void Step(PhysicalRigState* s, double u_mm, double i_cmd_A);
   const PhysicalRig& rig() const { return rig_; }
-  /// CVODE's internal steps in the last Step() (0 for kRk4).
+  /// The integrator's internal steps in the last Step() (0 for kRk4).
   long last_internal_steps() const;
 
  private:
