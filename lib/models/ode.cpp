@@ -82,6 +82,10 @@ void OdeStepper::Init(double rtol, std::span<const double> atol) {
 
   // CVODE allocates its saved Jacobian lazily, on the first step: take one step of x' = 0 now
   // so that Advance() never allocates.
+  WarmUp();
+}
+
+void OdeStepper::WarmUp() {
   const OdeRhs user_rhs = rhs_;
   rhs_ = [](double, const double*, double* xdot, void* ctx) {
     for (int i = 0, n = *static_cast<const int*>(ctx); i < n; ++i) xdot[i] = 0.0;
@@ -106,16 +110,7 @@ void OdeStepper::InitErk(double rtol) {
   Check(ERKStepSetMaxNumSteps(arkode_, kMaxStepsPerAdvance) == ARK_SUCCESS,
         "ERKStepSetMaxNumSteps");
   // One warm-up step of x' = 0, as for CVODE: whatever ARKODE sets up lazily is set up here.
-  const OdeRhs user_rhs = rhs_;
-  rhs_ = [](double, const double*, double* xdot, void* ctx) {
-    for (int i = 0, n = *static_cast<const int*>(ctx); i < n; ++i) xdot[i] = 0.0;
-    return 0;
-  };
-  void* user_ctx = ctx_;
-  ctx_ = &n_;
-  std::vector<double> x0(n_, 0.0);
-  Advance(0.0, 1.0, x0.data());
-  rhs_ = user_rhs, ctx_ = user_ctx;
+  WarmUp();
 }
 
 OdeStepper::~OdeStepper() { Free(); }

@@ -75,6 +75,10 @@ class OdeStepper {
   static void ErrHandler(int code, const char* module, const char* function, char* msg, void* self);
   void Init(double rtol, std::span<const double> atol);
   void InitErk(double rtol);
+  /// One Advance() over [0, 1] of x' = 0 from x = 0: whatever the integrator sets up lazily on
+  /// its first step (CVODE's saved Jacobian, ARKODE's workspaces) is set up at construction, so
+  /// that Advance() never allocates.
+  void WarmUp();
   void Free();
 
   int n_;
