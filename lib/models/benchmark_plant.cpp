@@ -9,6 +9,7 @@
 #include <unsupported/Eigen/MatrixFunctions>
 
 #include "core/error.h"
+#include "models/phase_lag.h"
 #include "signal/random.h"
 
 namespace rths::models {
@@ -197,17 +198,7 @@ std::complex<double> FrequencyResponse(const BenchmarkPlant& m, double f_hz, boo
 double TimeLagS(const BenchmarkPlant& m, double f_hz, bool discrete) {
   if (!std::isfinite(f_hz) || !(f_hz > 0.0))
     throw Error("benchmark plant TimeLagS", fmt::format("f_hz must be finite and > 0 (got {})", f_hz));
-  // Sum the phase increments along a fine grid from DC (where Gp is real and positive); each
-  // increment is far below pi.
-  const int n = 16 + static_cast<int>(std::ceil(8.0 * f_hz));
-  std::complex<double> prev = m.DcGain();
-  double phase = 0.0;
-  for (int i = 1; i <= n; ++i) {
-    const std::complex<double> h = FrequencyResponse(m, f_hz * i / n, discrete);
-    phase += std::arg(h / prev);
-    prev = h;
-  }
-  return -phase / (2.0 * std::numbers::pi * f_hz);
+  return UnwrappedLagS(f_hz, m.DcGain(), [&](double f) { return FrequencyResponse(m, f, discrete); });
 }
 
 }  // namespace rths::models

@@ -8,6 +8,7 @@
 #include <unsupported/Eigen/MatrixFunctions>
 
 #include "core/error.h"
+#include "models/phase_lag.h"
 
 namespace rths::models {
 
@@ -72,17 +73,7 @@ std::complex<double> FrequencyResponse(const LinearServo& m, double f_hz, bool d
 
 double TimeLagS(const LinearServo& m, double f_hz, bool discrete) {
   if (!(f_hz > 0.0)) throw Error("TimeLagS", fmt::format("f_hz must be > 0 (got {})", f_hz));
-  // Unwrap by summing the phase increments along a fine grid from DC (where G is real and
-  // positive); each increment is far below pi.
-  const int n = 16 + static_cast<int>(std::ceil(8.0 * f_hz));
-  std::complex<double> prev = m.DcGain();
-  double phase = 0.0;
-  for (int i = 1; i <= n; ++i) {
-    const std::complex<double> h = FrequencyResponse(m, f_hz * i / n, discrete);
-    phase += std::arg(h / prev);
-    prev = h;
-  }
-  return -phase / (2.0 * std::numbers::pi * f_hz);
+  return UnwrappedLagS(f_hz, m.DcGain(), [&](double f) { return FrequencyResponse(m, f, discrete); });
 }
 
 ServoModel3 ServoPreset(std::string_view name) {
