@@ -8,15 +8,15 @@
 // The bound. A step is CPU-bound, not latency-bound: its five messages (desired_t, command_t,
 // measured_t, current_t, ack_t) are each sent once and delivered to sockets. On one port (LCM's
 // udpm) every message reaches every socket of the run, the sender's included: 5 x 5 = 25
-// deliveries, 15 of them to a subscriber (handled) and 10 to a process that drops them (ignored).
-// With a port per channel (lockstep/transport.h) a message reaches only its subscribers: 15
+// deliveries, 14 of them to a subscriber (handled) and 11 to a process that drops them (ignored).
+// With a port per channel (lockstep/transport.h) a message reaches only its subscribers: 14
 // handled deliveries, on our own sockets read in the event loop's thread (no LCM receive thread).
 // A loop of sends with no socket on the port gives the CPU of one send s; ping-pongs between two
 // processes, with 0, 1 and 3 idle listeners added, the CPU (user + system, of every process) of
 // one round trip, hence one handled delivery h and one ignored delivery i:
 //   one port:          C(L idle listeners) per round trip = 2 s + 2 h + 2 (1 + L) i
 //   port per channel:  C per round trip                   = 2 s + 2 h
-// A step then costs 5 s + 15 h + 10 i (one port) or 5 s + 15 h (port per channel) of CPU, and
+// A step then costs 5 s + 14 h + 11 i (one port) or 5 s + 14 h (port per channel) of CPU, and
 // the bound is cores / that: the rate if the participants computed and logged for free.
 #include <signal.h>
 #include <sys/prctl.h>
@@ -50,11 +50,11 @@ namespace ls = rths::lockstep;
 namespace {
 
 /// Handled deliveries per step: the subscribers of each step channel (docs/lockstep.md):
-/// desired_t: controller, semiactive, plant, logger; command_t: integrator, plant, logger;
+/// desired_t: controller, semiactive, logger (and an "ideal" plant); command_t: integrator, plant, logger;
 /// measured_t: integrator, controller, semiactive, logger; current_t: integrator, plant, logger;
 /// ack_t: integrator.
 constexpr int kSendsPerStep = 5;
-constexpr int kHandledPerStep = 4 + 3 + 4 + 3 + 1;
+constexpr int kHandledPerStep = 3 + 3 + 4 + 3 + 1;
 constexpr int kProcesses = 5;
 constexpr int kIgnoredPerStepOnePort = kSendsPerStep * kProcesses - kHandledPerStep;
 

@@ -1,5 +1,6 @@
-// bench-memq: the default scenario on memq:// in this process (what `rths run --transport memq`
-// runs), its steps/s, write system calls per step, and the split of a step's CPU time into model
+// bench-memq: the default scenario in this process (what `rths run --transport memq` runs: every
+// participant on lockstep::InprocChannels), its steps/s beside the same group on LCM's memq:// (the
+// former transport), write system calls per step, and the split of a step's CPU time into model
 // (integrator, controller, plant), encode/decode, transport and logging, each timed off-line on the
 // run's own inputs in the same process, side by side, because absolute times drift on shared
 // machines. "other" is what the parts leave of the whole step: the lockstep bookkeeping.
@@ -19,6 +20,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -31,9 +33,11 @@
 #include "control/tracking_controller.h"
 #include "io/event_log.h"
 #include "lockstep/runtime.h"
+#include "lockstep/transport.h"
 #include "models/mr_damper.h"
 #include "models/rig.h"
 #include "models/structure_file.h"
+#include "participants/factory.h"
 #include "participants/group.h"
 #include "participants/logger.h"
 #include "rths/ack_t.hpp"
@@ -95,13 +99,30 @@ struct Run {
   double steps_per_s = 0, writes_per_step = 0, reads_per_step = 0, wall_per_step_us = 0;
 };
 
-Run RunGroup(const rths::scenario::Scenario& s, const fs::path& out) {
+// The default group in this process: on the in-process queue (RunGroupInProcess, what `rths run
+// --transport memq` does), or `lcm_memq`: the same participants on one LCM memq:// instance, the
+// transport of memq runs before lockstep::InprocChannels (side by side, for the ratio).
+Run RunGroup(const rths::scenario::Scenario& s, const fs::path& out, bool lcm_memq = false) {
   fs::remove_all(out);
   fs::create_directories(out);
   long w0, r0, w1, r1;
   SysCalls(&w0, &r0);
   const auto t0 = Clock::now();
-  const auto outcomes = rths::participants::RunGroupInProcess({s}, 1, out.string());
+  std::vector<rths::participants::Outcome> outcomes;
+  if (lcm_memq) {
+    lcm::LCM lcm("memq://");
+    std::vector<std::unique_ptr<rths::lockstep::Participant>> owned;
+    std::vector<rths::lockstep::Participant*> group;
+    for (std::string_view role : rths::participants::kGroupOrder) {
+      owned.push_back(rths::participants::MakeParticipant(role, s, rths::participants::IdentityOf(s, 1), &lcm,
+                                                          out.string()));
+      group.push_back(owned.back().get());
+    }
+    rths::lockstep::RunLoop(&lcm, group);
+    for (const auto* p : group) outcomes.push_back(rths::participants::OutcomeOf(*p));
+  } else {
+    outcomes = rths::participants::RunGroupInProcess({s}, 1, out.string());
+  }
   const double wall = Seconds(t0);
   SysCalls(&w1, &r1);
   Run r;
@@ -166,7 +187,7 @@ double TimePlant(const rths::scenario::Scenario& s, const std::vector<Row>& rows
 }
 
 // The step's five messages, each encoded once and decoded by each of its receivers (desired_t by
-// the controller, semiactive law, plant and logger; command_t by the plant, logger and clock;
+// the controller, semiactive law and logger (and an "ideal" plant); command_t by the plant, logger and clock;
 // measured_t by the controller, semiactive law, logger and clock; current_t by the plant, logger
 // and clock; ack_t by the clock).
 double TimeCodec(const std::vector<Row>& rows) {
@@ -190,7 +211,7 @@ double TimeCodec(const std::vector<Row>& rows) {
     rths::lockstep::Encode(m, &bm);
     rths::lockstep::Encode(i, &bi);
     rths::lockstep::Encode(a, &ba);
-    for (int j = 0; j < 4; ++j) sink += d.decode(bd.data(), 0, static_cast<int>(bd.size()));
+    for (int j = 0; j < 3; ++j) sink += d.decode(bd.data(), 0, static_cast<int>(bd.size()));
     for (int j = 0; j < 3; ++j) sink += c.decode(bc.data(), 0, static_cast<int>(bc.size()));
     for (int j = 0; j < 4; ++j) sink += m.decode(bm.data(), 0, static_cast<int>(bm.size()));
     for (int j = 0; j < 3; ++j) sink += i.decode(bi.data(), 0, static_cast<int>(bi.size()));
@@ -201,24 +222,41 @@ double TimeCodec(const std::vector<Row>& rows) {
   return us;
 }
 
-// memq:// publish and dispatch of the step's five messages, with the group's fan-out.
-double TimeTransport(std::size_t steps) {
-  lcm::LCM lcm("memq://");
-  struct Sink {
-    long n = 0;
-    void On(const lcm::ReceiveBuffer*, const std::string&) { ++n; }
-  } sink;
-  const std::pair<const char*, int> fanout[] = {{rths::lockstep::kChDesired, 4}, {rths::lockstep::kChCommand, 3},
+// Publish and dispatch of the step's five messages with the group's fan-out (the plant reads
+// desired_t only when "ideal": 14 handled deliveries), on lockstep::InprocChannels or, `lcm_memq`,
+// on LCM's memq://.
+double TimeTransport(std::size_t steps, bool lcm_memq) {
+  const std::pair<const char*, int> fanout[] = {{rths::lockstep::kChDesired, 3}, {rths::lockstep::kChCommand, 3},
                                                 {rths::lockstep::kChMeasured, 4}, {rths::lockstep::kChCurrent, 3},
                                                 {rths::lockstep::kChAck, 1}};
-  for (const auto& [ch, n] : fanout)
-    for (int j = 0; j < n; ++j) lcm.subscribe(ch, &Sink::On, &sink);
   std::vector<std::uint8_t> payload(100, 0x5a);
+  long n_handled = 0;
+  if (lcm_memq) {
+    lcm::LCM lcm("memq://");
+    struct Sink {
+      long* n;
+      void On(const lcm::ReceiveBuffer*, const std::string&) { ++*n; }
+    } sink{&n_handled};
+    for (const auto& [ch, n] : fanout)
+      for (int j = 0; j < n; ++j) lcm.subscribe(ch, &Sink::On, &sink);
+    const auto t0 = Clock::now();
+    for (std::size_t k = 0; k < steps; ++k) {
+      for (const auto& [ch, n] : fanout) {
+        lcm.publish(ch, payload.data(), static_cast<unsigned>(payload.size()));
+        lcm.handle();
+      }
+    }
+    return Seconds(t0) / steps * 1e6;
+  }
+  rths::lockstep::InprocChannels bus;
+  const auto on = [](void* n, const lcm::ReceiveBuffer*) { ++*static_cast<long*>(n); };
+  for (const auto& [ch, n] : fanout)
+    for (int j = 0; j < n; ++j) bus.Subscribe(ch, on, &n_handled);
   const auto t0 = Clock::now();
   for (std::size_t k = 0; k < steps; ++k) {
     for (const auto& [ch, n] : fanout) {
-      lcm.publish(ch, payload.data(), static_cast<unsigned>(payload.size()));
-      lcm.handle();
+      bus.Publish(ch, payload.data(), static_cast<unsigned>(payload.size()));
+      bus.HandleTimeout(0);
     }
   }
   return Seconds(t0) / steps * 1e6;
@@ -339,10 +377,14 @@ int main(int argc, char** argv) {
   fs::create_directories(tmp);
 
   std::vector<double> rate, wall, writes, reads, integ, ctrl, plant, codec, transport, logging, logging_old;
+  std::vector<double> rate_lcm, transport_lcm, ratio;
   std::vector<double> erk_us, bdf_us;
   DamperFigures damper;
   for (int j = 0; j < repeat; ++j) {
     const Run r = RunGroup(s, tmp / "run");
+    const Run r_lcm = RunGroup(s, tmp / "run_lcm", true);
+    rate_lcm.push_back(r_lcm.steps_per_s);
+    ratio.push_back(r.steps_per_s / r_lcm.steps_per_s);
     rate.push_back(r.steps_per_s);
     wall.push_back(r.wall_per_step_us);
     writes.push_back(r.writes_per_step);
@@ -352,7 +394,8 @@ int main(int argc, char** argv) {
     ctrl.push_back(TimeController(s, rows));
     plant.push_back(TimePlant(s, rows));
     codec.push_back(TimeCodec(rows));
-    transport.push_back(TimeTransport(rows.size()));
+    transport.push_back(TimeTransport(rows.size(), false));
+    transport_lcm.push_back(TimeTransport(rows.size(), true));
     logging.push_back(TimeLogging(rows, tmp, false));
     logging_old.push_back(TimeLogging(rows, tmp, true));
     damper = TimeDamper(s, rows);
@@ -365,7 +408,9 @@ int main(int argc, char** argv) {
               std::round(seconds / s.run.dt_s), repeat);
   std::printf("memq lockstep (1 process)   %10.0f steps/s = %.1fx real time (%.2f us/step; wall incl. setup %.2f)\n",
               Median(rate), Median(rate) * s.run.dt_s, step_us, Median(wall));
-  std::printf("system calls per step        %6.2f write, %.2f read (/proc/self/io; memq pipe and logger)\n",
+  std::printf("  on LCM's memq:// (former)   %10.0f steps/s; in-process queue / LCM memq = %.2fx (median of per-run ratios)\n",
+              Median(rate_lcm), Median(ratio));
+  std::printf("system calls per step        %6.2f write, %.2f read (/proc/self/io; the logger)\n",
               Median(writes), Median(reads));
   std::printf("split of a step (each part timed off-line on the run's inputs):\n");
   const auto line = [&](const char* name, double us) {
@@ -374,12 +419,14 @@ int main(int argc, char** argv) {
   line("model: integrator", p.integrator);
   line("model: controller", p.controller);
   line("model: plant (servo + damper)", p.plant);
-  line("encode/decode (5 messages, 15 dec)", p.codec);
-  line("transport (memq, 5 msgs, fan-out)", p.transport);
+  line("encode/decode (5 messages, 14 dec)", p.codec);
+  line("transport (in-process queue)", p.transport);
   line("logging (1 pwrite + buffered CSV)", p.logging);
   line("other (lockstep bookkeeping)", std::max(0.0, step_us - p.Sum()));
   std::printf("  logging, former pattern (2 pwrite)  %7.2f us  = %.2fx the current one\n", Median(logging_old),
               Median(logging_old) / p.logging);
+  std::printf("  transport on LCM's memq:// (former)  %7.2f us  = %.2fx the current one\n", Median(transport_lcm),
+              Median(transport_lcm) / p.transport);
   std::printf("MR damper step alone, the run's motion and current, rtol %g:\n", s.plant.cvode_rtol);
   std::printf("  ARKODE ERK DP5(4) (default) %7.2f us/step, force error vs CVODE 1e-12: RMS %.2e, peak %.2e\n",
               Median(erk_us), damper.erk_rms, damper.erk_peak);

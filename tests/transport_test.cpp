@@ -1,5 +1,6 @@
 // The per-channel udpm transport (lockstep/transport.h): URL form, LCM wire compatibility, port
-// isolation, and a whole run bit-identical to one port and to memq.
+// isolation, and a whole run bit-identical to one port and to memq; the in-process queue of memq
+// runs (InprocChannels): order, re-entrant publishing, no allocation.
 #include <doctest/doctest.h>
 
 #include <unistd.h>
@@ -242,4 +243,64 @@ TEST_CASE("UdpmChannels: sending and receiving a message allocates nothing") {
   const long allocations = rths_test::AllocationCount() - before;
   CHECK(count.n == 101);
   CHECK(allocations == 0);
+}
+
+TEST_CASE("InprocChannels (memq): publish order across channels, messages published by handlers, no allocation") {
+  ls::InprocChannels bus;
+  struct Log {
+    ls::InprocChannels* bus;
+    std::vector<std::string> seen;  // "CHANNEL:payload" in the order handed over
+    static void Desired(void* self, const lcm::ReceiveBuffer* rb) {
+      auto* log = static_cast<Log*>(self);
+      const std::string p(static_cast<const char*>(rb->data), rb->data_size);
+      log->seen.push_back("D:" + p);
+      // A handler answers at once, as a participant does: its message queues behind the others.
+      const std::string answer = "c" + p;
+      log->bus->Publish(ls::kChCommand, answer.data(), static_cast<unsigned>(answer.size()));
+    }
+    static void Command(void* self, const lcm::ReceiveBuffer* rb) {
+      static_cast<Log*>(self)->seen.push_back("C:" + std::string(static_cast<const char*>(rb->data), rb->data_size));
+    }
+    static void Measured(void* self, const lcm::ReceiveBuffer* rb) {
+      static_cast<Log*>(self)->seen.push_back("M:" + std::string(static_cast<const char*>(rb->data), rb->data_size));
+    }
+  } log{&bus, {}};
+  REQUIRE(bus.Subscribe(ls::kChDesired, &Log::Desired, &log));
+  REQUIRE(bus.Subscribe(ls::kChCommand, &Log::Command, &log));
+  REQUIRE(bus.Subscribe(ls::kChMeasured, &Log::Measured, &log));
+  CHECK_FALSE(bus.Subscribe("SOME_OTHER_CHANNEL", &Log::Command, &log));
+  CHECK(bus.error().find("SOME_OTHER_CHANNEL") != std::string::npos);
+  CHECK(bus.Publish("SOME_OTHER_CHANNEL", "x", 1) == -1);
+
+  // Nothing queued: it waits the timeout (a deadline of the caller's) and reports nothing.
+  const auto t0 = std::chrono::steady_clock::now();
+  CHECK(bus.HandleTimeout(20) == 0);
+  CHECK(std::chrono::steady_clock::now() - t0 >= std::chrono::milliseconds(20));
+
+  bus.Publish(ls::kChMeasured, "1", 1);
+  bus.Publish(ls::kChDesired, "1", 1);
+  bus.Publish(ls::kChMeasured, "2", 1);
+  CHECK(bus.HandleTimeout(100) == 4);  // the three, then the command the desired_t handler sent
+  CHECK(log.seen == std::vector<std::string>{"M:1", "D:1", "M:2", "C:c1"});
+  CHECK(bus.HandleTimeout(0) == 0);
+
+  // Past its first capacity the queue grows once, keeping the order; then nothing is allocated.
+  log.seen.clear();
+  for (int i = 0; i < 100; ++i) bus.Publish(ls::kChMeasured, &"0123456789"[i % 10], 1);
+  int handled = 0;
+  while (int n = bus.HandleTimeout(0)) handled += n;
+  CHECK(handled == 100);
+  REQUIRE(log.seen.size() == 100);
+  for (int i = 0; i < 100; ++i) CHECK(log.seen[i] == std::string("M:") + "0123456789"[i % 10]);
+  log.seen.clear();
+  log.seen.reserve(400);
+  const long before = rths_test::AllocationCount();
+  for (int i = 0; i < 100; ++i) {
+    bus.Publish(ls::kChMeasured, "m", 1);
+    bus.Publish(ls::kChCommand, "c", 1);
+    bus.HandleTimeout(0);
+  }
+  CHECK(rths_test::AllocationCount() - before == 0);
+  CHECK(log.seen.size() == 200);
+  CHECK(bus.sent() == 3 + 1 + 100 + 200);
 }

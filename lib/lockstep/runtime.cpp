@@ -80,6 +80,10 @@ struct Participant::Route {
   Participant* self;
   std::string channel;
   Handler handler;
+  /// What a message of step k on this channel proves about the clock: desired_t 1 (it requested
+  /// step k), command_t / current_t 2 (they answer desired_t k: it requested step k), measured_t 3
+  /// (it follows command_t k-1: the clock requested step k-1); any other channel 0.
+  int step_evidence = 0;
   void OnMessage(const lcm::ReceiveBuffer* rbuf, const std::string&) { self->Deliver(this, rbuf); }
   static void OnChannelMessage(void* route, const lcm::ReceiveBuffer* rbuf) {
     auto* r = static_cast<Route*>(route);
@@ -104,7 +108,9 @@ Participant::Participant(std::string name, RunIdentity id, Timing timing, lcm::L
 Participant::~Participant() = default;
 
 void Participant::Subscribe(const char* channel, Handler handler) {
-  routes_.push_back(std::make_unique<Route>(Route{this, channel, std::move(handler)}));
+  const std::string_view ch(channel);
+  const int evidence = ch == kChDesired ? 1 : (ch == kChCommand || ch == kChCurrent) ? 2 : ch == kChMeasured ? 3 : 0;
+  routes_.push_back(std::make_unique<Route>(Route{this, channel, std::move(handler), evidence}));
   if (channels_) {
     if (!channels_->Subscribe(channel, &Route::OnChannelMessage, routes_.back().get())) {
       throw std::runtime_error(fmt::format("{}: {}", name_, channels_->error()));
@@ -114,7 +120,7 @@ void Participant::Subscribe(const char* channel, Handler handler) {
   }
 }
 
-void Participant::Attach(UdpmChannels* channels) {
+void Participant::Attach(Channels* channels) {
   if (lcm_) throw std::runtime_error(name_ + ": Attach: already subscribed on an LCM instance");
   channels_ = channels;
   for (auto& r : routes_) {
@@ -126,6 +132,7 @@ void Participant::Attach(UdpmChannels* channels) {
 
 int Participant::Send(const char* channel, const std::uint8_t* data, std::size_t size) {
   if (channels_) return channels_->Publish(channel, data, static_cast<unsigned int>(size));
+  if (!lcm_) return -1;  // neither on an LCM instance nor attached
   return lcm_->publish(channel, data, static_cast<unsigned int>(size));
 }
 
@@ -170,15 +177,20 @@ void Participant::Deliver(Route* route, const lcm::ReceiveBuffer* rbuf) {
 void Participant::DeliverNow(Route* route, const lcm::ReceiveBuffer* rbuf) {
   if (finished_) return;
   if (follow_) last_clock_ = SteadyClock::now();  // any message counts as the feed being alive
-  if (!is_clock_ && route->channel == kChDesired) {
+  if (!is_clock_ && route->step_evidence > 0) {
     // Only the clock publishes desired_t: it is alive, and it has sent GO (a lost GO is
-    // repaired here: the first message of a step of our run starts us).
+    // repaired here: the first message of a step of our run starts us). A participant that
+    // does not read desired_t (the plant, unless it is "ideal") learns the same from the first
+    // command_t, current_t or measured_t of a step it had not seen: the clock requested it.
     std::int64_t run_id = 0, k = 0;
     if (PeekRunAndStep(static_cast<const std::uint8_t*>(rbuf->data), rbuf->data_size, &run_id, &k) &&
         run_id == id_.run_id) {
-      HeardClock(SteadyClock::now());
-      last_clock_step_ = std::max(last_clock_step_, k);
-      if (!lingering_) StartRunning();
+      if (route->step_evidence == 3) --k;
+      if (route->step_evidence == 1 || k > last_clock_step_) {
+        HeardClock(SteadyClock::now());
+        last_clock_step_ = std::max(last_clock_step_, k);
+        if (route->step_evidence == 1 && !lingering_) StartRunning();
+      }
     }
   }
   route->handler(rbuf);

@@ -6,8 +6,9 @@
 ///
 /// The same participant objects run as separate processes, each with its own LCM instance on
 /// `udpm://` (one UDP port per run), or each with the sockets of a per-channel run (UdpmChannels,
-/// lockstep/transport.h: one UDP port per channel), or all in one process sharing one `memq://`
-/// instance (memq queues belong to one lcm_t, so in that mode LCM dispatches from one thread).
+/// lockstep/transport.h: one UDP port per channel), or all in one process and one thread on one
+/// in-process queue (a memq run: InprocChannels, lockstep/transport.h). A participant on an LCM
+/// instance of its own (`memq://` too) is still supported (tests, participants of your own).
 #include <array>
 #include <chrono>
 #include <csignal>
@@ -27,7 +28,7 @@
 
 namespace rths::lockstep {
 
-class UdpmChannels;
+class Channels;
 
 /// Lockstep runtime knobs (docs/lockstep.md).
 struct LockstepConfig {
@@ -259,9 +260,10 @@ class Participant {
   void Follow(double idle_exit_s);
 
   /// Moves every subscription, and every publication from now on, to `channels` (a per-channel
-  /// udpm run). For a participant built with lcm = nullptr, before RunLoop; `channels` must
-  /// outlive it. Throws std::runtime_error if a channel cannot be opened.
-  void Attach(UdpmChannels* channels);
+  /// udpm run, or the in-process queue of a memq run). For a participant built with
+  /// lcm = nullptr, before RunLoop; `channels` must outlive it. Throws std::runtime_error if a
+  /// channel cannot be opened.
+  void Attach(Channels* channels);
 
   /// Called by the event loop after every handled message and on every poll timeout: delivers
   /// held (delayed) messages that are due, then Poll(). `idle` is true when no message was
@@ -355,7 +357,7 @@ class Participant {
   const RunIdentity id_;
   const Timing timing_;
   lcm::LCM* const lcm_;
-  UdpmChannels* channels_ = nullptr;  ///< set by Attach (then lcm_ is unused)
+  Channels* channels_ = nullptr;  ///< set by Attach (then lcm_ is unused)
   bool is_clock_ = false;
   LinkStats stats_;
   double stepping_s_ = 0;

@@ -3,8 +3,8 @@
 /// process receives only the channels it subscribes to (docs/lockstep.md, "Transports").
 ///
 /// On one port every udpm datagram reaches every socket of the run, the sender's included: 5
-/// messages x 5 processes = 25 deliveries per step, 10 of them to processes that drop them. With a
-/// port per channel a step costs 15 deliveries, each one wanted. The datagrams are LCM's own
+/// messages x 5 processes = 25 deliveries per step, 11 of them to processes that drop them. With a
+/// port per channel a step costs 14 deliveries, each one wanted. The datagrams are LCM's own
 /// (small-message format "LC02": magic, sequence number, channel, NUL, payload), so `lcm-spy`,
 /// `lcm-logger` and any LCM program read and write them on the channel's port; but the sockets are
 /// our own and are read in the event loop's thread, without LCM's receive thread and its notify
@@ -53,35 +53,54 @@ struct UdpmUrl {
 /// True if `url` is a udpm:// URL asking for a port per channel (`port_per_channel=1`).
 bool IsPortPerChannel(const std::string& url);
 
-/// Sockets of one process on a per-channel run: one receive socket per subscribed channel (bound
-/// to its port, member of the group) and one send socket. Read by HandleTimeout in the caller's
-/// thread. Nothing is allocated per message: one receive buffer, headers sent with sendmsg.
-class UdpmChannels {
+/// What a participant publishes on and subscribes through when it is not on an LCM instance
+/// (Participant::Attach): the per-channel udpm sockets (UdpmChannels) or the in-process queue of a
+/// memq run (InprocChannels). Only the run's channels (kPortChannels) are carried.
+class Channels {
  public:
   /// Called with every message of a subscribed channel (rbuf->data: the payload).
   using Callback = void (*)(void* context, const lcm::ReceiveBuffer* rbuf);
+  virtual ~Channels() = default;
 
-  /// Opens the send socket. `url.port_per_channel` must be set. Check good() afterwards.
-  explicit UdpmChannels(const UdpmUrl& url);
-  ~UdpmChannels();
-  UdpmChannels(const UdpmChannels&) = delete;
-  UdpmChannels& operator=(const UdpmChannels&) = delete;
-
-  /// False if a socket could not be opened, bound or joined to the group (error() says which).
+  /// False if the transport could not be set up (error() says why).
   bool good() const { return error_.empty(); }
   const std::string& error() const { return error_; }
 
-  /// Calls `callback(context, rbuf)` for every message on `channel` (one of kPortChannels),
-  /// opening its receive socket on first use. False (and error() says why) if it cannot.
-  bool Subscribe(const char* channel, Callback callback, void* context);
-  /// Sends `size` bytes on `channel` (one of kPortChannels) as one LCM datagram. 0 on success,
-  /// -1 on failure (an unknown channel, a message too large for one datagram, a send error).
-  int Publish(const char* channel, const void* data, unsigned size);
-  /// Waits at most `timeout_ms` for a message on any subscribed channel, then hands at most one
-  /// waiting message per channel to its callbacks; before a handshake message (an ABORT, DONE) it
-  /// hands over every message waiting on the other channels, sent before it, as on one port. Returns how many it handled (> 0), 0 if none
-  /// came in time, < 0 on a receive error (errno set; EINTR: a signal).
-  int HandleTimeout(int timeout_ms);
+  /// Calls `callback(context, rbuf)` for every message on `channel` (one of kPortChannels). False
+  /// (and error() says why) if it cannot.
+  virtual bool Subscribe(const char* channel, Callback callback, void* context) = 0;
+  /// Sends `size` bytes on `channel` (one of kPortChannels). 0 on success, -1 on failure.
+  virtual int Publish(const char* channel, const void* data, unsigned size) = 0;
+  /// Waits at most `timeout_ms` for a message, then hands what came in to the callbacks. Returns
+  /// how many it handled (> 0), 0 if none came in time, < 0 on an error (errno set; EINTR: a
+  /// signal), as lcm::LCM::handleTimeout does.
+  virtual int HandleTimeout(int timeout_ms) = 0;
+
+ protected:
+  std::string error_;
+};
+
+/// Sockets of one process on a per-channel run: one receive socket per subscribed channel (bound
+/// to its port, member of the group) and one send socket. Read by HandleTimeout in the caller's
+/// thread. Nothing is allocated per message: one receive buffer, headers sent with sendmsg.
+class UdpmChannels final : public Channels {
+ public:
+  /// Opens the send socket. `url.port_per_channel` must be set. Check good() afterwards (false if
+  /// a socket could not be opened, bound or joined to the group; error() says which).
+  explicit UdpmChannels(const UdpmUrl& url);
+  ~UdpmChannels() override;
+  UdpmChannels(const UdpmChannels&) = delete;
+  UdpmChannels& operator=(const UdpmChannels&) = delete;
+
+  /// Opens the channel's receive socket on first use.
+  bool Subscribe(const char* channel, Callback callback, void* context) override;
+  /// One LCM datagram; -1 for an unknown channel, a message too large for one datagram, a send
+  /// error.
+  int Publish(const char* channel, const void* data, unsigned size) override;
+  /// Hands at most one waiting message per channel to its callbacks; before a handshake message
+  /// (an ABORT, DONE) it hands over every message waiting on the other channels, sent before it,
+  /// as on one port.
+  int HandleTimeout(int timeout_ms) override;
 
   /// Datagrams received and sent so far (all channels).
   std::int64_t received() const { return received_; }
@@ -96,7 +115,6 @@ class UdpmChannels {
   bool Dispatch(Socket* s);
 
   UdpmUrl url_;
-  std::string error_;
   int send_fd_ = -1;
   std::uint32_t seqno_ = 0;
   std::array<Socket, kPortChannels.size()> sockets_{};
@@ -105,8 +123,46 @@ class UdpmChannels {
   std::int64_t received_ = 0, sent_ = 0;
 };
 
-/// RunLoop on a per-channel transport (participants attached with Participant::Attach).
-int RunLoop(UdpmChannels* channels, const std::vector<Participant*>& participants,
+/// The in-process transport of a memq run (`rths run --transport memq`, the reproductions, replay):
+/// every participant in one process and one thread, attached to one of these. A publish appends
+/// the message to one FIFO queue; HandleTimeout hands queued messages to their subscribers in
+/// publish order, the messages their handlers publish included. It replaces LCM's `memq://`
+/// provider, which costs per message a malloc and free, a write and a read on a notify pipe, and
+/// a regular-expression match of the channel against every subscription (LCM 1.3.1); the
+/// payloads, and the order in which every participant sees them, are the same (lockstep_test,
+/// transport_test). Nothing is allocated per message once the queue has grown to the run's
+/// largest backlog (a handful of messages): every slot holds 1 KiB from the start.
+class InprocChannels final : public Channels {
+ public:
+  InprocChannels();
+  bool Subscribe(const char* channel, Callback callback, void* context) override;
+  /// Copies the message into the queue; -1 for a channel that is not a run channel.
+  int Publish(const char* channel, const void* data, unsigned size) override;
+  /// Hands queued messages over, up to kMaxBatch (then returns, so the caller's timers run);
+  /// with none queued it sleeps `timeout_ms` (in one thread nothing can arrive meanwhile: the
+  /// caller's deadlines, a held message or a re-request, are what it waits for) and returns 0.
+  int HandleTimeout(int timeout_ms) override;
+
+  /// Messages handed over per HandleTimeout at most.
+  static constexpr int kMaxBatch = 64;
+  /// Messages published so far.
+  std::int64_t sent() const { return sent_; }
+
+ private:
+  struct Message {
+    int channel = -1;
+    std::int64_t utime = 0;
+    Bytes bytes;
+  };
+  std::array<std::vector<std::pair<Callback, void*>>, kPortChannels.size()> callbacks_;
+  std::vector<Message> ring_;  ///< the queue: count_ messages from head_, wrapping
+  std::size_t head_ = 0, count_ = 0;
+  Message current_;  ///< the message being handed over (swapped out of the ring)
+  std::int64_t sent_ = 0;
+};
+
+/// RunLoop on a transport of our own (participants attached with Participant::Attach).
+int RunLoop(Channels* channels, const std::vector<Participant*>& participants,
             const volatile std::sig_atomic_t* stop = nullptr);
 
 }  // namespace rths::lockstep

@@ -7,6 +7,7 @@
 #include <fmt/core.h>
 
 #include "core/error.h"
+#include "lockstep/transport.h"
 #include "participants/factory.h"
 
 namespace rths::participants {
@@ -143,8 +144,7 @@ std::vector<Outcome> RunGroupInProcess(const std::vector<scenario::Scenario>& pe
                               NameOf(lockstep::kProcessFaultNames, kind)));
     }
   }
-  lcm::LCM lcm("memq://");
-  if (!lcm.good()) throw Error("RunGroupInProcess", "cannot create a memq:// LCM instance");
+  lockstep::InprocChannels bus;
   std::vector<std::unique_ptr<lockstep::Participant>> owned;
   std::vector<lockstep::Participant*> group;
   for (std::size_t i = 0; i < std::size(kGroupOrder); ++i) {
@@ -161,10 +161,11 @@ std::vector<Outcome> RunGroupInProcess(const std::vector<scenario::Scenario>& pe
       }
       if (extra.faults.network.any()) f.network = extra.faults.network;
     }
-    owned.push_back(MakeParticipant(kGroupOrder[i], s, IdentityOf(s, run_id), &lcm, out_dir, std::move(f)));
+    owned.push_back(MakeParticipant(kGroupOrder[i], s, IdentityOf(s, run_id), nullptr, out_dir, std::move(f)));
+    owned.back()->Attach(&bus);
     group.push_back(owned.back().get());
   }
-  lockstep::RunLoop(&lcm, group, stop);
+  lockstep::RunLoop(&bus, group, stop);
   std::vector<Outcome> outcomes;
   for (const auto* p : group) outcomes.push_back(OutcomeOf(*p));
   return outcomes;

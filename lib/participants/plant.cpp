@@ -11,12 +11,13 @@ Plant::Plant(const scenario::Scenario& s, lockstep::RunIdentity id, lcm::LCM* lc
       noise_f_kN_(s.plant.noise_f_kN_rms),
       noise_(signal::MakeGaussian(s.plant.noise_seed)) {
   SetAnswerChannel(lockstep::kMeasured, &cache_);
-  Subscribe(lockstep::kChDesired, [this](const lcm::ReceiveBuffer* rbuf) {
-    if (!finished() && Receive(&desired_, lockstep::kDesired, rbuf) == lockstep::Put::kNew &&
-        rig_->TracksDesired()) {
-      TryStep();
-    }
-  });
+  // Only the "ideal" plant reads desired_t (r_k); the others would receive one message per step
+  // for nothing (docs/lockstep.md, "Transports").
+  if (rig_->TracksDesired()) {
+    Subscribe(lockstep::kChDesired, [this](const lcm::ReceiveBuffer* rbuf) {
+      if (!finished() && Receive(&desired_, lockstep::kDesired, rbuf) == lockstep::Put::kNew) TryStep();
+    });
+  }
   Subscribe(lockstep::kChCommand, [this](const lcm::ReceiveBuffer* rbuf) {
     if (!finished() && Receive(&command_, lockstep::kCommand, rbuf) == lockstep::Put::kNew) TryStep();
   });

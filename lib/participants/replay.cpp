@@ -7,6 +7,7 @@
 
 #include "core/error.h"
 #include "lockstep/clock.h"
+#include "lockstep/transport.h"
 #include "participants/factory.h"
 
 namespace rths::participants {
@@ -88,31 +89,31 @@ std::vector<Outcome> RunReplay(const scenario::Scenario& s, const io::RunLog& re
     throw Error(record.source, fmt::format("cannot replay {} steps: the log holds {} complete steps", steps,
                                            record.CompleteSteps()));
   }
-  lcm::LCM lcm("memq://");
-  if (!lcm.good()) throw Error("replay", "cannot create a memq:// LCM instance");
+  lockstep::InprocChannels bus;
   lockstep::RunIdentity id = IdentityOf(s, run_id);
   id.n_steps = steps;
   const lockstep::Timing timing = TimingOf(s);
   std::vector<std::unique_ptr<lockstep::Participant>> owned;
   for (std::string_view role : kGroupOrder) {
     if (IsLive(live, role)) {
-      owned.push_back(MakeParticipant(role, s, id, &lcm, out_dir, {}));
+      owned.push_back(MakeParticipant(role, s, id, nullptr, out_dir, {}));
     } else if (role == "integrator") {
-      owned.push_back(std::make_unique<RecordedClock>(&record.desired, id, timing, &lcm));
+      owned.push_back(std::make_unique<RecordedClock>(&record.desired, id, timing, nullptr));
     } else if (role == "controller") {
       owned.push_back(std::make_unique<RecordedAnswer<rths::command_t>>(
-          "controller", &record.command, id, timing, &lcm, lockstep::kChCommand, lockstep::kCommand));
+          "controller", &record.command, id, timing, nullptr, lockstep::kChCommand, lockstep::kCommand));
     } else if (role == "plant") {
       owned.push_back(std::make_unique<RecordedAnswer<rths::measured_t>>(
-          "plant", &record.measured, id, timing, &lcm, lockstep::kChMeasured, lockstep::kMeasured));
+          "plant", &record.measured, id, timing, nullptr, lockstep::kChMeasured, lockstep::kMeasured));
     } else {
       owned.push_back(std::make_unique<RecordedAnswer<rths::current_t>>(
-          "semiactive", &record.current, id, timing, &lcm, lockstep::kChCurrent, lockstep::kCurrent));
+          "semiactive", &record.current, id, timing, nullptr, lockstep::kChCurrent, lockstep::kCurrent));
     }
   }
   std::vector<lockstep::Participant*> group;
   for (auto& p : owned) group.push_back(p.get());
-  lockstep::RunLoop(&lcm, group, stop);
+  for (auto* p : group) p->Attach(&bus);
+  lockstep::RunLoop(&bus, group, stop);
   std::vector<Outcome> outcomes;
   for (const auto* p : group) outcomes.push_back(OutcomeOf(*p));
   return outcomes;
