@@ -1,0 +1,197 @@
+// bench-compare: this checkout against another checkout of rths (a commit before a change), side by
+// side in one invocation, because absolute times drift on shared machines: the default run's
+// steps/s on udpm (one port, and a port per channel where both checkouts have it) and on memq,
+// and the wall time of the full reproductions (Fig. 9, Table 2 by default). Every pair runs back
+// to back, the two checkouts alternating which goes first, repeated; it prints medians and the
+// median of per-pair speed-ups (this checkout's rate over the other's, the other's time over this one's). The reproductions' tables of the two checkouts are then
+// compared cell by cell: identical, or how far apart.
+//
+//   build/bin/bench-compare --other DIR [--repeat N] [--seconds S] [--studies fig9,table2] [--out DIR]
+//
+// DIR is a built checkout (its ./rths and build/bin), e.g.
+//   git worktree add --detach /tmp/old COMMIT && cmake -S /tmp/old -B /tmp/old/build -G Ninja
+//     -DCMAKE_BUILD_TYPE=RelWithDebInfo && cmake --build /tmp/old/build   (one command)
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+#include <fmt/core.h>
+#include <nlohmann/json.hpp>
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+double Median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  if (v.empty()) return 0.0;
+  const std::size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+std::string Quote(const std::string& s) {
+  std::string q = "'";
+  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
+
+/// Runs `cmd` (output to `log`); its wall time [s], or a negative value if it failed.
+double Timed(const std::string& cmd, const fs::path& log) {
+  const auto t0 = Clock::now();
+  const int rc = std::system((cmd + " > " + Quote(log.string()) + " 2>&1").c_str());
+  const double s = std::chrono::duration<double>(Clock::now() - t0).count();
+  return rc == 0 ? s : -1.0;
+}
+
+/// One measurement kind: a command per checkout and what to read from it.
+struct Kind {
+  std::string name;
+  std::string args;  ///< after `rths`
+  bool run = true;   ///< a `rths run` (steps/s from summary.json); else a study (wall time)
+  std::string table; ///< study: the table file to compare
+};
+
+struct Sample {
+  std::vector<double> mine, other, ratio;  ///< steps/s (run) or seconds (study); ratio this/other
+};
+
+double Measure(const fs::path& tree, const Kind& k, const fs::path& out) {
+  fs::remove_all(out);
+  const std::string cmd = fmt::format("{} {} --out {}", Quote((tree / "rths").string()), k.args, Quote(out.string()));
+  const double wall = Timed(cmd, out.string() + ".log");
+  if (wall < 0) return -1.0;
+  if (!k.run) return wall;
+  std::ifstream in(out / "summary.json");
+  const auto j = nlohmann::json::parse(in, nullptr, false);
+  return j.is_discarded() ? -1.0 : j.value("steps_per_s", -1.0);
+}
+
+/// Cells of a CSV file.
+std::vector<std::vector<std::string>> Cells(const fs::path& p) {
+  std::ifstream in(p);
+  std::vector<std::vector<std::string>> rows;
+  std::string line;
+  while (std::getline(in, line)) {
+    std::vector<std::string> row;
+    std::stringstream ss(line);
+    std::string cell;
+    while (std::getline(ss, cell, ',')) row.push_back(cell);
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+/// "identical", or how the two tables differ.
+std::string CompareTables(const fs::path& a, const fs::path& b) {
+  if (!fs::exists(a) || !fs::exists(b)) return "missing";
+  const auto ra = Cells(a), rb = Cells(b);
+  if (ra == rb) return "identical, cell for cell";
+  if (ra.size() != rb.size()) return fmt::format("different shapes: {} rows against {}", ra.size(), rb.size());
+  int text = 0, numeric = 0;
+  double max_abs = 0, max_rel = 0;
+  for (std::size_t i = 0; i < ra.size(); ++i) {
+    if (ra[i].size() != rb[i].size()) return fmt::format("row {} has {} cells against {}", i, ra[i].size(), rb[i].size());
+    for (std::size_t j = 0; j < ra[i].size(); ++j) {
+      if (ra[i][j] == rb[i][j]) continue;
+      char* ea = nullptr;
+      char* eb = nullptr;
+      const double x = std::strtod(ra[i][j].c_str(), &ea), y = std::strtod(rb[i][j].c_str(), &eb);
+      if (*ea != '\0' || *eb != '\0' || ea == ra[i][j].c_str()) {
+        ++text;
+        continue;
+      }
+      ++numeric;
+      max_abs = std::max(max_abs, std::abs(x - y));
+      if (y != 0) max_rel = std::max(max_rel, std::abs(x - y) / std::abs(y));
+    }
+  }
+  return fmt::format("{} numbers differ (largest difference {:.3g}, relative {:.3g}), {} text cells differ", numeric,
+                     max_abs, max_rel, text);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"bench-compare: this checkout against another (an older commit), side by side: run rates and "
+               "reproduction wall times, and whether the reproductions' numbers are the same"};
+  std::string other_dir, out_dir, studies = "fig9,table2";
+  int repeat = 3;
+  double seconds = 10.0;
+  app.add_option("--other", other_dir, "the other checkout (built: its ./rths and build/bin)")->required();
+  app.add_option("--repeat", repeat, "pairs of each measurement (medians printed)")->capture_default_str();
+  app.add_option("--seconds", seconds, "simulated seconds of the default runs")->capture_default_str();
+  app.add_option("--studies", studies, "reproductions to time, comma-separated ('' for none)")->capture_default_str();
+  app.add_option("--out", out_dir, "where the runs go (default: a temporary folder, removed)");
+  CLI11_PARSE(app, argc, argv);
+
+  const fs::path mine = fs::canonical(fs::read_symlink("/proc/self/exe").parent_path() / "../..");
+  const fs::path other = fs::canonical(other_dir);
+  const bool keep = !out_dir.empty();
+  const fs::path tmp = keep ? fs::path(out_dir) : fs::temp_directory_path() / fmt::format("rths_bench_compare_{}", ::getpid());
+  fs::create_directories(tmp);
+
+  const std::string set = fmt::format("--set run.duration_s={}", seconds);
+  std::vector<Kind> kinds = {{"udpm, one port", "run " + set, true, ""},
+                             {"udpm, port per channel", "run --port-per-channel " + set, true, ""},
+                             {"memq", "run --transport memq " + set, true, ""}};
+  std::stringstream ss(studies);
+  for (std::string name; std::getline(ss, name, ',');) {
+    if (!name.empty()) kinds.push_back({"reproduce " + name, "reproduce " + name, false, name + ".csv"});
+  }
+  std::printf("bench-compare: %s (this) against %s (other), %d pairs each, alternating which runs first\n",
+              mine.c_str(), other.c_str(), repeat);
+  std::printf("%-26s %14s %14s %12s\n", "", "this", "other", "speed-up");
+  for (const Kind& k : kinds) {
+    Sample s;
+    bool other_lacks = false;
+    for (int r = 0; r < repeat && !other_lacks; ++r) {
+      const fs::path a = tmp / fmt::format("this_{}_{}", &k - kinds.data(), r);
+      const fs::path b = tmp / fmt::format("other_{}_{}", &k - kinds.data(), r);
+      double x, y;
+      if (r % 2 == 0) {
+        x = Measure(mine, k, a);
+        y = Measure(other, k, b);
+      } else {
+        y = Measure(other, k, b);
+        x = Measure(mine, k, a);
+      }
+      if (x < 0) {
+        std::fprintf(stderr, "bench-compare: %s failed in this checkout (see %s.log)\n", k.name.c_str(), a.c_str());
+        return 1;
+      }
+      if (y < 0) {
+        other_lacks = true;  // e.g. an option the older checkout does not have
+        s.mine.push_back(x);
+        break;
+      }
+      s.mine.push_back(x), s.other.push_back(y), s.ratio.push_back(k.run ? x / y : y / x);
+    }
+    if (other_lacks) {
+      std::printf("%-26s %10.*f %-3s %14s %12s  (the other checkout cannot run it)\n", k.name.c_str(), k.run ? 0 : 1,
+                  Median(s.mine), k.run ? "/s" : "s", "-", "-");
+      continue;
+    }
+    std::printf("%-26s %10.*f %-3s %10.*f %-3s %11.2fx\n", k.name.c_str(), k.run ? 0 : 1, Median(s.mine),
+                k.run ? "/s" : "s", k.run ? 0 : 1, Median(s.other), k.run ? "/s" : "s", Median(s.ratio));
+    if (!k.run) {
+      const std::string same = CompareTables(tmp / fmt::format("this_{}_0", &k - kinds.data()) / k.table,
+                                             tmp / fmt::format("other_{}_0", &k - kinds.data()) / k.table);
+      std::printf("%-26s %s: %s\n", "", k.table.c_str(), same.c_str());
+    }
+  }
+  std::printf("(runs: steps/s from summary.json; reproductions: wall time; speed-up: median over the pairs of this\n"
+              " checkout's rate over the other's, or the other's time over this one's)\n");
+  if (!keep) fs::remove_all(tmp);
+  return 0;
+}
