@@ -119,9 +119,11 @@ TEST_CASE("a silent participant stops the run, named, with the log valid up to t
   CHECK(r.code == rths::lockstep::kExitLockstep);
   const std::string& clock_error = r.errors.back();  // integrator is last
   CAPTURE(clock_error);
-  CHECK(clock_error.find("step 321: plant stopped answering") != std::string::npos);
-  // Those that only waited for the plant's measurement are named apart, never blamed.
-  CHECK(clock_error.find("(controller, semiactive and logger only waited for it)") != std::string::npos);
+  // The plant's answer to command_t 320 is measured_t 321, part of the barrier of step 320
+  // (docs/lockstep.md, "One step"): the run stops at step 320, naming what is missing.
+  CHECK(clock_error.find("step 320: plant stopped answering: no measured_t 321") != std::string::npos);
+  // The logger, which only waited for the plant's measurement, is named apart, never blamed.
+  CHECK(clock_error.find("(logger only waited for it)") != std::string::npos);
   const auto log = ReadRunLog((dir / "log.lcm").string());
   CHECK(log.CompleteSteps() == 321);
   CHECK(log.AbortReason().find("plant") != std::string::npos);

@@ -52,12 +52,17 @@ ClockParticipant::ClockParticipant(std::string name, RunIdentity id, Timing timi
   auto on_answer = [this](auto* box, Channel ch) {
     return [this, box, ch](const lcm::ReceiveBuffer* rbuf) {
       if (finished()) return;
-      if (Receive(box, ch, rbuf) == Put::kNew && box->last_k() == k_) CheckBarrier();
+      if (Receive(box, ch, rbuf) != Put::kNew) return;
+      const std::int64_t k = box->last_k();
+      if (k == k_ || (ch == kMeasured && k == k_ + 1 && WaitsForNextMeasured())) CheckBarrier();
     };
   };
-  Subscribe(kChMeasured, on_answer(&measured_, kMeasured));
-  Subscribe(kChCommand, on_answer(&command_, kCommand));
-  Subscribe(kChCurrent, on_answer(&current_, kCurrent));
+  // The logger acknowledges step k only once it holds measured_t k, command_t k and current_t k
+  // (and measured_t k+1 when the barrier includes it), so those are here when ack_t k is: only
+  // ack_t wakes the clock (one wake-up per step, not four).
+  Subscribe(kChMeasured, on_answer(&measured_, kMeasured), Wake::kLater);
+  Subscribe(kChCommand, on_answer(&command_, kCommand), Wake::kLater);
+  Subscribe(kChCurrent, on_answer(&current_, kCurrent), Wake::kLater);
   Subscribe(kChAck, on_answer(&ack_, kAck));
 }
 
@@ -109,6 +114,7 @@ void ClockParticipant::ListMissing(std::int64_t k, WantList* out) const {
   if (!command_.Get(k)) out->Add(kCommand, k);
   if (!current_.Get(k)) out->Add(kCurrent, k);
   if (!ack_.Get(k)) out->Add(kAck, k);
+  if (k == k_ && WaitsForNextMeasured() && !measured_.Get(k + 1)) out->Add(kMeasured, k + 1);
 }
 
 void ClockParticipant::SendGo() {
@@ -172,6 +178,7 @@ void ClockParticipant::CheckBarrier() {
   const rths::measured_t* m = measured_.Get(k_);
   const rths::command_t* c = command_.Get(k_);
   if (!m || !c || !current_.Get(k_) || !ack_.Get(k_)) return;
+  if (WaitsForNextMeasured() && !measured_.Get(k_ + 1)) return;
   const auto now = SteadyClock::now();
   if (rerequests_ == 0) {
     // How long a step takes when nothing is lost (a moving average over ~16 steps): it sets how
@@ -210,7 +217,8 @@ void ClockParticipant::IssueNext() {
 void ClockParticipant::FailStalled(SteadyClock::time_point now) {
   // Silent: its answer of step k is missing and it never said what it lacked. Waiting: its
   // answer is missing but it asked for inputs (alive; it waits for a silent one).
-  const bool answered[kRoster.size()] = {true, command_.Get(k_) != nullptr, measured_.Get(k_) != nullptr,
+  const bool plant_answered = measured_.Get(k_) && (!WaitsForNextMeasured() || measured_.Get(k_ + 1));
+  const bool answered[kRoster.size()] = {true, command_.Get(k_) != nullptr, plant_answered,
                                          current_.Get(k_) != nullptr, ack_.Get(k_) != nullptr};
   std::vector<std::string> silent, waiting;
   for (std::size_t i = 1; i < kRoster.size(); ++i) {
@@ -229,8 +237,12 @@ void ClockParticipant::FailStalled(SteadyClock::time_point now) {
     }
     std::erase(waiting, silent.front());
   }
-  std::string reason = fmt::format("step {}: {} stopped answering: no answer after {:.3g} s and {} re-requests",
-                                   k_, JoinNames(silent), Seconds(step_since_, now), rerequests_);
+  // The plant's answer to step k is measured_t k+1 when the barrier includes it: name it.
+  const std::string missing = silent.size() == 1 && silent.front() == "plant" && measured_.Get(k_)
+                                  ? fmt::format("no measured_t {}", k_ + 1)
+                                  : std::string("no answer");
+  std::string reason = fmt::format("step {}: {} stopped answering: {} after {:.3g} s and {} re-requests", k_,
+                                   JoinNames(silent), missing, Seconds(step_since_, now), rerequests_);
   if (!waiting.empty()) reason += fmt::format(" ({} only waited for it)", JoinNames(waiting));
   Fail(kExitLockstep, reason, true, k_, silent.size() == 1 ? silent.front() : JoinNames(silent));
 }

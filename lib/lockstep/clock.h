@@ -5,7 +5,8 @@
 /// same scenario hash, step count and dt; then GO (with the roster) and step 0.
 /// Step k: the clock publishes desired_t k (its own answer, and the request of step k), then
 /// waits for the barrier of step k: measured_t k (plant), command_t k (controller),
-/// current_t k (semiactive) and ack_t k (logger: every message of step k is on disk).
+/// current_t k (semiactive), ack_t k (logger: every message of step k is on disk) and, for a
+/// plant that answers command_t k (SetBarrierIncludesNextMeasured), measured_t k+1.
 /// Silence for `rerequest_ms` (then twice as long each time, up to 1 s) re-requests step k: a
 /// repair_t listing the answers it lacks; their owners re-send them from their caches, and
 /// whoever lacks an input says so in a repair_t of its own (docs/lockstep.md, "Repair").
@@ -46,6 +47,11 @@ class ClockParticipant : public Participant {
 
   void Poll(SteadyClock::time_point now, bool idle) override;
   SteadyClock::time_point PollDeadline() const override;
+
+  /// The barrier of step k includes measured_t k+1 (but for the last step): for a plant that
+  /// answers command_t k with measured_t k+1 (every plant but "ideal"; docs/lockstep.md, "One
+  /// step"). Call before GO.
+  void SetBarrierIncludesNextMeasured(bool on) { next_measured_ = on; }
 
   /// Step currently requested (-1 before GO).
   std::int64_t current_step() const { return k_; }
@@ -98,6 +104,9 @@ class ClockParticipant : public Participant {
   /// Who sent a repair_t for the current step (alive, but lacking inputs).
   std::array<bool, kRoster.size()> reported_{};
   std::int64_t k_ = -1;
+  bool next_measured_ = false;  ///< SetBarrierIncludesNextMeasured
+  /// The barrier of step k_ waits for measured_t k_+1.
+  bool WaitsForNextMeasured() const { return next_measured_ && k_ + 1 < id_.n_steps; }
   int rerequests_ = 0;  ///< re-requests of the current step (or DONEs after the first)
   double typical_step_s_ = 0;  ///< moving average of the steps that needed no re-request [s]
   bool done_ = false;

@@ -84,6 +84,7 @@ struct Participant::Route {
   /// step k), command_t / current_t 2 (they answer desired_t k: it requested step k), measured_t 3
   /// (it follows command_t k-1: the clock requested step k-1); any other channel 0.
   int step_evidence = 0;
+  Wake wake = Wake::kOnArrival;
   void OnMessage(const lcm::ReceiveBuffer* rbuf, const std::string&) { self->Deliver(this, rbuf); }
   static void OnChannelMessage(void* route, const lcm::ReceiveBuffer* rbuf) {
     auto* r = static_cast<Route*>(route);
@@ -107,12 +108,12 @@ Participant::Participant(std::string name, RunIdentity id, Timing timing, lcm::L
 
 Participant::~Participant() = default;
 
-void Participant::Subscribe(const char* channel, Handler handler) {
+void Participant::Subscribe(const char* channel, Handler handler, Wake wake) {
   const std::string_view ch(channel);
   const int evidence = ch == kChDesired ? 1 : (ch == kChCommand || ch == kChCurrent) ? 2 : ch == kChMeasured ? 3 : 0;
-  routes_.push_back(std::make_unique<Route>(Route{this, channel, std::move(handler), evidence}));
+  routes_.push_back(std::make_unique<Route>(Route{this, channel, std::move(handler), evidence, wake}));
   if (channels_) {
-    if (!channels_->Subscribe(channel, &Route::OnChannelMessage, routes_.back().get())) {
+    if (!channels_->Subscribe(channel, &Route::OnChannelMessage, routes_.back().get(), wake)) {
       throw std::runtime_error(fmt::format("{}: {}", name_, channels_->error()));
     }
   } else if (lcm_) {
@@ -124,7 +125,7 @@ void Participant::Attach(Channels* channels) {
   if (lcm_) throw std::runtime_error(name_ + ": Attach: already subscribed on an LCM instance");
   channels_ = channels;
   for (auto& r : routes_) {
-    if (!channels_->Subscribe(r->channel.c_str(), &Route::OnChannelMessage, r.get())) {
+    if (!channels_->Subscribe(r->channel.c_str(), &Route::OnChannelMessage, r.get(), r->wake)) {
       throw std::runtime_error(fmt::format("{}: {}", name_, channels_->error()));
     }
   }

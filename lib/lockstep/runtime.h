@@ -140,6 +140,18 @@ void Encode(const Msg& msg, Bytes* out) {
 /// 8-byte type hash), without decoding it; false if it is too short.
 bool PeekRunAndStep(const std::uint8_t* data, std::size_t size, std::int64_t* run_id, std::int64_t* k);
 
+/// Whether a message on a subscribed channel wakes the participant's event loop. Only the
+/// per-channel udpm transport (UdpmChannels) acts on it; the others hand every message over as it
+/// comes.
+enum class Wake : std::int8_t {
+  kOnArrival,  ///< wake up for it (every channel by default)
+  /// Do not wake up for it: it is read, before anything else, whenever a kOnArrival message wakes
+  /// the loop, and at the loop's timeouts (at most 5 ms apart). For a channel whose message of
+  /// step k is always sent before a message this participant does wake for, which then finds it
+  /// queued (loopback multicast hands a datagram to every socket at once): a wake-up saved per step.
+  kLater,
+};
+
 /// What a mailbox did with a message.
 enum class Put { kNew, kDuplicate, kStale, kForeign, kBad };
 
@@ -275,8 +287,9 @@ class Participant {
 
  protected:
   using Handler = std::function<void(const lcm::ReceiveBuffer*)>;
-  /// Subscribes `handler` to `channel`; every message passes the fault injector first.
-  void Subscribe(const char* channel, Handler handler);
+  /// Subscribes `handler` to `channel`; every message passes the fault injector first. `wake`:
+  /// whether its messages wake this participant (per-channel udpm; see Wake).
+  void Subscribe(const char* channel, Handler handler, Wake wake = Wake::kOnArrival);
   /// Declares this participant's per-step answer channel and its cache: a repair_t that wants
   /// (channel, k) gets the cached bytes of k re-sent.
   void SetAnswerChannel(Channel channel, const AnswerCache* cache);
@@ -292,7 +305,8 @@ class Participant {
   /// Called when the run stops abnormally (ABORT or own failure): flush what is committed.
   virtual void OnStop() {}
   /// Appends to `out` the inputs this participant lacks to advance up to step k (its answer of
-  /// k, or for the plant measured_t k). Called when the clock re-requests step k.
+  /// k; for the plant measured_t k+1, or measured_t k if "ideal"). Called when the clock
+  /// re-requests step k.
   virtual void ListMissing(std::int64_t /*k*/, WantList* /*out*/) const {}
 
   /// Publishes raw bytes on a channel (LCM or the attached channels); 0 on success.

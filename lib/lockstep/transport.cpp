@@ -121,7 +121,7 @@ bool IsPortPerChannel(const std::string& url) {
   return u && u->port_per_channel;
 }
 
-UdpmChannels::UdpmChannels(const UdpmUrl& url) : url_(url) {
+UdpmChannels::UdpmChannels(const UdpmUrl& url) : url_(url), buffers_(kBatch * kBufferBytes) {
   for (std::size_t i = 0; i < kPortChannels.size(); ++i) sockets_[i].channel = kPortChannels[i];
   if (!url_.port_per_channel) {
     error_ = "UdpmChannels needs a URL with port_per_channel=1";
@@ -146,7 +146,7 @@ UdpmChannels::~UdpmChannels() {
   }
 }
 
-bool UdpmChannels::Subscribe(const char* channel, Callback callback, void* context) {
+bool UdpmChannels::Subscribe(const char* channel, Callback callback, void* context, Wake wake) {
   const int i = PortOffset(channel);
   if (i < 0) {
     error_ = fmt::format("channel {} has no port of its own (not a run channel)", channel);
@@ -188,6 +188,7 @@ bool UdpmChannels::Subscribe(const char* channel, Callback callback, void* conte
     s.fd = fd;
     poll_order_.push_back(i);
   }
+  s.wakes = s.wakes || wake == Wake::kOnArrival;
   s.callbacks.emplace_back(callback, context);
   return true;
 }
@@ -215,35 +216,69 @@ int UdpmChannels::Publish(const char* channel, const void* data, unsigned size) 
   return 0;
 }
 
-bool UdpmChannels::Dispatch(Socket* s) {
-  const ssize_t n = ::recv(s->fd, buffer_.data(), buffer_.size(), 0);
-  if (n < 0) return false;  // EAGAIN: another reader took it, or nothing after all
+void UdpmChannels::Deliver(Socket* s, std::uint8_t* datagram, std::size_t size) {
   ++received_;
-  const auto size = static_cast<std::size_t>(n);
-  if (size < 9) return true;
+  if (size < 9) return;
   std::uint32_t magic = 0;
-  std::memcpy(&magic, buffer_.data(), 4);
-  if (ntohl(magic) != kShortMagic) return true;  // a fragment of a large message: none of ours
-  const auto* channel = reinterpret_cast<const char*>(buffer_.data() + 8);
+  std::memcpy(&magic, datagram, 4);
+  if (ntohl(magic) != kShortMagic) return;  // a fragment of a large message: none of ours
+  const auto* channel = reinterpret_cast<const char*>(datagram + 8);
   const auto* end = static_cast<const char*>(std::memchr(channel, '\0', size - 8));
-  if (!end || std::strcmp(channel, s->channel) != 0) return true;  // another channel on our port
+  if (!end || std::strcmp(channel, s->channel) != 0) return;  // another channel on our port
   const std::size_t header = 8 + static_cast<std::size_t>(end - channel) + 1;
-  lcm::ReceiveBuffer rb{buffer_.data() + header, static_cast<std::uint32_t>(size - header), WallUtime()};
+  lcm::ReceiveBuffer rb{datagram + header, static_cast<std::uint32_t>(size - header), WallUtime()};
   for (const auto& [callback, context] : s->callbacks) callback(context, &rb);
+}
+
+bool UdpmChannels::Dispatch(Socket* s) {
+  const ssize_t n = ::recv(s->fd, buffers_.data(), kBufferBytes, 0);
+  if (n < 0) return false;  // EAGAIN: another reader took it, or nothing after all
+  Deliver(s, buffers_.data(), static_cast<std::size_t>(n));
   return true;
+}
+
+int UdpmChannels::Drain(Socket* s) {
+  std::array<iovec, kBatch> iov{};
+  std::array<mmsghdr, kBatch> msgs{};
+  int handled = 0;
+  while (handled < 256) {  // bounded under a flood
+    for (int i = 0; i < kBatch; ++i) {
+      iov[i] = {buffers_.data() + i * kBufferBytes, kBufferBytes};
+      msgs[i] = {};
+      msgs[i].msg_hdr.msg_iov = &iov[i];
+      msgs[i].msg_hdr.msg_iovlen = 1;
+    }
+    const int n = ::recvmmsg(s->fd, msgs.data(), kBatch, MSG_DONTWAIT, nullptr);
+    if (n <= 0) break;  // EAGAIN: nothing (more) waiting
+    // Hand them over only after the call: a callback may publish, never receive, meanwhile.
+    for (int i = 0; i < n; ++i) Deliver(s, buffers_.data() + i * kBufferBytes, msgs[i].msg_len);
+    handled += n;
+    if (n < kBatch) break;  // the queue is empty: no further call to find that out
+  }
+  return handled;
 }
 
 int UdpmChannels::HandleTimeout(int timeout_ms) {
   std::array<pollfd, kPortChannels.size()> fds{};
-  const std::size_t n = poll_order_.size();
-  for (std::size_t j = 0; j < n; ++j) fds[j] = {sockets_[poll_order_[j]].fd, POLLIN, 0};
+  std::array<Socket*, kPortChannels.size()> socks{};
+  std::size_t n = 0;
+  for (const int i : poll_order_) {
+    if (!sockets_[i].wakes) continue;
+    socks[n] = &sockets_[i];
+    fds[n++] = {sockets_[i].fd, POLLIN, 0};
+  }
   const int r = ::poll(fds.data(), n, timeout_ms);
-  if (r <= 0) return r;
+  if (r < 0) return r;
+  // What does not wake us was sent before what did (or is found at the timeout): it goes first.
   int handled = 0;
+  for (const int i : poll_order_) {
+    if (!sockets_[i].wakes) handled += Drain(&sockets_[i]);
+  }
+  if (r == 0) return handled;
   Socket* handshake = nullptr;
   for (std::size_t j = 0; j < n; ++j) {
     if (!(fds[j].revents & POLLIN)) continue;
-    Socket* s = &sockets_[poll_order_[j]];
+    Socket* s = socks[j];
     if (s->channel == kPortChannels[0]) {
       handshake = s;
     } else if (Dispatch(s)) {
@@ -255,8 +290,7 @@ int UdpmChannels::HandleTimeout(int timeout_ms) {
     // Loopback delivery is done within the sender's send call, so whatever was sent before this
     // handshake message is queued by now: hand it all over first, as one port's FIFO would.
     for (const int i : poll_order_) {
-      if (&sockets_[i] == handshake) continue;
-      for (int m = 0; m < 256 && Dispatch(&sockets_[i]); ++m) ++handled;  // bounded under a flood
+      if (&sockets_[i] != handshake) handled += Drain(&sockets_[i]);
     }
     if (Dispatch(handshake)) ++handled;
   }
@@ -274,7 +308,7 @@ InprocChannels::InprocChannels() : ring_(16) {
   current_.bytes.reserve(kInprocSlotBytes);
 }
 
-bool InprocChannels::Subscribe(const char* channel, Callback callback, void* context) {
+bool InprocChannels::Subscribe(const char* channel, Callback callback, void* context, Wake) {
   const int i = PortOffset(channel);
   if (i < 0) {
     error_ = fmt::format("channel {} is not a run channel", channel);

@@ -67,8 +67,9 @@ class Channels {
   const std::string& error() const { return error_; }
 
   /// Calls `callback(context, rbuf)` for every message on `channel` (one of kPortChannels). False
-  /// (and error() says why) if it cannot.
-  virtual bool Subscribe(const char* channel, Callback callback, void* context) = 0;
+  /// (and error() says why) if it cannot. `wake`: whether its messages wake HandleTimeout (Wake;
+  /// a transport may hand every message over as it comes regardless).
+  virtual bool Subscribe(const char* channel, Callback callback, void* context, Wake wake = Wake::kOnArrival) = 0;
   /// Sends `size` bytes on `channel` (one of kPortChannels). 0 on success, -1 on failure.
   virtual int Publish(const char* channel, const void* data, unsigned size) = 0;
   /// Waits at most `timeout_ms` for a message, then hands what came in to the callbacks. Returns
@@ -92,14 +93,17 @@ class UdpmChannels final : public Channels {
   UdpmChannels(const UdpmChannels&) = delete;
   UdpmChannels& operator=(const UdpmChannels&) = delete;
 
-  /// Opens the channel's receive socket on first use.
-  bool Subscribe(const char* channel, Callback callback, void* context) override;
+  /// Opens the channel's receive socket on first use. A socket wakes HandleTimeout if any of its
+  /// subscriptions is Wake::kOnArrival.
+  bool Subscribe(const char* channel, Callback callback, void* context, Wake wake = Wake::kOnArrival) override;
   /// One LCM datagram; -1 for an unknown channel, a message too large for one datagram, a send
   /// error.
   int Publish(const char* channel, const void* data, unsigned size) override;
-  /// Hands at most one waiting message per channel to its callbacks; before a handshake message
-  /// (an ABORT, DONE) it hands over every message waiting on the other channels, sent before it,
-  /// as on one port.
+  /// Waits for a message on a channel that wakes (Wake::kOnArrival); then first hands over every
+  /// message waiting on the channels that do not wake (sent before the one that woke it, or
+  /// found at the timeout), then at most one waiting message per waking channel; before a
+  /// handshake message (an ABORT, DONE) it hands over every message waiting on the other
+  /// channels, sent before it, as on one port.
   int HandleTimeout(int timeout_ms) override;
 
   /// Datagrams received and sent so far (all channels).
@@ -110,16 +114,27 @@ class UdpmChannels final : public Channels {
   struct Socket {
     int fd = -1;
     const char* channel = nullptr;
+    bool wakes = false;  ///< in the poll set: some subscription is Wake::kOnArrival
     std::vector<std::pair<Callback, void*>> callbacks;
   };
+  /// Receives one datagram from `s` and hands it over; false if none was waiting.
   bool Dispatch(Socket* s);
+  /// Receives every datagram waiting on `s` (recvmmsg, kBatch at a time, at most 256) and hands
+  /// them over; how many.
+  int Drain(Socket* s);
+  /// Hands one received datagram to the socket's callbacks (if it is an LCM message of its channel).
+  void Deliver(Socket* s, std::uint8_t* datagram, std::size_t size);
+
+  /// Datagrams received per recvmmsg call, and the size of each receive buffer (the largest datagram).
+  static constexpr int kBatch = 8;
+  static constexpr std::size_t kBufferBytes = 65536;
 
   UdpmUrl url_;
   int send_fd_ = -1;
   std::uint32_t seqno_ = 0;
   std::array<Socket, kPortChannels.size()> sockets_{};
   std::vector<int> poll_order_;  ///< indices of open receive sockets, in opening order
-  std::array<std::uint8_t, 65536> buffer_{};
+  std::vector<std::uint8_t> buffers_;  ///< kBatch receive buffers of 64 KiB, one after another
   std::int64_t received_ = 0, sent_ = 0;
 };
 
@@ -135,7 +150,8 @@ class UdpmChannels final : public Channels {
 class InprocChannels final : public Channels {
  public:
   InprocChannels();
-  bool Subscribe(const char* channel, Callback callback, void* context) override;
+  /// `wake` is ignored: every message is handed over in publish order.
+  bool Subscribe(const char* channel, Callback callback, void* context, Wake wake = Wake::kOnArrival) override;
   /// Copies the message into the queue; -1 for a channel that is not a run channel.
   int Publish(const char* channel, const void* data, unsigned size) override;
   /// Hands queued messages over, up to kMaxBatch (then returns, so the caller's timers run);

@@ -7,7 +7,7 @@ namespace rths::participants {
 Controller::Controller(const scenario::Scenario& s, lockstep::RunIdentity id, lcm::LCM* lcm,
                        lockstep::Faults faults)
     : DesiredMeasuredParticipant("controller", std::move(id), TimingOf(s), lcm, std::move(faults),
-                                 lockstep::kChCommand, lockstep::kCommand),
+                                 lockstep::kChCommand, lockstep::kCommand, PlantAnswersCommand(s)),
       law_(control::MakeTrackingController(s.controller, s.run.dt_s)) {}
 
 void Controller::Compute(std::int64_t, const rths::desired_t& d, const rths::measured_t& m,

@@ -62,6 +62,8 @@ OutputBytes EstimateOutputBytes(const scenario::Scenario& s) {
   return b;
 }
 
+bool PlantAnswersCommand(const scenario::Scenario& s) { return s.plant.kind != models::PlantKind::kIdeal; }
+
 std::unique_ptr<lockstep::Participant> MakeParticipant(std::string_view role, const scenario::Scenario& s,
                                                        const lockstep::RunIdentity& id, lcm::LCM* lcm,
                                                        const std::string& out_dir, lockstep::Faults faults) {
@@ -71,7 +73,7 @@ std::unique_ptr<lockstep::Participant> MakeParticipant(std::string_view role, co
   if (role == "semiactive") return std::make_unique<Semiactive>(s, id, lcm, std::move(faults));
   if (role == "logger") {
     return std::make_unique<Logger>(id, TimingOf(s), lcm, out_dir + "/log.lcm", out_dir + "/signals.csv",
-                                    std::move(faults), s.run.csv_every);
+                                    std::move(faults), s.run.csv_every, PlantAnswersCommand(s));
   }
   throw Error("", fmt::format("unknown participant role '{}'", role));
 }

@@ -22,6 +22,11 @@ lockstep::Timing TimingOf(const scenario::Scenario& s);
 /// apply to every participant, the process fault to its role only).
 lockstep::Faults FaultsOf(const scenario::Scenario& s, std::string_view role);
 
+/// True when the plant answers command_t k with measured_t k+1 (every plant but "ideal", which
+/// answers desired_t k with measured_t k). Then the logger acknowledges step k only once it also
+/// holds measured_t k+1, so that measured_t k+1 is always sent before desired_t k+1 (Logger).
+bool PlantAnswersCommand(const scenario::Scenario& s);
+
 /// Builds the participant `role` on `lcm`, subject to `faults`. The logger writes
 /// `out_dir`/log.lcm and `out_dir`/signals.csv. Throws rths::Error (unknown role, bad model,
 /// unwritable output).

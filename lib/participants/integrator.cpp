@@ -23,6 +23,7 @@ Integrator::Integrator(const scenario::Scenario& s, lockstep::RunIdentity id, lc
       predefined_(s.structure.mode == models::StructureMode::kPredefined),
       dt_s_(s.run.dt_s),
       safety_(s.safety, s.run.dt_s) {
+  SetBarrierIncludesNextMeasured(PlantAnswersCommand(s));
   const auto n = static_cast<std::size_t>(id.n_steps);
   const std::string dir = FolderOf(s.path);
   if (predefined_) {

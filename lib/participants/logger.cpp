@@ -44,11 +44,12 @@ std::int64_t LogBytesPerStep(int n_dof) {
 }
 
 Logger::Logger(lockstep::RunIdentity id, lockstep::Timing timing, lcm::LCM* lcm, const std::string& log_path,
-               const std::string& csv_path, lockstep::Faults faults, int csv_every)
+               const std::string& csv_path, lockstep::Faults faults, int csv_every, bool ack_after_next_measured)
     : Participant("logger", std::move(id), timing, lcm, std::move(faults)),
       log_path_(log_path),
       csv_path_(csv_path),
-      csv_every_(csv_every) {
+      csv_every_(csv_every),
+      ack_after_next_measured_(ack_after_next_measured) {
   if (csv_every_ < 0) throw Error(csv_path_, fmt::format("csv_every = {}: must be >= 0", csv_every_));
   log_fd_ = CreateFile(log_path_, "event log");
   try {
@@ -76,18 +77,23 @@ Logger::Logger(lockstep::RunIdentity id, lockstep::Timing timing, lcm::LCM* lcm,
     }
   }
   SetAnswerChannel(lockstep::kAck, &ack_cache_);
+  // What wakes the logger (docs/lockstep.md, "Wake-ups"): desired_t k and measured_t k are sent
+  // before command_t k (the controller needs both), so command_t and current_t; when step k also
+  // waits for measured_t k+1, which the plant sends after both, that one alone.
+  using lockstep::Wake;
+  const Wake answers = ack_after_next_measured_ ? Wake::kLater : Wake::kOnArrival;
   Subscribe(lockstep::kChDesired, [this](const lcm::ReceiveBuffer* rbuf) {
     OnStepMessage(&desired_, &raw_desired_, lockstep::kDesired, rbuf);
-  });
+  }, Wake::kLater);
   Subscribe(lockstep::kChCommand, [this](const lcm::ReceiveBuffer* rbuf) {
     OnStepMessage(&command_, &raw_command_, lockstep::kCommand, rbuf);
-  });
+  }, answers);
   Subscribe(lockstep::kChMeasured, [this](const lcm::ReceiveBuffer* rbuf) {
     OnStepMessage(&measured_, &raw_measured_, lockstep::kMeasured, rbuf);
-  });
+  }, ack_after_next_measured_ ? Wake::kOnArrival : Wake::kLater);
   Subscribe(lockstep::kChCurrent, [this](const lcm::ReceiveBuffer* rbuf) {
     OnStepMessage(&current_, &raw_current_, lockstep::kCurrent, rbuf);
-  });
+  }, answers);
 }
 
 Logger::~Logger() {
@@ -120,13 +126,13 @@ std::string Logger::Append(int fd, const std::string& path, const std::uint8_t* 
 }
 
 void Logger::FailWrite(const std::string& why, std::int64_t k) {
-  // log.lcm ends on the last acknowledged step (it may hold part of step k); the buffered rows
-  // are all of acknowledged steps: write them (a failed write cuts signals.csv to a whole row).
+  // log.lcm ends on the last written step (it may hold part of step k); the buffered rows are
+  // all of written steps: write them (a failed write cuts signals.csv to a whole row).
   const bool cut_log = ::ftruncate(log_fd_, static_cast<off_t>(log_acked_)) == 0;
   const bool csv_ok = csv_fd_ < 0 || CloseCsv().empty();
   std::string reason = fmt::format("{} (at step {}; the log and signals.csv end on step {}, the last "
-                                   "acknowledged one{})",
-                                   why, k, next_ - 1,
+                                   "complete one{})",
+                                   why, k, written_ - 1,
                                    !cut_log ? "; cutting the log back failed"
                                    : !csv_ok ? "; signals.csv ends earlier, on a whole row"
                                              : "");
@@ -216,52 +222,61 @@ void Logger::ListMissing(std::int64_t k, lockstep::WantList* out) const {
   if (!command_.Get(next_)) out->Add(lockstep::kCommand, next_);
   if (!measured_.Get(next_)) out->Add(lockstep::kMeasured, next_);
   if (!current_.Get(next_)) out->Add(lockstep::kCurrent, next_);
+  if (WaitsForNextMeasured(next_) && !measured_.Get(next_ + 1)) out->Add(lockstep::kMeasured, next_ + 1);
 }
 
 void Logger::TryAck() {
   while (running() && next_ < id_.n_steps && !Stalled(next_)) {
     const std::int64_t k = next_;
-    const rths::desired_t* d = desired_.Get(k);
-    const rths::command_t* c = command_.Get(k);
-    const rths::measured_t* m = measured_.Get(k);
-    const rths::current_t* i = current_.Get(k);
-    if (!d || !c || !m || !i) return;
-    MaybeFault(k);
-    // The four events of step k in channel order, one write.
-    step_bytes_.clear();
-    const std::size_t slot = static_cast<std::size_t>(k % 4);
-    for (auto [ch, ring] : {std::pair{lockstep::kChDesired, &raw_desired_}, {lockstep::kChCommand, &raw_command_},
-                            {lockstep::kChMeasured, &raw_measured_}, {lockstep::kChCurrent, &raw_current_}}) {
-      const lockstep::Bytes& r = (*ring)[slot];
-      io::AppendEvent(&step_bytes_, event_number_++, StepUtime(k), ch, r.data(), r.size());
-    }
-    if (const std::string why = Append(log_fd_, log_path_, step_bytes_.data(), step_bytes_.size(), &log_end_);
-        !why.empty()) {
-      FailWrite(why, k);
-      return;
-    }
-    if (csv_fd_ < 0 || csv_closed_ || k % csv_every_ != 0) {  // this step has no row of signals.csv
-      log_acked_ = log_end_;
-      Acknowledge(k);
-      continue;
-    }
-    char row[kCsvRowMaxBytes + 1];
-    const int n = std::snprintf(row, sizeof row,
-                                "%" PRId64 ",%.6f,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n",
-                                k, static_cast<double>(k) * id_.dt_s, d->r_mm, c->u_mm, c->u_ff_mm, c->u_fb_mm,
-                                m->y_mm, d->r_mm - m->y_mm, m->f_kN, i->i_cmd_A, m->current_A,
-                                d->ground_acc_mm_s2);
-    if (n < 0 || static_cast<std::size_t>(n) >= sizeof row) {
-      FailWrite(fmt::format("formatting row {} of {} failed", k, csv_path_), k);
-      return;
-    }
-    if (const std::string why = AddCsvRow(row, static_cast<std::size_t>(n)); !why.empty()) {
-      FailWrite(why, k);
-      return;
-    }
-    log_acked_ = log_end_;
+    if (written_ == k && !WriteStep(k)) return;
+    // Written; acknowledged once measured_t k+1 is in too, where the plant answers command_t.
+    if (WaitsForNextMeasured(k) && !measured_.Get(k + 1)) return;
     Acknowledge(k);
   }
+}
+
+bool Logger::WriteStep(std::int64_t k) {
+  const rths::desired_t* d = desired_.Get(k);
+  const rths::command_t* c = command_.Get(k);
+  const rths::measured_t* m = measured_.Get(k);
+  const rths::current_t* i = current_.Get(k);
+  if (!d || !c || !m || !i) return false;
+  MaybeFault(k);
+  // The four events of step k in channel order, one write.
+  step_bytes_.clear();
+  const std::size_t slot = static_cast<std::size_t>(k % 4);
+  for (auto [ch, ring] : {std::pair{lockstep::kChDesired, &raw_desired_}, {lockstep::kChCommand, &raw_command_},
+                          {lockstep::kChMeasured, &raw_measured_}, {lockstep::kChCurrent, &raw_current_}}) {
+    const lockstep::Bytes& r = (*ring)[slot];
+    io::AppendEvent(&step_bytes_, event_number_++, StepUtime(k), ch, r.data(), r.size());
+  }
+  if (const std::string why = Append(log_fd_, log_path_, step_bytes_.data(), step_bytes_.size(), &log_end_);
+      !why.empty()) {
+    FailWrite(why, k);
+    return false;
+  }
+  if (csv_fd_ < 0 || csv_closed_ || k % csv_every_ != 0) {  // this step has no row of signals.csv
+    log_acked_ = log_end_;
+    ++written_;
+    return true;
+  }
+  char row[kCsvRowMaxBytes + 1];
+  const int n = std::snprintf(row, sizeof row,
+                              "%" PRId64 ",%.6f,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n",
+                              k, static_cast<double>(k) * id_.dt_s, d->r_mm, c->u_mm, c->u_ff_mm, c->u_fb_mm,
+                              m->y_mm, d->r_mm - m->y_mm, m->f_kN, i->i_cmd_A, m->current_A,
+                              d->ground_acc_mm_s2);
+  if (n < 0 || static_cast<std::size_t>(n) >= sizeof row) {
+    FailWrite(fmt::format("formatting row {} of {} failed", k, csv_path_), k);
+    return false;
+  }
+  if (const std::string why = AddCsvRow(row, static_cast<std::size_t>(n)); !why.empty()) {
+    FailWrite(why, k);
+    return false;
+  }
+  log_acked_ = log_end_;
+  ++written_;
+  return true;
 }
 
 void Logger::Acknowledge(std::int64_t k) {

@@ -3,11 +3,12 @@
 /// a step it could not store (docs/lockstep.md).
 ///
 /// Step k (inputs -> answer):
-///   desired_t k, command_t k, measured_t k, current_t k  ->  ack_t k
+///   desired_t k, command_t k, measured_t k, current_t k (+ measured_t k+1)  ->  ack_t k
 /// The first copy of every (channel, k) is kept; re-sent duplicates are ignored. Once all four
 /// messages of step k are in, they are appended to log.lcm (a standard LCM event log, readable by
-/// lcm-logplayer and lcm-spy) in channel order with one pwrite(2), and only then is ack_t k
-/// published: the clock cannot advance past a step the logger has not handed to the kernel. The
+/// lcm-logplayer and lcm-spy) in channel order with one pwrite(2), and only then, and once
+/// measured_t k+1 is in too where the plant answers command_t k (ack_after_next_measured), is
+/// ack_t k published: the clock cannot advance past a step the logger has not handed to the kernel. The
 /// handshake is logged on its own channel as it arrives (first copy per participant and phase).
 ///
 /// signals.csv is a derived copy of the log (every column comes from the four messages), so its
@@ -15,7 +16,7 @@
 /// fallocate(2) (so a full disk cannot fail a flush); where the file system cannot reserve space,
 /// each row is written with the step as before. The buffer is flushed when DONE arrives, when the
 /// run stops (ABORT, an interrupt, a write error) and when the logger is destroyed: signals.csv
-/// then ends on the last acknowledged step, like log.lcm. Only if the logger process itself is
+/// then ends on the last written step, like log.lcm. Only if the logger process itself is
 /// killed (SIGKILL) may signals.csv end earlier, on a whole row; log.lcm is complete regardless.
 /// One write system call per step, instead of two (bench/memq.cpp counts them).
 ///
@@ -25,7 +26,7 @@
 /// later ones the current step's time.
 ///
 /// A failed or short write (disk full, I/O error) stops the run: log.lcm is cut back to the end of
-/// the last acknowledged step, the buffered rows (all of acknowledged steps) are written to
+/// the last written step, the buffered rows (all of written steps) are written to
 /// signals.csv (cut back to its last whole row if that fails too), ABORT is broadcast naming the
 /// file and the error, and the logger exits with kExitOutput.
 #include <cstdint>
@@ -54,16 +55,23 @@ class Logger : public lockstep::Participant {
  public:
   /// Creates `log_path` (LCM event log) and `csv_path` (signals: a row for every `csv_every`-th
   /// step, k = 0, N, 2N, ...; csv_every = 0: no CSV file at all; scenario key run.csv_every);
-  /// throws rths::Error.
+  /// throws rths::Error. `ack_after_next_measured`: step k is written and acknowledged only once
+  /// measured_t k+1 is in as well (but for the last step), for a plant that answers command_t k
+  /// with measured_t k+1 (PlantAnswersCommand): the clock then sends desired_t k+1 after
+  /// measured_t k+1 in every run, so the controller and the semiactive law wake once per step,
+  /// for desired_t (docs/lockstep.md, "Wake-ups"). Never for a plant whose measured_t k+1 needs
+  /// desired_t k+1 (the "ideal" plant, a replayed one): that would wait forever.
   Logger(lockstep::RunIdentity id, lockstep::Timing timing, lcm::LCM* lcm, const std::string& log_path,
-         const std::string& csv_path, lockstep::Faults faults = {}, int csv_every = 1);
+         const std::string& csv_path, lockstep::Faults faults = {}, int csv_every = 1,
+         bool ack_after_next_measured = false);
   ~Logger() override;
 
   /// Bytes of signals.csv rows buffered before one write (and reserved ahead on disk).
   static constexpr std::size_t kCsvFlushBytes = 64 * 1024;
 
-  /// Steps acknowledged so far.
-  std::int64_t steps_written() const { return next_; }
+  /// Steps written so far (every step acknowledged, and at most one more whose acknowledgement
+  /// waits for measured_t k+1).
+  std::int64_t steps_written() const { return written_; }
   /// Write system calls (pwrite, ftruncate, fallocate) made so far, handshake included.
   std::int64_t write_calls() const { return write_calls_; }
 
@@ -84,13 +92,18 @@ class Logger : public lockstep::Participant {
                      const lcm::ReceiveBuffer* rbuf);
   void OnHandshakeSeen(const lcm::ReceiveBuffer* rbuf, const rths::handshake_t& msg) override;
   void TryAck();
+  /// Writes step k (log.lcm and its signals.csv row) if its four messages are in; false if they
+  /// are not, or the write failed (the run is then stopped).
+  bool WriteStep(std::int64_t k);
+  /// Step k waits for measured_t k+1 too (ack_after_next_measured, but for the last step).
+  bool WaitsForNextMeasured(std::int64_t k) const { return ack_after_next_measured_ && k + 1 < id_.n_steps; }
   /// Publishes ack_t k (step k is stored) and moves on to k + 1.
   void Acknowledge(std::int64_t k);
   /// Appends `bytes` to the file `fd` (every byte, or none: on failure the file is cut back to
   /// `*good_end`); advances `*good_end`. Returns "" or the error, naming the file.
   std::string Append(int fd, const std::string& path, const std::uint8_t* data, std::size_t size,
                      std::int64_t* good_end);
-  /// Cuts both files back to the last acknowledged step and stops the run (kExitOutput).
+  /// Cuts both files back to the last written step and stops the run (kExitOutput).
   void FailWrite(const std::string& why, std::int64_t k);
   /// Adds a row to signals.csv: to the buffer (written once it holds kCsvFlushBytes) or, where no
   /// space can be reserved, straight to the file. Returns "" or the error.
@@ -103,9 +116,10 @@ class Logger : public lockstep::Participant {
 
   std::string log_path_, csv_path_;
   int csv_every_ = 1;  ///< signals.csv row every this many steps; 0: no signals.csv
+  bool ack_after_next_measured_ = false;  ///< step k also waits for measured_t k+1
   int log_fd_ = -1, csv_fd_ = -1;
   std::int64_t log_end_ = 0, csv_end_ = 0;      ///< bytes written, each ending on a whole event / row
-  std::int64_t log_acked_ = 0;                  ///< log bytes at the last acknowledged step
+  std::int64_t log_acked_ = 0;                  ///< log bytes at the end of the last written step
   std::string csv_buf_;                         ///< rows of acknowledged steps not yet written
   bool csv_buffered_ = false;                   ///< space is reserved ahead: rows are buffered
   bool csv_closed_ = false;                     ///< final flush done (or failed): no more rows
@@ -113,7 +127,8 @@ class Logger : public lockstep::Participant {
   std::int64_t write_calls_ = 0;
   std::int64_t event_number_ = 0;
   std::int64_t start_utime_ = -1;  ///< wall-clock time of GO [us since the epoch]; -1 before
-  std::int64_t next_ = 0;  ///< next step to acknowledge
+  std::int64_t next_ = 0;     ///< next step to acknowledge
+  std::int64_t written_ = 0;  ///< steps written: next_ or next_ + 1
   lockstep::StepMailbox<rths::desired_t> desired_;
   lockstep::StepMailbox<rths::command_t> command_;
   lockstep::StepMailbox<rths::measured_t> measured_;

@@ -18,16 +18,21 @@ Plant::Plant(const scenario::Scenario& s, lockstep::RunIdentity id, lcm::LCM* lc
       if (!finished() && Receive(&desired_, lockstep::kDesired, rbuf) == lockstep::Put::kNew) TryStep();
     });
   }
+  // The "ideal" plant wakes for desired_t k only: command_t and current_t of step k-1 were sent
+  // before the clock could request step k.
+  const lockstep::Wake answers = rig_->TracksDesired() ? lockstep::Wake::kLater : lockstep::Wake::kOnArrival;
   Subscribe(lockstep::kChCommand, [this](const lcm::ReceiveBuffer* rbuf) {
     if (!finished() && Receive(&command_, lockstep::kCommand, rbuf) == lockstep::Put::kNew) TryStep();
-  });
+  }, answers);
   Subscribe(lockstep::kChCurrent, [this](const lcm::ReceiveBuffer* rbuf) {
     if (!finished() && Receive(&current_, lockstep::kCurrent, rbuf) == lockstep::Put::kNew) TryStep();
-  });
+  }, answers);
 }
 
 void Plant::ListMissing(std::int64_t k, lockstep::WantList* out) const {
-  if (next_ > k) return;
+  // The barrier of step k holds measured_t k+1 when the plant answers command_t k (the clock's
+  // SetBarrierIncludesNextMeasured), else ("ideal") measured_t k.
+  if (next_ > k + (rig_->TracksDesired() ? 0 : 1)) return;
   if (rig_->TracksDesired() && !desired_.Get(next_)) out->Add(lockstep::kDesired, next_);
   if (next_ >= 1) {
     if (!rig_->TracksDesired() && !command_.Get(next_ - 1)) out->Add(lockstep::kCommand, next_ - 1);

@@ -9,6 +9,7 @@
 #include "lockstep/clock.h"
 #include "lockstep/transport.h"
 #include "participants/factory.h"
+#include "participants/logger.h"
 
 namespace rths::participants {
 
@@ -95,8 +96,17 @@ std::vector<Outcome> RunReplay(const scenario::Scenario& s, const io::RunLog& re
   const lockstep::Timing timing = TimingOf(s);
   std::vector<std::unique_ptr<lockstep::Participant>> owned;
   for (std::string_view role : kGroupOrder) {
-    if (IsLive(live, role)) {
+    if (role == "logger") {
+      // A recorded plant answers desired_t k with measured_t k: the logger must not wait for
+      // measured_t k+1 (Logger, ack_after_next_measured).
+      owned.push_back(std::make_unique<Logger>(id, timing, nullptr, out_dir + "/log.lcm", out_dir + "/signals.csv",
+                                               lockstep::Faults{}, s.run.csv_every, false));
+    } else if (IsLive(live, role)) {
       owned.push_back(MakeParticipant(role, s, id, nullptr, out_dir, {}));
+      if (role == "integrator" && !IsLive(live, "plant")) {
+        // The recorded plant answers desired_t k with measured_t k: no measured_t k+1 in the barrier.
+        static_cast<lockstep::ClockParticipant*>(owned.back().get())->SetBarrierIncludesNextMeasured(false);
+      }
     } else if (role == "integrator") {
       owned.push_back(std::make_unique<RecordedClock>(&record.desired, id, timing, nullptr));
     } else if (role == "controller") {

@@ -45,7 +45,7 @@ double CurrentSchedule::At(std::int64_t k) const {
 Semiactive::Semiactive(const scenario::Scenario& s, lockstep::RunIdentity id, lcm::LCM* lcm,
                        lockstep::Faults faults)
     : DesiredMeasuredParticipant("semiactive", std::move(id), TimingOf(s), lcm, std::move(faults),
-                                 lockstep::kChCurrent, lockstep::kCurrent),
+                                 lockstep::kChCurrent, lockstep::kCurrent, PlantAnswersCommand(s)),
       f_prev_kN_(0.0) {
   if (s.semiactive.mode == control::SemiactiveMode::kClippedOptimal) {
     const control::ClippedOptimalOptions o{s.semiactive.r_weight, s.semiactive.noise_ratio,

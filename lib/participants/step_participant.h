@@ -12,17 +12,22 @@ namespace rths::participants {
 template <class AnswerMsg>
 class DesiredMeasuredParticipant : public lockstep::Participant {
  public:
+  /// `measured_first`: measured_t k is sent before desired_t k in this run (the plant answers
+  /// command_t, and the logger waits for measured_t k+1 before acknowledging step k:
+  /// PlantAnswersCommand); then only desired_t wakes this participant, else ("ideal" plant: it
+  /// answers desired_t k) only measured_t (docs/lockstep.md, "Wake-ups").
   DesiredMeasuredParticipant(std::string name, lockstep::RunIdentity id, lockstep::Timing timing,
                              lcm::LCM* lcm, lockstep::Faults faults, const char* answer_channel,
-                             lockstep::Channel answer_code)
+                             lockstep::Channel answer_code, bool measured_first)
       : Participant(std::move(name), std::move(id), timing, lcm, std::move(faults)), channel_(answer_channel) {
+    using lockstep::Wake;
     SetAnswerChannel(answer_code, &cache_);
     Subscribe(lockstep::kChDesired, [this](const lcm::ReceiveBuffer* rbuf) {
       if (!finished() && Receive(&desired_, lockstep::kDesired, rbuf) == lockstep::Put::kNew) TryStep();
-    });
+    }, measured_first ? Wake::kOnArrival : Wake::kLater);
     Subscribe(lockstep::kChMeasured, [this](const lcm::ReceiveBuffer* rbuf) {
       if (!finished() && Receive(&measured_, lockstep::kMeasured, rbuf) == lockstep::Put::kNew) TryStep();
-    });
+    }, measured_first ? Wake::kLater : Wake::kOnArrival);
   }
 
  protected:
