@@ -16,8 +16,12 @@
 // one round trip, hence one handled delivery h and one ignored delivery i:
 //   one port:          C(L idle listeners) per round trip = 2 s + 2 h + 2 (1 + L) i
 //   port per channel:  C per round trip                   = 2 s + 2 h
-// A step then costs 5 s + 14 h + 11 i (one port) or 5 s + 14 h (port per channel) of CPU, and
-// the bound is cores / that: the rate if the participants computed and logged for free.
+// On a port per channel only 6 of the 14 deliveries wake their reader; the other 8 are read, with
+// recvmmsg, when it wakes for the one that completes its step (docs/lockstep.md, "Wake-ups"). A
+// ping-pong in which each side also sends one such message before each ping or pong gives the
+// cost l of a delivery that wakes no one:  C_later = 2 s + 2 h + 2 (s + l).
+// A step then costs 5 s + 14 h + 11 i (one port) or 5 s + 6 h + 8 l (port per channel) of CPU,
+// and the bound is cores / that: the rate if the participants computed and logged for free.
 #include <signal.h>
 #include <sys/prctl.h>
 #include <sys/resource.h>
@@ -55,6 +59,10 @@ namespace {
 /// ack_t: integrator.
 constexpr int kSendsPerStep = 5;
 constexpr int kHandledPerStep = 3 + 3 + 4 + 3 + 1;
+/// Of those, on a port per channel, the ones that wake their reader (clock: ack_t; controller,
+/// semiactive: desired_t; plant: command_t, current_t; logger: measured_t) and the others.
+constexpr int kWakingPerStep = 6;
+constexpr int kLaterPerStep = kHandledPerStep - kWakingPerStep;
 constexpr int kProcesses = 5;
 constexpr int kIgnoredPerStepOnePort = kSendsPerStep * kProcesses - kHandledPerStep;
 
@@ -64,13 +72,18 @@ double CpuSeconds(int who) {
   return u.ru_utime.tv_sec + u.ru_utime.tv_usec * 1e-6 + u.ru_stime.tv_sec + u.ru_stime.tv_usec * 1e-6;
 }
 
-/// The two channels of the ping-pong (run channels, so a per-channel transport carries them).
+/// The two channels of the ping-pong (run channels, so a per-channel transport carries them), and
+/// the two that carry a message that wakes no one, sent before each ping (to the echo) and each
+/// pong (to the pinger).
 constexpr const char* kPing = ls::kChDesired;
 constexpr const char* kPong = ls::kChCommand;
+constexpr const char* kLaterToEcho = ls::kChCurrent;
+constexpr const char* kLaterToPinger = ls::kChMeasured;
 
 /// A process that receives on one transport: echoes PING as PONG, or (a listener) only handles
 /// what it subscribed to. `subscribe`: 0 nothing (an idle LCM listener: subscribed to a channel no
-/// one sends), 1 PING (echo), 2 PING and PONG (a subscribed listener).
+/// one sends), 1 PING (echo), 2 PING and PONG (a subscribed listener), 3 PING (echo) and, without
+/// waking for it, kLaterToEcho; it sends a kLaterToPinger message before each PONG (per channel).
 [[noreturn]] void Child(const std::string& url, bool per_channel, int subscribe) {
   ::prctl(PR_SET_PDEATHSIG, SIGTERM);
   struct Ctx {
@@ -78,10 +91,13 @@ constexpr const char* kPong = ls::kChCommand;
     ls::UdpmChannels* ch = nullptr;
     bool echo = false;
   } ctx;
-  ctx.echo = subscribe == 1;
+  ctx.echo = subscribe == 1 || subscribe == 3;
+  static bool later = false;
+  later = subscribe == 3;
   auto on = [](void* c, const lcm::ReceiveBuffer* rb) {
     auto* x = static_cast<Ctx*>(c);
     if (!x->echo) return;
+    if (x->ch && later) x->ch->Publish(kLaterToPinger, rb->data, rb->data_size);
     if (x->ch) x->ch->Publish(kPong, rb->data, rb->data_size);
     else x->lcm->publish(kPong, rb->data, rb->data_size);
   };
@@ -90,6 +106,7 @@ constexpr const char* kPong = ls::kChCommand;
     ctx.ch = &ch;
     if (subscribe >= 1) ch.Subscribe(kPing, on, &ctx);
     if (subscribe == 2) ch.Subscribe(kPong, on, &ctx);
+    if (subscribe == 3) ch.Subscribe(kLaterToEcho, [](void*, const lcm::ReceiveBuffer*) {}, nullptr, ls::Wake::kLater);
     for (;;) ch.HandleTimeout(1000);
   }
   lcm::LCM lcm(url);
@@ -106,15 +123,17 @@ constexpr const char* kPong = ls::kChCommand;
 }
 
 /// CPU of one round trip [s], all processes together, with `idle` idle and `subscribed`
-/// subscribed listeners besides the echo, `round_trips` of a 160-byte payload.
-double PingPongCpu(const std::string& url, bool per_channel, int idle, int subscribed, int round_trips) {
+/// subscribed listeners besides the echo, `round_trips` of a 160-byte payload. `later` (per
+/// channel): each side also sends a message the other does not wake for before each ping / pong.
+double PingPongCpu(const std::string& url, bool per_channel, int idle, int subscribed, int round_trips,
+                   bool later = false) {
   std::vector<pid_t> kids;
   auto spawn = [&](int subscribe) {
     const pid_t pid = ::fork();
     if (pid == 0) Child(url, per_channel, subscribe);
     kids.push_back(pid);
   };
-  spawn(1);
+  spawn(later ? 3 : 1);
   for (int i = 0; i < idle; ++i) spawn(0);
   for (int i = 0; i < subscribed; ++i) spawn(2);
   std::vector<std::uint8_t> payload(160, 0x5a);
@@ -129,11 +148,15 @@ double PingPongCpu(const std::string& url, bool per_channel, int idle, int subsc
   if (per_channel) {
     ch = std::make_unique<ls::UdpmChannels>(*ls::UdpmUrl::Parse(url));
     ch->Subscribe(kPong, on, &got);
+    if (later) ch->Subscribe(kLaterToPinger, [](void*, const lcm::ReceiveBuffer*) {}, nullptr, ls::Wake::kLater);
   } else {
     lcm = std::make_unique<lcm::LCM>(url);
     lcm->subscribe(kPong, &Sub::On, &sub);
   }
-  auto publish = [&] { ch ? ch->Publish(kPing, payload.data(), 160) : lcm->publish(kPing, payload.data(), 160); };
+  auto publish = [&] {
+    if (ch && later) ch->Publish(kLaterToEcho, payload.data(), 160);
+    ch ? ch->Publish(kPing, payload.data(), 160) : lcm->publish(kPing, payload.data(), 160);
+  };
   auto handle = [&](int ms) { return ch ? ch->HandleTimeout(ms) : lcm->handleTimeout(ms); };
   // Warm up until the echo answers, and the listeners have had time to join.
   while (got == 0) {
@@ -256,13 +279,14 @@ int main(int argc, char** argv) {
   const int port = 17600 + ::getpid() % 2000 * 8;
   const std::string one = fmt::format("udpm://239.255.76.67:{}?ttl=0", port);
   const std::string per = fmt::format("udpm://239.255.76.67:{}?ttl=0&port_per_channel=1", port);
-  std::vector<double> c00, c10, c30, s_one, s_per, p00, r_one, r_per, r_memq, cpu_one, cpu_per, cpu_memq, gain;
+  std::vector<double> c00, c10, c30, s_one, s_per, p00, p_later, r_one, r_per, r_memq, cpu_one, cpu_per, cpu_memq, gain;
   for (int r = 0; r < repeat; ++r) {
     c00.push_back(PingPongCpu(one, false, 0, 0, round_trips));
     c10.push_back(PingPongCpu(one, false, 1, 0, round_trips));
     c30.push_back(PingPongCpu(one, false, 3, 0, round_trips));
     s_one.push_back(SendCpu(one, false, 4 * round_trips));
     p00.push_back(PingPongCpu(per, true, 0, 0, round_trips));
+    p_later.push_back(PingPongCpu(per, true, 0, 0, round_trips, true));
     s_per.push_back(SendCpu(per, true, 4 * round_trips));
     const Run a = LockstepRun(bin, scen, "--transport udpm", tmp / "one", steps);
     const Run b = LockstepRun(bin, scen, "--transport udpm --port-per-channel", tmp / "per", steps);
@@ -281,10 +305,10 @@ int main(int argc, char** argv) {
   const double s = Median(s_one);
   const double h = (C00 - 2 * s - 2 * i) / 2.0;
   const double step_one = kSendsPerStep * s + kHandledPerStep * h + kIgnoredPerStepOnePort * i;
-  // Port per channel: C = 2 s' + 2 h'.
-  const double P00 = Median(p00);
-  const double sp = Median(s_per), hp = (P00 - 2 * sp) / 2.0;
-  const double step_per = kSendsPerStep * sp + kHandledPerStep * hp;
+  // Port per channel: C = 2 s' + 2 h'; C_later = C + 2 (s' + l).
+  const double P00 = Median(p00), PL = Median(p_later);
+  const double sp = Median(s_per), hp = (P00 - 2 * sp) / 2.0, lp = (PL - P00) / 2.0 - sp;
+  const double step_per = kSendsPerStep * sp + kWakingPerStep * hp + kLaterPerStep * lp;
   const double bound_one = cores / step_one, bound_per = cores / step_per;
   const double one_rate = Median(r_one), per_rate = Median(r_per), memq_rate = Median(r_memq);
   auto us = [](double x) { return x * 1e6; };
@@ -294,12 +318,15 @@ int main(int argc, char** argv) {
   std::printf("ping-pong CPU per round trip (all processes, user + system), 160-byte payload:\n");
   std::printf("  LCM, one port: no listener %6.1f us, 1 idle listener %6.1f us, 3 idle listeners %6.1f us\n", us(C00),
               us(C10), us(C30));
-  std::printf("  port per channel:          %6.1f us\n", us(P00));
-  std::printf("cost of one          send     handled delivery   ignored delivery\n");
-  std::printf("  LCM, one port      %6.1f us   %6.1f us          %6.1f us\n", us(s), us(h), us(i));
-  std::printf("  port per channel   %6.1f us   %6.1f us               -\n", us(sp), us(hp));
-  std::printf("per step: %d sends; one port %d deliveries (%d handled, %d ignored); port per channel %d\n",
-              kSendsPerStep, kSendsPerStep * kProcesses, kHandledPerStep, kIgnoredPerStepOnePort, kHandledPerStep);
+  std::printf("  port per channel:          %6.1f us, with a message each way that wakes no one %6.1f us\n", us(P00),
+              us(PL));
+  std::printf("cost of one          send     handled delivery   ignored delivery   delivery read later\n");
+  std::printf("  LCM, one port      %6.1f us   %6.1f us          %6.1f us                -\n", us(s), us(h), us(i));
+  std::printf("  port per channel   %6.1f us   %6.1f us               -          %6.1f us\n", us(sp), us(hp), us(lp));
+  std::printf("per step: %d sends; one port %d deliveries (%d handled, %d ignored); port per channel %d (%d wake "
+              "their reader, %d are read later)\n",
+              kSendsPerStep, kSendsPerStep * kProcesses, kHandledPerStep, kIgnoredPerStepOnePort, kHandledPerStep,
+              kWakingPerStep, kLaterPerStep);
   std::printf("transport CPU per step: one port %6.1f us, port per channel %6.1f us\n", us(step_one), us(step_per));
   std::printf("bound (%u cores / transport CPU per step): one port %8.0f steps/s, port per channel %8.0f steps/s\n",
               cores, bound_one, bound_per);
