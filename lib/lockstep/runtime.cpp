@@ -80,10 +80,14 @@ struct Participant::Route {
   Participant* self;
   std::string channel;
   Handler handler;
-  /// What a message of step k on this channel proves about the clock: desired_t 1 (it requested
-  /// step k), command_t / current_t 2 (they answer desired_t k: it requested step k), measured_t 3
-  /// (it follows command_t k-1: the clock requested step k-1); any other channel 0.
-  int step_evidence = 0;
+  /// What a message of step k on this channel proves about the clock.
+  enum Evidence {
+    kNothing,    ///< not a step channel
+    kRequest,    ///< desired_t: it requested step k
+    kAnswer,     ///< command_t, current_t: they answer desired_t k, so it requested step k
+    kNextState,  ///< measured_t: it follows command_t k-1, so it requested step k-1
+  };
+  Evidence step_evidence = kNothing;
   Wake wake = Wake::kOnArrival;
   void OnMessage(const lcm::ReceiveBuffer* rbuf, const std::string&) { self->Deliver(this, rbuf); }
   static void OnChannelMessage(void* route, const lcm::ReceiveBuffer* rbuf) {
@@ -110,7 +114,10 @@ Participant::~Participant() = default;
 
 void Participant::Subscribe(const char* channel, Handler handler, Wake wake) {
   const std::string_view ch(channel);
-  const int evidence = ch == kChDesired ? 1 : (ch == kChCommand || ch == kChCurrent) ? 2 : ch == kChMeasured ? 3 : 0;
+  const Route::Evidence evidence = ch == kChDesired                       ? Route::kRequest
+                                   : (ch == kChCommand || ch == kChCurrent) ? Route::kAnswer
+                                   : ch == kChMeasured                      ? Route::kNextState
+                                                                            : Route::kNothing;
   routes_.push_back(std::make_unique<Route>(Route{this, channel, std::move(handler), evidence, wake}));
   if (channels_) {
     if (!channels_->Subscribe(channel, &Route::OnChannelMessage, routes_.back().get(), wake)) {
@@ -178,7 +185,7 @@ void Participant::Deliver(Route* route, const lcm::ReceiveBuffer* rbuf) {
 void Participant::DeliverNow(Route* route, const lcm::ReceiveBuffer* rbuf) {
   if (finished_) return;
   if (follow_) last_clock_ = SteadyClock::now();  // any message counts as the feed being alive
-  if (!is_clock_ && route->step_evidence > 0) {
+  if (!is_clock_ && route->step_evidence != Route::kNothing) {
     // Only the clock publishes desired_t: it is alive, and it has sent GO (a lost GO is
     // repaired here: the first message of a step of our run starts us). A participant that
     // does not read desired_t (the plant, unless it is "ideal") learns the same from the first
@@ -186,11 +193,12 @@ void Participant::DeliverNow(Route* route, const lcm::ReceiveBuffer* rbuf) {
     std::int64_t run_id = 0, k = 0;
     if (PeekRunAndStep(static_cast<const std::uint8_t*>(rbuf->data), rbuf->data_size, &run_id, &k) &&
         run_id == id_.run_id) {
-      if (route->step_evidence == 3) --k;
-      if (route->step_evidence == 1 || k > last_clock_step_) {
+      if (route->step_evidence == Route::kNextState) --k;
+      const bool request = route->step_evidence == Route::kRequest;
+      if (request || k > last_clock_step_) {
         HeardClock(SteadyClock::now());
         last_clock_step_ = std::max(last_clock_step_, k);
-        if (route->step_evidence == 1 && !lingering_) StartRunning();
+        if (request && !lingering_) StartRunning();
       }
     }
   }

@@ -123,6 +123,8 @@ bool IsPortPerChannel(const std::string& url) {
 
 UdpmChannels::UdpmChannels(const UdpmUrl& url) : url_(url), buffers_(kBatch * kBufferBytes) {
   for (std::size_t i = 0; i < kPortChannels.size(); ++i) sockets_[i].channel = kPortChannels[i];
+  to_.sin_family = AF_INET;
+  ::inet_pton(AF_INET, url_.group.c_str(), &to_.sin_addr);  // checked by UdpmUrl::Parse
   if (!url_.port_per_channel) {
     error_ = "UdpmChannels needs a URL with port_per_channel=1";
     return;
@@ -202,9 +204,7 @@ int UdpmChannels::Publish(const char* channel, const void* data, unsigned size) 
   iovec iov[3] = {{const_cast<std::uint32_t*>(header), sizeof header},
                   {const_cast<char*>(channel), channel_len},
                   {const_cast<void*>(data), size}};
-  sockaddr_in to{};
-  to.sin_family = AF_INET;
-  ::inet_pton(AF_INET, url_.group.c_str(), &to.sin_addr);
+  sockaddr_in to = to_;
   to.sin_port = htons(static_cast<std::uint16_t>(url_.port + i));
   msghdr msg{};
   msg.msg_name = &to;

@@ -13,6 +13,8 @@
 /// The URL of such a run is the base URL with `port_per_channel=1`:
 /// `udpm://239.255.76.67:PORT?ttl=0&port_per_channel=1`. Channel i of kPortChannels travels on
 /// PORT + i; the plain LCM URL of one channel is UdpmUrl::ChannelUrl.
+#include <netinet/in.h>
+
 #include <array>
 #include <cstdint>
 #include <optional>
@@ -130,6 +132,7 @@ class UdpmChannels final : public Channels {
   static constexpr std::size_t kBufferBytes = 65536;
 
   UdpmUrl url_;
+  sockaddr_in to_{};  ///< the group at the base port (a channel's port is set per send)
   int send_fd_ = -1;
   std::uint32_t seqno_ = 0;
   std::array<Socket, kPortChannels.size()> sockets_{};

@@ -151,6 +151,16 @@ int RoleMain(std::string_view role, int argc, char** argv) {
       o.realtime_setup = lockstep::EnterRealtime(s.realtime.sched_fifo, s.realtime.priority, s.realtime.lock_memory);
       if (!o.realtime_setup.note.empty()) std::fprintf(stderr, "%s: %s\n", name.c_str(), o.realtime_setup.note.c_str());
     }
+    // Follow mode if asked, then the event loop on the participant's transport; its outcome.
+    auto run = [&](lockstep::Participant* p, auto* transport) {
+      if (follow) {
+        if (role == "integrator") throw Error("--follow", "the integrator is the clock: it cannot follow");
+        p->Follow(follow_idle_s);
+      }
+      const int rc = lockstep::RunLoop(transport, {p}, &g_stop);
+      o = OutcomeOf(*p, o);
+      if (o.exit_code == 0) o.exit_code = rc;  // e.g. the receive failed
+    };
     if (lockstep::IsPortPerChannel(url)) {
       // One UDP port per channel (lockstep/transport.h): this process receives only its channels.
       lockstep::UdpmChannels channels(*lockstep::UdpmUrl::Parse(url));
@@ -168,27 +178,14 @@ int RoleMain(std::string_view role, int argc, char** argv) {
         o.exit_code = lockstep::kExitLockstep;
         o.message = fmt::format("cannot open the channels of {}: {}{}{}", url, why, hint.empty() ? "" : "\n", hint);
       } else {
-        if (follow) {
-          if (role == "integrator") throw Error("--follow", "the integrator is the clock: it cannot follow");
-          p->Follow(follow_idle_s);
-        }
-        const int rc = lockstep::RunLoop(&channels, {p.get()}, &g_stop);
-        o = OutcomeOf(*p, o);
-        if (o.exit_code == 0) o.exit_code = rc;
+        run(p.get(), static_cast<lockstep::Channels*>(&channels));
       }
     } else if (lcm::LCM lcm(url); !lcm.good()) {
       std::string hint = lockstep::CheckMulticastRoute();
       o.exit_code = lockstep::kExitLockstep;
       o.message = fmt::format("cannot open LCM at {}{}{}", url, hint.empty() ? "" : "\n", hint);
     } else {
-      auto p = MakeParticipant(role, s, IdentityOf(s, run_id), &lcm, out_dir);
-      if (follow) {
-        if (role == "integrator") throw Error("--follow", "the integrator is the clock: it cannot follow");
-        p->Follow(follow_idle_s);
-      }
-      const int rc = lockstep::RunLoop(&lcm, {p.get()}, &g_stop);
-      o = OutcomeOf(*p, o);
-      if (o.exit_code == 0) o.exit_code = rc;  // e.g. the LCM receive failed
+      run(MakeParticipant(role, s, IdentityOf(s, run_id), &lcm, out_dir).get(), &lcm);
     }
   } catch (const Error& e) {
     o.exit_code = lockstep::kExitUsage;
