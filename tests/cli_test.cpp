@@ -54,6 +54,7 @@ TEST_CASE("every command: a usage error exits 2, --help exits 0 and shows `rths 
     std::string out;
     CHECK(RunTool(tool, "--no-such-option", &out) == 2);
     CHECK(out.find("Run with --help") != std::string::npos);
+    CHECK(out.find(std::string("rths ") + tool + ": ") != std::string::npos);  // one prefix style
     CHECK(RunTool(tool, "--help", &out) == 0);
     CHECK(out.find(std::string("rths ") + tool) != std::string::npos);
     CHECK(out.find("bin/rths-") == std::string::npos);  // not the build path

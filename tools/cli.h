@@ -15,8 +15,15 @@ namespace rths::tools {
 /// Exit code of every usage error and bad input (README).
 inline constexpr int kExitUsage = 2;
 
-/// Names `app` "rths <sub>" for its usage line and help.
-inline void NameCommand(CLI::App& app, const std::string& sub) { app.name("rths " + sub); }
+/// Names `app` "rths <sub>" for its usage line and help, and prefixes its usage errors with
+/// "rths <sub>: " like every other message of the command. Call before adding subcommands (they
+/// inherit the prefix).
+inline void NameCommand(CLI::App& app, const std::string& sub) {
+  app.name("rths " + sub);
+  app.failure_message([](const CLI::App* a, const CLI::Error& e) {
+    return a->get_name() + ": " + e.what() + "\nRun with --help for more information.\n";
+  });
+}
 
 /// Parses the command line. Returns -1 to go on, or the code to exit with: 0 after --help,
 /// kExitUsage after a usage error (message already printed).

@@ -13,6 +13,7 @@
 
 int main(int argc, char** argv) {
   CLI::App app{"rths structure: make and inspect structure files (M, K, C as text)"};
+  rths::tools::NameCommand(app, "structure");
   app.require_subcommand(1);
   std::string file, out, comment;
   std::vector<double> masses, stiffness;
@@ -27,7 +28,6 @@ int main(int argc, char** argv) {
   shear->add_option("--damping", zeta, "damping ratio in every mode")->capture_default_str();
   shear->add_option("--comment", comment, "comment written after the header");
   shear->add_option("--out", out, "file to write")->required();
-  rths::tools::NameCommand(app, "structure");
   if (const int code = rths::tools::ParseCommandLine(app, argc, argv); code >= 0) return code;
   try {
     rths::models::StructureMatrices m;
