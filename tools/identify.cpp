@@ -179,7 +179,7 @@ void PlotDamper(const std::string& png, const std::vector<DamperPlotRecord>& rec
   o << "set output '" << png << "'\n";
   o << fmt::format("set multiplot layout {},2 title 'MR damper {}: measured (blue) and fitted model (red)'\n", rows,
                    GnuplotSafe(what));
-  o << "set grid\nset key top left\n";
+  o << "set grid\nunset key\n";  // the title names the colours: a key would cover the loops
   for (std::size_t i = 0; i < rows; ++i) {
     const auto& rec = *recs[i].rec;
     const fs::path dat = dir / fmt::format("r{}.dat", i);
