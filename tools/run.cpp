@@ -598,7 +598,7 @@ int main(int argc, char** argv) {
                   static_cast<long long>(s.steps()), s.run.dt_s, transport.c_str());
       std::printf("  output           about %s: log.lcm %s, %s\n", Megabytes(sizes.total_bytes).c_str(),
                   Megabytes(sizes.log_bytes).c_str(),
-                  s.run.csv_every == 0 ? "no signals.csv (--compact)"
+                  s.run.csv_every == 0 ? "no signals.csv (run.csv_every = 0, as --compact)"
                   : s.run.csv_every == 1
                       ? fmt::format("signals.csv {} (--compact: none)", Megabytes(sizes.csv_bytes)).c_str()
                       : fmt::format("signals.csv {} (every {} steps)", Megabytes(sizes.csv_bytes), s.run.csv_every).c_str());
