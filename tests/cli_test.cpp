@@ -4,6 +4,7 @@
 // output; identify writes plots only where told.
 #include <sys/wait.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
@@ -155,6 +156,10 @@ TEST_CASE("identify writes a plot only where told") {
                   &out, cwd) == 0);
   CHECK(fs::file_size(dir / "model.png") > 10000);  // beside --out
   CHECK(fs::is_empty(cwd));
+  std::vector<std::string> names;  // the picture only: no gnuplot data or script beside it
+  for (const auto& e : fs::directory_iterator(dir)) names.push_back(e.path().filename().string());
+  std::sort(names.begin(), names.end());
+  CHECK(names == std::vector<std::string>{"cwd", "model.png", "model.toml", "run"});
 }
 
 TEST_CASE("progress: drawn with an ETA on a terminal, nothing when the output is not one") {

@@ -81,6 +81,7 @@ TEST_CASE("a plot makes a PNG, and its script carries the labels, legend and opt
   mag.log_y = true;
   Panel lag = MakePanel("", "Frequency [Hz]", "Time lag [ms]");
   lag.x_range = std::make_pair(0.0, 50.0);
+  lag.shade_x = std::make_pair(0.5, 40.0);  // a fitted band
   Series a = MakeSeries("G_FF,0.0A + LP"), b = MakeSeries("it's dashed", "black", 2);
   for (int i = 1; i <= 50; ++i) {
     a.x.push_back(i);
@@ -108,6 +109,12 @@ TEST_CASE("a plot makes a PNG, and its script carries the labels, legend and opt
   CHECK(gp.find("set logscale y") != std::string::npos);
   CHECK(gp.find("set xrange [0:50]") != std::string::npos);
   CHECK(gp.find("dt 2 lc rgb 'black'") != std::string::npos);
+  // The shaded band: on the second panel only, behind the curves; the first panel clears it.
+  const auto shade = gp.find("set object 1 rect from 0.5,graph 0 to 40,graph 1 behind");
+  REQUIRE(shade != std::string::npos);
+  CHECK(gp.find("set object 1 rect", shade + 1) == std::string::npos);
+  CHECK(gp.find("# panel 2") < shade);
+  CHECK(gp.find("unset object 1") < gp.find("# panel 2"));
 
   // The data: three curves, whitespace-separated columns, the NaN point left out.
   const std::string dat = Slurp(files.dat);

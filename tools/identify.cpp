@@ -32,6 +32,7 @@
 #include "ident/damper_fit.h"
 #include "ident/spencer_fit.h"
 #include "ident/identify.h"
+#include "io/plot.h"
 #include "io/rig_record.h"
 #include "io/utfsm.h"
 #include "signal/spectral.h"
@@ -67,19 +68,39 @@ double ModelPhase(const std::function<std::complex<double>(double)>& g, double f
   return ph;
 }
 
+/// Draws `fig` with io::Plot in a private temporary folder and puts only its PNG at `png` (the
+/// user asked for a picture, not gnuplot's data and script).
+void PlotTo(rths::io::Figure fig, const std::string& png) {
+  const fs::path dir = fs::temp_directory_path() / fmt::format("rths_identify_{}", ::getpid());
+  std::error_code ec;
+  fs::remove_all(dir, ec);
+  fs::create_directories(dir);
+  fig.name = "plot";
+  try {
+    const auto files = rths::io::Plot(fig, dir);
+    fs::copy_file(files.png, png, fs::copy_options::overwrite_existing, ec);
+    if (ec) throw Error(png, "cannot write the plot: " + ec.message());
+  } catch (...) {
+    fs::remove_all(dir, ec);
+    throw;
+  }
+  fs::remove_all(dir, ec);
+}
+
 /// Fig. 6 style: magnitude, phase [deg], time lag [ms] and coherence vs frequency 0-50 Hz, measured
-/// H1 beside the continuous fit and the ZOH-consistent fit. Private helper until lib/report has one.
+/// H1 beside the continuous fit and the ZOH-consistent fit's discrete response; the fitted band shaded.
 void PlotBode(const std::string& png, const std::string& title, const rths::ident::IdentifyResult& rc,
               const rths::ident::IdentifyResult& rz) {
+  using rths::io::MakePanel;
+  using rths::io::MakeSeries;
+  using rths::io::Series;
   const double fmax = std::min(50.0, 0.5 / rc.dt_s);
-  const fs::path dir = fs::temp_directory_path() / fmt::format("rths_identify_{}", ::getpid());
-  fs::create_directories(dir);
-  const fs::path meas = dir / "measured.dat", model = dir / "model.dat", script = dir / "plot.gp";
-  double lag_lo = 1e300, lag_hi = -1e300;  // the models' time-lag range [ms], for the lag axis
+  const double deg = 180.0 / std::numbers::pi;
+  // Measured: the excited points (fitted or not), phase unwrapped over them.
+  Series m_mag = MakeSeries("measured H1", rths::io::ReadableColors()[0]);
+  m_mag.width = 2.0;
+  Series m_ph = m_mag, m_lag = m_mag, m_coh = m_mag;
   {
-    // Measured: the excited band points (those fitted or not), phase unwrapped over them.
-    std::ofstream o(meas);
-    o << "# f_hz |H| phase_deg lag_ms coherence\n";
     double peak = 0.0;
     for (std::size_t i = 0; i < rc.s_uu.size(); ++i)
       if (rc.frf.f_hz[i] <= fmax) peak = std::max(peak, rc.s_uu[i]);
@@ -91,71 +112,64 @@ void PlotBode(const std::string& png, const std::string& title, const rths::iden
       ph = prev == 0.0 ? std::arg(h) : ph + std::arg(h / prev);
       prev = h;
       const double f = rc.frf.f_hz[i];
-      o << fmt::format("{:.6g} {:.6g} {:.6g} {:.6g} {:.6g}\n", f, std::abs(h), ph * 180.0 / std::numbers::pi,
-                       -ph / (2.0 * std::numbers::pi * f) * 1e3, rc.frf.coherence[i]);
+      for (Series* s : {&m_mag, &m_ph, &m_lag, &m_coh}) s->x.push_back(f);
+      m_mag.y.push_back(std::abs(h));
+      m_ph.y.push_back(ph * deg);
+      m_lag.y.push_back(-ph / (2.0 * std::numbers::pi * f) * 1e3);
+      m_coh.y.push_back(rc.frf.coherence[i]);
     }
   }
+  // Models on a fine grid.
+  Series c_mag = MakeSeries("Eq. 15 fit", "#000000", 2);
+  c_mag.width = 2.0;
+  Series z_mag = MakeSeries("ZOH-consistent fit", rths::io::ReadableColors()[1], 3);
+  z_mag.width = 3.5;
+  Series c_ph = c_mag, c_lag = c_mag, z_ph = z_mag, z_lag = z_mag;
+  double lag_lo = 1e300, lag_hi = -1e300;  // the models' time-lag range [ms], for the lag axis
   {
-    std::ofstream o(model);
-    o << "# f_hz |G_cont| phase_deg lag_ms |G_zoh| phase_deg lag_ms\n";
     const auto gc = [&](double f) { return rc.fit.model.Response(f); };
     const auto zoh = rths::ident::Discretise(rz.fit.model, rz.dt_s);
     const auto gz = [&](double f) { return rths::ident::ZohResponse(zoh, f); };
     for (int i = 1; i <= 500; ++i) {
       const double f = fmax * i / 500.0, w = 2.0 * std::numbers::pi * f;
       const double pc = ModelPhase(gc, f), pz = ModelPhase(gz, f);
-      lag_lo = std::min({lag_lo, -pc / w * 1e3, -pz / w * 1e3});
-      lag_hi = std::max({lag_hi, -pc / w * 1e3, -pz / w * 1e3});
-      o << fmt::format("{:.6g} {:.6g} {:.6g} {:.6g} {:.6g} {:.6g} {:.6g}\n", f, std::abs(gc(f)),
-                       pc * 180.0 / std::numbers::pi, -pc / w * 1e3, std::abs(gz(f)), pz * 180.0 / std::numbers::pi,
-                       -pz / w * 1e3);
+      for (Series* s : {&c_mag, &c_ph, &c_lag, &z_mag, &z_ph, &z_lag}) s->x.push_back(f);
+      c_mag.y.push_back(std::abs(gc(f)));
+      z_mag.y.push_back(std::abs(gz(f)));
+      c_ph.y.push_back(pc * deg);
+      z_ph.y.push_back(pz * deg);
+      c_lag.y.push_back(-pc / w * 1e3);
+      z_lag.y.push_back(-pz / w * 1e3);
+      lag_lo = std::min({lag_lo, c_lag.y.back(), z_lag.y.back()});
+      lag_hi = std::max({lag_hi, c_lag.y.back(), z_lag.y.back()});
     }
   }
-  {
-    std::ofstream o(script);
-    const std::string band = fmt::format("set object 1 rect from {},graph 0 to {},graph 1 behind fc rgb '#eeeeee' fs solid noborder\n",
-                                         rc.fitted_lo_hz, rc.fitted_hi_hz);
-    o << "set terminal pngcairo size 900,1100 font 'Sans,10'\n";
-    o << "set output '" << png << "'\n";
-    o << "set multiplot layout 4,1 title '" << title << "'\n";
-    o << fmt::format("set xrange [0:{}]\nset grid\nset key top right\nset lmargin 12\n", fmax);
-    o << band;
-    o << "set ylabel 'magnitude |G_{yu}| [mm/mm]'\n";
-    o << "plot '" << meas.string() << "' u 1:2 w l lw 2 lc rgb '#1f77b4' t 'measured (H1)', '" << model.string()
-      << "' u 1:2 w l dt 2 lw 2 lc rgb 'black' t 'fitted model (Eq. 15)', '' u 1:5 w l dt (3,5) lw 3 lc rgb '#d62728' t "
-         "'ZOH-consistent fit, discretised'\n";
-    o << "set ylabel 'phase [deg]'\n";
-    o << "plot '" << meas.string() << "' u 1:3 w l lw 2 lc rgb '#1f77b4' t 'measured (H1)', '" << model.string()
-      << "' u 1:3 w l dt 2 lw 2 lc rgb 'black' t 'fitted model', '' u 1:6 w l dt (3,5) lw 3 lc rgb '#d62728' t "
-         "'ZOH-consistent fit'\n";
-    o << fmt::format("set ylabel 'time lag -phase/{{/Symbol w}} [ms]'\nset yrange [{}:{}]\n", 0.7 * lag_lo, 1.3 * lag_hi);
-    o << "plot '" << meas.string() << "' u 1:4 w l lw 2 lc rgb '#1f77b4' t 'measured (H1)', '" << model.string()
-      << "' u 1:4 w l dt 2 lw 2 lc rgb 'black' t 'fitted model', '' u 1:7 w l dt (3,5) lw 3 lc rgb '#d62728' t "
-         "'ZOH-consistent fit'\n";
-    o << "set ylabel 'coherence {/Symbol g}^2'\nset yrange [0:1.05]\nset key bottom right\nset xlabel 'frequency [Hz]'\n";
-    o << "plot '" << meas.string() << "' u 1:5 w l lw 2 lc rgb '#1f77b4' t 'measured; shaded: fitted band'\n";
-    o << "unset multiplot\n";
+  rths::io::Figure fig;
+  fig.title = title;
+  fig.width_px = 1100;
+  fig.panel_height_px = 270;
+  auto mag = MakePanel("", "Frequency [Hz]", "Magnitude |G_yu| [mm/mm]");
+  mag.series = {m_mag, c_mag, z_mag};
+  auto pha = MakePanel("", "Frequency [Hz]", "Phase [deg]");
+  pha.series = {m_ph, c_ph, z_ph};
+  auto lag = MakePanel("", "Frequency [Hz]", "Time lag -phase/ω [ms]");
+  lag.series = {m_lag, c_lag, z_lag};
+  lag.y_range = std::make_pair(0.7 * lag_lo, 1.3 * lag_hi);
+  auto coh = MakePanel("", "Frequency [Hz]", "Coherence γ² [-]");
+  coh.series = {m_coh};
+  coh.y_range = std::make_pair(0.0, 1.05);
+  // One legend, beside the first panel; every panel the same margins so the axes line up.
+  const int right = rths::io::KeyMarginChars({&mag});
+  for (auto* p : {&mag, &pha, &lag, &coh}) {
+    p->x_range = std::make_pair(0.0, fmax);
+    p->shade_x = std::make_pair(rc.fitted_lo_hz, rc.fitted_hi_hz);
+    p->key = p == &mag ? "outside right top" : "off";
+    p->left_margin_chars = 12;
+    p->right_margin_chars = right;
   }
-  const std::string cmd = fmt::format("gnuplot '{}' 2>'{}'", script.string(), (dir / "gnuplot.err").string());
-  const int rc_sys = std::system(cmd.c_str());
-  std::string err;
-  if (rc_sys != 0) {
-    std::ifstream e(dir / "gnuplot.err");
-    std::getline(e, err);
-  }
-  fs::remove_all(dir);
-  if (rc_sys != 0)
-    throw Error(png, fmt::format("gnuplot failed ({}); is gnuplot-nox installed? {}", rc_sys, err));
-}
-
-/// Text safe for gnuplot's enhanced mode.
-std::string GnuplotSafe(const std::string& s) {
-  std::string o;
-  for (char ch : s) {
-    if (ch == '_' || ch == '^' || ch == '{' || ch == '}' || ch == '@' || ch == '&') o += '\\';
-    if (ch != '\'') o += ch;
-  }
-  return o;
+  mag.title = fmt::format("shaded: the fitted band, {:.4g}-{:.4g} Hz", rc.fitted_lo_hz, rc.fitted_hi_hz);
+  fig.panels = {mag, pha, lag, coh};
+  PlotTo(std::move(fig), png);
 }
 
 /// One record of the --damper plot: the record, whether it was fitted, the model's force [kN],
@@ -168,43 +182,40 @@ struct DamperPlotRecord {
 };
 
 /// --damper plot: per record (training, then held-out), force against velocity and against
-/// displacement, measured and model, over the record's last 60 % (the steady cycles).
+/// displacement, measured and model, over the record's last 60 % (the steady cycles). No legend
+/// over the loops: the title names the colours.
 void PlotDamper(const std::string& png, const std::vector<DamperPlotRecord>& recs, const std::string& what) {
-  const fs::path dir = fs::temp_directory_path() / fmt::format("rths_identify_damper_{}", ::getpid());
-  fs::create_directories(dir);
-  const fs::path script = dir / "plot.gp";
-  std::ofstream o(script);
-  const std::size_t rows = recs.size();
-  o << fmt::format("set terminal pngcairo size 1000,{} font 'Sans,9'\n", 60 + 260 * rows);
-  o << "set output '" << png << "'\n";
-  o << fmt::format("set multiplot layout {},2 title 'MR damper {}: measured (blue) and fitted model (red)'\n", rows,
-                   GnuplotSafe(what));
-  o << "set grid\nunset key\n";  // the title names the colours: a key would cover the loops
-  for (std::size_t i = 0; i < rows; ++i) {
-    const auto& rec = *recs[i].rec;
-    const fs::path dat = dir / fmt::format("r{}.dat", i);
-    std::ofstream d(dat);
-    for (std::size_t k = rec.size() * 2 / 5; k < rec.size(); ++k)
-      d << fmt::format("{:.6g} {:.6g} {:.6g} {:.6g}\n", rec.y_mm[k], recs[i].v_mm_s[k], rec.f_kN[k], recs[i].F_kN[k]);
-    const std::string name = GnuplotSafe(fs::path(rec.source).filename().string());
-    const std::string title = fmt::format("{} ({}, Eq. 31 on f {:.1f} %)", name, recs[i].fitted ? "fitted" : "held out",
-                                          recs[i].nrmse_f_pct);
-    o << fmt::format("set title '{}'\nset xlabel 'velocity [mm/s]'\nset ylabel 'force [kN]'\n", title);
-    o << "plot '" << dat.string() << "' u 2:3 w l lw 1.5 lc rgb '#1f77b4' t 'measured', '' u 2:4 w l lw 1.5 lc rgb '#d62728' t 'model'\n";
-    o << "set xlabel 'displacement [mm]'\n";
-    o << "plot '" << dat.string() << "' u 1:3 w l lw 1.5 lc rgb '#1f77b4' t 'measured', '' u 1:4 w l lw 1.5 lc rgb '#d62728' t 'model'\n";
+  const std::string measured_color = rths::io::ReadableColors()[0], model_color = rths::io::ReadableColors()[1];
+  rths::io::Figure fig;
+  fig.title = fmt::format("MR damper {}: measured (blue) and fitted model (vermillion)", what);
+  fig.columns = 2;
+  fig.width_px = 1000;
+  fig.panel_height_px = 260;
+  for (const auto& r : recs) {
+    const auto& rec = *r.rec;
+    const std::string title = fmt::format("{} ({}, Eq. 31 on f {:.1f} %)", fs::path(rec.source).filename().string(),
+                                          r.fitted ? "fitted" : "held out", r.nrmse_f_pct);
+    auto fv = rths::io::MakePanel(title, "Velocity [mm/s]", "Force [kN]");
+    auto fx = rths::io::MakePanel(title, "Displacement [mm]", "Force [kN]");
+    rths::io::Series mv = rths::io::MakeSeries("", measured_color), pv = rths::io::MakeSeries("", model_color);
+    rths::io::Series mx = mv, px = pv;
+    for (std::size_t k = rec.size() * 2 / 5; k < rec.size(); ++k) {
+      mv.x.push_back(r.v_mm_s[k]);
+      mv.y.push_back(rec.f_kN[k]);
+      pv.x.push_back(r.v_mm_s[k]);
+      pv.y.push_back(r.F_kN[k]);
+      mx.x.push_back(rec.y_mm[k]);
+      mx.y.push_back(rec.f_kN[k]);
+      px.x.push_back(rec.y_mm[k]);
+      px.y.push_back(r.F_kN[k]);
+    }
+    fv.series = {mv, pv};
+    fx.series = {mx, px};
+    fv.key = fx.key = "off";
+    fig.panels.push_back(std::move(fv));
+    fig.panels.push_back(std::move(fx));
   }
-  o << "unset multiplot\n";
-  o.close();
-  const std::string cmd = fmt::format("gnuplot '{}' 2>'{}'", script.string(), (dir / "gnuplot.err").string());
-  const int rc = std::system(cmd.c_str());
-  std::string err;
-  if (rc != 0) {
-    std::ifstream e(dir / "gnuplot.err");
-    std::getline(e, err);
-  }
-  fs::remove_all(dir);
-  if (rc != 0) throw Error(png, fmt::format("gnuplot failed ({}); is gnuplot-nox installed? {}", rc, err));
+  PlotTo(std::move(fig), png);
 }
 
 /// Options of the --damper mode beyond the fits' own.
@@ -448,18 +459,11 @@ int main(int argc, char** argv) {
       std::printf("(no plot: give --plot FILE.png or --out FILE.toml for a Bode plot beside it)\n");
       return 0;
     }
-    std::string name;  // enhanced-text safe
     const fs::path rp(record);
     const std::string shown = rp.filename() == "log.lcm" && !rp.parent_path().filename().empty()
                                   ? (rp.parent_path().filename() / rp.filename()).string()
                                   : rp.filename().string();
-    for (char ch : shown) {
-      if (ch == '_' || ch == '^' || ch == '{' || ch == '}' || ch == '@' || ch == '&') name += '\\';
-      if (ch != '\'') name += ch;
-    }
-    PlotBode(plot, fmt::format("G_{{yu}}: {} (fitted {:.4g}-{:.4g} Hz, {} poles)", name,
-                               rc.fitted_lo_hz, rc.fitted_hi_hz, poles),
-             rc, rz);
+    PlotBode(plot, fmt::format("G_yu: {} ({} poles; measured H1, fitted models)", shown, poles), rc, rz);
     std::printf("wrote %s\n", plot.c_str());
   } catch (const std::exception& e) {
     std::fprintf(stderr, "rths identify: %s\n", e.what());

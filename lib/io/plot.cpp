@@ -272,6 +272,11 @@ PlotFiles Plot(const Figure& fig, const fs::path& dir) {
       gp << ")\n";
     }
     gp << fmt::format("set boxwidth {} absolute\nset style fill solid 0.85 border -1\n", Num(panel.box_width));
+    gp << "unset object 1\n";
+    if (panel.shade_x) {
+      gp << fmt::format("set object 1 rect from {},graph 0 to {},graph 1 behind fc rgb '#ebebeb' fs solid 1.0 noborder\n",
+                        Num(panel.shade_x->first), Num(panel.shade_x->second));
+    }
     gp << "set key default\n";  // nothing of the previous panel's key (outside, width) carries over
     if (panel.key == "off") {
       gp << "set key off\n";

@@ -47,6 +47,9 @@ struct Panel {
   /// Labelled x ticks (x, label), e.g. categories of a bar chart; empty = numeric ticks.
   std::vector<std::pair<double, std::string>> x_tics;
   double box_width = 0.8;                          ///< width of "boxes" bars [x units]
+  /// An x interval [x units] shaded light grey behind the data over the panel's height (a fitted
+  /// band, say); unset = none.
+  std::optional<std::pair<double, double>> shade_x;
 };
 
 struct Figure {
