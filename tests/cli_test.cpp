@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cstdlib>
 #include <fstream>
+#include <iterator>
 #include <sstream>
 #include <string>
 
@@ -119,7 +120,7 @@ TEST_CASE("rths run --set and --compact: the scenario that ran is in the folder;
                            &out);
   INFO(out);
   REQUIRE(code == 0);
-  CHECK(out.find("output           about") != std::string::npos);  // the size, said up front
+  CHECK(out.find("output           0.") != std::string::npos);  // the size, said up front (exact: no CSV)
   CHECK(out.find("no signals.csv") != std::string::npos);
   CHECK_FALSE(fs::exists(dir / "run" / "signals.csv"));
   const auto log = rths::io::ReadRunLog((dir / "run" / "log.lcm").string());
@@ -168,8 +169,9 @@ TEST_CASE("progress: drawn with an ETA on a terminal, nothing when the output is
   CHECK(rths::ProgressLine::FormatSeconds(185) == "3 min 05 s");
   CHECK(rths::ProgressLine::FormatSeconds(3725) == "1 h 02 min");
   const fs::path dir = TempDir("cli_progress");
+  // 60000 steps: at memq's 90k steps/s still over half a second, a few redraws.
   const std::string run = std::string(RTHS_BIN_DIR) + "/rths-run " + Scenario("default.toml") +
-                          " --transport memq --skip-space-check --compact --set run.duration_s=10 --out ";
+                          " --transport memq --skip-space-check --compact --set run.duration_s=30 --out ";
   std::string out;
   REQUIRE(RunTool("run", Scenario("default.toml") + " --transport memq --skip-space-check --compact --set run.duration_s=10 --out " +
                              (dir / "pipe").string(),
@@ -188,6 +190,55 @@ TEST_CASE("progress: drawn with an ETA on a terminal, nothing when the output is
   ss << in.rdbuf();
   const std::string tty = ss.str();
   CHECK(tty.find("\r\033[Krths run ") != std::string::npos);
-  CHECK(tty.find(" of 20000") != std::string::npos);
+  CHECK(tty.find(" of 60000") != std::string::npos);
   CHECK(tty.find("tracking error") != std::string::npos);  // the summary after it, on a clean line
+}
+
+TEST_CASE("no output replaces what a run recorded or the file being read") {
+  const fs::path dir = TempDir("cli_guard");
+  const fs::path run = dir / "run";
+  std::string out;
+  REQUIRE(RunTool("run", Scenario("default.toml") + " --transport memq --skip-space-check --set run.duration_s=2.5 --out " +
+                             run.string(),
+                  &out) == 0);
+  const auto digest = [&] {
+    std::string d;
+    for (const char* f : {"log.lcm", "scenario.toml", "summary.json", "signals.csv"}) {
+      std::ifstream in(run / f, std::ios::binary);
+      d += std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    }
+    return d;
+  };
+  const std::string before = digest();
+  const std::string log = (run / "log.lcm").string();
+  struct Case {
+    const char* tool;
+    std::string args, says;
+  };
+  const std::vector<Case> cases = {
+      {"log", "dump " + log + " --csv " + log, "is the input"},
+      {"log", "dump " + log + " --csv " + (run / "." / "log.lcm").string(), "is the input"},
+      {"export", run.string() + " --csv " + log, "is the input"},
+      {"export", run.string() + " --mat " + (run / "scenario.toml").string(), "is the input"},
+      {"export", run.string() + " --csv " + (run / "signals.csv").string(), "would replace the signals.csv"},
+      {"export", run.string() + " --mat " + (dir / "x.csv").string(), "did you mean --csv?"},
+      {"export", run.string() + " --csv " + (dir / "x.mat").string(), "did you mean --mat?"},
+      {"record", run.string() + " --out " + log, "is the input"},
+      {"identify", log + " --out " + (run / "scenario.toml").string(), "would replace the scenario.toml"},
+      {"identify", log + " --plot " + (run / "summary.json").string(), "would replace the summary.json"},
+      {"utfsm-convert", log + " --out " + log, "is the input"},
+      {"diagnose", "--train a.csv --test b.csv --out " + run.string(), "output folder exists and is not empty"},
+      {"run", Scenario("default.toml") + " --transport memq --out " + log, "is a file, not a folder"},
+      {"run", run.string() + " --transport memq", "is a folder, not a scenario file"},
+  };
+  for (const auto& c : cases) {
+    CAPTURE(c.tool);
+    CAPTURE(c.args);
+    CHECK(RunTool(c.tool, c.args, &out) == 2);
+    CHECK(out.find(c.says) != std::string::npos);
+    CHECK(out.find(std::string("rths ") + c.tool + ": ") != std::string::npos);
+  }
+  CHECK(digest() == before);  // every recorded byte is still there
+  CHECK_FALSE(fs::exists(dir / "x.csv"));
+  CHECK_FALSE(fs::exists(dir / "x.mat"));
 }

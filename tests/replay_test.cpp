@@ -5,6 +5,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <sstream>
 #include <string>
 
@@ -154,6 +155,20 @@ TEST_CASE("rths replay: bad input is refused before anything runs") {
   CHECK(Replay(rec.string() + " --live pump --out " + (dir / "a").string(), &out) == 2);
   CHECK(out.find("integrator, controller, plant, semiactive") != std::string::npos);
   CHECK(Replay(rec.string() + " --live logger --out " + (dir / "b").string(), &out) == 2);
+  CHECK(out.find("always runs its own logger") != std::string::npos);
+  {  // a scenario at another step: the step-by-step comparison would be meaningless
+    std::ifstream in(rec / "scenario.toml");
+    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const auto at = text.find("[run]\n");  // the recording ran at the default 0.0005 s
+    REQUIRE(at != std::string::npos);
+    text.insert(at + 6, "dt_s = 0.001\n");
+    std::ofstream(dir / "dt.toml") << text;
+    CHECK(Replay(rec.string() + " --live plant --scenario " + (dir / "dt.toml").string() + " --out " +
+                     (dir / "e").string(),
+                 &out) == 2);
+    CHECK(out.find("but the recording ran at 0.0005 s") != std::string::npos);
+    CHECK(!fs::exists(dir / "e"));
+  }
   CHECK(Replay((dir / "nothing").string() + " --live plant --out " + (dir / "c").string(), &out) == 2);
   CHECK(out.find("log.lcm") != std::string::npos);
   CHECK(Replay(rec.string() + " --live plant --steps 5000 --out " + (dir / "d").string(), &out) == 2);

@@ -52,6 +52,7 @@ int main(int argc, char** argv) {
   rths::diagnosis::NominalModel model;
   const auto axis = time_from_header ? rths::io::TimeAxis::kHeader : rths::io::TimeAxis::kColumn;
   try {
+    if (!out.empty()) rths::io::RequireNewOrEmptyFolder(out, "an earlier diagnosis or a run");
     for (const auto& p : train) tr.push_back(rths::io::ReadRecordAny(p, axis));
     for (const auto& p : test) te.push_back(rths::io::ReadRecordAny(p, axis));
     model = model_file.empty() ? rths::diagnosis::PaperModel() : rths::diagnosis::LoadModel(model_file);

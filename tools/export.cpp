@@ -17,6 +17,7 @@
 #include "cli.h"
 #include "core/error.h"
 #include "io/mat_export.h"
+#include "io/output_folder.h"
 #include "io/run_log.h"
 #include "io/run_signals.h"
 #include "scenario/scenario.h"
@@ -53,8 +54,7 @@ std::string ReadText(const fs::path& p) {
 
 /// The step of the run: a handshake's dt_s (what ran), else the run's scenario.toml.
 double StepOfRun(const rths::io::RunLog& log, const fs::path& scenario) {
-  for (const auto& h : log.handshakes)
-    if (h.dt_s > 0.0) return h.dt_s;
+  if (const double dt_s = log.StepS(); dt_s > 0.0) return dt_s;
   if (!fs::exists(scenario))
     throw rths::Error(log.source, fmt::format("no handshake says the step dt and there is no {}", scenario.string()));
   return rths::scenario::LoadScenario(scenario.string()).run.dt_s;
@@ -107,13 +107,20 @@ int main(int argc, char** argv) {
       throw rths::Error(run_dir, "no log.lcm in this folder (a run folder of rths run holds log.lcm, "
                                  "scenario.toml, signals.csv and summary.json)");
     if (mat_path.empty() && csv_path.empty()) mat_path = (dir / "export.mat").string();
+    const fs::path scenario_path = dir / "scenario.toml";
+    // Nothing the run recorded is replaced, and the two options are not swapped by mistake.
+    if (!mat_path.empty()) rths::io::RefuseToReplaceRecord(mat_path, {log_path, scenario_path}, "--mat");
+    if (!csv_path.empty()) rths::io::RefuseToReplaceRecord(csv_path, {log_path, scenario_path, mat_path}, "--csv");
+    if (fs::path(mat_path).extension() == ".csv")
+      throw rths::Error("--mat " + mat_path, "a MATLAB file named .csv: did you mean --csv? (--mat FILE.mat)");
+    if (fs::path(csv_path).extension() == ".mat")
+      throw rths::Error("--csv " + csv_path, "a CSV file named .mat: did you mean --mat? (--csv FILE.csv)");
 
     const auto log = rths::io::ReadRunLog(log_path.string());
     const std::int64_t steps = log.CompleteSteps();
     if (steps <= 0)
       throw rths::Error(log_path.string(), fmt::format("no complete step to export ({})",
                                                        log.Complete() ? "empty run" : log.TruncationReason()));
-    const fs::path scenario_path = dir / "scenario.toml";
     const auto signals = rths::io::SignalsFromRunLog(log, StepOfRun(log, scenario_path));
 
     rths::io::ExportMeta meta;

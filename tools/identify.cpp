@@ -32,6 +32,7 @@
 #include "ident/damper_fit.h"
 #include "ident/spencer_fit.h"
 #include "ident/identify.h"
+#include "io/output_folder.h"
 #include "io/plot.h"
 #include "io/rig_record.h"
 #include "io/utfsm.h"
@@ -387,6 +388,12 @@ int main(int argc, char** argv) {
   if (const int code = rths::tools::ParseCommandLine(app, argc, argv); code >= 0) return code;
 
   try {
+    {  // no output replaces a record being read, or what a run recorded (the scenario that ran, say)
+      std::vector<fs::path> inputs(records.begin(), records.end());
+      inputs.insert(inputs.end(), checks.begin(), checks.end());
+      if (!out.empty()) rths::io::RefuseToReplaceRecord(out, inputs, "--out");
+      if (!plot.empty()) rths::io::RefuseToReplaceRecord(plot, inputs, "--plot");
+    }
     if (damper) {
       dc.records = records;
       dc.checks = checks;

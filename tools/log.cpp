@@ -24,6 +24,7 @@
 #include "io/csv.h"
 #include "io/event_log.h"
 #include "io/log_compare.h"
+#include "io/output_folder.h"
 #include "io/run_log.h"
 #include "lockstep/runtime.h"
 
@@ -253,6 +254,7 @@ int main(int argc, char** argv) {
   try {
     if (*dump) {
       const std::string channel = dump_channel.empty() ? "" : DumpChannelName(dump_channel);
+      if (!dump_csv.empty()) rths::io::RefuseToReplaceRecord(dump_csv, {files[0]}, "--csv");
       const auto log = rths::io::ReadRunLog(files[0]);
       std::FILE* out = stdout;
       std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(nullptr, std::fclose);

@@ -12,6 +12,7 @@
 #include <CLI/CLI.hpp>
 
 #include "cli.h"
+#include "io/output_folder.h"
 #include "io/rig_record.h"
 #include "io/run_log.h"
 
@@ -37,6 +38,8 @@ int main(int argc, char** argv) {
     return 2;
   }
   try {
+    if (out.empty()) out = (fs::path(run_dir) / "record.csv").string();
+    rths::io::RefuseToReplaceRecord(out, {log_path}, "--out");
     const rths::io::RunLog log = rths::io::ReadRunLog(log_path.string());
     rths::io::RigRecord rec = rths::io::RigRecordFromRunLog(log, log_path.string());
     rec.metadata.emplace_back("producer", "rths record");
@@ -45,7 +48,6 @@ int main(int argc, char** argv) {
       if (c == '\n' || c == '\r') c = ' ';  // one metadata line
     }
     if (!reason.empty()) rec.metadata.emplace_back("run_stopped", reason);
-    if (out.empty()) out = (fs::path(run_dir) / "record.csv").string();
     rths::io::WriteRigRecord(rec, out);
     std::printf("%s: %zu samples at dt = %g s (%.3f s) -> %s\n", run_dir.c_str(), rec.size(), rec.dt_s,
                 rec.DurationS(), out.c_str());

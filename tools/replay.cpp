@@ -79,7 +79,11 @@ int main(int argc, char** argv) {
   try {
     std::stringstream ss(live_arg);
     for (std::string role; std::getline(ss, role, ',');) {
-      if (role.empty() || role == "logger") continue;
+      if (role.empty()) continue;
+      if (role == "logger") {
+        throw rths::Error("--live", "logger: the replay always runs its own logger (it records the replay); name "
+                                    "integrator, controller, plant or semiactive");
+      }
       rths::participants::AnswerChannelOf(role);  // throws naming the allowed roles
       if (std::find(live.begin(), live.end(), role) == live.end()) live.push_back(role);
     }
@@ -103,6 +107,11 @@ int main(int argc, char** argv) {
                                                                           "relative path, give the original with --scenario)"
                                                                         : ""));
     }
+    if (const double dt_log = record.StepS(); dt_log > 0.0 && s.run.dt_s != dt_log) {
+      throw rths::Error(scenario_path, fmt::format("run.dt_s = {} s, but the recording ran at {} s: a replay compares "
+                                                   "step by step, so the step must be the recording's",
+                                                   s.run.dt_s, dt_log));
+    }
     recorded_sha = RecordedSha(record);
     steps = std::min(complete, s.steps());
     if (steps_arg > 0) {
@@ -118,9 +127,7 @@ int main(int argc, char** argv) {
                    static_cast<long long>(s.steps()), static_cast<long long>(complete), static_cast<long long>(steps));
     }
     out = out_arg.empty() ? rths::io::NewOutputFolder("replay-" + s.run.name) : fs::path(out_arg);
-    if (fs::exists(out) && !fs::is_empty(out)) {
-      throw rths::Error(out.string(), "output folder exists and is not empty; refusing to overwrite (choose another --out)");
-    }
+    rths::io::RequireNewOrEmptyFolder(out, "a previous replay or run");
     fs::create_directories(out);
     fs::copy_file(scenario_path, out / "scenario.toml");
   } catch (const std::exception& e) {

@@ -15,6 +15,7 @@
 
 #include "cli.h"
 #include "core/error.h"
+#include "io/output_folder.h"
 #include "io/rig_record.h"
 #include "io/utfsm.h"
 
@@ -31,12 +32,11 @@ int main(int argc, char** argv) {
   rths::tools::NameCommand(app, "utfsm-convert");
   if (const int code = rths::tools::ParseCommandLine(app, argc, argv); code >= 0) return code;
   try {
+    if (out.empty()) out = std::filesystem::path(input).filename().replace_extension(".csv").string();
+    rths::io::RefuseToReplaceRecord(out, {input}, "--out");
     auto rec = rths::io::ReadRecordOrUtfsm(input);
     if (from_s != 0.0 || to_s != std::numeric_limits<double>::infinity())
       rec = rths::io::CutRigRecord(rec, from_s, to_s);
-    if (out.empty()) out = std::filesystem::path(input).filename().replace_extension(".csv").string();
-    if (std::filesystem::exists(out) && std::filesystem::equivalent(out, input))
-      throw rths::Error(out, "the output would overwrite the input; give another --out");
     rths::io::WriteRigRecord(rec, out);
     std::printf("%s: %zu samples at dt = %g s (%.3f s) -> %s\n", input.c_str(), rec.size(), rec.dt_s,
                 rec.DurationS(), out.c_str());

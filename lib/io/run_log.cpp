@@ -227,6 +227,13 @@ RunLog Read(EventLogReader& reader) {
 
 }  // namespace
 
+double RunLog::StepS() const {
+  for (const auto& h : handshakes) {
+    if (h.dt_s > 0.0 && std::isfinite(h.dt_s)) return h.dt_s;
+  }
+  return 0.0;
+}
+
 std::int64_t RunLog::CompleteSteps() const {
   const std::size_t n = std::min({desired.size(), command.size(), measured.size(), current.size()});
   std::size_t k = 0;

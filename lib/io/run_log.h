@@ -57,6 +57,9 @@ struct RunLog {
 
   /// Steps 0..n-1 for which every per-step channel has its message.
   std::int64_t CompleteSteps() const;
+  /// The step of the lockstep clock [s] the handshakes carry (the first positive, finite dt_s);
+  /// 0 if no handshake says.
+  double StepS() const;
   /// The ABORT reason in the log ("" if none).
   std::string AbortReason() const;
   /// True if the run finished and its log is whole: DONE is in it and no event is cut short.

@@ -145,11 +145,16 @@ bool ClockParticipant::AccountStep(SteadyClock::time_point now) {
     rt_.max_consecutive_misses = std::max(rt_.max_consecutive_misses, ++consecutive_misses_);
     const std::int64_t limit = timing_.pacing.max_consecutive_misses;
     if (limit > 0 && consecutive_misses_ >= limit) {
+      // Where the time went: a step issued late (the host woke the clock late, or the previous
+      // step ran over) misses its deadline however fast it runs.
+      const double late_ms = 1e3 * Seconds(ReleaseOf(k_ + 1), now);
+      const double issued_late_ms = 1e3 * std::max(0.0, Seconds(ReleaseOf(k_), step_since_));
       Fail(kExitRealtime,
-           fmt::format("step {}: {} consecutive deadline misses (realtime.max_consecutive_misses = {}): this step "
-                       "took {:.3g} ms for a {:.3g} ms period; {} of {} steps missed so far",
-                       k_, consecutive_misses_, limit, 1e3 * Seconds(step_since_, now), 1e3 * rt_.period_s,
-                       rt_.misses, rt_.steps),
+           fmt::format("step {}: {} consecutive deadline misses (realtime.max_consecutive_misses = {}): the step ended "
+                       "{:.3g} ms after its deadline; it was issued {:.3g} ms after its release and took {:.3g} ms "
+                       "(period {:.3g} ms); {} of {} steps missed so far",
+                       k_, consecutive_misses_, limit, late_ms, issued_late_ms, 1e3 * Seconds(step_since_, now),
+                       1e3 * rt_.period_s, rt_.misses, rt_.steps),
            true, k_);
       return false;
     }

@@ -113,9 +113,14 @@ void Preflight(std::vector<RunSpec>* specs, const std::vector<std::string>& over
     sum.log += b.log;
     sum.csv += b.csv;
   }
-  log(fmt::format("{} runs will write about {:.0f} MB: log.lcm {:.0f} MB, signals.csv {}", specs->size(),
-                  sum.total() / 1e6, sum.log / 1e6,
-                  sum.csv > 0 ? fmt::format("{:.0f} MB (--compact: none)", sum.csv / 1e6) : std::string("none")));
+  // log.lcm's size is exact, the CSV's a bound (a row's length depends on its numbers).
+  if (sum.csv > 0) {
+    log(fmt::format("{} runs will write at most {:.0f} MB: log.lcm {:.0f} MB, signals.csv up to {:.0f} MB (--compact: "
+                    "none)",
+                    specs->size(), sum.total() / 1e6, sum.log / 1e6, sum.csv / 1e6));
+  } else {
+    log(fmt::format("{} runs will write {:.0f} MB: log.lcm, no signals.csv", specs->size(), sum.log / 1e6));
+  }
 }
 
 namespace {

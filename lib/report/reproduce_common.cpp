@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include "core/error.h"
+#include "io/output_folder.h"
 #include "report/reproduce.h"
 
 namespace rths::report {
@@ -14,15 +15,7 @@ namespace rths::report {
 namespace fs = std::filesystem;
 
 void PrepareOutDir(const fs::path& dir) {
-  if (dir.empty()) throw Error("--out", "empty output folder name");
-  if (fs::exists(dir)) {
-    if (!fs::is_directory(dir)) throw Error(dir.string(), "exists and is not a folder");
-    if (!fs::is_empty(dir)) {
-      throw Error(dir.string(), "output folder exists and is not empty; refusing to overwrite an "
-                                "earlier reproduction (choose another --out)");
-    }
-    return;
-  }
+  io::RequireNewOrEmptyFolder(dir, "an earlier reproduction");
   fs::create_directories(dir);
 }
 

@@ -806,13 +806,7 @@ RunData LoadRunData(const fs::path& run_dir) {
   }
 
   const io::RunLog log = io::ReadRunLog(log_path.string());
-  double dt_s = 0.0;
-  for (const auto& h : log.handshakes) {
-    if (h.dt_s > 0.0 && std::isfinite(h.dt_s)) {
-      dt_s = h.dt_s;
-      break;
-    }
-  }
+  double dt_s = log.StepS();
   if (dt_s <= 0.0 && d.scenario) dt_s = d.scenario->run.dt_s;
   if (!(dt_s > 0.0))
     throw Error(log_path.string(), "no step size: no handshake in the log carries dt_s and scenario.toml does not load");

@@ -871,6 +871,10 @@ void ValidateStructure(const StructureConfig& st, const std::string& scenario_pa
     CheckFileExists(check, "structure.file", scenario_path, st.file);
     check.InRange("structure.actuator_dof", st.actuator_dof,
                   {1, 10000, false, false, "1-based; at most the structure's number of DOFs"});
+  } else if (st.mode == models::StructureMode::kRths && st.actuator_dof != 1) {
+    check.Fail("structure.actuator_dof", fmt::format("{}: an SDOF structure has one DOF (only kind = \"file\" takes "
+                                                     "another)",
+                                                     st.actuator_dof));
   }
   if (!st.reference_file.empty()) ValidateReferenceFile(st, scenario_path, check);
   ValidateSignal(st.ground, "structure.ground", scenario_path, check);
@@ -1000,11 +1004,32 @@ std::string ToToml(const Scenario& s) {
   return "# Written by rths (scenario::ToToml): every key, explicit.\n" + writer.Text();
 }
 
-Scenario LoadScenario(const std::string& path) {
+namespace {
+
+/// The bytes of a scenario file. Throws rths::Error naming `path` if it is a folder (a run folder
+/// given by mistake, say) or cannot be read.
+std::string ReadScenarioFile(const std::string& path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) {
+    throw Error(path, "is a folder, not a scenario file (give a .toml file, e.g. scenarios/default.toml; a run "
+                      "folder's scenario is RUN_DIR/scenario.toml)");
+  }
   std::ifstream in(path, std::ios::binary);
   if (!in) throw Error(path, "cannot open scenario file");
-  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::string bytes;
+  try {
+    bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  } catch (const std::exception& e) {
+    throw Error(path, std::string("cannot read scenario file: ") + e.what());
+  }
   if (in.bad()) throw Error(path, "cannot read scenario file");
+  return bytes;
+}
+
+}  // namespace
+
+Scenario LoadScenario(const std::string& path) {
+  const std::string bytes = ReadScenarioFile(path);
   Scenario s = ParseScenario(bytes, path);
   s.sha256 = Sha256Hex(bytes);
   return s;
@@ -1098,10 +1123,7 @@ std::string ApplyOverrides(std::string_view toml_text, const std::vector<std::st
 
 Scenario LoadScenario(const std::string& path, const std::vector<std::string>& sets) {
   if (sets.empty()) return LoadScenario(path);
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error(path, "cannot open scenario file");
-  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (in.bad()) throw Error(path, "cannot read scenario file");
+  const std::string bytes = ReadScenarioFile(path);
   const std::string text = ApplyOverrides(bytes, sets, path);
   try {
     Scenario s = ParseScenario(text, path);
