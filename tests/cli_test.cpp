@@ -103,6 +103,14 @@ TEST_CASE("--set is checked like the file and names itself in the error") {
   CHECK(out.find("(set by --set run.dt_s=-1)") != std::string::npos);
   CHECK(RunTool("design", Scenario("default.toml") + " --set controller.kindd=ff", &out) == 2);
   CHECK(out.find("unknown key") != std::string::npos);
+  CHECK(out.find("(set by --set controller.kindd=ff)") != std::string::npos);
+  CHECK(RunTool("design", Scenario("default.toml") + " --set foo.bar=1", &out) == 2);  // an unknown table
+  CHECK(out.find("foo: unknown table") != std::string::npos);
+  CHECK(out.find("(set by --set foo.bar=1)") != std::string::npos);
+  CHECK(RunTool("design", Scenario("default.toml") + " --set faults.drop=0.2 --set faults.delay=0.2 --set faults.reorder=0.2",
+                &out) == 2);  // a sum over keys: every --set of the table
+  CHECK(out.find("= 0.6: the sum must not exceed 0.5") != std::string::npos);
+  CHECK(out.find("(set by --set faults.drop=0.2, --set faults.delay=0.2, --set faults.reorder=0.2)") != std::string::npos);
   // reproduce: checked on every run of the study before any runs, naming the run.
   const fs::path dir = TempDir("cli_reproduce_set");
   CHECK(RunTool("reproduce", "fig7 --quick --plant linear --set run.dt_s=0.3 --out " + (dir / "f7").string(), &out) == 2);

@@ -226,7 +226,8 @@ TEST_CASE("out-of-range values name the key, the value and the range") {
   CheckContains(ErrorOf("[lockstep]\ntimeout_ms = 250\n"), {"lockstep.timeout_ms: was renamed lockstep.rerequest_ms"});
   CheckContains(ErrorOf("[lockstep]\nmax_attempts = 8\n"), {"lockstep.max_attempts: was replaced by lockstep.stall_budget_s"});
   CheckContains(ErrorOf("[faults]\ndrop = 0.6\n"), {"faults.drop: 0.6 is out of range [0, 0.5]"});
-  CheckContains(ErrorOf("[faults]\ndrop = 0.3\ndelay = 0.3\n"), {"faults.drop: 0.6 is out of range", "must not exceed 0.5"});
+  CheckContains(ErrorOf("[faults]\ndrop = 0.3\ndelay = 0.3\n"),
+                {"faults: drop + duplicate + delay + reorder = 0.3 + 0 + 0.3 + 0 = 0.6: the sum must not exceed 0.5"});
   CheckContains(ErrorOf("[faults]\nrecv_buf_bytes = 100\n"), {"faults.recv_buf_bytes: 100 is out of range [1024, 134217728]"});
   CheckContains(ErrorOf("[faults.process]\nrole = \"plant\"\nkind = \"explode\"\n"),
                 {"faults.process.kind: \"explode\" is not allowed", "\"stop\""});

@@ -908,8 +908,11 @@ void ValidatePlant(const PlantConfig& p, const Check& check) {
 }
 
 void ValidateFaults(const FaultConfig& f, const Check& check) {
-  check.InRange("faults.drop", f.drop + f.duplicate + f.delay + f.reorder,
-                {0.0, 0.5, false, false, "drop + duplicate + delay + reorder must not exceed 0.5"});
+  if (const double sum = f.drop + f.duplicate + f.delay + f.reorder; !(sum <= 0.5 + 1e-12)) {
+    check.Fail("faults", fmt::format("drop + duplicate + delay + reorder = {} + {} + {} + {} = {:.6g}: the sum must not "
+                                     "exceed 0.5 (each in [0, 0.5])",
+                                     f.drop, f.duplicate, f.delay, f.reorder, sum));
+  }
   if (f.recv_buf_bytes != 0) {
     check.InRange("faults.recv_buf_bytes", static_cast<double>(f.recv_buf_bytes),
                   {1024.0, 134217728.0, false, false, "0 for the host's default, else [1024, 2^27]"});
@@ -1060,14 +1063,27 @@ std::string Trim(std::string_view s) {
   return std::string(s.substr(b, e - b + 1));
 }
 
-/// Rethrows a validation error about a key that --set changed with the --set argument named.
+/// Rethrows a validation error about a key that --set changed with the --set argument named: the
+/// error's key (after "FILE: ") is the set key, a table holding it ("foo" for --set foo.bar=1, an
+/// unknown table), or a key inside it. A --set of exactly the error's key is named alone (the last
+/// one: it is in force); else every --set inside the table (a sum over its keys, say).
 [[noreturn]] void RethrowWithSet(const Error& e, const std::vector<std::string>& sets) {
+  const std::string& where = e.where();
+  const auto colon = where.rfind(": ");
+  const std::string wkey = colon == std::string::npos ? where : where.substr(colon + 2);
+  const auto within = [](const std::string& inner, const std::string& outer) {
+    return inner == outer || (inner.size() > outer.size() && inner.compare(0, outer.size(), outer) == 0 &&
+                              inner[outer.size()] == '.');
+  };
+  std::string exact, inside;
   for (const auto& set : sets) {
     const std::string key = Trim(std::string_view(set).substr(0, set.find('=')));
-    if (!key.empty() && e.where().find(key) != std::string::npos) {
-      throw Error(e.where(), e.problem() + " (set by --set " + set + ")");
-    }
+    if (key.empty() || wkey.empty()) continue;
+    if (key == wkey) exact = set;
+    if (within(key, wkey) || within(wkey, key)) inside += (inside.empty() ? "--set " : ", --set ") + set;
   }
+  if (!exact.empty()) throw Error(where, e.problem() + " (set by --set " + exact + ")");
+  if (!inside.empty()) throw Error(where, e.problem() + " (set by " + inside + ")");
   throw e;
 }
 
