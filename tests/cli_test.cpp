@@ -238,6 +238,9 @@ TEST_CASE("no output replaces what a run recorded or the file being read") {
       {"diagnose", "--train a.csv --test b.csv --out " + run.string(), "output folder exists and is not empty"},
       {"run", Scenario("default.toml") + " --transport memq --out " + log, "is a file, not a folder"},
       {"run", run.string() + " --transport memq", "is a folder, not a scenario file"},
+      {"report", log, "is a file, not a run folder: give the folder that holds log.lcm (here " + run.string() + ")"},
+      {"export", log, "is a file, not a run folder"},
+      {"record", log, "is a file, not a run folder"},
   };
   for (const auto& c : cases) {
     CAPTURE(c.tool);

@@ -101,11 +101,7 @@ int main(int argc, char** argv) {
   if (const int code = rths::tools::ParseCommandLine(app, argc, argv); code >= 0) return code;
   try {
     const fs::path dir(run_dir);
-    if (!fs::is_directory(dir)) throw rths::Error(run_dir, "not a folder (give a run folder with log.lcm)");
-    const fs::path log_path = dir / "log.lcm";
-    if (!fs::exists(log_path))
-      throw rths::Error(run_dir, "no log.lcm in this folder (a run folder of rths run holds log.lcm, "
-                                 "scenario.toml, signals.csv and summary.json)");
+    const fs::path log_path = rths::io::RunFolderLog(dir);
     if (mat_path.empty() && csv_path.empty()) mat_path = (dir / "export.mat").string();
     const fs::path scenario_path = dir / "scenario.toml";
     // Nothing the run recorded is replaced, and the two options are not swapped by mistake.

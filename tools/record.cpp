@@ -25,16 +25,11 @@ int main(int argc, char** argv) {
   app.add_option("--out", out, "output CSV (default: RUN_DIR/record.csv)");
   rths::tools::NameCommand(app, "record");
   if (const int code = rths::tools::ParseCommandLine(app, argc, argv); code >= 0) return code;
-  std::error_code ec;
-  if (!fs::is_directory(run_dir, ec)) {
-    std::fprintf(stderr, "rths record: %s: no such run folder (give the folder `rths run` printed, e.g. "
-                         "runs/<time>-<name>)\n", run_dir.c_str());
-    return 2;
-  }
-  const fs::path log_path = fs::path(run_dir) / "log.lcm";
-  if (!fs::is_regular_file(log_path, ec)) {
-    std::fprintf(stderr, "rths record: %s: no log.lcm in this folder (not a run folder of `rths run`?)\n",
-                 run_dir.c_str());
+  fs::path log_path;
+  try {
+    log_path = rths::io::RunFolderLog(run_dir);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "rths record: %s\n", e.what());
     return 2;
   }
   try {

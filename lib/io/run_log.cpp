@@ -227,6 +227,26 @@ RunLog Read(EventLogReader& reader) {
 
 }  // namespace
 
+std::filesystem::path RunFolderLog(const std::filesystem::path& run_dir) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const auto st = fs::status(run_dir, ec);
+  if (!fs::exists(st)) {
+    throw Error(run_dir.string(), "no such run folder (give the folder `rths run` printed, e.g. runs/<time>-<name>)");
+  }
+  if (!fs::is_directory(st)) {
+    const fs::path parent = run_dir.has_parent_path() ? run_dir.parent_path() : fs::path(".");
+    throw Error(run_dir.string(), fmt::format("is a file, not a run folder: give the folder that holds log.lcm{}",
+                                              run_dir.filename() == "log.lcm" ? " (here " + parent.string() + ")" : ""));
+  }
+  const fs::path log = run_dir / "log.lcm";
+  if (!fs::is_regular_file(log, ec)) {
+    throw Error(run_dir.string(), "no log.lcm in this folder (a run folder of `rths run` holds log.lcm, scenario.toml, "
+                                  "summary.json)");
+  }
+  return log;
+}
+
 double RunLog::StepS() const {
   for (const auto& h : handshakes) {
     if (h.dt_s > 0.0 && std::isfinite(h.dt_s)) return h.dt_s;

@@ -9,6 +9,7 @@
 /// is not an error: RunLog says whether the clock's DONE is in it (the run finished) and where a
 /// cut-short last event starts, and CompleteSteps() says up to which step it is valid.
 #include <cstdint>
+#include <filesystem>
 #include <map>
 #include <string>
 #include <vector>
@@ -85,6 +86,11 @@ struct RunMetrics {
   double steps_per_s = 0.0;
 };
 RunMetrics ComputeMetrics(const RunLog& log);
+
+/// The log.lcm of a run folder (RUN_DIR of rths run or rths replay). Throws rths::Error naming
+/// `run_dir`: it does not exist, it is a file (log.lcm itself given: "give its folder"), or it
+/// holds no log.lcm.
+std::filesystem::path RunFolderLog(const std::filesystem::path& run_dir);
 
 /// Reads `path`. Throws rths::Error (where = path, problem "byte N: ...") if it cannot be opened,
 /// is empty or not an LCM event log, or an event is corrupt: a payload that does not decode

@@ -763,12 +763,8 @@ std::vector<std::size_t> MinMaxDecimate(const std::vector<double>& x, std::size_
 }
 
 RunData LoadRunData(const fs::path& run_dir) {
+  const fs::path log_path = io::RunFolderLog(run_dir);
   std::error_code ec;
-  if (!fs::is_directory(run_dir, ec))
-    throw Error(run_dir.string(), "no such run folder (give the folder `rths run` printed, e.g. runs/<time>-<name>)");
-  const fs::path log_path = run_dir / "log.lcm";
-  if (!fs::is_regular_file(log_path, ec))
-    throw Error(run_dir.string(), "no log.lcm in this folder (not a run folder of `rths run`?)");
   RunData d;
   d.run_dir = run_dir;
 
