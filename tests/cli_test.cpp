@@ -138,6 +138,9 @@ TEST_CASE("rths run --set and --compact: the scenario that ran is in the folder;
   const auto s = rths::scenario::LoadScenario((dir / "run" / "scenario.toml").string());
   CHECK(s.run.duration_s == 0.25);
   CHECK(s.run.csv_every == 0);
+  // The CSV a compact run left out can be made where it would have been (nothing is replaced).
+  CHECK(RunTool("export", (dir / "run").string() + " --csv " + (dir / "run" / "signals.csv").string(), &out) == 0);
+  CHECK(Lines(dir / "run" / "signals.csv") == 1 + 500);
 
   // run.csv_every = 10: a row for k = 0, 10, ..., 490 after the header.
   REQUIRE(RunTool("run", Scenario("default.toml") + " --transport memq --skip-space-check --set run.duration_s=0.25 --set run.csv_every=10 --out " +

@@ -64,7 +64,8 @@ void RefuseToReplaceRecord(const fs::path& out, const std::vector<fs::path>& inp
   fs::path parent = fs::absolute(out, ec).parent_path();
   const std::string name = out.filename().string();
   const auto& recorded = RecordedRunFiles();
-  if (fs::exists(parent / "log.lcm", ec) && std::find(recorded.begin(), recorded.end(), name) != recorded.end()) {
+  if (fs::exists(parent / "log.lcm", ec) && std::find(recorded.begin(), recorded.end(), name) != recorded.end() &&
+      fs::exists(parent / name, ec)) {
     throw Error(where, fmt::format("would replace the {} of the run in {}; refusing to overwrite a run's record "
                                    "(choose another file name)",
                                    name, parent.string()));

@@ -25,9 +25,9 @@ void RequireNewOrEmptyFolder(const std::filesystem::path& dir, std::string_view 
 const std::vector<std::string>& RecordedRunFiles();
 
 /// Checks that writing the file `out` (given by `option`, e.g. "--csv") replaces neither one of
-/// `inputs` (the same file, also through another path or a link) nor a file a run recorded (one
-/// of RecordedRunFiles() in a folder that holds a log.lcm). Throws rths::Error naming `option`
-/// and `out`. An `out` that does not exist yet passes unless it names one of those.
+/// `inputs` (the same file, also through another path or a link) nor a file a run recorded (an
+/// existing one of RecordedRunFiles() in a folder that holds a log.lcm: the signals.csv a
+/// compact run left out may be made). Throws rths::Error naming `option` and `out`.
 void RefuseToReplaceRecord(const std::filesystem::path& out, const std::vector<std::filesystem::path>& inputs,
                            std::string_view option);
 
