@@ -435,7 +435,7 @@ TEST_CASE("DesignController: every kind designs, reports and serialises; ff_lqg 
   }
   const ctl::DesignSummary d = ctl::DesignController(Config("ff_lqg"), kDt);
   REQUIRE(d.plants[1].loop.has_value());
-  CHECK(d.plants[1].model.name == "avg");
+  CHECK(d.plants[1].name == "avg");
   CHECK(d.plants[1].loop->critical.phase_margin_deg == doctest::Approx(63.3).epsilon(0.001));
   CHECK_THROWS_AS(ctl::DesignController(Config("pid"), kDt), rths::Error);
 }

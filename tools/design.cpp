@@ -1,7 +1,8 @@
 // rths-design: design the controller a scenario names and print its summary (docs/controllers.md).
 //   rths design SCENARIO.toml [--out FILE.json]
-// Prints the coefficients, filter sections, LQR and Kalman gains, closed-loop poles, margins and
-// G_yr on the design model and on the 0.0 A / avg / 2.5 A models; --out writes the same as JSON.
+// Prints the coefficients, filter sections, LQR and Kalman gains, transfer functions and poles (lti),
+// closed-loop poles, margins and G_yr on the design model and on the 0.0 A / avg / 2.5 A models (or,
+// for a scenario with plant.kind = "benchmark", on its plant Gp); --out writes the same as JSON.
 // Exit codes: 0 ok, 2 bad command line, scenario or design.
 #include <cstdio>
 #include <exception>
@@ -12,6 +13,7 @@
 #include <CLI/CLI.hpp>
 
 #include "control/design.h"
+#include "models/benchmark_plant.h"
 #include "scenario/scenario.h"
 #include "cli.h"
 
@@ -26,7 +28,13 @@ int main(int argc, char** argv) {
   if (const int code = rths::tools::ParseCommandLine(app, argc, argv); code >= 0) return code;
   try {
     const rths::scenario::Scenario s = rths::scenario::LoadScenario(scenario_path, sets);
-    const rths::control::DesignSummary d = rths::control::DesignController(s.controller, s.run.dt_s);
+    std::vector<rths::control::DesignPlant> plants;
+    if (s.plant.kind == rths::models::PlantKind::kBenchmark) {
+      // Gp is m/m, i.e. mm/mm: its ZOH model is the plant u -> y as the controller sees it.
+      const auto g = rths::models::BenchmarkPlant::Make(s.plant.benchmark.params, s.run.dt_s);
+      plants.push_back({"benchmark plant Gp ([plant.benchmark])", {g.Phi, g.Gamma, g.C, 0.0, s.run.dt_s}});
+    }
+    const rths::control::DesignSummary d = rths::control::DesignController(s.controller, s.run.dt_s, plants);
     std::fputs(d.Report().c_str(), stdout);
     if (!out.empty()) {
       std::ofstream f(out);

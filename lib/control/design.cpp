@@ -51,9 +51,32 @@ nlohmann::json SosJson(const signal::Sos& sos) {
   return a;
 }
 
+std::string TfText(const DiscreteTf& h) {
+  std::string b, a;
+  for (std::size_t i = 0; i < h.b.size(); ++i) b += fmt::format("{}{:.15g}", i ? ", " : "", h.b[i]);
+  for (std::size_t i = 0; i < h.a.size(); ++i) a += fmt::format("{}{:.15g}", i ? ", " : "", h.a[i]);
+  return fmt::format("b = [{}], a = [{}]", b, a);
+}
+
+nlohmann::json LtiPartJson(const LtiPart& p) {
+  nlohmann::json poles = nlohmann::json::array();
+  for (const auto z : p.discrete.Poles()) poles.push_back({z.real(), z.imag()});
+  nlohmann::json j = {{"given", p.given},
+                      {"b", p.discrete.b},
+                      {"a", p.discrete.a},
+                      {"poles_z", poles},
+                      {"integrators", p.stability.integrators},
+                      {"unstable_poles", p.stability.unstable},
+                      {"dc_gain", p.stability.integrators > 0 ? nlohmann::json(nullptr)
+                                                              : nlohmann::json(p.discrete.Response(0.0).real())}};
+  if (p.given) j["coefficients"] = {{"num", p.coefficients.num}, {"den", p.coefficients.den}};
+  return j;
+}
+
 }  // namespace
 
-DesignSummary DesignController(const control::ControllerConfig& cfg, double dt_s) {
+DesignSummary DesignController(const control::ControllerConfig& cfg, double dt_s,
+                               const std::vector<DesignPlant>& extra) {
   const auto controller = MakeTrackingController(cfg, dt_s);
   DesignSummary s;
   s.config = cfg;
@@ -65,17 +88,27 @@ DesignSummary DesignController(const control::ControllerConfig& cfg, double dt_s
   if (const auto* p = dynamic_cast<const InverseLowpass*>(c)) s.lowpass = {p->design()};
   if (const auto* p = dynamic_cast<const BumplessInverseLowpass*>(c)) s.lowpass = {p->low(), p->high()};
   if (const auto* p = dynamic_cast<const FeedforwardLqg*>(c)) s.feedforward = p->feedforward(), s.lqg = p->design();
+  if (const auto* p = dynamic_cast<const LtiController*>(c)) s.lti = p->design();
 
-  std::vector<std::pair<models::ServoModel3, double>> models;
-  const bool uses_model = cfg.kind == control::ControllerKind::kFf || cfg.kind == control::ControllerKind::kFfLp || cfg.kind == control::ControllerKind::kFfLqg;
-  if (uses_model && cfg.model.name == "custom") models.emplace_back(cfg.model, 0.0);
-  models.emplace_back(models::ServoPreset("0.0A"), 0.0);
-  models.emplace_back(models::ServoPreset("avg"), 0.5 * cfg.current_high_A);
-  models.emplace_back(models::ServoPreset("2.5A"), cfg.current_high_A);
-  for (const auto& [model, current] : models) {
-    PlantCheck pc{model, current, {}, std::nullopt};
-    const ControllerLti lti = controller->Linearize(current);
-    const DiscreteSs g = ServoZoh(model, dt_s);
+  struct Candidate {
+    PlantCheck check;
+    DiscreteSs g;
+  };
+  std::vector<Candidate> plants;
+  auto servo = [&](const models::ServoModel3& m, double current) {
+    plants.push_back({{m.name, m, current, {}, std::nullopt}, ServoZoh(m, dt_s)});
+  };
+  const bool uses_model = cfg.kind == control::ControllerKind::kFf || cfg.kind == control::ControllerKind::kFfLp ||
+                          cfg.kind == control::ControllerKind::kFfLqg || cfg.kind == control::ControllerKind::kLti;
+  if (uses_model && cfg.model.name == "custom") servo(cfg.model, 0.0);
+  for (const DesignPlant& p : extra) plants.push_back({{p.name, std::nullopt, 0.0, {}, std::nullopt}, p.g});
+  if (extra.empty()) {
+    servo(models::ServoPreset("0.0A"), 0.0);
+    servo(models::ServoPreset("avg"), 0.5 * cfg.current_high_A);
+    servo(models::ServoPreset("2.5A"), cfg.current_high_A);
+  }
+  for (auto& [pc, g] : plants) {
+    const ControllerLti lti = controller->Linearize(pc.current_A);
     for (double f : kFrequencies) {
       pc.tracking.push_back({f, std::abs(TrackingResponse(lti, g, f)), TrackingLagS(lti, g, f) * 1e3});
     }
@@ -133,8 +166,32 @@ std::string DesignSummary::Report() const {
     o += "  estimator poles eig(Phi - Phi L C):\n";
     for (Eigen::Index i = 0; i < d.estimator_poles.size(); ++i) o += "    " + Pole(d.estimator_poles(i), dt_s) + "\n";
   }
+  if (lti) {
+    const LtiDesign& d = *lti;
+    o += fmt::format("u = C(z) (T(z) r - y), domain {}{}, coefficients in powers of z^-1 (b: numerator, a: "
+                     "denominator, a0 = 1):\n",
+                     NameOf(kTfDomainNames, d.config.domain),
+                     d.config.domain == TfDomain::kS
+                         ? fmt::format(", {} at dt = {} s", NameOf(kDiscretisationNames, d.config.discretisation), dt_s)
+                         : "");
+    for (const auto& [label, part] : {std::pair{"C (feedback)", &d.feedback}, {"T (reference)", &d.reference}}) {
+      if (!part->given) {
+        o += fmt::format("  {}: 1 (not given)\n", label);
+        continue;
+      }
+      o += fmt::format("  {}: {}\n", label, TfText(part->discrete));
+      o += fmt::format("    {} pole(s), {} integrator(s), {} unstable{}\n", part->discrete.order(),
+                       part->stability.integrators, part->stability.unstable,
+                       part->stability.integrators > 0
+                           ? ""
+                           : fmt::format(", DC gain {:.6g}", part->discrete.Response(0.0).real()));
+      for (const auto z : part->discrete.Poles()) o += "    " + Pole(z, dt_s) + "\n";
+    }
+    if (d.config.saturation_mm > 0) o += fmt::format("  output saturation |u| <= {} mm\n", d.config.saturation_mm);
+    if (d.config.rate_limit_mm_s > 0) o += fmt::format("  rate limit |du/dt| <= {} mm/s\n", d.config.rate_limit_mm_s);
+  }
   for (const PlantCheck& p : plants) {
-    o += fmt::format("on the ZOH plant {}{}:\n", ModelText(p.model),
+    o += fmt::format("on the ZOH plant {}{}:\n", p.model ? ModelText(*p.model) : p.name,
                      config.kind == control::ControllerKind::kBumplessLp ? fmt::format(" at {} A", p.current_A) : "");
     o += "  f [Hz]    |G_yr|   lag [ms]\n";
     for (const auto& t : p.tracking) o += fmt::format("  {:6.1f}  {:8.4f}  {:8.4f}\n", t.f_hz, t.magnitude, t.lag_ms);
@@ -188,8 +245,17 @@ nlohmann::json DesignSummary::ToJson() const {
                 {"regulator_poles", Complex(d.regulator_poles)},
                 {"estimator_poles", Complex(d.estimator_poles)}};
   }
+  if (lti) {
+    j["lti"] = {{"domain", NameOf(kTfDomainNames, lti->config.domain)},
+                {"discretisation", NameOf(kDiscretisationNames, lti->config.discretisation)},
+                {"feedback", LtiPartJson(lti->feedback)},
+                {"reference", LtiPartJson(lti->reference)},
+                {"saturation_mm", lti->config.saturation_mm},
+                {"rate_limit_mm_s", lti->config.rate_limit_mm_s}};
+  }
   for (const PlantCheck& p : plants) {
-    nlohmann::json pj = {{"model", ModelJson(p.model)}, {"current_A", p.current_A}};
+    nlohmann::json pj = {{"name", p.name}, {"current_A", p.current_A}};
+    if (p.model) pj["model"] = ModelJson(*p.model);
     for (const auto& t : p.tracking) {
       pj["tracking"].push_back({{"f_hz", t.f_hz}, {"magnitude", t.magnitude}, {"lag_ms", t.lag_ms}});
     }

@@ -7,6 +7,7 @@
 #include "control/baselines.h"
 #include "control/inverse_lowpass.h"
 #include "control/lqg.h"
+#include "control/lti_controller.h"
 #include "core/error.h"
 
 namespace rths::control {
@@ -70,6 +71,7 @@ std::unique_ptr<TrackingController> MakeTrackingController(const control::Contro
         cfg.current_high_A);
   }
   if (k == ControllerKind::kFfLqg) return std::make_unique<FeedforwardLqg>(cfg.model, cfg.lqg, cfg.half_step_ahead, dt_s);
+  if (k == ControllerKind::kLti) return std::make_unique<LtiController>(MakeLtiDesign(cfg.lti, dt_s));
   throw Error("controller.kind", "unknown controller");
 }
 

@@ -9,6 +9,7 @@
 /// Every kind of Table 1 (docs/controllers.md): `none`, `ff` (here), `poly3` and `lead`
 /// (baselines.h), `ff_lp` and `bumpless_lp` (inverse_lowpass.h), `ff_lqg` (lqg.h). A controller is
 /// an immutable design, computed once in its constructor, plus its per-step state.
+#include <array>
 #include <memory>
 
 #include "control/feedforward.h"
@@ -24,11 +25,18 @@ struct Measurement {
   double current_A = 0.0;  ///< effective damper current at t_k [A] (after the driver dynamics)
 };
 
-/// One step's command, split into its parts [mm].
+/// Most coefficients an adaptive controller reports per step (command_t.adapt).
+inline constexpr int kMaxAdaptive = 4;
+
+/// One step's command, split into its parts [mm], and an adaptive controller's coefficients.
 struct Command {
   double u_mm = 0.0;
   double u_ff_mm = 0.0;
   double u_fb_mm = 0.0;
+  /// Number of adaptive coefficients in use this step (0 for a fixed controller).
+  int n_adapt = 0;
+  /// The coefficients of u = sum_i adapt[i] x_t^(i) used for u_k: a_0 [-], a_1 [s], a_2 [s^2], a_3 [s^3].
+  std::array<double, kMaxAdaptive> adapt{};
 };
 
 /// A controller as linear discrete maps (for analysis; docs/controllers.md):

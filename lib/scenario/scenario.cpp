@@ -25,6 +25,7 @@
 
 #include "core/error.h"
 #include "core/names.h"
+#include "control/lti_controller.h"
 
 namespace rths::scenario {
 
@@ -210,6 +211,35 @@ class Section {
       }
     }
     *out = m;
+  }
+
+  /// A transfer function: an inline table {num = [...], den = [...]} of numbers (docs/scenarios.md).
+  /// Absent: the default (1). Each array is read as given; CheckTf judges the values.
+  void Tf(std::string_view key, control::TfCoefficients* out) {
+    const toml::node* node = Declare(key, false);
+    if (node == nullptr) return;
+    constexpr std::string_view kExpected = "a table {num = [...], den = [...]} (coefficients in descending powers)";
+    const auto* table = node->as_table();
+    if (table == nullptr) WrongType(key, kExpected, *node);
+    Section tf(file_, table, Dotted(key) + ".");
+    control::TfCoefficients c;
+    for (auto [name, field] : {std::pair{"num", &c.num}, {"den", &c.den}}) {
+      const toml::node* a = tf.Declare(name, false);
+      if (a == nullptr) continue;
+      const auto* array = a->as_array();
+      if (array == nullptr) tf.WrongType(name, "an array of numbers, e.g. [2.0, 95.0]", *a);
+      for (const toml::node& e : *array) {
+        if (const auto* f = e.as_floating_point()) {
+          field->push_back(f->get());
+        } else if (const auto* i = e.as_integer()) {
+          field->push_back(static_cast<double>(i->get()));
+        } else {
+          tf.Fail(name, fmt::format("element {} is {}: expected a number", field->size() + 1, DescribeNode(e)));
+        }
+      }
+    }
+    tf.Finish();
+    *out = std::move(c);
   }
 
   /// A sub-table (absent -> an empty section, so every key keeps its default).
@@ -416,6 +446,15 @@ void ControllerFields(V& v, ControllerConfig& c, const Context& cx) {
     t.Number("W", c.lqg.W, OpenClosed(0.0, 1e12));
     t.Number("V", c.lqg.V, OpenClosed(0.0, 1e12));
   });
+  v.Table("lti", [&](V& t) {
+    t.Tf("feedback", c.lti.feedback);
+    t.Tf("reference", c.lti.reference);
+    t.Choice("domain", c.lti.domain, control::kTfDomainNames);
+    t.Choice("discretisation", c.lti.discretisation, control::kDiscretisationNames);
+    t.Bool("allow_unstable", c.lti.allow_unstable);
+    t.Number("saturation_mm", c.lti.saturation_mm, {0.0, 1e6, false, false, "0 for no limit"});
+    t.Number("rate_limit_mm_s", c.lti.rate_limit_mm_s, {0.0, 1e9, false, false, "0 for no limit"});
+  });
 }
 
 template <typename V>
@@ -612,6 +651,7 @@ class Reader {
     v = *value;
   }
   void Servo(std::string_view key, ServoModel3& m) { section_->Servo(key, &m); }
+  void Tf(std::string_view key, control::TfCoefficients& tf) { section_->Tf(key, &tf); }
   template <typename F>
   void Table(std::string_view key, F&& fields, bool /*present*/ = true) {
     Section sub = section_->Sub(key);
@@ -712,6 +752,15 @@ class Writer {
     Key(key, TomlString(std::string(NameOf(names, v))));
   }
   void Servo(std::string_view key, ServoModel3& m) { Key(key, TomlServo(m)); }
+  void Tf(std::string_view key, control::TfCoefficients& tf) {
+    if (tf.Empty()) return;  // the default, 1
+    auto list = [](const std::vector<double>& v) {
+      std::string t = "[";
+      for (std::size_t i = 0; i < v.size(); ++i) t += (i ? ", " : "") + TomlNumber(v[i]);
+      return t + "]";
+    };
+    Key(key, fmt::format("{{ num = {}, den = {} }}", list(tf.num), list(tf.den)));
+  }
   template <typename F>
   void Table(std::string_view key, F&& fields, bool present = true) {
     if (!present) return;
@@ -764,6 +813,7 @@ class Checker {
     }
   }
   void Servo(std::string_view key, ServoModel3& m) { ValidateServo(m, Dotted(key), *check_); }
+  void Tf(std::string_view, control::TfCoefficients&) {}  // ValidateController: CheckTf and stability
   template <typename F>
   void Table(std::string_view key, F&& fields, bool present = true) {
     if (!present) return;
@@ -835,6 +885,18 @@ void ValidateSignal(const SignalSpec& s, std::string_view prefix, const std::str
   if (s.kind == signal::SignalKind::kFile) {
     if (s.file.empty()) check.Fail(key("file"), "missing: kind = \"file\" needs a file path");
     CheckFileExists(check, key("file"), scenario_path, s.file);
+  }
+}
+
+/// The controller's design checks that span keys (an `lti` transfer function's coefficients and
+/// poles): the design is made once here, as the participant will make it, and its error is given
+/// the scenario's file name.
+void ValidateController(const ControllerConfig& c, double dt_s, const Check& check) {
+  if (c.kind != control::ControllerKind::kLti) return;
+  try {
+    control::MakeLtiDesign(c.lti, dt_s);
+  } catch (const Error& e) {
+    check.Fail(e.where(), e.problem());
   }
 }
 
@@ -957,6 +1019,7 @@ void ValidateScenario(const Scenario& s) {
       s.structure.mode != models::StructureMode::kRths) {
     check.Fail("semiactive.mode", "\"clipped_optimal\" needs a structure to control (structure.mode = \"rths\")");
   }
+  ValidateController(s.controller, s.run.dt_s, check);
   ValidatePlant(s.plant, check);
   ValidateFaults(s.faults, check);
 }
