@@ -200,7 +200,7 @@ TEST_CASE("a memq run with structure.reference_file: J1-J9 from its log, in summ
   // the numerical floors differ from the reference's. The criteria equal those of the records
   // built here by hand from the log's columns and an independent integration of the reference.
   rths::scenario::Scenario s_ref = s;
-  s_ref.structure.reference_file = kBuildings + "silva3_reference.txt";
+  s_ref.structure.reference_file = kBuildings + "silva3_reference_case1.txt";
   const rths::io::RunLog log = rths::io::ReadRunLog((dir / "log.lcm").string());
   const rths::signal::BenchmarkCriteria got = rths::io::BenchmarkCriteriaOfRun(log, s_ref);
   const rths::io::RunSignals sig = rths::io::SignalsFromRunLog(log, s.run.dt_s);
@@ -245,7 +245,7 @@ TEST_CASE("a memq run with structure.reference_file: J1-J9 from its log, in summ
 
 TEST_CASE("too few steps: the summary says why there are no criteria, the rest of it stands") {
   const fs::path dir = TempDir("benchmark_short");
-  const fs::path file = WriteScenario(dir, Scenario(kBuildings + "silva3_reference.txt", 40 * kDt));
+  const fs::path file = WriteScenario(dir, Scenario(kBuildings + "silva3_reference_case1.txt", 40 * kDt));
   const auto s = rths::scenario::LoadScenario(file.string());
   REQUIRE(RunMemq({s}, dir).code == 0);
   rths::participants::RunSummary sum;
@@ -270,7 +270,7 @@ TEST_CASE("too few steps: the summary says why there are no criteria, the rest o
 
 TEST_CASE("rths run: summary.json gets benchmark_criteria and the terminal a J1-J9 line") {
   const fs::path dir = TempDir("benchmark_cli");
-  const fs::path file = WriteScenario(dir, Scenario(kBuildings + "silva3_reference.txt", 0.5));
+  const fs::path file = WriteScenario(dir, Scenario(kBuildings + "silva3_reference_case1.txt", 0.5));
   std::string out;
   const int code = RunCli(fmt::format("{} --transport memq --out {}", file.string(), (dir / "run").string()), &out);
   CAPTURE(out);
@@ -285,7 +285,7 @@ TEST_CASE("rths run: summary.json gets benchmark_criteria and the terminal a J1-
 TEST_CASE("structure.reference_file: resolved like structure.file, checked, written by ToToml") {
   const fs::path dir = TempDir("benchmark_scenario");
   // Relative to the scenario's folder.
-  fs::copy_file(kBuildings + "silva3_reference.txt", dir / "ref.txt");
+  fs::copy_file(kBuildings + "silva3_reference_case1.txt", dir / "ref.txt");
   std::string text = Scenario("ref.txt", 1.0);
   const auto s = rths::scenario::ParseScenario(text, (dir / "x.toml").string());
   CHECK(fs::equivalent(s.structure.reference_file, dir / "ref.txt"));
@@ -303,7 +303,7 @@ TEST_CASE("structure.reference_file: resolved like structure.file, checked, writ
   CHECK(ScenarioError(Scenario(kBuildings + "ohtori9_ns.txt", 1.0))
             .find("structure.reference_file: " + kBuildings + "ohtori9_ns.txt has 9 DOFs but structure.file") !=
         std::string::npos);
-  const std::string sdof = "[structure]\nkind = \"sdof\"\nreference_file = \"" + kBuildings + "silva3_reference.txt\"\n";
+  const std::string sdof = "[structure]\nkind = \"sdof\"\nreference_file = \"" + kBuildings + "silva3_reference_case1.txt\"\n";
   CHECK(ScenarioError(sdof).find("structure.reference_file: needs structure.mode = \"rths\" and structure.kind = \"file\"") !=
         std::string::npos);
   std::ofstream(dir / "bad.txt") << "n 3\nM kg\n";

@@ -12,6 +12,7 @@
 #include <string>
 
 #include <Eigen/LU>
+#include <fmt/format.h>
 
 #include "core/error.h"
 #include "models/benchmark_structures.h"
@@ -100,40 +101,72 @@ TEST_CASE("the partition: numerical + experimental == reference; M_n iota == M_r
   CHECK_THROWS_AS(Silva3Structures({2000.0, 1.19e6, 0.0097}), rths::Error);  // M_n not positive definite
 }
 
-TEST_CASE("data/buildings/silva3_*.txt load to Silva3Structures() (to the printed precision)") {
+TEST_CASE("data/buildings/silva3_*.txt load to Silva3Structures() (to the printed precision), every case") {
   if (std::getenv("RTHS_WRITE_DATA")) {
     WriteSilva3StructureFiles(kData);
-    MESSAGE("rewrote " << kData << "silva3_reference.txt and silva3_numerical_case1.txt");
+    MESSAGE("rewrote " << kData << "silva3_reference_case{1-4}.txt and silva3_numerical_case{1-4}.txt");
   }
-  const BenchmarkStructures b = Silva3Structures();
-  const StructureMatrices ref = LoadStructureFile(kData + "silva3_reference.txt");
-  const StructureMatrices num = LoadStructureFile(kData + "silva3_numerical_case1.txt");
-  // %.17g round-trips a double; the masses go through kg (x 1e6 and back), hence 1e-15.
-  CHECK(RelDiff(ref.M, b.reference.M) < 1e-15);
-  CHECK(RelDiff(ref.K, b.reference.K) < 1e-15);
-  CHECK(RelDiff(ref.C, b.reference.C) < 1e-15);
-  CHECK(ref.iota.size() == 0);
-  CHECK(RelDiff(num.M, b.numerical.M) < 1e-15);
-  CHECK(RelDiff(num.K, b.numerical.K) < 1e-15);
-  CHECK(RelDiff(num.C, b.numerical.C) < 1e-15);
-  REQUIRE(num.iota.size() == 3);
-  CHECK(RelDiff(num.iota, b.numerical.iota) < 1e-15);
-  // The same files are written again from the function, byte for byte (same platform).
   const fs::path dir = TempDir("write");
   WriteSilva3StructureFiles(dir.string());
   auto slurp = [](const fs::path& p) {
     std::ifstream in(p);
     return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
   };
-  for (const char* name : {"silva3_reference.txt", "silva3_numerical_case1.txt"}) {
-    CAPTURE(name);
-    CHECK(slurp(dir / name) == slurp(fs::path(kData) / name));
+  for (const BenchmarkCase& c : kBenchmarkCases) {
+    CAPTURE(c.number);
+    const BenchmarkStructures b = Silva3Structures({}, c);
+    const std::string ref_name = "silva3_reference_case" + std::to_string(c.number) + ".txt";
+    const std::string num_name = "silva3_numerical_case" + std::to_string(c.number) + ".txt";
+    const StructureMatrices ref = LoadStructureFile(kData + ref_name);
+    const StructureMatrices num = LoadStructureFile(kData + num_name);
+    // %.17g round-trips a double; the masses go through kg (x 1e6 and back), hence 1e-15.
+    CHECK(RelDiff(ref.M, b.reference.M) < 1e-15);
+    CHECK(RelDiff(ref.K, b.reference.K) < 1e-15);
+    CHECK(RelDiff(ref.C, b.reference.C) < 1e-15);
+    CHECK(ref.iota.size() == 0);
+    CHECK(RelDiff(num.M, b.numerical.M) < 1e-15);
+    CHECK(RelDiff(num.K, b.numerical.K) < 1e-15);
+    CHECK(RelDiff(num.C, b.numerical.C) < 1e-15);
+    REQUIRE(num.iota.size() == 3);
+    CHECK(RelDiff(num.iota, b.numerical.iota) < 1e-15);
+    // The same files are written again from the function, byte for byte (same platform).
+    for (const std::string& name : {ref_name, num_name}) {
+      CAPTURE(name);
+      CHECK(slurp(dir / name) == slurp(fs::path(kData) / name));
+    }
+    // Comments say where the numbers come from.
+    const std::string text = slurp(fs::path(kData) / num_name);
+    CHECK(text.find("Silva, Gomez, Maghareh, Dyke & Spencer") != std::string::npos);
+    CHECK(text.find("m_e = 29.13 kg") != std::string::npos);
+    CHECK(text.find("M_n iota = M_ref 1") != std::string::npos);
+    CHECK(text.find(fmt::format("case {}: floor mass {:g} kg", c.number, c.floor_mass_kg)) != std::string::npos);
   }
-  // Comments say where the numbers come from.
-  const std::string text = slurp(fs::path(kData) / "silva3_numerical_case1.txt");
-  CHECK(text.find("Silva, Gomez, Maghareh, Dyke & Spencer") != std::string::npos);
-  CHECK(text.find("m_e = 29.13 kg") != std::string::npos);
-  CHECK(text.find("M_n iota = M_ref 1") != std::string::npos);
+}
+
+TEST_CASE("the four cases: floor mass and modal damping of Table 1, the modes the reference code gives") {
+  // Modes of the reference code's Case_N.mat (its K differs from the printed 4-digit one by < 5e-6).
+  const double modes[4][3] = {{3.612, 15.997, 38.086}, {3.444, 15.252, 36.314}, {3.168, 14.030, 33.404},
+                              {3.612, 15.997, 38.086}};
+  for (const BenchmarkCase& c : kBenchmarkCases) {
+    CAPTURE(c.number);
+    const BenchmarkStructures b = Silva3Structures({}, c);
+    CHECK(b.reference.M(1, 1) == doctest::Approx(c.floor_mass_kg * 1e-6).epsilon(1e-15));
+    const Modes m = ModalAnalysis(b.reference);
+    for (int i = 0; i < 3; ++i) {
+      CHECK(m.frequency_hz[i] == doctest::Approx(modes[c.number - 1][i]).epsilon(2e-4));
+      CHECK(m.damping_ratio[i] == doctest::Approx(c.zeta).epsilon(1e-9));
+    }
+    // numerical + experimental = reference; the specimen is the same in every case.
+    CHECK(RelDiff(b.numerical.K + b.experimental.K, b.reference.K) < 1e-15);
+    CHECK(b.experimental.M(0, 0) == doctest::Approx(29.13e-6).epsilon(1e-15));
+  }
+  CHECK(BenchmarkCaseNumber(3).floor_mass_kg == 1300.0);
+  CHECK_THROWS_AS(BenchmarkCaseNumber(5), rths::Error);
+  // A perturbed specimen changes K11 and C11 of the numerical substructure only.
+  const BenchmarkStructures p = Silva3Structures({29.13, 1.25e6, 0.0097}, kBenchmarkCases[2]);
+  const BenchmarkStructures n = Silva3Structures({}, kBenchmarkCases[2]);
+  CHECK(p.numerical.K(0, 0) == doctest::Approx(n.numerical.K(0, 0) - 0.06).epsilon(1e-12));
+  CHECK(p.reference.K == n.reference.K);
 }
 
 TEST_CASE("the iota line: read, written only when not ones, refused when short, carried into the integrator") {

@@ -9,6 +9,8 @@
 
 #include <doctest/doctest.h>
 
+#include <fmt/format.h>
+
 #include "alloc_counter.h"
 #include "lockstep/runtime.h"
 #include "models/mr_damper.h"
@@ -110,4 +112,17 @@ kind = "ideal"
 mode = "pulse"
 pulse_hz = 20.0
 )");
+}
+
+TEST_CASE("no allocation per step: the adaptive controllers (their coefficients in command_t) and lti") {
+  for (const char* kind : {"ats", "ambc", "lti"}) {
+    CAPTURE(kind);
+    CheckNoAllocationPerStep(kind, fmt::format(R"(
+[controller]
+kind = "{}"
+[controller.lti]
+feedback = {{ num = [2.0, 95.0], den = [1.0, 0.0] }}
+reference = {{ num = [50.8, 8570.0], den = [1.0, 8570.0] }}
+)", kind));
+  }
 }

@@ -365,8 +365,7 @@ TEST_CASE("history: two columns with commas, non-uniform steps, start after 0") 
 }
 
 TEST_CASE("history: the El Centro record resamples to 2 kHz with its peak in place") {
-  const std::string path = "/work/shared/data/ground_motion/elcentro_1940_ns_g.txt";
-  if (!std::filesystem::exists(path)) return;
+  const std::string path = std::string(RTHS_SOURCE_DIR) + "/data/ground_motion/elcentro_1940_ns_g.txt";
   // data/README.md: 1560 samples at 0.02 s, peak -0.31882 g at t = 2.02 s (row 101).
   const double dt = 0.0005;
   const std::size_t n = 70000;  // 35 s
@@ -379,6 +378,22 @@ TEST_CASE("history: the El Centro record resamples to 2 kHz with its peak in pla
   CHECK(x[1557 * 40 + 20] == doctest::Approx(-0.00003 * 9806.65).epsilon(1e-12));
   const std::size_t last = 1559 * 40;  // t = 31.18 s
   for (std::size_t k = last + 1; k < n; ++k) REQUIRE(x[k] == 0.0);
+}
+
+TEST_CASE("history: start_s delays the record and pads it with zeros at the file's own step (the benchmark's record)") {
+  const std::string path = std::string(RTHS_SOURCE_DIR) + "/data/ground_motion/elcentro_1940_ns_g.txt";
+  const double dt = 0.0025;  // 8 samples per file step
+  const std::size_t n = 16480;  // 41.2 s
+  const auto plain = sig::LoadHistory(path, 0.02, 1.0, dt, n);
+  const auto padded = sig::LoadHistory(path, 0.02, 1.0, dt, n, 5.0);
+  for (std::size_t k = 0; k < 1992; ++k) REQUIRE(padded[k] == 0.0);  // zeros up to 4.98 s
+  // From 4.98 s to 5.00 s the record ramps from 0 to its first value (0.0063 g), as the file
+  // padded with zero rows at 0.02 s would.
+  CHECK(padded[1996] == doctest::Approx(0.5 * 0.0063).epsilon(1e-12));
+  for (std::size_t k = 2000; k < 2000 + 12480; ++k) REQUIRE(padded[k] == doctest::Approx(plain[k - 2000]).epsilon(1e-12));
+  CHECK(padded[2000 + 1559 * 8] == doctest::Approx(plain[1559 * 8]));  // last row at 36.18 s
+  for (std::size_t k = 2000 + 1560 * 8; k < n; ++k) REQUIRE(padded[k] == 0.0);
+  CHECK_THROWS_AS(sig::LoadHistory(path, 0.02, 1.0, dt, n, -1.0), rths::Error);
 }
 
 TEST_CASE("history: errors name the file and line") {

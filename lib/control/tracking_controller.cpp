@@ -4,6 +4,8 @@
 
 #include <fmt/format.h>
 
+#include "control/ambc.h"
+#include "control/ats.h"
 #include "control/baselines.h"
 #include "control/inverse_lowpass.h"
 #include "control/lqg.h"
@@ -72,6 +74,8 @@ std::unique_ptr<TrackingController> MakeTrackingController(const control::Contro
   }
   if (k == ControllerKind::kFfLqg) return std::make_unique<FeedforwardLqg>(cfg.model, cfg.lqg, cfg.half_step_ahead, dt_s);
   if (k == ControllerKind::kLti) return std::make_unique<LtiController>(MakeLtiDesign(cfg.lti, dt_s));
+  if (k == ControllerKind::kAts) return std::make_unique<AtsController>(MakeAtsDesign(cfg.ats, dt_s));
+  if (k == ControllerKind::kAmbc) return std::make_unique<AmbcController>(MakeAmbcDesign(cfg.ambc, cfg.model, dt_s));
   throw Error("controller.kind", "unknown controller");
 }
 

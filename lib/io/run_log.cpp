@@ -93,7 +93,7 @@ const std::vector<Wire> kHandshakeLayout = {kI64, kI8,    kString,      kString,
                                                       kI64, kCount, kStringArray, kStringArray, kString};
 const std::vector<Wire> kDesiredLayout = {kI64, kI64, kF64, kF64, kF64,      kF64,
                                                     kF64, kF64, kF64, kCount, kF64Array, kF64Array};
-const std::vector<Wire> kCommandLayout = {kI64, kI64, kF64, kF64, kF64};
+const std::vector<Wire> kCommandLayout = {kI64, kI64, kF64, kF64, kF64, kCount, kF64Array};
 const std::vector<Wire> kMeasuredLayout = {kI64, kI64, kF64, kF64, kF64};
 const std::vector<Wire> kCurrentLayout = {kI64, kI64, kF64, kF64};
 

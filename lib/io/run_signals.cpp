@@ -1,5 +1,6 @@
 #include "io/run_signals.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 
@@ -109,6 +110,23 @@ RunSignals SignalsFromRunLog(const RunLog& log, double dt_s) {
     put(i_eff, m.current_A);
     put(i_cmd, i.i_cmd_A);
     put(f_des, i.f_desired_kN);
+  }
+  // An adaptive controller's coefficients (command_t.adapt: ats 3, ambc 4), one column each, at the
+  // end so that every other column keeps its place; NaN at a step that reported fewer.
+  int n_adapt = 0;
+  for (std::size_t j = 0; j < n; ++j) n_adapt = std::max(n_adapt, std::min(log.command[j].n_adapt, 4));
+  static constexpr const char* kAdaptNames[4] = {"a0", "a1_s", "a2_s2", "a3_s3"};
+  static constexpr const char* kAdaptUnits[4] = {"", "s", "s^2", "s^3"};
+  for (int q = 0; q < n_adapt; ++q) {
+    const std::size_t col = AddColumn(&s, kAdaptNames[q], kAdaptUnits[q],
+                                      fmt::format("adaptive controller's coefficient of the target's derivative {} "
+                                                  "(u = sum a_i x_t^(i); command_t.adapt[{}])",
+                                                  q, q),
+                                      n);
+    for (std::size_t j = 0; j < n; ++j) {
+      const auto& c = log.command[j];
+      s.columns[col].values.push_back(q < c.n_adapt && q < static_cast<int>(c.adapt.size()) ? c.adapt[q] : std::nan(""));
+    }
   }
   return s;
 }

@@ -29,7 +29,12 @@ std::string FrequencyList(const StructureMatrices& m) {
 
 double BenchmarkSpecimen::c_e_N_s_per_m() const { return 2.0 * zeta_e * std::sqrt(m_e_kg * k_e_N_per_m); }
 
-BenchmarkStructures Silva3Structures(const BenchmarkSpecimen& e) {
+const BenchmarkCase& BenchmarkCaseNumber(int number) {
+  if (number < 1 || number > 4) throw Error("benchmark case", fmt::format("{} is out of range [1, 4]", number));
+  return kBenchmarkCases[number - 1];
+}
+
+BenchmarkStructures Silva3Structures(const BenchmarkSpecimen& e, const BenchmarkCase& c) {
   if (!(e.m_e_kg > 0.0) || !std::isfinite(e.m_e_kg))
     throw Error("Silva3Structures: m_e_kg", fmt::format("{} is out of range (0, inf)", e.m_e_kg));
   if (!(e.k_e_N_per_m > 0.0) || !std::isfinite(e.k_e_N_per_m))
@@ -39,13 +44,13 @@ BenchmarkStructures Silva3Structures(const BenchmarkSpecimen& e) {
 
   BenchmarkStructures b;
   StructureMatrices& r = b.reference;
-  r.M = Eigen::MatrixXd::Identity(3, 3) * (1000.0 * kKgToProject);
+  r.M = Eigen::MatrixXd::Identity(3, 3) * (c.floor_mass_kg * kKgToProject);
   Eigen::Matrix3d k_si;
   k_si << 2.6055, -2.3134, 0.5937,  //
       -2.3134, 3.2561, -1.4420,     //
       0.5937, -1.4420, 0.9267;
   r.K = (1e7 * kNPerMToProject) * Eigen::MatrixXd(k_si);
-  r.C = ModalDampingMatrix(r.M, r.K, kSilva3ModalDamping);
+  r.C = ModalDampingMatrix(r.M, r.K, c.zeta);
 
   StructureMatrices& x = b.experimental;
   x.M = x.K = x.C = Eigen::MatrixXd::Zero(3, 3);
@@ -65,45 +70,63 @@ BenchmarkStructures Silva3Structures(const BenchmarkSpecimen& e) {
   return b;
 }
 
-void WriteSilva3StructureFiles(const std::string& dir) {
-  const BenchmarkSpecimen e;
-  const BenchmarkStructures b = Silva3Structures(e);
-  const std::string source =
-      "RTHS benchmark problem: Silva, Gomez, Maghareh, Dyke & Spencer, Mech. Syst. Signal Process. 2020\n"
-      "(docs/benchmark.md). Written by models::WriteSilva3StructureFiles (lib/models/benchmark_structures.cpp);\n"
-      "tests/benchmark_structures_test.cpp checks this file against it (RTHS_WRITE_DATA=1 rewrites it).\n";
-  const std::string reference_comment =
-      "Reference (monolithic) structure of the benchmark, 3 stories.\n" + source +
-      "M = 1000 I3 kg (the benchmark's).\n"
-      "K = 1e7 x [[2.6055, -2.3134, 0.5937], [-2.3134, 3.2561, -1.4420], [0.5937, -1.4420, 0.9267]] N/m\n"
-      "  = 10 x the same matrix in kN/mm (1 N/m = 1e-6 kN/mm).\n"
-      "C: 5 % damping in every mode, C = M Phi diag(2 zeta w_i) Phi^T M, Phi mass-normalised\n"
-      "  (models::ModalDampingMatrix).\n"
-      "Modes: " + FrequencyList(b.reference) + ".\n"
-      "Displacements relative to the ground; iota = 1 (no iota line).";
+namespace {
+const char* kSource =
+    "RTHS benchmark problem: Silva, Gomez, Maghareh, Dyke & Spencer, Mech. Syst. Signal Process. 2020\n"
+    "(docs/benchmark.md). Written by models::WriteSilva3StructureFiles (lib/models/benchmark_structures.cpp);\n"
+    "tests/benchmark_structures_test.cpp checks this file against it (RTHS_WRITE_DATA=1 rewrites it).\n";
+
+std::string CaseText(const BenchmarkCase& c) {
+  return fmt::format("case {}: floor mass {:g} kg, {:g} % damping in every mode", c.number, c.floor_mass_kg,
+                     100.0 * c.zeta);
+}
+}  // namespace
+
+void WriteSilva3NumericalFile(const std::string& path, const BenchmarkCase& c, const BenchmarkSpecimen& e,
+                              const std::string& note) {
+  const BenchmarkStructures b = Silva3Structures(e, c);
   const double c_e = e.c_e_N_s_per_m();
-  const std::string numerical_comment =
-      "Numerical substructure of the benchmark, case 1: the reference (silva3_reference.txt) minus the\n"
-      "experimental substructure at floor 1 (DOF 1, where the actuator acts).\n" +
-      source +
-      fmt::format("Experimental substructure (the benchmark's, case 1): m_e = {:g} kg, k_e = {:g} N/m = {:g} kN/mm,\n"
+  const double m = c.floor_mass_kg;
+  const std::string comment =
+      fmt::format("Numerical substructure of the benchmark, {}: the reference\n"
+                  "(silva3_reference_case{}.txt) minus the experimental substructure at floor 1 (DOF 1, the actuator's).\n",
+                  CaseText(c), c.number) +
+      (note.empty() ? "" : note + "\n") + kSource +
+      fmt::format("Experimental substructure: m_e = {:g} kg, k_e = {:.9g} N/m = {:.9g} kN/mm,\n"
                   "  zeta_e = {:g}, c_e = 2 zeta_e sqrt(m_e k_e) = {:.6g} N s/m = {:.6g} kN*s/mm.\n",
-                  e.m_e_kg, e.k_e_N_per_m, e.k_e_N_per_m * kNPerMToProject, e.zeta_e, c_e,
-                  c_e * kNsPerMToProject) +
-      fmt::format("M11 = 1000 - {:g} = {:g} kg; K11 = K_ref,11 - k_e; C11 = C_ref,11 - c_e; every other entry\n"
+                  e.m_e_kg, e.k_e_N_per_m, e.k_e_N_per_m * kNPerMToProject, e.zeta_e, c_e, c_e * kNsPerMToProject) +
+      fmt::format("M11 = {:g} - {:g} = {:g} kg; K11 = K_ref,11 - k_e; C11 = C_ref,11 - c_e; every other entry\n"
                   "  is the reference's.\n",
-                  e.m_e_kg, 1000.0 - e.m_e_kg) +
+                  m, e.m_e_kg, m - e.m_e_kg) +
       fmt::format("iota: the measured force carries only m_e x''_1 (relative), so the specimen mass's ground\n"
-                  "  inertia stays here: M_n iota = M_ref 1, iota_1 = 1000 / {:g} = {:.9g}.\n"
+                  "  inertia stays here: M_n iota = M_ref 1, iota_1 = {:g} / {:g} = {:.9g}.\n"
                   "  (The integrator's absolute acceleration of floor 1, x''_1 + iota_1 a_g, is therefore off\n"
                   "  by (iota_1 - 1) a_g; nothing in the benchmark uses it.)\n",
-                  1000.0 - e.m_e_kg, b.numerical.iota(0)) +
+                  m, m - e.m_e_kg, b.numerical.iota(0)) +
       "Modes (of this substructure alone): " + FrequencyList(b.numerical) + ".\n" +
-      "Scenario: structure.kind = \"file\", actuator_dof = 1, specimen_count = 1,\n"
-      "  reference_file = \"silva3_reference.txt\" (in this folder) for the criteria J1-J9.";
+      fmt::format("Scenario: structure.kind = \"file\", actuator_dof = 1, specimen_count = 1,\n"
+                  "  reference_file = \"silva3_reference_case{}.txt\" (in data/buildings/) for the criteria J1-J9.",
+                  c.number);
+  WriteStructureFile(path, b.numerical, comment);
+}
+
+void WriteSilva3StructureFiles(const std::string& dir) {
   const std::filesystem::path d(dir);
-  WriteStructureFile((d / "silva3_reference.txt").string(), b.reference, reference_comment);
-  WriteStructureFile((d / "silva3_numerical_case1.txt").string(), b.numerical, numerical_comment);
+  for (const BenchmarkCase& c : kBenchmarkCases) {
+    const BenchmarkStructures b = Silva3Structures({}, c);
+    const std::string reference_comment =
+        fmt::format("Reference (monolithic) structure of the benchmark, 3 stories, {}.\n", CaseText(c)) + kSource +
+        fmt::format("M = {:g} I3 kg (the benchmark's Table 1).\n", c.floor_mass_kg) +
+        "K = 1e7 x [[2.6055, -2.3134, 0.5937], [-2.3134, 3.2561, -1.4420], [0.5937, -1.4420, 0.9267]] N/m\n"
+        "  = 10 x the same matrix in kN/mm (1 N/m = 1e-6 kN/mm); the same in every case.\n" +
+        fmt::format("C: {:g} % damping in every mode, C = M Phi diag(2 zeta w_i) Phi^T M, Phi mass-normalised\n"
+                    "  (models::ModalDampingMatrix).\n",
+                    100.0 * c.zeta) +
+        "Modes: " + FrequencyList(b.reference) + ".\n" + "Displacements relative to the ground; iota = 1 (no iota line).";
+    WriteStructureFile((d / fmt::format("silva3_reference_case{}.txt", c.number)).string(), b.reference,
+                       reference_comment);
+    WriteSilva3NumericalFile((d / fmt::format("silva3_numerical_case{}.txt", c.number)).string(), c, {});
+  }
 }
 
 }  // namespace rths::models

@@ -50,7 +50,7 @@ struct StructureConfig {
   StructureKind kind = StructureKind::kSdof;
   std::string file;           ///< kind = "file": path, relative to the scenario file's folder
   /// mode = "rths", kind = "file", optional: the monolithic reference structure of a partitioned
-  /// test (a structure file with as many DOFs as `file`; e.g. data/buildings/silva3_reference.txt),
+  /// test (a structure file with as many DOFs as `file`; e.g. data/buildings/silva3_reference_case1.txt),
   /// integrated offline under the run's ground acceleration for the benchmark criteria J1-J9
   /// (io/benchmark_run.h). "" for none. Relative to the scenario file's folder.
   std::string reference_file;

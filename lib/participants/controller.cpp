@@ -19,6 +19,8 @@ void Controller::Compute(std::int64_t, const rths::desired_t& d, const rths::mea
   out->u_mm = g * c.u_mm;
   out->u_ff_mm = g * c.u_ff_mm;
   out->u_fb_mm = g * c.u_fb_mm;
+  out->n_adapt = c.n_adapt;
+  out->adapt.assign(c.adapt.begin(), c.adapt.begin() + c.n_adapt);  // capacity kept after the first step
 }
 
 }  // namespace rths::participants

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <fstream>
 #include <future>
+#include <optional>
 #include <numeric>
 #include <sstream>
 
@@ -185,6 +186,29 @@ PageFigure TrackingError(const io::RunSignals& s, const RunReportOptions& o) {
   pf.figure.panels = {err, zoom};
   pf.caption_html = "Top: e = r - y [mm] over the run. Bottom: r, u and y [mm] over the 0.5 s around the "
                     "largest |e|, every step.";
+  return pf;
+}
+
+/// An adaptive controller's coefficients over the run (columns a0, a1_s, ... of RunSignals), one
+/// panel each (they differ by orders of magnitude); nullopt for a fixed controller.
+std::optional<PageFigure> Adaptation(const io::RunSignals& s, const RunReportOptions& o) {
+  if (s.Find("a0") == nullptr) return std::nullopt;
+  const auto& t = s.At("t_s").values;
+  PageFigure pf{NewFigure("adaptation", o), "Adaptive controller: coefficients", ""};
+  pf.figure.panel_height_px = 200;
+  const char* colors[4] = {kColorU, kColorY, kColorR, kColorF};
+  const char* names[4] = {"a0", "a1_s", "a2_s2", "a3_s3"};
+  for (int i = 0; i < 4; ++i) {
+    const io::SignalColumn* c = s.Find(names[i]);
+    if (c == nullptr) break;
+    Panel p = MakePanel("", "t [s]", c->unit.empty() ? "a0 [-]" : fmt::format("a{} [{}]", i, c->unit));
+    p.key = "off";
+    p.series = {History(names[i], colors[i], t, c->values, o.max_plot_points)};
+    pf.figure.panels.push_back(p);
+  }
+  pf.caption_html = "The coefficients of u = a0 x_t + a1 x_t' + a2 x_t'' (+ a3 x_t''') the controller used at "
+                    "each step (command_t.adapt; ats and ambc, docs/controllers.md): a0 is about the inverse "
+                    "of the plant's gain, a1 about its delay [s].";
   return pf;
 }
 
@@ -857,6 +881,7 @@ ReportFiles WriteRunReport(const RunData& d, const RunReportOptions& o) {
     figures.push_back(TimeHistories(d.signals, o));
     figures.push_back(TrackingError(d.signals, o));
     figures.push_back(Loops(d.signals, o));
+    if (auto ad = Adaptation(d.signals, o)) figures.push_back(*ad);
     FrequencyFigures ff = Frequency(d.signals, o);
     if (ff.spectra) figures.push_back(*ff.spectra);
     if (ff.gyr) figures.push_back(*ff.gyr);
@@ -878,7 +903,7 @@ ReportFiles WriteRunReport(const RunData& d, const RunReportOptions& o) {
     }
   }
   // An earlier report's figure that this one does not draw would stay beside the page: remove it.
-  for (const char* stale : {"time_histories", "tracking_error", "loops", "spectra", "gyr", "benchmark"}) {
+  for (const char* stale : {"time_histories", "tracking_error", "loops", "adaptation", "spectra", "gyr", "benchmark"}) {
     if (std::any_of(drawn.begin(), drawn.end(), [&](const PageFigure& pf) { return pf.figure.name == stale; }))
       continue;
     for (const char* ext : {".png", ".dat", ".gp"}) fs::remove(fig_dir / (std::string(stale) + ext), ec);

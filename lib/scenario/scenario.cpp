@@ -25,6 +25,8 @@
 
 #include "core/error.h"
 #include "core/names.h"
+#include "control/ambc.h"
+#include "control/ats.h"
 #include "control/lti_controller.h"
 
 namespace rths::scenario {
@@ -242,6 +244,26 @@ class Section {
     *out = std::move(c);
   }
 
+  /// A fixed number of numbers: an array [v1, ..., vn] of exactly `n` numbers (floats or integers).
+  void Numbers(std::string_view key, double* out, std::size_t n) {
+    const toml::node* node = Declare(key, false);
+    if (node == nullptr) return;
+    const auto* array = node->as_array();
+    const std::string expected = fmt::format("an array of {} numbers", n);
+    if (array == nullptr) WrongType(key, expected, *node);
+    if (array->size() != n) Fail(key, fmt::format("{} values: expected {} ({})", array->size(), n, expected));
+    for (std::size_t i = 0; i < n; ++i) {
+      const toml::node& e = *array->get(i);
+      if (const auto* f = e.as_floating_point()) {
+        out[i] = f->get();
+      } else if (const auto* v = e.as_integer()) {
+        out[i] = static_cast<double>(v->get());
+      } else {
+        Fail(key, fmt::format("element {} is {}: expected a number", i + 1, DescribeNode(e)));
+      }
+    }
+  }
+
   /// A sub-table (absent -> an empty section, so every key keeps its default).
   Section Sub(std::string_view key) {
     const toml::node* node = Declare(key, true);
@@ -392,6 +414,7 @@ void SignalFields(V& v, SignalSpec& s, std::string_view rms_key, const Context& 
   v.Number("file_dt_s", s.file_dt_s, Closed(0.0, 10.0));
   v.Number("scale", s.scale, kAny);  // finite and not 0: ValidateSignal
   v.Number("taper_s", s.taper_s, Closed(0.0, 60.0));
+  v.Number("start_s", s.start_s, Closed(0.0, 3600.0));
 }
 
 template <typename V>
@@ -454,6 +477,32 @@ void ControllerFields(V& v, ControllerConfig& c, const Context& cx) {
     t.Bool("allow_unstable", c.lti.allow_unstable);
     t.Number("saturation_mm", c.lti.saturation_mm, {0.0, 1e6, false, false, "0 for no limit"});
     t.Number("rate_limit_mm_s", c.lti.rate_limit_mm_s, {0.0, 1e9, false, false, "0 for no limit"});
+  });
+  // [controller.ats] and [controller.ambc]: per-key ranges here; bounds against each other and the
+  // initial values, the window against dt: ValidateController (the designs' own checks).
+  v.Table("ats", [&](V& t) {
+    control::AtsConfig& a = c.ats;
+    t.Numbers("initial", a.initial, Closed(-1e6, 1e6));
+    t.Numbers("lower", a.lower, Closed(-1e6, 1e6));
+    t.Numbers("upper", a.upper, Closed(-1e6, 1e6));
+    t.Numbers("max_rate_per_s", a.max_rate_per_s, OpenClosed(0.0, 1e12));
+    t.Number("window_s", a.window_s, OpenClosed(0.0, 100.0));
+    t.Integer("skip", a.skip, Closed(1, 1e6));
+    t.Number("filter_hz", a.filter_hz, {0.0, 0.5 / cx.dt_s, true, true, "below the Nyquist frequency 0.5/run.dt_s"});
+    t.Integer("filter_order", a.filter_order, Closed(1, 8));
+    t.Number("threshold_mm", a.threshold_mm, Closed(0.0, 1e4));
+    t.Choice("derivatives", a.derivatives, control::kTargetDerivativesNames);
+  });
+  v.Table("ambc", [&](V& t) {
+    control::AmbcConfig& a = c.ambc;
+    t.Choice("start", a.start, control::kAmbcStartNames);
+    t.Numbers("initial", a.initial, Closed(-1e6, 1e6));
+    t.Numbers("gain_log10", a.gain_log10, Closed(-30.0, 30.0));
+    t.Numbers("lower", a.lower, Closed(-1e12, 1e12));
+    t.Numbers("upper", a.upper, Closed(-1e12, 1e12));
+    t.Number("filter_hz", a.filter_hz, {0.0, 0.5 / cx.dt_s, true, true, "below the Nyquist frequency 0.5/run.dt_s"});
+    t.Integer("filter_order", a.filter_order, Closed(1, 8));
+    t.Choice("derivatives", a.derivatives, control::kTargetDerivativesNames);
   });
 }
 
@@ -652,6 +701,8 @@ class Reader {
   }
   void Servo(std::string_view key, ServoModel3& m) { section_->Servo(key, &m); }
   void Tf(std::string_view key, control::TfCoefficients& tf) { section_->Tf(key, &tf); }
+  template <std::size_t N>
+  void Numbers(std::string_view key, std::array<double, N>& v, const Range&) { section_->Numbers(key, v.data(), N); }
   template <typename F>
   void Table(std::string_view key, F&& fields, bool /*present*/ = true) {
     Section sub = section_->Sub(key);
@@ -752,6 +803,12 @@ class Writer {
     Key(key, TomlString(std::string(NameOf(names, v))));
   }
   void Servo(std::string_view key, ServoModel3& m) { Key(key, TomlServo(m)); }
+  template <std::size_t N>
+  void Numbers(std::string_view key, std::array<double, N>& v, const Range&) {
+    std::string t = "[";
+    for (std::size_t i = 0; i < N; ++i) t += (i ? ", " : "") + TomlNumber(v[i]);
+    Key(key, t + "]");
+  }
   void Tf(std::string_view key, control::TfCoefficients& tf) {
     if (tf.Empty()) return;  // the default, 1
     auto list = [](const std::vector<double>& v) {
@@ -814,6 +871,10 @@ class Checker {
   }
   void Servo(std::string_view key, ServoModel3& m) { ValidateServo(m, Dotted(key), *check_); }
   void Tf(std::string_view, control::TfCoefficients&) {}  // ValidateController: CheckTf and stability
+  template <std::size_t N>
+  void Numbers(std::string_view key, std::array<double, N>& v, const Range& r) {
+    for (std::size_t i = 0; i < N; ++i) check_->InRange(fmt::format("{}[{}]", Dotted(key), i), v[i], r);
+  }
   template <typename F>
   void Table(std::string_view key, F&& fields, bool present = true) {
     if (!present) return;
@@ -889,12 +950,13 @@ void ValidateSignal(const SignalSpec& s, std::string_view prefix, const std::str
 }
 
 /// The controller's design checks that span keys (an `lti` transfer function's coefficients and
-/// poles): the design is made once here, as the participant will make it, and its error is given
-/// the scenario's file name.
+/// poles; the bounds, initial values and windows of `ats` and `ambc`): the design is made once
+/// here, as the participant will make it, and its error is given the scenario's file name.
 void ValidateController(const ControllerConfig& c, double dt_s, const Check& check) {
-  if (c.kind != control::ControllerKind::kLti) return;
   try {
-    control::MakeLtiDesign(c.lti, dt_s);
+    if (c.kind == control::ControllerKind::kLti) control::MakeLtiDesign(c.lti, dt_s);
+    if (c.kind == control::ControllerKind::kAts) control::MakeAtsDesign(c.ats, dt_s);
+    if (c.kind == control::ControllerKind::kAmbc) control::MakeAmbcDesign(c.ambc, c.model, dt_s);
   } catch (const Error& e) {
     check.Fail(e.where(), e.problem());
   }

@@ -136,7 +136,7 @@ void CheckTimes(const std::string& path, const std::vector<Row>& rows) {
 }  // namespace
 
 std::vector<double> LoadHistory(const std::string& path, double file_dt_s, double scale, double dt_s,
-                                std::size_t n) {
+                                std::size_t n, double start_s) {
   if (!(file_dt_s >= 0.0) || !std::isfinite(file_dt_s)) {
     throw Error(path, fmt::format("file_dt_s = {}: allowed > 0, or 0 for a file with a time column",
                                   file_dt_s));
@@ -145,6 +145,9 @@ std::vector<double> LoadHistory(const std::string& path, double file_dt_s, doubl
     throw Error(path, fmt::format("dt_s = {}: allowed > 0", dt_s));
   }
   if (!std::isfinite(scale)) throw Error(path, fmt::format("scale = {}: must be finite", scale));
+  if (!(start_s >= 0.0) || !std::isfinite(start_s)) {
+    throw Error(path, fmt::format("start_s = {}: allowed >= 0", start_s));
+  }
 
   const bool has_time = file_dt_s == 0.0;
   std::vector<Row> rows = ReadRows(path, has_time);
@@ -152,6 +155,13 @@ std::vector<double> LoadHistory(const std::string& path, double file_dt_s, doubl
     CheckTimes(path, rows);
   } else {
     for (std::size_t j = 0; j < rows.size(); ++j) rows[j].t = static_cast<double>(j) * file_dt_s;
+  }
+  if (start_s > 0.0) {  // zeros at the file's own step before and after, then the delay
+    const double first_step = rows.size() > 1 ? rows[1].t - rows[0].t : file_dt_s;
+    const double last_step = rows.size() > 1 ? rows.back().t - rows[rows.size() - 2].t : file_dt_s;
+    for (Row& r : rows) r.t += start_s;
+    if (first_step > 0.0 && rows.front().t - first_step >= 0.0) rows.insert(rows.begin(), Row{rows.front().t - first_step, 0.0, 0});
+    if (last_step > 0.0) rows.push_back(Row{rows.back().t + last_step, 0.0, 0});
   }
 
   // Linear interpolation on the rows' time axis; zero outside [t_first, t_last]. A tolerance of
@@ -193,7 +203,7 @@ std::vector<double> MakeSignal(const signal::SignalSpec& spec, double dt_s, std:
     if (spec.file.empty()) throw Error("signal.file", "empty path for kind = \"file\"");
     std::filesystem::path p(spec.file);
     if (p.is_relative() && !scenario_dir.empty()) p = std::filesystem::path(scenario_dir) / p;
-    x = LoadHistory(p.string(), spec.file_dt_s, spec.scale, dt_s, n);
+    x = LoadHistory(p.string(), spec.file_dt_s, spec.scale, dt_s, n, spec.start_s);
       break;
     }
     case SignalKind::kZero:

@@ -31,6 +31,10 @@ struct SignalSpec {
   /// Raised-cosine fade-in over the first taper_s seconds [s], [0, 60]: a BLWN record cut after
   /// its discarded start begins mid-motion, which would ask the actuator for a step.
   double taper_s = 0.0;
+  /// kind = "file": the record's time 0 falls at this run time [s], [0, 3600]; > 0 pads it with
+  /// zeros before and after at the file's own step (the RTHS benchmark's ElCentroAccelNoScaling is
+  /// our El Centro record with start_s = 5: 5 s of zeros, the record, then zeros).
+  double start_s = 0.0;
   bool operator==(const SignalSpec&) const = default;
 };
 
@@ -44,16 +48,18 @@ struct SignalSpec {
 ///     have no gap: no step may exceed 1.5 x the median step (missing rows).
 /// Output: x_k = scale * v(k dt_s), k = 0 .. n - 1, with v linearly interpolated between rows;
 /// zero before the first row's time and after the last row's time (a record shorter than the
-/// run is padded with zeros). The unit of x is the file's unit times `scale`.
+/// run is padded with zeros). The unit of x is the file's unit times `scale`. start_s > 0 delays the
+/// record by start_s [s] and adds a zero row one file step before its first row and one after its
+/// last, so that it ramps from and to zero as a file padded with zeros at its own step would.
 /// Throws rths::Error("path:line", ...) for a non-numeric or empty field, a wrong number of
 /// columns, a non-increasing or negative time, a gap; rths::Error("path", ...) for a file that
 /// cannot be read or has no data rows; and for file_dt_s < 0, dt_s <= 0 or a non-finite scale.
 std::vector<double> LoadHistory(const std::string& path, double file_dt_s, double scale, double dt_s,
-                                std::size_t n);
+                                std::size_t n, double start_s = 0.0);
 
 /// The n-sample record described by `spec` at step dt_s [s]:
 ///   kind "blwn": Blwn(band_hz, rms, dt_s, n, seed, discard_s) (signal/blwn.h);
-///   kind "file": LoadHistory(file, file_dt_s, scale, dt_s, n), a relative `file` being taken
+///   kind "file": LoadHistory(file, file_dt_s, scale, dt_s, n, start_s), a relative `file` being taken
 ///                relative to `scenario_dir` (the scenario file's folder);
 ///   kind "zero": n zeros.
 /// Then the first spec.taper_s seconds are faded in (ApplyTaper).

@@ -1,0 +1,184 @@
+// The benchmark's loop closed as the lockstep testbed or as the reference code closes it
+// (report/benchmark_loop.h, docs/benchmark.md "How the loop is closed").
+#include "report/benchmark_loop.h"
+
+#include <cmath>
+#include <filesystem>
+#include <memory>
+
+#include <Eigen/Dense>
+#include <fmt/format.h>
+
+#include "control/lti_controller.h"
+#include "core/error.h"
+#include "io/benchmark_run.h"
+#include "models/rig.h"
+#include "models/structure.h"
+#include "models/structure_file.h"
+#include "signal/history.h"
+#include "signal/random.h"
+
+namespace rths::report {
+
+namespace {
+
+/// x' = A x + b_g a_g + b_f f for a structure's state x = [x; x'] [mm, mm/s]:
+///   A = [[0, I], [-M^-1 K, -M^-1 C]],  b_g = [0; -iota],  b_f = [0; -M^-1 s].
+struct ContinuousStructure {
+  Eigen::MatrixXd A;
+  Eigen::VectorXd b_g, b_f;
+  int n = 0;
+};
+
+ContinuousStructure Continuous(const models::LinearStructure& st) {
+  ContinuousStructure c;
+  c.n = st.dofs();
+  const Eigen::MatrixXd minv = st.M.inverse();
+  c.A = Eigen::MatrixXd::Zero(2 * c.n, 2 * c.n);
+  c.A.topRightCorner(c.n, c.n) = Eigen::MatrixXd::Identity(c.n, c.n);
+  c.A.bottomLeftCorner(c.n, c.n) = -minv * st.K;
+  c.A.bottomRightCorner(c.n, c.n) = -minv * st.C;
+  c.b_g = Eigen::VectorXd::Zero(2 * c.n);
+  c.b_g.tail(c.n) = -st.iota;
+  c.b_f = Eigen::VectorXd::Zero(2 * c.n);
+  if (st.specimen_dir.size() == c.n) c.b_f.tail(c.n) = -minv * st.specimen_dir;
+  return c;
+}
+
+/// One classical RK4 step over dt with the force held and a_g at t, t + dt/2, t + dt.
+void Rk4(const ContinuousStructure& c, Eigen::VectorXd* x, double dt, const double ag[3], double f) {
+  auto rate = [&](const Eigen::VectorXd& z, double a) -> Eigen::VectorXd { return c.A * z + c.b_g * a + c.b_f * f; };
+  const Eigen::VectorXd k1 = rate(*x, ag[0]);
+  const Eigen::VectorXd k2 = rate(*x + 0.5 * dt * k1, ag[1]);
+  const Eigen::VectorXd k3 = rate(*x + 0.5 * dt * k2, ag[1]);
+  const Eigen::VectorXd k4 = rate(*x + dt * k3, ag[2]);
+  *x += dt / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
+}
+
+/// Rounds x [mm] to a multiple of q [m] (a Simulink Quantizer on metres); q = 0: unchanged.
+double Quantise(double x_mm, double q_m) {
+  if (q_m <= 0.0) return x_mm;
+  return 1e3 * q_m * std::round(1e-3 * x_mm / q_m);
+}
+
+/// The reference code's example-controller subsystem: T and C with converters around them.
+struct QuantisedLti {
+  control::LtiDesign design;
+  control::LtiState state;
+  double q_m = 0.0;
+  double Step(double target_mm, double y_mm) {
+    const double t = Quantise(control::FilterStep(design.reference.discrete, &state.reference,
+                                                  Quantise(target_mm, q_m)),
+                              q_m);
+    return Quantise(control::FilterStep(design.feedback.discrete, &state.feedback, Quantise(t - y_mm, q_m)), q_m);
+  }
+};
+
+std::string IntegrationName(LoopIntegration i) { return i == LoopIntegration::kRk4 ? "rk4" : "central difference"; }
+
+}  // namespace
+
+std::string LoopOptions::Label() const {
+  std::string l = fmt::format("substructure {}, force delay {}, reference {}", IntegrationName(substructure),
+                              force_delay_steps, IntegrationName(reference));
+  if (quantise_m > 0.0) l += fmt::format(", converters {:.3g} um", 1e6 * quantise_m);
+  return l;
+}
+
+LoopOptions LockstepLoop() { return {}; }
+
+LoopOptions ReferenceCodeLoop() {
+  return {LoopIntegration::kRk4, 1, LoopIntegration::kRk4, std::ldexp(1.0, -18)};
+}
+
+LoopResult RunBenchmarkLoop(const scenario::Scenario& s, const LoopOptions& o) {
+  const std::string& where = s.path.empty() ? std::string("<scenario>") : s.path;
+  if (s.structure.mode != models::StructureMode::kRths || s.structure.kind != models::StructureKind::kFile ||
+      s.structure.reference_file.empty()) {
+    throw Error(where + ": structure", "the benchmark loop needs mode \"rths\", kind \"file\" and a reference_file");
+  }
+  if (s.plant.kind != models::PlantKind::kBenchmark) throw Error(where + ": plant.kind", "needs \"benchmark\"");
+  if (o.force_delay_steps < 0 || o.force_delay_steps > 1) throw Error("force_delay_steps", "allowed 0 or 1");
+  if (o.quantise_m > 0.0 && s.controller.kind != control::ControllerKind::kLti) {
+    throw Error(where + ": controller.kind", "the reference code's converters are modelled for an \"lti\" controller only");
+  }
+  const double dt = s.run.dt_s;
+  const auto n = static_cast<std::size_t>(s.steps());
+  const std::string dir = std::filesystem::path(s.path).parent_path().string();
+
+  const models::LinearStructure st = models::StructureFromScenario(s.structure, s.path);
+  const models::LinearStructure ref = io::ReferenceStructure(s, st.dofs());
+  const int a = st.actuator_dof;
+  const std::vector<double> ground = signal::MakeSignal(s.structure.ground, dt, n, dir);
+  std::vector<double> ground_half;  // a_g at k dt/2 (rk4 stages)
+  if (o.substructure == LoopIntegration::kRk4 || o.reference == LoopIntegration::kRk4) {
+    ground_half = signal::MakeSignal(s.structure.ground, 0.5 * dt, 2 * n + 1, dir);
+  }
+
+  const std::unique_ptr<models::Rig> rig = models::MakeRig(s.plant, dt);
+  signal::GaussianState noise = signal::MakeGaussian(s.plant.noise_seed);
+  const std::unique_ptr<control::TrackingController> law = control::MakeTrackingController(s.controller, dt);
+  QuantisedLti quantised;
+  if (o.quantise_m > 0.0) quantised = {control::MakeLtiDesign(s.controller.lti, dt), {}, o.quantise_m};
+  control::ExtrapolationState past;
+
+  const models::CentralDifference cd = models::CentralDifference::Make(st, dt);
+  models::StructureState cd_state = models::MakeState(cd);
+  const ContinuousStructure cs = Continuous(st);
+  Eigen::VectorXd rk_state = Eigen::VectorXd::Zero(2 * st.dofs());
+
+  signal::BenchmarkSignals rec;
+  rec.dt_s = dt;
+  rec.actuator_floor = a + 1;
+  rec.x_m.resize(n);
+  rec.x_t.resize(n);
+  rec.x_n.assign(st.dofs(), std::vector<double>(n));
+  LoopResult out;
+  double f_prev = 0.0;  // f_{k-1}: the Unit Delay's initial condition is 0
+  for (std::size_t k = 0; k < n; ++k) {
+    const bool rk4 = o.substructure == LoopIntegration::kRk4;
+    const Eigen::VectorXd& x = rk4 ? rk_state : cd_state.x;
+    const double r = x(a);
+    // Readings at t_k, the noise drawn as procs/plant draws it (y then f).
+    const double ny = s.plant.noise_y_mm_rms > 0.0 ? s.plant.noise_y_mm_rms * signal::NextGaussian(&noise) : 0.0;
+    const double nf = s.plant.noise_f_kN_rms > 0.0 ? s.plant.noise_f_kN_rms * signal::NextGaussian(&noise) : 0.0;
+    const double y = rig->MeasuredYMm(ny);
+    const double f = rig->f_kN() + nf;
+    const control::Derivatives d = control::StepDerivatives(&past, r, dt);
+    double u = law->Step(d, {y, f, rig->current_A()}).u_mm;
+    if (o.quantise_m > 0.0) u = quantised.Step(r, y);
+    if (!std::isfinite(u) || !std::isfinite(r)) throw Error("benchmark loop", fmt::format("diverged at step {}", k));
+    out.peak_u_mm = std::max(out.peak_u_mm, std::abs(u));
+    rec.x_m[k] = y;
+    rec.x_t[k] = r;
+    for (int i = 0; i < st.dofs(); ++i) rec.x_n[i][k] = x(i);
+    // t_k -> t_{k+1}: the plant with u_k held, the substructure with f_{k-d}.
+    rig->Step(u, 0.0);
+    const double f_used = o.force_delay_steps == 1 ? f_prev : f;
+    if (rk4) {
+      const double ag[3] = {ground_half[2 * k], ground_half[2 * k + 1], ground_half[2 * k + 2]};
+      Rk4(cs, &rk_state, dt, ag, f_used);
+    } else {
+      models::Advance(cd, &cd_state, ground[k], f_used);
+    }
+    f_prev = f;
+  }
+  out.steps = static_cast<std::int64_t>(n);
+
+  if (o.reference == LoopIntegration::kRk4) {
+    const ContinuousStructure cr = Continuous(ref);
+    Eigen::VectorXd z = Eigen::VectorXd::Zero(2 * ref.dofs());
+    rec.x_r.assign(ref.dofs(), std::vector<double>(n));
+    for (std::size_t k = 0; k < n; ++k) {
+      for (int i = 0; i < ref.dofs(); ++i) rec.x_r[i][k] = z(i);
+      const double ag[3] = {ground_half[2 * k], ground_half[2 * k + 1], ground_half[2 * k + 2]};
+      Rk4(cr, &z, dt, ag, 0.0);
+    }
+  } else {
+    rec.x_r = io::ReferenceResponse(ref, dt, ground);
+  }
+  out.j = signal::BenchmarkCriteriaFrom(rec);
+  return out;
+}
+
+}  // namespace rths::report
