@@ -126,18 +126,23 @@ int main(int argc, char** argv) {
                   r.runs.size(), r.numerical.size(), r.wall_s);
     } else if (name == "benchmark") {
       const auto r = rths::report::ReproduceBenchmark(opts, keep_logs);  // report/benchmark_study.h
-      const auto names = rths::report::BenchmarkControllerNames();
-      std::printf("\nnominal plant (J1 [ms], J2-J9 [%%]; benchmark.md has the perturbed runs' spread)\n%-8s", "");
-      for (int j = 1; j <= 9; ++j) std::printf(" %8s", fmt::format("J{}", j).c_str());
-      std::printf("\n");
-      for (const auto& row : r.rows) {
-        if (row.run != "nominal") continue;
-        const auto& j = row.j;
-        std::printf("%-8s %8.1f %8.2f %8.2f %8.2f %8.2f %8.2f %8.2f %8.2f %8.2f%s\n", row.controller.c_str(), j.J1_ms,
-                    j.J2_pct, j.J3_pct, j.J4_pct, j.J5_pct, j.J6_pct, j.J7_pct, j.J8_pct, j.J9_pct,
-                    row.stopped == "no" ? "" : "  (stopped)");
+      const auto& published = rths::report::PublishedExampleCriteria();
+      for (int c = 1; c <= 4; ++c) {
+        std::printf("\ncase %d, nominal plant (J1 [ms], J2-J9 [%%]; benchmark.md has the perturbed spread)\n%-17s", c, "");
+        for (int j = 1; j <= 9; ++j) std::printf(" %7s", fmt::format("J{}", j).c_str());
+        std::printf("\n%-17s", "example published");
+        for (int j = 0; j < 9; ++j) std::printf(" %7.*f", j == 0 ? 1 : 2, published[c - 1][j]);
+        std::printf("\n");
+        for (const auto& row : r.rows) {
+          if (row.run != "nominal" || row.case_number != c) continue;
+          std::printf("%-17s", row.controller.c_str());
+          for (int j = 0; j < 9; ++j) std::printf(" %7.*f", j == 0 ? 1 : 2, row.j.At(j));
+          std::printf("%s\n", row.stopped == "no" ? "" : "  (stopped)");
+        }
       }
-      std::printf("\n%zu runs in %.1f s; benchmark.csv, benchmark.md, benchmark.png\n", r.rows.size(), r.wall_s);
+      std::printf("\n%zu runs in %.1f s; benchmark.csv, benchmark_summary.csv, benchmark_loop.csv, benchmark.md, "
+                  "benchmark.png\n",
+                  r.rows.size(), r.wall_s);
     } else if (name == "fig6") {
       const auto r = rths::report::ReproduceFig6(opts);
       std::printf("\n%-5s %-3s %12s %12s %8s\n", "cond", "", "paper", "ours", "diff");

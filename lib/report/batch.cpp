@@ -178,6 +178,8 @@ RunResult RunOne(const RunSpec& spec) {
     res.tracking_pct = sum.metrics->tracking_nrmse_pct;
     res.peak_force_kN = sum.metrics->peak_force_kN;
   }
+  res.benchmark = sum.benchmark_criteria;
+  res.benchmark_error = sum.benchmark_error;
   try {
     fs::create_directories(spec.dir);
     std::ofstream(spec.dir / "summary.json") << sum.ToJson().dump(2) << "\n";

@@ -7,11 +7,13 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "core/progress.h"
 #include "scenario/scenario.h"
+#include "signal/benchmark_criteria.h"
 
 namespace rths::report {
 
@@ -32,6 +34,10 @@ struct RunResult {
   double wall_s = 0.0;
   double tracking_pct = 0.0;         ///< Eq. 31 over every logged step (r_k, y_k)
   double peak_force_kN = 0.0;
+  /// The benchmark's J1-J9 over the logged steps, for a scenario with a structure.reference_file
+  /// (as summary.json's "benchmark_criteria"); why not, in benchmark_error.
+  std::optional<signal::BenchmarkCriteria> benchmark;
+  std::string benchmark_error;
 };
 
 /// A run's signals, read back from its log.lcm, per step k (docs/lockstep.md).

@@ -82,6 +82,11 @@ double PearsonCorrelation(std::span<const double> a, std::span<const double> b) 
   return sab / std::sqrt(saa * sbb);
 }
 
+double BenchmarkCriteria::At(int i) const {
+  const double v[9] = {J1_ms, J2_pct, J3_pct, J4_pct, J5_pct, J6_pct, J7_pct, J8_pct, J9_pct};
+  return i >= 0 && i < 9 ? v[i] : std::nan("");
+}
+
 BenchmarkCriteria BenchmarkCriteria::Rounded() const {
   BenchmarkCriteria r = *this;
   r.J1_ms = Round(J1_ms, 0.1);

@@ -55,6 +55,8 @@ struct BenchmarkCriteria {
   BenchmarkCriteria Rounded() const;
   /// One line, rounded as the benchmark reports: "J1 25.4 ms  J2 12.34 %  ...  J9 0.12 %".
   std::string Format() const;
+  /// J(i + 1): i = 0 gives J1_ms, i = 1 .. 8 give J2_pct .. J9_pct.
+  double At(int i) const;
 };
 
 /// The inputs of BenchmarkCriteriaFrom: equal-length records sampled at dt_s.

@@ -1,0 +1,281 @@
+// The files of `rths reproduce benchmark` (report/benchmark_study.h): CSV tables, benchmark.md and
+// benchmark.png from a finished study.
+#include <cmath>
+#include <fstream>
+
+#include <fmt/format.h>
+
+#include "io/csv.h"
+#include "io/plot.h"
+#include "models/benchmark_plant.h"
+#include "models/benchmark_structures.h"
+#include "report/benchmark_study.h"
+#include "report/figures.h"
+
+namespace rths::report {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr std::array<const char*, 9> kJNames = {"J1_ms",  "J2_pct", "J3_pct", "J4_pct", "J5_pct",
+                                                "J6_pct", "J7_pct", "J8_pct", "J9_pct"};
+
+/// J1 to 0.1 ms, the others to 0.01 % (the benchmark's rounding), as text.
+std::string JText(double v, int i) {
+  if (!std::isfinite(v)) return "nan";
+  return i == 0 ? fmt::format("{:.1f}", v) : fmt::format("{:.2f}", v);
+}
+
+/// Text for a Markdown table cell: '|' escaped.
+std::string MdCell(const std::string& text) {
+  std::string out;
+  for (char c : text) {
+    if (c == '|') out += '\\';
+    out += c;
+  }
+  return out;
+}
+
+std::string MdHeader(const std::string& first, const std::string& extra = "") {
+  std::string h = "| " + first + " |";
+  std::string rule = "|---|";
+  for (const char* n : kJNames) h += fmt::format(" {} |", n), rule += "---:|";
+  if (!extra.empty()) h += " " + extra + " |", rule += "---|";
+  return h + "\n" + rule + "\n";
+}
+
+int Stable(const BenchmarkResult& res, int case_number, const std::string& controller, bool perturbed_only) {
+  int n = 0;
+  for (const auto& row : res.rows) {
+    if (row.case_number == case_number && row.controller == controller && row.stable &&
+        (!perturbed_only || row.run != "nominal"))
+      ++n;
+  }
+  return n;
+}
+
+const BenchmarkRow* Nominal(const BenchmarkResult& res, int case_number, const std::string& controller) {
+  for (const auto& row : res.rows) {
+    if (row.case_number == case_number && row.controller == controller && row.run == "nominal") return &row;
+  }
+  return nullptr;
+}
+
+void WriteCsvs(const BenchmarkResult& res, const fs::path& dir) {
+  const auto names = BenchmarkControllerNames();
+  {
+    std::vector<std::string> header{"case", "controller", "run"};
+    for (const char* n : kJNames) header.push_back(n);
+    header.push_back("stopped");
+    io::CsvWriter csv(dir / "benchmark.csv", header);
+    for (const auto& row : res.rows) {
+      std::vector<std::string> f{std::to_string(row.case_number), row.controller, row.run};
+      for (int j = 0; j < 9; ++j) f.push_back(row.criteria_ok ? JText(row.j.At(j), j) : "nan");
+      f.push_back(row.stopped);
+      csv.Row(f);
+    }
+    csv.Close();
+  }
+  {
+    std::vector<std::string> header{"case", "controller", "statistic"};
+    for (const char* n : kJNames) header.push_back(n);
+    header.insert(header.end(), {"stable_runs", "runs"});
+    io::CsvWriter csv(dir / "benchmark_summary.csv", header);
+    for (int cs = 1; cs <= 4; ++cs) {
+      for (std::size_t c = 0; c < names.size(); ++c) {
+        const std::string stable = std::to_string(Stable(res, cs, names[c], false));
+        const std::string runs = std::to_string(res.perturbed + 1);
+        auto row = [&](const std::string& stat, auto value) {
+          std::vector<std::string> f{std::to_string(cs), names[c], stat};
+          for (int j = 0; j < 9; ++j) f.push_back(JText(value(j), j));
+          f.push_back(stable);
+          f.push_back(runs);
+          csv.Row(f);
+        };
+        if (names[c] == "example_pi_lead") row("published", [&](int j) { return PublishedExampleCriteria()[cs - 1][j]; });
+        const BenchmarkRow* nom = Nominal(res, cs, names[c]);
+        row("nominal", [&](int j) { return nom && nom->criteria_ok ? nom->j.At(j) : std::nan(""); });
+        const auto& sp = res.spread[cs - 1][c];
+        row("mean", [&](int j) { return sp[j].mean; });
+        row("std", [&](int j) { return sp[j].std; });
+        row("min", [&](int j) { return sp[j].min; });
+        row("max", [&](int j) { return sp[j].max; });
+      }
+    }
+    csv.Close();
+  }
+  {
+    std::vector<std::string> header{"case", "loop", "closing"};
+    for (const char* n : kJNames) header.push_back(n);
+    io::CsvWriter csv(dir / "benchmark_loop.csv", header);
+    for (const auto& l : res.loops) {
+      std::vector<std::string> f{std::to_string(l.case_number), l.variant, l.label};
+      for (int j = 0; j < 9; ++j) f.push_back(JText(l.j.At(j), j));
+      csv.Row(f);
+    }
+    csv.Close();
+  }
+  {
+    io::CsvWriter csv(dir / "benchmark_plants.csv",
+                      {"run", "seed", "b1_per_s", "b2_per_s2", "a3_per_s", "k_e_N_per_m", "dc_gain", "lag_1hz_ms"});
+    for (const auto& row : res.rows) {
+      if (row.case_number != 1 || row.controller != names[0]) continue;
+      const auto m = models::BenchmarkPlant::Make(row.plant, kBenchmarkDtS);
+      csv.Row({row.run, std::to_string(row.seed), fmt::format("{:.6g}", row.plant.b1), fmt::format("{:.6g}", row.plant.b2),
+               fmt::format("{:.6g}", row.plant.a3), fmt::format("{:.6g}", row.plant.k_e_N_per_m),
+               fmt::format("{:.5f}", m.DcGain()), fmt::format("{:.3f}", 1e3 * models::TimeLagS(m, 1.0, false))});
+    }
+    csv.Close();
+  }
+}
+
+void WriteFigure(const BenchmarkResult& res, const ReproduceOptions& opts) {
+  const auto names = BenchmarkControllerNames();
+  io::Figure fig;
+  fig.name = "benchmark";
+  fig.width_px = 1400;
+  fig.panel_height_px = 330;
+  const char* colors[4] = {"#0072B2", "#E69F00", "#009E73", "#CC79A7"};
+  std::string axis = "controller (";
+  for (std::size_t c = 0; c < names.size(); ++c) axis += fmt::format("{}{} {}", c ? ", " : "", c + 1, names[c]);
+  axis += ")";
+  const std::array<std::pair<int, const char*>, 4> panels = {
+      {{0, "J1: time delay [ms]"}, {1, "J2: RMS tracking error [%]"}, {3, "J4: RMS error vs the reference [%]"},
+       {6, "J7: RMS error of floor 3 vs the reference [%]"}}};
+  for (const auto& [j, title] : panels) {
+    io::Panel p = io::MakePanel(fmt::format("{} (filled: nominal plant; open: {} perturbed plants{})", title,
+                                            res.perturbed, opts.quick ? ", --quick" : ""),
+                                axis, fmt::format("J{} [{}]", j + 1, j == 0 ? "ms" : "%"));
+    p.x_range = std::make_pair(0.5, names.size() + 0.5);
+    p.key = "outside right top";
+    p.log_y = j != 0;
+    for (int cs = 1; cs <= 4; ++cs) {
+      io::Series nom, pert;
+      nom.title = fmt::format("case {}", cs);
+      nom.with = "points pt 7 ps 1.6";
+      nom.color = colors[cs - 1];
+      pert.title = "";
+      pert.with = "points pt 6 ps 0.8";
+      pert.color = colors[cs - 1];
+      for (std::size_t c = 0; c < names.size(); ++c) {
+        for (const auto& row : res.rows) {
+          if (row.case_number != cs || row.controller != names[c] || !row.criteria_ok) continue;
+          const double v = row.j.At(j);
+          if (!std::isfinite(v) || (p.log_y && !(v > 0))) continue;
+          io::Series& s = row.run == "nominal" ? nom : pert;
+          s.x.push_back(static_cast<double>(c + 1) + 0.12 * (cs - 2.5) + (row.run == "nominal" ? 0.0 : 0.04));
+          s.y.push_back(v);
+        }
+      }
+      p.series.push_back(pert);
+      p.series.push_back(nom);
+    }
+    p.right_margin_chars = io::KeyMarginChars({&p});
+    fig.panels.push_back(p);
+  }
+  fig.gnuplot = opts.gnuplot;
+  io::Plot(fig, opts.out_dir);
+}
+
+void WriteMarkdown(const BenchmarkResult& res, const ReproduceOptions& opts) {
+  const auto names = BenchmarkControllerNames();
+  const auto& id = res.id;
+  std::ofstream md(opts.out_dir / "benchmark.md");
+  md << "# The RTHS benchmark problem (Silva et al. 2020) as its reference code runs it: J1-J9\n\n"
+     << fmt::format("Made by `rths reproduce benchmark{}`: {} lockstep runs (4 partitioning cases x {} controllers x "
+                    "nominal + {} perturbed plants) of {:g} s (El Centro x 0.4 padded with 5 s of zeros, g = 9.81 "
+                    "m/s^2) at 4096 Hz in {:.0f} s wall time ({} at a time). Criteria: docs/benchmark.md; J1 [ms], "
+                    "J2-J9 [%]. J1 searches lags of 0-49 samples (0-11.96 ms): a run lagging more reads 12.0 ms.\n\n",
+                    opts.quick ? " --quick" : "", res.rows.size(), names.size(), res.perturbed, res.duration_s,
+                    res.wall_s, opts.jobs)
+     << "## Identification and design\n\n"
+     << fmt::format("A BLWN command (0-{:g} Hz, RMS 1 mm, no controller) through the nominal plant with its sensor "
+                    "noise; a 3-pole model of Eq. 15 fitted to G_yu over 0.5-{:g} Hz (identify.txt, identify.toml):\n\n"
+                    "    G(s) = {:.5g} / ((s + {:.5g})(s^2 + {:.5g} s + {:.5g}))\n\n"
+                    "DC gain {:.4f} (the plant: {:.4f}); low-frequency lag {:.2f} ms (the plant at 1 Hz: {:.2f} ms).\n\n",
+                    kBenchmarkIdBandHz, kBenchmarkFitHiHz, id.model.K, id.model.p, id.model.b, id.model.c,
+                    id.fit.fit.model.DcGain(), id.plant_dc_gain, id.model_lag_ms, id.plant_lag_ms)
+     << fmt::format("Controllers: `example_pi_lead`, the benchmark's example (C(s) = 2 + 95/s, T(s) = 50.83 (s + "
+                    "168.6)/(s + 8570.4), Tustin: an `lti` scenario, scenarios/benchmark/caseN_example.toml); `ff` "
+                    "and `ff_lqg` (default LQG weights) on the fitted model; `poly3` and `lead` compensating {:.1f} ms "
+                    "(max_delay_ms raised to {:g} ms); `ats` with OpenFresco's parameters; `ambc` from "
+                    "RobustAMBCvRTHS's initial model with its gains; `none`. None was tuned on these runs.\n\n",
+                    id.compensated_delay_ms, BenchmarkController("poly3", id).max_delay_ms);
+  for (int cs = 1; cs <= 4; ++cs) {
+    const models::BenchmarkCase& bc = models::kBenchmarkCases[cs - 1];
+    md << fmt::format("## Case {} (floor mass {:g} kg, {:g} % damping)\n\nNominal plant:\n\n", cs, bc.floor_mass_kg,
+                      100 * bc.zeta)
+       << MdHeader("controller", "stopped");
+    md << "| example_pi_lead, **published** |";
+    for (int j = 0; j < 9; ++j) md << " " << JText(PublishedExampleCriteria()[cs - 1][j], j) << " |";
+    md << " Table 3 of the benchmark paper |\n";
+    for (const auto& name : names) {
+      const BenchmarkRow* row = Nominal(res, cs, name);
+      if (!row) continue;
+      md << "| " << name << " |";
+      for (int j = 0; j < 9; ++j) md << " " << (row->criteria_ok ? JText(row->j.At(j), j) : "nan") << " |";
+      md << " " << MdCell(row->stopped) << " |\n";
+    }
+    md << fmt::format("\n{} perturbed plants: mean +/- standard deviation; stable runs (all steps, finite criteria) of "
+                      "nominal + perturbed:\n\n",
+                      res.perturbed)
+       << MdHeader("controller", "stable");
+    for (std::size_t c = 0; c < names.size(); ++c) {
+      md << "| " << names[c] << " |";
+      for (int j = 0; j < 9; ++j) {
+        const auto& s = res.spread[cs - 1][c][j];
+        md << " " << JText(s.mean, j) << " +/- " << JText(s.std, j) << " |";
+      }
+      md << fmt::format(" {} of {} |\n", Stable(res, cs, names[c], false), res.perturbed + 1);
+    }
+    md << "\n";
+  }
+  md << "## How the loop is closed (the example controller, nominal plant)\n\n"
+     << "The same scenario closed in one process (report/benchmark_loop.h): `lockstep` as the testbed closes it "
+        "(central difference, x_k+1 from the force measured at k; equal to the lockstep run above), then the "
+        "reference code's differences one at a time: the numerical substructure and the reference integrated "
+        "continuously by RK4 (ode4), the measured force's unit delay, its converters (2^-18 m).\n\n"
+     << MdHeader("case, loop");
+  for (int cs = 1; cs <= 4; ++cs) {
+    for (const auto& l : res.loops) {
+      if (l.case_number != cs) continue;
+      md << "| " << cs << ", " << l.variant << " |";
+      for (int j = 0; j < 9; ++j) md << " " << JText(l.j.At(j), j) << " |";
+      md << "\n";
+    }
+    md << "| " << cs << ", **published** |";
+    for (int j = 0; j < 9; ++j) md << " " << JText(PublishedExampleCriteria()[cs - 1][j], j) << " |";
+    md << "\n";
+  }
+  int stopped = 0;
+  for (const auto& row : res.rows) stopped += row.stopped != "no";
+  md << fmt::format("\n{} of {} runs stopped before the end (criteria over the steps they ran).\n", stopped,
+                    res.rows.size());
+  for (const auto& row : res.rows) {
+    if (row.stopped != "no")
+      md << fmt::format("- case {} {} {}: {} (after {} steps)\n", row.case_number, row.controller, row.run, row.stopped,
+                        row.steps);
+  }
+  md << "\n## Published values\n\n"
+     << "The published row of each case is Table 3 of Silva, Gomez, Maghareh, Dyke & Spencer, \"Benchmark control "
+        "problem for real-time hybrid simulation\" (Mech. Syst. Signal Process. 135, 2020), as printed in the "
+        "preprint shipped with the benchmark's reference package (github MECHS-RCN/BENCHMARKS, \"RTHS code RT "
+        "V23.zip\", V23 of 6 Feb 2019, p. 30): the example controller, nominal plant, El Centro. The paper gives "
+        "no perturbed statistics (it says the controller stayed stable over 20 random plants). Nothing here was "
+        "tuned to them; docs/benchmark.md explains the differences.\n";
+}
+
+}  // namespace
+
+void WriteBenchmarkOutputs(const BenchmarkResult& res, const ReproduceOptions& opts) {
+  WriteCsvs(res, opts.out_dir);
+  if (io::GnuplotAvailable(opts.gnuplot)) {
+    WriteFigure(res, opts);
+  } else if (opts.log) {
+    opts.log("benchmark: gnuplot not found, no benchmark.png (apt-get install gnuplot-nox)");
+  }
+  WriteMarkdown(res, opts);
+}
+
+}  // namespace rths::report
