@@ -4,8 +4,14 @@
 // linear maps used by `rths design`, allocation-free steps, and the scenario keys.
 #include <doctest/doctest.h>
 
+#include <unistd.h>
+
 #include <cmath>
 #include <complex>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <string>
 #include <vector>
 
@@ -285,4 +291,28 @@ saturation_mm = 20
   other.replace(other.find("kind = \"lti\""), 12, "kind = \"none\"");
   other.replace(other.find("den = [1, 0]"), 12, "den = [1, -3]");
   CHECK(error_of(other).empty());
+}
+
+TEST_CASE("examples/matlab/rths_lti_toml.m (GNU Octave) writes [controller] lines that design to the same coefficients") {
+  REQUIRE_MESSAGE(std::system("command -v octave-cli > /dev/null 2>&1") == 0,
+                  "octave-cli is missing: apt-get install octave (scripts/bootstrap.sh installs it)");
+  const std::string dir = std::string(RTHS_SOURCE_DIR) + "/examples/matlab";
+  const std::string out = (std::filesystem::temp_directory_path() / ("rths_lti_toml_" + std::to_string(::getpid()) + ".toml")).string();
+  // The benchmark's example, continuous, with every digit of MATLAB's tf object.
+  const std::string script = "addpath('" + dir + "'); t = rths_lti_toml([2 95], [1 0], [50.83163360273612 8570.397339444286], "
+                             "[1 8570.397339444286]); f = fopen('" + out + "', 'w'); fprintf(f, '%s', t); fclose(f);";
+  // octave-cli may print "error: ignoring const execution_exception& while preparing to exit" and exit 0.
+  REQUIRE(std::system(("octave-cli --no-gui --norc --eval \"" + script + "\" > /dev/null 2>&1").c_str()) == 0);
+  std::ifstream in(out);
+  const std::string lines((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::filesystem::remove(out);
+  const rths::scenario::Scenario s =
+      rths::scenario::ParseScenario("[run]\ndt_s = 0.000244140625\nduration_s = 1.0\n" + lines, "octave.toml");
+  CHECK(s.controller.kind == ctl::ControllerKind::kLti);
+  CHECK(s.controller.lti.feedback.num == std::vector<double>{2.0, 95.0});
+  CHECK(s.controller.lti.reference.num == std::vector<double>{50.83163360273612, 8570.397339444286});
+  CHECK(s.controller.lti.reference.den == std::vector<double>{1.0, 8570.397339444286});
+  const ctl::LtiDesign d = ctl::MakeLtiDesign(s.controller.lti, kDt);
+  CHECK(d.feedback.discrete.b[0] == 2.0115966796875);
+  CHECK(d.reference.discrete.b[0] == doctest::Approx(25.35336272).epsilon(1e-9));
 }
