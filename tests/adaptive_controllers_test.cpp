@@ -21,6 +21,7 @@
 #include "control/transfer_function.h"
 #include "core/error.h"
 #include "models/servo_linear.h"
+#include "scenario/scenario.h"
 #include "signal/blwn.h"
 #include "signal/random.h"
 
@@ -657,4 +658,59 @@ TEST_CASE("refused configurations name the scenario key and the allowed range") 
   cfg.kind = ctl::ControllerKind::kAts;
   cfg.ats.skip = -3;
   CHECK(KeyOf([&] { ctl::MakeTrackingController(cfg, kAtsDt); }) == "controller.ats.skip");
+}
+
+TEST_CASE("scenario keys: [controller.ats] and [controller.ambc] read, written back, refused with the file and key") {
+  const std::string base = R"(
+[run]
+dt_s = 0.000244140625
+duration_s = 1.0
+[controller]
+kind = "ats"
+[controller.ats]
+initial = [1.0, 0.025, 3e-4]
+upper = [1.2, 0.05, 0.003]
+window_s = 0.5
+derivatives = "difference"
+[controller.ambc]
+start = "given"
+gain_log10 = [7, 5, 2, 1]
+)";
+  auto error_of = [](const std::string& text) {
+    try {
+      rths::scenario::ParseScenario(text, "x.toml");
+    } catch (const rths::Error& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  REQUIRE(error_of(base).empty());
+  const rths::scenario::Scenario s = rths::scenario::ParseScenario(base, "x.toml");
+  CHECK(s.controller.ats.initial == std::array<double, 3>{1.0, 0.025, 3e-4});
+  CHECK(s.controller.ats.upper[1] == 0.05);
+  CHECK(s.controller.ats.lower == rths::control::AtsConfig{}.lower);  // default kept
+  CHECK(s.controller.ats.derivatives == rths::control::TargetDerivatives::kDifference);
+  CHECK(s.controller.ambc.start == rths::control::AmbcStart::kGiven);
+  CHECK(s.controller.ambc.gain_log10 == std::array<double, 4>{7, 5, 2, 1});
+  const rths::scenario::Scenario back = rths::scenario::ParseScenario(rths::scenario::ToToml(s), "y.toml");
+  CHECK(back.controller.ats == s.controller.ats);
+  CHECK(back.controller.ambc == s.controller.ambc);
+
+  auto with = [&](const std::string& from, const std::string& to) {
+    std::string t = base;
+    t.replace(t.find(from), from.size(), to);
+    return t;
+  };
+  // The design's checks across keys, named with the file.
+  CHECK(error_of(with("initial = [1.0, 0.025, 3e-4]", "initial = [1.0, 0.09, 3e-4]")).find("x.toml: controller.ats.initial") == 0);
+  CHECK(error_of(with("window_s = 0.5", "window_s = 0.001")).find("x.toml: controller.ats.window_s") == 0);
+  // Per-key ranges and shapes.
+  CHECK(error_of(with("upper = [1.2, 0.05, 0.003]", "upper = [1.2, 0.05]")).find("x.toml: controller.ats.upper: 2 values: expected 3") == 0);
+  CHECK(error_of(with("upper = [1.2, 0.05, 0.003]", "upper = [1.2, \"a\", 0.003]")).find("x.toml: controller.ats.upper: element 2") == 0);
+  CHECK(error_of(with("gain_log10 = [7, 5, 2, 1]", "gain_log10 = [7, 50, 2, 1]")).find("x.toml: controller.ambc.gain_log10[1]: 50 is out of range") == 0);
+  CHECK(error_of(with("derivatives = \"difference\"", "derivatives = \"spline\"")).find("x.toml: controller.ats.derivatives") == 0);
+  // ambc's design is checked when it is the kind: start "model" needs a model inside its bounds.
+  std::string ambc = with("kind = \"ats\"", "kind = \"ambc\"");
+  CHECK(error_of(ambc).empty());
+  CHECK(error_of(ambc + "lower = [2.0, 0, 0, 0]\n").find("x.toml: controller.ambc.") == 0);
 }
