@@ -28,6 +28,7 @@
 #include <Eigen/Dense>
 
 #include "alloc_counter.h"
+#include "test_support.h"
 
 namespace ctl = rths::control;
 namespace sig = rths::signal;
@@ -163,15 +164,6 @@ ctl::AmbcConfig GivenAmbc(std::array<double, 4> initial) {
   return c;
 }
 
-std::vector<double> SimulateSs(const ctl::DiscreteSs& s, const std::vector<double>& u) {
-  Eigen::VectorXd x = Eigen::VectorXd::Zero(s.order());
-  std::vector<double> y(u.size());
-  for (std::size_t k = 0; k < u.size(); ++k) {
-    y[k] = (s.C * x).value() + s.D * u[k];
-    x = s.A * x + s.B * u[k];
-  }
-  return y;
-}
 
 std::string KeyOf(const std::function<void()>& make) {
   try {
@@ -541,7 +533,7 @@ TEST_CASE("Linearize matches Step for fixed coefficients (ats before its trigger
     for (ctl::TrackingController* c : {static_cast<ctl::TrackingController*>(&c1), static_cast<ctl::TrackingController*>(&c2)}) {
       const ctl::ControllerLti lti = c->Linearize(0.0);
       CHECK(!lti.has_feedback);
-      const std::vector<double> expected = SimulateSs(lti.ff, r);
+      const std::vector<double> expected = ctl::Simulate(lti.ff, r);
       ctl::ExtrapolationState past;
       double worst = 0.0, peak = 0.0;
       for (std::size_t k = 0; k < r.size(); ++k) {
@@ -676,14 +668,7 @@ derivatives = "difference"
 start = "given"
 gain_log10 = [7, 5, 2, 1]
 )";
-  auto error_of = [](const std::string& text) {
-    try {
-      rths::scenario::ParseScenario(text, "x.toml");
-    } catch (const rths::Error& e) {
-      return std::string(e.what());
-    }
-    return std::string();
-  };
+  auto error_of = [](const std::string& text) { return rths_test::ParseError(text); };
   REQUIRE(error_of(base).empty());
   const rths::scenario::Scenario s = rths::scenario::ParseScenario(base, "x.toml");
   CHECK(s.controller.ats.initial == std::array<double, 3>{1.0, 0.025, 3e-4});

@@ -49,16 +49,6 @@ ControllerConfig Config(const std::string& kind, const char* model = "avg", doub
   return c;
 }
 
-// y_k of x_{k+1} = A x_k + B u_k, y_k = C x_k + D u_k, from rest.
-std::vector<double> Simulate(const ctl::DiscreteSs& s, const std::vector<double>& u) {
-  Eigen::VectorXd x = Eigen::VectorXd::Zero(s.order());
-  std::vector<double> y(u.size());
-  for (std::size_t k = 0; k < u.size(); ++k) {
-    y[k] = (s.C * x).value() + s.D * u[k];
-    x = s.A * x + s.B * u[k];
-  }
-  return y;
-}
 
 }  // namespace
 
@@ -186,8 +176,8 @@ TEST_CASE("every controller's Step() is its Linearize() (and bumpless blends, ne
     const ctl::ControllerLti lo = c->Linearize(0.0), hi = c->Linearize(cfg.current_high_A);
     std::vector<double> e(n), i_A(n);
     for (std::size_t k = 0; k < n; ++k) e[k] = y[k] - r[k], i_A[k] = 1.5 + 1.5 * std::sin(k * 0.01);  // 0..3 A
-    const std::vector<double> u_lo = Simulate(lo.ff, r), u_hi = Simulate(hi.ff, r);
-    const std::vector<double> u_fb = lo.has_feedback ? Simulate(lo.fb, e) : std::vector<double>(n, 0.0);
+    const std::vector<double> u_lo = ctl::Simulate(lo.ff, r), u_hi = ctl::Simulate(hi.ff, r);
+    const std::vector<double> u_fb = lo.has_feedback ? ctl::Simulate(lo.fb, e) : std::vector<double>(n, 0.0);
     ctl::ExtrapolationState past;
     double worst = 0.0;
     for (std::size_t k = 0; k < n; ++k) {

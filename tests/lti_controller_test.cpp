@@ -24,6 +24,7 @@
 #include "signal/blwn.h"
 
 #include "alloc_counter.h"
+#include "test_support.h"
 
 namespace ctl = rths::control;
 using cd = std::complex<double>;
@@ -264,14 +265,7 @@ saturation_mm = 20
   const rths::scenario::Scenario back = rths::scenario::ParseScenario(rths::scenario::ToToml(s), "y.toml");
   CHECK(back.controller.lti == s.controller.lti);
 
-  auto error_of = [](const std::string& text) {
-    try {
-      rths::scenario::ParseScenario(text, "x.toml");
-    } catch (const rths::Error& e) {
-      return std::string(e.what());
-    }
-    return std::string();
-  };
+  auto error_of = [](const std::string& text) { return rths_test::ParseError(text); };
   std::string bad = base;
   bad.replace(bad.find("den = [1, 0]"), 12, "den = [1, -3]");
   CHECK(error_of(bad).find("x.toml: controller.lti.feedback: unstable") == 0);

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "core/error.h"
+#include "test_support.h"
 
 namespace fs = std::filesystem;
 using rths::scenario::LoadScenario;
@@ -26,13 +27,9 @@ const fs::path kSourceDir = RTHS_SOURCE_DIR;
 
 /// The message of the rths::Error that parsing `text` throws ("" and a failed check if none).
 std::string ErrorOf(std::string_view text, const std::string& path = "bad.toml") {
-  try {
-    ParseScenario(text, path);
-  } catch (const rths::Error& e) {
-    return e.what();
-  }
-  FAIL_CHECK("expected an rths::Error for:\n" << text);
-  return "";
+  const std::string message = rths_test::ParseError(text, path);
+  if (message.empty()) FAIL_CHECK("expected an rths::Error for:\n" << text);
+  return message;
 }
 
 /// Checks that `message` contains every one of `parts`.

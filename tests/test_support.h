@@ -74,6 +74,16 @@ inline int RunCli(const std::string& args, std::string* output = nullptr, const 
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
+/// The message of the rths::Error that parsing scenario `text` (named `path`) throws; "" if none.
+inline std::string ParseError(std::string_view text, const std::string& path = "x.toml") {
+  try {
+    rths::scenario::ParseScenario(text, path);
+  } catch (const rths::Error& e) {
+    return e.what();
+  }
+  return "";
+}
+
 inline bool UdpmAvailable() { return rths::lockstep::CheckMulticastRoute().empty(); }
 
 }  // namespace rths_test

@@ -20,6 +20,16 @@ std::complex<double> DiscreteSs::Response(double f_hz) const {
   return (C.cast<cd>() * x).value() + D;
 }
 
+std::vector<double> Simulate(const DiscreteSs& s, const std::vector<double>& u) {
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(s.order());
+  std::vector<double> y(u.size());
+  for (std::size_t k = 0; k < u.size(); ++k) {
+    y[k] = (s.C * x).value() + s.D * u[k];
+    x = s.A * x + s.B * u[k];
+  }
+  return y;
+}
+
 DiscreteSs StaticGain(double d, double dt_s) {
   return {Eigen::MatrixXd(0, 0), Eigen::VectorXd(0), Eigen::RowVectorXd(0), d, dt_s};
 }

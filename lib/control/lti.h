@@ -4,6 +4,7 @@
 /// Van Loan discretisation, and diagonal balancing for badly scaled realisations (the servo
 /// models' phase variables span 1 to 1e7 in size).
 #include <complex>
+#include <vector>
 
 #include <Eigen/Core>
 
@@ -25,6 +26,9 @@ struct DiscreteSs {
   /// H(z) = C (zI - A)^-1 B + D at z = e^{j 2 pi f dt}.
   std::complex<double> Response(double f_hz) const;
 };
+
+/// y_k of `s` driven by u_k from rest (x_0 = 0), k = 0 .. u.size()-1. Allocates (analysis only).
+std::vector<double> Simulate(const DiscreteSs& s, const std::vector<double>& u);
 
 /// A static gain D (n = 0).
 DiscreteSs StaticGain(double d, double dt_s);
