@@ -28,6 +28,7 @@ namespace fs = std::filesystem;
 using rths_test::RunCli;
 using rths_test::RunMemq;
 using rths_test::TempDir;
+using rths_test::Slurp;
 using rths_test::WriteScenario;
 
 namespace {
@@ -77,13 +78,6 @@ stall_budget_s = 10.0
 handshake_timeout_s = 10.0
 )",
                      duration_s, kBuildings, reference, kElCentro);
-}
-
-std::string Slurp(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
 }
 
 std::string ScenarioError(const std::string& text) {

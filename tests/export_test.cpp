@@ -26,6 +26,8 @@
 namespace fs = std::filesystem;
 using namespace rths_test;
 
+using rths_test::Slurp;
+
 namespace {
 
 // 0.2 s at 2 kHz: 400 steps of the default SDOF scenario (tracking ff, MR damper at 0 A).
@@ -61,13 +63,6 @@ struct ToolResult {
   std::string out;  ///< standard output
   std::string err;  ///< standard error
 };
-
-std::string Slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
 
 /// Runs `command` with sh; its stdout and stderr are captured apart.
 ToolResult Shell(const std::string& command) {

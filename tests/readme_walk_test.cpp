@@ -18,16 +18,11 @@
 #include "scenario/scenario.h"
 #include "test_support.h"
 
+using rths_test::Slurp;
+
 namespace {
 
 namespace fs = std::filesystem;
-
-std::string Slurp(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
 
 /// The command lines of the README's walk block (between the walk markers, inside ```sh), with
 /// their trailing comments removed.

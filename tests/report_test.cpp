@@ -19,15 +19,7 @@
 
 using namespace rths::io;
 using rths_test::TempDir;
-
-namespace {
-std::string Slurp(const std::filesystem::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-}  // namespace
+using rths_test::Slurp;
 
 TEST_CASE("CSV fields are quoted exactly when RFC 4180 requires it") {
   CHECK(CsvField("None") == "None");

@@ -24,23 +24,11 @@
 
 using namespace rths::report;
 using rths_test::TempDir;
+using rths_test::Slurp;
+using rths_test::Number;
 namespace fs = std::filesystem;
 
 namespace {
-
-std::string Slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-double Number(const std::string& s) {
-  double v = std::nan("");
-  const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
-  if (ec != std::errc() || end != s.data() + s.size()) return std::nan("");
-  return v;
-}
 
 bool IsPng(const fs::path& p) {
   const std::string s = Slurp(p);

@@ -25,6 +25,7 @@
 namespace fs = std::filesystem;
 using rths_test::RunCli;
 using rths_test::TempDir;
+using rths_test::Slurp;
 using rths_test::WriteScenario;
 
 namespace {
@@ -56,13 +57,6 @@ max_current_A = 1.0
 stall_budget_s = 5.0
 handshake_timeout_s = 10.0
 )";
-
-std::string Slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
 
 nlohmann::json ReadJson(const fs::path& p) { return nlohmann::json::parse(Slurp(p)); }
 

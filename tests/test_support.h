@@ -3,6 +3,8 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <charconv>
+#include <cmath>
 #include <cstdlib>
 #include <sstream>
 
@@ -22,6 +24,22 @@
 namespace rths_test {
 
 namespace fs = std::filesystem;
+
+/// The whole file as bytes ("" if it cannot be read).
+inline std::string Slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+/// A CSV cell as a number; NaN unless the whole cell is one.
+inline double Number(const std::string& s) {
+  double v = std::nan("");
+  const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+  if (ec != std::errc() || end != s.data() + s.size()) return std::nan("");
+  return v;
+}
 
 /// A fresh, empty folder under the system's temp folder, unique to this test process.
 inline fs::path TempDir(const std::string& name) {

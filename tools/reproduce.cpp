@@ -1,4 +1,4 @@
-// rths-reproduce: `rths reproduce NAME [--out DIR] [--quick] [--plant physical|linear] [--jobs N]`.
+// rths-reproduce: `rths reproduce NAME [--out DIR] [--quick] [--plant physical|linear] [--jobs N] [--extended]`.
 //
 // Reproduces one figure or table of the paper (docs/experiments.md) into a new folder: CSV tables,
 // Markdown, PNG figures and, for the lockstep studies, every run's folder. The work is done by
@@ -59,6 +59,10 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"fig5", "fig6", "fig7", "fig8", "fig9", "fig11", "table2", "benchmark"}));
   app.add_option("--out", out_arg, "output folder (default: a new folder under runs/); never overwritten");
   app.add_flag("--quick", quick, "shorter records (for tests; numbers are noisier)");
+  bool extended = false;
+  app.add_flag("--extended", extended,
+               "table2: also the extended table (table2_extended.csv/.md/.png): ats, ambc and a PI + phase lead "
+               "beside none, ff and ff_lqg; the paper's 36 rows unchanged");
   bool keep_logs = false;
   app.add_flag("--keep-logs", keep_logs,
                "benchmark: keep every perturbed run's log.lcm (default: removed once scored; about 50 MB per full run)");
@@ -80,6 +84,11 @@ int main(int argc, char** argv) {
     return rths::tools::kExitUsage;
   }
 
+  if (extended && name != "table2") {
+    std::fprintf(stderr, "rths reproduce %s: --extended is for table2 only\n", name.c_str());
+    return rths::tools::kExitUsage;
+  }
+
   rths::report::ReproduceOptions opts;
   opts.out_dir = out_arg.empty() ? rths::io::NewOutputFolder(fmt::format("reproduce-{}{}", name, quick ? "-quick" : ""))
                                   : fs::path(out_arg);
@@ -87,6 +96,7 @@ int main(int argc, char** argv) {
   opts.plant = plant;
   opts.jobs = jobs;
   opts.overrides = sets;
+  opts.extended = extended;
   rths::ProgressLine progress("rths reproduce " + name);
   opts.progress = &progress;
   opts.log = [&progress](std::string_view line) {
@@ -96,7 +106,8 @@ int main(int argc, char** argv) {
   };
   const auto t0 = std::chrono::steady_clock::now();
   try {
-    std::printf("rths reproduce %s%s -> %s\n", name.c_str(), quick ? " (quick)" : "", opts.out_dir.string().c_str());
+    std::printf("rths reproduce %s%s%s -> %s\n", name.c_str(), quick ? " (quick)" : "", extended ? " (extended)" : "",
+                opts.out_dir.string().c_str());
     std::fflush(stdout);
     if (name == "fig5") {
       const auto r = rths::report::ReproduceFig5(opts);
@@ -117,6 +128,24 @@ int main(int argc, char** argv) {
       }
       std::printf("\n");
       for (const auto& c : r.claims) PrintCheck(c.holds, c.text, c.detail, Standing(name, plant, quick));
+      if (extended) {
+        std::printf("\nextended table (Eq. 31 [%%]; table2_extended.md has the peaks, the second halves and the "
+                    "adaptive coefficients)\n%-6s %-8s %9s %9s  %s\n",
+                    "cond", "ctrl", "0-5 Hz", "0-15 Hz", "stopped");
+        for (std::size_t i = 0; i < r.extended.size(); ++i) {
+          const auto& a = r.extended[i];
+          if (a.band != "0-5") continue;
+          for (const auto& b : r.extended) {
+            if (b.condition != a.condition || b.controller != a.controller || b.band != "0-15") continue;
+            std::string stop;
+            for (const auto* x : {&a, &b}) {
+              if (x->stopped != "no") stop += fmt::format("{}{} Hz: {}", stop.empty() ? "" : "; ", x->band, x->stopped);
+            }
+            std::printf("%-6s %-8s %9.3f %9.3f  %s\n", a.condition.c_str(), a.controller.c_str(), a.ours_pct, b.ours_pct,
+                        stop.empty() ? "no" : stop.c_str());
+          }
+        }
+      }
     } else if (name == "fig9") {
       const auto r = rths::report::ReproduceFig9(opts);  // report/studies.h; table in fig9.md
       std::printf("fig9: %zu runs in %.1f s; fig9.csv, fig9.md, fig9.png\n", r.rows.size(), r.wall_s);

@@ -42,15 +42,6 @@ constexpr double kFitLoHz = 0.5, kFitHiHz = 40.0;  // the paper: models accurate
 constexpr double kPlotMaxHz = 50.0;
 constexpr double kDt = 0.0005;
 
-std::string Stamp() {
-  const std::time_t now = std::time(nullptr);
-  char stamp[32];
-  std::tm tm{};
-  gmtime_r(&now, &tm);
-  std::strftime(stamp, sizeof stamp, "%Y-%m-%d %H:%M UTC", &tm);
-  return stamp;
-}
-
 std::string Sig(double v) { return std::isfinite(v) ? fmt::format("{:#.4g}", v) : FormatSig(v); }
 
 // Runs the specs (preflight first), logging progress; throws if any failed.
@@ -335,7 +326,7 @@ Fig6Result ReproduceFig6(const ReproduceOptions& opts) {
   {
     std::ofstream md(opts.out_dir / "fig6.md");
     md << "# Fig. 6: identified servohydraulic models\n\n"
-       << fmt::format("Made by `rths reproduce fig6{} --plant {}` on {}.\n\n", opts.quick ? " --quick" : "", opts.plant, Stamp())
+       << fmt::format("Made by `rths reproduce fig6{} --plant {}` on {}.\n\n", opts.quick ? " --quick" : "", opts.plant, UtcStamp())
        << fmt::format("BLWN 0-50 Hz, RMS {} mm, {:g} s, commanded with no controller (u = r) at 0.0 A and 2.5 A; "
                       "G_yu by H1 (Welch, Hann, 50 % overlap, {} segments of {:.3g} s); "
                       "K / ((s + p)(s^2 + b s + c)) fitted over {:g}-{:g} Hz as the model whose zero-order hold at "
@@ -501,7 +492,7 @@ Fig78Result ReproduceFig78(const ReproduceOptions& opts, const std::string& figu
     std::ofstream md(opts.out_dir / (figure + ".md"));
     md << fmt::format("# Fig. {}: G_yr for each controller with {} in the damper\n\n", figure == "fig7" ? 7 : 8, cond_text)
        << fmt::format("Made by `rths reproduce {}{} --plant {}` on {}.\n\n", figure, opts.quick ? " --quick" : "",
-                      opts.plant, Stamp())
+                      opts.plant, UtcStamp())
        << fmt::format("Desired displacement r: BLWN 0-50 Hz, RMS {} mm, {:g} s, through each controller of Table 1 "
                       "for the condition; G_yr by H1 (Welch, Hann, 50 % overlap, {} segments of {:.3g} s). "
                       "Curves in `{}.csv`, figure `{}.png`.\n\n",

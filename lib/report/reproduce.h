@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -33,7 +34,14 @@ struct ReproduceOptions {
   std::vector<std::string> overrides;
   /// Progress with an ETA of the lockstep batches (null: none); the main program decides.
   ProgressLine* progress = nullptr;
+  /// table2 only: also run the extended table (table2_extended.csv/.md/.png): the field's adaptive
+  /// compensators and a PI + phase lead beside the paper's proposed controllers. The paper's 36
+  /// rows and their files are the same with or without it.
+  bool extended = false;
 };
+
+/// Now, as "YYYY-MM-DD HH:MM UTC": the stamp of a reproduction's Markdown.
+std::string UtcStamp();
 
 /// Creates `dir`, or accepts it if it exists and is empty; throws rths::Error if it holds
 /// anything (a reproduction never overwrites an earlier one).
@@ -93,14 +101,102 @@ struct Claim {
   std::string detail;              ///< the numbers behind it
 };
 
+// --- Table 2, extended (issue 25; docs/reproduce_table2.md "--extended") ---------------------
+
+/// `pi_lead`: a PI feedback C(s) = Kp + Ki/s and a phase lead T(s) = k (s - zero)/(s - pole) on the
+/// reference (u = C (T r - y), an `lti` controller, Tustin at the run's dt), designed on a design
+/// model by a fixed rule (DesignPiLead), in the manner of the RTHS benchmark's example controller.
+struct PiLeadDesign {
+  models::ServoModel3 model;         ///< the design model (ZOH at dt_s)
+  double dt_s = 0.0;
+  // The rule's constants.
+  double target_pm_deg = 60.0;       ///< phase margin of the PI loop
+  double max_sensitivity_db = 6.02;  ///< its peak sensitivity bound (Ms <= 2: gain margin >= 6 dB)
+  double safety_deg = 5.0;           ///< added to the PI loop's margin for the lead (the benchmark's)
+  double fac = 2.0;                  ///< the lead's pole moved out by fac, k = a fac (the benchmark's)
+  double lag_hz = 1.0;               ///< where the PI loop's remaining lag is measured
+  // The PI.
+  double kp = 0.0, ki = 0.0;         ///< [-], [1/s]
+  double pi_crossover_hz = 0.0;      ///< the crossover the rule chose
+  double pi_phase_margin_deg = 0.0;  ///< of the PI loop (AnalyzeLoop)
+  double pi_delay_margin_ms = 0.0;
+  double pi_peak_sensitivity_db = 0.0;
+  double pi_spectral_radius = 0.0;   ///< of the closed loop's poles
+  int pi_crossovers = 0;             ///< gain crossovers of the PI loop (the rule requires one)
+  bool pi_stable = false;
+  double pi_lag_ms = 0.0;            ///< lag of y behind r at lag_hz with T = 1 [ms]
+  // The lead.
+  double phi_deg = 0.0;              ///< pi_phase_margin_deg + safety_deg
+  double a = 0.0;                    ///< (1 + sin phi)/(1 - sin phi)
+  double tl_s = 0.0;                 ///< Tl = pi_lag / (a - 1/fac): the lead's low-frequency advance
+                                     ///< a Tl - Tl/fac equals the PI loop's lag
+  double w_m_rad_s = 0.0;            ///< 1/(Tl sqrt a)
+  double zero = 0.0, pole = 0.0;     ///< T's zero -1/(a Tl) and pole -fac/Tl [1/s]
+  double k = 0.0;                    ///< a fac (T(0) = 1)
+  // The whole controller on the design model (G_yr, e.g. lag_ms[1] at 5 Hz).
+  std::vector<double> check_hz;      ///< 1, 5, 10, 15 Hz
+  std::vector<double> gyr_magnitude, gyr_lag_ms;
+  control::ControllerConfig controller;  ///< kind "lti", ready to run
+  /// The rule and the numbers, in a few lines of text (for table2_extended.md and the console).
+  std::string Describe() const;
+};
+/// The rule (docs/reproduce_table2.md): (1) the PI: for every crossover frequency w on a grid below
+/// Nyquist, the Kp >= 0, Ki > 0 that give the discrete loop C G (Tustin PI, ZOH model) |L| = 1 and
+/// a phase margin target_pm_deg at w; of these, the largest Ki (the closed loop's low-frequency lag
+/// is 1/(Ki G(0))) whose loop has a peak sensitivity <= max_sensitivity_db; checked with
+/// control::AnalyzeLoop: stable, one crossover, the margin, the peak. (2) the lead, with the
+/// benchmark's formulas: phi = the PI loop's margin + safety_deg, a = (1 + sin phi)/(1 - sin phi),
+/// and Tl (the one number the benchmark chose by hand through w_m) such that the lead's
+/// low-frequency advance a Tl - Tl/fac equals the PI loop's lag at lag_hz; pole = -fac/Tl, zero =
+/// -1/(a Tl), k = a fac. Throws rths::Error if no PI meets the margin with one stable crossover.
+PiLeadDesign DesignPiLead(const models::ServoModel3& model, double dt_s);
+
+/// One row of the extended table: a condition, band and controller.
+struct Table2ExtendedRow {
+  std::string condition, band;       ///< "0.0A" | "2.5A" | "pulse"; "0-5" | "0-15"
+  std::string controller;            ///< none, ff, ff_lqg, ats, ambc, pi_lead
+  std::string table2_row;            ///< the Table 2 row whose run it is ("G_FF,2.5A"), or ""
+  double ours_pct = 0.0;             ///< Eq. 31 over every logged step (NaN: no log)
+  double second_half_pct = 0.0;      ///< Eq. 31 over the second half of the logged steps
+  double peak_error_mm = 0.0;        ///< max |r_k - y_k|
+  std::int64_t steps = 0, steps_planned = 0;
+  std::string stopped = "no";        ///< "no", or why the run stopped (the safety monitor's reason)
+  std::vector<double> final_coefficients;  ///< ats, ambc: a0 [-], a1 [s], a2 [s^2] (, a3 [s^3]) at the last step
+  double adapt_start_s = -1.0;       ///< ats, ambc: first time the coefficients left their start (-1: never)
+  double duration_s = 0.0;
+  std::filesystem::path run_dir;
+};
+
+/// One controller of the extended table, for one condition.
+struct Table2ExtendedController {
+  std::string condition;             ///< "0.0A" | "2.5A" | "pulse"
+  std::string name;                  ///< none, ff, ff_lqg, ats, ambc, pi_lead
+  std::string table2_row;            ///< none, ff, ff_lqg: the Table 2 row whose run it is; else ""
+  std::string design;                ///< one line: how it is set up
+  control::ControllerConfig controller;
+};
+/// The extended table's controllers for one condition, in order: none, ff, ff_lqg (the condition's
+/// Table 2 rows "None", its G_FF row, "G_FF,avgA + LQG"), ats (AtsConfig's defaults), ambc
+/// (start = "model" on the design model of the condition's G_FF row, other keys default),
+/// pi_lead (`pi_lead.controller`).
+std::vector<Table2ExtendedController> Table2ExtendedControllers(const std::string& condition,
+                                                                const PiLeadDesign& pi_lead);
+
 struct Table2Result {
   std::vector<Table2Row> rows;     ///< 36: condition x controller x band, in the paper's order
   std::vector<Claim> claims;
+  /// --extended: 36 rows, condition x band x controller, in Table2ExtendedControllers' order.
+  std::vector<Table2ExtendedRow> extended;
+  std::optional<PiLeadDesign> pi_lead;  ///< --extended: the design on Eq. 30
   double wall_s = 0.0;
 };
 /// Runs the 36 lockstep runs (60 s records; --quick: 6 s, and 20 s for the "None" rows so that
 /// their check against the paper means something) and writes table2.csv
 /// (condition,controller,band_hz,paper_pct,ours_pct), table2.md and runs/<row>/.
+/// With opts.extended, in the same batch, the extended table's 18 new runs (ats, ambc, pi_lead per
+/// condition and band; none, ff and ff_lqg are the Table 2 rows' runs) and table2_extended.csv,
+/// table2_extended.md, table2_extended.png (if gnuplot is there); a new run the safety monitor
+/// stops is a row with its reason, not an error (a Table 2 row that fails still throws).
 /// Throws rths::Error before running anything if a controller or the plant is not available.
 Table2Result ReproduceTable2(const ReproduceOptions& opts);
 /// The claims of E3 on a finished table (rows as ReproduceTable2 returns them).

@@ -2,6 +2,8 @@
 #include <unistd.h>
 
 #include <atomic>
+#include <ctime>
+#include <string>
 #include <filesystem>
 
 #include <fmt/format.h>
@@ -13,6 +15,15 @@
 namespace rths::report {
 
 namespace fs = std::filesystem;
+
+std::string UtcStamp() {
+  const std::time_t now = std::time(nullptr);
+  char stamp[32];
+  std::tm tm{};
+  gmtime_r(&now, &tm);
+  std::strftime(stamp, sizeof stamp, "%Y-%m-%d %H:%M UTC", &tm);
+  return stamp;
+}
 
 void PrepareOutDir(const fs::path& dir) {
   io::RequireNewOrEmptyFolder(dir, "an earlier reproduction");

@@ -12,6 +12,8 @@
 #include "core/error.h"
 #include "io/csv.h"
 #include "report/reproduce.h"
+#include "report/studies.h"
+#include "report/table2_extended.h"
 
 namespace rths::report {
 
@@ -74,7 +76,7 @@ scenario::Scenario Table2Scenario(const Table2Controller& row, double band_hz, c
                                   double duration_s) {
   scenario::Scenario s;
   s.run.name = Slug(fmt::format("table2 {} {}hz {}", row.condition, BandText(band_hz), row.name));
-  s.run.dt_s = 0.0005;
+  s.run.dt_s = kTable2DtS;
   s.run.duration_s = duration_s;
   s.structure.mode = models::StructureMode::kPredefined;
   s.structure.derivatives = models::Derivatives::kExtrapolated;  // Eqs. 20-22, the causal RTHS path
@@ -199,11 +201,7 @@ void WriteMarkdown(const fs::path& file, const ReproduceOptions& opts, const std
                    const std::vector<Claim>& claims, double quick_s) {
   std::ofstream md(file);
   if (!md) throw Error(file.string(), "cannot open for writing");
-  const std::time_t now = std::time(nullptr);
-  char stamp[32];
-  std::tm tm{};
-  gmtime_r(&now, &tm);
-  std::strftime(stamp, sizeof stamp, "%Y-%m-%d %H:%M UTC", &tm);
+  const std::string stamp = UtcStamp();
   md << "# Table 2: tracking performance for predefined displacement histories\n\n"
      << fmt::format("Made by `rths reproduce table2{} --plant {}` on {}.\n\n", opts.quick ? " --quick" : "",
                     opts.plant, stamp)
@@ -281,11 +279,59 @@ Table2Result ReproduceTable2(const ReproduceOptions& opts) {
       rows.push_back(r);
     }
   }
+  const std::size_t n_paper = specs.size();
+  // --extended: the new runs (ats, ambc, pi_lead) after the paper's; none, ff and ff_lqg are the
+  // Table 2 rows' runs.
+  std::vector<Table2ExtendedRow> ext;
+  std::vector<std::size_t> ext_source;  // per extended row: its run's index in specs
+  std::optional<PiLeadDesign> pi_lead;
+  std::vector<double> durations;
+  for (const auto& r : rows) durations.push_back(r.duration_s);
+  if (opts.extended) {
+    pi_lead = DesignPiLead(models::ServoPreset("avg"), kTable2DtS);
+    if (opts.log) {
+      std::string text = pi_lead->Describe();
+      while (!text.empty() && text.back() == '\n') text.pop_back();
+      opts.log(text);
+    }
+    for (const char* cond : {"0.0A", "2.5A", "pulse"}) {
+      const auto ctrls = Table2ExtendedControllers(cond, *pi_lead);
+      for (double band : kBands) {
+        for (const auto& c : ctrls) {
+          Table2ExtendedRow e;
+          e.condition = cond;
+          e.band = BandText(band);
+          e.controller = c.name;
+          e.table2_row = c.table2_row;
+          if (!c.table2_row.empty()) {
+            std::size_t i = 0;
+            while (i < n_paper && !(rows[i].condition == e.condition && rows[i].controller == c.table2_row &&
+                                    rows[i].band == e.band)) {
+              ++i;
+            }
+            if (i == n_paper) throw Error("table2 --extended", "no Table 2 row " + c.table2_row);
+            e.duration_s = rows[i].duration_s;
+            e.run_dir = rows[i].run_dir;
+            ext_source.push_back(i);
+          } else {
+            e.duration_s = opts.quick ? quick_s : kFullDurationS;
+            e.run_dir = opts.out_dir / "runs" / Slug(fmt::format("{} {}hz {}", cond, e.band, c.name));
+            Table2Controller row{cond, c.name, 0.0, 0.0, "", "", c.controller};
+            ext_source.push_back(specs.size());
+            specs.push_back({fmt::format("{} {} Hz {}", cond, e.band, c.name),
+                             Table2Scenario(row, band, opts.plant, e.duration_s), e.run_dir});
+            durations.push_back(e.duration_s);
+          }
+          ext.push_back(e);
+        }
+      }
+    }
+  }
   // Longest runs first, so that the threads finish together.
   std::vector<std::size_t> order(specs.size());
   for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
   std::stable_sort(order.begin(), order.end(),
-                   [&](std::size_t a, std::size_t b) { return rows[a].duration_s > rows[b].duration_s; });
+                   [&](std::size_t a, std::size_t b) { return durations[a] > durations[b]; });
   std::vector<RunSpec> ordered;
   for (std::size_t i : order) ordered.push_back(specs[i]);
 
@@ -301,14 +347,17 @@ Table2Result ReproduceTable2(const ReproduceOptions& opts) {
                   : fmt::format("  [{:2}/{}] {:<32} FAILED: {}", done, total, r.label, r.error));
   });
   std::vector<std::string> failed;
+  std::vector<std::size_t> position(specs.size());  // spec i ran as ordered[position[i]]
   for (std::size_t j = 0; j < results.size(); ++j) {
+    position[order[j]] = j;
+    if (order[j] >= n_paper) continue;  // an extended run: its row says how it went
     Table2Row& row = rows[order[j]];
     row.ours_pct = results[j].tracking_pct;
     if (!results[j].ok) failed.push_back(fmt::format("  {}: {}", results[j].label, results[j].error));
   }
   if (!failed.empty()) {
     std::string msg = fmt::format("{} of {} runs failed (their folders are under {}):", failed.size(),
-                                  results.size(), (opts.out_dir / "runs").string());
+                                  n_paper, (opts.out_dir / "runs").string());
     for (const auto& f : failed) msg += "\n" + f;
     throw Error("table2", msg);
   }
@@ -324,6 +373,18 @@ Table2Result ReproduceTable2(const ReproduceOptions& opts) {
     csv.Close();
   }
   WriteMarkdown(opts.out_dir / "table2.md", opts, rows, res.claims, quick_s);
+  if (opts.extended) {
+    for (std::size_t i = 0; i < ext.size(); ++i) {
+      const std::size_t j = position[ext_source[i]];
+      ext[i].stopped = StoppedText(results[j]);
+      ext[i].steps_planned = ordered[j].scenario.steps();  // after any --set
+      ext[i].duration_s = ordered[j].scenario.run.duration_s;
+    }
+    MeasureExtendedRows(&ext, opts.jobs);
+    WriteTable2Extended(opts, ext, *pi_lead);
+    res.extended = ext;
+    res.pi_lead = pi_lead;
+  }
   res.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return res;
 }
