@@ -19,6 +19,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/error.h"
+#include "report/html.h"
 #include "report/run_report.h"
 #include "test_support.h"
 

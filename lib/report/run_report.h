@@ -103,7 +103,4 @@ std::vector<double> CentralDifference(const std::vector<double>& x, double dt_s)
 /// envelope and every peak survive). max_points >= 4.
 std::vector<std::size_t> MinMaxDecimate(const std::vector<double>& x, std::size_t max_points);
 
-/// Text with &, <, >, " and ' escaped for HTML.
-std::string HtmlEscape(const std::string& text);
-
 }  // namespace rths::report

@@ -12,6 +12,13 @@ namespace rths::signal {
 /// differ in length.
 double RmsErrorPercent(std::span<const double> r, std::span<const double> y);
 
+/// Root mean square of x, sqrt(sum x_i^2 / n) (0 for no samples).
+double Rms(std::span<const double> x);
+
+/// The largest |x_i| over the finite samples (0 if none); `at` (if given) gets its index (0 if
+/// none).
+double PeakAbs(std::span<const double> x, std::size_t* at = nullptr);
+
 /// Eq. 31 accumulated sample by sample (for a logger). Add() allocates nothing; Percent() is
 /// equal to RmsErrorPercent over the samples added so far.
 struct RmsErrorAccumulator {

@@ -1,0 +1,25 @@
+#pragma once
+/// @file The small HTML writer of rths's pages (the run report, docs/report.md): escaping, a
+/// table row, the head of a page with the shared style sheet, and an atomic file write. Pages are
+/// self-contained: no JavaScript, no network.
+#include <filesystem>
+#include <string>
+
+namespace rths::report {
+
+/// Text with &, <, >, " and ' escaped for HTML.
+std::string HtmlEscape(const std::string& text);
+
+/// One row of a two-column table: `<tr><th>name</th><td id="id">value_html</td></tr>` (no id
+/// attribute if `id` is empty); `name` and `value_html` are HTML already.
+std::string HtmlRow(const std::string& name, const std::string& value_html, const std::string& id = "");
+
+/// The start of a page up to and including `<body>`: doctype, UTF-8, the title (escaped here) and
+/// the shared style sheet (headings, tables, banners `.banner.failed|.note|.ok`, figures, `.where`).
+std::string HtmlHead(const std::string& title);
+
+/// Writes `text` to `path` through `path.tmp` and a rename, so that a reader never sees half a
+/// page. Throws rths::Error naming the file if it cannot be written.
+void WriteFileAtomically(const std::filesystem::path& path, const std::string& text);
+
+}  // namespace rths::report

@@ -1,0 +1,55 @@
+#pragma once
+/// @file The figures of the run report (internal to report/run_report.cpp): each a gnuplot figure
+/// with its heading and caption, from a run's decoded signals (io/run_signals.h). Units: mm, kN,
+/// A, s; frequencies Hz.
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "io/plot.h"
+#include "io/run_signals.h"
+#include "report/run_report.h"
+
+namespace rths::report::run_figures {
+
+/// One figure of the page: the gnuplot figure, its heading and its caption (HTML).
+struct PageFigure {
+  io::Figure figure;
+  std::string heading;
+  std::string caption_html;
+};
+
+/// r, u, y [mm]; f (and the clipped-optimal desired force) [kN]; i_cmd, i_eff [A] against t [s].
+PageFigure TimeHistories(const io::RunSignals& s, const RunReportOptions& o);
+/// e = r - y [mm] over the run, and r, u, y over the 0.5 s around the largest |e|.
+PageFigure TrackingError(const io::RunSignals& s, const RunReportOptions& o);
+/// An adaptive controller's coefficients (columns a0, a1_s, ...), one panel each; nullopt for a
+/// fixed controller.
+std::optional<PageFigure> Adaptation(const io::RunSignals& s, const RunReportOptions& o);
+/// f [kN] against y [mm] and against y' [mm/s] (central difference).
+PageFigure Loops(const io::RunSignals& s, const RunReportOptions& o);
+
+/// The spectra and G_yr, and the numbers the page quotes from them.
+struct FrequencyFigures {
+  std::optional<PageFigure> spectra, gyr;
+  std::string summary_html;  ///< band, magnitude range, time lag ("" if none)
+  std::vector<std::string> notes;
+};
+/// Welch spectra of r, y, e and the H1 estimate of G_yr over the excited band of r, with the notes
+/// saying why one is missing.
+FrequencyFigures Frequency(const io::RunSignals& s, const RunReportOptions& o);
+
+/// The RTHS benchmark's criteria and their figure (scenarios with structure.reference_file).
+struct BenchmarkSection {
+  std::optional<PageFigure> figure;
+  std::string table_html;  ///< the J1-J9 table ("" if none)
+  std::string note;        ///< why there are no criteria ("" if there are)
+};
+/// The RTHS benchmark's J1-J9 table and figure (io/benchmark_run.h), for a scenario with
+/// structure.reference_file; empty otherwise, or a note if they cannot be computed.
+BenchmarkSection Benchmark(const RunData& d, const RunReportOptions& o);
+
+/// True if every panel has at least one finite point (io::Plot refuses a panel without one).
+bool Drawable(const io::Figure& fig);
+
+}  // namespace rths::report::run_figures
