@@ -15,6 +15,7 @@
 
 #include "core/error.h"
 #include "io/benchmark_run.h"
+#include "models/ground_response.h"
 #include "io/plot.h"
 #include "models/benchmark_structures.h"
 #include "models/structure.h"
@@ -100,7 +101,7 @@ TEST_CASE("the partition: numerical substructure + the experimental force of the
   const std::vector<double> ag = ElCentro(n);
   const rths::models::BenchmarkStructures b = rths::models::Silva3Structures();
   const auto ref = rths::models::LinearStructure::Make(b.reference.M, b.reference.C, b.reference.K, 0, 1.0);
-  const std::vector<std::vector<double>> xr = rths::io::ReferenceResponse(ref, kDt, ag);
+  const std::vector<std::vector<double>> xr = rths::models::GroundResponse(ref, kDt, ag);
   REQUIRE(xr.size() == 3);
   REQUIRE(xr[0].size() == n);
 
@@ -144,14 +145,14 @@ TEST_CASE("the partition: numerical substructure + the experimental force of the
   CHECK(none.J7_pct > 5.0);
 }
 
-TEST_CASE("ReferenceResponse: x_k depends on a_g up to k-1, from rest; SDOF closed form of the first steps") {
+TEST_CASE("GroundResponse: x_k depends on a_g up to k-1, from rest; SDOF closed form of the first steps") {
   // SDOF m = 1e-3, k = 1, c = 0: x_0 = 0, x_1 = -dt^2 a_g,0, x_2 = 2 x_1 - k dt^2 / m x_1 - dt^2 a_g,1.
   const Eigen::MatrixXd M = Eigen::MatrixXd::Constant(1, 1, 1e-3), K = Eigen::MatrixXd::Constant(1, 1, 1.0),
                         C = Eigen::MatrixXd::Zero(1, 1);
   const auto s = rths::models::LinearStructure::Make(M, C, K, 0, 1.0);
   const double dt = 1e-3;
   const std::vector<double> ag = {100.0, -50.0, 7.0};
-  const auto x = rths::io::ReferenceResponse(s, dt, ag);
+  const auto x = rths::models::GroundResponse(s, dt, ag);
   REQUIRE(x.size() == 1);
   REQUIRE(x[0].size() == 3);
   CHECK(x[0][0] == 0.0);
@@ -159,7 +160,7 @@ TEST_CASE("ReferenceResponse: x_k depends on a_g up to k-1, from rest; SDOF clos
   CHECK(x[0][1] == doctest::Approx(x1).epsilon(1e-14));
   CHECK(x[0][2] == doctest::Approx(2 * x1 - dt * dt / 1e-3 * x1 + dt * dt * 50.0).epsilon(1e-12));
   // Unstable step: refused.
-  CHECK_THROWS_AS(rths::io::ReferenceResponse(s, 1.0, ag), rths::Error);
+  CHECK_THROWS_AS(rths::models::GroundResponse(s, 1.0, ag), rths::Error);
 }
 
 TEST_CASE("a memq run with structure.reference_file: J1-J9 from its log, in summary.json and the run's lines") {

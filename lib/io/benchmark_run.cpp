@@ -3,22 +3,10 @@
 #include <fmt/format.h>
 
 #include "core/error.h"
+#include "models/ground_response.h"
 #include "models/structure_file.h"
 
 namespace rths::io {
-
-std::vector<std::vector<double>> ReferenceResponse(const models::LinearStructure& reference, double dt_s,
-                                                   std::span<const double> ground_acc_mm_s2) {
-  const models::CentralDifference cd = models::CentralDifference::Make(reference, dt_s);
-  models::StructureState st = models::MakeState(cd);
-  const std::size_t n = ground_acc_mm_s2.size();
-  std::vector<std::vector<double>> x(static_cast<std::size_t>(cd.dofs()), std::vector<double>(n, 0.0));
-  for (std::size_t k = 0; k < n; ++k) {
-    if (k > 0) models::Advance(cd, &st, ground_acc_mm_s2[k - 1], 0.0);  // x_k from a_g,k-1 (as the integrator)
-    for (int i = 0; i < cd.dofs(); ++i) x[static_cast<std::size_t>(i)][k] = st.x[i];
-  }
-  return x;
-}
 
 models::LinearStructure ReferenceStructure(const scenario::Scenario& s, int run_dofs) {
   const std::string where = fmt::format("{}: structure.reference_file", s.path.empty() ? "<scenario text>" : s.path);
@@ -53,7 +41,7 @@ signal::BenchmarkSignals BenchmarkSignalsFromRun(const RunSignals& signals, cons
   b.x_t = signals.At("r_mm").values;
   for (int i = 1; i <= dofs; ++i) b.x_n.push_back(signals.At(fmt::format("x{}_mm", i)).values);
   try {
-    b.x_r = ReferenceResponse(ref, signals.dt_s, signals.At("ground_acc_mm_s2").values);
+    b.x_r = models::GroundResponse(ref, signals.dt_s, signals.At("ground_acc_mm_s2").values);
   } catch (const Error& e) {
     throw Error(fmt::format("{}: structure.reference_file", s.path), e.what());
   }

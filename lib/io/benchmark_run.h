@@ -3,10 +3,8 @@
 /// docs/benchmark.md): the monolithic reference structure (structure.reference_file) integrated
 /// offline under the ground acceleration the run's log holds, against what the run logged.
 ///
-/// Reference response: the same central difference as the integrator (models/structure.h, Eqs. 1-3)
-/// at the run's dt, from rest, without a specimen, driven by desired_t.ground_acc_mm_s2 of each
-/// logged step: x_r,0 = 0 and x_r,k+1 from x_r,k, x_r,k-1 and a_g,k, so x_r,k depends on a_g up to
-/// k-1 exactly as the integrator's x_k does.
+/// Reference response: models::GroundResponse (models/ground_response.h) at the run's dt, driven by
+/// desired_t.ground_acc_mm_s2 of each logged step.
 ///
 /// The criteria's records, per logged step k (io/run_signals.h column names, mm):
 ///     x_m = y_mm (measured_t.y_mm),  x_t = r_mm (desired_t.r_mm),
@@ -24,13 +22,6 @@
 #include "signal/benchmark_criteria.h"
 
 namespace rths::io {
-
-/// The response x_r,k [mm] of `reference` (no specimen force) at dt_s [s] to the ground
-/// acceleration a_g,k [mm/s^2], from rest: one row per sample k = 0..N-1 (N = ground's length),
-/// x_r[i][k] for floor i + 1. Throws rths::Error if dt_s is at or above the central-difference
-/// stability limit of `reference` (CentralDifference::Make).
-std::vector<std::vector<double>> ReferenceResponse(const models::LinearStructure& reference, double dt_s,
-                                                   std::span<const double> ground_acc_mm_s2);
 
 /// The monolithic reference structure a scenario names (structure.reference_file, with its iota),
 /// the specimen position at structure.actuator_dof (count 1; unused: no force). Throws

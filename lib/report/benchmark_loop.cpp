@@ -12,6 +12,7 @@
 #include "control/lti_controller.h"
 #include "core/error.h"
 #include "io/benchmark_run.h"
+#include "models/ground_response.h"
 #include "models/rig.h"
 #include "models/structure.h"
 #include "models/structure_file.h"
@@ -175,7 +176,7 @@ LoopResult RunBenchmarkLoop(const scenario::Scenario& s, const LoopOptions& o) {
       Rk4(cr, &z, dt, ag, 0.0);
     }
   } else {
-    rec.x_r = io::ReferenceResponse(ref, dt, ground);
+    rec.x_r = models::GroundResponse(ref, dt, ground);
   }
   out.j = signal::BenchmarkCriteriaFrom(rec);
   return out;

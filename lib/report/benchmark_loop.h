@@ -21,7 +21,7 @@
 ///    t_k + dt;
 ///  - force_delay_steps d: 0 (the lockstep's x_{k+1} uses f_k) or 1 (the reference code's Unit
 ///    Delay on the measured force);
-///  - reference: the monolithic structure by "cd" (io::ReferenceResponse, as rths run scores) or by
+///  - reference: the monolithic structure by "cd" (models::GroundResponse, as rths run scores) or by
 ///    "rk4" (continuous, as the reference code's lsim);
 ///  - quantise_m: the reference code's converters around its example controller (`lti` only): its
 ///    target, the reference filter's output, the error and the command each rounded to a multiple
