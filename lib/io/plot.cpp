@@ -32,16 +32,16 @@ bool ValidName(const std::string& s) {
   return true;
 }
 
-std::string FindOnPath(const std::string& program) {
+/// Folders a program named without a path is looked for in: the system's own. The user's PATH is
+/// read by the main program, which passes a path (tools/cli.h ProgramOnPath).
+constexpr const char* kProgramDirs[] = {"/usr/local/bin", "/usr/bin", "/bin"};
+
+std::string FindProgram(const std::string& program) {
   if (program.find('/') != std::string::npos) {
     return ::access(program.c_str(), X_OK) == 0 ? program : "";
   }
-  const char* path = std::getenv("PATH");
-  std::stringstream ss(path ? path : "/usr/local/bin:/usr/bin:/bin");
-  std::string dir;
-  while (std::getline(ss, dir, ':')) {
-    if (dir.empty()) dir = ".";
-    const std::string candidate = dir + "/" + program;
+  for (const char* dir : kProgramDirs) {
+    const std::string candidate = std::string(dir) + "/" + program;
     if (::access(candidate.c_str(), X_OK) == 0 && fs::is_regular_file(candidate)) return candidate;
   }
   return "";
@@ -158,7 +158,7 @@ int KeyMarginChars(const std::vector<const Panel*>& panels) {
   return std::max(12, static_cast<int>(longest) + 10);
 }
 
-bool GnuplotAvailable(const std::string& program) { return !FindOnPath(program).empty(); }
+bool GnuplotAvailable(const std::string& program) { return !FindProgram(program).empty(); }
 
 PlotFiles Plot(const Figure& fig, const fs::path& dir) {
   const std::string where = "plot " + fig.name;
@@ -167,7 +167,7 @@ PlotFiles Plot(const Figure& fig, const fs::path& dir) {
   }
   if (fig.panels.empty()) throw Error(where, "no panels");
   if (fig.columns < 1) throw Error(where, "columns must be >= 1");
-  const std::string exe = FindOnPath(fig.gnuplot);
+  const std::string exe = FindProgram(fig.gnuplot);
   if (exe.empty()) {
     throw Error(where, fmt::format("gnuplot is not installed (no '{}' on PATH): install it with "
                                    "`apt-get install gnuplot-nox` (Debian) and run again",
