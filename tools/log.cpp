@@ -360,7 +360,7 @@ int main(int argc, char** argv) {
   if (const int code = rths::tools::ParseCommandLine(app, argc, argv); code >= 0) return code;
   try {
     if (*dump) return DumpCommand(files[0], dump_channel, dump_csv);
-    if (*stats || *digest) return StatsCommand(files, *digest);
+    if (*stats || *digest) return StatsCommand(files, static_cast<bool>(*digest));
     return CompareCommand(files);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "rths log: %s\n", e.what());
