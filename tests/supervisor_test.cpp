@@ -28,9 +28,10 @@ duration_s = 0.25
 nlohmann::json Summary(const fs::path& run) { return nlohmann::json::parse(std::ifstream(run / "summary.json")); }
 
 /// `j` without what differs from one run of the same scenario to the next: the run id, wall and
-/// stepping times, the teardown time and, on udpm, the URL (its port) and the link counters.
+/// stepping times, the clock's step latencies, the teardown time and, on udpm, the URL (its port)
+/// and the link counters.
 nlohmann::json Comparable(nlohmann::json j, bool udpm) {
-  std::vector<std::string> drop = {"run_id", "wall_s", "stepping_s", "steps_per_s", "teardown_s"};
+  std::vector<std::string> drop = {"run_id", "wall_s", "stepping_s", "steps_per_s", "teardown_s", "realtime"};
   if (udpm) drop.insert(drop.end(), {"lcm_url", "link", "stats"});
   if (j.is_object()) {
     for (const auto& key : drop) j.erase(key);
