@@ -5,10 +5,16 @@
 ///     prints CLI11's message and the usage hint on stderr and exits 2, like every other bad input;
 ///   - messages on stderr start with "rths <sub>: ".
 /// Header-only; the tools include it, the libraries never do.
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
 #include <string>
 #include <vector>
 
 #include <CLI/CLI.hpp>
+
+#include "core/progress.h"
 
 namespace rths::tools {
 
@@ -26,8 +32,10 @@ inline void NameCommand(CLI::App& app, const std::string& sub) {
 }
 
 /// Parses the command line. Returns -1 to go on, or the code to exit with: 0 after --help,
-/// kExitUsage after a usage error (message already printed).
+/// kExitUsage after a usage error (message already printed). A non-empty RTHS_NO_PROGRESS in the
+/// environment turns the progress lines off (core/progress.h).
 inline int ParseCommandLine(CLI::App& app, int argc, char** argv) {
+  if (const char* off = std::getenv("RTHS_NO_PROGRESS"); off != nullptr && *off != '\0') ProgressLine::TurnOff();
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -35,6 +43,24 @@ inline int ParseCommandLine(CLI::App& app, int argc, char** argv) {
     return code == 0 ? 0 : kExitUsage;
   }
   return -1;
+}
+
+/// `name` as found on the user's PATH (the first executable regular file), or `name` itself if it
+/// holds a '/' or is not found (the library then looks in the system's folders, io/plot.h).
+inline std::string ProgramOnPath(const std::string& name) {
+  const char* path = std::getenv("PATH");
+  if (name.find('/') != std::string::npos || path == nullptr) return name;
+  std::string dirs = path;
+  for (std::size_t start = 0; start <= dirs.size();) {
+    std::size_t end = dirs.find(':', start);
+    if (end == std::string::npos) end = dirs.size();
+    const std::string dir = end > start ? dirs.substr(start, end - start) : ".";
+    const std::string candidate = dir + "/" + name;
+    std::error_code ec;
+    if (::access(candidate.c_str(), X_OK) == 0 && std::filesystem::is_regular_file(candidate, ec)) return candidate;
+    start = end + 1;
+  }
+  return name;
 }
 
 /// Adds the repeatable `--set KEY=VALUE` option (scenario overrides, scenario::ApplyOverrides).

@@ -226,6 +226,113 @@ std::int64_t Dump(const std::string& path, const rths::io::RunLog& log, const st
   return rows;
 }
 
+/// `rths log dump`: the CSV to standard output or --csv (no half-written file left behind).
+int DumpCommand(const std::string& path, const std::string& channel_arg, const std::string& csv) {
+  const std::string channel = channel_arg.empty() ? "" : DumpChannelName(channel_arg);
+  if (!csv.empty()) rths::io::RefuseToReplaceRecord(csv, {path}, "--csv");
+  const auto log = rths::io::ReadRunLog(path);
+  std::FILE* out = stdout;
+  std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(nullptr, std::fclose);
+  if (!csv.empty()) {
+    file.reset(std::fopen(csv.c_str(), "wb"));
+    if (!file) throw rths::Error(csv, fmt::format("cannot write the file: {}", std::strerror(errno)));
+    out = file.get();
+  }
+  std::int64_t skipped = 0, rows = 0;
+  const std::string out_name = csv.empty() ? "standard output" : csv;
+  try {
+    rows = Dump(path, log, channel, out, out_name, &skipped);
+    if (std::fflush(out) != 0 || (file && std::fclose(file.release()) != 0))
+      throw rths::Error(out_name, fmt::format("write failed: {}", std::strerror(errno)));
+  } catch (...) {
+    // No half-written file is left behind (a device or FIFO is left alone).
+    std::error_code ec;
+    file.reset();
+    if (!csv.empty() && std::filesystem::is_regular_file(std::filesystem::symlink_status(csv, ec)))
+      std::filesystem::remove(csv, ec);
+    throw;
+  }
+  if (!csv.empty())
+    std::fprintf(stderr, "rths log: %s: %lld messages to %s\n", path.c_str(), static_cast<long long>(rows),
+                 csv.c_str());
+  if (channel.empty() && skipped > 0)
+    std::fprintf(stderr, "rths log: note: %s: %lld events on other channels not dumped\n", path.c_str(),
+                 static_cast<long long>(skipped));
+  if (!log.Complete()) {
+    std::fprintf(stderr, "rths log: note: %s: %s; dumped every complete event\n", path.c_str(),
+                 log.TruncationReason().c_str());
+    return kTruncated;
+  }
+  return kOk;
+}
+
+/// `rths log stats` and `rths log digest`.
+int StatsCommand(const std::vector<std::string>& files, bool digest) {
+  int code = kOk;
+  for (const auto& f : files) {
+    const auto log = rths::io::ReadRunLog(f);
+    if (!log.Complete()) code = kTruncated;
+    if (digest) {
+      std::printf("%s  %s\n", rths::io::PayloadDigest(log).c_str(), f.c_str());
+      if (!log.Complete())
+        std::fprintf(stderr, "rths log: %s: %s; the digest covers what it holds (%lld complete steps)\n", f.c_str(),
+                     log.TruncationReason().c_str(), static_cast<long long>(log.CompleteSteps()));
+      continue;
+    }
+    PrintStats(f, log);
+  }
+  return code;
+}
+
+/// Prints where channel `ch` of the two logs first differs (and by how much, for the step channels);
+/// returns whether it does.
+bool CompareChannelPayloads(const rths::io::RunLog& a, const rths::io::RunLog& b, const std::string& ch,
+                            const std::vector<std::vector<std::uint8_t>>& pa,
+                            const std::vector<std::vector<std::uint8_t>>& pb) {
+  if (pa.size() != pb.size()) {
+    std::printf("%s: %zu vs %zu steps\n", ch.c_str(), pa.size(), pb.size());
+    return true;
+  }
+  for (std::size_t k = 0; k < pa.size(); ++k) {
+    if (pa[k] == pb[k]) continue;
+    std::printf("%s: first difference at k = %zu\n", ch.c_str(), k);
+    if (ch == "RTHS_DESIRED" || ch == "RTHS_COMMAND" || ch == "RTHS_MEASURED" || ch == "RTHS_CURRENT") {
+      // How much, field by field (B - A).
+      const auto d = rths::io::CompareChannel(a, b, ch, static_cast<std::int64_t>(pa.size()));
+      const std::string text = rths::io::Describe(d);
+      if (const auto nl = text.find('\n'); nl != std::string::npos) std::printf("%s\n", text.substr(nl + 1).c_str());
+    }
+    return true;
+  }
+  return false;
+}
+
+/// `rths log compare A B`.
+int CompareCommand(const std::vector<std::string>& files) {
+  const auto a = rths::io::ReadRunLog(files[0]);
+  const auto b = rths::io::ReadRunLog(files[1]);
+  for (const auto* l : {&a, &b})
+    if (!l->Complete()) std::fprintf(stderr, "rths log: note: %s: %s\n", l->source.c_str(), l->TruncationReason().c_str());
+  int differences = 0;
+  for (const auto& [ch, pa] : a.payload) {
+    const auto it = b.payload.find(ch);
+    if (it == b.payload.end()) {
+      std::printf("%s: only in %s (%zu steps)\n", ch.c_str(), files[0].c_str(), pa.size());
+      ++differences;
+      continue;
+    }
+    if (CompareChannelPayloads(a, b, ch, pa, it->second)) ++differences;
+  }
+  for (const auto& [ch, pb] : b.payload) {
+    if (!a.payload.count(ch)) {
+      std::printf("%s: only in %s (%zu steps)\n", ch.c_str(), files[1].c_str(), pb.size());
+      ++differences;
+    }
+  }
+  std::printf(differences ? "logs differ\n" : "identical payloads per (channel, k)\n");
+  return differences ? kDiffer : kOk;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -252,99 +359,9 @@ int main(int argc, char** argv) {
   dump->add_option("--csv", dump_csv, "write the CSV to this file (default: standard output)");
   if (const int code = rths::tools::ParseCommandLine(app, argc, argv); code >= 0) return code;
   try {
-    if (*dump) {
-      const std::string channel = dump_channel.empty() ? "" : DumpChannelName(dump_channel);
-      if (!dump_csv.empty()) rths::io::RefuseToReplaceRecord(dump_csv, {files[0]}, "--csv");
-      const auto log = rths::io::ReadRunLog(files[0]);
-      std::FILE* out = stdout;
-      std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(nullptr, std::fclose);
-      if (!dump_csv.empty()) {
-        file.reset(std::fopen(dump_csv.c_str(), "wb"));
-        if (!file) throw rths::Error(dump_csv, fmt::format("cannot write the file: {}", std::strerror(errno)));
-        out = file.get();
-      }
-      std::int64_t skipped = 0, rows = 0;
-      const std::string out_name = dump_csv.empty() ? "standard output" : dump_csv;
-      try {
-        rows = Dump(files[0], log, channel, out, out_name, &skipped);
-        if (std::fflush(out) != 0 || (file && std::fclose(file.release()) != 0))
-          throw rths::Error(out_name, fmt::format("write failed: {}", std::strerror(errno)));
-      } catch (...) {
-        // No half-written file is left behind (a device or FIFO is left alone).
-        std::error_code ec;
-        file.reset();
-        if (!dump_csv.empty() && std::filesystem::is_regular_file(std::filesystem::symlink_status(dump_csv, ec)))
-          std::filesystem::remove(dump_csv, ec);
-        throw;
-      }
-      if (!dump_csv.empty())
-        std::fprintf(stderr, "rths log: %s: %lld messages to %s\n", files[0].c_str(), static_cast<long long>(rows),
-                     dump_csv.c_str());
-      if (channel.empty() && skipped > 0)
-        std::fprintf(stderr, "rths log: note: %s: %lld events on other channels not dumped\n", files[0].c_str(),
-                     static_cast<long long>(skipped));
-      if (!log.Complete()) {
-        std::fprintf(stderr, "rths log: note: %s: %s; dumped every complete event\n", files[0].c_str(),
-                     log.TruncationReason().c_str());
-        return kTruncated;
-      }
-      return kOk;
-    }
-    if (*stats || *digest) {
-      int code = kOk;
-      for (const auto& f : files) {
-        const auto log = rths::io::ReadRunLog(f);
-        if (!log.Complete()) code = kTruncated;
-        if (*digest) {
-          std::printf("%s  %s\n", rths::io::PayloadDigest(log).c_str(), f.c_str());
-          if (!log.Complete())
-            std::fprintf(stderr, "rths log: %s: %s; the digest covers what it holds (%lld complete steps)\n", f.c_str(),
-                         log.TruncationReason().c_str(), static_cast<long long>(log.CompleteSteps()));
-          continue;
-        }
-        PrintStats(f, log);
-      }
-      return code;
-    }
-    const auto a = rths::io::ReadRunLog(files[0]);
-    const auto b = rths::io::ReadRunLog(files[1]);
-    for (const auto* l : {&a, &b})
-      if (!l->Complete()) std::fprintf(stderr, "rths log: note: %s: %s\n", l->source.c_str(), l->TruncationReason().c_str());
-    int differences = 0;
-    for (const auto& [ch, pa] : a.payload) {
-      const auto it = b.payload.find(ch);
-      if (it == b.payload.end()) {
-        std::printf("%s: only in %s (%zu steps)\n", ch.c_str(), files[0].c_str(), pa.size());
-        ++differences;
-        continue;
-      }
-      if (pa.size() != it->second.size()) {
-        std::printf("%s: %zu vs %zu steps\n", ch.c_str(), pa.size(), it->second.size());
-        ++differences;
-        continue;
-      }
-      for (std::size_t k = 0; k < pa.size(); ++k) {
-        if (pa[k] != it->second[k]) {
-          std::printf("%s: first difference at k = %zu\n", ch.c_str(), k);
-          if (ch == "RTHS_DESIRED" || ch == "RTHS_COMMAND" || ch == "RTHS_MEASURED" || ch == "RTHS_CURRENT") {
-            // How much, field by field (B - A).
-            const auto d = rths::io::CompareChannel(a, b, ch, static_cast<std::int64_t>(pa.size()));
-            const std::string text = rths::io::Describe(d);
-            if (const auto nl = text.find('\n'); nl != std::string::npos) std::printf("%s\n", text.substr(nl + 1).c_str());
-          }
-          ++differences;
-          break;
-        }
-      }
-    }
-    for (const auto& [ch, pb] : b.payload) {
-      if (!a.payload.count(ch)) {
-        std::printf("%s: only in %s (%zu steps)\n", ch.c_str(), files[1].c_str(), pb.size());
-        ++differences;
-      }
-    }
-    std::printf(differences ? "logs differ\n" : "identical payloads per (channel, k)\n");
-    return differences ? kDiffer : kOk;
+    if (*dump) return DumpCommand(files[0], dump_channel, dump_csv);
+    if (*stats || *digest) return StatsCommand(files, static_cast<bool>(*digest));
+    return CompareCommand(files);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "rths log: %s\n", e.what());
     return kBadInput;

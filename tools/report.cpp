@@ -43,6 +43,7 @@ int main(int argc, char** argv) {
   rths::tools::NameCommand(app, "report");
   if (const int code = rths::tools::ParseCommandLine(app, argc, argv); code >= 0) return code;
   o.out_dir = out;
+  o.gnuplot = rths::tools::ProgramOnPath(o.gnuplot);
 
   rths::report::RunData data;
   try {

@@ -3,9 +3,9 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 
 #include <fmt/format.h>
 
@@ -14,12 +14,12 @@ namespace rths {
 namespace {
 constexpr auto kRedraw = std::chrono::milliseconds(250);
 constexpr std::size_t kMaxWidth = 100;  ///< characters; longer lines are cut (no wrap on narrow terminals)
+std::atomic<bool> g_turned_off{false};
 }  // namespace
 
-bool ProgressLine::StderrIsTerminal() {
-  const char* off = std::getenv("RTHS_NO_PROGRESS");
-  return ::isatty(2) == 1 && (off == nullptr || *off == '\0');
-}
+bool ProgressLine::StderrIsTerminal() { return ::isatty(2) == 1 && !g_turned_off; }
+
+void ProgressLine::TurnOff() { g_turned_off = true; }
 
 std::string ProgressLine::FormatSeconds(double s) {
   if (!(s >= 0.0) || !std::isfinite(s)) return "?";

@@ -18,8 +18,8 @@ using ProgressFn = std::function<void(double done, double total, std::string_vie
 
 class ProgressLine {
  public:
-  /// `enabled`: draw at all; by default, only if stderr is a terminal (isatty(2)) and the
-  /// environment does not set RTHS_NO_PROGRESS. Main programs decide; libraries take a
+  /// `enabled`: draw at all; by default, only if stderr is a terminal (isatty(2)) and the main
+  /// program has not turned progress lines off (TurnOff). Main programs decide; libraries take a
   /// ProgressLine* that may be null.
   explicit ProgressLine(std::string label, bool enabled = StderrIsTerminal());
   ~ProgressLine();  ///< clears the line (Finish())
@@ -32,8 +32,11 @@ class ProgressLine {
   void Finish();
   bool enabled() const { return enabled_; }
 
-  /// True if stderr is a terminal and RTHS_NO_PROGRESS is unset or empty.
+  /// True if stderr is a terminal and progress lines were not turned off.
   static bool StderrIsTerminal();
+  /// Turns every later progress line of this process off: a main program's answer to the user
+  /// (tools/cli.h: the environment sets RTHS_NO_PROGRESS). Libraries never call it.
+  static void TurnOff();
   /// "12 s", "3 min 05 s", "1 h 02 min".
   static std::string FormatSeconds(double s);
 

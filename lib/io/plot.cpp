@@ -32,16 +32,16 @@ bool ValidName(const std::string& s) {
   return true;
 }
 
-std::string FindOnPath(const std::string& program) {
+/// Folders a program named without a path is looked for in: the system's own. The user's PATH is
+/// read by the main program, which passes a path (tools/cli.h ProgramOnPath).
+constexpr const char* kProgramDirs[] = {"/usr/local/bin", "/usr/bin", "/bin"};
+
+std::string FindProgram(const std::string& program) {
   if (program.find('/') != std::string::npos) {
     return ::access(program.c_str(), X_OK) == 0 ? program : "";
   }
-  const char* path = std::getenv("PATH");
-  std::stringstream ss(path ? path : "/usr/local/bin:/usr/bin:/bin");
-  std::string dir;
-  while (std::getline(ss, dir, ':')) {
-    if (dir.empty()) dir = ".";
-    const std::string candidate = dir + "/" + program;
+  for (const char* dir : kProgramDirs) {
+    const std::string candidate = std::string(dir) + "/" + program;
     if (::access(candidate.c_str(), X_OK) == 0 && fs::is_regular_file(candidate)) return candidate;
   }
   return "";
@@ -158,27 +158,15 @@ int KeyMarginChars(const std::vector<const Panel*>& panels) {
   return std::max(12, static_cast<int>(longest) + 10);
 }
 
-bool GnuplotAvailable(const std::string& program) { return !FindOnPath(program).empty(); }
+bool GnuplotAvailable(const std::string& program) { return !FindProgram(program).empty(); }
 
-PlotFiles Plot(const Figure& fig, const fs::path& dir) {
-  const std::string where = "plot " + fig.name;
-  if (!ValidName(fig.name)) {
-    throw Error(where, "figure name must be letters, digits, '_', '-' or '.'");
-  }
-  if (fig.panels.empty()) throw Error(where, "no panels");
-  if (fig.columns < 1) throw Error(where, "columns must be >= 1");
-  const std::string exe = FindOnPath(fig.gnuplot);
-  if (exe.empty()) {
-    throw Error(where, fmt::format("gnuplot is not installed (no '{}' on PATH): install it with "
-                                   "`apt-get install gnuplot-nox` (Debian) and run again",
-                                   fig.gnuplot));
-  }
-  fs::create_directories(dir);
-  PlotFiles files{dir / (fig.name + ".dat"), dir / (fig.name + ".gp"), dir / (fig.name + ".png")};
+namespace {
 
-  // Data: one block per curve with at least one finite point; `index` counts the blocks.
-  std::ofstream dat(files.dat);
-  if (!dat) throw Error(files.dat.string(), "cannot open for writing");
+/// Writes the data file: one block per curve with at least one finite point. Returns, per panel,
+/// each curve's block (-1: none). Throws rths::Error on a malformed figure.
+std::vector<std::vector<int>> WriteData(const Figure& fig, const fs::path& file, const std::string& where) {
+  std::ofstream dat(file);
+  if (!dat) throw Error(file.string(), "cannot open for writing");
   dat << "# " << fig.name << ": data of " << fig.name << ".png (whitespace-separated columns; "
       << "one block per curve, blocks separated by two blank lines: gnuplot `index`)\n";
   std::vector<std::vector<int>> index(fig.panels.size());
@@ -222,9 +210,72 @@ PlotFiles Plot(const Figure& fig, const fs::path& dir) {
     if (!has) throw Error(where, fmt::format("panel {} ('{}') has no finite point to plot", p + 1, panel.ylabel));
   }
   dat.close();
-  if (!dat) throw Error(files.dat.string(), "write failed");
+  if (!dat) throw Error(file.string(), "write failed");
+  return index;
+}
 
-  // Script.
+/// Panel p's part of the script: axes, ranges, tics, key and its curves (`blocks`: each curve's
+/// data block, -1 for a curve without a finite point).
+void WritePanel(std::ostringstream& gp, const Panel& panel, std::size_t p, const std::vector<int>& blocks,
+                const std::string& dat_name) {
+  gp << "\n# panel " << p + 1 << "\n"
+     << "unset logscale\nset grid\nset autoscale\n"
+     << "set title " << GnuplotQuote(panel.title) << "\n"
+     << "set xlabel " << GnuplotQuote(panel.xlabel) << "\n"
+     << "set ylabel " << GnuplotQuote(panel.ylabel) << "\n";
+  if (panel.log_x) gp << "set logscale x\n";
+  if (panel.log_y) gp << "set logscale y\n";
+  // Log axes: plain tick labels (1e-06, 0.001, 100), not gnuplot's fixed "0.0000010".
+  gp << "set format x " << (panel.log_x ? "'%g'" : "'% h'") << "\nset format y " << (panel.log_y ? "'%g'" : "'% h'")
+     << "\n";
+  gp << (panel.x_range ? fmt::format("set xrange [{}:{}]\n", Num(panel.x_range->first), Num(panel.x_range->second))
+                       : std::string("set xrange [*:*]\n"));
+  gp << (panel.y_range ? fmt::format("set yrange [{}:{}]\n", Num(panel.y_range->first), Num(panel.y_range->second))
+                       : std::string("set yrange [*:*]\n"));
+  gp << fmt::format("set lmargin {}\nset rmargin {}\n", panel.left_margin_chars < 0 ? -1 : panel.left_margin_chars,
+                    panel.right_margin_chars < 0 ? -1 : panel.right_margin_chars);
+  if (panel.x_tics.empty()) {
+    gp << "set xtics autofreq\n";
+  } else {
+    gp << "set xtics (";
+    for (std::size_t i = 0; i < panel.x_tics.size(); ++i) {
+      gp << (i ? ", " : "") << GnuplotQuote(panel.x_tics[i].second) << " " << Num(panel.x_tics[i].first);
+    }
+    gp << ")\n";
+  }
+  gp << fmt::format("set boxwidth {} absolute\nset style fill solid 0.85 border -1\n", Num(panel.box_width));
+  gp << "unset object 1\n";
+  if (panel.shade_x) {
+    gp << fmt::format("set object 1 rect from {},graph 0 to {},graph 1 behind fc rgb '#ebebeb' fs solid 1.0 noborder\n",
+                      Num(panel.shade_x->first), Num(panel.shade_x->second));
+  }
+  gp << "set key default\n";  // nothing of the previous panel's key (outside, width) carries over
+  if (panel.key == "off") {
+    gp << "set key off\n";
+  } else {
+    gp << "set key on " << panel.key << " box opaque spacing 1.2";
+    // Beside the axes: one character more than gnuplot's estimate of the titles, whose capitals
+    // run wider ("G_FF,avgA + LQG" would start left of its box).
+    if (panel.key.find("outside") != std::string::npos && panel.key.find("width") == std::string::npos) gp << " width 1";
+    gp << "\n";
+  }
+  gp << "plot ";
+  bool first = true;
+  for (std::size_t s = 0; s < panel.series.size(); ++s) {
+    if (blocks[s] < 0) continue;
+    const Series& ser = panel.series[s];
+    if (!first) gp << ", \\\n     ";
+    first = false;
+    gp << dat_name << " index " << blocks[s] << " using 1:2 with " << ser.with;
+    if (ser.with != "points") gp << " lw " << Num(ser.width) << " dt " << ser.dash;
+    if (!ser.color.empty()) gp << " lc rgb " << GnuplotQuote(ser.color);
+    gp << (ser.title.empty() ? std::string(" notitle") : " title " + GnuplotQuote(ser.title));
+  }
+  gp << "\n";
+}
+
+/// The gnuplot script of the figure (runnable again by hand), its curves read from `index`'s blocks.
+std::string Script(const Figure& fig, const std::vector<std::vector<int>>& index) {
   const int rows = static_cast<int>((fig.panels.size() + fig.columns - 1) / fig.columns);
   const int height = rows * fig.panel_height_px + (fig.title.empty() ? 0 : 40);
   const std::string dat_name = GnuplotQuote(fig.name + ".dat");
@@ -244,69 +295,36 @@ PlotFiles Plot(const Figure& fig, const fs::path& dir) {
     if (!fig.title.empty()) gp << " title " << GnuplotQuote(fig.title);
     gp << "\n";
   }
-  for (std::size_t p = 0; p < fig.panels.size(); ++p) {
-    const Panel& panel = fig.panels[p];
-    gp << "\n# panel " << p + 1 << "\n"
-       << "unset logscale\nset grid\nset autoscale\n"
-       << "set title " << GnuplotQuote(panel.title) << "\n"
-       << "set xlabel " << GnuplotQuote(panel.xlabel) << "\n"
-       << "set ylabel " << GnuplotQuote(panel.ylabel) << "\n";
-    if (panel.log_x) gp << "set logscale x\n";
-    if (panel.log_y) gp << "set logscale y\n";
-    // Log axes: plain tick labels (1e-06, 0.001, 100), not gnuplot's fixed "0.0000010".
-    gp << "set format x " << (panel.log_x ? "'%g'" : "'% h'") << "\nset format y " << (panel.log_y ? "'%g'" : "'% h'")
-       << "\n";
-    gp << (panel.x_range ? fmt::format("set xrange [{}:{}]\n", Num(panel.x_range->first), Num(panel.x_range->second))
-                         : std::string("set xrange [*:*]\n"));
-    gp << (panel.y_range ? fmt::format("set yrange [{}:{}]\n", Num(panel.y_range->first), Num(panel.y_range->second))
-                         : std::string("set yrange [*:*]\n"));
-    gp << fmt::format("set lmargin {}\nset rmargin {}\n", panel.left_margin_chars < 0 ? -1 : panel.left_margin_chars,
-                      panel.right_margin_chars < 0 ? -1 : panel.right_margin_chars);
-    if (panel.x_tics.empty()) {
-      gp << "set xtics autofreq\n";
-    } else {
-      gp << "set xtics (";
-      for (std::size_t i = 0; i < panel.x_tics.size(); ++i) {
-        gp << (i ? ", " : "") << GnuplotQuote(panel.x_tics[i].second) << " " << Num(panel.x_tics[i].first);
-      }
-      gp << ")\n";
-    }
-    gp << fmt::format("set boxwidth {} absolute\nset style fill solid 0.85 border -1\n", Num(panel.box_width));
-    gp << "unset object 1\n";
-    if (panel.shade_x) {
-      gp << fmt::format("set object 1 rect from {},graph 0 to {},graph 1 behind fc rgb '#ebebeb' fs solid 1.0 noborder\n",
-                        Num(panel.shade_x->first), Num(panel.shade_x->second));
-    }
-    gp << "set key default\n";  // nothing of the previous panel's key (outside, width) carries over
-    if (panel.key == "off") {
-      gp << "set key off\n";
-    } else {
-      gp << "set key on " << panel.key << " box opaque spacing 1.2";
-      // Beside the axes: one character more than gnuplot's estimate of the titles, whose capitals
-      // run wider ("G_FF,avgA + LQG" would start left of its box).
-      if (panel.key.find("outside") != std::string::npos && panel.key.find("width") == std::string::npos) gp << " width 1";
-      gp << "\n";
-    }
-    gp << "plot ";
-    bool first = true;
-    for (std::size_t s = 0; s < panel.series.size(); ++s) {
-      if (index[p][s] < 0) continue;
-      const Series& ser = panel.series[s];
-      if (!first) gp << ", \\\n     ";
-      first = false;
-      gp << dat_name << " index " << index[p][s] << " using 1:2 with " << ser.with;
-      if (ser.with != "points") gp << " lw " << Num(ser.width) << " dt " << ser.dash;
-      if (!ser.color.empty()) gp << " lc rgb " << GnuplotQuote(ser.color);
-      gp << (ser.title.empty() ? std::string(" notitle") : " title " + GnuplotQuote(ser.title));
-    }
-    gp << "\n";
-  }
+  for (std::size_t p = 0; p < fig.panels.size(); ++p) WritePanel(gp, fig.panels[p], p, index[p], dat_name);
   if (fig.panels.size() > 1 || !fig.title.empty()) gp << "\nunset multiplot\n";
   gp << "set output\n";
+  return gp.str();
+}
+
+}  // namespace
+
+PlotFiles Plot(const Figure& fig, const fs::path& dir) {
+  const std::string where = "plot " + fig.name;
+  if (!ValidName(fig.name)) {
+    throw Error(where, "figure name must be letters, digits, '_', '-' or '.'");
+  }
+  if (fig.panels.empty()) throw Error(where, "no panels");
+  if (fig.columns < 1) throw Error(where, "columns must be >= 1");
+  const std::string exe = FindProgram(fig.gnuplot);
+  if (exe.empty()) {
+    throw Error(where, fmt::format("gnuplot is not installed (no '{}' on PATH): install it with "
+                                   "`apt-get install gnuplot-nox` (Debian) and run again",
+                                   fig.gnuplot));
+  }
+  fs::create_directories(dir);
+  PlotFiles files{dir / (fig.name + ".dat"), dir / (fig.name + ".gp"), dir / (fig.name + ".png")};
+
+  const std::vector<std::vector<int>> index = WriteData(fig, files.dat, where);
+  const std::string script = Script(fig, index);
   {
     std::ofstream out(files.gp);
     if (!out) throw Error(files.gp.string(), "cannot open for writing");
-    out << gp.str();
+    out << script;
     if (!out) throw Error(files.gp.string(), "write failed");
   }
 

@@ -60,7 +60,7 @@ struct Figure {
   int width_px = 1000;          ///< whole figure (about 6.7 in at 150 dpi)
   int panel_height_px = 330;    ///< per row of panels
   std::string font = "sans,11";
-  std::string gnuplot = "gnuplot";  ///< program to run (a name on PATH or a path)
+  std::string gnuplot = "gnuplot";  ///< program to run: a path, or a name in /usr/local/bin, /usr/bin, /bin
 };
 
 /// A panel with its title and axis labels (the rest default).
@@ -117,7 +117,8 @@ struct PlotFiles {
 /// or if gnuplot fails (with its messages) or leaves no PNG.
 PlotFiles Plot(const Figure& figure, const std::filesystem::path& dir);
 
-/// True if `program` can be run (found on PATH, or an executable path).
+/// True if `program` can be run (an executable path, or a name found in /usr/local/bin, /usr/bin
+/// or /bin; a main program looks the user's PATH up itself: tools/cli.h ProgramOnPath).
 bool GnuplotAvailable(const std::string& program = "gnuplot");
 
 /// A string as a gnuplot single-quoted literal ('' for a quote inside).

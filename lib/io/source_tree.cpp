@@ -2,7 +2,6 @@
 
 #include <unistd.h>
 
-#include <cstdlib>
 #include <system_error>
 #include <vector>
 
@@ -12,9 +11,9 @@ namespace rths::io {
 
 namespace fs = std::filesystem;
 
-fs::path FindSourceFile(const std::string& rel) {
+fs::path FindSourceFile(const std::string& rel, const fs::path& root) {
   std::vector<fs::path> roots;
-  if (const char* env = std::getenv("RTHS_SOURCE_DIR"); env && *env) roots.emplace_back(env);
+  if (!root.empty()) roots.push_back(root);
   std::error_code ec;
   for (fs::path p = fs::current_path(ec); !ec && !p.empty(); p = p.parent_path()) {
     roots.push_back(p);

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <atomic>
-#include <chrono>
 #include <cmath>
 #include <fstream>
 #include <mutex>
@@ -18,6 +17,9 @@
 #include "participants/factory.h"
 #include "participants/group.h"
 #include "participants/run_summary.h"
+#include "supervisor/run.h"
+#include "supervisor/scenario_file.h"
+#include "supervisor/summary_builder.h"
 
 namespace rths::report {
 
@@ -57,17 +59,18 @@ Trace ReadTrace(const fs::path& run_dir) {
   return t;
 }
 
+namespace {
+
+/// The first line of a study's scenario.toml.
+std::string ScenarioHeader(const RunSpec& spec) {
+  return spec.label + " (written by rths reproduce; every key is written out)";
+}
+
+}  // namespace
+
 scenario::Scenario WriteScenarioFile(const RunSpec& spec) {
   fs::create_directories(spec.dir);
-  const fs::path file = spec.dir / "scenario.toml";
-  {
-    std::ofstream out(file, std::ios::binary);
-    if (!out) throw Error(file.string(), "cannot open for writing");
-    out << "# " << spec.label << " (written by rths reproduce; every key is written out)\n"
-        << scenario::ToToml(spec.scenario);
-    if (!out) throw Error(file.string(), "write failed");
-  }
-  return scenario::LoadScenario(file.string());
+  return supervisor::WriteScenarioFile(spec.dir / "scenario.toml", ScenarioHeader(spec), spec.scenario);
 }
 
 void Preflight(const std::vector<RunSpec>& specs) {
@@ -125,53 +128,39 @@ void Preflight(std::vector<RunSpec>* specs, const std::vector<std::string>& over
 
 namespace {
 
+/// One run of the batch through the supervisor (memq, in this thread); its summary.json says how
+/// it went, also when it could not run.
 RunResult RunOne(const RunSpec& spec) {
   RunResult res;
   res.label = spec.label;
   res.dir = spec.dir;
-  participants::RunSummary sum;
-  sum.label = spec.label;
-  sum.scenario = (spec.dir / "scenario.toml").string();
-  sum.run_id = lockstep::NewRunId();
-  sum.transport = "memq";
-  const auto t0 = std::chrono::steady_clock::now();
-  std::string error;
   if (fs::exists(spec.dir / "log.lcm")) {  // the folder's run and its summary stay as they are
     res.error = Error(spec.dir.string(), "holds a run already; refusing to overwrite it").what();
     return res;
   }
+  supervisor::RunRequest request;
+  request.scenario = spec.scenario;
+  request.scenario_header = ScenarioHeader(spec);
+  request.transport = "memq";
+  request.out = spec.dir;
+  request.checks = false;  // Preflight did
+  request.study = true;
+  request.label = spec.label;
+  participants::RunSummary sum;
   try {
-    const scenario::Scenario s = WriteScenarioFile(spec);
-    sum.scenario_sha256 = s.sha256;
-    sum.steps_expected = s.steps();
-    const auto outcomes = participants::RunGroupInProcess({s}, sum.run_id, spec.dir.string());
-    participants::SetOutcomes(outcomes, &sum);
-    if (const auto* culprit = participants::RootCause(outcomes)) {
-      error = fmt::format("{} exited with code {}: {}", culprit->role, culprit->exit_code, culprit->message);
-    }
-    sum.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    participants::ReadLog((spec.dir / "log.lcm").string(), s, &sum);  // + J1-J9 with a reference_file
-    participants::SetVerdict(participants::Judge(outcomes), false, &sum);
-    if (error.empty() && !sum.log_error.empty()) error = sum.log_error;
-    if (error.empty() && sum.steps != s.steps()) {
-      error = fmt::format("the log holds {} of {} steps", sum.steps, s.steps());
-    }
-  } catch (const std::exception& e) {
-    error = e.what();
-    sum.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    sum = supervisor::Run(request).summary;
+  } catch (const supervisor::RunError& e) {
+    sum = e.summary();
     if (fs::exists(spec.dir / "log.lcm")) participants::ReadLog((spec.dir / "log.lcm").string(), &sum);
-  }
-  if (!error.empty()) {
-    sum.stopped = error;  // as the study reports it (RunResult::error)
-    // The verdict's status stands (a safety stop is "stopped by the safety monitor", as in rths
-    // run); an error the verdict did not see (set-up, log, missing steps) makes the run failed.
-    if (sum.status == "completed") {
-      sum.status = "failed";
-      sum.exit_code = lockstep::kExitLockstep;
+    supervisor::MarkStudyFailure(e.what(), &sum);
+    try {
+      fs::create_directories(spec.dir);
+      std::ofstream(spec.dir / "summary.json") << sum.ToJson().dump(2) << "\n";
+    } catch (const std::exception&) {
     }
   }
-  res.error = error;
-  res.ok = error.empty();
+  res.error = sum.status == "completed" ? "" : sum.stopped;
+  res.ok = res.error.empty();
   res.wall_s = sum.wall_s;
   res.steps = sum.steps;
   if (sum.metrics) {
@@ -180,11 +169,6 @@ RunResult RunOne(const RunSpec& spec) {
   }
   res.benchmark = sum.benchmark_criteria;
   res.benchmark_error = sum.benchmark_error;
-  try {
-    fs::create_directories(spec.dir);
-    std::ofstream(spec.dir / "summary.json") << sum.ToJson().dump(2) << "\n";
-  } catch (const std::exception&) {
-  }
   return res;
 }
 

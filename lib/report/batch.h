@@ -1,6 +1,7 @@
 #pragma once
-/// @file Many lockstep runs side by side: each run a whole participant group in this process on
-/// its own memq:// instance (participants/group.h), `jobs` groups at a time in threads. Every run
+/// @file Many lockstep runs side by side: each run made by the supervisor (supervisor/run.h), a
+/// whole participant group in this process on its own memq:// instance, `jobs` groups at a time in
+/// threads. Every run
 /// gets a folder of its own with the exact scenario file that ran (scenario.toml, written by
 /// scenario::ToToml and loaded back, so its hash is that of the file), log.lcm, signals.csv and
 /// summary.json.

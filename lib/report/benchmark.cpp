@@ -184,7 +184,7 @@ BenchmarkResult ReproduceBenchmark(const ReproduceOptions& opts, bool keep_logs)
   PrepareOutDir(opts.out_dir);
   std::vector<scenario::Scenario> bases;
   for (const models::BenchmarkCase& bc : models::kBenchmarkCases) {
-    const fs::path file = io::FindSourceFile(fmt::format("scenarios/benchmark/case{}_example.toml", bc.number));
+    const fs::path file = io::FindSourceFile(fmt::format("scenarios/benchmark/case{}_example.toml", bc.number), opts.source_dir);
     bases.push_back(scenario::LoadScenario(file.string()));
     if (bases.back().plant.kind != models::PlantKind::kBenchmark) {
       throw Error(file.string(), "plant.kind must be \"benchmark\" for this study");

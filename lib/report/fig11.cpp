@@ -183,7 +183,7 @@ Fig11Result ReproduceFig11(const ReproduceOptions& opts) {
   const auto t0 = std::chrono::steady_clock::now();
   PrepareOutDir(opts.out_dir);
   if (opts.plant != "ideal") RequirePlant(opts.plant, opts.out_dir);
-  const fs::path base_file = io::FindSourceFile("scenarios/fig11_base.toml");
+  const fs::path base_file = io::FindSourceFile("scenarios/fig11_base.toml", opts.source_dir);
   const scenario::Scenario base = scenario::LoadScenario(base_file.string());
   const double duration = opts.quick ? kFig11QuickS : kFig11FullS;
   const auto controllers = Fig11Controllers();

@@ -29,6 +29,9 @@ struct ReproduceOptions {
   int jobs = 2;                           ///< lockstep groups run at the same time (threads)
   std::function<void(std::string_view)> log;  ///< progress lines ("" = silent)
   std::string gnuplot = "gnuplot";        ///< plotting program
+  /// The rths checkout the user named (the tool's RTHS_SOURCE_DIR): searched first for the studies'
+  /// base scenarios (scenarios/fig9_base.toml, ...); "" only the search of io::FindSourceFile.
+  std::filesystem::path source_dir;
   /// `--set KEY=VALUE` overrides applied to every lockstep run's scenario after the study set its
   /// own keys (scenario::WithOverrides, in Preflight); checked like a file.
   std::vector<std::string> overrides;

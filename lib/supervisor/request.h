@@ -1,0 +1,109 @@
+#pragma once
+/// @file What a run is asked to be (RunRequest), what it became (RunResult) and how it can fail
+/// before it ends (RunError): the supervisor's interface, for `rths run`, the studies' batch
+/// runner (report/batch.h) and tests (docs/lockstep.md).
+#include <algorithm>
+#include <csignal>
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/error.h"
+#include "io/run_log.h"
+#include "participants/run_summary.h"
+#include "scenario/scenario.h"
+#include "supervisor/disk.h"
+
+namespace rths::supervisor {
+
+/// What `rths run --external` changes: the roles the user runs, and how long everyone waits for
+/// them.
+struct ExternalRoles {
+  std::vector<std::string> roles;
+  double join_timeout_s = 0;  ///< [s] 0: the scenario's lockstep.handshake_timeout_s
+  bool has(const std::string& role) const { return std::find(roles.begin(), roles.end(), role) != roles.end(); }
+};
+
+/// A replay (participants/replay.h): the roles in `live` are built from the scenario, the others
+/// answer steps 0..steps-1 from `record`.
+struct ReplaySource {
+  const io::RunLog* record = nullptr;  ///< the recorded run (outlives the run)
+  std::int64_t steps = 0;              ///< <= record->CompleteSteps()
+  std::vector<std::string> live;
+};
+
+/// What has been decided before the run starts (passed to RunRequest::on_start).
+struct RunPlan {
+  scenario::Scenario scenario;        ///< the scenario that runs (loaded back from the folder's file if written)
+  std::string scenario_path;          ///< the file the participants read
+  std::string url;                    ///< udpm: the run's LCM URL; memq: "memq://"
+  std::int64_t run_id = 0;
+  std::filesystem::path out;          ///< the output folder
+  OutputEstimate sizes;               ///< what the run will write
+  bool created_out = false;           ///< the folder did not exist before the run
+};
+
+/// One run to make.
+struct RunRequest {
+  scenario::Scenario scenario;        ///< loaded, `--set` overrides applied
+  std::string scenario_path;          ///< the file it was loaded from ("" for a scenario built in code)
+  /// How out/scenario.toml is made: "" copies scenario_path; otherwise the scenario is written out
+  /// in full (scenario::ToToml) under the comment line "# <scenario_header>" and loaded back, so
+  /// its hash is the file's, and the participants read that file.
+  std::string scenario_header;
+  std::string transport = "udpm";     ///< "udpm": one process per participant; "memq": this process
+  std::string lcm_url;                ///< udpm: "" picks udpm://239.255.76.67:<a free port>?ttl=0
+  bool port_per_channel = false;      ///< udpm with a picked URL: a free port per channel
+  std::filesystem::path out;          ///< the output folder ("" a new one under runs/)
+  std::filesystem::path bin_dir;      ///< udpm: where the rths-<role> programs are
+  std::int64_t run_id = 0;            ///< 0: a new random id
+  ExternalRoles external;             ///< udpm: roles the user runs
+  std::vector<std::string> role_args; ///< udpm: extra arguments for every participant process
+  /// Check before a byte is written that the scenario builds, the transport can carry it, the
+  /// folder is new or empty and (check_disk_space) the disk has room. Off for a study's batch and a
+  /// replay: they check beforehand.
+  bool checks = true;
+  bool check_disk_space = true;       ///< refuse a run that will not fit on the disk
+  /// A run of a study's batch (report::RunBatch): never removes its folder; its summary has the
+  /// label and neither the URL nor the output estimate, and a run that did not complete every step
+  /// is marked failed (supervisor/summary_builder.h).
+  bool study = false;
+  std::optional<ReplaySource> replay;  ///< memq: replay a recorded run instead
+  /// The summary's file in the output folder, reserved before the run and written at its end
+  /// ("": none; a replay writes replay.json, supervisor/replay_report.h).
+  std::string summary_file = "summary.json";
+  std::string label;                  ///< a study's run label (summary.json "label")
+  bool progress = false;              ///< draw the run's progress on stderr (ProgressLine)
+  /// Set it (a signal handler) to stop the run; udpm runs also set it on SIGINT / SIGTERM.
+  /// Null: the run cannot be interrupted.
+  volatile std::sig_atomic_t* interrupted = nullptr;
+  std::function<void(const std::string&)> on_warning;  ///< e.g. "this run will write about 3 GB"
+  std::function<void(const RunPlan&)> on_start;        ///< called once, just before the participants start
+};
+
+/// A finished run (also one that failed: its summary says how).
+struct RunResult {
+  participants::RunSummary summary;   ///< as written to out/summary.json
+  RunPlan plan;
+  bool summary_written = false;       ///< false: the summary file could not be written (or none was asked for)
+};
+
+/// A run that could not be made or could not finish: exit_code kExitUsage (nothing ran; the
+/// folder made for it removed) or kExitLockstep (the group could not run). `summary` holds what
+/// was known.
+class RunError : public Error {
+ public:
+  RunError(int exit_code, const std::string& what, participants::RunSummary summary)
+      : Error("", what), exit_code_(exit_code), summary_(std::move(summary)) {}
+  int exit_code() const { return exit_code_; }
+  const participants::RunSummary& summary() const { return summary_; }
+
+ private:
+  int exit_code_;
+  participants::RunSummary summary_;
+};
+
+}  // namespace rths::supervisor

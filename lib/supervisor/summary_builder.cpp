@@ -1,0 +1,60 @@
+#include "supervisor/summary_builder.h"
+
+#include <fmt/format.h>
+
+#include "lockstep/runtime.h"
+#include "supervisor/realtime_figures.h"
+
+namespace rths::supervisor {
+
+participants::RunSummary SummaryHead(const RunRequest& request, const RunPlan& plan) {
+  participants::RunSummary sum;
+  sum.label = request.label;
+  sum.scenario = plan.scenario_path;
+  sum.scenario_sha256 = plan.scenario.sha256;
+  sum.run_id = plan.run_id;
+  sum.transport = request.transport;
+  sum.steps_expected = plan.scenario.steps();
+  if (!request.study) {
+    sum.lcm_url = plan.url;
+    sum.output_estimate_bytes = static_cast<std::int64_t>(plan.sizes.total_bytes);
+  }
+  return sum;
+}
+
+participants::RunSummary BuildSummary(const RunRequest& request, const RunPlan& plan, const GroupEnd& end) {
+  participants::RunSummary sum = SummaryHead(request, plan);
+  sum.wall_s = end.wall_s;
+  participants::ReadLog((plan.out / "log.lcm").string(), plan.scenario, &sum);  // + J1-J9 with a reference_file
+  participants::SetOutcomes(end.outcomes, &sum);
+  participants::SetVerdict(participants::Judge(end.outcomes), end.interrupted, &sum);
+  if (sum.failure && end.noticed) {
+    sum.failure->teardown_s = std::chrono::duration<double>(Clock::now() - *end.noticed).count();
+  }
+  if (plan.scenario.realtime.enabled) {
+    sum.realtime = RealtimeFigures(plan.scenario, end.outcomes, request.transport, end.memq_setup);
+  }
+  if (request.study) {
+    if (const std::string error = StudyError(sum); !error.empty()) MarkStudyFailure(error, &sum);
+  }
+  return sum;
+}
+
+std::string StudyError(const participants::RunSummary& sum) {
+  if (const auto* culprit = participants::RootCause(sum.participants)) {
+    return fmt::format("{} exited with code {}: {}", culprit->role, culprit->exit_code, culprit->message);
+  }
+  if (!sum.log_error.empty()) return sum.log_error;
+  if (sum.steps != sum.steps_expected) return fmt::format("the log holds {} of {} steps", sum.steps, sum.steps_expected);
+  return "";
+}
+
+void MarkStudyFailure(const std::string& error, participants::RunSummary* sum) {
+  sum->stopped = error;
+  if (sum->status == "completed") {
+    sum->status = "failed";
+    sum->exit_code = lockstep::kExitLockstep;
+  }
+}
+
+}  // namespace rths::supervisor

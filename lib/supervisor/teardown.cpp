@@ -1,0 +1,73 @@
+#include "supervisor/teardown.h"
+
+#include <algorithm>
+#include <csignal>
+#include <fstream>
+#include <iterator>
+
+#include <fmt/format.h>
+#include <lcm/lcm-cpp.hpp>
+
+#include "lockstep/runtime.h"
+#include "lockstep/transport.h"
+
+namespace rths::supervisor {
+
+void BroadcastAbort(const std::string& url, std::int64_t run_id, const std::string& reason) {
+  // A run with a port per channel hears handshakes on the handshake channel's port.
+  const auto parsed = lockstep::UdpmUrl::Parse(url);
+  lcm::LCM lcm(parsed ? parsed->ChannelUrl(lockstep::kChHandshake) : url);
+  if (!lcm.good()) return;
+  rths::handshake_t h{};
+  h.run_id = run_id;
+  h.phase = lockstep::kAbort;
+  h.participant = "supervisor";
+  h.k = -1;
+  h.n_roster = 0;
+  h.reason = reason;
+  lockstep::Bytes bytes;
+  lockstep::Encode(h, &bytes);
+  for (int i = 0; i < 3; ++i) lcm.publish(lockstep::kChHandshake, bytes.data(), bytes.size());
+}
+
+char ProcessState(pid_t pid) {
+  std::ifstream in(fmt::format("/proc/{}/stat", pid));
+  std::string all((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const auto close = all.rfind(')');
+  return close != std::string::npos && close + 2 < all.size() ? all[close + 2] : 0;
+}
+
+void Teardown::Start(const std::string& reason) {
+  if (started_) return;
+  started_ = true;
+  noticed_ = Clock::now();
+  BroadcastAbort(url_, run_id_, reason);
+  term_at_ = noticed_ + kGraceAbort;
+}
+
+int Teardown::WaitMs(int idle_ms) const {
+  const auto now = Clock::now();
+  auto until = [&](Clock::time_point t) {
+    return static_cast<int>(std::chrono::ceil<std::chrono::milliseconds>(t - now).count());
+  };
+  int ms = idle_ms;
+  if (started_ && !termed_) ms = until(term_at_);
+  if (termed_ && !killed_) ms = until(kill_at_);
+  return std::max(ms, 0);
+}
+
+int Teardown::Due() {
+  const auto t = Clock::now();
+  if (started_ && !termed_ && t >= term_at_) {
+    termed_ = true;
+    kill_at_ = t + kGraceTerm;
+    return SIGTERM;
+  }
+  if (termed_ && !killed_ && t >= kill_at_) {
+    killed_ = true;
+    return SIGKILL;
+  }
+  return 0;
+}
+
+}  // namespace rths::supervisor
