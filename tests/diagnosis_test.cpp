@@ -21,7 +21,7 @@
 #include "core/error.h"
 #include "diagnosis/diagnosis.h"
 #include "diagnosis/report_figures.h"
-#include "diagnosis/synthetic.h"
+#include "validation/synthetic.h"
 #include "io/rig_record.h"
 #include "models/mr_damper.h"
 #include "models/servo_linear.h"
@@ -29,6 +29,7 @@
 
 namespace fs = std::filesystem;
 using namespace rths::diagnosis;
+using namespace rths::validation;
 namespace m = rths::models;
 
 namespace {
