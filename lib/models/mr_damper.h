@@ -59,7 +59,8 @@ inline constexpr MrDamperField kMrDamperFields[] = {
     {"gamma_a", &MrDamperParams::gamma_a, 0, false}, {"gamma_b", &MrDamperParams::gamma_b, 0, false},
     {"gamma_c", &MrDamperParams::gamma_c, 0, false}, {"A", &MrDamperParams::A, 0, false},
     {"n", &MrDamperParams::n, 1, false},             {"k0", &MrDamperParams::k0, 0, false},
-    {"k1", &MrDamperParams::k1, 0, false},           {"x0", &MrDamperParams::x0, -std::numeric_limits<double>::infinity(), false},
+    {"k1", &MrDamperParams::k1, 0, false},
+    {"x0", &MrDamperParams::x0, -std::numeric_limits<double>::infinity(), false},
 };
 
 /// The model's coefficients at one current (Eqs. 35-39); units as in MrDamperParams.
