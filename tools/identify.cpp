@@ -14,6 +14,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -87,6 +88,33 @@ void PlotTo(rths::io::Figure fig, const std::string& png) {
   fs::remove_all(dir, ec);
 }
 
+/// The measured H1 up to fmax [Hz] as four series (magnitude, phase [deg], time lag [ms],
+/// coherence): the excited points (fitted or not), phase unwrapped over them.
+std::array<rths::io::Series, 4> MeasuredSeries(const rths::ident::IdentifyResult& rc, double fmax) {
+  const double deg = 180.0 / std::numbers::pi;
+  rths::io::Series m_mag = rths::io::MakeSeries("measured H1", rths::io::ReadableColors()[0]);
+  m_mag.width = 2.0;
+  rths::io::Series m_ph = m_mag, m_lag = m_mag, m_coh = m_mag;
+  double peak = 0.0;
+  for (std::size_t i = 0; i < rc.s_uu.size(); ++i)
+    if (rc.frf.f_hz[i] <= fmax) peak = std::max(peak, rc.s_uu[i]);
+  double ph = 0.0;
+  std::complex<double> prev = 0.0;
+  for (std::size_t i = 1; i < rc.frf.f_hz.size() && rc.frf.f_hz[i] <= fmax; ++i) {
+    if (rc.s_uu[i] < rc.options.min_excitation * peak || std::abs(rc.frf.h[i]) == 0.0) continue;
+    const auto h = rc.frf.h[i];
+    ph = prev == 0.0 ? std::arg(h) : ph + std::arg(h / prev);
+    prev = h;
+    const double f = rc.frf.f_hz[i];
+    for (rths::io::Series* s : {&m_mag, &m_ph, &m_lag, &m_coh}) s->x.push_back(f);
+    m_mag.y.push_back(std::abs(h));
+    m_ph.y.push_back(ph * deg);
+    m_lag.y.push_back(-ph / (2.0 * std::numbers::pi * f) * 1e3);
+    m_coh.y.push_back(rc.frf.coherence[i]);
+  }
+  return {m_mag, m_ph, m_lag, m_coh};
+}
+
 /// Fig. 6 style: magnitude, phase [deg], time lag [ms] and coherence vs frequency 0-50 Hz, measured
 /// H1 beside the continuous fit and the ZOH-consistent fit's discrete response; the fitted band shaded.
 void PlotBode(const std::string& png, const std::string& title, const rths::ident::IdentifyResult& rc,
@@ -96,29 +124,7 @@ void PlotBode(const std::string& png, const std::string& title, const rths::iden
   using rths::io::Series;
   const double fmax = std::min(50.0, 0.5 / rc.dt_s);
   const double deg = 180.0 / std::numbers::pi;
-  // Measured: the excited points (fitted or not), phase unwrapped over them.
-  Series m_mag = MakeSeries("measured H1", rths::io::ReadableColors()[0]);
-  m_mag.width = 2.0;
-  Series m_ph = m_mag, m_lag = m_mag, m_coh = m_mag;
-  {
-    double peak = 0.0;
-    for (std::size_t i = 0; i < rc.s_uu.size(); ++i)
-      if (rc.frf.f_hz[i] <= fmax) peak = std::max(peak, rc.s_uu[i]);
-    double ph = 0.0;
-    std::complex<double> prev = 0.0;
-    for (std::size_t i = 1; i < rc.frf.f_hz.size() && rc.frf.f_hz[i] <= fmax; ++i) {
-      if (rc.s_uu[i] < rc.options.min_excitation * peak || std::abs(rc.frf.h[i]) == 0.0) continue;
-      const auto h = rc.frf.h[i];
-      ph = prev == 0.0 ? std::arg(h) : ph + std::arg(h / prev);
-      prev = h;
-      const double f = rc.frf.f_hz[i];
-      for (Series* s : {&m_mag, &m_ph, &m_lag, &m_coh}) s->x.push_back(f);
-      m_mag.y.push_back(std::abs(h));
-      m_ph.y.push_back(ph * deg);
-      m_lag.y.push_back(-ph / (2.0 * std::numbers::pi * f) * 1e3);
-      m_coh.y.push_back(rc.frf.coherence[i]);
-    }
-  }
+  const auto [m_mag, m_ph, m_lag, m_coh] = MeasuredSeries(rc, fmax);
   // Models on a fine grid.
   Series c_mag = MakeSeries("Eq. 15 fit", "#000000", 2);
   c_mag.width = 2.0;
@@ -366,9 +372,9 @@ int RunActuator(const ActuatorCli& a) {
 }
 
 /// The --damper options of the command line (their checks beyond DamperFitOptions::IsValid).
-void AddDamperOptions(CLI::App* app, rths::ident::DamperFitOptions* o, std::string* input, std::string* filter,
-                      bool* no_offset) {
-  app->add_option("--current", o->current_A, "--damper: fit at this one current [A] (the records' constant current)");
+void AddDamperOptions(CLI::App* app, rths::ident::DamperFitOptions* o, double* current_A, std::string* input,
+                      std::string* filter, bool* no_offset) {
+  app->add_option("--current", *current_A, "--damper: fit at this one current [A] (the records' constant current)");
   app->add_option("--A", o->A, "--damper: Bouc-Wen A [-], held fixed (Table 3)")->capture_default_str();
   app->add_option("--velocity-cutoff-hz", o->velocity_cutoff_hz,
                   "--damper: cutoff of the zero-phase smoothing differentiator [Hz] (0: 4 x the band edge of each "
@@ -396,6 +402,7 @@ int main(int argc, char** argv) {
   ActuatorCli ac;
   rths::ident::DamperFitOptions fo;
   std::string input, filter = "first_order";
+  double current_A = 0.0;
   app.add_option("record", records,
                  "CSV rig record or LCM run log (log.lcm) of ours; with --damper one or more damper tests (also UTFSM "
                  "damper files)")
@@ -407,7 +414,7 @@ int main(int argc, char** argv) {
                "fit the Spencer MR damper model instead: at one current (--current) or, without it, its current- or "
                "voltage-dependent form (Eqs. 32-39) with a control filter, from records with any input history");
   app.add_option("--check", checks, "--damper: held-out records to score the fitted model on");
-  AddDamperOptions(&app, &fo, &input, &filter, &no_offset);
+  AddDamperOptions(&app, &fo, &current_A, &input, &filter, &no_offset);
   app.add_option("--band", ac.band, "frequency band fitted, LO-HI [Hz] (the paper's range)")->capture_default_str();
   app.add_option("--poles", ac.poles, "number of poles N of Eq. 15")->capture_default_str();
   app.add_option("--segment-s", ac.segment_s, "Welch segment length [s] (0: min(4 s, 2/9 of the record))")
@@ -430,6 +437,7 @@ int main(int argc, char** argv) {
       if (!ac.plot.empty()) rths::io::RefuseToReplaceRecord(ac.plot, inputs, "--plot");
     }
     ac.time = time_from_header ? rths::io::TimeAxis::kHeader : rths::io::TimeAxis::kColumn;
+    if (app.count("--current") > 0) fo.current_A = current_A;
     if (damper) {
       if (fo.current_A) {
         if (!(*fo.current_A >= 0.0)) throw Error("--current", fmt::format("{} A: must be >= 0", *fo.current_A));
