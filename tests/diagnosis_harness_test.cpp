@@ -1,4 +1,4 @@
-// The diagnosis's validation harness, CI size (lib/diagnosis/harness.h; the full one is
+// The diagnosis's validation harness, CI size (lib/validation/harness.h; the full one is
 // bench/diagnosis.cpp): records with known effects made by the plant's RIG MODE
 // (models::MakeRig with plant.effects / plant.unmodelled) and, one seed, by the effect BLOCKS
 // (MakeRecordBlocks), diagnosed without the truth, scored against the harness targets
@@ -10,10 +10,11 @@
 #include <doctest/doctest.h>
 #include <fmt/format.h>
 
-#include "diagnosis/harness.h"
+#include "validation/harness.h"
 #include "harness_support.h"
 
 using namespace rths::diagnosis;
+using namespace rths::validation;
 
 TEST_CASE("harness (rig mode): confusion table and held-out shrink meet the harness targets") {
   HarnessOptions o;

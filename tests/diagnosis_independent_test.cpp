@@ -1,4 +1,4 @@
-// The diagnosis on records of the INDEPENDENT generator (lib/diagnosis/independent_rig.h: a
+// The diagnosis on records of the INDEPENDENT generator (lib/validation/independent_rig.h: a
 // continuous RK4 simulation written apart from the rig mode, with its own effect forms,
 // excitation families and anti-aliased sensor noise; docs/diagnosis.md "Validation harness").
 // The generator's own integration is checked against a twice-finer one; nominal records (no
@@ -10,11 +10,12 @@
 #include <doctest/doctest.h>
 #include <fmt/format.h>
 
-#include "diagnosis/harness.h"
+#include "validation/harness.h"
 #include "harness_support.h"
-#include "diagnosis/independent_rig.h"
+#include "validation/independent_rig.h"
 
 using namespace rths::diagnosis;
+using namespace rths::validation;
 
 namespace {
 
@@ -25,6 +26,13 @@ double NrmsePctOf(const std::vector<double>& ref, const std::vector<double>& x) 
     sr += ref[k] * ref[k];
   }
   return 100.0 * std::sqrt(se / sr);
+}
+
+// The El Centro record of the earthquake commands, read here (the generator takes data, not paths).
+const std::vector<double>& ElCentroG() {
+  static const std::vector<double> g =
+      ReadGroundMotion(std::string(RTHS_SOURCE_DIR) + "/data/ground_motion/elcentro_1940_ns_g.txt");
+  return g;
 }
 
 IndependentExcitation Ex(CommandFamily f, double lo, double hi, CurrentPattern p, std::uint64_t seed) {
@@ -38,6 +46,7 @@ IndependentExcitation Ex(CommandFamily f, double lo, double hi, CurrentPattern p
   e.current_max_A = p == CurrentPattern::kConstant ? 1.2 : 2.5;
   e.current_period_s = 0.7;
   e.seed = seed;
+  if (f == CommandFamily::kEarthquake) e.ground_g = ElCentroG();
   return e;
 }
 
@@ -135,6 +144,7 @@ TEST_CASE("harness (independent generator): confusion table and held-out shrink 
   o.duration_s = 6.0;
   o.generator = Generator::kIndependent;
   o.pairs = true;
+  o.ground_g = ElCentroG();
   const auto sc = rths_test::RunHarnessReported(o);
   REQUIRE(sc.single_n == 9 * o.seeds);
   REQUIRE(sc.pair_n == 6 * o.seeds);

@@ -9,10 +9,11 @@
 
 #include "diagnosis/diagnosis.h"
 #include "diagnosis/stages.h"
-#include "diagnosis/synthetic.h"
+#include "validation/synthetic.h"
 #include "models/servo_linear.h"
 
 using namespace rths::diagnosis;
+using namespace rths::validation;
 namespace m = rths::models;
 namespace st = rths::diagnosis::stages;
 

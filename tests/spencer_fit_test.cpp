@@ -190,8 +190,9 @@ TEST_CASE("FitSpencer recovers Eqs. 35-39 and eta from a rig-mode record with a 
   const double eta = 120.0, dt = 1.0 / 3000.0;
   const std::vector<rths::io::RigRecord> train = {RigModeRecord(eta, dt, 20.0, 20.0, 8.0, 5, "train")};
   const auto test = RigModeRecord(eta, dt, 6.0, 8.0, 4.0, 6, "test");
-  rths::ident::SpencerFitOptions o;
-  const auto fit = rths::ident::FitSpencer(train, false, o);
+  rths::ident::DamperFitOptions o;
+  o.input = rths::ident::DamperInput::kCurrent;
+  const auto fit = rths::ident::FitSpencer(train, o);
   MESSAGE(fit.Report());
   const auto t = m::MrDamperParams::Table3();
   const auto& p = fit.params;
@@ -214,7 +215,7 @@ TEST_CASE("FitSpencer recovers Eqs. 35-39 and eta from a rig-mode record with a 
   // Without the filter the same record fits worse: the filter is a real part of the model.
   o.filter = ControlFilter::kNone;
   o.max_iterations = 40;
-  const auto none = rths::ident::FitSpencer(train, false, o);
+  const auto none = rths::ident::FitSpencer(train, o);
   CHECK(none.records[0].nrmse_f_pct > fit.records[0].nrmse_f_pct);
 
   // The model file: the scenario parser and the diagnosis read the same model back.
@@ -245,15 +246,16 @@ TEST_CASE("FitSpencer: bad input is refused with the reason") {
     rec.i_A.push_back(1.0);
   }
   try {
-    rths::ident::FitSpencer({rec}, false);
+    rths::ident::FitSpencer({rec}, {.input = rths::ident::DamperInput::kCurrent});
     FAIL("a constant current was accepted");
   } catch (const rths::Error& e) {
     CHECK(std::string(e.what()).find("--current") != std::string::npos);
   }
-  CHECK_THROWS_AS(rths::ident::FitSpencer({rec}, true), rths::Error);  // no v_V column
-  rths::ident::SpencerFitOptions o;
+  // No v_V column:
+  CHECK_THROWS_AS(rths::ident::FitSpencer({rec}, {.input = rths::ident::DamperInput::kVoltage}), rths::Error);
+  rths::ident::DamperFitOptions o;
   o.threads = -1;
-  CHECK_THROWS_AS(rths::ident::FitSpencer({rec}, false, o), rths::Error);
+  CHECK_THROWS_AS(rths::ident::FitSpencer({rec}, o), rths::Error);
 }
 
 

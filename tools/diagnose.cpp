@@ -25,6 +25,24 @@
 
 namespace fs = std::filesystem;
 
+namespace {
+
+/// DIR/fitted_model.toml (the nominal model and the selected effects); returns the line saying
+/// where, or a warning if it could not be written.
+std::string WriteFittedModel(const rths::diagnosis::NominalModel& model, const rths::diagnosis::Result& r,
+                             const fs::path& dir) {
+  try {
+    const fs::path model_path = dir / "fitted_model.toml";
+    std::ofstream f(model_path);
+    if (!(f << rths::diagnosis::FittedModelToml(model, r))) throw rths::Error(model_path.string(), "cannot write");
+    return fmt::format("fitted model: {} (nominal + selected effects; rths run / design take it)\n", model_path.string());
+  } catch (const std::exception& e) {
+    return fmt::format("warning: fitted_model.toml: {}\n", e.what());
+  }
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
   CLI::App app{"rths diagnose: where the model is wrong, which unmodelled effect, how far the gap shrinks"};
   std::vector<std::string> train, test;
@@ -82,16 +100,7 @@ int main(int argc, char** argv) {
     } catch (const std::exception& e) {
       report_note = fmt::format("warning: report.html: {}\n", e.what());
     }
-    std::string model_note;
-    try {
-      const fs::path model_path = dir / "fitted_model.toml";
-      std::ofstream f(model_path);
-      if (!(f << rths::diagnosis::FittedModelToml(model, r))) throw rths::Error(model_path.string(), "cannot write");
-      model_note = fmt::format("fitted model: {} (nominal + selected effects; rths run / design take it)\n",
-                               model_path.string());
-    } catch (const std::exception& e) {
-      model_note = fmt::format("warning: fitted_model.toml: {}\n", e.what());
-    }
+    const std::string model_note = WriteFittedModel(model, r, dir);
     const auto detail = brief ? rths::diagnosis::SummaryDetail::kBrief : rths::diagnosis::SummaryDetail::kFull;
     std::printf("rths diagnose\n%s%s%s", rths::diagnosis::Summary(r, detail).c_str(), report_note.c_str(),
                 model_note.c_str());

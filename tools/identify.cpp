@@ -7,13 +7,14 @@
 // rths identify --damper RECORD... --current A [--check RECORD...] [--A A] [--velocity-cutoff-hz F]
 //                        [--out FILE.toml]
 // Fits the Spencer MR damper model (Eqs. 32-34) at one current to damper tests (rig records, LCM
-// logs, or UTFSM damper files: x = y_mm, F = f_kN) by least squares on the force
-// (ident/damper_fit.h); prints the parameters, the force error per record (and per held-out
-// --check record) and the model as a [plant.damper] TOML fragment.
+// logs, or UTFSM damper files: x = y_mm, F = f_kN) by least squares on the force, or without
+// --current its current- or voltage-dependent form (ident/damper_model.h); prints the parameters,
+// the force error per record (and per held-out --check record) and the model as a TOML fragment.
 // docs/identification.md. Exit 0 ok, 2 bad input.
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -29,8 +30,7 @@
 #include "cli.h"
 #include "core/error.h"
 #include "core/progress.h"
-#include "ident/damper_fit.h"
-#include "ident/spencer_fit.h"
+#include "ident/damper_model.h"
 #include "ident/identify.h"
 #include "io/output_folder.h"
 #include "io/plot.h"
@@ -88,6 +88,33 @@ void PlotTo(rths::io::Figure fig, const std::string& png) {
   fs::remove_all(dir, ec);
 }
 
+/// The measured H1 up to fmax [Hz] as four series (magnitude, phase [deg], time lag [ms],
+/// coherence): the excited points (fitted or not), phase unwrapped over them.
+std::array<rths::io::Series, 4> MeasuredSeries(const rths::ident::IdentifyResult& rc, double fmax) {
+  const double deg = 180.0 / std::numbers::pi;
+  rths::io::Series m_mag = rths::io::MakeSeries("measured H1", rths::io::ReadableColors()[0]);
+  m_mag.width = 2.0;
+  rths::io::Series m_ph = m_mag, m_lag = m_mag, m_coh = m_mag;
+  double peak = 0.0;
+  for (std::size_t i = 0; i < rc.s_uu.size(); ++i)
+    if (rc.frf.f_hz[i] <= fmax) peak = std::max(peak, rc.s_uu[i]);
+  double ph = 0.0;
+  std::complex<double> prev = 0.0;
+  for (std::size_t i = 1; i < rc.frf.f_hz.size() && rc.frf.f_hz[i] <= fmax; ++i) {
+    if (rc.s_uu[i] < rc.options.min_excitation * peak || std::abs(rc.frf.h[i]) == 0.0) continue;
+    const auto h = rc.frf.h[i];
+    ph = prev == 0.0 ? std::arg(h) : ph + std::arg(h / prev);
+    prev = h;
+    const double f = rc.frf.f_hz[i];
+    for (rths::io::Series* s : {&m_mag, &m_ph, &m_lag, &m_coh}) s->x.push_back(f);
+    m_mag.y.push_back(std::abs(h));
+    m_ph.y.push_back(ph * deg);
+    m_lag.y.push_back(-ph / (2.0 * std::numbers::pi * f) * 1e3);
+    m_coh.y.push_back(rc.frf.coherence[i]);
+  }
+  return {m_mag, m_ph, m_lag, m_coh};
+}
+
 /// Fig. 6 style: magnitude, phase [deg], time lag [ms] and coherence vs frequency 0-50 Hz, measured
 /// H1 beside the continuous fit and the ZOH-consistent fit's discrete response; the fitted band shaded.
 void PlotBode(const std::string& png, const std::string& title, const rths::ident::IdentifyResult& rc,
@@ -97,29 +124,7 @@ void PlotBode(const std::string& png, const std::string& title, const rths::iden
   using rths::io::Series;
   const double fmax = std::min(50.0, 0.5 / rc.dt_s);
   const double deg = 180.0 / std::numbers::pi;
-  // Measured: the excited points (fitted or not), phase unwrapped over them.
-  Series m_mag = MakeSeries("measured H1", rths::io::ReadableColors()[0]);
-  m_mag.width = 2.0;
-  Series m_ph = m_mag, m_lag = m_mag, m_coh = m_mag;
-  {
-    double peak = 0.0;
-    for (std::size_t i = 0; i < rc.s_uu.size(); ++i)
-      if (rc.frf.f_hz[i] <= fmax) peak = std::max(peak, rc.s_uu[i]);
-    double ph = 0.0;
-    std::complex<double> prev = 0.0;
-    for (std::size_t i = 1; i < rc.frf.f_hz.size() && rc.frf.f_hz[i] <= fmax; ++i) {
-      if (rc.s_uu[i] < rc.options.min_excitation * peak || std::abs(rc.frf.h[i]) == 0.0) continue;
-      const auto h = rc.frf.h[i];
-      ph = prev == 0.0 ? std::arg(h) : ph + std::arg(h / prev);
-      prev = h;
-      const double f = rc.frf.f_hz[i];
-      for (Series* s : {&m_mag, &m_ph, &m_lag, &m_coh}) s->x.push_back(f);
-      m_mag.y.push_back(std::abs(h));
-      m_ph.y.push_back(ph * deg);
-      m_lag.y.push_back(-ph / (2.0 * std::numbers::pi * f) * 1e3);
-      m_coh.y.push_back(rc.frf.coherence[i]);
-    }
-  }
+  const auto [m_mag, m_ph, m_lag, m_coh] = MeasuredSeries(rc, fmax);
   // Models on a fine grid.
   Series c_mag = MakeSeries("Eq. 15 fit", "#000000", 2);
   c_mag.width = 2.0;
@@ -222,8 +227,6 @@ void PlotDamper(const std::string& png, const std::vector<DamperPlotRecord>& rec
 /// Options of the --damper mode beyond the fits' own.
 struct DamperCli {
   std::vector<std::string> records, checks;
-  double current_A = -1.0;          ///< >= 0: the one-current fit
-  std::string input;                ///< "current" | "voltage" | "" (current if the records have i_A)
   std::string out, plot;
   rths::io::TimeAxis time = rths::io::TimeAxis::kColumn;
 };
@@ -252,136 +255,175 @@ std::string Names(const std::vector<std::string>& paths) {
   return names;
 }
 
-/// The --damper mode at one current (file comment).
-int RunDamper(const DamperCli& c, const rths::ident::DamperFitOptions& o) {
+/// The --damper mode (file comment): at one current (--current) or with any input history.
+int RunDamper(const DamperCli& c, rths::ident::DamperFitOptions o) {
   const auto recs = ReadDamperRecords(c.records, c.time);
   const auto held = ReadDamperRecords(c.checks, c.time);
-  const auto fit = rths::ident::FitDamper(recs, c.current_A, o);
-  std::printf("rths identify --damper: %zu record(s) at %g A\n%s", recs.size(), c.current_A, fit.Report().c_str());
+  rths::ProgressLine progress("rths identify --damper");
+  if (progress.enabled()) {
+    o.progress = [&progress](double done, double total, std::string_view what) { progress.Update(done, total, what); };
+  }
+  const auto fit = rths::ident::FitDamperModel(recs, o);
+  progress.Finish();
+  const bool voltage = fit.voltage();
+  const char* input = voltage ? "voltage" : "current";
+  if (fit.at_current) {
+    std::printf("rths identify --damper: %zu record(s) at %g A\n%s", recs.size(), *o.current_A, fit.Report().c_str());
+  } else {
+    std::printf("rths identify --damper: %zu record(s), %s input %g to %g %s\n%s", recs.size(), input,
+                fit.any_input->input_min, fit.any_input->input_max, voltage ? "V" : "A", fit.Report().c_str());
+  }
   if (!held.empty()) {
     std::printf("  held-out force error (Eq. 31 on f), same model:\n");
+    const int width = fit.at_current ? 6 : 7;
     for (const auto& h : held) {
-      const auto sc = rths::ident::ScoreDamper(fit.coef, h, o.velocity_cutoff_hz);
-      std::printf("    %-40s %6zu samples at %g s, peak %.4g kN: %.3f %%\n", sc.source.c_str(), sc.samples, sc.dt_s,
-                  sc.peak_force_kN, sc.nrmse_f_pct);
+      const auto sc = fit.Score(h);
+      std::printf("    %-40s %*zu samples at %g s, peak %.4g kN: %.3f %%\n", sc.source.c_str(), width, sc.samples,
+                  sc.dt_s, sc.peak_force_kN, sc.nrmse_f_pct);
     }
   }
-  WriteModel(rths::ident::DamperTomlFragment(
-                 fit, fmt::format("rths identify --damper {} --current {}", Names(c.records), c.current_A)),
+  WriteModel(fit.ModelToml(fit.at_current
+                               ? fmt::format("rths identify --damper {} --current {}", Names(c.records), *o.current_A)
+                               : fmt::format("rths identify --damper {} ({} input)", Names(c.records), input)),
              c.out);
-  if (!c.plot.empty()) {
-    std::vector<DamperPlotRecord> all;
-    auto add = [&](const rths::io::RigRecord& r, bool fitted) {
-      const double cutoff = o.velocity_cutoff_hz > 0.0 ? o.velocity_cutoff_hz : rths::ident::VelocityCutoffHz(r);
-      auto v = rths::ident::SmoothVelocity(r.y_mm, r.dt_s, cutoff);
-      auto F = rths::ident::SimulateDamperForce(fit.coef, r.y_mm, v, r.dt_s);
-      const double pct = rths::ident::ScoreForce(r, F, cutoff).nrmse_f_pct;
-      all.push_back({&r, fitted, std::move(F), std::move(v), pct});
-    };
-    for (const auto& r : recs) add(r, true);
-    for (const auto& r : held) add(r, false);
-    PlotDamper(c.plot, all, fmt::format("at {} A", c.current_A));
-    std::printf("wrote %s\n", c.plot.c_str());
-  }
+  if (c.plot.empty()) return 0;
+  std::vector<DamperPlotRecord> all;
+  auto add = [&](const rths::io::RigRecord& r, bool fitted) {
+    const double cutoff = fit.CutoffHz(r);
+    auto F = fit.PredictForce(r);
+    const double pct = rths::ident::ScoreForce(r, F, cutoff).nrmse_f_pct;
+    all.push_back({&r, fitted, std::move(F), rths::ident::SmoothVelocity(r.y_mm, r.dt_s, cutoff), pct});
+  };
+  for (const auto& r : recs) add(r, true);
+  for (const auto& r : held) add(r, false);
+  PlotDamper(c.plot, all,
+             fit.at_current ? fmt::format("at {} A", *o.current_A) : (voltage ? "(voltage input)" : "(current input)"));
+  std::printf("wrote %s\n", c.plot.c_str());
   return 0;
 }
 
-/// The --damper mode with any input history: Eqs. 32-39 with the control filter.
-int RunSpencer(const DamperCli& c, const rths::ident::SpencerFitOptions& o) {
-  const auto recs = ReadDamperRecords(c.records, c.time);
-  const auto held = ReadDamperRecords(c.checks, c.time);
-  bool voltage = c.input == "voltage";
-  if (c.input.empty()) voltage = !recs.empty() && recs[0].i_A.empty();
-  rths::ProgressLine progress("rths identify --damper");
-  rths::ident::SpencerFitOptions opts = o;
-  if (progress.enabled()) {
-    opts.progress = [&progress](double done, double total, std::string_view what) { progress.Update(done, total, what); };
+/// The actuator fit's command line (file comment).
+struct ActuatorCli {
+  std::string record, band = "0.5-40", weights = "inverse-variance", out, plot;
+  int poles = 3;
+  double segment_s = 0.0;
+  rths::io::TimeAxis time = rths::io::TimeAxis::kColumn;
+};
+
+/// The actuator options of the command line, checked.
+rths::ident::IdentifyOptions ActuatorOptions(const ActuatorCli& a) {
+  rths::ident::IdentifyOptions o;
+  std::tie(o.fit.band_lo_hz, o.fit.band_hi_hz) = ParseBand(a.band);
+  o.fit.poles = a.poles;
+  o.segment_s = a.segment_s;
+  if (a.weights == "inverse-variance") {
+    o.fit.weighting = rths::ident::Weighting::kInverseVariance;
+  } else if (a.weights == "coherence") {
+    o.fit.weighting = rths::ident::Weighting::kCoherence;
+  } else if (a.weights == "uniform") {
+    o.fit.weighting = rths::ident::Weighting::kUniform;
+  } else {
+    throw Error("--weights", fmt::format("\"{}\": allowed inverse-variance, coherence, uniform", a.weights));
   }
-  const auto fit = rths::ident::FitSpencer(recs, voltage, opts);
-  progress.Finish();
-  std::printf("rths identify --damper: %zu record(s), %s input %g to %g %s\n%s", recs.size(),
-              voltage ? "voltage" : "current", fit.input_min, fit.input_max, voltage ? "V" : "A", fit.Report().c_str());
-  if (!held.empty()) {
-    std::printf("  held-out force error (Eq. 31 on f), same model:\n");
-    for (const auto& h : held) {
-      const auto sc = rths::ident::ScoreSpencer(fit.params, fit.driver, fit.filter, h, voltage, o.velocity_cutoff_hz);
-      std::printf("    %-40s %7zu samples at %g s, peak %.4g kN: %.3f %%\n", sc.source.c_str(), sc.samples, sc.dt_s,
-                  sc.peak_force_kN, sc.nrmse_f_pct);
-    }
+  if (a.segment_s < 0.0) throw Error("--segment-s", fmt::format("{}: must be > 0 (0 = default)", a.segment_s));
+  std::string why;
+  if (!o.fit.IsValid(&why)) throw Error("--poles/--band", why);
+  return o;
+}
+
+/// The actuator fit (file comment): the two fits, their report, the model file and the Bode plot.
+int RunActuator(const ActuatorCli& a) {
+  const rths::ident::IdentifyOptions o = ActuatorOptions(a);
+  const auto rec = rths::io::ReadRecordAny(a.record, a.time);
+  for (const auto& w : rec.warnings) std::fprintf(stderr, "rths identify: warning: %s\n", w.c_str());
+
+  // The model as the paper fits it (continuous, Eq. 15) and the one whose ZOH simulation at the
+  // record's step reproduces the record (docs/identification.md, "Two fits").
+  const auto rc = rths::ident::Identify(rec.u_mm, rec.y_mm, rec.dt_s, o);
+  auto oz = o;
+  oz.fit.zoh_dt_s = rec.dt_s;
+  const auto rz = rths::ident::Identify(rec.u_mm, rec.y_mm, rec.dt_s, oz);
+
+  std::printf("rths identify: %s\n%s", a.record.c_str(), rc.Report().c_str());
+  std::printf("\nZOH-consistent fit (the continuous model whose zero-order-hold discretisation at dt = %g s matches "
+              "the measured response):\n%s",
+              rec.dt_s, rz.fit.Report().c_str());
+  std::printf("time domain: Eq. 31 error of the predicted y %.3f %%\n", rz.prediction.model_error_pct);
+  WriteModel(rths::ident::ScenarioFragment(
+                 rc, rz,
+                 fmt::format("rths identify {} (band {}-{} Hz, {} poles, {} weights)",
+                             fs::path(a.record).filename().string(), o.fit.band_lo_hz, o.fit.band_hi_hz, a.poles,
+                             a.weights)),
+             a.out);
+  // Plots go only where the user said: --plot, or beside --out.
+  std::string plot = a.plot;
+  if (plot.empty() && !a.out.empty()) plot = fs::path(a.out).replace_extension(".png").string();
+  if (plot.empty()) {
+    std::printf("(no plot: give --plot FILE.png or --out FILE.toml for a Bode plot beside it)\n");
+    return 0;
   }
-  WriteModel(rths::ident::SpencerModelToml(fit, fmt::format("rths identify --damper {} ({} input)", Names(c.records),
-                                                            voltage ? "voltage" : "current")),
-             c.out);
-  if (!c.plot.empty()) {
-    std::vector<DamperPlotRecord> all;
-    auto add = [&](const rths::io::RigRecord& r, bool fitted) {
-      const double cutoff = o.velocity_cutoff_hz > 0.0 ? o.velocity_cutoff_hz : rths::ident::VelocityCutoffHz(r);
-      auto F = rths::ident::PredictSpencerForce(fit.params, fit.driver, fit.filter, r, voltage, cutoff);
-      const double pct = rths::ident::ScoreForce(r, F, cutoff).nrmse_f_pct;
-      all.push_back({&r, fitted, std::move(F), rths::ident::SmoothVelocity(r.y_mm, r.dt_s, cutoff), pct});
-    };
-    for (const auto& r : recs) add(r, true);
-    for (const auto& r : held) add(r, false);
-    PlotDamper(c.plot, all, voltage ? "(voltage input)" : "(current input)");
-    std::printf("wrote %s\n", c.plot.c_str());
-  }
+  const fs::path rp(a.record);
+  const std::string shown = rp.filename() == "log.lcm" && !rp.parent_path().filename().empty()
+                                ? (rp.parent_path().filename() / rp.filename()).string()
+                                : rp.filename().string();
+  PlotBode(plot, fmt::format("G_yu: {} ({} poles; measured H1, fitted models)", shown, a.poles), rc, rz);
+  std::printf("wrote %s\n", plot.c_str());
   return 0;
+}
+
+/// The --damper options of the command line (their checks beyond DamperFitOptions::IsValid).
+void AddDamperOptions(CLI::App* app, rths::ident::DamperFitOptions* o, double* current_A, std::string* input,
+                      std::string* filter, bool* no_offset) {
+  app->add_option("--current", *current_A, "--damper: fit at this one current [A] (the records' constant current)");
+  app->add_option("--A", o->A, "--damper: Bouc-Wen A [-], held fixed (Table 3)")->capture_default_str();
+  app->add_option("--velocity-cutoff-hz", o->velocity_cutoff_hz,
+                  "--damper: cutoff of the zero-phase smoothing differentiator [Hz] (0: 4 x the band edge of each "
+                  "record's velocity, at least 50 Hz, at most 0.45 / dt)")
+      ->capture_default_str();
+  app->add_option("--input", *input,
+                  "--damper without --current: the control input, current (column i_A) or voltage (column v_V) "
+                  "(default: current if the records have i_A)")
+      ->check(CLI::IsMember({"current", "voltage"}));
+  app->add_option("--filter", *filter,
+                  "--damper without --current: control filter between command and parameters: first_order "
+                  "(u' = -eta (u - v), eta fitted; default), eq40 (the paper's Eq. 40 + 75 Hz low-pass, fixed), none")
+      ->check(CLI::IsMember({"first_order", "eq40", "none"}));
+  app->add_flag("--no-offset", *no_offset, "--damper without --current: hold k1 = x0 = 0 (no accumulator force)");
+  app->add_option("--threads", o->threads, "--damper without --current: threads for the Jacobian (0: one per core)")
+      ->capture_default_str();
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{"rths identify: fit the servohydraulic model of Eq. 15 to a record of command u and measured y"};
-  std::string record, band = "0.5-40", out, plot, weights = "inverse-variance";
   std::vector<std::string> records, checks;
-  int poles = 3;
-  double segment_s = 0.0;
-  bool damper = false;
-  DamperCli dc;
-  double& current_A = dc.current_A;
-  rths::ident::DamperFitOptions damper_options;
-  rths::ident::SpencerFitOptions spencer_options;
-  std::string filter = "first_order";
-  bool no_offset = false;
+  bool damper = false, time_from_header = false, no_offset = false;
+  ActuatorCli ac;
+  rths::ident::DamperFitOptions fo;
+  std::string input, filter = "first_order";
+  double current_A = 0.0;
   app.add_option("record", records,
                  "CSV rig record or LCM run log (log.lcm) of ours; with --damper one or more damper tests (also UTFSM "
                  "damper files)")
       ->required();
-  bool time_from_header = false;
   app.add_flag("--time-from-header", time_from_header,
                "take the step from the record's '# dt_s' line; the time column need only lie within half a step "
                "of t_0 + k dt_s (for a rounded time column)");
   app.add_flag("--damper", damper,
                "fit the Spencer MR damper model instead: at one current (--current) or, without it, its current- or "
                "voltage-dependent form (Eqs. 32-39) with a control filter, from records with any input history");
-  app.add_option("--current", current_A, "--damper: fit at this one current [A] (the records' constant current)");
   app.add_option("--check", checks, "--damper: held-out records to score the fitted model on");
-  app.add_option("--A", damper_options.A, "--damper: Bouc-Wen A [-], held fixed (Table 3)")->capture_default_str();
-  app.add_option("--velocity-cutoff-hz", damper_options.velocity_cutoff_hz,
-                 "--damper: cutoff of the zero-phase smoothing differentiator [Hz] (0: 4 x the band edge of each "
-                 "record's velocity, at least 50 Hz, at most 0.45 / dt)")
+  AddDamperOptions(&app, &fo, &current_A, &input, &filter, &no_offset);
+  app.add_option("--band", ac.band, "frequency band fitted, LO-HI [Hz] (the paper's range)")->capture_default_str();
+  app.add_option("--poles", ac.poles, "number of poles N of Eq. 15")->capture_default_str();
+  app.add_option("--segment-s", ac.segment_s, "Welch segment length [s] (0: min(4 s, 2/9 of the record))")
       ->capture_default_str();
-  app.add_option("--input", dc.input,
-                 "--damper without --current: the control input, current (column i_A) or voltage (column v_V) "
-                 "(default: current if the records have i_A)")
-      ->check(CLI::IsMember({"current", "voltage"}));
-  app.add_option("--filter", filter,
-                 "--damper without --current: control filter between command and parameters: first_order "
-                 "(u' = -eta (u - v), eta fitted; default), eq40 (the paper's Eq. 40 + 75 Hz low-pass, fixed), none")
-      ->check(CLI::IsMember({"first_order", "eq40", "none"}));
-  app.add_flag("--no-offset", no_offset, "--damper without --current: hold k1 = x0 = 0 (no accumulator force)");
-  app.add_option("--threads", spencer_options.threads,
-                 "--damper without --current: threads for the Jacobian (0: one per core)")
-      ->capture_default_str();
-  app.add_option("--band", band, "frequency band fitted, LO-HI [Hz] (the paper's range)")->capture_default_str();
-  app.add_option("--poles", poles, "number of poles N of Eq. 15")->capture_default_str();
-  app.add_option("--segment-s", segment_s, "Welch segment length [s] (0: min(4 s, 2/9 of the record))")
-      ->capture_default_str();
-  app.add_option("--weights", weights, "frequency weights")
+  app.add_option("--weights", ac.weights, "frequency weights")
       ->check(CLI::IsMember({"inverse-variance", "coherence", "uniform"}))
       ->capture_default_str();
-  app.add_option("--out", out, "write the scenario fragment ([plant] actuator, [controller] model) here");
-  app.add_option("--plot", plot,
+  app.add_option("--out", ac.out, "write the scenario fragment ([plant] actuator, [controller] model) here");
+  app.add_option("--plot", ac.plot,
                  "Bode plot PNG (default: beside --out with the extension .png; none without --out); with --damper: "
                  "force against velocity and displacement per record (only if given)");
   rths::tools::NameCommand(app, "identify");
@@ -391,90 +433,31 @@ int main(int argc, char** argv) {
     {  // no output replaces a record being read, or what a run recorded (the scenario that ran, say)
       std::vector<fs::path> inputs(records.begin(), records.end());
       inputs.insert(inputs.end(), checks.begin(), checks.end());
-      if (!out.empty()) rths::io::RefuseToReplaceRecord(out, inputs, "--out");
-      if (!plot.empty()) rths::io::RefuseToReplaceRecord(plot, inputs, "--plot");
+      if (!ac.out.empty()) rths::io::RefuseToReplaceRecord(ac.out, inputs, "--out");
+      if (!ac.plot.empty()) rths::io::RefuseToReplaceRecord(ac.plot, inputs, "--plot");
     }
+    ac.time = time_from_header ? rths::io::TimeAxis::kHeader : rths::io::TimeAxis::kColumn;
+    if (app.count("--current") > 0) fo.current_A = current_A;
     if (damper) {
-      dc.records = records;
-      dc.checks = checks;
-      dc.out = out;
-      dc.plot = plot;
-      dc.time = time_from_header ? rths::io::TimeAxis::kHeader : rths::io::TimeAxis::kColumn;
-      if (app.count("--current") > 0) {
-        if (!(current_A >= 0.0)) throw Error("--current", fmt::format("{} A: must be >= 0", current_A));
-        if (!dc.input.empty() || app.count("--filter") > 0 || no_offset)
+      if (fo.current_A) {
+        if (!(*fo.current_A >= 0.0)) throw Error("--current", fmt::format("{} A: must be >= 0", *fo.current_A));
+        if (!input.empty() || app.count("--filter") > 0 || no_offset)
           throw Error("--input/--filter/--no-offset", "only for the fit with any input history (without --current)");
-        return RunDamper(dc, damper_options);
       }
-      spencer_options.A = damper_options.A;
-      spencer_options.velocity_cutoff_hz = damper_options.velocity_cutoff_hz;
-      spencer_options.filter = *rths::ValueOf(rths::ident::kControlFilterNames, filter);
-      spencer_options.accumulator = !no_offset;
-      return RunSpencer(dc, spencer_options);
+      fo.input = input == "voltage"   ? rths::ident::DamperInput::kVoltage
+                 : input == "current" ? rths::ident::DamperInput::kCurrent
+                                      : rths::ident::DamperInput::kAuto;
+      fo.filter = *rths::ValueOf(rths::ident::kControlFilterNames, filter);
+      fo.accumulator = !no_offset;
+      return RunDamper({records, checks, ac.out, ac.plot, ac.time}, fo);
     }
-    if (app.count("--current") > 0 || !checks.empty()) throw Error("--current/--check", "only with --damper");
+    if (fo.current_A || !checks.empty()) throw Error("--current/--check", "only with --damper");
     if (records.size() != 1)
       throw Error("record", fmt::format("{} records given: the actuator fit takes one (or use --damper)", records.size()));
-    record = records[0];
-    rths::ident::IdentifyOptions o;
-    std::tie(o.fit.band_lo_hz, o.fit.band_hi_hz) = ParseBand(band);
-    o.fit.poles = poles;
-    o.segment_s = segment_s;
-    if (weights == "inverse-variance") {
-      o.fit.weighting = rths::ident::Weighting::kInverseVariance;
-    } else if (weights == "coherence") {
-      o.fit.weighting = rths::ident::Weighting::kCoherence;
-    } else if (weights == "uniform") {
-      o.fit.weighting = rths::ident::Weighting::kUniform;
-    } else {
-      throw Error("--weights", fmt::format("\"{}\": allowed inverse-variance, coherence, uniform", weights));
-    }
-    if (segment_s < 0.0) throw Error("--segment-s", fmt::format("{}: must be > 0 (0 = default)", segment_s));
-    std::string why;
-    if (!o.fit.IsValid(&why)) throw Error("--poles/--band", why);
-
-    const auto axis = time_from_header ? rths::io::TimeAxis::kHeader : rths::io::TimeAxis::kColumn;
-    const auto rec = rths::io::ReadRecordAny(record, axis);
-    for (const auto& w : rec.warnings) std::fprintf(stderr, "rths identify: warning: %s\n", w.c_str());
-
-    // The model as the paper fits it (continuous, Eq. 15) and the one whose ZOH simulation at the
-    // record's step reproduces the record (docs/identification.md, "Two fits").
-    const auto rc = rths::ident::Identify(rec.u_mm, rec.y_mm, rec.dt_s, o);
-    auto oz = o;
-    oz.fit.zoh_dt_s = rec.dt_s;
-    const auto rz = rths::ident::Identify(rec.u_mm, rec.y_mm, rec.dt_s, oz);
-
-    std::printf("rths identify: %s\n%s", record.c_str(), rc.Report().c_str());
-    std::printf("\nZOH-consistent fit (the continuous model whose zero-order-hold discretisation at dt = %g s matches "
-                "the measured response):\n%s",
-                rec.dt_s, rz.fit.Report().c_str());
-    std::printf("time domain: Eq. 31 error of the predicted y %.3f %%\n", rz.prediction.model_error_pct);
-
-    const std::string toml = rths::ident::ScenarioFragment(
-        rc, rz,
-        fmt::format("rths identify {} (band {}-{} Hz, {} poles, {} weights)", fs::path(record).filename().string(),
-                    o.fit.band_lo_hz, o.fit.band_hi_hz, poles, weights));
-    std::printf("\n%s", toml.c_str());
-    if (!out.empty()) {
-      std::ofstream f(out);
-      if (!(f << toml)) throw Error(out, "cannot write the model file");
-      std::printf("\nwrote %s\n", out.c_str());
-    }
-    // Plots go only where the user said: --plot, or beside --out.
-    if (plot.empty() && !out.empty()) plot = fs::path(out).replace_extension(".png").string();
-    if (plot.empty()) {
-      std::printf("(no plot: give --plot FILE.png or --out FILE.toml for a Bode plot beside it)\n");
-      return 0;
-    }
-    const fs::path rp(record);
-    const std::string shown = rp.filename() == "log.lcm" && !rp.parent_path().filename().empty()
-                                  ? (rp.parent_path().filename() / rp.filename()).string()
-                                  : rp.filename().string();
-    PlotBode(plot, fmt::format("G_yu: {} ({} poles; measured H1, fitted models)", shown, poles), rc, rz);
-    std::printf("wrote %s\n", plot.c_str());
+    ac.record = records[0];
+    return RunActuator(ac);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "rths identify: %s\n", e.what());
     return 2;
   }
-  return 0;
 }

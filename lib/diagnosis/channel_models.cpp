@@ -179,6 +179,160 @@ ForcePredictor::ForcePredictor(const models::MrDamperParams& damper, bool curren
   damper_.Validate();
 }
 
+namespace {
+
+/// Eqs. 35-39 tabulated on a 1 mA grid over the currents a record can reach (the effective
+/// current overshoots a step of the command by a few per cent), linear interpolation between
+/// (relative error below 1e-5 for Table 3's rates); exact outside the table.
+class CoefficientTable {
+ public:
+  CoefficientTable(const models::MrDamperParams& damper, std::span<const double> i_A) : damper_(damper) {
+    double imin = i_A[0], imax = i_A[0];
+    for (double v : i_A) imin = std::min(imin, v), imax = std::max(imax, v);
+    const double span = imax - imin;
+    tlo_ = imin - 0.25 * span - 0.01;
+    const double thi = imax + 0.25 * span + 0.01;
+    nt_ = static_cast<std::size_t>(std::ceil((thi - tlo_) / kDi)) + 2;
+    table_.resize(nt_);
+    for (std::size_t j = 0; j < nt_; ++j) table_[j] = models::CoefficientsAt(damper_, tlo_ + kDi * static_cast<double>(j));
+  }
+  models::MrDamperCoefficients At(double i) const {
+    const double x = (i - tlo_) / kDi;
+    if (!(x >= 0.0) || x >= static_cast<double>(nt_ - 1)) return models::CoefficientsAt(damper_, i);
+    const auto j = static_cast<std::size_t>(x);
+    const double w = x - static_cast<double>(j);
+    const auto& a = table_[j];
+    const auto& b = table_[j + 1];
+    models::MrDamperCoefficients c = a;
+    c.alpha += w * (b.alpha - a.alpha);
+    c.c0 += w * (b.c0 - a.c0);
+    c.c1 += w * (b.c1 - a.c1);
+    c.beta += w * (b.beta - a.beta);
+    c.gamma += w * (b.gamma - a.gamma);
+    return c;
+  }
+
+ private:
+  static constexpr double kDi = 1e-3;  ///< the grid step [A]
+  const models::MrDamperParams& damper_;
+  double tlo_ = 0;
+  std::size_t nt_ = 0;
+  std::vector<models::MrDamperCoefficients> table_;
+};
+
+/// The motion inside step k -> k+1: the cubic Hermite interpolant of (x, v) at both ends, or the
+/// quintic through the accelerations too.
+struct StepMotion {
+  double dt, x0, x1, v0, v1, a0, a1;
+  bool quintic;
+  /// x [mm] and x' [mm/s] at tau [s] into the step.
+  void At(double tau, double* x, double* xd) const {
+    const double t = tau / dt;
+    const double t2 = t * t, t3 = t2 * t;
+    if (quintic) {  // Hermite through (x, v, a) at both ends
+      const double t4 = t3 * t, t5 = t4 * t, d2 = dt * dt;
+      *x = (1 - 10 * t3 + 15 * t4 - 6 * t5) * x0 + (t - 6 * t3 + 8 * t4 - 3 * t5) * dt * v0 +
+           0.5 * (t2 - 3 * t3 + 3 * t4 - t5) * d2 * a0 + (10 * t3 - 15 * t4 + 6 * t5) * x1 +
+           (-4 * t3 + 7 * t4 - 3 * t5) * dt * v1 + 0.5 * (t3 - 2 * t4 + t5) * d2 * a1;
+      *xd = ((-30 * t2 + 60 * t3 - 30 * t4) * x0 + (1 - 18 * t2 + 32 * t3 - 15 * t4) * dt * v0 +
+             0.5 * (2 * t - 9 * t2 + 12 * t3 - 5 * t4) * d2 * a0 + (30 * t2 - 60 * t3 + 30 * t4) * x1 +
+             (-12 * t2 + 28 * t3 - 15 * t4) * dt * v1 + 0.5 * (3 * t2 - 8 * t3 + 5 * t4) * d2 * a1) /
+            dt;
+      return;
+    }
+    *x = (2 * t3 - 3 * t2 + 1) * x0 + (t3 - 2 * t2 + t) * dt * v0 + (-2 * t3 + 3 * t2) * x1 + (t3 - t2) * dt * v1;
+    *xd = ((6 * t2 - 6 * t) * x0 + (3 * t2 - 4 * t + 1) * dt * v0 + (-6 * t2 + 6 * t) * x1 + (3 * t2 - 2 * t) * dt * v1) / dt;
+  }
+};
+
+/// Substeps of a step (file comment): from the size of the local Jacobian at the start of the
+/// step, more across a reversal of the relative velocity; in [1, 256].
+int Substeps(const models::MrDamperCoefficients& c0, const models::MrDamperState& s, const StepMotion& mo) {
+  const double dt = mo.dt;
+  const double vmax = std::max(std::abs(mo.v0), std::abs(mo.v1));
+  const double zabs = std::abs(s.z_mm);
+  const double zpow = c0.n == 2.0 ? zabs : std::pow(zabs, c0.n - 1.0);
+  const double lam = (c0.beta + c0.gamma) * c0.n * zpow * vmax + c0.A * c0.alpha / (c0.c0 + c0.c1) +
+                     c0.k0 / (c0.c0 + c0.c1);
+  int m = std::clamp(static_cast<int>(std::ceil(dt * lam / kRk4StepLambda)), 1, 256);
+  // A reversal of the relative velocity r = x' - y' inside the step (r changes sign between its
+  // ends, the end's taken with the state at the start): Eq. 33 has a kink there (|r|), which
+  // RK4 integrates with an error of about A alpha |r'| h^2 / 8 in alpha z (its slope jumps by up
+  // to A), whatever the Jacobian's size. Substeps so that it stays below kKinkForceTolKn.
+  const double r0 = mo.v0 - models::DamperRates(c0, s, mo.x0, mo.v0).ydot_mm_s;
+  const double r1 = mo.v1 - models::DamperRates(c0, s, mo.x1, mo.v1).ydot_mm_s;
+  const double dr = std::abs(mo.v1 - mo.v0);
+  if (r0 * r1 <= 0.0) {
+    const double kink = c0.A * c0.alpha * dr / dt / 8.0;  // [kN / s^2]
+    if (kink > 0) m = std::clamp(static_cast<int>(std::ceil(dt * std::sqrt(kink / kKinkForceTolKn))), m, 256);
+  }
+  return m;
+}
+
+/// The effective current at tau = j h / 2, j = 0 .. 2m, inside a step from the closed form of
+/// models/current_driver.h, i_c = i_h + r_1 e_1 e^{lambda_1 tau} + 2 Re(r e_q e^{lambda tau}),
+/// with the exponentials advanced by multiplication (cached per substep count).
+class HalfStepCurrents {
+ public:
+  explicit HalfStepCurrents(const models::CurrentDriver& driver) : driver_(driver), ic_(2 * 256 + 1) {}
+  void Fill(const models::CurrentDriverState& cs, int m, double h) {
+    if (m != cached_m_) {
+      cached_m_ = m;
+      half1_ = std::exp(driver_.pole1 * 0.5 * h);
+      half_ = std::exp(driver_.pole * 0.5 * h);
+    }
+    double e1 = cs.e1_A_s;
+    std::complex<double> eq = cs.eq_A_s;
+    for (int j = 0; j <= 2 * m; ++j) {
+      ic_[static_cast<std::size_t>(j)] = cs.held_A + driver_.residue1 * e1 + 2.0 * (driver_.residue * eq).real();
+      e1 *= half1_;
+      eq *= half_;
+    }
+  }
+  double operator[](int j) const { return ic_[static_cast<std::size_t>(j)]; }
+
+ private:
+  const models::CurrentDriver& driver_;
+  int cached_m_ = -1;
+  double half1_ = 1.0;
+  std::complex<double> half_{1.0, 0.0};
+  std::vector<double> ic_;
+};
+
+/// m classical RK4 substeps of Eqs. 32-33 over the step, the coefficients from c0 (constant) or
+/// at the half-step currents ic.
+void IntegrateStep(const StepMotion& mo, int m, bool constant, const models::MrDamperCoefficients& c0,
+                   const HalfStepCurrents& ic, const CoefficientTable& coef, models::MrDamperState* sp) {
+  models::MrDamperState& s = *sp;
+  const double h = mo.dt / m;
+  models::MrDamperCoefficients cmid = c0, cend = c0, cstart = c0;
+  double xa, va;
+  mo.At(0.0, &xa, &va);
+  for (int j = 0; j < m; ++j) {
+    const double tb = j * h + 0.5 * h, tc = j * h + h;
+    if (!constant) {
+      cstart = j == 0 ? c0 : cend;
+      cmid = coef.At(ic[2 * j + 1]);
+      cend = coef.At(ic[2 * j + 2]);
+    }
+    double xb, vb, xc, vc;
+    mo.At(tb, &xb, &vb);
+    mo.At(tc, &xc, &vc);
+    const models::MrDamperRates r1 = models::DamperRates(cstart, s, xa, va);
+    const models::MrDamperState s2{s.y_mm + 0.5 * h * r1.ydot_mm_s, s.z_mm + 0.5 * h * r1.zdot_mm_s};
+    const models::MrDamperRates r2 = models::DamperRates(cmid, s2, xb, vb);
+    const models::MrDamperState s3{s.y_mm + 0.5 * h * r2.ydot_mm_s, s.z_mm + 0.5 * h * r2.zdot_mm_s};
+    const models::MrDamperRates r3 = models::DamperRates(cmid, s3, xb, vb);
+    const models::MrDamperState s4{s.y_mm + h * r3.ydot_mm_s, s.z_mm + h * r3.zdot_mm_s};
+    const models::MrDamperRates r4 = models::DamperRates(cend, s4, xc, vc);
+    s.y_mm += h / 6.0 * (r1.ydot_mm_s + 2 * r2.ydot_mm_s + 2 * r3.ydot_mm_s + r4.ydot_mm_s);
+    s.z_mm += h / 6.0 * (r1.zdot_mm_s + 2 * r2.zdot_mm_s + 2 * r3.zdot_mm_s + r4.zdot_mm_s);
+    xa = xc, va = vc;
+  }
+}
+
+}  // namespace
+
 std::vector<double> ForcePredictor::Predict(const SmoothedMotion& motion, std::span<const double> i_A,
                                             const models::EffectSet& effects) const {
   auto f = PredictUnscaled(motion, i_A, effects);
@@ -199,44 +353,12 @@ std::vector<double> ForcePredictor::PredictUnscaled(const SmoothedMotion& motion
   fe.Reset(i_A[0]);
   models::CurrentDriverState cs = models::SteadyState(i_A[0]);
   models::MrDamperState s{};
-  const double dt = dt_s_;
-  // Eqs. 35-39 tabulated on a 1 mA grid over the currents this record can reach (the effective
-  // current overshoots a step of the command by a few per cent), linear interpolation between
-  // (relative error below 1e-5 for Table 3's rates); exact outside the table.
-  double imin = i_A[0], imax = i_A[0];
-  for (double v : i_A) imin = std::min(imin, v), imax = std::max(imax, v);
-  const double span = imax - imin;
-  const double tlo = imin - 0.25 * span - 0.01, thi = imax + 0.25 * span + 0.01;
-  const double di = 1e-3;
-  const auto nt = static_cast<std::size_t>(std::ceil((thi - tlo) / di)) + 2;
-  std::vector<models::MrDamperCoefficients> table(nt);
-  for (std::size_t j = 0; j < nt; ++j) table[j] = models::CoefficientsAt(damper_, tlo + di * static_cast<double>(j));
-  auto coef_at = [&](double i) {
-    const double x = (i - tlo) / di;
-    if (!(x >= 0.0) || x >= static_cast<double>(nt - 1)) return models::CoefficientsAt(damper_, i);
-    const auto j = static_cast<std::size_t>(x);
-    const double w = x - static_cast<double>(j);
-    const auto& a = table[j];
-    const auto& b = table[j + 1];
-    models::MrDamperCoefficients c = a;
-    c.alpha += w * (b.alpha - a.alpha);
-    c.c0 += w * (b.c0 - a.c0);
-    c.c1 += w * (b.c1 - a.c1);
-    c.beta += w * (b.beta - a.beta);
-    c.gamma += w * (b.gamma - a.gamma);
-    return c;
-  };
-  // The effective current inside a step at tau = j h / 2 from the closed form of
-  // models/current_driver.h, i_c = i_h + r_1 e_1 e^{lambda_1 tau} + 2 Re(r e_q e^{lambda tau}),
-  // with the exponentials advanced by multiplication (cached per substep count).
-  int cached_m = -1;
-  double half1 = 1.0;
-  std::complex<double> half{1.0, 0.0};
-  std::vector<double> ic(2 * 256 + 1);
+  const CoefficientTable coef(damper_, i_A);
+  HalfStepCurrents ic(driver_);
   const bool quintic = motion.a_mm_s2.size() == n;
   for (std::size_t k = 0; k < n; ++k) {
     const double ic_k = current_dynamics_ ? models::EffectiveCurrentA(driver_, cs) : cs.held_A;
-    f[k] = models::DamperForceKn(coef_at(ic_k), s, motion.x_mm[k], motion.v_mm_s[k]);
+    f[k] = models::DamperForceKn(coef.At(ic_k), s, motion.x_mm[k], motion.v_mm_s[k]);
     if (k + 1 == n) break;
     const double il = fe.Current(i_A[k]);
     if (current_dynamics_) {
@@ -245,84 +367,18 @@ std::vector<double> ForcePredictor::PredictUnscaled(const SmoothedMotion& motion
       cs = models::SteadyState(il);
     }
     const bool constant = !current_dynamics_ || models::AtSteadyState(cs);
-    const double x0 = motion.x_mm[k], x1 = motion.x_mm[k + 1];
-    const double v0 = motion.v_mm_s[k], v1 = motion.v_mm_s[k + 1];
-    const double a0 = quintic ? motion.a_mm_s2[k] : 0.0, a1 = quintic ? motion.a_mm_s2[k + 1] : 0.0;
-    // Substeps from the size of the local Jacobian at the start of the step (file comment).
-    const models::MrDamperCoefficients c0 = coef_at(constant ? cs.held_A : models::EffectiveCurrentAt(driver_, cs, 0.0));
-    const double vmax = std::max(std::abs(v0), std::abs(v1));
-    const double zabs = std::abs(s.z_mm);
-    const double zpow = c0.n == 2.0 ? zabs : std::pow(zabs, c0.n - 1.0);
-    const double lam = (c0.beta + c0.gamma) * c0.n * zpow * vmax + c0.A * c0.alpha / (c0.c0 + c0.c1) +
-                       c0.k0 / (c0.c0 + c0.c1);
-    int m = std::clamp(static_cast<int>(std::ceil(dt * lam / kRk4StepLambda)), 1, 256);
-    // A reversal of the relative velocity r = x' - y' inside the step (r changes sign between its
-    // ends, the end's taken with the state at the start): Eq. 33 has a kink there (|r|), which
-    // RK4 integrates with an error of about A alpha |r'| h^2 / 8 in alpha z (its slope jumps by up
-    // to A), whatever the Jacobian's size. Substeps so that it stays below kKinkForceTolKn.
-    const double r0 = v0 - models::DamperRates(c0, s, x0, v0).ydot_mm_s;
-    const double r1 = v1 - models::DamperRates(c0, s, x1, v1).ydot_mm_s;
-    const double dr = std::abs(v1 - v0);
-    if (r0 * r1 <= 0.0) {
-      const double kink = c0.A * c0.alpha * dr / dt / 8.0;  // [kN / s^2]
-      if (kink > 0) m = std::clamp(static_cast<int>(std::ceil(dt * std::sqrt(kink / kKinkForceTolKn))), m, 256);
-    }
-    const double h = dt / m;
-    if (!constant) {
-      if (m != cached_m) {
-        cached_m = m;
-        half1 = std::exp(driver_.pole1 * 0.5 * h);
-        half = std::exp(driver_.pole * 0.5 * h);
-      }
-      double e1 = cs.e1_A_s;
-      std::complex<double> eq = cs.eq_A_s;
-      for (int j = 0; j <= 2 * m; ++j) {
-        ic[static_cast<std::size_t>(j)] = cs.held_A + driver_.residue1 * e1 + 2.0 * (driver_.residue * eq).real();
-        e1 *= half1;
-        eq *= half;
-      }
-    }
-    auto motion_at = [&](double tau, double* x, double* xd) {
-      const double t = tau / dt;
-      const double t2 = t * t, t3 = t2 * t;
-      if (quintic) {  // Hermite through (x, v, a) at both ends
-        const double t4 = t3 * t, t5 = t4 * t, d2 = dt * dt;
-        *x = (1 - 10 * t3 + 15 * t4 - 6 * t5) * x0 + (t - 6 * t3 + 8 * t4 - 3 * t5) * dt * v0 +
-             0.5 * (t2 - 3 * t3 + 3 * t4 - t5) * d2 * a0 + (10 * t3 - 15 * t4 + 6 * t5) * x1 +
-             (-4 * t3 + 7 * t4 - 3 * t5) * dt * v1 + 0.5 * (t3 - 2 * t4 + t5) * d2 * a1;
-        *xd = ((-30 * t2 + 60 * t3 - 30 * t4) * x0 + (1 - 18 * t2 + 32 * t3 - 15 * t4) * dt * v0 +
-               0.5 * (2 * t - 9 * t2 + 12 * t3 - 5 * t4) * d2 * a0 + (30 * t2 - 60 * t3 + 30 * t4) * x1 +
-               (-12 * t2 + 28 * t3 - 15 * t4) * dt * v1 + 0.5 * (3 * t2 - 8 * t3 + 5 * t4) * d2 * a1) /
-              dt;
-        return;
-      }
-      *x = (2 * t3 - 3 * t2 + 1) * x0 + (t3 - 2 * t2 + t) * dt * v0 + (-2 * t3 + 3 * t2) * x1 + (t3 - t2) * dt * v1;
-      *xd = ((6 * t2 - 6 * t) * x0 + (3 * t2 - 4 * t + 1) * dt * v0 + (-6 * t2 + 6 * t) * x1 + (3 * t2 - 2 * t) * dt * v1) / dt;
-    };
-    models::MrDamperCoefficients cmid = c0, cend = c0, cstart = c0;
-    double xa, va;
-    motion_at(0.0, &xa, &va);
-    for (int j = 0; j < m; ++j) {
-      const double tb = j * h + 0.5 * h, tc = j * h + h;
-      if (!constant) {
-        cstart = j == 0 ? c0 : cend;
-        cmid = coef_at(ic[static_cast<std::size_t>(2 * j + 1)]);
-        cend = coef_at(ic[static_cast<std::size_t>(2 * j + 2)]);
-      }
-      double xb, vb, xc, vc;
-      motion_at(tb, &xb, &vb);
-      motion_at(tc, &xc, &vc);
-      const models::MrDamperRates r1 = models::DamperRates(cstart, s, xa, va);
-      const models::MrDamperState s2{s.y_mm + 0.5 * h * r1.ydot_mm_s, s.z_mm + 0.5 * h * r1.zdot_mm_s};
-      const models::MrDamperRates r2 = models::DamperRates(cmid, s2, xb, vb);
-      const models::MrDamperState s3{s.y_mm + 0.5 * h * r2.ydot_mm_s, s.z_mm + 0.5 * h * r2.zdot_mm_s};
-      const models::MrDamperRates r3 = models::DamperRates(cmid, s3, xb, vb);
-      const models::MrDamperState s4{s.y_mm + h * r3.ydot_mm_s, s.z_mm + h * r3.zdot_mm_s};
-      const models::MrDamperRates r4 = models::DamperRates(cend, s4, xc, vc);
-      s.y_mm += h / 6.0 * (r1.ydot_mm_s + 2 * r2.ydot_mm_s + 2 * r3.ydot_mm_s + r4.ydot_mm_s);
-      s.z_mm += h / 6.0 * (r1.zdot_mm_s + 2 * r2.zdot_mm_s + 2 * r3.zdot_mm_s + r4.zdot_mm_s);
-      xa = xc, va = vc;
-    }
+    const StepMotion mo{dt_s_,
+                        motion.x_mm[k],
+                        motion.x_mm[k + 1],
+                        motion.v_mm_s[k],
+                        motion.v_mm_s[k + 1],
+                        quintic ? motion.a_mm_s2[k] : 0.0,
+                        quintic ? motion.a_mm_s2[k + 1] : 0.0,
+                        quintic};
+    const models::MrDamperCoefficients c0 = coef.At(constant ? cs.held_A : models::EffectiveCurrentAt(driver_, cs, 0.0));
+    const int m = Substeps(c0, s, mo);
+    if (!constant) ic.Fill(cs, m, dt_s_ / m);
+    IntegrateStep(mo, m, constant, c0, ic, coef, &s);
     if (current_dynamics_) models::Advance(driver_, &cs);
   }
   return f;

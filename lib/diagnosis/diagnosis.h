@@ -48,9 +48,10 @@
 
 namespace rths::diagnosis {
 
-/// Knobs of the method (defaults: those of `rths diagnose`, documented in docs/diagnosis.md).
-/// Every threshold, ratio, iteration count and grid size of Diagnose lives here; Diagnose refuses
-/// options that are not IsValid() and writes the ones it used into diagnosis.json ("options").
+/// The settings of the method a user or a lab would change (defaults: those of `rths diagnose`,
+/// documented in docs/diagnosis.md). The fixed search effort and statistics are the constants of
+/// diagnosis/tuning.h. Diagnose refuses options that are not IsValid() and writes the ones it used,
+/// with the constants, into diagnosis.json ("options").
 struct Options {
   // --- data and channels
   double warmup_s = 0.1;               ///< start of every record left out of all sums [s], >= 0
@@ -58,74 +59,44 @@ struct Options {
   double smooth_hz = 20.0;             ///< zero-phase smoothing of the y residual for the force channel [Hz], > 0
   /// Upper bound of every smoothing cutoff, in cycles per sample: cutoff <= this / dt_s [Hz]; in (0, 0.5).
   double max_smooth_cycles_per_sample = 0.45;
-  /// Displacement-only records (u = y): the damper's motion is the measured y smoothed at this
-  /// times smooth_hz (above the excitation), at most max_smooth_cycles_per_sample / dt_s; > 0.
-  double displacement_only_smooth_factor = 4.0;
-  /// Upper end of servovalve_saturation's vmax search range, as a multiple of the largest
-  /// measured velocity of the training records (capped at the effect library's 1e9 mm/s); >= 1.
-  double vmax_search_factor = 2.0;
 
-  // --- noise floor and residual statistics
+  // --- noise floor
   /// Noise floor: the larger of the median PSDs over [noise_band_lo, noise_band_split] and
   /// [noise_band_split, noise_band_hi] (fractions of f_Nyquist), the plateau of the residual's
   /// spectrum whether the sensor noise is white or anti-alias filtered. lo in [0, 1).
   double noise_band_lo = 0.25;
   double noise_band_split = 0.5;       ///< (noise_band_lo, 1)
   double noise_band_hi = 0.95;         ///< (noise_band_split, 1]
-  int noise_psd_segment = 256;         ///< Welch segment length of the noise floor [samples], [8, 1048576]
-  int whiteness_lags = 20;             ///< lags l = 1 .. this of the whiteness number, [1, 10000]
-  int correlation_max_lag = 2000;      ///< tau_int sums the autocorrelation up to this lag [samples], >= 1
-  int correlation_lag_divisor = 4;     ///< ... and up to n / this of each record's n samples, >= 1
 
   // --- selection rules (file comment)
   double none_ratio = 1.6;             ///< rho_c at or below this: the channel is at its noise floor, >= 1
   double min_excess_reduction = 0.25;  ///< rule (b) above (also the pruning threshold), in (0, 1)
   double min_floor_gain = 0.5;         ///< rule (c) above: the SSE removed, in units of n sigma^2, >= 0
-  int max_effects_per_channel = 3;     ///< greedy stops after this many on one channel, >= 1
   /// A pure_delay beside another effect of its channel must be at least this many samples long
   /// (tau >= min_delay_samples dt), else it is not added and a refit that shrinks it below is
   /// undone: a sub-sample delay next to another effect compensates that effect's form or timing
   /// mismatch (a ZOH's half sample, a continuous vs. a discrete block), it is no transport delay.
   /// Alone it may be shorter. >= 0.
   double min_delay_samples = 1.0;
-  /// A fitted parameter within this fraction of its search range of either end (in log space for
-  /// log parameters) is "at a bound": the candidate is not an explanation; in [0, 0.5).
-  double at_bound_fraction = 1e-3;
   int swap_passes = 2;                 ///< rounds of swaps after the greedy loop (0: no swaps), [0, 100]
-  /// A swap is made if it lowers the channel's training SSE by more than this fraction; [0, 1).
-  double swap_min_gain = 1e-3;
 
   // --- held-out checks on the test records
   double min_test_shrink_pct = 30.0;   ///< the contract's 30 % on the test records, [0, 100]
   double max_test_worsening = 0.02;    ///< an effect raising the test NRMSE by more than this (relative) is dropped, >= 0
 
-  /// Progress by stage (channel x stage), for a terminal display; empty: none. Not in ToJson.
-  ProgressFn progress;
-
-  // --- parameter search (one effect) and joint refits (coordinate-wise)
-  int golden_iters_y = 24;             ///< golden-section iterations after the full-range grid, y effects, [0, 200]
-  int golden_iters_f = 12;             ///< ... force effects (each evaluation re-simulates the damper), [0, 200]
-  int refit_golden_iters_y = 14;       ///< golden-section iterations of a local refit, y effects, [0, 200]
-  int refit_golden_iters_f = 8;        ///< ... force effects, [0, 200]
-  double refit_bracket_factor = 1.3;   ///< local refit of a log parameter: [v / this, v x this], > 1
-  double refit_bracket_fraction = 0.05;  ///< local refit of a linear parameter: v +- this x its range, (0, 1]
+  // --- effort of the joint refits
   int refit_grid = 5;                  ///< grid points of a local refit's bracket, [2, 1000]
-  int simplex_evals = 48;              ///< Nelder-Mead evaluations of a two-parameter fit (after its grid), [3, 100000]
-  int refit_simplex_evals = 24;        ///< ... of a two-parameter local refit, [3, 100000]
-  /// Initial simplex step of a two-parameter fit, as a fraction of its grid spacing (log units); > 0.
-  double simplex_step_grid_fraction = 0.5;
-  double refit_simplex_step_first = 0.05;   ///< initial simplex step of a refit, first parameter [log units], > 0
-  double refit_simplex_step_second = 0.1;   ///< ... second parameter [log units], > 0
-  /// Joint refits stop when a coordinate round lowers the SSE by less than this fraction; [0, 1).
-  double refit_rel_tol = 1e-4;
-  int trial_refit_rounds = 2;          ///< coordinate rounds refitting a candidate's trial set, [1, 1000]
-  int refit_rounds = 6;                ///< ... after an addition, a swap or a held-out drop, [1, 1000]
+  int refit_rounds = 6;                ///< coordinate rounds after an addition, a swap or a held-out drop, [1, 1000]
+
+  // --- localisation and sensor checks
   /// A state condition holding in more than this share of the samples [%] localises nothing (a
   /// current switching every 0.1 s covers 99.9 % of them): reported as uninformative; (0, 100].
   double max_condition_samples_pct = 50.0;
   /// A channel exactly flat for this long [s] while the rig moves is a sensor fault; > 0.
   double sensor_flat_s = 0.25;
-  int prune_refit_rounds = 2;          ///< ... of the set without an effect, when pruning, [1, 1000]
+
+  /// Progress by stage (channel x stage), for a terminal display; empty: none. Not in ToJson.
+  ProgressFn progress;
 
   /// True if every field is in its range; else false and a message naming the field and its
   /// allowed range in *error (if not null).
@@ -172,7 +143,7 @@ struct EffectResult {
   double excess_reduction = 0;            ///< rule (b)'s fraction when it was last tried
   double delta_bic = 0;                   ///< rule (a)'s value when it was last tried
   bool selected = false;
-  /// A fitted parameter sits at an end of its search range (Options::at_bound_fraction): the
+  /// A fitted parameter sits at an end of its search range (tuning::kAtBoundFraction): the
   /// fit did not find the effect, it ran out of range; never selected, and left out of the
   /// terminal summary (diagnosis.json keeps it).
   bool at_bound = false;
@@ -246,7 +217,8 @@ Result Diagnose(const std::vector<io::RigRecord>& train, const std::vector<io::R
 /// ToJson(r.options).
 nlohmann::json ToJson(const Result& r);
 
-/// Every field of the options, by its name.
+/// Every field of the options and every constant of diagnosis/tuning.h, by its name (the
+/// constants under their former option names, e.g. "golden_iters_y").
 nlohmann::json ToJson(const Options& o);
 
 /// How much Summary says.

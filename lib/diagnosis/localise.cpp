@@ -71,68 +71,90 @@ ConditionMasks MakeConditionMasks(const LocaliseInput& r) {
   return cm;
 }
 
-void Localise(const std::string& channel, const std::vector<LocaliseInput>& recs, std::vector<Band>* bands,
-              std::vector<Condition>* conditions, std::vector<TimeWindow>* time) {
-  if (recs.empty()) return;
-  const double dt = recs[0].dt_s;
+namespace {
+
+/// The bands' edges [Hz]: 0, 1, 2, 5, 10, ... below f_Nyquist, then f_Nyquist.
+std::vector<double> BandEdges(double dt) {
   const double nyq = 0.5 / dt;
   std::vector<double> edges = {0, 1, 2, 5, 10, 20, 50, 100, 200, 500};
   while (!edges.empty() && edges.back() >= nyq) edges.pop_back();
   edges.push_back(nyq);
+  return edges;
+}
+
+/// Per band: residual and signal energy, and (y only) the measured-power-weighted sums of the
+/// coherence, the gain ratio and the phase difference of H_meas / H_model.
+struct BandSums {
+  explicit BandSums(std::size_t nb) : e_res(nb, 0), e_sig(nb, 0), coh(nb, 0), gain(nb, 0), phase(nb, 0), wsum(nb, 0) {}
+  std::vector<double> e_res, e_sig, coh, gain, phase, wsum;
+};
+
+/// Adds one record's Welch spectra (segments of 2 s, at least 64 samples, at most 1/8 of the
+/// record) to the sums; dt [s] is the first record's (one dt per diagnosis).
+void AddRecordBands(const std::string& channel, const LocaliseInput& r, double dt, const std::vector<double>& edges,
+                    BandSums* s) {
   const std::size_t nb = edges.size() - 1;
-  std::vector<double> e_res(nb, 0), e_sig(nb, 0), coh(nb, 0), gain(nb, 0), phase(nb, 0), wsum(nb, 0);
-  // --- bands
-  for (const auto& r : recs) {
-    const std::size_t n = r.meas.size();
-    if (n <= r.first + 64) continue;
-    std::vector<double> res(n - r.first), meas(r.meas.begin() + static_cast<std::ptrdiff_t>(r.first), r.meas.end());
-    for (std::size_t k = r.first; k < n; ++k) res[k - r.first] = r.meas[k] - r.pred[k];
-    const std::size_t L = std::max<std::size_t>(64, std::min<std::size_t>(static_cast<std::size_t>(std::lround(2.0 / dt)), res.size() / 8));
-    const auto pr = signal::WelchPsd(res, dt, L);
-    const auto pm = signal::WelchPsd(meas, dt, L);
-    const double df = 1.0 / (dt * static_cast<double>(L));
-    signal::FrequencyResponseEstimate hm, hp;
-    const bool frf = channel == "y" && r.u.size() == n;
-    if (frf) {
-      std::vector<double> u(r.u.begin() + static_cast<std::ptrdiff_t>(r.first), r.u.end());
-      std::vector<double> pred(r.pred.begin() + static_cast<std::ptrdiff_t>(r.first), r.pred.end());
-      hm = signal::H1Estimate(u, meas, dt, L);
-      hp = signal::H1Estimate(u, pred, dt, L);
-    }
-    for (std::size_t j = 0; j < pr.size(); ++j) {
-      const double f = static_cast<double>(j) * df;
-      std::size_t b = 0;
-      while (b + 1 < nb && f >= edges[b + 1]) ++b;
-      e_res[b] += pr[j] * df;
-      e_sig[b] += pm[j] * df;
-      if (frf && j > 0 && std::abs(hp.h[j]) > 0) {
-        const std::complex<double> ratio = hm.h[j] / hp.h[j];
-        const double w = pm[j];  // weight by the measured power
-        coh[b] += w * hm.coherence[j];
-        gain[b] += w * std::abs(ratio);
-        phase[b] += w * std::arg(ratio) * 180.0 / M_PI;
-        wsum[b] += w;
-      }
+  const std::size_t n = r.meas.size();
+  if (n <= r.first + 64) return;
+  std::vector<double> res(n - r.first), meas(r.meas.begin() + static_cast<std::ptrdiff_t>(r.first), r.meas.end());
+  for (std::size_t k = r.first; k < n; ++k) res[k - r.first] = r.meas[k] - r.pred[k];
+  const std::size_t L = std::max<std::size_t>(64, std::min<std::size_t>(static_cast<std::size_t>(std::lround(2.0 / dt)), res.size() / 8));
+  const auto pr = signal::WelchPsd(res, dt, L);
+  const auto pm = signal::WelchPsd(meas, dt, L);
+  const double df = 1.0 / (dt * static_cast<double>(L));
+  signal::FrequencyResponseEstimate hm, hp;
+  const bool frf = channel == "y" && r.u.size() == n;
+  if (frf) {
+    std::vector<double> u(r.u.begin() + static_cast<std::ptrdiff_t>(r.first), r.u.end());
+    std::vector<double> pred(r.pred.begin() + static_cast<std::ptrdiff_t>(r.first), r.pred.end());
+    hm = signal::H1Estimate(u, meas, dt, L);
+    hp = signal::H1Estimate(u, pred, dt, L);
+  }
+  for (std::size_t j = 0; j < pr.size(); ++j) {
+    const double f = static_cast<double>(j) * df;
+    std::size_t b = 0;
+    while (b + 1 < nb && f >= edges[b + 1]) ++b;
+    s->e_res[b] += pr[j] * df;
+    s->e_sig[b] += pm[j] * df;
+    if (frf && j > 0 && std::abs(hp.h[j]) > 0) {
+      const std::complex<double> ratio = hm.h[j] / hp.h[j];
+      const double w = pm[j];  // weight by the measured power
+      s->coh[b] += w * hm.coherence[j];
+      s->gain[b] += w * std::abs(ratio);
+      s->phase[b] += w * std::arg(ratio) * 180.0 / M_PI;
+      s->wsum[b] += w;
     }
   }
-  const double tot_r = std::accumulate(e_res.begin(), e_res.end(), 0.0);
-  const double tot_s = std::accumulate(e_sig.begin(), e_sig.end(), 0.0);
+}
+
+void LocaliseBands(const std::string& channel, const std::vector<LocaliseInput>& recs, std::vector<Band>* bands) {
+  const double dt = recs[0].dt_s;
+  const std::vector<double> edges = BandEdges(dt);
+  const std::size_t nb = edges.size() - 1;
+  BandSums s(nb);
+  for (const auto& r : recs) AddRecordBands(channel, r, dt, edges, &s);
+  const double tot_r = std::accumulate(s.e_res.begin(), s.e_res.end(), 0.0);
+  const double tot_s = std::accumulate(s.e_sig.begin(), s.e_sig.end(), 0.0);
   for (std::size_t b = 0; b < nb; ++b) {
     Band bd;
     bd.channel = channel;
     bd.lo_hz = edges[b];
     bd.hi_hz = edges[b + 1];
-    bd.share_pct = tot_r > 0 ? 100.0 * e_res[b] / tot_r : 0.0;
-    bd.signal_share_pct = tot_s > 0 ? 100.0 * e_sig[b] / tot_s : 0.0;
-    bd.rel_residual_pct = e_sig[b] > 0 ? 100.0 * std::sqrt(e_res[b] / e_sig[b]) : 0.0;
-    if (wsum[b] > 0) {
-      bd.coherence = coh[b] / wsum[b];
-      bd.gain_ratio = gain[b] / wsum[b];
-      bd.phase_diff_deg = phase[b] / wsum[b];
+    bd.share_pct = tot_r > 0 ? 100.0 * s.e_res[b] / tot_r : 0.0;
+    bd.signal_share_pct = tot_s > 0 ? 100.0 * s.e_sig[b] / tot_s : 0.0;
+    bd.rel_residual_pct = s.e_sig[b] > 0 ? 100.0 * std::sqrt(s.e_res[b] / s.e_sig[b]) : 0.0;
+    if (s.wsum[b] > 0) {
+      bd.coherence = s.coh[b] / s.wsum[b];
+      bd.gain_ratio = s.gain[b] / s.wsum[b];
+      bd.phase_diff_deg = s.phase[b] / s.wsum[b];
     }
     bands->push_back(bd);
   }
-  // --- conditions
+}
+
+/// The conditions' shares; returns the residual energy of all records (k >= first).
+double LocaliseConditions(const std::string& channel, const std::vector<LocaliseInput>& recs,
+                          std::vector<Condition>* conditions) {
   std::map<std::string, std::pair<double, double>> acc;  // name -> (residual energy, samples)
   std::vector<std::string> order;
   double tot_e = 0, tot_n = 0;
@@ -163,7 +185,12 @@ void Localise(const std::string& channel, const std::vector<LocaliseInput>& recs
     c.samples_pct = tot_n > 0 ? 100.0 * acc[name].second / tot_n : 0.0;
     conditions->push_back(c);
   }
-  // --- time windows
+  return tot_e;
+}
+
+/// The five windows (1 s, or a tenth of a record shorter than 10 s) holding the largest shares of tot_e.
+void LocaliseTime(const std::string& channel, const std::vector<LocaliseInput>& recs, double tot_e,
+                  std::vector<TimeWindow>* time) {
   std::vector<TimeWindow> wins;
   for (const auto& r : recs) {
     const std::size_t n = r.meas.size();
@@ -189,6 +216,16 @@ void Localise(const std::string& channel, const std::vector<LocaliseInput>& recs
   std::sort(wins.begin(), wins.end(), [](const TimeWindow& a, const TimeWindow& b) { return a.share_pct > b.share_pct; });
   if (wins.size() > 5) wins.resize(5);
   for (auto& w : wins) time->push_back(w);
+}
+
+}  // namespace
+
+void Localise(const std::string& channel, const std::vector<LocaliseInput>& recs, std::vector<Band>* bands,
+              std::vector<Condition>* conditions, std::vector<TimeWindow>* time) {
+  if (recs.empty()) return;
+  LocaliseBands(channel, recs, bands);
+  const double tot_e = LocaliseConditions(channel, recs, conditions);
+  LocaliseTime(channel, recs, tot_e, time);
 }
 
 }  // namespace rths::diagnosis

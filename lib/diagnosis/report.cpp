@@ -117,19 +117,12 @@ io::Figure SpectrumFigure(const Traces::Record& t, const std::string& ch, std::s
   return fig;
 }
 
-io::Figure FrfFigure(const Traces::Record& t, std::size_t first) {
-  std::vector<double> u(t.u.begin() + static_cast<std::ptrdiff_t>(first), t.u.end());
-  std::vector<double> ym(t.y_meas.begin() + static_cast<std::ptrdiff_t>(first), t.y_meas.end());
-  std::vector<double> yn(t.y_nom.begin() + static_cast<std::ptrdiff_t>(first), t.y_nom.end());
-  std::vector<double> yf(t.y_fin.begin() + static_cast<std::ptrdiff_t>(first), t.y_fin.end());
-  const std::size_t L = std::max<std::size_t>(64, std::min<std::size_t>(static_cast<std::size_t>(std::lround(2.0 / t.dt_s)), u.size() / 8));
-  const auto sm = signal::WelchCrossSpectra(u, ym, t.dt_s, L);
-  const auto hm = signal::H1FromSpectra(sm);
-  const auto hn = signal::H1Estimate(u, yn, t.dt_s, L);
-  const auto hf = signal::H1Estimate(u, yf, t.dt_s, L);
-  const auto phm = signal::UnwrapPhase(hm.h), phn = signal::UnwrapPhase(hn.h), phf = signal::UnwrapPhase(hf.h);
+namespace {
 
-  // The frequency axis: the input's excited band (from 0 Hz unless it starts well above).
+/// The FRF plot's frequency axis [Hz]: the input's kFrfEnergyFraction energy band (from 0 Hz
+/// unless it starts well above) over its coherent points, else its strong ones; *mask: at least
+/// two reliable points (coherence u -> y_meas at least kFrfMinCoherence) in it, so the others are left out.
+std::pair<double, double> FrfAxis(const signal::CrossSpectra& sm, const signal::FrequencyResponseEstimate& hm, bool* mask) {
   double peak = 0.0;
   for (std::size_t j = 1; j < sm.s_uu.size(); ++j) peak = std::max(peak, sm.s_uu[j]);
   std::vector<double> strong(sm.s_uu.size(), 0.0), excited(sm.s_uu.size(), 0.0);
@@ -142,12 +135,30 @@ io::Figure FrfFigure(const Traces::Record& t, std::size_t first) {
   auto [lo, hi] = peak > 0.0 ? EnergyBand(sm.f_hz, coherent ? excited : strong, kFrfEnergyFraction)
                              : std::make_pair(0.0, sm.f_hz.back());  // no input: the whole axis
   if (lo < 0.25 * hi) lo = 0.0;
-  // Reliable points: coherence u -> y_meas at least kFrfMinCoherence.
   std::size_t reliable = 0;
   for (std::size_t j = 1; j < hm.f_hz.size(); ++j) {
     if (hm.f_hz[j] >= lo && hm.f_hz[j] <= hi && hm.coherence[j] >= kFrfMinCoherence) ++reliable;
   }
-  const bool mask = reliable >= 2;
+  *mask = reliable >= 2;
+  return {lo, hi};
+}
+
+}  // namespace
+
+io::Figure FrfFigure(const Traces::Record& t, std::size_t first) {
+  std::vector<double> u(t.u.begin() + static_cast<std::ptrdiff_t>(first), t.u.end());
+  std::vector<double> ym(t.y_meas.begin() + static_cast<std::ptrdiff_t>(first), t.y_meas.end());
+  std::vector<double> yn(t.y_nom.begin() + static_cast<std::ptrdiff_t>(first), t.y_nom.end());
+  std::vector<double> yf(t.y_fin.begin() + static_cast<std::ptrdiff_t>(first), t.y_fin.end());
+  const std::size_t L = std::max<std::size_t>(64, std::min<std::size_t>(static_cast<std::size_t>(std::lround(2.0 / t.dt_s)), u.size() / 8));
+  const auto sm = signal::WelchCrossSpectra(u, ym, t.dt_s, L);
+  const auto hm = signal::H1FromSpectra(sm);
+  const auto hn = signal::H1Estimate(u, yn, t.dt_s, L);
+  const auto hf = signal::H1Estimate(u, yf, t.dt_s, L);
+  const auto phm = signal::UnwrapPhase(hm.h), phn = signal::UnwrapPhase(hn.h), phf = signal::UnwrapPhase(hf.h);
+  bool mask = false;
+  const std::pair<double, double> axis = FrfAxis(sm, hm, &mask);
+  const double lo = axis.first, hi = axis.second;
   io::Figure fig;
   fig.name = "frf_y";
   fig.title = fmt::format("u -> y: measured vs model (H1, test record), over the input's {:g} % energy band {:.3g}-{:.3g} Hz; {}",
@@ -265,31 +276,40 @@ io::Figure TraceFigure(const Traces::Record& t, const std::string& ch) {
   return fig;
 }
 
-void WriteReport(const Result& r, const Traces& traces, const fs::path& dir) {
+namespace {
+
+/// The plots of the first test record as PNGs in dir; returns their names, *note says why some or all are missing.
+std::vector<std::string> WritePlots(const Result& r, const Traces& traces, const fs::path& dir, std::string* note) {
   std::vector<std::string> pngs;
-  std::string plot_note;
-  if (!traces.test.empty() && io::GnuplotAvailable()) {
-    const auto& t = traces.test[0];
-    const auto first = static_cast<std::size_t>(std::lround(r.options.warmup_s / t.dt_s));
-    std::vector<io::Figure> figs = {SpectrumFigure(t, "y", first), FrfFigure(t, first)};
-    if (!t.f_nom.empty()) figs.push_back(SpectrumFigure(t, "f", first));
-    figs.push_back(ConditionFigure(r));
-    figs.push_back(TraceFigure(t, "y"));
-    if (!t.f_nom.empty()) figs.push_back(TraceFigure(t, "f"));
-    for (const auto& f : figs) {
-      if (f.panels.empty()) continue;
-      try {
-        io::Plot(f, dir);
-        pngs.push_back(f.name + ".png");
-      } catch (const std::exception& e) {
-        plot_note += fmt::format("<p>plot {} failed: {}</p>\n", f.name, Esc(e.what()));
-      }
-    }
-  } else if (traces.test.empty()) {
-    plot_note = "<p>No traces: no plots.</p>\n";
-  } else {
-    plot_note = "<p>gnuplot is not installed (apt-get install gnuplot-nox): no plots.</p>\n";
+  if (traces.test.empty()) {
+    *note = "<p>No traces: no plots.</p>\n";
+    return pngs;
   }
+  if (!io::GnuplotAvailable()) {
+    *note = "<p>gnuplot is not installed (apt-get install gnuplot-nox): no plots.</p>\n";
+    return pngs;
+  }
+  const auto& t = traces.test[0];
+  const auto first = static_cast<std::size_t>(std::lround(r.options.warmup_s / t.dt_s));
+  std::vector<io::Figure> figs = {SpectrumFigure(t, "y", first), FrfFigure(t, first)};
+  if (!t.f_nom.empty()) figs.push_back(SpectrumFigure(t, "f", first));
+  figs.push_back(ConditionFigure(r));
+  figs.push_back(TraceFigure(t, "y"));
+  if (!t.f_nom.empty()) figs.push_back(TraceFigure(t, "f"));
+  for (const auto& f : figs) {
+    if (f.panels.empty()) continue;
+    try {
+      io::Plot(f, dir);
+      pngs.push_back(f.name + ".png");
+    } catch (const std::exception& e) {
+      *note += fmt::format("<p>plot {} failed: {}</p>\n", f.name, Esc(e.what()));
+    }
+  }
+  return pngs;
+}
+
+/// The head of the page: the verdict, the model, the records.
+std::string HeadHtml(const Result& r) {
   std::string h;
   h += "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>rths diagnose</title>\n<style>"
        "body{font-family:sans-serif;max-width:1100px;margin:1em auto}table{border-collapse:collapse;margin:.5em 0}"
@@ -300,6 +320,12 @@ void WriteReport(const Result& r, const Traces& traces, const fs::path& dir) {
   h += fmt::format("<p>Model: {}<br>Training records: {}<br>Test records: {}<br>dt = {} s, {} samples, runtime {:.2f} s</p>\n",
                    Esc(r.model_source), Esc(fmt::format("{}", fmt::join(r.train, ", "))),
                    Esc(fmt::format("{}", fmt::join(r.test, ", "))), r.dt_s, r.samples, r.runtime_s);
+  return h;
+}
+
+/// The gap per channel and the effects.
+std::string ChannelsAndEffectsHtml(const Result& r) {
+  std::string h;
   h += "<h2>Gap per channel (test records)</h2>\n<table><tr><th>channel</th><th>NRMSE nominal [%]</th><th>train [%]</th>"
        "<th>after [%]</th><th>noise floor rms</th><th>residual / floor</th><th>whiteness Q20</th><th>status</th></tr>\n";
   for (const auto& c : r.channels) {
@@ -323,7 +349,13 @@ void WriteReport(const Result& r, const Traces& traces, const fs::path& dir) {
                      e.selected ? " class=sel" : "", e.name, e.channel, ps, e.test_nrmse_after, e.shrink_pct, e.train_nrmse_after,
                      e.selected ? fmt::format("yes ({})", e.order + 1) : "no");
   }
-  h += "</table>\n<h2>Where: frequency bands (nominal residual, test records)</h2>\n<table><tr><th>channel</th><th>band [Hz]</th>"
+  return h + "</table>\n";
+}
+
+/// Where: the frequency bands, the state conditions and the time windows.
+std::string WhereHtml(const Result& r) {
+  std::string h;
+  h += "<h2>Where: frequency bands (nominal residual, test records)</h2>\n<table><tr><th>channel</th><th>band [Hz]</th>"
        "<th>residual share [%]</th><th>signal share [%]</th><th>residual / signal in band [%]</th><th>coherence</th>"
        "<th>|H_meas / H_model|</th><th>phase diff [deg]</th></tr>\n";
   for (const auto& b : r.bands) {
@@ -349,7 +381,15 @@ void WriteReport(const Result& r, const Traces& traces, const fs::path& dir) {
   for (const auto& t : r.time)
     h += fmt::format("<tr><td class=l>{}</td><td class=l>{}</td><td>{:.2f}</td><td>{:.2f}</td><td>{:.1f}</td></tr>\n", t.channel,
                      Esc(t.record), t.t0_s, t.t1_s, t.share_pct);
-  h += "</table>\n";
+  return h + "</table>\n";
+}
+
+}  // namespace
+
+void WriteReport(const Result& r, const Traces& traces, const fs::path& dir) {
+  std::string plot_note;
+  const std::vector<std::string> pngs = WritePlots(r, traces, dir, &plot_note);
+  std::string h = HeadHtml(r) + ChannelsAndEffectsHtml(r) + WhereHtml(r);
   if (!r.warnings.empty()) {
     h += "<h2>Warnings</h2>\n<ul>\n";
     for (const auto& w : r.warnings) h += "<li>" + Esc(w) + "</li>\n";

@@ -158,7 +158,7 @@ void MarkNotDiagnosed(ChannelState* s);
 void SelectEffects(ChannelState* s, const std::vector<CandidateSpec>& specs, const Options& o);
 
 /// Up to o.swap_passes times: the effect of the set whose replacement by another candidate (fitted,
-/// then the set refitted) lowers the training SSE the most, by more than o.swap_min_gain of it, is
+/// then the set refitted) lowers the training SSE the most, by more than tuning::kSwapMinGain of it, is
 /// replaced. Each swap is a warning.
 void SwapEffects(ChannelState* s, const std::vector<CandidateSpec>& specs, const Options& o,
                  std::vector<std::string>* warnings);

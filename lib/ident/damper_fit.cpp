@@ -165,21 +165,6 @@ void Iterate(LmState* s, const std::vector<Prepared>& data, double A, int iterat
 
 }  // namespace
 
-bool DamperFitOptions::IsValid(std::string* error) const {
-  auto fail = [&](const std::string& m) {
-    if (error) *error = m;
-    return false;
-  };
-  if (!(A > 0.0) || !std::isfinite(A)) return fail(fmt::format("A = {}: must be > 0", A));
-  if (!(velocity_cutoff_hz >= 0.0) || !std::isfinite(velocity_cutoff_hz))
-    return fail(fmt::format("velocity_cutoff_hz = {}: must be >= 0 (0: from the record's band)", velocity_cutoff_hz));
-  if (start_iterations < 1) return fail(fmt::format("start_iterations = {}: must be >= 1", start_iterations));
-  if (max_iterations < 1) return fail(fmt::format("max_iterations = {}: must be >= 1", max_iterations));
-  if (!(current_tolerance_A >= 0.0))
-    return fail(fmt::format("current_tolerance_A = {}: must be >= 0", current_tolerance_A));
-  return true;
-}
-
 std::vector<double> SmoothVelocity(std::span<const double> x, double dt, double cutoff_hz) {
   const std::size_t n = x.size();
   if (n < 3) throw Error("SmoothVelocity", fmt::format("{} samples: need at least 3", n));
@@ -297,6 +282,27 @@ std::vector<double> SimulateDamperForce(const models::MrDamperCoefficients& k, s
   return f;
 }
 
+std::string RecordName(const io::RigRecord& record) { return record.source.empty() ? "record" : record.source; }
+
+void CheckDamperColumns(const io::RigRecord& rec) {
+  if (rec.size() < 3 || rec.f_kN.size() != rec.size() || rec.y_mm.size() != rec.size())
+    throw Error(RecordName(rec), "too few samples or columns of different lengths");
+}
+
+double ForceWeight(const io::RigRecord& rec) {
+  double sf = 0.0;
+  for (std::size_t k = 0; k < rec.size(); ++k) sf += rec.f_kN[k] * rec.f_kN[k];
+  if (!(sf > 0.0)) throw Error(RecordName(rec), "the force f_kN is zero throughout: nothing to fit");
+  return 1.0 / sf;
+}
+
+double PeakForce(const std::vector<io::RigRecord>& records) {
+  double fpeak = 0.0;
+  for (const auto& rec : records)
+    for (double f : rec.f_kN) fpeak = std::max(fpeak, std::abs(f));
+  return fpeak;
+}
+
 DamperRecordScore ScoreForce(const io::RigRecord& rec, std::span<const double> F, double velocity_cutoff_hz) {
   DamperRecordScore s;
   s.source = rec.source;
@@ -321,80 +327,101 @@ DamperRecordScore ScoreDamper(const models::MrDamperCoefficients& coef, const io
   return ScoreForce(rec, SimulateDamperForce(coef, rec.y_mm, v, rec.dt_s), cutoff);
 }
 
-DamperFitResult FitDamper(const std::vector<io::RigRecord>& records, double current_A,
-                          const DamperFitOptions& o) {
-  std::string why;
-  if (!o.IsValid(&why)) throw Error("DamperFitOptions", why);
-  if (records.empty()) throw Error("FitDamper", "no records");
-  if (!(current_A >= 0.0) || !std::isfinite(current_A))
-    throw Error("FitDamper", fmt::format("current {} A: must be >= 0", current_A));
-  std::vector<Prepared> data;
-  // Rough yield-force / viscous fit f ~ F_y sgn(v) + c v over every record, for the starts.
-  double a11 = 0, a12 = 0, a22 = 0, b1 = 0, b2 = 0, xmax = 0, vmax_all = 0;
-  for (const auto& rec : records) {
-    const std::string where = rec.source.empty() ? "record" : rec.source;
-    if (rec.size() < 3 || rec.f_kN.size() != rec.size() || rec.y_mm.size() != rec.size())
-      throw Error(where, "too few samples or columns of different lengths");
-    const auto& command = rec.Command();  // i_A, or v_V of a voltage-only record
-    for (std::size_t k = 0; k < command.size(); ++k) {
-      if (std::abs(command[k] - current_A) > o.current_tolerance_A)
-        throw Error(where, fmt::format("sample {} (t = {} s): current i_A = {} A differs from --current {} A by "
-                                       "more than {} A: the fit is at one current",
-                                       k + 1, k < rec.t_s.size() ? rec.t_s[k] : 0.0, command[k], current_A,
-                                       o.current_tolerance_A));
-    }
-    const double cutoff = o.velocity_cutoff_hz > 0.0 ? o.velocity_cutoff_hz : VelocityCutoffHz(rec);
-    Prepared p{&rec, SmoothVelocity(rec.y_mm, rec.dt_s, cutoff), 0.0, 0.0};
-    double sf = 0.0;
-    for (std::size_t k = 0; k < rec.size(); ++k) {
-      sf += rec.f_kN[k] * rec.f_kN[k];
-      p.vmax = std::max(p.vmax, std::abs(p.v[k]));
-      xmax = std::max(xmax, std::abs(rec.y_mm[k]));
-    }
-    if (!(sf > 0.0)) throw Error(where, "the force f_kN is zero throughout: nothing to fit");
-    p.weight = 1.0 / sf;
-    for (std::size_t k = 0; k < rec.size(); ++k) {
-      const double s = p.v[k] > 0.0 ? 1.0 : (p.v[k] < 0.0 ? -1.0 : 0.0), v = p.v[k], f = rec.f_kN[k];
-      a11 += p.weight * s * s;
-      a12 += p.weight * s * v;
-      a22 += p.weight * v * v;
-      b1 += p.weight * s * f;
-      b2 += p.weight * v * f;
-    }
-    vmax_all = std::max(vmax_all, p.vmax);
-    data.push_back(std::move(p));
-  }
-  if (!(vmax_all > 0.0)) throw Error("FitDamper", "the displacement never moves: nothing to fit");
-  const double det = a11 * a22 - a12 * a12;
-  double Fy = det > 0.0 ? (b1 * a22 - b2 * a12) / det : 0.0;
-  double c = det > 0.0 ? (a11 * b2 - a12 * b1) / det : 0.0;
-  double fpeak = 0.0;
-  for (const auto& rec : records)
-    for (double f : rec.f_kN) fpeak = std::max(fpeak, std::abs(f));
-  if (!(Fy > 0.0)) Fy = 0.5 * fpeak;
-  if (!(c > 0.0)) c = 0.1 * fpeak / vmax_all;
+namespace {
 
-  // Starts: pre-yield travel delta [mm] x c1/c0 (file comment of damper_fit.h).
+constexpr int kStartIterations = 6;  ///< LM iterations per start (DamperFitOptions::start_iterations unset)
+constexpr int kMaxIterations = 200;  ///< ... for the best start (max_iterations unset)
+
+/// Sums of the rough yield-force / viscous fit f ~ F_y sgn(v) + c v over every record, weighted.
+struct RoughSums {
+  double a11 = 0, a12 = 0, a22 = 0, b1 = 0, b2 = 0;
+};
+
+/// Throws rths::Error naming the record if a sample's current differs from current_A by more
+/// than the tolerance.
+void CheckOneCurrent(const io::RigRecord& rec, double current_A, double tolerance_A) {
+  const auto& command = rec.Command();  // i_A, or v_V of a voltage-only record
+  for (std::size_t k = 0; k < command.size(); ++k) {
+    if (std::abs(command[k] - current_A) > tolerance_A)
+      throw Error(RecordName(rec), fmt::format("sample {} (t = {} s): current i_A = {} A differs from --current {} A by "
+                                               "more than {} A: the fit is at one current",
+                                               k + 1, k < rec.t_s.size() ? rec.t_s[k] : 0.0, command[k], current_A,
+                                               tolerance_A));
+  }
+}
+
+/// One record prepared for the fit (its smoothed velocity and weight); adds it to the rough
+/// fit's sums and raises *xmax to its largest |x|.
+Prepared PrepareRecord(const io::RigRecord& rec, const DamperFitOptions& o, RoughSums* r, double* xmax) {
+  CheckDamperColumns(rec);
+  CheckOneCurrent(rec, *o.current_A, o.current_tolerance_A);
+  const double cutoff = o.velocity_cutoff_hz > 0.0 ? o.velocity_cutoff_hz : VelocityCutoffHz(rec);
+  Prepared p{&rec, SmoothVelocity(rec.y_mm, rec.dt_s, cutoff), 0.0, 0.0};
+  for (std::size_t k = 0; k < rec.size(); ++k) {
+    p.vmax = std::max(p.vmax, std::abs(p.v[k]));
+    *xmax = std::max(*xmax, std::abs(rec.y_mm[k]));
+  }
+  p.weight = ForceWeight(rec);
+  for (std::size_t k = 0; k < rec.size(); ++k) {
+    const double s = p.v[k] > 0.0 ? 1.0 : (p.v[k] < 0.0 ? -1.0 : 0.0), v = p.v[k], f = rec.f_kN[k];
+    r->a11 += p.weight * s * s;
+    r->a12 += p.weight * s * v;
+    r->a22 += p.weight * v * v;
+    r->b1 += p.weight * s * f;
+    r->b2 += p.weight * v * f;
+  }
+  return p;
+}
+
+/// The starts (file comment of damper_fit.h): pre-yield travel delta [mm] x c1/c0, around the
+/// rough yield force Fy [kN] and viscous c [kN s/mm], evaluated.
+std::vector<LmState> Starts(double Fy, double c, double xmax, const std::vector<Prepared>& data, double A) {
   std::vector<LmState> starts;
   for (double delta : {0.1, 0.5, 2.0}) {
     for (double ratio : {1.0, 10.0}) {
       const double c0 = c * (1.0 + ratio) / ratio, c1 = ratio * c0;
-      const double zmax = o.A * delta;                 // z_max = A delta
-      const double bg = 1.0 / (o.A * delta * delta);   // beta + gamma
+      const double zmax = A * delta;                    // z_max = A delta
+      const double bg = 1.0 / (A * delta * delta);      // beta + gamma
       const double alpha = Fy / zmax * (c0 + c1) / c1;  // alpha z_max c1 / (c0 + c1) = F_y
       const double k0 = 0.01 * Fy / std::max(xmax, 1e-3);
       LmState s;
       s.theta << std::log(alpha), std::log(c0), std::log(c1), std::log(k0), std::log(0.5 * bg), std::log(0.5 * bg);
       s.theta = Clamp(s.theta);
-      s.ev = Evaluate(s.theta, data, o.A, 0);
+      s.ev = Evaluate(s.theta, data, A, 0);
       starts.push_back(std::move(s));
     }
   }
+  return starts;
+}
+
+}  // namespace
+
+DamperFitResult FitDamper(const std::vector<io::RigRecord>& records, const DamperFitOptions& o) {
+  std::string why;
+  if (!o.IsValid(&why)) throw Error("DamperFitOptions", why);
+  if (!o.current_A) throw Error("DamperFitOptions", "current_A: the fit at one current needs it");
+  if (records.empty()) throw Error("FitDamper", "no records");
+  std::vector<Prepared> data;
+  RoughSums r;
+  double xmax = 0, vmax_all = 0;
+  for (const auto& rec : records) {
+    data.push_back(PrepareRecord(rec, o, &r, &xmax));
+    vmax_all = std::max(vmax_all, data.back().vmax);
+  }
+  if (!(vmax_all > 0.0)) throw Error("FitDamper", "the displacement never moves: nothing to fit");
+  const double det = r.a11 * r.a22 - r.a12 * r.a12;
+  double Fy = det > 0.0 ? (r.b1 * r.a22 - r.b2 * r.a12) / det : 0.0;
+  double c = det > 0.0 ? (r.a11 * r.b2 - r.a12 * r.b1) / det : 0.0;
+  const double fpeak = PeakForce(records);
+  if (!(Fy > 0.0)) Fy = 0.5 * fpeak;
+  if (!(c > 0.0)) c = 0.1 * fpeak / vmax_all;
+
+  std::vector<LmState> starts = Starts(Fy, c, xmax, data, o.A);
   DamperFitResult res;
-  res.current_A = current_A;
+  res.current_A = *o.current_A;
   int best = -1;
   for (std::size_t i = 0; i < starts.size(); ++i) {
-    if (std::isfinite(starts[i].ev.cost)) Iterate(&starts[i], data, o.A, o.start_iterations);
+    if (std::isfinite(starts[i].ev.cost)) Iterate(&starts[i], data, o.A, o.start_iterations.value_or(kStartIterations));
     res.start_costs.push_back(starts[i].ev.cost);
     if (std::isfinite(starts[i].ev.cost) && (best < 0 || starts[i].ev.cost < starts[static_cast<std::size_t>(best)].ev.cost))
       best = static_cast<int>(i);
@@ -402,7 +429,7 @@ DamperFitResult FitDamper(const std::vector<io::RigRecord>& records, double curr
   if (best < 0) throw Error("FitDamper", "no start gives a finite force prediction");
   LmState& s = starts[static_cast<std::size_t>(best)];
   s.converged = false;
-  Iterate(&s, data, o.A, o.max_iterations);
+  Iterate(&s, data, o.A, o.max_iterations.value_or(kMaxIterations));
   res.best_start = best;
   res.iterations = s.iterations;
   res.converged = s.converged;
@@ -451,13 +478,7 @@ models::MrDamperParams ParamsAtOneCurrent(const models::MrDamperCoefficients& k)
 
 std::string DamperTable(const models::MrDamperParams& p) {
   std::string o = "[plant.damper]\n";
-  const std::pair<const char*, double> fields[] = {
-      {"alpha_a", p.alpha_a}, {"alpha_b", p.alpha_b}, {"alpha_c", p.alpha_c}, {"c0_a", p.c0_a},
-      {"c0_b", p.c0_b},       {"c0_c", p.c0_c},       {"c1_a", p.c1_a},       {"c1_b", p.c1_b},
-      {"c1_c", p.c1_c},       {"beta_a", p.beta_a},   {"beta_b", p.beta_b},   {"beta_c", p.beta_c},
-      {"gamma_a", p.gamma_a}, {"gamma_b", p.gamma_b}, {"gamma_c", p.gamma_c}, {"A", p.A},
-      {"n", p.n},             {"k0", p.k0},           {"k1", p.k1},           {"x0", p.x0}};
-  for (const auto& [key, v] : fields) o += fmt::format("{} = {}\n", key, TomlFloat(v));
+  for (const models::MrDamperField& f : models::kMrDamperFields) o += fmt::format("{} = {}\n", f.key, TomlFloat(p.*f.member));
   return o;
 }
 

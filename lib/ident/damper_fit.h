@@ -35,6 +35,7 @@
 #include <string>
 #include <vector>
 
+#include "ident/damper_options.h"
 #include "io/rig_record.h"
 #include "models/mr_damper.h"
 
@@ -68,17 +69,19 @@ int DamperSubsteps(const models::MrDamperCoefficients& k, double dt_s, double vm
 std::vector<double> SimulateDamperForce(const models::MrDamperCoefficients& k, std::span<const double> x_mm,
                                         std::span<const double> v_mm_s, double dt_s, int substeps = 0);
 
-/// Options of FitDamper; defaults are those of `rths identify --damper`.
-struct DamperFitOptions {
-  double A = 300.0;                  ///< Bouc-Wen A, held fixed (file comment), > 0
-  double velocity_cutoff_hz = 0.0;   ///< SmoothVelocity cutoff [Hz], >= 0; 0 = VelocityCutoffHz per record
-  int start_iterations = 6;          ///< Levenberg-Marquardt iterations per start, >= 1
-  int max_iterations = 200;          ///< for the best start, >= 1
-  /// Largest |i_k - current| [A] accepted in a record (the fit is at one current), >= 0.
-  double current_tolerance_A = 0.05;
-  /// True if every field is in range; else false and a message naming the field.
-  bool IsValid(std::string* error) const;
-};
+/// The record's source, or "record" if it has none (where an error names it).
+std::string RecordName(const io::RigRecord& record);
+
+/// Throws rths::Error naming the record if it has fewer than 3 samples or its y_mm, f_kN columns
+/// differ in length from its time axis.
+void CheckDamperColumns(const io::RigRecord& record);
+
+/// A record's weight in the fits' cost J, 1 / sum_k f_k^2 [1/kN^2]; throws rths::Error naming the
+/// record if its force is zero throughout.
+double ForceWeight(const io::RigRecord& record);
+
+/// The largest |f| [kN] over the records.
+double PeakForce(const std::vector<io::RigRecord>& records);
 
 /// One record's score: Eq. 31 on force, sqrt(sum (f - F)^2 / sum f^2) x 100 %.
 struct DamperRecordScore {
@@ -108,12 +111,12 @@ struct DamperFitResult {
   std::string Report() const;
 };
 
-/// Fits the model at current_A to the records (their y_mm as x, f_kN as F; see the file
-/// comment). Throws rths::Error (where = the record's source) if a record's current differs from
-/// current_A by more than the tolerance or its force is all zero; (where = "DamperFitOptions")
-/// for invalid options; if no start gives a finite cost.
-DamperFitResult FitDamper(const std::vector<io::RigRecord>& records, double current_A,
-                          const DamperFitOptions& options = {});
+/// Fits the model at options.current_A to the records (their y_mm as x, f_kN as F; see the file
+/// comment; the options of the other fit are not read). Throws rths::Error (where = the record's
+/// source) if a record's current differs from current_A by more than the tolerance or its force
+/// is all zero; (where = "DamperFitOptions") for invalid options or no current_A; if no start
+/// gives a finite cost.
+DamperFitResult FitDamper(const std::vector<io::RigRecord>& records, const DamperFitOptions& options);
 
 /// Eq. 31 on force of `coef` on a record (held-out check), with the velocity of
 /// SmoothVelocity(y_mm, dt_s, velocity_cutoff_hz); 0 = VelocityCutoffHz(record).
@@ -123,7 +126,8 @@ DamperRecordScore ScoreDamper(const models::MrDamperCoefficients& coef, const io
 /// v as a TOML float (10 significant digits, always with a '.' or an exponent).
 std::string TomlFloat(double v);
 
-/// A [plant.damper] table with every MrDamperParams field, one per line (a TOML float each).
+/// A [plant.damper] table with every MrDamperParams field (models::kMrDamperFields), one per line
+/// (a TOML float each).
 std::string DamperTable(const models::MrDamperParams& params);
 
 /// The coefficients as current-independent MrDamperParams: p_a = p_b = the value, p_c = 0

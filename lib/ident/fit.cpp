@@ -322,14 +322,11 @@ bool FitOptions::IsValid(std::string* error) const {
   return true;
 }
 
-FitSummary FitPoleModel(std::span<const double> f_hz, std::span<const std::complex<double>> h,
-                        std::span<const double> coherence, const FitOptions& o) {
-  if (f_hz.size() != h.size() || f_hz.size() != coherence.size())
-    throw Error("FitPoleModel", fmt::format("f_hz, h and coherence differ in length ({}, {}, {})", f_hz.size(),
-                                            h.size(), coherence.size()));
-  std::string why;
-  if (!o.IsValid(&why)) throw Error("FitPoleModel", why);
+namespace {
 
+/// Step 1's input: the points in the band with coherence > 0, weighted by o.weighting.
+std::vector<Point> WeightedPoints(std::span<const double> f_hz, std::span<const std::complex<double>> h,
+                                  std::span<const double> coherence, const FitOptions& o) {
   std::vector<Point> pts;
   for (std::size_t k = 0; k < f_hz.size(); ++k) {
     if (!(f_hz[k] >= o.band_lo_hz && f_hz[k] <= o.band_hi_hz) || f_hz[k] <= 0.0) continue;
@@ -341,24 +338,17 @@ FitSummary FitPoleModel(std::span<const double> f_hz, std::span<const std::compl
     if (o.weighting == Weighting::kInverseVariance) w = std::min(g2, 0.999) / (1.0 - std::min(g2, 0.999));
     if (w > 0.0) pts.push_back({f_hz[k], h[k], w});
   }
-  const int N = o.poles;
-  if (pts.size() < static_cast<std::size_t>(2 * (N + 1)))
-    throw Error("FitPoleModel", fmt::format("only {} usable frequency points in the band {}-{} Hz (need at least "
-                                            "{} for {} poles)",
-                                            pts.size(), o.band_lo_hz, o.band_hi_hz, 2 * (N + 1), N));
-  double wsum = 0.0;
-  for (const auto& pt : pts) wsum += pt.w;
+  return pts;
+}
 
-  FitSummary out;
-  out.points = pts.size();
-  out.linear_start = LinearStart(pts, N, kTwoPi * o.band_hi_hz);
-  const bool odd = N % 2 == 1;
-
-  // Step 2: Levenberg-Marquardt (Marquardt's diagonal scaling) on theta.
-  // Box on theta (a projected step): every rate p, b_j, sqrt(c_j) within 1e-3 .. 1e3 times
-  // w_hi = 2 pi band_hi (far outside any band one can fit), K within e^(+/-300).
+/// Step 2: Levenberg-Marquardt (Marquardt's diagonal scaling) on theta from start, in a box (a
+/// projected step): every rate p, b_j, sqrt(c_j) within 1e-3 .. 1e3 times w_hi = 2 pi band_hi (far
+/// outside any band one can fit), K within e^(+/-300). Sets out's model, iterations and
+/// converged; returns the cost (the weighted sum of squares).
+double LevenbergMarquardt(const std::vector<Point>& pts, const PoleModel& start, const FitOptions& o, FitSummary* out) {
+  const bool odd = o.poles % 2 == 1;
   const double w_hi = kTwoPi * o.band_hi_hz, lo = std::log(1e-3 * w_hi), hi = std::log(1e3 * w_hi);
-  Eigen::VectorXd theta = ToTheta(out.linear_start), r, rn;
+  Eigen::VectorXd theta = ToTheta(start), r, rn;
   Eigen::VectorXd lower(theta.size()), upper(theta.size());
   lower[0] = -300.0, upper[0] = 300.0;
   for (Eigen::Index i = 1; i < theta.size(); ++i) {
@@ -397,31 +387,59 @@ FitSummary FitPoleModel(std::span<const double> f_hz, std::span<const std::compl
       }
     }
     if (!accepted) {  // no descent direction left: at a minimum (to rounding)
-      out.converged = true;
+      out->converged = true;
       break;
     }
     const double drop = cost - new_cost;
     cost = new_cost;
     Evaluate(theta, odd, pts, o.zoh_dt_s, &r, &J);
     if (step < 1e-12 || drop <= 1e-15 * std::max(cost, 1e-300)) {
-      out.converged = true;
+      out->converged = true;
       ++it;
       break;
     }
   }
-  out.iterations = it;
-  out.model = FromTheta(theta, odd);
-  out.weighted_rms_rel_error = std::sqrt(cost / wsum);
+  out->iterations = it;
+  out->model = FromTheta(theta, odd);
+  return cost;
+}
 
-  const ZohModel zoh = o.zoh_dt_s > 0.0 ? Discretise(out.model, o.zoh_dt_s) : ZohModel{};
+/// The fitted response's errors at the points (of its ZOH discretisation if o.zoh_dt_s > 0).
+void ScoreFit(const std::vector<Point>& pts, const FitOptions& o, FitSummary* out) {
+  const ZohModel zoh = o.zoh_dt_s > 0.0 ? Discretise(out->model, o.zoh_dt_s) : ZohModel{};
   double se = 0.0;
   for (const auto& pt : pts) {
-    const cd G = o.zoh_dt_s > 0.0 ? ZohResponse(zoh, pt.f_hz) : out.model.Response(pt.f_hz);
+    const cd G = o.zoh_dt_s > 0.0 ? ZohResponse(zoh, pt.f_hz) : out->model.Response(pt.f_hz);
     se += std::norm(G - pt.h) / std::norm(pt.h);
-    out.max_mag_error_pct = std::max(out.max_mag_error_pct, 100.0 * std::abs(std::abs(G) / std::abs(pt.h) - 1.0));
-    out.max_phase_error_deg = std::max(out.max_phase_error_deg, std::abs(std::arg(G / pt.h)) * 180.0 / std::numbers::pi);
+    out->max_mag_error_pct = std::max(out->max_mag_error_pct, 100.0 * std::abs(std::abs(G) / std::abs(pt.h) - 1.0));
+    out->max_phase_error_deg = std::max(out->max_phase_error_deg, std::abs(std::arg(G / pt.h)) * 180.0 / std::numbers::pi);
   }
-  out.rms_rel_error = std::sqrt(se / static_cast<double>(pts.size()));
+  out->rms_rel_error = std::sqrt(se / static_cast<double>(pts.size()));
+}
+
+}  // namespace
+
+FitSummary FitPoleModel(std::span<const double> f_hz, std::span<const std::complex<double>> h,
+                        std::span<const double> coherence, const FitOptions& o) {
+  if (f_hz.size() != h.size() || f_hz.size() != coherence.size())
+    throw Error("FitPoleModel", fmt::format("f_hz, h and coherence differ in length ({}, {}, {})", f_hz.size(),
+                                            h.size(), coherence.size()));
+  std::string why;
+  if (!o.IsValid(&why)) throw Error("FitPoleModel", why);
+  const std::vector<Point> pts = WeightedPoints(f_hz, h, coherence, o);
+  const int N = o.poles;
+  if (pts.size() < static_cast<std::size_t>(2 * (N + 1)))
+    throw Error("FitPoleModel", fmt::format("only {} usable frequency points in the band {}-{} Hz (need at least "
+                                            "{} for {} poles)",
+                                            pts.size(), o.band_lo_hz, o.band_hi_hz, 2 * (N + 1), N));
+  double wsum = 0.0;
+  for (const auto& pt : pts) wsum += pt.w;
+  FitSummary out;
+  out.points = pts.size();
+  out.linear_start = LinearStart(pts, N, kTwoPi * o.band_hi_hz);
+  const double cost = LevenbergMarquardt(pts, out.linear_start, o, &out);
+  out.weighted_rms_rel_error = std::sqrt(cost / wsum);
+  ScoreFit(pts, o, &out);
   return out;
 }
 

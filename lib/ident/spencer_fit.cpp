@@ -189,7 +189,7 @@ struct Evaluation {
 
 class Problem {
  public:
-  Problem(const std::vector<Prepared>& data, const SpencerFitOptions& o) : data_(data), o_(o) {
+  Problem(const std::vector<Prepared>& data, const DamperFitOptions& o) : data_(data), o_(o) {
     for (const auto& d : data_) total_ += d.n;
   }
   int dim() const { return Dim(o_.filter); }
@@ -249,7 +249,7 @@ class Problem {
 
  private:
   const std::vector<Prepared>& data_;
-  const SpencerFitOptions& o_;
+  const DamperFitOptions& o_;
   std::size_t total_ = 0;
 };
 
@@ -334,22 +334,6 @@ Rough RoughFit(const std::vector<Prepared>& data, const std::vector<std::vector<
 
 }  // namespace
 
-bool SpencerFitOptions::IsValid(std::string* error) const {
-  auto fail = [&](const std::string& m) {
-    if (error) *error = m;
-    return false;
-  };
-  if (!(A > 0.0) || !std::isfinite(A)) return fail(fmt::format("A = {}: must be > 0", A));
-  if (!(velocity_cutoff_hz >= 0.0) || !std::isfinite(velocity_cutoff_hz))
-    return fail(fmt::format("velocity_cutoff_hz = {}: must be >= 0 (0: from the record's band)", velocity_cutoff_hz));
-  if (!(eta_start_1_s > 0.0) || !std::isfinite(eta_start_1_s))
-    return fail(fmt::format("eta_start_1_s = {}: must be > 0", eta_start_1_s));
-  if (start_iterations < 1) return fail(fmt::format("start_iterations = {}: must be >= 1", start_iterations));
-  if (max_iterations < 1) return fail(fmt::format("max_iterations = {}: must be >= 1", max_iterations));
-  if (threads < 0) return fail(fmt::format("threads = {}: must be >= 0", threads));
-  return true;
-}
-
 std::span<const double> ControlInput(const io::RigRecord& rec, bool voltage) {
   const std::string where = rec.source.empty() ? "record" : rec.source;
   if (voltage) {
@@ -392,47 +376,54 @@ DamperRecordScore ScoreSpencer(const models::MrDamperParams& params, const model
   return ScoreForce(rec, PredictSpencerForce(params, driver, filter, rec, voltage, cutoff), cutoff);
 }
 
-SpencerFitResult FitSpencer(const std::vector<io::RigRecord>& records, bool voltage, const SpencerFitOptions& o) {
-  const auto t0 = std::chrono::steady_clock::now();
-  std::string why;
-  if (!o.IsValid(&why)) throw Error("SpencerFitOptions", why);
-  if (records.empty()) throw Error("FitSpencer", "no records");
+namespace {
+
+constexpr int kStartIterations = 8;  ///< LM iterations per start (DamperFitOptions::start_iterations unset)
+constexpr int kMaxIterations = 150;  ///< ... for the best start (max_iterations unset)
+
+/// What the records span: the largest |x| [mm] and |x'| [mm/s], the input's range [A or V].
+struct Extent {
+  double xmax = 0.0, vmax = 0.0, in_lo = kInf, in_hi = -kInf;
+};
+
+/// The records prepared for the fit (command, smoothed velocity, weight); checks them and the
+/// input's range (variable and >= 0). Throws rths::Error naming the record or the reason.
+std::vector<Prepared> PrepareRecords(const std::vector<io::RigRecord>& records, bool voltage, const DamperFitOptions& o,
+                                     Extent* e) {
   std::vector<Prepared> data;
-  double xmax = 0.0, vmax_all = 0.0, in_lo = kInf, in_hi = -kInf;
   for (const auto& rec : records) {
-    const std::string where = rec.source.empty() ? "record" : rec.source;
-    if (rec.size() < 3 || rec.f_kN.size() != rec.size() || rec.y_mm.size() != rec.size())
-      throw Error(where, "too few samples or columns of different lengths");
+    CheckDamperColumns(rec);
     Prepared p;
     p.rec = &rec;
     p.v = ControlInput(rec, voltage);
     p.cutoff_hz = o.velocity_cutoff_hz > 0.0 ? o.velocity_cutoff_hz : VelocityCutoffHz(rec);
     p.xdot = SmoothVelocity(rec.y_mm, rec.dt_s, p.cutoff_hz);
-    double sf = 0.0;
     for (std::size_t k = 0; k < rec.size(); ++k) {
-      sf += rec.f_kN[k] * rec.f_kN[k];
-      vmax_all = std::max(vmax_all, std::abs(p.xdot[k]));
-      xmax = std::max(xmax, std::abs(rec.y_mm[k]));
-      in_lo = std::min(in_lo, p.v[k]);
-      in_hi = std::max(in_hi, p.v[k]);
+      e->vmax = std::max(e->vmax, std::abs(p.xdot[k]));
+      e->xmax = std::max(e->xmax, std::abs(rec.y_mm[k]));
+      e->in_lo = std::min(e->in_lo, p.v[k]);
+      e->in_hi = std::max(e->in_hi, p.v[k]);
     }
-    if (!(sf > 0.0)) throw Error(where, "the force f_kN is zero throughout: nothing to fit");
-    p.weight = 1.0 / sf;
+    p.weight = ForceWeight(rec);
     p.n = rec.size();
     data.push_back(std::move(p));
   }
-  if (!(vmax_all > 0.0)) throw Error("FitSpencer", "the displacement never moves: nothing to fit");
+  if (!(e->vmax > 0.0)) throw Error("FitSpencer", "the displacement never moves: nothing to fit");
   const char* unit = voltage ? "V" : "A";
-  if (!(in_hi - in_lo > 1e-6))
+  if (!(e->in_hi - e->in_lo > 1e-6))
     throw Error("FitSpencer", fmt::format("the control input is constant ({} {}): its laws (Eqs. 35-39) cannot be "
                                           "fitted; fit at one current instead (--current)",
-                                          in_lo, unit));
-  if (in_lo < 0.0)
+                                          e->in_lo, unit));
+  if (e->in_lo < 0.0)
     throw Error("FitSpencer", fmt::format("the control input goes negative ({} {}): Eqs. 35-39 take an input >= 0",
-                                          in_lo, unit));
-  const int threads = o.threads > 0 ? o.threads : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+                                          e->in_lo, unit));
+  return data;
+}
 
-  // Rough ends: samples whose filtered input (eta of the starts) is in the lowest / highest tenth.
+/// The rough yield-force / viscous fits at the low and the high end of the input: over the
+/// samples whose filtered input (eta of the starts) is in the lowest / highest tenth of its range.
+std::pair<Rough, Rough> RoughEnds(const std::vector<Prepared>& data, const Extent& e, double fpeak,
+                                  const DamperFitOptions& o) {
   models::CurrentDriverParams d0;
   if (o.filter == ControlFilter::kFirstOrder) {
     d0.kind = models::CurrentFilter::kFirstOrder;
@@ -445,35 +436,29 @@ SpencerFitResult FitSpencer(const std::vector<io::RigRecord>& records, bool volt
     low[i].resize(u.size());
     high[i].resize(u.size());
     for (std::size_t k = 0; k < u.size(); ++k) {
-      low[i][k] = u[k] <= in_lo + 0.1 * (in_hi - in_lo);
-      high[i][k] = u[k] >= in_hi - 0.1 * (in_hi - in_lo);
+      low[i][k] = u[k] <= e.in_lo + 0.1 * (e.in_hi - e.in_lo);
+      high[i][k] = u[k] >= e.in_hi - 0.1 * (e.in_hi - e.in_lo);
     }
   }
-  double fpeak = 0.0;
-  for (const auto& rec : records)
-    for (double f : rec.f_kN) fpeak = std::max(fpeak, std::abs(f));
   auto sane = [&](Rough r) {
     if (!(r.Fy > 0.0)) r.Fy = 0.25 * fpeak;
-    if (!(r.c > 0.0)) r.c = 0.1 * fpeak / vmax_all;
+    if (!(r.c > 0.0)) r.c = 0.1 * fpeak / e.vmax;
     return r;
   };
-  const Rough ra = sane(RoughFit(data, low)), rb = sane(RoughFit(data, high));
+  return {sane(RoughFit(data, low)), sane(RoughFit(data, high))};
+}
 
-  // Starts (file comment) on the first part of every record (kStartShare of it, at least
-  // kStartMinS): pre-yield travel at each end of the input range x c1/c0.
-  std::vector<Prepared> part = data;
-  for (auto& d : part)
-    d.n = std::min(d.rec->size(), std::max(static_cast<std::size_t>(kStartShare * static_cast<double>(d.rec->size())),
-                                           static_cast<std::size_t>(kStartMinS / d.rec->dt_s)));
-  const Problem pb_part(part, o), pb(data, o);
-  const int P = pb.dim();
+/// The starts (file comment): pre-yield travel at each end of the input range x c1/c0 from the
+/// rough ends ra, rb, evaluated on pb (the first part of every record).
+std::vector<LmState> Starts(const Rough& ra, const Rough& rb, const Extent& e, const Problem& pb,
+                            const DamperFitOptions& o) {
   std::vector<LmState> starts;
   const std::pair<double, double> travels[] = {{0.1, 0.1}, {0.1, 0.5}, {0.5, 0.5}, {0.5, 2.0}, {2.0, 2.0}};
   for (const auto& [delta_a, delta_b] : travels) {
     for (double ratio : {1.0, 10.0}) {
       LmState s;
-      s.theta.resize(P);
-      const double rate = 2.0 / std::max(in_hi, 1e-6);
+      s.theta.resize(pb.dim());
+      const double rate = 2.0 / std::max(e.in_hi, 1e-6);
       const Rough* ends[2] = {&ra, &rb};
       for (int j = 0; j < 2; ++j) {
         const double delta = j == 0 ? delta_a : delta_b;
@@ -487,60 +472,88 @@ SpencerFitResult FitSpencer(const std::vector<io::RigRecord>& records, bool volt
         s.theta[12 + j] = std::log(0.5 * bg);
       }
       for (int l = 0; l < kLaws; ++l) s.theta[3 * l + 2] = std::log(rate);
-      s.theta[kK0] = std::log(0.01 * rb.Fy / std::max(xmax, 1e-3));
+      s.theta[kK0] = std::log(0.01 * rb.Fy / std::max(e.xmax, 1e-3));
       if (o.filter == ControlFilter::kFirstOrder) s.theta[kEta] = std::log(o.eta_start_1_s);
       s.theta = Clamp(s.theta);
       Workspace w;
       std::vector<double> f;
-      s.ev = pb_part.Evaluate(s.theta, nullptr, &w, &f);
+      s.ev = pb.Evaluate(s.theta, nullptr, &w, &f);
       starts.push_back(std::move(s));
     }
   }
+  return starts;
+}
+
+/// The start to continue on all the data: the best by its cost on the first part whose cost on
+/// all of it (pb) is finite (a start may meet a stiffer stretch later in the records); its ev is
+/// re-evaluated on all the data. -1 if none.
+int BestOnAllData(std::vector<LmState>* starts, const Problem& pb) {
+  std::vector<std::size_t> order(starts->size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::size_t a, std::size_t b) { return (*starts)[a].ev.cost < (*starts)[b].ev.cost; });
+  for (std::size_t i : order) {
+    if (!std::isfinite((*starts)[i].ev.cost)) break;
+    Workspace w;
+    std::vector<double> f;
+    (*starts)[i].ev = pb.Evaluate((*starts)[i].theta, nullptr, &w, &f);
+    if (std::isfinite((*starts)[i].ev.cost)) return static_cast<int>(i);
+  }
+  return -1;
+}
+
+}  // namespace
+
+bool UsesVoltage(const std::vector<io::RigRecord>& records, DamperInput input) {
+  if (input == DamperInput::kAuto) return !records.empty() && records[0].i_A.empty();
+  return input == DamperInput::kVoltage;
+}
+
+SpencerFitResult FitSpencer(const std::vector<io::RigRecord>& records, const DamperFitOptions& o) {
+  const auto t0 = std::chrono::steady_clock::now();
+  std::string why;
+  if (!o.IsValid(&why)) throw Error("DamperFitOptions", why);
+  if (records.empty()) throw Error("FitSpencer", "no records");
+  const bool voltage = UsesVoltage(records, o.input);
+  Extent e;
+  const std::vector<Prepared> data = PrepareRecords(records, voltage, o, &e);
+  const int threads = o.threads > 0 ? o.threads : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+  const auto [ra, rb] = RoughEnds(data, e, PeakForce(records), o);
+  // The starts run on the first part of every record (kStartShare of it, at least kStartMinS).
+  std::vector<Prepared> part = data;
+  for (auto& d : part)
+    d.n = std::min(d.rec->size(), std::max(static_cast<std::size_t>(kStartShare * static_cast<double>(d.rec->size())),
+                                           static_cast<std::size_t>(kStartMinS / d.rec->dt_s)));
+  const Problem pb_part(part, o), pb(data, o);
+  std::vector<LmState> starts = Starts(ra, rb, e, pb_part, o);
+  const int start_iterations = o.start_iterations.value_or(kStartIterations);
+  const int max_iterations = o.max_iterations.value_or(kMaxIterations);
   SpencerFitResult res;
   res.filter = o.filter;
   res.voltage = voltage;
-  res.input_min = in_lo;
-  res.input_max = in_hi;
-  int best = -1;
-  // Progress (SpencerFitOptions::progress): whole-record iterations, a start's counting a quarter.
-  const double work = 0.25 * static_cast<double>(starts.size() * static_cast<std::size_t>(o.start_iterations)) +
-                      static_cast<double>(o.max_iterations);
+  res.input_min = e.in_lo;
+  res.input_max = e.in_hi;
+  // Progress (DamperFitOptions::progress): whole-record iterations, a start's counting a quarter.
+  const double work = 0.25 * static_cast<double>(starts.size() * static_cast<std::size_t>(start_iterations)) +
+                      static_cast<double>(max_iterations);
   double done = 0.0;
   auto step = [&](double units, std::string_view what) {
     done += units;
     if (o.progress) o.progress(done, work, what);
   };
-  for (std::size_t i = 0; i < starts.size(); ++i) {
-    if (std::isfinite(starts[i].ev.cost))
-      Iterate(&starts[i], pb_part, o.start_iterations, threads, [&] { step(0.25, "starts"); });
-    res.start_costs.push_back(starts[i].ev.cost);
-    if (std::isfinite(starts[i].ev.cost) &&
-        (best < 0 || starts[i].ev.cost < starts[static_cast<std::size_t>(best)].ev.cost))
-      best = static_cast<int>(i);
+  bool any = false;
+  for (auto& st : starts) {
+    if (std::isfinite(st.ev.cost)) Iterate(&st, pb_part, start_iterations, threads, [&] { step(0.25, "starts"); });
+    res.start_costs.push_back(st.ev.cost);
+    any = any || std::isfinite(st.ev.cost);
   }
-  if (best < 0) throw Error("FitSpencer", "no start gives a finite force prediction");
-  // On all the data now: the best start by its cost on the first part whose cost on all of it
-  // is finite (a start may meet a stiffer stretch later in the records).
-  std::vector<std::size_t> order(starts.size());
-  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
-  std::stable_sort(order.begin(), order.end(),
-                   [&](std::size_t a, std::size_t b) { return starts[a].ev.cost < starts[b].ev.cost; });
-  best = -1;
-  for (std::size_t i : order) {
-    if (!std::isfinite(starts[i].ev.cost)) break;
-    Workspace w;
-    std::vector<double> f;
-    starts[i].ev = pb.Evaluate(starts[i].theta, nullptr, &w, &f);
-    if (std::isfinite(starts[i].ev.cost)) {
-      best = static_cast<int>(i);
-      break;
-    }
-  }
+  if (!any) throw Error("FitSpencer", "no start gives a finite force prediction");
+  const int best = BestOnAllData(&starts, pb);
   if (best < 0) throw Error("FitSpencer", "no start gives a finite force prediction on all the data");
   LmState& s = starts[static_cast<std::size_t>(best)];
   s.converged = false;
-  done = 0.25 * static_cast<double>(starts.size() * static_cast<std::size_t>(o.start_iterations));
-  Iterate(&s, pb, o.max_iterations, threads, [&] { step(1.0, "least squares on the whole record"); });
+  done = 0.25 * static_cast<double>(starts.size() * static_cast<std::size_t>(start_iterations));
+  Iterate(&s, pb, max_iterations, threads, [&] { step(1.0, "least squares on the whole record"); });
   if (o.progress) o.progress(work, work, "done");
   res.best_start = best;
   res.iterations = s.iterations;

@@ -39,38 +39,16 @@
 #include <string>
 #include <vector>
 
-#include "core/progress.h"
 #include "ident/damper_fit.h"
+#include "ident/damper_options.h"
 #include "io/rig_record.h"
 #include "models/current_driver.h"
 #include "models/mr_damper.h"
 
 namespace rths::ident {
 
-/// The control filter between the record's command and the parameters' input.
-enum class ControlFilter { kFirstOrder, kEq40, kNone };
-inline constexpr std::array<Named<ControlFilter>, 3> kControlFilterNames = {
-    {{ControlFilter::kFirstOrder, "first_order"}, {ControlFilter::kEq40, "eq40"}, {ControlFilter::kNone, "none"}}};
-
 /// Most substeps per sample the fit integrates with (file comment).
 inline constexpr int kMaxSpencerSubsteps = 64;
-
-/// Options of FitSpencer; defaults are those of `rths identify --damper` with a varying input.
-struct SpencerFitOptions {
-  double A = 300.0;                 ///< Bouc-Wen A, held fixed, > 0
-  double velocity_cutoff_hz = 0.0;  ///< SmoothVelocity cut-off [Hz]; 0 = VelocityCutoffHz per record
-  ControlFilter filter = ControlFilter::kFirstOrder;
-  double eta_start_1_s = 100.0;     ///< first-order filter: eta of the starts [1/s], > 0
-  bool accumulator = true;          ///< fit k1 and x0 (the force offset); false: k1 = x0 = 0
-  int start_iterations = 8;         ///< LM iterations per start (on a quarter of the data), >= 1
-  int max_iterations = 150;         ///< for the best start, >= 1
-  int threads = 0;                  ///< Jacobian threads; 0 = the machine's cores
-  /// Progress in LM iterations on the whole record (a start's iteration on a quarter counts a
-  /// quarter; the final fit counts max_iterations until it converges): empty = none.
-  ProgressFn progress;
-  /// True if every field is in range; else false and a message naming the field.
-  bool IsValid(std::string* error) const;
-};
 
 /// The fitted model and how well it fits.
 struct SpencerFitResult {
@@ -94,12 +72,15 @@ struct SpencerFitResult {
 /// else its i_A (throws if it has none).
 std::span<const double> ControlInput(const io::RigRecord& record, bool voltage);
 
-/// Fits the model to the records (file comment). voltage: drive it with each record's v_V
-/// column instead of i_A. Throws rths::Error (where = the record's source) for a record without
-/// that column, too short, or with zero force; (where = "SpencerFitOptions") for bad options;
-/// if no start gives a finite cost.
-SpencerFitResult FitSpencer(const std::vector<io::RigRecord>& records, bool voltage,
-                            const SpencerFitOptions& options = {});
+/// true if the fit drives the model with the records' v_V (DamperInput::kVoltage, or kAuto and the
+/// first record has no i_A), false for i_A.
+bool UsesVoltage(const std::vector<io::RigRecord>& records, DamperInput input);
+
+/// Fits the model to the records (file comment), driven by the input UsesVoltage(records,
+/// options.input) picks (options.current_A and current_tolerance_A are not read). Throws
+/// rths::Error (where = the record's source) for a record without that column, too short, or
+/// with zero force; (where = "DamperFitOptions") for bad options; if no start gives a finite cost.
+SpencerFitResult FitSpencer(const std::vector<io::RigRecord>& records, const DamperFitOptions& options = {});
 
 /// Force prediction F_k [kN] of the model on a record's motion and command (NaN from the first
 /// non-finite sample). velocity_cutoff_hz 0 = VelocityCutoffHz(record).

@@ -15,31 +15,17 @@ double AtCurrent(double a, double b, double c, double i) { return b + (a - b) * 
 }  // namespace
 
 void MrDamperParams::Validate() const {
-  struct Field {
-    const char* name;
-    double value;
-    double min;
-    bool strict;
-  };
-  // clang-format off
-  const Field fields[] = {
-      {"alpha_a", alpha_a, 0, false}, {"alpha_b", alpha_b, 0, false}, {"alpha_c", alpha_c, 0, false},
-      {"c0_a", c0_a, 0, true},        {"c0_b", c0_b, 0, true},        {"c0_c", c0_c, 0, false},
-      {"c1_a", c1_a, 0, true},        {"c1_b", c1_b, 0, true},        {"c1_c", c1_c, 0, false},
-      {"beta_a", beta_a, 0, false},   {"beta_b", beta_b, 0, false},   {"beta_c", beta_c, 0, false},
-      {"gamma_a", gamma_a, 0, false}, {"gamma_b", gamma_b, 0, false}, {"gamma_c", gamma_c, 0, false},
-      {"A", A, 0, false},             {"n", n, 1, false},             {"k0", k0, 0, false},
-      {"k1", k1, 0, false},
-  };
-  // clang-format on
-  for (const Field& f : fields) {
-    const bool ok = std::isfinite(f.value) && (f.strict ? f.value > f.min : f.value >= f.min);
+  for (const MrDamperField& f : kMrDamperFields) {
+    const double v = this->*f.member;
+    if (std::isinf(f.min)) {
+      if (!std::isfinite(v)) throw Error(fmt::format("MrDamperParams: {}", f.key), "must be finite");
+      continue;
+    }
+    const bool ok = std::isfinite(v) && (f.strict ? v > f.min : v >= f.min);
     if (!ok)
-      throw Error(
-          fmt::format("MrDamperParams: {}", f.name),
-          fmt::format("must be finite and {} {} (got {})", f.strict ? ">" : ">=", f.min, f.value));
+      throw Error(fmt::format("MrDamperParams: {}", f.key),
+                  fmt::format("must be finite and {} {} (got {})", f.strict ? ">" : ">=", f.min, v));
   }
-  if (!std::isfinite(x0)) throw Error("MrDamperParams: x0", "must be finite");
 }
 
 MrDamperCoefficients CoefficientsAt(const MrDamperParams& p, double i) {

@@ -12,6 +12,8 @@
 ///
 /// with alpha, c0, c1, beta, gamma depending on the current i [A] as p = p_b + (p_a - p_b)
 /// exp(-p_c i) (Eqs. 35-39). Current dynamics (Eq. 40) are not part of this file.
+#include <limits>
+
 #include "models/ode.h"
 
 namespace rths::models {
@@ -35,6 +37,30 @@ struct MrDamperParams {
   /// k0, k1 >= 0; rates >= 0; n >= 1; all finite).
   void Validate() const;
   bool operator==(const MrDamperParams&) const = default;
+};
+
+/// One field of MrDamperParams as scenarios, model files and messages name it: its key, the
+/// member, and its lower bound (Validate; -inf: only finite).
+struct MrDamperField {
+  const char* key;
+  double MrDamperParams::*member;
+  double min;
+  bool strict;  ///< value > min (else >= min)
+};
+/// Every MrDamperParams field, in the order of the struct (the one list of the 20 keys: the
+/// scenario reader and writer, Validate and the model files of rths identify walk it).
+inline constexpr MrDamperField kMrDamperFields[] = {
+    {"alpha_a", &MrDamperParams::alpha_a, 0, false}, {"alpha_b", &MrDamperParams::alpha_b, 0, false},
+    {"alpha_c", &MrDamperParams::alpha_c, 0, false}, {"c0_a", &MrDamperParams::c0_a, 0, true},
+    {"c0_b", &MrDamperParams::c0_b, 0, true},        {"c0_c", &MrDamperParams::c0_c, 0, false},
+    {"c1_a", &MrDamperParams::c1_a, 0, true},        {"c1_b", &MrDamperParams::c1_b, 0, true},
+    {"c1_c", &MrDamperParams::c1_c, 0, false},       {"beta_a", &MrDamperParams::beta_a, 0, false},
+    {"beta_b", &MrDamperParams::beta_b, 0, false},   {"beta_c", &MrDamperParams::beta_c, 0, false},
+    {"gamma_a", &MrDamperParams::gamma_a, 0, false}, {"gamma_b", &MrDamperParams::gamma_b, 0, false},
+    {"gamma_c", &MrDamperParams::gamma_c, 0, false}, {"A", &MrDamperParams::A, 0, false},
+    {"n", &MrDamperParams::n, 1, false},             {"k0", &MrDamperParams::k0, 0, false},
+    {"k1", &MrDamperParams::k1, 0, false},
+    {"x0", &MrDamperParams::x0, -std::numeric_limits<double>::infinity(), false},
 };
 
 /// The model's coefficients at one current (Eqs. 35-39); units as in MrDamperParams.

@@ -524,15 +524,7 @@ void PhysicalFields(V& v, PhysicalActuatorConfig& p) {
 /// Every MrDamperParams field; their ranges are the model's own (MrDamperParams::Validate).
 template <typename V>
 void DamperFields(V& v, models::MrDamperParams& d) {
-  for (auto [key, field] : {std::pair{"alpha_a", &d.alpha_a}, {"alpha_b", &d.alpha_b}, {"alpha_c", &d.alpha_c},
-                            {"c0_a", &d.c0_a},       {"c0_b", &d.c0_b},       {"c0_c", &d.c0_c},
-                            {"c1_a", &d.c1_a},       {"c1_b", &d.c1_b},       {"c1_c", &d.c1_c},
-                            {"beta_a", &d.beta_a},   {"beta_b", &d.beta_b},   {"beta_c", &d.beta_c},
-                            {"gamma_a", &d.gamma_a}, {"gamma_b", &d.gamma_b}, {"gamma_c", &d.gamma_c},
-                            {"A", &d.A},             {"n", &d.n},             {"k0", &d.k0},
-                            {"k1", &d.k1},           {"x0", &d.x0}}) {
-    v.Number(key, *field, kAny);
-  }
+  for (const models::MrDamperField& f : models::kMrDamperFields) v.Number(f.key, d.*f.member, kAny);
 }
 
 /// `[plant.benchmark]`: the benchmark's plant constants (SI, models::BenchmarkPlantParams) and

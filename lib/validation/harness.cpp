@@ -1,4 +1,4 @@
-#include "diagnosis/harness.h"
+#include "validation/harness.h"
 
 #include <algorithm>
 #include <chrono>
@@ -12,7 +12,7 @@
 #include "models/rig_effects.h"
 #include "signal/random.h"
 
-namespace rths::diagnosis {
+namespace rths::validation {
 
 namespace {
 
@@ -233,7 +233,8 @@ HarnessCase RunHarnessCase(const std::string& kind, std::uint64_t seed, const Ha
   std::sort(c.truth.begin(), c.truth.end());
   io::RigRecord rtr, rte;
   if (o.generator == Generator::kIndependent) {
-    const IndependentCase ic = IndependentHarnessCase(kind, seed, o.duration_s, o.noise_y_mm, o.noise_f_kN);
+    IndependentCase ic = IndependentHarnessCase(kind, seed, o.duration_s, o.noise_y_mm, o.noise_f_kN);
+    for (IndependentExcitation* ex : {&ic.train, &ic.test}) ex->ground_g = o.ground_g;
     c.params = ic.text;
     IndependentTruth ttr = ic.truth, tte = ic.truth;
     tte.noise_seed = ic.truth.noise_seed + 99991;
@@ -259,10 +260,10 @@ HarnessCase RunHarnessCase(const std::string& kind, std::uint64_t seed, const Ha
     rte = make(te, tte, fmt::format("{}-s{}-test", kind, seed));
   }
   const auto t0 = std::chrono::steady_clock::now();
-  const Result r = Diagnose({rtr}, {rte}, PaperModel(), Options{});
+  const diagnosis::Result r = diagnosis::Diagnose({rtr}, {rte}, diagnosis::PaperModel(), diagnosis::Options{});
   c.runtime_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   c.verdict = r.verdict;
-  if (o.verbose) std::printf("--- %s seed %llu [%s]\n%s", kind.c_str(), static_cast<unsigned long long>(seed), c.params.c_str(), Summary(r).c_str());
+  if (o.verbose) std::printf("--- %s seed %llu [%s]\n%s", kind.c_str(), static_cast<unsigned long long>(seed), c.params.c_str(), diagnosis::Summary(r).c_str());
   auto v = r.verdict;
   std::sort(v.begin(), v.end());
   c.right = v == c.truth;
@@ -273,7 +274,7 @@ HarnessCase RunHarnessCase(const std::string& kind, std::uint64_t seed, const Ha
     double s = 0;
     for (const auto& ch : chans) {
       const auto* cs = r.Channel(ch);
-      s += ShrinkPct(cs->gap_test_pct, cs->after_test_pct);
+      s += diagnosis::ShrinkPct(cs->gap_test_pct, cs->after_test_pct);
     }
     c.shrink_pct = chans.empty() ? 0 : s / static_cast<double>(chans.size());
   }
@@ -352,4 +353,4 @@ std::string FormatCase(const HarnessCase& c) {
                      c.runtime_s, c.params);
 }
 
-}  // namespace rths::diagnosis
+}  // namespace rths::validation

@@ -1,6 +1,6 @@
 #pragma once
 /// @file A second rig-record generator, written independently of the rig mode and of the effect
-/// blocks (models/rig_effects.h, models/effect_rig.h, diagnosis/synthetic.h), for validating the
+/// blocks (models/rig_effects.h, models/effect_rig.h, validation/synthetic.h), for validating the
 /// diagnosis on records it was not built alongside (docs/diagnosis.md "Validation harness",
 /// tests/diagnosis_independent_test.cpp). It uses only the model equations of docs/models.md
 /// (sections 1, 6, 13) and docs/rig_mode.md, the parameter structs (ServoModel3 "avg",
@@ -55,13 +55,14 @@
 /// * Sample pairing as docs/rig_record.md says: row k holds u_k (held from t_k), y_k and f_k
 ///   measured at t_k, and i_k, the current command held from t_k; y_0, f_0 at rest.
 #include <cstdint>
+#include <filesystem>
 #include <string>
 #include <string_view>
 #include <vector>
 
 #include "io/rig_record.h"
 
-namespace rths::diagnosis {
+namespace rths::validation {
 
 /// The command family of an independent record.
 enum class CommandFamily { kBandNoise, kChirp, kMultisine, kEarthquake };
@@ -88,7 +89,14 @@ struct IndependentExcitation {
   CurrentPattern current = CurrentPattern::kPulsed;
   double current_max_A = 2.5;     ///< on level, top of the staircase [A]; kConstant: the current
   double current_period_s = 1.0;  ///< pulse period, staircase step, telegraph mean hold [s]
+  /// kEarthquake: the ground acceleration [g] at 0.02 s steps (ReadGroundMotion of
+  /// data/ground_motion/elcentro_1940_ns_g.txt, read by the caller); unused otherwise.
+  std::vector<double> ground_g;
 };
+
+/// A ground-motion record [g]: whitespace-separated numbers (data/ground_motion/, 0.02 s steps).
+/// Throws rths::Error naming the file if it cannot be read or holds fewer than 10 samples.
+std::vector<double> ReadGroundMotion(const std::filesystem::path& file);
 
 /// The truth of an independent record: effects in this generator's own forms (file comment),
 /// their parameters in the library's units; 0 / negative = off unless said otherwise.
@@ -117,7 +125,7 @@ struct IndependentTruth {
 };
 
 /// The command u [mm] and current command i [A] of an excitation (n = duration / dt samples).
-/// Throws rths::Error for a bad band or an unreadable ground-motion file.
+/// Throws rths::Error for a bad band or an earthquake command without ex.ground_g.
 void MakeIndependentInputs(const IndependentExcitation& ex, std::vector<double>* u_mm, std::vector<double>* i_A);
 
 /// Noise-free samples y_k [mm], f_k [kN] at t_k = k dt of the truth driven by u, i (file comment):
@@ -138,4 +146,4 @@ std::vector<double> IndependentNoise(std::size_t n, double dt_s, double rms, Noi
 io::RigRecord MakeIndependentRecord(const IndependentExcitation& ex, const IndependentTruth& truth,
                                     const std::string& name);
 
-}  // namespace rths::diagnosis
+}  // namespace rths::validation

@@ -1,4 +1,4 @@
-#include "diagnosis/independent_rig.h"
+#include "validation/independent_rig.h"
 
 #include <algorithm>
 #include <array>
@@ -8,12 +8,11 @@
 #include <fmt/format.h>
 
 #include "core/error.h"
-#include "io/source_tree.h"
 #include "models/mr_damper.h"     // the parameter struct only (Table 3)
 #include "models/servo_linear.h"  // the parameter struct only (Eq. 30, "avg")
 #include "signal/random.h"        // seeded Gaussian deviates
 
-namespace rths::diagnosis {
+namespace rths::validation {
 
 std::string_view Name(CommandFamily f) {
   switch (f) {
@@ -153,25 +152,11 @@ std::vector<double> Multisine(const IndependentExcitation& ex, std::size_t n, si
   return u;
 }
 
-/// El Centro 1940 NS in g at 0.02 s (docs/models.md section 13).
-const std::vector<double>& ElCentroG() {
-  static const std::vector<double> ag = [] {
-    const auto path = io::FindSourceFile("data/ground_motion/elcentro_1940_ns_g.txt");
-    std::ifstream in(path);
-    if (!in) throw Error(path.string(), "cannot read the ground-motion record");
-    std::vector<double> v;
-    double x;
-    while (in >> x) v.push_back(x);
-    if (v.size() < 10) throw Error(path.string(), "too few samples in the ground-motion record");
-    return v;
-  }();
-  return ag;
-}
-
 /// The relative displacement of an SDOF (f_n = ex.lo_hz, zeta 3 %) under El Centro: the command of
 /// an RTHS-like test. RK4 at dt, the ground acceleration interpolated linearly, zero after its end.
 std::vector<double> Earthquake(const IndependentExcitation& ex, std::size_t n) {
-  const auto& ag = ElCentroG();
+  const auto& ag = ex.ground_g;
+  if (ag.size() < 10) throw Error("independent rig", "an earthquake command needs the ground motion (IndependentExcitation::ground_g)");
   const double g_mm = 9806.65, dtg = 0.02;
   const double w = 2.0 * kPi * (ex.lo_hz > 0 ? ex.lo_hz : 2.0), zeta = 0.03;
   auto acc = [&](double t) {
@@ -397,6 +382,16 @@ class ContinuousRig {
 
 }  // namespace
 
+std::vector<double> ReadGroundMotion(const std::filesystem::path& file) {
+  std::ifstream in(file);
+  if (!in) throw Error(file.string(), "cannot read the ground-motion record");
+  std::vector<double> v;
+  double x;
+  while (in >> x) v.push_back(x);
+  if (v.size() < 10) throw Error(file.string(), "too few samples in the ground-motion record");
+  return v;
+}
+
 void MakeIndependentInputs(const IndependentExcitation& ex, std::vector<double>* u_mm, std::vector<double>* i_A) {
   if (!(ex.dt_s > 0) || !(ex.duration_s > 0)) throw Error("independent rig", "duration and dt must be > 0");
   const auto n = static_cast<std::size_t>(std::lround(ex.duration_s / ex.dt_s));
@@ -506,11 +501,11 @@ io::RigRecord MakeIndependentRecord(const IndependentExcitation& ex, const Indep
     r.y_mm[k] = tr.y_mm[k] + ripple + ny[k];
     r.f_kN[k] = tr.f_kN[k] + nf[k];
   }
-  r.metadata.push_back({"generator", "diagnosis::MakeIndependentRecord (continuous RK4, independent forms)"});
+  r.metadata.push_back({"generator", "validation::MakeIndependentRecord (continuous RK4, independent forms)"});
   r.metadata.push_back({"command", fmt::format("{} {}-{} Hz, {} mm rms", Name(ex.command), ex.lo_hz, ex.hi_hz, ex.rms_mm)});
   r.metadata.push_back({"current", fmt::format("{} {} A, period {} s", Name(ex.current), ex.current_max_A, ex.current_period_s)});
   io::ValidateRigRecord(r, name);
   return r;
 }
 
-}  // namespace rths::diagnosis
+}  // namespace rths::validation

@@ -17,7 +17,7 @@
 #include "models/rig_effects.h"
 #include "scenario/scenario.h"
 
-namespace rths::diagnosis {
+namespace rths::validation {
 
 struct Excitation {
   double duration_s = 20.0;
@@ -48,4 +48,4 @@ io::RigRecord MakeRecordBlocks(const Excitation& ex, const Truth& truth, const s
 /// unmodelled = truth's ripple / stiffness. Throws rths::Error if the rig refuses the set.
 io::RigRecord MakeRecordRig(const Excitation& ex, const Truth& truth, const std::string& name);
 
-}  // namespace rths::diagnosis
+}  // namespace rths::validation

@@ -16,10 +16,10 @@
 #include <vector>
 
 #include "diagnosis/diagnosis.h"
-#include "diagnosis/independent_rig.h"
-#include "diagnosis/synthetic.h"
+#include "validation/independent_rig.h"
+#include "validation/synthetic.h"
 
-namespace rths::diagnosis {
+namespace rths::validation {
 
 /// Which generator makes the harness's records.
 enum class Generator {
@@ -38,6 +38,9 @@ struct HarnessOptions {
   bool pairs = true;             ///< include the two-effect cases
   double noise_y_mm = 0.01, noise_f_kN = 0.2;
   bool verbose = false;          ///< print each diagnosis's Summary() to stdout
+  /// kIndependent: the ground acceleration [g] of the earthquake test commands (ReadGroundMotion;
+  /// the caller reads the file, data/ground_motion/elcentro_1940_ns_g.txt).
+  std::vector<double> ground_g;
 };
 
 struct HarnessCase {
@@ -101,4 +104,4 @@ struct HarnessScore {
 };
 HarnessScore ScoreHarness(const std::vector<HarnessCase>& cases);
 
-}  // namespace rths::diagnosis
+}  // namespace rths::validation

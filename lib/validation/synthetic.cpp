@@ -1,4 +1,4 @@
-#include "diagnosis/synthetic.h"
+#include "validation/synthetic.h"
 
 #include <cmath>
 #include <utility>
@@ -14,7 +14,7 @@
 #include "signal/blwn.h"
 #include "signal/random.h"
 
-namespace rths::diagnosis {
+namespace rths::validation {
 
 void MakeInputs(const Excitation& ex, std::vector<double>* u_mm, std::vector<double>* i_A) {
   const auto n = static_cast<std::size_t>(std::lround(ex.duration_s / ex.dt_s));
@@ -151,7 +151,7 @@ io::RigRecord MakeRecordBlocks(const Excitation& ex, const Truth& truth, const s
     models::Step(servo, &xs, dfx.Pre(u[k]));
     x_prev = x, xd_prev = xd, d_prev = d, f_prev2 = f_prev, f_prev = f;
   }
-  r.metadata.push_back({"generator", "diagnosis::MakeRecordBlocks"});
+  r.metadata.push_back({"generator", "validation::MakeRecordBlocks"});
   io::ValidateRigRecord(r, name);
   return r;
 }
@@ -184,4 +184,4 @@ io::RigRecord MakeRecordRig(const Excitation& ex, const Truth& truth, const std:
   return r;
 }
 
-}  // namespace rths::diagnosis
+}  // namespace rths::validation

@@ -1,0 +1,132 @@
+#include "diagnosis/fit.h"
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <limits>
+
+#include "diagnosis/candidates.h"
+#include "diagnosis/search.h"
+#include "diagnosis/tuning.h"
+
+namespace rths::diagnosis::stages {
+
+namespace {
+
+/// The SSE of a candidate's parameter vector, the rest of the set held.
+using Objective = std::function<double(const std::vector<double>&)>;
+
+/// One parameter: the grid and golden section over its range, or over a bracket around its
+/// current value `cur` (a refit: cur not empty).
+double FitOneParam(const ParamSpec& range, bool is_f, const std::vector<double>& cur, const Options& o, const Objective& eval,
+                   std::vector<double>* x_out) {
+  ParamSpec ps = range;
+  int giters = is_f ? tuning::kGoldenItersF : tuning::kGoldenItersY;
+  const bool refit = !cur.empty();
+  if (refit) {
+    const double v = cur[0];
+    if (ps.log) {
+      ps.lo = std::max(range.lo, v / tuning::kRefitBracketFactor);
+      ps.hi = std::min(range.hi, v * tuning::kRefitBracketFactor);
+    } else {
+      const double w = tuning::kRefitBracketFraction * (range.hi - range.lo);
+      ps.lo = std::max(range.lo, v - w), ps.hi = std::min(range.hi, v + w);
+    }
+    ps.grid = o.refit_grid;
+    giters = is_f ? tuning::kRefitGoldenItersF : tuning::kRefitGoldenItersY;
+  }
+  double best = 0;
+  const double x = Minimise1D([&](double x) { return eval({x}); }, ps, giters, &best, refit ? cur : std::vector<double>{});
+  *x_out = {x};
+  return best;
+}
+
+/// The best point of the two parameters' log-spaced grid ({a.lo, b.lo} if none has a finite SSE).
+std::vector<double> GridStart(const ParamSpec& a, const ParamSpec& b, const Objective& eval) {
+  std::vector<double> v = {a.lo, b.lo};
+  double fb = std::numeric_limits<double>::infinity();
+  for (int i = 0; i < a.grid; ++i) {
+    const double xa = std::clamp(std::exp(std::log(a.lo) + (std::log(a.hi) - std::log(a.lo)) * i / (a.grid - 1)), a.lo, a.hi);
+    for (int j = 0; j < b.grid; ++j) {
+      const double xb = std::clamp(std::exp(std::log(b.lo) + (std::log(b.hi) - std::log(b.lo)) * j / (b.grid - 1)), b.lo, b.hi);
+      const double fv = eval({xa, xb});
+      if (fv < fb) fb = fv, v = {xa, xb};
+    }
+  }
+  return v;
+}
+
+/// Two parameters (oil_column_resonance), in log coordinates: Nelder-Mead from the grid's best
+/// point, or from the current values `cur` (a refit: cur not empty).
+double FitTwoParams(const ParamSpec& a, const ParamSpec& b, const std::vector<double>& cur, const Objective& eval,
+                    std::vector<double>* x_out) {
+  const bool refit = !cur.empty();
+  const std::vector<double> v = refit ? cur : GridStart(a, b, eval);
+  auto flog = [&](const std::vector<double>& t) {
+    const double xa = std::exp(t[0]), xb = std::exp(t[1]);
+    if (xa < a.lo || xa > a.hi || xb < b.lo || xb > b.hi) return std::numeric_limits<double>::infinity();
+    return eval({xa, xb});
+  };
+  const double step_a = refit ? tuning::kRefitSimplexStepFirst
+                              : tuning::kSimplexStepGridFraction * (std::log(a.hi) - std::log(a.lo)) / (a.grid - 1);
+  const double step_b = refit ? tuning::kRefitSimplexStepSecond
+                              : tuning::kSimplexStepGridFraction * (std::log(b.hi) - std::log(b.lo)) / (b.grid - 1);
+  double best = 0;
+  const auto t = NelderMead2(flog, {std::log(v[0]), std::log(v[1])}, {step_a, step_b},
+                             refit ? tuning::kRefitSimplexEvals : tuning::kSimplexEvals, &best);
+  *x_out = {std::exp(t[0]), std::exp(t[1])};
+  return best;
+}
+
+}  // namespace
+
+double FitEffect(const Channel& ch, const std::vector<CandidateSpec>& specs, Params* p, const std::string& name,
+                 const Options& o) {
+  const auto& spec = SpecOf(specs, name);
+  if (name == "damper_scale") {
+    (*p)[name] = {1.0};
+    double s = 1.0;
+    const auto pred = ch.Predict(ToSet(specs, *p), &s);
+    (*p)[name] = {s};
+    return ch.Sse(pred);
+  }
+  const bool refit = p->count(name) > 0;
+  const std::vector<double> cur = refit ? (*p)[name] : std::vector<double>{};
+  // A non-finite SSE (an overflow on absurd data) ranks last, so the searches below always
+  // have a best point and never compare NaNs.
+  const Objective eval = [&](const std::vector<double>& v) {
+    Params q = *p;
+    q[name] = v;
+    const double sse = ch.Sse(ch.Predict(ToSet(specs, q)));
+    return std::isfinite(sse) ? sse : std::numeric_limits<double>::infinity();
+  };
+  std::vector<double> x;
+  const double best = spec.params.size() == 1
+                          ? FitOneParam(spec.params[0], spec.channel == 'f', cur, o, eval, &x)
+                          : FitTwoParams(spec.params[0], spec.params[1], cur, eval, &x);
+  (*p)[name] = x;
+  return best;
+}
+
+double RefitAll(const Channel& ch, const std::vector<CandidateSpec>& specs, Params* p, double sse, int rounds,
+                const Options& o) {
+  if (p->empty()) return sse;
+  for (int r = 0; r < rounds; ++r) {
+    double s = sse;
+    for (const auto& name : [&] {
+           std::vector<std::string> v;
+           for (const auto& kv : *p) v.push_back(kv.first);
+           return v;
+         }()) {
+      Params q = *p;
+      const double sn = FitEffect(ch, specs, &q, name, o);
+      if (sn < s) s = sn, *p = q;
+    }
+    const bool done = sse - s < tuning::kRefitRelTol * sse;
+    sse = s;
+    if (done) break;
+  }
+  return sse;
+}
+
+}  // namespace rths::diagnosis::stages

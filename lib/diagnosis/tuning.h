@@ -1,0 +1,77 @@
+#pragma once
+/// @file The diagnosis's fixed numbers: search effort and residual statistics that no user tunes
+/// (the settings a user would change are diagnosis::Options). Each is written into diagnosis.json's
+/// "options" beside the Options fields (ToJson(Options)), so a result names every number it used;
+/// the static_asserts hold the ranges Options::IsValid checked when they were options.
+namespace rths::diagnosis::tuning {
+
+// --- channels
+/// Displacement-only records (u = y): the damper's motion is the measured y smoothed at this
+/// times Options::smooth_hz (above the excitation), at most max_smooth_cycles_per_sample / dt_s.
+inline constexpr double kDisplacementOnlySmoothFactor = 4.0;
+/// Upper end of servovalve_saturation's vmax search range, as a multiple of the largest measured
+/// velocity of the training records (capped at the effect library's 1e9 mm/s): room above the
+/// fastest motion seen, where a flow limit would start to bite.
+inline constexpr double kVmaxSearchFactor = 2.0;
+
+// --- noise floor and residual statistics
+/// Welch segment length of the noise floor [samples]: 256 gives a PSD resolution of f_s / 256,
+/// fine enough to find the plateau above the excitation and averaged over many segments.
+inline constexpr int kNoisePsdSegment = 256;
+/// Lags l = 1 .. this of the whiteness number (Ljung-Box-like; about this value if white).
+inline constexpr int kWhitenessLags = 20;
+/// tau_int sums the residual's autocorrelation up to this lag [samples] ...
+inline constexpr int kCorrelationMaxLag = 2000;
+/// ... and up to n / this of each record's n samples (the estimate is poor beyond a quarter).
+inline constexpr int kCorrelationLagDivisor = 4;
+
+// --- selection
+/// The greedy loop stops after this many effects on one channel (more overfits the training set).
+inline constexpr int kMaxEffectsPerChannel = 3;
+/// A fitted parameter within this fraction of its search range of either end (in log space for
+/// log parameters) is "at a bound": the candidate is not an explanation.
+inline constexpr double kAtBoundFraction = 1e-3;
+/// A swap is made if it lowers the channel's training SSE by more than this fraction.
+inline constexpr double kSwapMinGain = 1e-3;
+
+// --- parameter search (one effect) and joint refits (coordinate-wise)
+/// Golden-section iterations after the full-range grid: y effects ...
+inline constexpr int kGoldenItersY = 24;
+/// ... force effects (each evaluation re-simulates the damper, so fewer).
+inline constexpr int kGoldenItersF = 12;
+/// Golden-section iterations of a local refit: y effects ...
+inline constexpr int kRefitGoldenItersY = 14;
+/// ... force effects.
+inline constexpr int kRefitGoldenItersF = 8;
+/// Local refit of a log parameter: the bracket [v / this, v x this].
+inline constexpr double kRefitBracketFactor = 1.3;
+/// Local refit of a linear parameter: the bracket v +- this x its search range.
+inline constexpr double kRefitBracketFraction = 0.05;
+/// Nelder-Mead evaluations of a two-parameter fit (after its grid).
+inline constexpr int kSimplexEvals = 48;
+/// ... of a two-parameter local refit.
+inline constexpr int kRefitSimplexEvals = 24;
+/// Initial simplex step of a two-parameter fit, as a fraction of its grid spacing (log units).
+inline constexpr double kSimplexStepGridFraction = 0.5;
+/// Initial simplex step of a refit [log units]: first parameter ...
+inline constexpr double kRefitSimplexStepFirst = 0.05;
+/// ... second parameter.
+inline constexpr double kRefitSimplexStepSecond = 0.1;
+/// Joint refits stop when a coordinate round lowers the SSE by less than this fraction.
+inline constexpr double kRefitRelTol = 1e-4;
+/// Coordinate rounds refitting a candidate's trial set (a quick look; the winner gets refit_rounds).
+inline constexpr int kTrialRefitRounds = 2;
+/// Coordinate rounds of the set without an effect, when pruning.
+inline constexpr int kPruneRefitRounds = 2;
+
+static_assert(kDisplacementOnlySmoothFactor > 0 && kVmaxSearchFactor >= 1);
+static_assert(kNoisePsdSegment >= 8 && kWhitenessLags >= 1 && kCorrelationMaxLag >= 1 && kCorrelationLagDivisor >= 1);
+static_assert(kMaxEffectsPerChannel >= 1 && kAtBoundFraction >= 0 && kAtBoundFraction < 0.5);
+static_assert(kSwapMinGain >= 0 && kSwapMinGain < 1);
+static_assert(kGoldenItersY >= 0 && kGoldenItersF >= 0 && kRefitGoldenItersY >= 0 && kRefitGoldenItersF >= 0);
+static_assert(kRefitBracketFactor > 1 && kRefitBracketFraction > 0 && kRefitBracketFraction <= 1);
+static_assert(kSimplexEvals >= 3 && kRefitSimplexEvals >= 3);
+static_assert(kSimplexStepGridFraction > 0 && kRefitSimplexStepFirst > 0 && kRefitSimplexStepSecond > 0);
+static_assert(kRefitRelTol >= 0 && kRefitRelTol < 1 && kTrialRefitRounds >= 1 && kPruneRefitRounds >= 1);
+
+}  // namespace rths::diagnosis::tuning

@@ -1,0 +1,37 @@
+#include "ident/damper_model.h"
+
+namespace rths::ident {
+
+DamperModelFit FitDamperModel(const std::vector<io::RigRecord>& records, const DamperFitOptions& o) {
+  DamperModelFit fit;
+  fit.velocity_cutoff_hz = o.velocity_cutoff_hz;
+  if (o.current_A) fit.at_current = FitDamper(records, o);
+  else fit.any_input = FitSpencer(records, o);
+  return fit;
+}
+
+std::string DamperModelFit::Report() const { return at_current ? at_current->Report() : any_input->Report(); }
+
+double DamperModelFit::CutoffHz(const io::RigRecord& record) const {
+  return velocity_cutoff_hz > 0.0 ? velocity_cutoff_hz : VelocityCutoffHz(record);
+}
+
+std::vector<double> DamperModelFit::PredictForce(const io::RigRecord& r) const {
+  const double cutoff = CutoffHz(r);
+  if (any_input)
+    return PredictSpencerForce(any_input->params, any_input->driver, any_input->filter, r, any_input->voltage, cutoff);
+  return SimulateDamperForce(at_current->coef, r.y_mm, SmoothVelocity(r.y_mm, r.dt_s, cutoff), r.dt_s);
+}
+
+DamperRecordScore DamperModelFit::Score(const io::RigRecord& r) const {
+  if (any_input)
+    return ScoreSpencer(any_input->params, any_input->driver, any_input->filter, r, any_input->voltage,
+                        velocity_cutoff_hz);
+  return ScoreDamper(at_current->coef, r, velocity_cutoff_hz);
+}
+
+std::string DamperModelFit::ModelToml(const std::string& title) const {
+  return at_current ? DamperTomlFragment(*at_current, title) : SpencerModelToml(*any_input, title);
+}
+
+}  // namespace rths::ident
