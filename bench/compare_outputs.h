@@ -111,14 +111,14 @@ struct Mask {
 
 /// JSON keys whose values differ between two runs of the same commit (found by running every
 /// command twice in one checkout: --this D --other D): the run id, wall times and rates, the step
-/// latencies (the clock measures them on every run, paced or not) and "link", the udpm transport's
-/// counters of re-requested, repaired and duplicate messages (they follow the host's timing; the
-/// payloads do not: log.lcm is compared by payload).
+/// latencies (the clock measures them on every run, paced or not), the diagnosis' runtime and
+/// "link", the udpm transport's counters of re-requested, repaired and duplicate messages (they
+/// follow the host's timing; the payloads do not: log.lcm is compared by payload).
 inline const std::vector<std::string>& VolatileKeys() {
   static const std::vector<std::string> keys = {"run_id",         "wall_s",          "stepping_s",
                                                 "steps_per_s",    "link",            "latency_histogram_us",
                                                 "latency_max_us", "latency_p50_us",  "latency_p99_us",
-                                                "latency_p999_us", "max_release_late_us"};
+                                                "latency_p999_us", "max_release_late_us", "runtime_s"};
   return keys;
 }
 
@@ -130,6 +130,7 @@ inline std::vector<Mask> TextMasks(const std::vector<std::pair<std::string, std:
   }
   m.push_back({"'Made by ... on <date>'", std::regex(R"( on \d{4}-\d\d-\d\d \d\d:\d\d UTC)"), " on <date>"});
   m.push_back({"'in N s wall time'", std::regex(R"(in \d+(\.\d+)? s wall time)"), "in <wall> s wall time"});
+  m.push_back({"diagnosis 'runtime N s'", std::regex(R"(runtime:? \d+(\.\d+)? s)"), "runtime <wall> s"});
   m.push_back({"progress line '[i/N] ... (N.N s)'", std::regex(R"(\(\d+(\.\d+)? s\))"), "(<wall> s)"});
   return m;
 }
