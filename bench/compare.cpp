@@ -8,6 +8,33 @@
 //
 //   build/bin/bench-compare --other DIR [--repeat N] [--seconds S] [--studies fig9,table2] [--out DIR]
 //
+// --outputs: is the behaviour unchanged? The same commands run in both checkouts, into OUT/this and
+// OUT/other (cwd), and EVERY file they wrote is compared (bench/compare_outputs.h):
+//   - rths reproduce fig5 fig6 fig7 fig8 table2 fig9 fig11 benchmark, and table2 --extended
+//     (--quick unless --full);
+//   - rths design S --out S.json for every scenarios/**/*.toml (and its stdout);
+//   - scripts/real_data_study.sh real_data (rths utfsm-convert, identify, diagnose on data/utfsm);
+//   - rths run scenarios/rig_mode_example.toml (memq) twice: A as shipped (desired seed 3, noise
+//     seed 7), B with desired seed 4 and noise seed 8; rths record both; rths diagnose --train A
+//     --test B (the rig's unmodelled delay and damper scale, found on one seed, tested on another).
+// Each command's stdout, stderr and exit code are files too (NAME.stdout, .stderr, .rc). Files are
+// compared byte for byte; where they differ: log.lcm with `rths log compare` (payload per
+// (channel, k), run_id aside); JSON with the volatile keys masked (VolatileKeys: run_id, wall_s,
+// stepping_s, steps_per_s); text (CSV, Markdown, HTML, TOML, stdout) line by line with only the
+// differing lines masked: the two sides' folders (<ROOT>, <OUT>), "Made by ... on <date>" lines,
+// timestamps and wall-time phrases (TextMasks). PNG and other binaries: byte for byte. The masks
+// are what differs between two runs of the same commit: `--other .` runs this checkout twice.
+// It prints one line per file class and the verdict (identical, identical after masking with the
+// masks used, different with the first differing line, on one side only); exit 0 only if nothing
+// differs and no file is on one side only.
+//
+//   build/bin/bench-compare --outputs --other DIR [--full] [--only reproduce,design,real_data,rig]
+//       [--out DIR] [--no-run] [--other-set "--set KEY=VALUE"] [--this DIR]
+//
+// --no-run compares OUT/this and OUT/other as they are (e.g. after doctoring a file); --other-set
+// adds arguments to the other side's reproduce, design and rig runs (to see a difference caught);
+// --this takes another built checkout as this side (e.g. --this D --other D: one commit twice).
+//
 // DIR is a built checkout (its ./rths and build/bin), e.g.
 //   git worktree add --detach /tmp/old COMMIT && cmake -S /tmp/old -B /tmp/old/build -G Ninja
 //     -DCMAKE_BUILD_TYPE=RelWithDebInfo && cmake --build /tmp/old/build   (one command)
@@ -27,6 +54,8 @@
 #include <CLI/CLI.hpp>
 #include <fmt/core.h>
 #include <nlohmann/json.hpp>
+
+#include "compare_outputs.h"
 
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
@@ -133,13 +162,30 @@ int main(int argc, char** argv) {
   app.add_option("--seconds", seconds, "simulated seconds of the default runs")->capture_default_str();
   app.add_option("--studies", studies, "reproductions to time, comma-separated ('' for none)")->capture_default_str();
   app.add_option("--out", out_dir, "where the runs go (default: a temporary folder, removed)");
+  bool outputs_mode = false;
+  outputs::Options oo;
+  app.add_flag("--outputs", outputs_mode, "compare every output file of the same commands in both checkouts");
+  app.add_flag("--full", oo.full, "--outputs: reproductions without --quick");
+  app.add_option("--only", oo.only, "--outputs: groups to run (reproduce,design,real_data,rig; default all)");
+  app.add_flag("--no-run", [&](std::int64_t) { oo.run = false; }, "--outputs: compare OUT/this and OUT/other as they are");
+  std::string this_dir;
+  app.add_option("--this", this_dir, "--outputs: the checkout taken as this one (default: this program's)");
+  app.add_option("--other-set", oo.other_set, "--outputs: arguments for the other side's runs, e.g. \"--set K=V\"");
   CLI11_PARSE(app, argc, argv);
 
-  const fs::path mine = fs::canonical(fs::read_symlink("/proc/self/exe").parent_path() / "../..");
+  const fs::path mine = fs::canonical(this_dir.empty() ? fs::read_symlink("/proc/self/exe").parent_path() / "../.."
+                                                      : fs::path(this_dir));
   const fs::path other = fs::canonical(other_dir);
   const bool keep = !out_dir.empty();
   const fs::path tmp = keep ? fs::path(out_dir) : fs::temp_directory_path() / fmt::format("rths_bench_compare_{}", ::getpid());
   fs::create_directories(tmp);
+  if (outputs_mode) {
+    oo.mine = mine, oo.other = other, oo.out = fs::absolute(tmp);
+    const auto t0 = Clock::now();
+    const int code = outputs::Run(oo);
+    std::printf("wall time %.0f s; outputs in %s\n", std::chrono::duration<double>(Clock::now() - t0).count(), tmp.c_str());
+    return code;
+  }
 
   const std::string set = fmt::format("--set run.duration_s={}", seconds);
   std::vector<Kind> kinds = {{"udpm, one port", "run " + set, true, ""},

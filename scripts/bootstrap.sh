@@ -19,6 +19,8 @@ packages=(
   libmatio-dev                     # .mat export (rths export): MATLAB v5, and v7.3 through HDF5
   octave                           # the test that loads an exported .mat in GNU Octave
   chromium                         # the test that screenshots a run report headless
+  unzip                            # the test that lists the Java types jar
+  bsdutils util-linux mount        # script (a terminal for cli_test), unshare and mount (reliability_test)
 )
 missing=()
 for p in "${packages[@]}"; do

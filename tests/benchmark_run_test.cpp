@@ -223,19 +223,16 @@ TEST_CASE("a memq run with structure.reference_file: J1-J9 from its log, in summ
   CHECK(got.J2_pct == 0.0);  // the ideal plant still tracks its target exactly
 
   // `rths report` of the run: the table and the figure.
-  if (rths::io::GnuplotAvailable("gnuplot")) {
-    const auto files = rths::report::WriteRunReport(dir);
-    const std::string html = Slurp(files.html);
-    CHECK(html.find("<table id=\"benchmark_criteria\">") != std::string::npos);
-    CHECK(html.find("<td id=\"J1\">0.0 ms</td>") != std::string::npos);
-    CHECK(html.find("<td id=\"J9\">0.00 %</td>") != std::string::npos);
-    bool figure = false;
-    for (const auto& f : files.figures) figure = figure || f.filename() == "benchmark.png";
-    CHECK(figure);
-    CHECK(fs::file_size(dir / "figures" / "benchmark.png") > 1000);
-  } else {
-    MESSAGE("gnuplot is not installed: the report's part of this test is skipped");
-  }
+  rths_test::RequireTool("gnuplot", "gnuplot-nox");
+  const auto files = rths::report::WriteRunReport(dir);
+  const std::string html = Slurp(files.html);
+  CHECK(html.find("<table id=\"benchmark_criteria\">") != std::string::npos);
+  CHECK(html.find("<td id=\"J1\">0.0 ms</td>") != std::string::npos);
+  CHECK(html.find("<td id=\"J9\">0.00 %</td>") != std::string::npos);
+  bool figure = false;
+  for (const auto& f : files.figures) figure = figure || f.filename() == "benchmark.png";
+  CHECK(figure);
+  CHECK(fs::file_size(dir / "figures" / "benchmark.png") > 1000);
 }
 
 TEST_CASE("too few steps: the summary says why there are no criteria, the rest of it stands") {

@@ -189,10 +189,7 @@ TEST_CASE("progress: drawn with an ETA on a terminal, nothing when the output is
                   &out) == 0);
   CHECK(out.find("\033[K") == std::string::npos);  // not a terminal: no progress line
   // On a terminal (a pseudo-terminal from script(1)): the line, redrawn in place, with the step.
-  if (std::system("command -v script >/dev/null 2>&1") != 0) {
-    MESSAGE("script(1) is not installed: the terminal case is skipped");
-    return;
-  }
+  rths_test::RequireTool("script", "bsdutils");
   const fs::path txt = dir / "tty.txt";
   const std::string cmd = "env -u RTHS_NO_PROGRESS script -qc \"" + run + (dir / "tty").string() + "\" /dev/null > " + txt.string();
   REQUIRE(std::system(cmd.c_str()) == 0);

@@ -23,6 +23,7 @@
 #include "diagnosis/report_figures.h"
 #include "validation/synthetic.h"
 #include "io/rig_record.h"
+#include "test_support.h"
 #include "models/mr_damper.h"
 #include "models/servo_linear.h"
 #include "signal/blwn.h"
@@ -434,10 +435,7 @@ TEST_CASE("bad input: records with different dt, and the command's exit code 2 n
   CHECK_THROWS_AS(Diagnose({}, {te}, PaperModel(), Options{}), rths::Error);
 
   const std::string bin = std::string(RTHS_BIN_DIR) + "/rths-diagnose";
-  if (::access(bin.c_str(), X_OK) != 0) {
-    MESSAGE("rths-diagnose is not built in " << RTHS_BIN_DIR << ": command checks skipped");
-    return;
-  }
+  rths_test::RequireBuilt("rths-diagnose");
   const auto dir = TempDir("bad");
   rths::io::WriteRigRecord(tr, (dir / "good.csv").string());
   {  // a missing column

@@ -77,8 +77,6 @@ ToolResult Tool(const std::string& tool, const std::string& args) {
   return Shell(std::string(RTHS_BIN_DIR) + "/rths-" + tool + " " + args);
 }
 
-bool HaveProgram(const std::string& name) { return std::system(("command -v " + name + " > /dev/null 2>&1").c_str()) == 0; }
-
 /// The signals of the recorded run, as rths export decodes them.
 const rths::io::RunSignals& RecordedSignals() {
   static const rths::io::RunSignals s = [] {
@@ -252,10 +250,7 @@ TEST_CASE("rths export: .mat v5 and v7.3 read back by GNU Octave, and CSV, equal
     for (std::size_t k = 0; k < s.steps(); ++k) CHECK(std::stod(table[k + 1][j]) == s.columns[j].values[k]);
   }
 
-  if (!HaveProgram("octave-cli")) {
-    MESSAGE("octave-cli is not installed: the .mat files are not read back (apt-get install octave)");
-    return;
-  }
+  RequireTool("octave-cli", "octave");
   // Octave prints key value lines; char() because Octave reads v7.3 strings as uint16 codes.
   for (const fs::path& mat : {mat5, mat73}) {
     CAPTURE(mat);
@@ -447,11 +442,10 @@ TEST_CASE("rths log dump: every message decoded, per channel and all together") 
 }
 
 TEST_CASE("Java types jar: built with the tree, and buildable in a tree configured without Java") {
-  if (!fs::exists("/usr/share/java/lcm.jar") || !HaveProgram("javac") || !HaveProgram("jar")) {
-    MESSAGE("javac, jar or /usr/share/java/lcm.jar missing: the jar is not built (apt-get install "
-            "default-jdk-headless liblcm-java)");
-    return;
-  }
+  RequireTool("javac", "default-jdk-headless");
+  RequireTool("jar", "default-jdk-headless");
+  RequireFile("/usr/share/java/lcm.jar", "liblcm-java");
+  RequireTool("unzip", "unzip");
   // Part of the default build when Java was there at configure time.
   const fs::path jar = fs::path(RTHS_BIN_DIR).parent_path() / "rths_lcmtypes.jar";
   const std::string why = jar.string() + " missing: build the default target (or lcmtypes_jar)";
@@ -461,7 +455,8 @@ TEST_CASE("Java types jar: built with the tree, and buildable in a tree configur
   CHECK(list.out.find("rths/handshake_t.class") != std::string::npos);
 
   // MATLAB's way of decoding a log with the jar (docs/export.md), in Octave's JVM.
-  if (HaveProgram("octave-cli")) {
+  RequireTool("octave-cli", "octave");
+  {  // INFO's scope
     const fs::path& run = RecordedRun();
     const std::string script =
         "if ~usejava('jvm'); printf('nojvm\\n'); exit(0); end; javaaddpath('/usr/share/java/lcm.jar'); "
@@ -471,16 +466,14 @@ TEST_CASE("Java types jar: built with the tree, and buildable in a tree configur
         "f(end+1) = m.f_kN; end; end; log.close(); printf('n %d\\nsum_f %.17g\\nend ok\\n', numel(f), sum(f));";
     const auto o = Shell("octave-cli --no-gui --norc --eval \"" + script + "\"");
     INFO(o.out, o.err);
-    if (o.out.find("nojvm") != std::string::npos) {
-      MESSAGE("Octave has no JVM: the jar is not tried from Octave");
-    } else {
-      REQUIRE(o.code == 0);
-      const auto kv = KeyValues(o.out);
-      REQUIRE(kv.count("end"));
-      CHECK(std::stoll(kv.at("n")) == kSteps);
-      const auto& s = RecordedSignals();
-      CHECK(std::stod(kv.at("sum_f")) == doctest::Approx(Sum(s.At("f_kN").values)).epsilon(1e-12));
-    }
+    REQUIRE_MESSAGE(o.out.find("nojvm") == std::string::npos,
+                    "Octave has no JVM: apt-get install default-jdk-headless (scripts/bootstrap.sh installs it)");
+    REQUIRE(o.code == 0);
+    const auto kv = KeyValues(o.out);
+    REQUIRE(kv.count("end"));
+    CHECK(std::stoll(kv.at("n")) == kSteps);
+    const auto& s = RecordedSignals();
+    CHECK(std::stod(kv.at("sum_f")) == doctest::Approx(Sum(s.At("f_kN").values)).epsilon(1e-12));
   }
 
   // A tree configured as if javac were absent (JAVAC=OFF): the target exists all the same and

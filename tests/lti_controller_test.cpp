@@ -288,8 +288,7 @@ saturation_mm = 20
 }
 
 TEST_CASE("examples/matlab/rths_lti_toml.m (GNU Octave) writes [controller] lines that design to the same coefficients") {
-  REQUIRE_MESSAGE(std::system("command -v octave-cli > /dev/null 2>&1") == 0,
-                  "octave-cli is missing: apt-get install octave (scripts/bootstrap.sh installs it)");
+  rths_test::RequireTool("octave-cli", "octave");
   const std::string dir = std::string(RTHS_SOURCE_DIR) + "/examples/matlab";
   const std::string out = (std::filesystem::temp_directory_path() / ("rths_lti_toml_" + std::to_string(::getpid()) + ".toml")).string();
   // The benchmark's example, continuous, with every digit of MATLAB's tf object.

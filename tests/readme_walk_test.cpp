@@ -56,7 +56,6 @@ int RunLine(std::string line, const fs::path& cwd, std::string* out) {
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
-bool OnPath(const std::string& program) { return std::system(("command -v " + program + " >/dev/null 2>&1").c_str()) == 0; }
 
 }  // namespace
 
@@ -64,10 +63,7 @@ TEST_CASE("README first steps: run + report, export, Octave, a --set variant") {
   const std::vector<std::string> lines = WalkLines();
   REQUIRE(lines.size() == 5);
   CHECK(lines[0] == "bash scripts/bootstrap.sh");  // the install, which CI has run already
-  if (!rths_test::UdpmAvailable()) {
-    MESSAGE("no multicast route: the walk's udpm runs are skipped (bootstrap adds the route as root)");
-    return;
-  }
+  if (!rths_test::UdpmAvailable()) FAIL("udpm cannot run on this host: " << rths::lockstep::CheckMulticastRoute());
   const fs::path cwd = rths_test::TempDir("readme_walk");
   std::string out;
 
@@ -95,13 +91,10 @@ TEST_CASE("README first steps: run + report, export, Octave, a --set variant") {
   CHECK(fs::file_size(first / "export.mat") > 100000);
 
   // 4. The .mat in Octave: the example prints Eq. 31 as rths run does.
-  if (OnPath("octave-cli")) {
-    INFO(lines[3]);
-    CHECK_MESSAGE(RunLine(lines[3], cwd, &out) == 0, out);
-    CHECK_MESSAGE(out.find(fmt::format("tracking error     {:.3f} %", nrmse)) != std::string::npos, out);
-  } else {
-    MESSAGE("octave-cli is not installed (bootstrap installs it): the Octave line is skipped");
-  }
+  rths_test::RequireTool("octave-cli", "octave");
+  INFO(lines[3]);
+  CHECK_MESSAGE(RunLine(lines[3], cwd, &out) == 0, out);
+  CHECK_MESSAGE(out.find(fmt::format("tracking error     {:.3f} %", nrmse)) != std::string::npos, out);
 
   // 5. The variant: --set takes, --compact leaves out signals.csv, and no compensation tracks worse.
   INFO(lines[4]);

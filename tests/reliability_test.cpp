@@ -343,7 +343,7 @@ void CheckWriteFailure(const fs::path& run, int code, const std::string& output,
 
 }  // namespace
 
-TEST_CASE("disk full: the run stops with exit 7 naming the file; log and CSV end on the last acknowledged step") {
+TEST_CASE("disk full (EFBIG): the run stops with exit 7 naming the file; log and CSV end on the last acknowledged step") {
   if (!UdpmAvailable()) FAIL("udpm cannot run on this host: " << rths::lockstep::CheckMulticastRoute());
   const auto dir = TempDir("disk_full");
   const auto scen = WriteScenario(dir, "[run]\nduration_s = 20.0\n");  // about 28 MB of output
@@ -354,23 +354,25 @@ TEST_CASE("disk full: the run stops with exit 7 naming the file; log and CSV end
     const int code = RunCli(scen.string() + " --out " + run.string(), &output, "ulimit -f 2048; ");
     CheckWriteFailure(run, code, output, "File too large");
   }
-  SUBCASE("a 2 MB tmpfs (ENOSPC), where this host lets us mount one") {
-    const auto mnt = dir / "mnt";
-    if (!MountSmallTmpfs(mnt)) {
-      MESSAGE("cannot mount a tmpfs here (not root?): only the EFBIG case ran");
-      return;
-    }
-    std::string output;
-    // Checked up front, the run is refused and nothing is created ...
-    int code = RunCli(scen.string() + " --out " + (mnt / "run").string(), &output);
-    CHECK(code == rths::lockstep::kExitUsage);
-    CHECK(output.find("not enough free disk space: this run writes about 28") != std::string::npos);
-    CHECK_FALSE(fs::exists(mnt / "run"));
-    // ... and when the disk fills up during the run anyway, the run stops cleanly.
-    code = RunCli(scen.string() + " --skip-space-check --out " + (mnt / "run").string(), &output);
-    CheckWriteFailure(mnt / "run", code, output, "No space left on device");
-    Unmount(mnt);
-  }
+}
+
+TEST_CASE("disk full on a 2 MB tmpfs (ENOSPC): refused up front; filled during the run, exit 7 "
+          "(root only: mount)" * doctest::skip(!IsRoot())) {
+  if (!UdpmAvailable()) FAIL("udpm cannot run on this host: " << rths::lockstep::CheckMulticastRoute());
+  const auto dir = TempDir("disk_full_tmpfs");
+  const auto scen = WriteScenario(dir, "[run]\nduration_s = 20.0\n");  // about 28 MB of output
+  const auto mnt = dir / "mnt";
+  REQUIRE_MESSAGE(MountSmallTmpfs(mnt), "mount -t tmpfs failed as root");
+  std::string output;
+  // Checked up front, the run is refused and nothing is created ...
+  int code = RunCli(scen.string() + " --out " + (mnt / "run").string(), &output);
+  CHECK(code == rths::lockstep::kExitUsage);
+  CHECK(output.find("not enough free disk space: this run writes about 28") != std::string::npos);
+  CHECK_FALSE(fs::exists(mnt / "run"));
+  // ... and when the disk fills up during the run anyway, the run stops cleanly.
+  code = RunCli(scen.string() + " --skip-space-check --out " + (mnt / "run").string(), &output);
+  CheckWriteFailure(mnt / "run", code, output, "No space left on device");
+  Unmount(mnt);
 }
 
 TEST_CASE("interrupt: a run that will write gigabytes is announced; Ctrl-C stops it with its log valid") {
@@ -429,11 +431,10 @@ TEST_CASE("interrupt: a run that will write gigabytes is announced; Ctrl-C stops
   }
 }
 
-TEST_CASE("no multicast route: one clear message, nothing left behind, memq works with the same --out") {
-  if (std::system("unshare -n true 2>/dev/null") != 0) {
-    MESSAGE("cannot make a network namespace here (not root?): skipped");
-    return;
-  }
+TEST_CASE("no multicast route: one clear message, nothing left behind, memq works with the same --out "
+          "(root only: a network namespace)" * doctest::skip(!IsRoot())) {
+  RequireTool("unshare", "util-linux");
+  REQUIRE_MESSAGE(std::system("unshare -n true 2>/dev/null") == 0, "unshare -n failed as root: no network namespaces here");
   const auto dir = TempDir("no_route");
   const auto scen = WriteScenario(dir, kTiny);
   const auto run = dir / "run";

@@ -680,10 +680,7 @@ TEST_CASE("rig mode: a lockstep run (memq) with effects on, then its rig record 
 
 TEST_CASE("rths record: writes RUN_DIR/record.csv; a missing run folder or log exits 2") {
   const std::string bin = std::string(RTHS_BIN_DIR) + "/rths-record";
-  if (!fs::exists(bin)) {
-    MESSAGE("rths-record is not built in " << RTHS_BIN_DIR << ": skipped");
-    return;
-  }
+  rths_test::RequireBuilt("rths-record");
   const fs::path dir = rths_test::TempDir("record_cli");
   CHECK(std::system((bin + " " + (dir / "nothing").string() + " > /dev/null 2>&1").c_str()) == 2 * 256);
   CHECK(std::system((bin + " " + dir.string() + " > /dev/null 2>&1").c_str()) == 2 * 256);  // no log.lcm

@@ -69,11 +69,6 @@ int Shell(const std::string& cmd, std::string* output) {
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
-bool OnPath(const std::string& program) {
-  std::string out;
-  return Shell("command -v " + program, &out) == 0;
-}
-
 /// A run of kScenario (+ extra TOML) by `rths-run --transport memq` into dir/run; its exit code.
 int MakeRun(const fs::path& dir, const std::string& extra = "") {
   const fs::path scenario = WriteScenario(dir, std::string(kScenario) + extra);
@@ -186,10 +181,7 @@ TEST_CASE("the report of a run: five real figures, the Eq. 31 value of summary.j
   CHECK(html.find("http") == std::string::npos);  // nothing from the network
 
   // Each PNG is a picture, not an empty frame: its pixels vary and some are ink.
-  if (!OnPath("octave-cli")) {
-    MESSAGE("octave-cli is not installed: the PNGs and the screenshot are not decoded");
-    return;
-  }
+  rths_test::RequireTool("octave-cli", "octave");
   const auto stats = OctaveImageStats(files.figures);
   for (const auto& name : kFigures) {
     CAPTURE(name);
@@ -202,10 +194,7 @@ TEST_CASE("the report of a run: five real figures, the Eq. 31 value of summary.j
   CHECK(stats.at("gyr.png").blue_pixels > 100);              // the coherence is drawn
 
   // The page in a headless browser: not blank, and the figures load (their blue is on screen).
-  if (!OnPath("chromium")) {
-    MESSAGE("chromium is not installed: the page is not rendered");
-    return;
-  }
+  rths_test::RequireTool("chromium", "chromium");
   const fs::path shot = dir / "screenshot.png";
   std::string out;
   const int code = Shell("timeout 120 chromium --headless --no-sandbox --disable-gpu --user-data-dir='" +

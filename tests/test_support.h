@@ -104,4 +104,34 @@ inline std::string ParseError(std::string_view text, const std::string& path = "
 
 inline bool UdpmAvailable() { return rths::lockstep::CheckMulticastRoute().empty(); }
 
+// One policy for tests that need something outside the build: they fail, naming the Debian package
+// that provides it (scripts/bootstrap.sh installs every one, and CI runs it), never pass silently.
+// What cannot be had without root is an explicit, counted skip: TEST_CASE(... * doctest::skip(!IsRoot())).
+
+/// Whether `program` is on PATH.
+inline bool OnPath(const std::string& program) {
+  return std::system(("command -v " + program + " > /dev/null 2>&1").c_str()) == 0;
+}
+
+/// Fails the test unless `program` is on PATH; the message names `package`, which installs it.
+inline void RequireTool(const std::string& program, const std::string& package) {
+  REQUIRE_MESSAGE(OnPath(program), program << " is not installed: apt-get install " << package
+                                           << " (scripts/bootstrap.sh installs it)");
+}
+
+/// Fails the test unless `file` exists; the message names `package`, which installs it.
+inline void RequireFile(const fs::path& file, const std::string& package) {
+  REQUIRE_MESSAGE(fs::exists(file), file.string() << " is missing: apt-get install " << package
+                                                  << " (scripts/bootstrap.sh installs it)");
+}
+
+/// Fails the test unless RTHS_BIN_DIR/`program` is built (the default target builds every program).
+inline void RequireBuilt(const std::string& program) {
+  const fs::path bin = fs::path(RTHS_BIN_DIR) / program;
+  REQUIRE_MESSAGE(::access(bin.c_str(), X_OK) == 0, bin.string() << " is not built: cmake --build build");
+}
+
+/// Whether the tests run as root (CI does): mounting a tmpfs and making a network namespace need it.
+inline bool IsRoot() { return ::geteuid() == 0; }
+
 }  // namespace rths_test

@@ -12,6 +12,7 @@
 #include <fmt/format.h>
 
 #include "core/error.h"
+#include "core/text.h"
 
 namespace rths::io {
 
@@ -19,19 +20,13 @@ namespace {
 
 constexpr const char* kMagic = "# rths rig record v1";
 
-std::string Trim(std::string s) {
-  const auto b = s.find_first_not_of(" \t\r\n");
-  if (b == std::string::npos) return "";
-  const auto e = s.find_last_not_of(" \t\r\n");
-  return s.substr(b, e - b + 1);
-}
-
 std::vector<std::string> SplitCsv(const std::string& line) {
   std::vector<std::string> out;
   std::size_t start = 0;
   while (true) {
     const auto comma = line.find(',', start);
-    out.push_back(Trim(line.substr(start, comma == std::string::npos ? std::string::npos : comma - start)));
+    const std::size_t n = comma == std::string::npos ? std::string::npos : comma - start;
+    out.emplace_back(Trim(std::string_view(line).substr(start, n), kLineWhitespace));
     if (comma == std::string::npos) break;
     start = comma + 1;
   }
@@ -191,7 +186,7 @@ RigRecord ParseRigRecord(std::string_view text, const std::string& path, TimeAxi
   std::string line;
   std::size_t ln = 0;
 
-  if (!std::getline(in, line) || Trim(line) != kMagic) {
+  if (!std::getline(in, line) || Trim(line, kLineWhitespace) != kMagic) {
     throw Error(Where(path, 1), fmt::format("not a rig record: the first line must be \"{}\"", kMagic));
   }
   ln = 1;
@@ -200,12 +195,13 @@ RigRecord ParseRigRecord(std::string_view text, const std::string& path, TimeAxi
   std::size_t header_line = 0;
   while (std::getline(in, line)) {
     ++ln;
-    const std::string s = Trim(line);
+    const std::string s(Trim(line, kLineWhitespace));
     if (s.empty()) continue;
     if (s[0] == '#') {
       const auto colon = s.find(':');
       if (colon == std::string::npos) continue;  // a plain comment
-      const std::string key = Trim(s.substr(1, colon - 1)), value = Trim(s.substr(colon + 1));
+      const std::string key(Trim(s.substr(1, colon - 1), kLineWhitespace));
+      const std::string value(Trim(s.substr(colon + 1), kLineWhitespace));
       if (key == "dt_s") {
         if (!ParseFinite(value, &rec.dt_s) || !DtInRange(rec.dt_s))
           throw Error(Where(path, ln), fmt::format("dt_s must be a number in [{:g}, {:g}] s (got \"{}\")", kMinDtS,
@@ -255,7 +251,7 @@ RigRecord ParseRigRecord(std::string_view text, const std::string& path, TimeAxi
   std::vector<std::size_t> row_line;
   while (std::getline(in, line)) {
     ++ln;
-    const std::string s = Trim(line);
+    const std::string s(Trim(line, kLineWhitespace));
     if (s.empty() || s[0] == '#') continue;
     const auto f = SplitCsv(s);
     if (f.size() != cols.size()) {

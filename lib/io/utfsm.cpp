@@ -10,20 +10,14 @@
 #include <fmt/format.h>
 
 #include "core/error.h"
+#include "core/text.h"
 
 namespace rths::io {
 
 namespace {
 
-std::string Trim(const std::string& s) {
-  const auto b = s.find_first_not_of(" \t\r\n");
-  if (b == std::string::npos) return "";
-  const auto e = s.find_last_not_of(" \t\r\n");
-  return s.substr(b, e - b + 1);
-}
-
 bool ParseFinite(const std::string& s, double* v) {
-  const std::string t = Trim(s);
+  const std::string t(Trim(s, kLineWhitespace));
   if (t.empty()) return false;
   char* end = nullptr;
   *v = std::strtod(t.c_str(), &end);
@@ -60,7 +54,7 @@ RigRecord ReadUtfsmActuator(const std::string& path, const UtfsmActuatorOptions&
   ++ln;
   const auto colon = line.find(':');
   double hsize = 0.0;
-  if (colon == std::string::npos || Trim(line.substr(0, colon)) != "Header Size" ||
+  if (colon == std::string::npos || Trim(line.substr(0, colon), kLineWhitespace) != "Header Size" ||
       !ParseFinite(line.substr(colon + 1), &hsize) || hsize < 1 || hsize > 10000 || hsize != std::floor(hsize))
     throw Error(Where(path, 1), "not a DAQ export: the first line must be 'Header Size: <lines>' (1 to 10000)");
   double dt = 0.0;
@@ -68,7 +62,7 @@ RigRecord ReadUtfsmActuator(const std::string& path, const UtfsmActuatorOptions&
   while (ln < static_cast<std::size_t>(hsize) && std::getline(in, line)) {
     ++ln;
     const auto c = line.find(':');
-    if (c != std::string::npos && Trim(line.substr(0, c)) == "Sampling Interval" &&
+    if (c != std::string::npos && Trim(line.substr(0, c), kLineWhitespace) == "Sampling Interval" &&
         (!ParseFinite(line.substr(c + 1), &dt) || dt < kMinDtS || dt > kMaxDtS))
       throw Error(Where(path, ln), fmt::format("bad Sampling Interval (a number of seconds in [{:g}, {:g}])", kMinDtS,
                                                kMaxDtS));
@@ -82,7 +76,7 @@ RigRecord ReadUtfsmActuator(const std::string& path, const UtfsmActuatorOptions&
   std::vector<double> y, f, u;
   while (std::getline(in, line)) {
     ++ln;
-    if (Trim(line).empty()) continue;
+    if (Trim(line, kLineWhitespace).empty()) continue;
     std::vector<std::string> fields;
     std::stringstream ss(line);
     std::string field;
@@ -173,7 +167,7 @@ RigRecord ReadUtfsmDamper(const std::string& path) {
   std::size_t ln = 0;
   while (std::getline(in, line)) {
     ++ln;
-    if (Trim(line).empty()) continue;
+    if (Trim(line, kLineWhitespace).empty()) continue;
     std::stringstream ss(line);
     std::vector<std::string> fields;
     std::string field;
@@ -212,7 +206,7 @@ RigRecord ReadUtfsm(const std::string& path) {
   if (!in) throw Error(path, "cannot open");
   std::string first;
   std::getline(in, first);
-  if (Trim(first).rfind("Header Size", 0) == 0) return ReadUtfsmActuator(path);
+  if (Trim(first, kLineWhitespace).rfind("Header Size", 0) == 0) return ReadUtfsmActuator(path);
   return ReadUtfsmDamper(path);
 }
 
@@ -222,7 +216,7 @@ RigRecord ReadRecordOrUtfsm(const std::string& path, TimeAxis time) {
   if (!in) throw Error(path, "cannot open");
   std::string first;
   std::getline(in, first);
-  if (Trim(first).rfind("# rths rig record", 0) == 0) return ReadRecordAny(path, time);
+  if (Trim(first, kLineWhitespace).rfind("# rths rig record", 0) == 0) return ReadRecordAny(path, time);
   return ReadUtfsm(path);
 }
 

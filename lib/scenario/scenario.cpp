@@ -25,6 +25,7 @@
 
 #include "core/error.h"
 #include "core/names.h"
+#include "core/text.h"
 #include "control/ambc.h"
 #include "control/ats.h"
 #include "control/lti_controller.h"
@@ -1173,13 +1174,6 @@ std::vector<std::string> SplitDotted(const std::string& key) {
   return parts;
 }
 
-std::string Trim(std::string_view s) {
-  const auto b = s.find_first_not_of(" \t");
-  if (b == std::string_view::npos) return "";
-  const auto e = s.find_last_not_of(" \t");
-  return std::string(s.substr(b, e - b + 1));
-}
-
 /// Rethrows a validation error about a key that --set changed with the --set argument named: the
 /// error's key (after "FILE: ") is the set key, a table holding it ("foo" for --set foo.bar=1, an
 /// unknown table), or a key inside it. A --set of exactly the error's key is named alone (the last
@@ -1194,7 +1188,7 @@ std::string Trim(std::string_view s) {
   };
   std::string exact, inside;
   for (const auto& set : sets) {
-    const std::string key = Trim(std::string_view(set).substr(0, set.find('=')));
+    const std::string key(Trim(std::string_view(set).substr(0, set.find('=')), kTomlWhitespace));
     if (key.empty() || wkey.empty()) continue;
     if (key == wkey) exact = set;
     if (within(key, wkey) || within(wkey, key)) inside += (inside.empty() ? "--set " : ", --set ") + set;
@@ -1217,12 +1211,13 @@ std::string ApplyOverrides(std::string_view toml_text, const std::vector<std::st
   }
   for (const auto& set : sets) {
     const auto eq = set.find('=');
-    const std::string key = eq == std::string::npos ? "" : Trim(std::string_view(set).substr(0, eq));
+    const std::string key =
+        eq == std::string::npos ? "" : std::string(Trim(std::string_view(set).substr(0, eq), kTomlWhitespace));
     if (eq == std::string::npos || key.empty()) {
       throw Error("--set " + set, "expected KEY=VALUE with a dotted scenario key, e.g. --set run.duration_s=5 "
                                   "(every key: docs/scenarios.md)");
     }
-    const std::string text = Trim(std::string_view(set).substr(eq + 1));
+    const std::string text(Trim(std::string_view(set).substr(eq + 1), kTomlWhitespace));
     toml::table value_table;
     try {
       value_table = toml::parse("v = " + text);

@@ -11,6 +11,7 @@
 #include <fmt/format.h>
 
 #include "core/error.h"
+#include "core/text.h"
 #include "signal/blwn.h"
 
 namespace rths::signal {
@@ -23,13 +24,6 @@ struct Row {
 };
 
 std::string Where(const std::string& path, int line) { return fmt::format("{}:{}", path, line); }
-
-std::string_view Trim(std::string_view s) {
-  const auto first = s.find_first_not_of(" \t\r\v\f");
-  if (first == std::string_view::npos) return {};
-  const auto last = s.find_last_not_of(" \t\r\v\f");
-  return s.substr(first, last - first + 1);
-}
 
 double ParseNumber(std::string_view field, const std::string& where) {
   std::string_view digits = field;
