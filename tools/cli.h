@@ -10,10 +10,9 @@
 
 #include <CLI/CLI.hpp>
 
-namespace rths::tools {
+#include "lockstep/exit_code.h"
 
-/// Exit code of every usage error and bad input (README).
-inline constexpr int kExitUsage = 2;
+namespace rths::tools {
 
 /// Names `app` "rths <sub>" for its usage line and help, and prefixes its usage errors with
 /// "rths <sub>: " like every other message of the command. Call before adding subcommands (they
@@ -26,13 +25,13 @@ inline void NameCommand(CLI::App& app, const std::string& sub) {
 }
 
 /// Parses the command line. Returns -1 to go on, or the code to exit with: 0 after --help,
-/// kExitUsage after a usage error (message already printed).
+/// lockstep::kExitUsage after a usage error (message already printed).
 inline int ParseCommandLine(CLI::App& app, int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     const int code = app.exit(e);
-    return code == 0 ? 0 : kExitUsage;
+    return code == 0 ? 0 : lockstep::kExitUsage;
   }
   return -1;
 }

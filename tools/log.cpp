@@ -26,13 +26,12 @@
 #include "io/log_compare.h"
 #include "io/output_folder.h"
 #include "io/run_log.h"
-#include "lockstep/runtime.h"
+#include "lockstep/exit_code.h"
+#include "lockstep/protocol.h"
 
 namespace {
 
-/// Exit codes (also in the --help footer).
-enum Exit : int { kOk = 0, kDiffer = 1, kBadInput = 2, kTruncated = 3 };
-
+/// The exit codes (lockstep::LogExitCode) in the --help footer.
 constexpr const char* kExitHelp =
     "Exit codes:\n"
     "  0  stats/digest/dump: every log is complete (the run finished: DONE is in it, no event cut short);\n"
@@ -286,15 +285,15 @@ int main(int argc, char** argv) {
       if (!log.Complete()) {
         std::fprintf(stderr, "rths log: note: %s: %s; dumped every complete event\n", files[0].c_str(),
                      log.TruncationReason().c_str());
-        return kTruncated;
+        return rths::lockstep::kLogTruncated;
       }
-      return kOk;
+      return rths::lockstep::kLogOk;
     }
     if (*stats || *digest) {
-      int code = kOk;
+      int code = rths::lockstep::kLogOk;
       for (const auto& f : files) {
         const auto log = rths::io::ReadRunLog(f);
-        if (!log.Complete()) code = kTruncated;
+        if (!log.Complete()) code = rths::lockstep::kLogTruncated;
         if (*digest) {
           std::printf("%s  %s\n", rths::io::PayloadDigest(log).c_str(), f.c_str());
           if (!log.Complete())
@@ -344,9 +343,9 @@ int main(int argc, char** argv) {
       }
     }
     std::printf(differences ? "logs differ\n" : "identical payloads per (channel, k)\n");
-    return differences ? kDiffer : kOk;
+    return differences ? rths::lockstep::kLogDiffer : rths::lockstep::kLogOk;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "rths log: %s\n", e.what());
-    return kBadInput;
+    return rths::lockstep::kLogBadInput;
   }
 }

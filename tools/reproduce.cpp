@@ -81,12 +81,12 @@ int main(int argc, char** argv) {
   if (compact) sets.push_back("run.csv_every=0");
   if (!sets.empty() && name == "fig5") {
     std::fprintf(stderr, "rths reproduce fig5: --set/--compact: fig5 runs the damper model alone, no scenario\n");
-    return rths::tools::kExitUsage;
+    return rths::lockstep::kExitUsage;
   }
 
   if (extended && name != "table2") {
     std::fprintf(stderr, "rths reproduce %s: --extended is for table2 only\n", name.c_str());
-    return rths::tools::kExitUsage;
+    return rths::lockstep::kExitUsage;
   }
 
   rths::report::ReproduceOptions opts;
