@@ -45,7 +45,6 @@
 #include <lcm/lcm-cpp.hpp>
 #include <nlohmann/json.hpp>
 
-#include "lockstep/runtime.h"
 #include "lockstep/transport.h"
 
 namespace fs = std::filesystem;

@@ -32,7 +32,9 @@
 #include "control/feedforward.h"
 #include "control/tracking_controller.h"
 #include "io/event_log.h"
-#include "lockstep/runtime.h"
+#include "lockstep/participant.h"
+#include "lockstep/run_loop.h"
+#include "lockstep/step_table.h"
 #include "lockstep/transport.h"
 #include "models/mr_damper.h"
 #include "models/rig.h"
@@ -113,7 +115,7 @@ Run RunGroup(const rths::scenario::Scenario& s, const fs::path& out, bool lcm_me
     lcm::LCM lcm("memq://");
     std::vector<std::unique_ptr<rths::lockstep::Participant>> owned;
     std::vector<rths::lockstep::Participant*> group;
-    for (std::string_view role : rths::participants::kGroupOrder) {
+    for (std::string_view role : rths::lockstep::kBuildOrder) {
       owned.push_back(rths::participants::MakeParticipant(role, s, rths::participants::IdentityOf(s, 1), &lcm,
                                                           out.string()));
       group.push_back(owned.back().get());

@@ -25,7 +25,7 @@
 #include <fmt/core.h>
 #include <nlohmann/json.hpp>
 
-#include "lockstep/runtime.h"
+#include "lockstep/transport.h"
 
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;

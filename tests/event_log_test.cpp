@@ -19,7 +19,7 @@
 #include "io/event_log.h"
 #include "io/rig_record.h"
 #include "io/run_log.h"
-#include "lockstep/runtime.h"
+#include "lockstep/protocol.h"
 #include "test_support.h"
 
 namespace {

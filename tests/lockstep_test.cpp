@@ -17,7 +17,10 @@
 
 #include "io/event_log.h"
 #include "io/run_log.h"
-#include "lockstep/runtime.h"
+#include "lockstep/exit_code.h"
+#include "lockstep/faults.h"
+#include "lockstep/protocol.h"
+#include "lockstep/transport.h"
 #include "participants/factory.h"
 #include "scenario/scenario.h"
 #include "test_support.h"

@@ -12,7 +12,7 @@
 #include <fmt/format.h>
 
 #include "alloc_counter.h"
-#include "lockstep/runtime.h"
+#include "lockstep/transport.h"
 #include "models/mr_damper.h"
 #include "participants/group.h"
 #include "scenario/scenario.h"

@@ -20,7 +20,7 @@
 #include "io/rig_record.h"
 #include "models/current_driver.h"
 #include "models/rig.h"
-#include "participants/semiactive.h"
+#include "control/current_schedule.h"
 #include "scenario/scenario.h"
 #include "signal/blwn.h"
 #include "test_support.h"
@@ -47,7 +47,7 @@ rths::io::RigRecord RigModeRecord(double eta_1_s, double dt, double duration_s, 
   sa.pulse_hz = 2.0;
   sa.pulse_duty = 0.6;
   sa.pulse_seed = seed;
-  const rths::participants::CurrentSchedule schedule(sa, dt);
+  const rths::control::CurrentSchedule schedule(sa, dt);
   const auto n = static_cast<std::size_t>(std::llround(duration_s / dt));
   const auto u = rths::signal::Blwn(band_hz, rms_mm, dt, n, seed, 1.0);
   rths::io::RigRecord rec;
@@ -96,7 +96,7 @@ TEST_CASE("random_pulse: a pure function of k, levels spread over [0, max], off 
   sa.pulse_hz = 2.0;
   sa.pulse_duty = 0.5;
   const double dt = 0.001;
-  const rths::participants::CurrentSchedule a(sa, dt), b(sa, dt);
+  const rths::control::CurrentSchedule a(sa, dt), b(sa, dt);
   double lo = 9, hi = -9;
   for (std::int64_t k = 0; k < 20000; ++k) {
     const double i = a.At(k);
@@ -110,7 +110,7 @@ TEST_CASE("random_pulse: a pure function of k, levels spread over [0, max], off 
   CHECK(lo < 0.5);
   CHECK(hi > 2.0);
   sa.pulse_seed = 2;
-  CHECK(rths::participants::CurrentSchedule(sa, dt).At(0) != a.At(0));
+  CHECK(rths::control::CurrentSchedule(sa, dt).At(0) != a.At(0));
 }
 
 TEST_CASE("[plant.current_driver] and random_pulse are read, written back and range-checked") {

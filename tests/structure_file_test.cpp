@@ -7,7 +7,7 @@
 
 #include "core/error.h"
 #include "models/structure_file.h"
-#include "participants/semiactive.h"
+#include "control/current_schedule.h"
 
 namespace fs = std::filesystem;
 using namespace rths::models;
@@ -65,7 +65,7 @@ TEST_CASE("structure files round-trip, and bad files are refused naming file and
 TEST_CASE("semiactive schedules: the 0.5 Hz, 50 % pulse of Table 2 and the constant modes") {
   rths::control::SemiactiveConfig cfg;
   cfg.mode = rths::control::SemiactiveMode::kPulse;
-  const rths::participants::CurrentSchedule pulse(cfg, 0.0005);
+  const rths::control::CurrentSchedule pulse(cfg, 0.0005);
   int on = 0;
   for (int k = 0; k < 4000; ++k) on += pulse.At(k) == 2.5;
   CHECK(on == 2000);
@@ -74,10 +74,10 @@ TEST_CASE("semiactive schedules: the 0.5 Hz, 50 % pulse of Table 2 and the const
   CHECK(pulse.At(2000) == 0.0);
   CHECK(pulse.At(4000) == 2.5);  // period 2 s
   cfg.mode = rths::control::SemiactiveMode::kPassiveOn;
-  CHECK(rths::participants::CurrentSchedule(cfg, 0.0005).At(12345) == 2.5);
+  CHECK(rths::control::CurrentSchedule(cfg, 0.0005).At(12345) == 2.5);
   cfg.mode = rths::control::SemiactiveMode::kConstant;
   cfg.current_A = 1.25;
-  CHECK(rths::participants::CurrentSchedule(cfg, 0.0005).At(7) == 1.25);
+  CHECK(rths::control::CurrentSchedule(cfg, 0.0005).At(7) == 1.25);
   cfg.mode = rths::control::SemiactiveMode::kPassiveOff;
-  CHECK(rths::participants::CurrentSchedule(cfg, 0.0005).At(7) == 0.0);
+  CHECK(rths::control::CurrentSchedule(cfg, 0.0005).At(7) == 0.0);
 }

@@ -16,7 +16,8 @@
 
 #include <doctest/doctest.h>
 
-#include "lockstep/runtime.h"
+#include "lockstep/faults.h"
+#include "lockstep/transport.h"
 #include "participants/factory.h"
 #include "participants/group.h"
 #include "scenario/scenario.h"
@@ -62,7 +63,7 @@ struct MemqRun {
 };
 
 /// Runs every participant in this process on memq://, like `rths run --transport memq`.
-/// `per_role` holds one scenario for all, or one per role in participants::kGroupOrder.
+/// `per_role` holds one scenario for all, or one per role in lockstep::kBuildOrder.
 inline MemqRun RunMemq(const std::vector<rths::scenario::Scenario>& per_role, const fs::path& out,
                        const std::string& fault_role = "", rths::lockstep::Faults faults = {}) {
   std::vector<rths::participants::RoleFault> f;

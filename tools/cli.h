@@ -14,12 +14,12 @@
 
 #include <CLI/CLI.hpp>
 
+#include "lockstep/exit_code.h"
+
 #include "core/progress.h"
 
 namespace rths::tools {
 
-/// Exit code of every usage error and bad input (README).
-inline constexpr int kExitUsage = 2;
 
 /// Names `app` "rths <sub>" for its usage line and help, and prefixes its usage errors with
 /// "rths <sub>: " like every other message of the command. Call before adding subcommands (they
@@ -32,7 +32,7 @@ inline void NameCommand(CLI::App& app, const std::string& sub) {
 }
 
 /// Parses the command line. Returns -1 to go on, or the code to exit with: 0 after --help,
-/// kExitUsage after a usage error (message already printed). A non-empty RTHS_NO_PROGRESS in the
+/// lockstep::kExitUsage after a usage error (message already printed). A non-empty RTHS_NO_PROGRESS in the
 /// environment turns the progress lines off (core/progress.h).
 inline int ParseCommandLine(CLI::App& app, int argc, char** argv) {
   if (const char* off = std::getenv("RTHS_NO_PROGRESS"); off != nullptr && *off != '\0') ProgressLine::TurnOff();
@@ -40,7 +40,7 @@ inline int ParseCommandLine(CLI::App& app, int argc, char** argv) {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     const int code = app.exit(e);
-    return code == 0 ? 0 : kExitUsage;
+    return code == 0 ? 0 : lockstep::kExitUsage;
   }
   return -1;
 }

@@ -20,15 +20,14 @@
 #include "io/output_folder.h"
 #include "io/run_log.h"
 #include "io/run_signals.h"
+#include "lockstep/exit_code.h"
 #include "scenario/scenario.h"
 
 namespace fs = std::filesystem;
 
 namespace {
 
-/// Exit codes (also in the --help footer).
-enum Exit : int { kOk = 0, kInternal = 1, kBadInput = 2, kTruncated = 3 };
-
+/// The exit codes (lockstep::LogExitCode) in the --help footer.
 constexpr const char* kExitHelp =
     "Layout of the .mat file (docs/export.md): one struct 'rths' with rths.signals.<name> (n x 1 double\n"
     "per signal), rths.units.<name>, rths.descriptions.<name>, rths.names (comma-separated, column order) and\n"
@@ -144,14 +143,14 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "rths export: note: %s: %s; exported its %lld complete steps (k = 0..%lld)\n",
                    log_path.c_str(), log.TruncationReason().c_str(), static_cast<long long>(steps),
                    static_cast<long long>(steps - 1));
-      return kTruncated;
+      return rths::lockstep::kLogTruncated;
     }
-    return kOk;
+    return rths::lockstep::kLogOk;
   } catch (const rths::Error& e) {
     std::fprintf(stderr, "rths export: %s\n", e.what());
-    return ExitNow(kBadInput);
+    return ExitNow(rths::lockstep::kLogBadInput);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "rths export: internal failure: %s\n", e.what());
-    return ExitNow(kInternal);
+    return ExitNow(rths::lockstep::kLogInternal);
   }
 }

@@ -26,12 +26,12 @@
 #include "io/log_compare.h"
 #include "io/output_folder.h"
 #include "io/run_log.h"
-#include "lockstep/runtime.h"
+#include "lockstep/exit_code.h"
+#include "lockstep/protocol.h"
 
 namespace {
 
-/// Exit codes (also in the --help footer).
-enum Exit : int { kOk = 0, kDiffer = 1, kBadInput = 2, kTruncated = 3 };
+/// The exit codes (lockstep::LogExitCode) in the --help footer.
 
 constexpr const char* kExitHelp =
     "Exit codes:\n"
@@ -261,17 +261,17 @@ int DumpCommand(const std::string& path, const std::string& channel_arg, const s
   if (!log.Complete()) {
     std::fprintf(stderr, "rths log: note: %s: %s; dumped every complete event\n", path.c_str(),
                  log.TruncationReason().c_str());
-    return kTruncated;
+    return rths::lockstep::kLogTruncated;
   }
-  return kOk;
+  return rths::lockstep::kLogOk;
 }
 
 /// `rths log stats` and `rths log digest`.
 int StatsCommand(const std::vector<std::string>& files, bool digest) {
-  int code = kOk;
+  int code = rths::lockstep::kLogOk;
   for (const auto& f : files) {
     const auto log = rths::io::ReadRunLog(f);
-    if (!log.Complete()) code = kTruncated;
+    if (!log.Complete()) code = rths::lockstep::kLogTruncated;
     if (digest) {
       std::printf("%s  %s\n", rths::io::PayloadDigest(log).c_str(), f.c_str());
       if (!log.Complete())
@@ -330,7 +330,7 @@ int CompareCommand(const std::vector<std::string>& files) {
     }
   }
   std::printf(differences ? "logs differ\n" : "identical payloads per (channel, k)\n");
-  return differences ? kDiffer : kOk;
+  return differences ? rths::lockstep::kLogDiffer : rths::lockstep::kLogOk;
 }
 
 }  // namespace
@@ -364,6 +364,6 @@ int main(int argc, char** argv) {
     return CompareCommand(files);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "rths log: %s\n", e.what());
-    return kBadInput;
+    return rths::lockstep::kLogBadInput;
   }
 }

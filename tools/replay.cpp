@@ -23,7 +23,7 @@
 #include "core/error.h"
 #include "io/output_folder.h"
 #include "io/run_log.h"
-#include "lockstep/runtime.h"
+#include "lockstep/exit_code.h"
 #include "participants/replay.h"
 #include "scenario/scenario.h"
 #include "supervisor/replay_report.h"
@@ -36,8 +36,6 @@ namespace {
 
 volatile std::sig_atomic_t g_interrupted = 0;
 void OnSignal(int) { g_interrupted = 1; }
-
-constexpr int kIdentical = 0, kDiffer = 1, kBadInput = 2;
 
 struct Options {
   std::string run_dir, live, out, scenario;
@@ -173,13 +171,13 @@ void PrintHeader(const Options& o, const Replay& r) {
 int Finish(const Replay& r, const sup::ReplayReport& report) {
   for (const auto& line : report.lines) std::printf("  %s\n", line.c_str());
   if (!report.log_error.empty()) std::fprintf(stderr, "rths replay: %s\n", report.log_error.c_str());
-  int code = report.compared && !report.identical ? kDiffer : kIdentical;
+  int code = report.compared && !report.identical ? rths::lockstep::kLogDiffer : rths::lockstep::kLogOk;
   if (report.failed) {
     code = g_interrupted ? 130 : (report.verdict.exit_code != 0 ? report.verdict.exit_code : rths::lockstep::kExitLockstep);
     std::fprintf(stderr, "rths replay: FAILED after %lld steps: %s\n", static_cast<long long>(report.replayed),
                  g_interrupted ? "interrupted" : report.verdict.what.c_str());
   } else {
-    std::printf(code == kIdentical ? "identical: the live outputs reproduce the recording bit for bit\n"
+    std::printf(code == rths::lockstep::kLogOk ? "identical: the live outputs reproduce the recording bit for bit\n"
                                    : "different: the live outputs differ from the recording (see above)\n");
   }
   std::ofstream(r.out / "replay.json") << report.ToJson(code).dump(2) << "\n";
@@ -204,7 +202,7 @@ int main(int argc, char** argv) {
     r = Prepare(o);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "rths replay: %s\n", e.what());
-    return kBadInput;
+    return rths::lockstep::kLogBadInput;
   }
   sup::RunRequest request;
   request.scenario = r.s;
@@ -221,7 +219,7 @@ int main(int argc, char** argv) {
     result = sup::Run(request);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "rths replay: %s\n", e.what());
-    return kBadInput;
+    return rths::lockstep::kLogBadInput;
   }
   const sup::ReplayFacts facts{o.run_dir, r.live, r.steps, r.s.sha256, r.recorded_sha};
   return Finish(r, sup::CompareReplay(facts, r.record, r.out, result.summary.participants, g_interrupted != 0));

@@ -50,7 +50,7 @@ int main(int argc, char** argv) {
     data = rths::report::LoadRunData(run_dir);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "rths report: %s\n", e.what());
-    return rths::tools::kExitUsage;
+    return rths::lockstep::kExitUsage;
   }
   try {
     const rths::report::ReportFiles files = rths::report::WriteRunReport(data, o);

@@ -196,11 +196,11 @@ int CheckOptions(Options* o) {
   if (o->compact) o->sets.push_back("run.csv_every=0");
   if (!o->sets.empty() && o->name == "fig5") {
     std::fprintf(stderr, "rths reproduce fig5: --set/--compact: fig5 runs the damper model alone, no scenario\n");
-    return rths::tools::kExitUsage;
+    return rths::lockstep::kExitUsage;
   }
   if (o->extended && o->name != "table2") {
     std::fprintf(stderr, "rths reproduce %s: --extended is for table2 only\n", o->name.c_str());
-    return rths::tools::kExitUsage;
+    return rths::lockstep::kExitUsage;
   }
   return -1;
 }

@@ -12,7 +12,8 @@
 #include <fmt/core.h>
 
 #include "core/progress.h"
-#include "lockstep/runtime.h"
+#include "lockstep/exit_code.h"
+#include "lockstep/transport.h"
 #include "lockstep/transport.h"
 #include "report/run_report.h"
 #include "scenario/scenario.h"

@@ -9,7 +9,7 @@
 
 #include "core/error.h"
 #include "io/event_log.h"
-#include "lockstep/runtime.h"
+#include "lockstep/protocol.h"
 #include "scenario/scenario.h"
 #include "signal/metrics.h"
 

@@ -15,13 +15,6 @@ double Seconds(SteadyClock::time_point a, SteadyClock::time_point b) {
   return std::chrono::duration<double>(b - a).count();
 }
 
-int RosterIndex(const std::string& name) {
-  for (std::size_t i = 0; i < kRoster.size(); ++i) {
-    if (name == kRoster[i].name) return static_cast<int>(i);
-  }
-  return -1;
-}
-
 std::string JoinNames(const std::vector<std::string>& names) {
   std::string out;
   for (std::size_t i = 0; i < names.size(); ++i) {
@@ -32,9 +25,9 @@ std::string JoinNames(const std::vector<std::string>& names) {
 }
 }  // namespace
 
-ClockParticipant::ClockParticipant(std::string name, RunIdentity id, Timing timing, lcm::LCM* lcm,
-                                   Faults faults)
-    : Participant(std::move(name), std::move(id), timing, lcm, std::move(faults)) {
+ClockParticipant::ClockParticipant(std::string name, RunIdentity id, LockstepConfig config, lcm::LCM* lcm,
+                                   const Wiring& wiring, Faults faults)
+    : Participant(std::move(name), std::move(id), config, lcm, std::move(faults)), wiring_(wiring) {
   is_clock_ = true;
   hello_.fill(false);
   bye_.fill(false);
@@ -49,21 +42,20 @@ ClockParticipant::ClockParticipant(std::string name, RunIdentity id, Timing timi
   rt_.paced = timing_.pacing.enabled;
   rt_.period_s = timing_.pacing.period_s;
   SetAnswerChannel(kDesired, &desired_cache_);
-  auto on_answer = [this](auto* box, Channel ch) {
-    return [this, box, ch](const lcm::ReceiveBuffer* rbuf) {
+  // The barrier of step k is the clock's inputs of step k+1 (wiring.h); only the last of them to
+  // be sent (ack_t: the logger acknowledges step k once it holds the rest) wakes the clock.
+  const ResolvedRole& clock = wiring_.Clock();
+  for (int c = kDesired; c < kChannelCodes; ++c) {
+    if (!clock.reads[c]) continue;
+    const auto channel = static_cast<Channel>(c);
+    Subscribe(ChannelName(channel), [this, channel](const lcm::ReceiveBuffer* rbuf) {
       if (finished()) return;
-      if (Receive(box, ch, rbuf) != Put::kNew) return;
-      const std::int64_t k = box->last_k();
-      if (k == k_ || (ch == kMeasured && k == k_ + 1 && WaitsForNextMeasured())) CheckBarrier();
-    };
-  };
-  // The logger acknowledges step k only once it holds measured_t k, command_t k and current_t k
-  // (and measured_t k+1 when the barrier includes it), so those are here when ack_t k is: only
-  // ack_t wakes the clock (one wake-up per step, not four).
-  Subscribe(kChMeasured, on_answer(&measured_, kMeasured), Wake::kLater);
-  Subscribe(kChCommand, on_answer(&command_, kCommand), Wake::kLater);
-  Subscribe(kChCurrent, on_answer(&current_, kCurrent), Wake::kLater);
-  Subscribe(kChAck, on_answer(&ack_, kAck));
+      std::int64_t k = -1;
+      const Put put = boxes_.Add(channel, rbuf, id_.run_id, &k);
+      Count(channel, put, k);
+      if (put == Put::kNew && k_ >= 0 && wiring_.Clock().Waits(channel, k, k_ + 1)) CheckBarrier();
+    }, clock.wake[c]);
+  }
 }
 
 void ClockParticipant::OnHandshakeForClock(const rths::handshake_t& msg, SteadyClock::time_point now) {
@@ -109,17 +101,25 @@ void ClockParticipant::OnRepairForClock(const rths::repair_t& msg) {
   if (i >= 0 && msg.k == k_) reported_[i] = true;
 }
 
-void ClockParticipant::ListMissing(std::int64_t k, WantList* out) const {
-  if (!measured_.Get(k)) out->Add(kMeasured, k);
-  if (!command_.Get(k)) out->Add(kCommand, k);
-  if (!current_.Get(k)) out->Add(kCurrent, k);
-  if (!ack_.Get(k)) out->Add(kAck, k);
-  if (k == k_ && WaitsForNextMeasured() && !measured_.Get(k + 1)) out->Add(kMeasured, k + 1);
+void ClockParticipant::Lacks(std::int64_t k, WantList* out) const {
+  const ResolvedRole& clock = wiring_.Clock();
+  for (int i = 0; i < clock.n_waits; ++i) {
+    const std::int64_t j = k + 1 + clock.waits[i].offset;
+    if (Exists(j) && !boxes_.Has(clock.waits[i].channel, j)) out->Add(clock.waits[i].channel, j);
+  }
+}
+
+bool ClockParticipant::Answered(const ResolvedRole& role) const {
+  for (int b = 0; b < role.row->n_barrier; ++b) {
+    const std::int64_t j = k_ + role.row->barrier[b];
+    if (Exists(j) && !boxes_.Has(role.row->answer, j)) return false;
+  }
+  return true;
 }
 
 void ClockParticipant::SendGo() {
   std::vector<std::string> roster;
-  for (const auto& r : kRoster) roster.emplace_back(r.name);
+  for (std::string_view r : kRoster) roster.emplace_back(r);
   SendHandshake(kGo, 0, "", &roster);  // several copies; a lost GO is also repaired by step 0
   go_at_ = SteadyClock::now();
   OnGo();
@@ -166,7 +166,7 @@ bool ClockParticipant::AccountStep(SteadyClock::time_point now) {
 
 void ClockParticipant::IssueStep(std::int64_t k) {
   MaybeFault(k);
-  const rths::measured_t* prev = k > 0 ? measured_.Get(k - 1) : nullptr;
+  const rths::measured_t* prev = k > 0 ? boxes_.measured.Get(k - 1) : nullptr;
   ComputeDesired(k, prev, &desired_);
   desired_.run_id = id_.run_id;
   desired_.k = k;
@@ -180,10 +180,12 @@ void ClockParticipant::IssueStep(std::int64_t k) {
 
 void ClockParticipant::CheckBarrier() {
   if (finished() || done_ || k_ < 0 || Stalled(k_)) return;
-  const rths::measured_t* m = measured_.Get(k_);
-  const rths::command_t* c = command_.Get(k_);
-  if (!m || !c || !current_.Get(k_) || !ack_.Get(k_)) return;
-  if (WaitsForNextMeasured() && !measured_.Get(k_ + 1)) return;
+  WantList lacks;
+  Lacks(k_, &lacks);
+  if (!lacks.empty()) return;
+  const rths::measured_t* m = boxes_.measured.Get(k_);
+  const rths::command_t* c = boxes_.command.Get(k_);
+  if (!m || !c) return;  // every table has them in the barrier (safety check)
   const auto now = SteadyClock::now();
   if (rerequests_ == 0) {
     // How long a step takes when nothing is lost (a moving average over ~16 steps): it sets how
@@ -222,30 +224,35 @@ void ClockParticipant::IssueNext() {
 void ClockParticipant::FailStalled(SteadyClock::time_point now) {
   // Silent: its answer of step k is missing and it never said what it lacked. Waiting: its
   // answer is missing but it asked for inputs (alive; it waits for a silent one).
-  const bool plant_answered = measured_.Get(k_) && (!WaitsForNextMeasured() || measured_.Get(k_ + 1));
-  const bool answered[kRoster.size()] = {true, command_.Get(k_) != nullptr, plant_answered,
-                                         current_.Get(k_) != nullptr, ack_.Get(k_) != nullptr};
   std::vector<std::string> silent, waiting;
-  for (std::size_t i = 1; i < kRoster.size(); ++i) {
-    if (answered[i]) continue;
-    (reported_[i] ? waiting : silent).push_back(kRoster[i].name);
+  for (int i = 0; i < kRosterSize; ++i) {
+    const ResolvedRole& r = wiring_.roles()[i];
+    if (r.row->clock || Answered(r)) continue;
+    (reported_[i] ? waiting : silent).emplace_back(r.role());
   }
   if (silent.empty()) {
     // Every one that lacks its answer says it is waiting: blame the first in the step's order
     // (the plant's measurement feeds everyone, then the controller and semiactive, then the logger).
-    for (const char* role : {"plant", "controller", "semiactive", "logger"}) {
-      const int i = RosterIndex(role);
-      if (!answered[i]) {
-        silent.push_back(role);
+    for (int i : wiring_.step_order()) {
+      if (!Answered(wiring_.roles()[i])) {
+        silent.emplace_back(kRoster[i]);
         break;
       }
     }
     std::erase(waiting, silent.front());
   }
-  // The plant's answer to step k is measured_t k+1 when the barrier includes it: name it.
-  const std::string missing = silent.size() == 1 && silent.front() == "plant" && measured_.Get(k_)
-                                  ? fmt::format("no measured_t {}", k_ + 1)
-                                  : std::string("no answer");
+  // A lone silent role that gave its answer of step k but not a later one the barrier holds (the
+  // plant's measured_t k+1): name the message.
+  std::string missing = "no answer";
+  if (silent.size() == 1) {
+    const ResolvedRole& r = wiring_.Of(silent.front());
+    for (int b = 0; b < r.row->n_barrier; ++b) {
+      const std::int64_t j = k_ + r.row->barrier[b];
+      if (!Exists(j) || boxes_.Has(r.row->answer, j)) continue;
+      if (r.row->barrier[b] != 0) missing = fmt::format("no {} {}", MessageName(r.row->answer), j);
+      break;
+    }
+  }
   std::string reason = fmt::format("step {}: {} stopped answering: {} after {:.3g} s and {} re-requests", k_,
                                    JoinNames(silent), missing, Seconds(step_since_, now), rerequests_);
   if (!waiting.empty()) reason += fmt::format(" ({} only waited for it)", JoinNames(waiting));
@@ -264,8 +271,8 @@ void ClockParticipant::Poll(SteadyClock::time_point now, bool idle) {
   if (k_ < 0) {  // handshake
     if (idle && Seconds(start_, now) > timing_.handshake_timeout_s) {
       std::vector<std::string> missing;
-      for (std::size_t i = 0; i < kRoster.size(); ++i) {
-        if (!hello_[i]) missing.emplace_back(kRoster[i].name);
+      for (int i = 0; i < kRosterSize; ++i) {
+        if (!hello_[i]) missing.emplace_back(kRoster[i]);
       }
       Fail(kExitLockstep,
            fmt::format("no HELLO from {} within {:g} s: not started, crashed, or on another LCM "
@@ -290,8 +297,8 @@ void ClockParticipant::Poll(SteadyClock::time_point now, bool idle) {
   if (done_) {
     if (idle && Seconds(step_since_, now) > timing_.stall_budget_s) {
       std::vector<std::string> missing;
-      for (std::size_t i = 0; i < kRoster.size(); ++i) {
-        if (!bye_[i]) missing.emplace_back(kRoster[i].name);
+      for (int i = 0; i < kRosterSize; ++i) {
+        if (!bye_[i]) missing.emplace_back(kRoster[i]);
       }
       std::fprintf(stderr, "%s: every step committed, but no BYE from %s within %g s\n", name_.c_str(),
                    JoinNames(missing).c_str(), timing_.stall_budget_s);
@@ -315,7 +322,7 @@ void ClockParticipant::Poll(SteadyClock::time_point now, bool idle) {
   ++rerequests_;
   last_send_ = now;
   WantList wants;
-  ListMissing(k_, &wants);
+  Lacks(k_, &wants);
   SendRepair(k_, wants);
 }
 

@@ -6,7 +6,8 @@
 /// Step k: the clock publishes desired_t k (its own answer, and the request of step k), then
 /// waits for the barrier of step k: measured_t k (plant), command_t k (controller),
 /// current_t k (semiactive), ack_t k (logger: every message of step k is on disk) and, for a
-/// plant that answers command_t k (SetBarrierIncludesNextMeasured), measured_t k+1.
+/// plant that answers command_t k, measured_t k+1: the barrier is derived from the step table
+/// (lockstep/wiring.h), as the clock's inputs of step k+1.
 /// Silence for `rerequest_ms` (then twice as long each time, up to 1 s) re-requests step k: a
 /// repair_t listing the answers it lacks; their owners re-send them from their caches, and
 /// whoever lacks an input says so in a repair_t of its own (docs/lockstep.md, "Repair").
@@ -14,44 +15,28 @@
 /// neither answered nor said what they lacked (the silent ones) apart from those that only
 /// waited. Steps are never skipped: step k+1 is issued only after the barrier of step k.
 /// After the last step: DONE until every BYE is in, then CLOSE.
-/// Paced (Timing::pacing, docs/realtime.md): step k is released at GO + k dt of the wall clock,
+/// Paced (LockstepConfig::pacing, docs/realtime.md): step k is released at GO + k dt of the wall clock,
 /// not as soon as step k-1 completes; every step's latency and deadline are accounted.
 #include <array>
 #include <string>
 #include <string_view>
 #include <vector>
 
-#include "lockstep/runtime.h"
-#include "rths/ack_t.hpp"
-#include "rths/command_t.hpp"
-#include "rths/current_t.hpp"
-#include "rths/desired_t.hpp"
-#include "rths/measured_t.hpp"
+#include "lockstep/participant.h"
+#include "lockstep/step_mailboxes.h"
+#include "lockstep/step_table.h"
+#include "lockstep/wiring.h"
 
 namespace rths::lockstep {
 
-/// The participants every run has, in roster order, and the channel of each one's step answer.
-struct RosterEntry {
-  const char* name;
-  const char* channel;  ///< channel of its per-step answer (nullptr for the clock itself)
-};
-inline constexpr std::array<RosterEntry, 5> kRoster{{{"integrator", kChDesired},
-                                                     {"controller", kChCommand},
-                                                     {"plant", kChMeasured},
-                                                     {"semiactive", kChCurrent},
-                                                     {"logger", kChAck}}};
-
 class ClockParticipant : public Participant {
  public:
-  ClockParticipant(std::string name, RunIdentity id, Timing timing, lcm::LCM* lcm, Faults faults = {});
+  /// `wiring`: the run's wiring (its clock row gives the barrier); copied.
+  ClockParticipant(std::string name, RunIdentity id, LockstepConfig config, lcm::LCM* lcm, const Wiring& wiring,
+                   Faults faults = {});
 
   void Poll(SteadyClock::time_point now, bool idle) override;
   SteadyClock::time_point PollDeadline() const override;
-
-  /// The barrier of step k includes measured_t k+1 (but for the last step): for a plant that
-  /// answers command_t k with measured_t k+1 (every plant but "ideal"; docs/lockstep.md, "One
-  /// step"). Call before GO.
-  void SetBarrierIncludesNextMeasured(bool on) { next_measured_ = on; }
 
   /// Step currently requested (-1 before GO).
   std::int64_t current_step() const { return k_; }
@@ -76,7 +61,7 @@ class ClockParticipant : public Participant {
   void OnHandshakeForClock(const rths::handshake_t& msg, SteadyClock::time_point now) override;
   void OnRepairForClock(const rths::repair_t& msg) override;
   /// The answers of step k the barrier lacks.
-  void ListMissing(std::int64_t k, WantList* out) const override;
+  void Lacks(std::int64_t k, WantList* out) const override;
 
  private:
   void CheckBarrier();
@@ -92,21 +77,21 @@ class ClockParticipant : public Participant {
   /// Paced: when step k is released (t0 + k dt).
   SteadyClock::time_point ReleaseOf(std::int64_t k) const;
 
-  StepMailbox<rths::measured_t> measured_;
-  StepMailbox<rths::command_t> command_;
-  StepMailbox<rths::current_t> current_;
-  StepMailbox<rths::ack_t> ack_;
+  /// Whether the barrier item (channel, k + offset) exists in this run.
+  bool Exists(std::int64_t j) const { return j >= 0 && j < id_.n_steps; }
+  /// Whether `role` gave every answer the barrier of step k_ waits for.
+  bool Answered(const ResolvedRole& role) const;
+
+  const Wiring wiring_;
+  StepMailboxes boxes_;
   AnswerCache desired_cache_;
   rths::desired_t desired_{};
 
-  std::array<bool, kRoster.size()> hello_{};
-  std::array<bool, kRoster.size()> bye_{};
+  std::array<bool, kRosterSize> hello_{};
+  std::array<bool, kRosterSize> bye_{};
   /// Who sent a repair_t for the current step (alive, but lacking inputs).
-  std::array<bool, kRoster.size()> reported_{};
+  std::array<bool, kRosterSize> reported_{};
   std::int64_t k_ = -1;
-  bool next_measured_ = false;  ///< SetBarrierIncludesNextMeasured
-  /// The barrier of step k_ waits for measured_t k_+1.
-  bool WaitsForNextMeasured() const { return next_measured_ && k_ + 1 < id_.n_steps; }
   int rerequests_ = 0;  ///< re-requests of the current step (or DONEs after the first)
   double typical_step_s_ = 0;  ///< moving average of the steps that needed no re-request [s]
   bool done_ = false;

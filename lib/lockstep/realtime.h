@@ -35,6 +35,7 @@ struct Pacing {
   double period_s = 0.0;  ///< dt [s]
   /// Stop the run (exit kExitRealtime) after this many consecutive misses; 0 = never.
   std::int64_t max_consecutive_misses = 0;
+  bool operator==(const Pacing&) const = default;
 };
 
 /// Durations in log-spaced bins: 100 per decade from 1 us to 100 s (neighbouring bin edges 2.3 %

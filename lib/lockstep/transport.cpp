@@ -1,5 +1,7 @@
 #include "lockstep/transport.h"
 
+#include "lockstep/run_loop.h"
+
 #include <arpa/inet.h>
 #include <netinet/in.h>
 #include <poll.h>
@@ -10,6 +12,8 @@
 
 #include <cerrno>
 #include <cstring>
+#include <fstream>
+#include <sstream>
 
 #include <fmt/core.h>
 
@@ -364,6 +368,27 @@ int RunLoop(Channels* channels, const std::vector<Participant*>& participants,
             const volatile std::sig_atomic_t* stop) {
   return RunLoopWith([channels](int timeout_ms) { return channels->HandleTimeout(timeout_ms); }, participants,
                      stop);
+}
+
+std::string CheckMulticastRoute() {
+  // /proc/net/route: Iface Destination Gateway Flags RefCnt Use Metric Mask ... (hex, little-endian)
+  std::ifstream in("/proc/net/route");
+  if (!in) return "";  // not Linux-like; let LCM decide
+  std::string line;
+  std::getline(in, line);  // header
+  const std::uint32_t group = 0x010000E0;  // 224.0.0.1 in /proc's byte order
+  while (std::getline(in, line)) {
+    std::istringstream ss(line);
+    std::string iface;
+    unsigned long dest = 0, gw = 0, flags = 0, refcnt = 0, use = 0, metric = 0, mask = 0;
+    ss >> iface >> std::hex >> dest >> gw >> flags >> std::dec >> refcnt >> use >> metric >> std::hex >>
+        mask;
+    if (!ss) continue;
+    if ((group & mask) == dest && (flags & 0x1)) return "";
+  }
+  return "this host has no route for multicast (224.0.0.0/4), so LCM's udpm transport cannot work.\n"
+         "Fix (as root):  ip route add 224.0.0.0/4 dev lo\n"
+         "or run in one process instead:  ./rths run --transport memq";
 }
 
 }  // namespace rths::lockstep

@@ -16,6 +16,7 @@
 #include <netinet/in.h>
 
 #include <array>
+#include <csignal>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -24,9 +25,11 @@
 
 #include <lcm/lcm-cpp.hpp>
 
-#include "lockstep/runtime.h"
+#include "lockstep/protocol.h"
 
 namespace rths::lockstep {
+
+class Participant;
 
 /// The channels of a run in port order: channel i travels on base port + i.
 inline constexpr std::array<const char*, 7> kPortChannels{kChHandshake, kChDesired, kChCommand, kChMeasured,
@@ -183,5 +186,9 @@ class InprocChannels final : public Channels {
 /// RunLoop on a transport of our own (participants attached with Participant::Attach).
 int RunLoop(Channels* channels, const std::vector<Participant*>& participants,
             const volatile std::sig_atomic_t* stop = nullptr);
+
+/// Checks the host can do LCM multicast on loopback (`udpm`); returns "" if fine, or a message
+/// telling the user how to fix it (ip route add 224.0.0.0/4 dev lo).
+std::string CheckMulticastRoute();
 
 }  // namespace rths::lockstep

@@ -12,6 +12,7 @@
 
 #include "core/error.h"
 #include "io/reserved_file.h"
+#include "lockstep/run_loop.h"
 #include "lockstep/transport.h"
 #include "participants/controller.h"
 #include "participants/group.h"
@@ -28,13 +29,15 @@ lockstep::RunIdentity IdentityOf(const scenario::Scenario& s, std::int64_t run_i
   return {run_id, s.sha256, s.steps(), s.run.dt_s};
 }
 
-lockstep::Timing TimingOf(const scenario::Scenario& s) {
-  lockstep::Timing t;
-  t.rerequest_ms = s.lockstep.rerequest_ms;
-  t.stall_budget_s = s.lockstep.stall_budget_s;
-  t.handshake_timeout_s = s.lockstep.handshake_timeout_s;
-  t.pacing = {s.realtime.enabled, s.run.dt_s, s.realtime.max_consecutive_misses};
-  return t;
+lockstep::LockstepConfig LockstepOf(const scenario::Scenario& s) {
+  lockstep::LockstepConfig c = s.lockstep;
+  c.pacing = {s.realtime.enabled, s.run.dt_s, s.realtime.max_consecutive_misses};
+  return c;
+}
+
+lockstep::Wiring WiringOf(const scenario::Scenario& s) {
+  if (s.plant.kind == models::PlantKind::kIdeal) return lockstep::Wiring::Resolve({{"plant", lockstep::kIdealVariant}});
+  return lockstep::Wiring::Resolve();
 }
 
 lockstep::Faults FaultsOf(const scenario::Scenario& s, std::string_view role) {
@@ -62,20 +65,25 @@ OutputBytes EstimateOutputBytes(const scenario::Scenario& s) {
   return b;
 }
 
-bool PlantAnswersCommand(const scenario::Scenario& s) { return s.plant.kind != models::PlantKind::kIdeal; }
+std::unique_ptr<lockstep::Participant> MakeParticipant(std::string_view role, const scenario::Scenario& s,
+                                                       const lockstep::RunIdentity& id, lcm::LCM* lcm,
+                                                       const std::string& out_dir, lockstep::Faults faults,
+                                                       const lockstep::Wiring& wiring) {
+  if (role == "integrator") return std::make_unique<Integrator>(s, id, lcm, wiring, std::move(faults));
+  if (role == "controller") return std::make_unique<Controller>(s, id, lcm, wiring, std::move(faults));
+  if (role == "plant") return std::make_unique<Plant>(s, id, lcm, wiring, std::move(faults));
+  if (role == "semiactive") return std::make_unique<Semiactive>(s, id, lcm, wiring, std::move(faults));
+  if (role == "logger") {
+    return std::make_unique<Logger>(id, LockstepOf(s), lcm, wiring, out_dir + "/log.lcm", out_dir + "/signals.csv",
+                                    std::move(faults), s.run.csv_every);
+  }
+  throw Error("", fmt::format("unknown participant role '{}'", role));
+}
 
 std::unique_ptr<lockstep::Participant> MakeParticipant(std::string_view role, const scenario::Scenario& s,
                                                        const lockstep::RunIdentity& id, lcm::LCM* lcm,
                                                        const std::string& out_dir, lockstep::Faults faults) {
-  if (role == "integrator") return std::make_unique<Integrator>(s, id, lcm, std::move(faults));
-  if (role == "controller") return std::make_unique<Controller>(s, id, lcm, std::move(faults));
-  if (role == "plant") return std::make_unique<Plant>(s, id, lcm, std::move(faults));
-  if (role == "semiactive") return std::make_unique<Semiactive>(s, id, lcm, std::move(faults));
-  if (role == "logger") {
-    return std::make_unique<Logger>(id, TimingOf(s), lcm, out_dir + "/log.lcm", out_dir + "/signals.csv",
-                                    std::move(faults), s.run.csv_every, PlantAnswersCommand(s));
-  }
-  throw Error("", fmt::format("unknown participant role '{}'", role));
+  return MakeParticipant(role, s, id, lcm, out_dir, std::move(faults), WiringOf(s));
 }
 
 std::unique_ptr<lockstep::Participant> MakeParticipant(std::string_view role, const scenario::Scenario& s,
@@ -85,8 +93,10 @@ std::unique_ptr<lockstep::Participant> MakeParticipant(std::string_view role, co
 }
 
 void CheckBuildable(const scenario::Scenario& s) {
-  for (std::string_view role : {"integrator", "controller", "plant", "semiactive"}) {
-    MakeParticipant(role, s, IdentityOf(s, 1), nullptr, "", {});
+  const lockstep::Wiring wiring = WiringOf(s);
+  for (const lockstep::ResolvedRole& r : wiring.roles()) {
+    if (r.row->acks_barrier) continue;  // the logger: it would create the run's files
+    MakeParticipant(r.role(), s, IdentityOf(s, 1), nullptr, "", {}, wiring);
   }
 }
 
@@ -100,39 +110,90 @@ std::string OutcomePath(const std::string& out_dir, const std::string& role) {
 }
 /// Its space is reserved at start-up, so that a disk that fills up during the run cannot take it.
 constexpr std::size_t kOutcomeReserve = 8192;
-}  // namespace
 
-int RoleMain(std::string_view role, int argc, char** argv) {
-  const std::string name(role);
-  CLI::App app{fmt::format("rths-{}: the {} participant of a lockstep run (started by `rths run`)",
-                           name, name)};
+/// The command line of a participant process.
+struct RoleArgs {
   std::string scenario_path, url, out_dir = ".";
   std::int64_t run_id = 0;
-  app.add_option("--scenario", scenario_path, "scenario TOML file")->required();
-  app.add_option("--lcm-url", url, "LCM URL, e.g. udpm://239.255.76.67:7667?ttl=0")->required();
-  app.add_option("--run-id", run_id, "run id shared by every participant")->required();
-  app.add_option("--out", out_dir, "output folder (the logger's files; logs/<role>.json for everyone)");
   double handshake_timeout_s = 0;
-  app.add_option("--handshake-timeout-s", handshake_timeout_s,
+  bool follow = false;
+  double follow_idle_s = 2.0;
+  bool realtime = false;
+};
+
+/// Parses the command line of procs/<role>; -1 to go on, else the code to exit with.
+int ParseRoleArgs(const std::string& name, int argc, char** argv, RoleArgs* a) {
+  CLI::App app{fmt::format("rths-{}: the {} participant of a lockstep run (started by `rths run`)", name, name)};
+  app.add_option("--scenario", a->scenario_path, "scenario TOML file")->required();
+  app.add_option("--lcm-url", a->url, "LCM URL, e.g. udpm://239.255.76.67:7667?ttl=0")->required();
+  app.add_option("--run-id", a->run_id, "run id shared by every participant")->required();
+  app.add_option("--out", a->out_dir, "output folder (the logger's files; logs/<role>.json for everyone)");
+  app.add_option("--handshake-timeout-s", a->handshake_timeout_s,
                  "wait this long for the handshake instead of the scenario's lockstep.handshake_timeout_s "
                  "(rths run --external: time for the external participants to join) [s]")
       ->check(CLI::Range(0.1, 86400.0));
-  bool follow = false;
-  double follow_idle_s = 2.0;
-  app.add_flag("--follow", follow,
+  app.add_flag("--follow", a->follow,
                "follow mode: no handshake, no clock; answer each step as soon as its inputs arrive (fed by "
                "lcm-logplayer from a recorded log, with that log's --run-id; docs/replay.md). Delivery is not "
                "guaranteed: a lost input stops the answers there");
-  app.add_option("--follow-idle-s", follow_idle_s, "follow mode: finish after this long without a message [s]")
+  app.add_option("--follow-idle-s", a->follow_idle_s, "follow mode: finish after this long without a message [s]")
       ->check(CLI::Range(0.1, 3600.0))
       ->capture_default_str();
-  bool realtime = false;
-  app.add_flag("--realtime", realtime, "real-time paced mode, as if the scenario said [realtime] enabled = true");
+  app.add_flag("--realtime", a->realtime, "real-time paced mode, as if the scenario said [realtime] enabled = true");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     return app.exit(e) == 0 ? 0 : lockstep::kExitUsage;
   }
+  return -1;
+}
+
+/// Follow mode if asked, then the event loop on the participant's transport; its outcome in `*o`.
+template <class Transport>
+void RunParticipant(const RoleArgs& a, lockstep::Participant* p, Transport* transport, Outcome* o) {
+  if (a.follow) {
+    if (p->name() == lockstep::kClockRole) throw Error("--follow", "the integrator is the clock: it cannot follow");
+    p->Follow(a.follow_idle_s);
+  }
+  const int rc = lockstep::RunLoop(transport, {p}, &g_stop);
+  *o = OutcomeOf(*p, *o);
+  if (o->exit_code == 0) o->exit_code = rc;  // e.g. the receive failed
+}
+
+/// Builds the participant on the transport of `a.url` (one LCM instance, or a port per channel:
+/// this process then receives only its channels) and runs it.
+void RunOnTransport(std::string_view role, const scenario::Scenario& s, const RoleArgs& a, Outcome* o) {
+  auto more = [] {  // how to fix the host, if that is the reason
+    const std::string hint = lockstep::CheckMulticastRoute();
+    return hint.empty() ? hint : "\n" + hint;
+  };
+  if (lockstep::IsPortPerChannel(a.url)) {
+    lockstep::UdpmChannels channels(*lockstep::UdpmUrl::Parse(a.url));
+    auto p = MakeParticipant(role, s, IdentityOf(s, a.run_id), nullptr, a.out_dir);
+    std::string why = channels.error();
+    if (why.empty()) {
+      try {
+        p->Attach(&channels);
+      } catch (const std::runtime_error& e) {
+        why = e.what();
+      }
+    }
+    if (why.empty()) return RunParticipant(a, p.get(), static_cast<lockstep::Channels*>(&channels), o);
+    o->exit_code = lockstep::kExitLockstep;
+    o->message = fmt::format("cannot open the channels of {}: {}{}", a.url, why, more());
+  } else if (lcm::LCM lcm(a.url); !lcm.good()) {
+    o->exit_code = lockstep::kExitLockstep;
+    o->message = fmt::format("cannot open LCM at {}{}", a.url, more());
+  } else {
+    RunParticipant(a, MakeParticipant(role, s, IdentityOf(s, a.run_id), &lcm, a.out_dir).get(), &lcm, o);
+  }
+}
+}  // namespace
+
+int RoleMain(std::string_view role, int argc, char** argv) {
+  const std::string name(role);
+  RoleArgs a;
+  if (const int code = ParseRoleArgs(name, argc, argv, &a); code >= 0) return code;
   // A file grown past RLIMIT_FSIZE must fail the write (EFBIG), not kill the process.
   std::signal(SIGXFSZ, SIG_IGN);
   // SIGTERM (the supervisor's teardown) or SIGINT (Ctrl-C reaches the whole process group): stop
@@ -141,52 +202,17 @@ int RoleMain(std::string_view role, int argc, char** argv) {
   std::signal(SIGINT, OnStopSignal);
   Outcome o;
   o.role = name;
-  io::ReserveFile(OutcomePath(out_dir, name), kOutcomeReserve, "{}\n");
+  io::ReserveFile(OutcomePath(a.out_dir, name), kOutcomeReserve, "{}\n");
   try {
-    scenario::Scenario s = scenario::LoadScenario(scenario_path);
+    scenario::Scenario s = scenario::LoadScenario(a.scenario_path);
     // Not part of the handshake's identity (the hash is of the file): only how long to wait.
-    if (handshake_timeout_s > 0) s.lockstep.handshake_timeout_s = handshake_timeout_s;
-    if (realtime) s.realtime.enabled = true;  // pacing is not part of the identity either
+    if (a.handshake_timeout_s > 0) s.lockstep.handshake_timeout_s = a.handshake_timeout_s;
+    if (a.realtime) s.realtime.enabled = true;  // pacing is not part of the identity either
     if (s.realtime.enabled) {
       o.realtime_setup = lockstep::EnterRealtime(s.realtime.sched_fifo, s.realtime.priority, s.realtime.lock_memory);
       if (!o.realtime_setup.note.empty()) std::fprintf(stderr, "%s: %s\n", name.c_str(), o.realtime_setup.note.c_str());
     }
-    // Follow mode if asked, then the event loop on the participant's transport; its outcome.
-    auto run = [&](lockstep::Participant* p, auto* transport) {
-      if (follow) {
-        if (role == "integrator") throw Error("--follow", "the integrator is the clock: it cannot follow");
-        p->Follow(follow_idle_s);
-      }
-      const int rc = lockstep::RunLoop(transport, {p}, &g_stop);
-      o = OutcomeOf(*p, o);
-      if (o.exit_code == 0) o.exit_code = rc;  // e.g. the receive failed
-    };
-    if (lockstep::IsPortPerChannel(url)) {
-      // One UDP port per channel (lockstep/transport.h): this process receives only its channels.
-      lockstep::UdpmChannels channels(*lockstep::UdpmUrl::Parse(url));
-      auto p = MakeParticipant(role, s, IdentityOf(s, run_id), nullptr, out_dir);
-      std::string why = channels.error();
-      if (why.empty()) {
-        try {
-          p->Attach(&channels);
-        } catch (const std::runtime_error& e) {
-          why = e.what();
-        }
-      }
-      if (!why.empty()) {
-        const std::string hint = lockstep::CheckMulticastRoute();
-        o.exit_code = lockstep::kExitLockstep;
-        o.message = fmt::format("cannot open the channels of {}: {}{}{}", url, why, hint.empty() ? "" : "\n", hint);
-      } else {
-        run(p.get(), static_cast<lockstep::Channels*>(&channels));
-      }
-    } else if (lcm::LCM lcm(url); !lcm.good()) {
-      std::string hint = lockstep::CheckMulticastRoute();
-      o.exit_code = lockstep::kExitLockstep;
-      o.message = fmt::format("cannot open LCM at {}{}{}", url, hint.empty() ? "" : "\n", hint);
-    } else {
-      run(MakeParticipant(role, s, IdentityOf(s, run_id), &lcm, out_dir).get(), &lcm);
-    }
+    RunOnTransport(role, s, a, &o);
   } catch (const Error& e) {
     o.exit_code = lockstep::kExitUsage;
     o.message = e.what();
@@ -195,7 +221,7 @@ int RoleMain(std::string_view role, int argc, char** argv) {
     o.message = fmt::format("internal error: {}", e.what());
   }
   if (o.exit_code != 0) std::fprintf(stderr, "%s: %s\n", name.c_str(), o.message.c_str());
-  io::OverwriteFile(OutcomePath(out_dir, name), OutcomeToJson(o).dump(2) + "\n");
+  io::OverwriteFile(OutcomePath(a.out_dir, name), OutcomeToJson(o).dump(2) + "\n");
   return o.exit_code;
 }
 

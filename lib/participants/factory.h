@@ -5,31 +5,33 @@
 #include <string>
 #include <string_view>
 
-#include "lockstep/runtime.h"
+#include "lockstep/config.h"
+#include "lockstep/faults.h"
+#include "lockstep/participant.h"
+#include "lockstep/wiring.h"
 #include "scenario/scenario.h"
 
 namespace rths::participants {
 
-/// Role names in roster order: integrator (clock), controller, plant, semiactive, logger.
-inline constexpr std::string_view kRoles[] = {"integrator", "controller", "plant", "semiactive",
-                                              "logger"};
-
 /// What the handshake compares, from a loaded scenario.
 lockstep::RunIdentity IdentityOf(const scenario::Scenario& s, std::int64_t run_id);
-/// Lockstep knobs from the scenario's [lockstep] table.
-lockstep::Timing TimingOf(const scenario::Scenario& s);
+/// Lockstep knobs: the scenario's [lockstep] table, with the clock's pacing from [realtime].
+lockstep::LockstepConfig LockstepOf(const scenario::Scenario& s);
+/// The run's wiring (lockstep/wiring.h), checked: the step table with the plant's "ideal" row when
+/// plant.kind = "ideal" (it answers desired_t k with measured_t k). Throws rths::Error.
+lockstep::Wiring WiringOf(const scenario::Scenario& s);
 /// The faults of the scenario's [faults] table that `role` is subject to (the network faults
 /// apply to every participant, the process fault to its role only).
 lockstep::Faults FaultsOf(const scenario::Scenario& s, std::string_view role);
 
-/// True when the plant answers command_t k with measured_t k+1 (every plant but "ideal", which
-/// answers desired_t k with measured_t k). Then the logger acknowledges step k only once it also
-/// holds measured_t k+1, so that measured_t k+1 is always sent before desired_t k+1 (Logger).
-bool PlantAnswersCommand(const scenario::Scenario& s);
-
-/// Builds the participant `role` on `lcm`, subject to `faults`. The logger writes
-/// `out_dir`/log.lcm and `out_dir`/signals.csv. Throws rths::Error (unknown role, bad model,
-/// unwritable output).
+/// Builds the participant `role` on `lcm` (nullptr: attach it to a transport later), wired by
+/// `wiring`, subject to `faults`. The logger writes `out_dir`/log.lcm and `out_dir`/signals.csv.
+/// Throws rths::Error (unknown role, bad model, unwritable output).
+std::unique_ptr<lockstep::Participant> MakeParticipant(std::string_view role, const scenario::Scenario& s,
+                                                       const lockstep::RunIdentity& id, lcm::LCM* lcm,
+                                                       const std::string& out_dir, lockstep::Faults faults,
+                                                       const lockstep::Wiring& wiring);
+/// As above, with WiringOf(s).
 std::unique_ptr<lockstep::Participant> MakeParticipant(std::string_view role, const scenario::Scenario& s,
                                                        const lockstep::RunIdentity& id, lcm::LCM* lcm,
                                                        const std::string& out_dir, lockstep::Faults faults);
@@ -38,9 +40,9 @@ std::unique_ptr<lockstep::Participant> MakeParticipant(std::string_view role, co
                                                        const lockstep::RunIdentity& id, lcm::LCM* lcm,
                                                        const std::string& out_dir);
 
-/// Builds every participant but the logger once, off-line, and throws away: a scenario whose
-/// models cannot be built (a structure file with errors, a design that fails) is refused before
-/// any process starts. Throws rths::Error.
+/// Checks the run's wiring and builds every participant but the logger once, off-line, and throws
+/// away: a scenario whose models cannot be built (a structure file with errors, a design that
+/// fails) is refused before any process starts. Throws rths::Error.
 void CheckBuildable(const scenario::Scenario& s);
 
 /// What a run of `s` stores [bytes]: log.lcm (every step) and signals.csv (every run.csv_every-th

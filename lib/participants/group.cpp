@@ -7,6 +7,7 @@
 #include <fmt/core.h>
 
 #include "core/error.h"
+#include "lockstep/step_table.h"
 #include "lockstep/transport.h"
 #include "participants/factory.h"
 
@@ -132,7 +133,8 @@ std::vector<Outcome> RunGroupInProcess(const std::vector<scenario::Scenario>& pe
                                        std::int64_t run_id, const std::string& out_dir,
                                        const std::vector<RoleFault>& faults,
                                        const volatile std::sig_atomic_t* stop) {
-  if (per_role.size() != 1 && per_role.size() != std::size(kGroupOrder)) {
+  const auto& order = lockstep::kBuildOrder;  // the logger subscribes before anyone publishes
+  if (per_role.size() != 1 && per_role.size() != order.size()) {
     throw Error("RunGroupInProcess", "give one scenario, or one per role");
   }
   for (const auto& s : per_role) {
@@ -147,11 +149,11 @@ std::vector<Outcome> RunGroupInProcess(const std::vector<scenario::Scenario>& pe
   lockstep::InprocChannels bus;
   std::vector<std::unique_ptr<lockstep::Participant>> owned;
   std::vector<lockstep::Participant*> group;
-  for (std::size_t i = 0; i < std::size(kGroupOrder); ++i) {
+  for (std::size_t i = 0; i < order.size(); ++i) {
     const auto& s = per_role[per_role.size() == 1 ? 0 : i];
-    lockstep::Faults f = FaultsOf(s, kGroupOrder[i]);
+    lockstep::Faults f = FaultsOf(s, order[i]);
     for (const auto& extra : faults) {
-      if (extra.role != kGroupOrder[i]) continue;
+      if (extra.role != order[i]) continue;
       f.targeted.insert(f.targeted.end(), extra.faults.targeted.begin(), extra.faults.targeted.end());
       f.command_gain = extra.faults.command_gain;
       if (extra.faults.process != lockstep::ProcessFault::kNone) {
@@ -161,7 +163,7 @@ std::vector<Outcome> RunGroupInProcess(const std::vector<scenario::Scenario>& pe
       }
       if (extra.faults.network.any()) f.network = extra.faults.network;
     }
-    owned.push_back(MakeParticipant(kGroupOrder[i], s, IdentityOf(s, run_id), nullptr, out_dir, std::move(f)));
+    owned.push_back(MakeParticipant(order[i], s, IdentityOf(s, run_id), nullptr, out_dir, std::move(f)));
     owned.back()->Attach(&bus);
     group.push_back(owned.back().get());
   }

@@ -3,20 +3,20 @@
 /// `rths run --transport memq` does, and what the reproduction studies and tests use to run
 /// many groups side by side (each group has its own instance, so they cannot cross-talk).
 /// Also how a run's outcomes are judged: who is to blame when it fails.
+#include <csignal>
 #include <string>
 #include <string_view>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
-#include "lockstep/runtime.h"
+#include "lockstep/faults.h"
+#include "lockstep/link_stats.h"
+#include "lockstep/participant.h"
+#include "lockstep/realtime.h"
 #include "scenario/scenario.h"
 
 namespace rths::participants {
-
-/// Order the group is built in: the logger subscribes before anyone publishes.
-inline constexpr std::string_view kGroupOrder[] = {"logger", "plant", "controller", "semiactive",
-                                                   "integrator"};
 
 /// Test-only faults for one role, on top of the scenario's [faults] (targeted faults, a
 /// controller sign error).
@@ -59,7 +59,7 @@ Outcome OutcomeFromJson(const nlohmann::json& j);
 nlohmann::json StatsToJson(const lockstep::LinkStats& s);
 
 /// Runs a whole group on memq://; `out_dir` receives log.lcm and signals.csv. `per_role` holds
-/// one scenario for every role, or five, in kGroupOrder (tests give one role another file).
+/// one scenario for every role, or five, in lockstep::kBuildOrder (tests give one role another file).
 /// Throws rths::Error if a participant cannot be built (bad model, unwritable output) or the
 /// scenario asks for a process fault that would take this whole process down (crash, kill, stop).
 /// `stop` (optional): set it (from a signal handler) to interrupt the run.

@@ -12,51 +12,39 @@
 namespace rths::participants {
 
 namespace {
-std::string FolderOf(const std::string& path) {
-  return std::filesystem::path(path).parent_path().string();
+/// The scenario's numerical substructure, its histories read for `n` steps.
+models::NumericalSubstructure MakeSubstructure(const scenario::Scenario& s, std::size_t n) {
+  const std::string dir = std::filesystem::path(s.path).parent_path().string();
+  if (s.structure.mode == models::StructureMode::kPredefined) {
+    return models::NumericalSubstructure::Predefined(signal::MakeSignal(s.structure.desired, s.run.dt_s, n, dir));
+  }
+  auto m = models::NumericalSubstructure::Integrated(models::StructureFromScenario(s.structure, s.path), s.run.dt_s, {});
+  m.ground_mm_s2 = signal::MakeSignal(s.structure.ground, s.run.dt_s, n, dir);  // after the structure's checks
+  return m;
 }
 }  // namespace
 
 Integrator::Integrator(const scenario::Scenario& s, lockstep::RunIdentity id, lcm::LCM* lcm,
-                       lockstep::Faults faults)
-    : ClockParticipant("integrator", id, TimingOf(s), lcm, std::move(faults)),
-      predefined_(s.structure.mode == models::StructureMode::kPredefined),
+                       const lockstep::Wiring& wiring, lockstep::Faults faults)
+    : ClockParticipant("integrator", id, LockstepOf(s), lcm, wiring, std::move(faults)),
       dt_s_(s.run.dt_s),
+      substructure_(MakeSubstructure(s, static_cast<std::size_t>(id.n_steps))),
+      state_(models::MakeState(substructure_)),
       safety_(s.safety, s.run.dt_s) {
-  SetBarrierIncludesNextMeasured(PlantAnswersCommand(s));
-  const auto n = static_cast<std::size_t>(id.n_steps);
-  const std::string dir = FolderOf(s.path);
-  if (predefined_) {
-    r_mm_ = signal::MakeSignal(s.structure.desired, dt_s_, n, dir);
-    if (s.structure.derivatives == models::Derivatives::kCentral) central_ = control::CentralDerivatives(r_mm_, dt_s_);
-    state_.x = Eigen::VectorXd::Zero(1);
-    state_.abs_acc_prev = Eigen::VectorXd::Zero(1);
-  } else {
-    const models::LinearStructure structure = models::StructureFromScenario(s.structure, s.path);
-    cd_ = models::CentralDifference::Make(structure, dt_s_);
-    state_ = models::MakeState(*cd_);
-    dof_ = structure.actuator_dof;
-    ground_mm_s2_ = signal::MakeSignal(s.structure.ground, dt_s_, n, dir);
+  if (substructure_.predefined() && s.structure.derivatives == models::Derivatives::kCentral) {
+    central_ = control::CentralDerivatives(substructure_.r_mm, dt_s_);
   }
 }
 
 void Integrator::ComputeDesired(std::int64_t k, const rths::measured_t* measured_prev,
                                 rths::desired_t* out) {
-  double r = 0.0, ground = 0.0;
-  if (predefined_) {
-    r = r_mm_[k];
-    state_.x[0] = r;
-  } else {
-    if (k > 0) {
-      if (!measured_prev) throw Error("integrator", "measured_t of the previous step is missing");
-      // x_k from x_{k-1}, x_{k-2}, a_g,k-1 and the force measured at k-1 (Eq. 1 with Eqs. 2-3).
-      models::Advance(*cd_, &state_, ground_mm_s2_[k - 1], measured_prev->f_kN);
-    }
-    r = state_.x[dof_];
-    ground = ground_mm_s2_[k];
-  }
+  const bool predefined = substructure_.predefined();
+  if (!predefined && k > 0 && !measured_prev) throw Error("integrator", "measured_t of the previous step is missing");
+  // x_k from x_{k-1}, x_{k-2}, a_g,k-1 and the force measured at k-1 (Eq. 1 with Eqs. 2-3).
+  const double r = models::Step(substructure_, &state_, k, k > 0 && measured_prev ? measured_prev->f_kN : 0.0);
+  const double ground = models::GroundAt(substructure_, k);
   control::Derivatives d = control::StepDerivatives(&extrapolation_, r, dt_s_);
-  if (central_) d = central_->At(r_mm_, static_cast<std::size_t>(k));
+  if (central_) d = central_->At(substructure_.r_mm, static_cast<std::size_t>(k));
 
   out->r_mm = r;
   out->rd_mm_s = d.rd;
@@ -73,7 +61,7 @@ void Integrator::ComputeDesired(std::int64_t k, const rths::measured_t* measured
   }
   for (int j = 0; j < n; ++j) {
     out->x_mm[j] = state_.x[j];
-    out->abs_acc_mm_s2[j] = (predefined_ || k == 0) ? 0.0 : state_.abs_acc_prev[j];
+    out->abs_acc_mm_s2[j] = (predefined || k == 0) ? 0.0 : state_.abs_acc_prev[j];
   }
 }
 

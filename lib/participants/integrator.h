@@ -8,13 +8,14 @@
 /// r'_k, r''_k, r'''_k by Eqs. 20-22 from the r sequence (identical to the central-difference
 /// accelerations), the structure's displacements x_k and absolute accelerations at k-1.
 /// In "predefined" mode r_k is read from a history (BLWN or file); derivatives by Eqs. 20-22
-/// or, offline, by non-causal central differences of the known record.
+/// or, offline, by non-causal central differences of the known record. The integration itself is
+/// models::NumericalSubstructure; this participant wires it to the lockstep clock.
 #include <optional>
 #include <vector>
 
 #include "control/feedforward.h"
 #include "lockstep/clock.h"
-#include "models/structure.h"
+#include "models/numerical_substructure.h"
 #include "safety/monitor.h"
 #include "scenario/scenario.h"
 
@@ -22,7 +23,9 @@ namespace rths::participants {
 
 class Integrator final : public lockstep::ClockParticipant {
  public:
-  Integrator(const scenario::Scenario& s, lockstep::RunIdentity id, lcm::LCM* lcm, lockstep::Faults faults = {});
+  /// `wiring`: the run's (WiringOf(s), or a replay's): the barrier the clock waits for.
+  Integrator(const scenario::Scenario& s, lockstep::RunIdentity id, lcm::LCM* lcm, const lockstep::Wiring& wiring,
+             lockstep::Faults faults = {});
 
  protected:
   void ComputeDesired(std::int64_t k, const rths::measured_t* measured_prev,
@@ -33,13 +36,9 @@ class Integrator final : public lockstep::ClockParticipant {
                                   const rths::command_t& command) override;
 
  private:
-  const bool predefined_;
   const double dt_s_;
-  std::optional<models::CentralDifference> cd_;
+  const models::NumericalSubstructure substructure_;
   models::StructureState state_;
-  int dof_ = 0;
-  std::vector<double> ground_mm_s2_;  ///< a_g,k for every step (rths mode)
-  std::vector<double> r_mm_;          ///< r_k for every step (predefined mode)
   std::optional<control::DerivativeRecords> central_;  ///< offline derivatives, if chosen
   control::ExtrapolationState extrapolation_{};
   safety::Monitor safety_;

@@ -43,13 +43,13 @@ std::int64_t LogBytesPerStep(int n_dof) {
   return events;
 }
 
-Logger::Logger(lockstep::RunIdentity id, lockstep::Timing timing, lcm::LCM* lcm, const std::string& log_path,
-               const std::string& csv_path, lockstep::Faults faults, int csv_every, bool ack_after_next_measured)
-    : Participant("logger", std::move(id), timing, lcm, std::move(faults)),
+Logger::Logger(lockstep::RunIdentity id, lockstep::LockstepConfig config, lcm::LCM* lcm,
+               const lockstep::Wiring& wiring, const std::string& log_path, const std::string& csv_path,
+               lockstep::Faults faults, int csv_every)
+    : StepAnswerer("logger", std::move(id), config, lcm, std::move(faults), wiring.Of("logger")),
       log_path_(log_path),
       csv_path_(csv_path),
-      csv_every_(csv_every),
-      ack_after_next_measured_(ack_after_next_measured) {
+      csv_every_(csv_every) {
   if (csv_every_ < 0) throw Error(csv_path_, fmt::format("csv_every = {}: must be >= 0", csv_every_));
   log_fd_ = CreateFile(log_path_, "event log");
   try {
@@ -76,24 +76,6 @@ Logger::Logger(lockstep::RunIdentity id, lockstep::Timing timing, lcm::LCM* lcm,
       throw Error(csv_path_, why);
     }
   }
-  SetAnswerChannel(lockstep::kAck, &ack_cache_);
-  // What wakes the logger (docs/lockstep.md, "Wake-ups"): desired_t k and measured_t k are sent
-  // before command_t k (the controller needs both), so command_t and current_t; when step k also
-  // waits for measured_t k+1, which the plant sends after both, that one alone.
-  using lockstep::Wake;
-  const Wake answers = ack_after_next_measured_ ? Wake::kLater : Wake::kOnArrival;
-  Subscribe(lockstep::kChDesired, [this](const lcm::ReceiveBuffer* rbuf) {
-    OnStepMessage(&desired_, &raw_desired_, lockstep::kDesired, rbuf);
-  }, Wake::kLater);
-  Subscribe(lockstep::kChCommand, [this](const lcm::ReceiveBuffer* rbuf) {
-    OnStepMessage(&command_, &raw_command_, lockstep::kCommand, rbuf);
-  }, answers);
-  Subscribe(lockstep::kChMeasured, [this](const lcm::ReceiveBuffer* rbuf) {
-    OnStepMessage(&measured_, &raw_measured_, lockstep::kMeasured, rbuf);
-  }, ack_after_next_measured_ ? Wake::kOnArrival : Wake::kLater);
-  Subscribe(lockstep::kChCurrent, [this](const lcm::ReceiveBuffer* rbuf) {
-    OnStepMessage(&current_, &raw_current_, lockstep::kCurrent, rbuf);
-  }, answers);
 }
 
 Logger::~Logger() {
@@ -181,21 +163,22 @@ std::string Logger::OnDone() { return CloseCsv(); }  // every step is in log.lcm
 
 void Logger::OnStop() { CloseCsv(); }
 
-template <class Msg>
-void Logger::OnStepMessage(lockstep::StepMailbox<Msg>* box, RawRing* raw, lockstep::Channel channel,
-                           const lcm::ReceiveBuffer* rbuf) {
-  if (finished()) return;
-  if (Receive(box, channel, rbuf) != lockstep::Put::kNew) return;
-  lockstep::Bytes& slot = (*raw)[box->last_k() % 4];
+void Logger::OnInput(lockstep::Channel channel, std::int64_t k, const lcm::ReceiveBuffer* rbuf) {
+  RawRing* raw = channel == lockstep::kDesired    ? &raw_desired_
+                 : channel == lockstep::kCommand  ? &raw_command_
+                 : channel == lockstep::kMeasured ? &raw_measured_
+                 : channel == lockstep::kCurrent  ? &raw_current_
+                                                  : nullptr;
+  if (!raw) return;
+  lockstep::Bytes& slot = (*raw)[k % 4];
   const auto* data = static_cast<const std::uint8_t*>(rbuf->data);
   slot.assign(data, data + rbuf->data_size);  // reuses its capacity after the first steps
-  Guarded(box->last_k(), [&] { TryAck(); });
 }
 
 void Logger::OnHandshakeSeen(const lcm::ReceiveBuffer* rbuf, const rths::handshake_t& msg) {
   if (finished() || !handshakes_logged_.emplace(msg.participant, msg.phase).second) return;
   step_bytes_.clear();
-  const std::int64_t utime = start_utime_ < 0 ? rbuf->recv_utime : StepUtime(next_);
+  const std::int64_t utime = start_utime_ < 0 ? rbuf->recv_utime : StepUtime(next_step());
   io::AppendEvent(&step_bytes_, event_number_, utime, lockstep::kChHandshake, rbuf->data,
                   rbuf->data_size);
   if (const std::string why = Append(log_fd_, log_path_, step_bytes_.data(), step_bytes_.size(), &log_end_);
@@ -210,38 +193,24 @@ void Logger::OnHandshakeSeen(const lcm::ReceiveBuffer* rbuf, const rths::handsha
 void Logger::OnGo() {
   const auto now = std::chrono::system_clock::now().time_since_epoch();
   start_utime_ = std::chrono::duration_cast<std::chrono::microseconds>(now).count();
+  StepAnswerer::OnGo();
 }
 
 std::int64_t Logger::StepUtime(std::int64_t k) const {
   return start_utime_ + std::llround(static_cast<double>(k) * id_.dt_s * 1e6);
 }
 
-void Logger::ListMissing(std::int64_t k, lockstep::WantList* out) const {
-  if (next_ > k) return;
-  if (!desired_.Get(next_)) out->Add(lockstep::kDesired, next_);
-  if (!command_.Get(next_)) out->Add(lockstep::kCommand, next_);
-  if (!measured_.Get(next_)) out->Add(lockstep::kMeasured, next_);
-  if (!current_.Get(next_)) out->Add(lockstep::kCurrent, next_);
-  if (WaitsForNextMeasured(next_) && !measured_.Get(next_ + 1)) out->Add(lockstep::kMeasured, next_ + 1);
+bool Logger::Compute(std::int64_t k, const lockstep::StepInputs& in, rths::ack_t* out) {
+  if (!WriteStep(k, in)) return false;
+  out->participant = name_;
+  return true;
 }
 
-void Logger::TryAck() {
-  while (running() && next_ < id_.n_steps && !Stalled(next_)) {
-    const std::int64_t k = next_;
-    if (written_ == k && !WriteStep(k)) return;
-    // Written; acknowledged once measured_t k+1 is in too, where the plant answers command_t.
-    if (WaitsForNextMeasured(k) && !measured_.Get(k + 1)) return;
-    Acknowledge(k);
-  }
-}
-
-bool Logger::WriteStep(std::int64_t k) {
-  const rths::desired_t* d = desired_.Get(k);
-  const rths::command_t* c = command_.Get(k);
-  const rths::measured_t* m = measured_.Get(k);
-  const rths::current_t* i = current_.Get(k);
-  if (!d || !c || !m || !i) return false;
-  MaybeFault(k);
+bool Logger::WriteStep(std::int64_t k, const lockstep::StepInputs& in) {
+  const rths::desired_t* d = in.desired;
+  const rths::command_t* c = in.command;
+  const rths::measured_t* m = in.measured;
+  const rths::current_t* i = in.current;
   // The four events of step k in channel order, one write.
   step_bytes_.clear();
   const std::size_t slot = static_cast<std::size_t>(k % 4);
@@ -277,14 +246,6 @@ bool Logger::WriteStep(std::int64_t k) {
   log_acked_ = log_end_;
   ++written_;
   return true;
-}
-
-void Logger::Acknowledge(std::int64_t k) {
-  ack_.run_id = id_.run_id;
-  ack_.k = k;
-  ack_.participant = name_;
-  Answer(lockstep::kChAck, &ack_cache_, k, ack_);
-  ++next_;
 }
 
 }  // namespace rths::participants

@@ -6,9 +6,9 @@
 ///   desired_t k, command_t k, measured_t k, current_t k (+ measured_t k+1)  ->  ack_t k
 /// The first copy of every (channel, k) is kept; re-sent duplicates are ignored. Once all four
 /// messages of step k are in, they are appended to log.lcm (a standard LCM event log, readable by
-/// lcm-logplayer and lcm-spy) in channel order with one pwrite(2), and only then, and once
-/// measured_t k+1 is in too where the plant answers command_t k (ack_after_next_measured), is
-/// ack_t k published: the clock cannot advance past a step the logger has not handed to the kernel. The
+/// lcm-logplayer and lcm-spy) in channel order with one pwrite(2), and only then, and once the
+/// rest of the barrier of step k is in too (measured_t k+1 where the plant answers command_t k: the
+/// logger's row of the step table, lockstep/step_table.h), is ack_t k published: the clock cannot advance past a step the logger has not handed to the kernel. The
 /// handshake is logged on its own channel as it arrives (first copy per participant and phase).
 ///
 /// signals.csv is a derived copy of the log (every column comes from the four messages), so its
@@ -34,12 +34,9 @@
 #include <string>
 #include <utility>
 
-#include "lockstep/runtime.h"
+#include "lockstep/step_participant.h"
 #include "rths/ack_t.hpp"
-#include "rths/command_t.hpp"
-#include "rths/current_t.hpp"
-#include "rths/desired_t.hpp"
-#include "rths/measured_t.hpp"
+#include "rths/handshake_t.hpp"
 
 namespace rths::participants {
 
@@ -51,19 +48,17 @@ std::int64_t StoredBytesPerStep(int n_dof);
 /// divided by this is about the steps written (progress displays).
 std::int64_t LogBytesPerStep(int n_dof);
 
-class Logger : public lockstep::Participant {
+class Logger : public lockstep::StepAnswerer<rths::ack_t> {
  public:
   /// Creates `log_path` (LCM event log) and `csv_path` (signals: a row for every `csv_every`-th
   /// step, k = 0, N, 2N, ...; csv_every = 0: no CSV file at all; scenario key run.csv_every);
-  /// throws rths::Error. `ack_after_next_measured`: step k is written and acknowledged only once
-  /// measured_t k+1 is in as well (but for the last step), for a plant that answers command_t k
-  /// with measured_t k+1 (PlantAnswersCommand): the clock then sends desired_t k+1 after
-  /// measured_t k+1 in every run, so the controller and the semiactive law wake once per step,
-  /// for desired_t (docs/lockstep.md, "Wake-ups"). Never for a plant whose measured_t k+1 needs
-  /// desired_t k+1 (the "ideal" plant, a replayed one): that would wait forever.
-  Logger(lockstep::RunIdentity id, lockstep::Timing timing, lcm::LCM* lcm, const std::string& log_path,
-         const std::string& csv_path, lockstep::Faults faults = {}, int csv_every = 1,
-         bool ack_after_next_measured = false);
+  /// throws rths::Error. `wiring`: the run's (WiringOf(s), or a replay's): step k is written as
+  /// soon as its four messages are in, and acknowledged once everything else the barrier of step k
+  /// waits for is in as well (measured_t k+1 where the plant answers command_t k): the clock then
+  /// sends desired_t k+1 after measured_t k+1 in every run, so the controller and the semiactive
+  /// law wake once per step, for desired_t (docs/lockstep.md, "Wake-ups").
+  Logger(lockstep::RunIdentity id, lockstep::LockstepConfig config, lcm::LCM* lcm, const lockstep::Wiring& wiring,
+         const std::string& log_path, const std::string& csv_path, lockstep::Faults faults = {}, int csv_every = 1);
   ~Logger() override;
 
   /// Bytes of signals.csv rows buffered before one write (and reserved ahead on disk).
@@ -79,7 +74,10 @@ class Logger : public lockstep::Participant {
   std::string OnDone() override;  // writes the buffered rows of signals.csv
   void OnStop() override;         // the same, on an abnormal stop
   void OnGo() override;
-  void ListMissing(std::int64_t k, lockstep::WantList* out) const override;
+  /// Writes step k (log.lcm and its signals.csv row); the ack follows once the barrier is in.
+  bool Compute(std::int64_t k, const lockstep::StepInputs& in, rths::ack_t* out) override;
+  /// Keeps the raw bytes of the four logged channels (what is written to the log).
+  void OnInput(lockstep::Channel channel, std::int64_t k, const lcm::ReceiveBuffer* rbuf) override;
 
  private:
   /// Timestamp of the events of step k [us since the epoch]: start + k dt.
@@ -87,18 +85,10 @@ class Logger : public lockstep::Participant {
   /// The raw bytes of one channel's messages of the last four steps (what is written to the log).
   using RawRing = std::array<lockstep::Bytes, 4>;
 
-  template <class Msg>
-  void OnStepMessage(lockstep::StepMailbox<Msg>* box, RawRing* raw, lockstep::Channel channel,
-                     const lcm::ReceiveBuffer* rbuf);
   void OnHandshakeSeen(const lcm::ReceiveBuffer* rbuf, const rths::handshake_t& msg) override;
-  void TryAck();
-  /// Writes step k (log.lcm and its signals.csv row) if its four messages are in; false if they
-  /// are not, or the write failed (the run is then stopped).
-  bool WriteStep(std::int64_t k);
-  /// Step k waits for measured_t k+1 too (ack_after_next_measured, but for the last step).
-  bool WaitsForNextMeasured(std::int64_t k) const { return ack_after_next_measured_ && k + 1 < id_.n_steps; }
-  /// Publishes ack_t k (step k is stored) and moves on to k + 1.
-  void Acknowledge(std::int64_t k);
+  /// Writes step k (log.lcm and its signals.csv row) from its four messages; false if the write
+  /// failed (the run is then stopped).
+  bool WriteStep(std::int64_t k, const lockstep::StepInputs& in);
   /// Appends `bytes` to the file `fd` (every byte, or none: on failure the file is cut back to
   /// `*good_end`); advances `*good_end`. Returns "" or the error, naming the file.
   std::string Append(int fd, const std::string& path, const std::uint8_t* data, std::size_t size,
@@ -116,7 +106,6 @@ class Logger : public lockstep::Participant {
 
   std::string log_path_, csv_path_;
   int csv_every_ = 1;  ///< signals.csv row every this many steps; 0: no signals.csv
-  bool ack_after_next_measured_ = false;  ///< step k also waits for measured_t k+1
   int log_fd_ = -1, csv_fd_ = -1;
   std::int64_t log_end_ = 0, csv_end_ = 0;      ///< bytes written, each ending on a whole event / row
   std::int64_t log_acked_ = 0;                  ///< log bytes at the end of the last written step
@@ -127,16 +116,9 @@ class Logger : public lockstep::Participant {
   std::int64_t write_calls_ = 0;
   std::int64_t event_number_ = 0;
   std::int64_t start_utime_ = -1;  ///< wall-clock time of GO [us since the epoch]; -1 before
-  std::int64_t next_ = 0;     ///< next step to acknowledge
-  std::int64_t written_ = 0;  ///< steps written: next_ or next_ + 1
-  lockstep::StepMailbox<rths::desired_t> desired_;
-  lockstep::StepMailbox<rths::command_t> command_;
-  lockstep::StepMailbox<rths::measured_t> measured_;
-  lockstep::StepMailbox<rths::current_t> current_;
+  std::int64_t written_ = 0;  ///< steps written: the next to acknowledge, or one more
   RawRing raw_desired_{}, raw_command_{}, raw_measured_{}, raw_current_{};
   lockstep::Bytes step_bytes_;  ///< the step's four events, written at once
-  lockstep::AnswerCache ack_cache_;
-  rths::ack_t ack_{};
   rths::handshake_t hs_{};
   std::set<std::pair<std::string, int>> handshakes_logged_;
 };

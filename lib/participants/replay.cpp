@@ -9,7 +9,8 @@
 #include "lockstep/clock.h"
 #include "lockstep/transport.h"
 #include "participants/factory.h"
-#include "participants/logger.h"
+#include "lockstep/step_participant.h"
+#include "lockstep/step_table.h"
 
 namespace rths::participants {
 
@@ -18,9 +19,9 @@ namespace {
 /// The clock, issuing the recorded desired_t of every step.
 class RecordedClock final : public lockstep::ClockParticipant {
  public:
-  RecordedClock(const std::vector<rths::desired_t>* record, lockstep::RunIdentity id, lockstep::Timing timing,
-                lcm::LCM* lcm)
-      : ClockParticipant("integrator", std::move(id), timing, lcm), record_(record) {}
+  RecordedClock(const std::vector<rths::desired_t>* record, lockstep::RunIdentity id,
+                lockstep::LockstepConfig config, const lockstep::Wiring& wiring)
+      : ClockParticipant("integrator", std::move(id), config, nullptr, wiring), record_(record) {}
 
  protected:
   void ComputeDesired(std::int64_t k, const rths::measured_t*, rths::desired_t* out) override {
@@ -32,41 +33,23 @@ class RecordedClock final : public lockstep::ClockParticipant {
 };
 
 /// A controller, plant or semiactive that answers step k with its recorded message, once the
-/// clock has requested step k (desired_t k arrived).
+/// clock has requested step k (desired_t k arrived): the role's "recorded" row of the step table.
 template <class Msg>
-class RecordedAnswer final : public lockstep::Participant {
+class RecordedAnswer final : public lockstep::StepAnswerer<Msg> {
  public:
-  RecordedAnswer(std::string role, const std::vector<Msg>* record, lockstep::RunIdentity id, lockstep::Timing timing,
-                 lcm::LCM* lcm, const char* channel, lockstep::Channel code)
-      : Participant(std::move(role), std::move(id), timing, lcm), record_(record), channel_(channel) {
-    SetAnswerChannel(code, &cache_);
-    Subscribe(lockstep::kChDesired, [this](const lcm::ReceiveBuffer* rbuf) {
-      if (!finished() && Receive(&desired_, lockstep::kDesired, rbuf) == lockstep::Put::kNew) TryStep();
-    });
-  }
+  RecordedAnswer(std::string_view role, const std::vector<Msg>* record, lockstep::RunIdentity id,
+                 lockstep::LockstepConfig config, const lockstep::Wiring& wiring)
+      : lockstep::StepAnswerer<Msg>(std::string(role), std::move(id), config, nullptr, {}, wiring.Of(role)),
+        record_(record) {}
 
  protected:
-  void ListMissing(std::int64_t k, lockstep::WantList* out) const override {
-    if (next_ <= k && !desired_.Get(next_)) out->Add(lockstep::kDesired, next_);
+  bool Compute(std::int64_t k, const lockstep::StepInputs&, Msg* out) override {
+    *out = (*record_)[static_cast<std::size_t>(k)];
+    return true;
   }
 
  private:
-  void TryStep() {
-    while (running() && next_ < id_.n_steps && desired_.Get(next_)) {
-      answer_ = (*record_)[static_cast<std::size_t>(next_)];
-      answer_.run_id = id_.run_id;
-      answer_.k = next_;
-      Answer(channel_, &cache_, next_, answer_);
-      ++next_;
-    }
-  }
-
   const std::vector<Msg>* record_;
-  const char* const channel_;
-  lockstep::StepMailbox<rths::desired_t> desired_;
-  lockstep::AnswerCache cache_;
-  Msg answer_{};
-  std::int64_t next_ = 0;
 };
 
 bool IsLive(const std::vector<std::string>& live, std::string_view role) {
@@ -76,10 +59,13 @@ bool IsLive(const std::vector<std::string>& live, std::string_view role) {
 }  // namespace
 
 const char* AnswerChannelOf(std::string_view role) {
-  for (const auto& r : lockstep::kRoster) {
-    if (role == r.name && role != "logger") return r.channel;
+  std::string roles;  // the roles a replay can take live: all but the logger
+  for (const lockstep::RoleRow& r : lockstep::kStepTable) {
+    if (!r.variant.empty() || r.acks_barrier) continue;
+    if (role == r.role) return lockstep::ChannelName(r.answer);
+    roles += (roles.empty() ? "" : ", ") + std::string(r.role);
   }
-  throw Error("replay", fmt::format("unknown role '{}' (live roles: integrator, controller, plant, semiactive)", role));
+  throw Error("replay", fmt::format("unknown role '{}' (live roles: {})", role, roles));
 }
 
 std::vector<Outcome> RunReplay(const scenario::Scenario& s, const io::RunLog& record, std::int64_t steps,
@@ -93,31 +79,30 @@ std::vector<Outcome> RunReplay(const scenario::Scenario& s, const io::RunLog& re
   lockstep::InprocChannels bus;
   lockstep::RunIdentity id = IdentityOf(s, run_id);
   id.n_steps = steps;
-  const lockstep::Timing timing = TimingOf(s);
+  const lockstep::LockstepConfig config = LockstepOf(s);
+  // The roles not live answer from the record: their "recorded" rows (the integrator's is its own).
+  lockstep::Wiring wiring = WiringOf(s);
+  std::vector<lockstep::RoleVariant> variants;
+  for (const lockstep::ResolvedRole& r : wiring.roles()) {
+    if (!IsLive(live, r.role()) && !r.row->clock) {
+      variants.push_back({r.role(), lockstep::kRecordedVariant});
+    } else if (!r.row->variant.empty()) {
+      variants.push_back({r.role(), r.row->variant});
+    }
+  }
+  wiring = lockstep::Wiring::Resolve(variants);
   std::vector<std::unique_ptr<lockstep::Participant>> owned;
-  for (std::string_view role : kGroupOrder) {
-    if (role == "logger") {
-      // A recorded plant answers desired_t k with measured_t k: the logger must not wait for
-      // measured_t k+1 (Logger, ack_after_next_measured).
-      owned.push_back(std::make_unique<Logger>(id, timing, nullptr, out_dir + "/log.lcm", out_dir + "/signals.csv",
-                                               lockstep::Faults{}, s.run.csv_every, false));
-    } else if (IsLive(live, role)) {
-      owned.push_back(MakeParticipant(role, s, id, nullptr, out_dir, {}));
-      if (role == "integrator" && !IsLive(live, "plant")) {
-        // The recorded plant answers desired_t k with measured_t k: no measured_t k+1 in the barrier.
-        static_cast<lockstep::ClockParticipant*>(owned.back().get())->SetBarrierIncludesNextMeasured(false);
-      }
+  for (std::string_view role : lockstep::kBuildOrder) {
+    if (IsLive(live, role)) {
+      owned.push_back(MakeParticipant(role, s, id, nullptr, out_dir, {}, wiring));
     } else if (role == "integrator") {
-      owned.push_back(std::make_unique<RecordedClock>(&record.desired, id, timing, nullptr));
+      owned.push_back(std::make_unique<RecordedClock>(&record.desired, id, config, wiring));
     } else if (role == "controller") {
-      owned.push_back(std::make_unique<RecordedAnswer<rths::command_t>>(
-          "controller", &record.command, id, timing, nullptr, lockstep::kChCommand, lockstep::kCommand));
+      owned.push_back(std::make_unique<RecordedAnswer<rths::command_t>>(role, &record.command, id, config, wiring));
     } else if (role == "plant") {
-      owned.push_back(std::make_unique<RecordedAnswer<rths::measured_t>>(
-          "plant", &record.measured, id, timing, nullptr, lockstep::kChMeasured, lockstep::kMeasured));
+      owned.push_back(std::make_unique<RecordedAnswer<rths::measured_t>>(role, &record.measured, id, config, wiring));
     } else {
-      owned.push_back(std::make_unique<RecordedAnswer<rths::current_t>>(
-          "semiactive", &record.current, id, timing, nullptr, lockstep::kChCurrent, lockstep::kCurrent));
+      owned.push_back(std::make_unique<RecordedAnswer<rths::current_t>>(role, &record.current, id, config, wiring));
     }
   }
   std::vector<lockstep::Participant*> group;

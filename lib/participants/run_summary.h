@@ -10,7 +10,8 @@
 #include <nlohmann/json.hpp>
 
 #include "io/run_log.h"
-#include "lockstep/runtime.h"
+#include "lockstep/exit_code.h"
+#include "lockstep/link_stats.h"
 #include "participants/group.h"
 #include "scenario/scenario.h"
 #include "signal/benchmark_criteria.h"

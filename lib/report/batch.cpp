@@ -13,7 +13,8 @@
 
 #include "core/error.h"
 #include "io/run_log.h"
-#include "lockstep/runtime.h"
+#include "lockstep/exit_code.h"
+#include "lockstep/protocol.h"
 #include "participants/factory.h"
 #include "participants/group.h"
 #include "participants/run_summary.h"

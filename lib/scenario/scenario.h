@@ -12,9 +12,9 @@
 
 #include "control/clipped_optimal.h"
 #include "control/controller_config.h"
+#include "lockstep/config.h"
 #include "lockstep/faults.h"
 #include "lockstep/realtime.h"
-#include "lockstep/runtime.h"
 #include "models/rig.h"
 #include "models/structure_file.h"
 #include "safety/monitor.h"

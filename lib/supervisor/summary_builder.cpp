@@ -2,7 +2,7 @@
 
 #include <fmt/format.h>
 
-#include "lockstep/runtime.h"
+#include "lockstep/exit_code.h"
 #include "supervisor/realtime_figures.h"
 
 namespace rths::supervisor {

@@ -8,7 +8,8 @@
 #include <fmt/format.h>
 #include <lcm/lcm-cpp.hpp>
 
-#include "lockstep/runtime.h"
+#include "lockstep/protocol.h"
+#include "lockstep/transport.h"
 #include "lockstep/transport.h"
 
 namespace rths::supervisor {

@@ -1,22 +1,17 @@
-#include "lockstep/runtime.h"
-
-#include "lockstep/transport.h"
+#include "lockstep/participant.h"
 
 #include <signal.h>
-#include <time.h>
 #include <sys/types.h>
 #include <unistd.h>
 
 #include <algorithm>
-#include <cerrno>
-#include <cstdio>
 #include <cstdlib>
-#include <fstream>
-#include <random>
-#include <sstream>
 #include <stdexcept>
 
 #include <fmt/core.h>
+
+#include "lockstep/step_table.h"
+#include "lockstep/transport.h"
 
 namespace rths::lockstep {
 
@@ -25,55 +20,10 @@ double SecondsBetween(SteadyClock::time_point a, SteadyClock::time_point b) {
   return std::chrono::duration<double>(b - a).count();
 }
 
-/// The clock's role name (it owns k; see clock.h).
-constexpr const char* kClockName = "integrator";
 /// Copies of ABORT, GO and CLOSE sent at once (each is also recovered otherwise; see
 /// docs/lockstep.md): a single loss then costs nothing.
 constexpr int kControlCopies = 3;
 }  // namespace
-
-const char* ChannelName(std::int8_t code) {
-  switch (code) {
-    case kDesired: return kChDesired;
-    case kCommand: return kChCommand;
-    case kMeasured: return kChMeasured;
-    case kCurrent: return kChCurrent;
-    case kAck: return kChAck;
-    default: return "";
-  }
-}
-
-double Timing::RerequestAfterS(int n, double typical_step_s) const {
-  const double longest = rerequest_ms * 1e-3;
-  const double first =
-      typical_step_s > 0 ? std::clamp(8.0 * typical_step_s, std::min(kMinRerequestS, longest), longest) : longest;
-  const double cap = std::max(longest, 1.0);
-  // The first few re-requests come at the same pace (a repair may need several round trips on
-  // a lossy link); then each waits twice as long (a loaded host is not flooded).
-  constexpr int kSteady = 4;
-  double wait = first;
-  for (int i = kSteady; i < n && wait < cap; ++i) wait *= 2.0;
-  return std::min(wait, cap);
-}
-
-std::int64_t NewRunId() {
-  std::random_device rd;
-  return static_cast<std::int64_t>(((std::uint64_t{rd()} << 32) ^ rd()) & 0x3fffffffffffffffULL) | 1;
-}
-
-double Timing::LingerS() const { return std::min(stall_budget_s, std::max(0.5, 10.0 * rerequest_ms * 1e-3)); }
-
-bool PeekRunAndStep(const std::uint8_t* data, std::size_t size, std::int64_t* run_id, std::int64_t* k) {
-  if (size < 24) return false;
-  auto be64 = [](const std::uint8_t* p) {
-    std::uint64_t v = 0;
-    for (int i = 0; i < 8; ++i) v = (v << 8) | p[i];
-    return static_cast<std::int64_t>(v);
-  };
-  *run_id = be64(data + 8);
-  *k = be64(data + 16);
-  return true;
-}
 
 /// One subscription of one participant: LCM calls OnMessage, which passes the fault injector.
 struct Participant::Route {
@@ -96,10 +46,10 @@ struct Participant::Route {
   }
 };
 
-Participant::Participant(std::string name, RunIdentity id, Timing timing, lcm::LCM* lcm, Faults faults)
+Participant::Participant(std::string name, RunIdentity id, LockstepConfig config, lcm::LCM* lcm, Faults faults)
     : name_(std::move(name)),
       id_(std::move(id)),
-      timing_(timing),
+      timing_(config),
       lcm_(lcm),
       faults_(std::move(faults)),
       injector_(faults_, std::hash<std::string>{}(name_)) {
@@ -324,7 +274,7 @@ void Participant::OnHandshake(const lcm::ReceiveBuffer* rbuf) {
     OnHandshakeForClock(hs_in_, now);
     return;
   }
-  if (hs_in_.participant != kClockName) return;
+  if (hs_in_.participant != kClockRole) return;
   HeardClock(now);
   switch (hs_in_.phase) {
     case kRequest:
@@ -361,7 +311,7 @@ void Participant::OnRepair(const lcm::ReceiveBuffer* rbuf) {
     return;
   }
   if (repair_in_.participant == name_) return;
-  const bool from_clock = repair_in_.participant == kClockName;
+  const bool from_clock = repair_in_.participant == kClockRole;
   if (from_clock && !is_clock_) {
     HeardClock(SteadyClock::now());
     if (!lingering_) StartRunning();  // GO was lost: the clock is running step k already
@@ -383,7 +333,7 @@ void Participant::OnRepair(const lcm::ReceiveBuffer* rbuf) {
   // The clock re-requests step k: say what we lack to get there.
   if (from_clock && running() && !Stalled(repair_in_.k)) {
     WantList wants;
-    ListMissing(repair_in_.k, &wants);
+    Lacks(repair_in_.k, &wants);
     if (!wants.empty()) SendRepair(repair_in_.k, wants);
   }
 }
@@ -409,7 +359,7 @@ void Participant::Poll(SteadyClock::time_point now, bool idle) {
            fmt::format("no GO from the clock (integrator): nothing heard from it for {:g} s; is it running "
                        "on the same LCM URL and run id?",
                        timing_.handshake_timeout_s),
-           false, -1, kClockName);
+           false, -1, std::string(kClockRole));
     }
     return;
   }
@@ -418,7 +368,7 @@ void Participant::Poll(SteadyClock::time_point now, bool idle) {
     Fail(kExitLockstep,
          fmt::format("step {}: the clock (integrator) stopped answering: silent for {:.3g} s", last_clock_step_,
                      SecondsBetween(last_clock_, now)),
-         true, last_clock_step_, kClockName);
+         true, last_clock_step_, std::string(kClockRole));
   }
 }
 
@@ -471,87 +421,6 @@ void Participant::Interrupt(const std::string& reason) {
   if (finished_) return;
   OnStop();
   Fail(kExitPeerAbort, reason, false);
-}
-
-int RunLoop(lcm::LCM* lcm, const std::vector<Participant*>& participants, const volatile std::sig_atomic_t* stop) {
-  return RunLoopWith([lcm](int timeout_ms) { return lcm->handleTimeout(timeout_ms); }, participants, stop);
-}
-
-int RunLoopWith(const std::function<int(int)>& handle, const std::vector<Participant*>& participants,
-                const volatile std::sig_atomic_t* stop) {
-  constexpr int kPollMs = 5;
-  for (;;) {
-    if (stop && *stop) {
-      for (Participant* p : participants) p->Interrupt("stopped by a signal (SIGINT or SIGTERM)");
-    }
-    bool all_done = true;
-    for (Participant* p : participants) all_done = all_done && p->finished();
-    if (all_done) break;
-    // A paced clock waiting for its next release: handle what has arrived, then sleep to the
-    // release on an absolute deadline (no drift, no millisecond rounding).
-    auto release = SteadyClock::time_point::max();
-    for (const Participant* p : participants) release = std::min(release, p->ReleaseAt());
-    if (release != SteadyClock::time_point::max()) {
-      int handled = 0;
-      while (handled < 64 && handle(0) > 0) {
-        ++handled;
-        const auto now = SteadyClock::now();
-        for (Participant* p : participants) p->Tick(now, false);
-      }
-      // steady_clock is CLOCK_MONOTONIC (libstdc++ on Linux); a release already past returns at once.
-      const auto ns = std::chrono::duration_cast<std::chrono::nanoseconds>(release.time_since_epoch()).count();
-      const timespec ts{static_cast<time_t>(ns / 1000000000), static_cast<long>(ns % 1000000000)};
-      while (::clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR) {
-        if (stop && *stop) break;
-      }
-      const auto now = SteadyClock::now();
-      for (Participant* p : participants) p->Tick(now, true);
-      continue;
-    }
-    // Wake up for the next deadline (a re-request, a held message), at most kPollMs away.
-    auto deadline = SteadyClock::now() + std::chrono::milliseconds(kPollMs);
-    for (const Participant* p : participants) deadline = std::min(deadline, p->NextDeadline());
-    const auto wait = std::chrono::ceil<std::chrono::milliseconds>(deadline - SteadyClock::now()).count();
-    errno = 0;
-    int r = handle(static_cast<int>(std::clamp<std::int64_t>(wait, 0, kPollMs)));
-    if (r < 0 && errno == EINTR) r = 0;  // a signal (e.g. SIGTERM: handled through `stop`)
-    if (r < 0) {
-      for (Participant* p : participants) {
-        if (!p->finished()) std::fprintf(stderr, "%s: LCM receive failed\n", p->name().c_str());
-      }
-      return kExitLockstep;
-    }
-    const auto now = SteadyClock::now();
-    for (Participant* p : participants) p->Tick(now, r == 0);
-  }
-  int first_own = 0, first_any = 0;
-  for (Participant* p : participants) {
-    const int c = p->exit_code();
-    if (c != 0 && first_any == 0) first_any = c;
-    if (c != 0 && c != kExitPeerAbort && first_own == 0) first_own = c;
-  }
-  return first_own != 0 ? first_own : first_any;
-}
-
-std::string CheckMulticastRoute() {
-  // /proc/net/route: Iface Destination Gateway Flags RefCnt Use Metric Mask ... (hex, little-endian)
-  std::ifstream in("/proc/net/route");
-  if (!in) return "";  // not Linux-like; let LCM decide
-  std::string line;
-  std::getline(in, line);  // header
-  const std::uint32_t group = 0x010000E0;  // 224.0.0.1 in /proc's byte order
-  while (std::getline(in, line)) {
-    std::istringstream ss(line);
-    std::string iface;
-    unsigned long dest = 0, gw = 0, flags = 0, refcnt = 0, use = 0, metric = 0, mask = 0;
-    ss >> iface >> std::hex >> dest >> gw >> flags >> std::dec >> refcnt >> use >> metric >> std::hex >>
-        mask;
-    if (!ss) continue;
-    if ((group & mask) == dest && (flags & 0x1)) return "";
-  }
-  return "this host has no route for multicast (224.0.0.0/4), so LCM's udpm transport cannot work.\n"
-         "Fix (as root):  ip route add 224.0.0.0/4 dev lo\n"
-         "or run in one process instead:  ./rths run --transport memq";
 }
 
 }  // namespace rths::lockstep
