@@ -143,6 +143,7 @@ inline std::vector<Mask> TextMasks(const std::vector<std::pair<std::string, std:
   }
   m.push_back({"'Made by ... on <date>'", std::regex(R"( on \d{4}-\d\d-\d\d \d\d:\d\d UTC)"), " on <date>"});
   m.push_back({"'in N s wall time'", std::regex(R"(in \d+(\.\d+)? s wall time)"), "in <wall> s wall time"});
+  m.push_back({"study's 'runs in N s' and 'time: N s'", std::regex(R"((runs in|time:) \d+(\.\d+)? s)"), "$1 <wall> s"});
   m.push_back({"diagnosis 'runtime N s'", std::regex(R"(runtime:? \d+(\.\d+)? s)"), "runtime <wall> s"});
   m.push_back({"progress line '[i/N] ... (N.N s)'", std::regex(R"(\(\d+(\.\d+)? s\))"), "(<wall> s)"});
   return m;
