@@ -2,6 +2,8 @@
 // bench-compare --outputs: every output file of the same commands in two checkouts, compared byte
 // for byte (see the top of compare.cpp). Included by compare.cpp only (bench/*.cpp are globbed as
 // one program each, so this mode is a header).
+#include <fmt/core.h>
+#include <fmt/format.h>
 #include <sys/wait.h>
 
 #include <algorithm>
@@ -12,15 +14,12 @@
 #include <fstream>
 #include <functional>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <regex>
 #include <set>
 #include <sstream>
 #include <string>
 #include <vector>
-
-#include <fmt/core.h>
-#include <fmt/format.h>
-#include <nlohmann/json.hpp>
 
 namespace outputs {
 
@@ -42,9 +41,11 @@ inline std::vector<Command> Commands(const fs::path& root, bool full, const std:
   const auto want = [&](const std::string& group) { return only.empty() || only.find(group) != std::string::npos; };
   if (want("reproduce")) {
     for (const char* n : {"fig5", "fig6", "fig7", "fig8", "table2", "fig9", "fig11", "benchmark"}) {
-      c.push_back({fmt::format("reproduce_{}", n), fmt::format("{{rths}} reproduce {}{} {{set}} --out {{out}}/reproduce_{}", n, quick, n)});
+      c.push_back({fmt::format("reproduce_{}", n),
+                   fmt::format("{{rths}} reproduce {}{} {{set}} --out {{out}}/reproduce_{}", n, quick, n)});
     }
-    c.push_back({"reproduce_table2_extended", "{rths} reproduce table2 --extended" + quick + " {set} --out {out}/reproduce_table2_extended"});
+    c.push_back({"reproduce_table2_extended",
+                 "{rths} reproduce table2 --extended" + quick + " {set} --out {out}/reproduce_table2_extended"});
   }
   if (want("design")) {
     std::vector<fs::path> scenarios;
@@ -86,10 +87,13 @@ inline std::string Quoted(const std::string& s) {
 
 /// Runs `cmd` in `root`'s side folder `out`: NAME.stdout, NAME.stderr, NAME.rc; its wall time [s].
 inline double RunOne(const Command& cmd, const fs::path& root, const fs::path& out, const std::string& set) {
-  const std::string line = Fill(cmd.line, {{"{rths}", Quoted((root / "rths").string())}, {"{root}", Quoted(root.string())},
-                                           {"{out}", Quoted(out.string())}, {"{set}", set}});
-  const std::string sh = fmt::format("cd {} && env -u RTHS_BIN_DIR bash -c {} > {}.stdout 2> {}.stderr; echo $? > {}.rc",
-                                     Quoted(out.string()), Quoted(line), cmd.name, cmd.name, cmd.name);
+  const std::string line = Fill(cmd.line, {{"{rths}", Quoted((root / "rths").string())},
+                                           {"{root}", Quoted(root.string())},
+                                           {"{out}", Quoted(out.string())},
+                                           {"{set}", set}});
+  const std::string sh =
+      fmt::format("cd {} && env -u RTHS_BIN_DIR bash -c {} > {}.stdout 2> {}.stderr; echo $? > {}.rc",
+                  Quoted(out.string()), Quoted(line), cmd.name, cmd.name, cmd.name);
   const auto t0 = std::chrono::steady_clock::now();
   (void)std::system(sh.c_str());
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -115,10 +119,18 @@ struct Mask {
 /// "link", the udpm transport's counters of re-requested, repaired and duplicate messages (they
 /// follow the host's timing; the payloads do not: log.lcm is compared by payload).
 inline const std::vector<std::string>& VolatileKeys() {
-  static const std::vector<std::string> keys = {"run_id",         "wall_s",          "stepping_s",
-                                                "steps_per_s",    "link",            "latency_histogram_us",
-                                                "latency_max_us", "latency_p50_us",  "latency_p99_us",
-                                                "latency_p999_us", "max_release_late_us", "runtime_s"};
+  static const std::vector<std::string> keys = {"run_id",
+                                                "wall_s",
+                                                "stepping_s",
+                                                "steps_per_s",
+                                                "link",
+                                                "latency_histogram_us",
+                                                "latency_max_us",
+                                                "latency_p50_us",
+                                                "latency_p99_us",
+                                                "latency_p999_us",
+                                                "max_release_late_us",
+                                                "runtime_s"};
   return keys;
 }
 
@@ -126,10 +138,12 @@ inline const std::vector<std::string>& VolatileKeys() {
 inline std::vector<Mask> TextMasks(const std::vector<std::pair<std::string, std::string>>& folders) {
   std::vector<Mask> m;
   for (const auto& [path, as] : folders) {
-    m.push_back({"folder " + as, std::regex(std::regex_replace(path, std::regex(R"([.^$|()\[\]{}*+?\\])"), R"(\$&)")), as});
+    m.push_back(
+        {"folder " + as, std::regex(std::regex_replace(path, std::regex(R"([.^$|()\[\]{}*+?\\])"), R"(\$&)")), as});
   }
   m.push_back({"'Made by ... on <date>'", std::regex(R"( on \d{4}-\d\d-\d\d \d\d:\d\d UTC)"), " on <date>"});
   m.push_back({"'in N s wall time'", std::regex(R"(in \d+(\.\d+)? s wall time)"), "in <wall> s wall time"});
+  m.push_back({"study's 'runs in N s' and 'time: N s'", std::regex(R"((runs in|time:) \d+(\.\d+)? s)"), "$1 <wall> s"});
   m.push_back({"diagnosis 'runtime N s'", std::regex(R"(runtime:? \d+(\.\d+)? s)"), "runtime <wall> s"});
   m.push_back({"progress line '[i/N] ... (N.N s)'", std::regex(R"(\(\d+(\.\d+)? s\))"), "(<wall> s)"});
   return m;
@@ -163,8 +177,8 @@ inline std::string MaskedJson(const std::string& text, bool* masked) {
 /// The outcome for one file present on both sides.
 struct Verdict {
   enum Kind { kIdentical, kMasked, kDifferent } kind = kIdentical;
-  std::string detail;            ///< the first difference (kDifferent)
-  std::set<std::string> masks;   ///< masks that made the file identical
+  std::string detail;           ///< the first difference (kDifferent)
+  std::set<std::string> masks;  ///< masks that made the file identical
 };
 
 inline std::string Clip(const std::string& s) { return s.size() > 110 ? s.substr(0, 110) + "..." : s; }
@@ -179,8 +193,10 @@ inline bool IsProgress(const std::string& line) {
 inline std::vector<std::string> ProgressLast(const std::vector<std::string>& lines, bool* moved) {
   std::vector<std::string> rest, progress;
   for (const std::string& l : lines) {
-    if (IsProgress(l)) progress.push_back(l.substr(l.find(']') + 1));
-    else rest.push_back(l);
+    if (IsProgress(l))
+      progress.push_back(l.substr(l.find(']') + 1));
+    else
+      rest.push_back(l);
   }
   std::sort(progress.begin(), progress.end());
   *moved = *moved || !progress.empty();
@@ -230,8 +246,8 @@ inline Verdict CompareText(std::string a, std::string b, bool json, bool console
 }
 
 inline bool IsText(const std::string& ext) {
-  static const std::set<std::string> text = {".csv", ".md", ".txt", ".toml", ".html", ".json", ".stdout",
-                                             ".stderr", ".rc", ".log", ".svg", ".m", ".dat", ".tex", ""};
+  static const std::set<std::string> text = {".csv", ".md",  ".txt", ".toml", ".html", ".json", ".stdout", ".stderr",
+                                             ".rc",  ".log", ".svg", ".m",    ".dat",  ".tex",  ""};
   return text.count(ext) > 0;
 }
 
@@ -241,13 +257,15 @@ inline Verdict CompareFile(const fs::path& a, const fs::path& b, const fs::path&
   if (ta == tb) return {};
   const std::string ext = a.extension().string();
   if (ext == ".lcm") {
-    const std::string cmd = fmt::format("{} log compare {} {} > /dev/null 2>&1", Quoted(rths.string()), Quoted(a.string()),
-                                        Quoted(b.string()));
+    const std::string cmd = fmt::format("{} log compare {} {} > /dev/null 2>&1", Quoted(rths.string()),
+                                        Quoted(a.string()), Quoted(b.string()));
     const int rc = std::system(cmd.c_str());
-    if (WIFEXITED(rc) && WEXITSTATUS(rc) == 0) return {Verdict::kMasked, "", {"log: payload per (channel, k), run_id aside"}};
+    if (WIFEXITED(rc) && WEXITSTATUS(rc) == 0)
+      return {Verdict::kMasked, "", {"log: payload per (channel, k), run_id aside"}};
     return {Verdict::kDifferent, "rths log compare: the logs differ", {}};
   }
-  if (!IsText(ext)) return {Verdict::kDifferent, fmt::format("bytes differ ({} against {} bytes)", ta.size(), tb.size()), {}};
+  if (!IsText(ext))
+    return {Verdict::kDifferent, fmt::format("bytes differ ({} against {} bytes)", ta.size(), tb.size()), {}};
   return CompareText(ta, tb, ext == ".json", ext == ".stdout" || ext == ".stderr", masks);
 }
 
@@ -293,7 +311,8 @@ inline int CompareTrees(const fs::path& a, const fs::path& b, const fs::path& rt
     if (v.kind == Verdict::kMasked) ++t.masked, ++total.masked, masks_used.insert(v.masks.begin(), v.masks.end());
     if (v.kind == Verdict::kDifferent) ++t.different, ++total.different, different.push_back(rel + ": " + v.detail);
   }
-  std::printf("\n%-10s %6s %10s %14s %10s %10s\n", "class", "files", "identical", "after masking", "different", "one side");
+  std::printf("\n%-10s %6s %10s %14s %10s %10s\n", "class", "files", "identical", "after masking", "different",
+              "one side");
   for (const auto& [cls, t] : by_class) {
     std::printf("%-10s %6d %10d %14d %10d %10d\n", cls.c_str(), t.n, t.identical, t.masked, t.different, t.one_side);
   }
@@ -308,10 +327,10 @@ inline int CompareTrees(const fs::path& a, const fs::path& b, const fs::path& rt
 /// Options of the outputs mode.
 struct Options {
   fs::path mine, other, out;
-  bool full = false;           ///< reproductions without --quick
-  bool run = true;             ///< false: compare OUT/this and OUT/other as they are
-  std::string only;            ///< groups to run (reproduce,design,real_data,rig; "" for all)
-  std::string other_set;       ///< --set arguments for the other side only (to show a difference is caught)
+  bool full = false;      ///< reproductions without --quick
+  bool run = true;        ///< false: compare OUT/this and OUT/other as they are
+  std::string only;       ///< groups to run (reproduce,design,real_data,rig; "" for all)
+  std::string other_set;  ///< --set arguments for the other side only (to show a difference is caught)
 };
 
 /// Runs every command in both checkouts into OUT/this and OUT/other, then compares every file.
@@ -327,13 +346,15 @@ inline int Run(const Options& o) {
       const double x = RunOne(c, o.mine, a, "");
       const double y = RunOne(c, o.other, b, o.other_set);
       const std::string rc_a = Slurp(a / (c.name + ".rc")), rc_b = Slurp(b / (c.name + ".rc"));
-      std::printf("  %-44s %7.1f s %7.1f s  exit %s / %s\n", c.name.c_str(), x, y, rc_a.substr(0, rc_a.find('\n')).c_str(),
-                  rc_b.substr(0, rc_b.find('\n')).c_str());
+      std::printf("  %-44s %7.1f s %7.1f s  exit %s / %s\n", c.name.c_str(), x, y,
+                  rc_a.substr(0, rc_a.find('\n')).c_str(), rc_b.substr(0, rc_b.find('\n')).c_str());
       std::fflush(stdout);
     }
   }
-  const auto masks = TextMasks({{fs::absolute(a).string(), "<OUT>"}, {fs::absolute(b).string(), "<OUT>"},
-                                {o.mine.string(), "<ROOT>"}, {o.other.string(), "<ROOT>"}});
+  const auto masks = TextMasks({{fs::absolute(a).string(), "<OUT>"},
+                                {fs::absolute(b).string(), "<OUT>"},
+                                {o.mine.string(), "<ROOT>"},
+                                {o.other.string(), "<ROOT>"}});
   return CompareTrees(a, b, o.mine / "rths", masks);
 }
 
