@@ -17,6 +17,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/error.h"
+#include "lockstep/step_table.h"
 
 namespace rths::supervisor {
 
@@ -80,10 +81,10 @@ pid_t Spawn(std::vector<std::string> args, const fs::path& log, const sigset_t& 
   ::_exit(127);
 }
 
-/// Starts every participant the user does not run, in kGroupOrder.
+/// Starts every participant the user does not run, in lockstep::kBuildOrder.
 Children StartAll(const ProcessGroupSpec& spec, const sigset_t& old_mask) {
   Children children;
-  for (const std::string_view role_view : participants::kGroupOrder) {
+  for (const std::string_view role_view : lockstep::kBuildOrder) {
     const std::string role(role_view);
     if (spec.external.has(role)) continue;
     const fs::path exe = spec.bin_dir / fmt::format("rths-{}", role);

@@ -25,7 +25,7 @@ struct ProcessGroupSpec {
   std::vector<std::string> role_args;     ///< extra arguments for every participant
 };
 
-/// Starts the group's processes (logger first, kGroupOrder), waits for every one, and tears the
+/// Starts the group's processes (logger first, lockstep::kBuildOrder), waits for every one, and tears the
 /// group down when one fails or on SIGINT / SIGTERM (which also set *interrupted). Returns each
 /// participant's outcome (its exit status, plus what it wrote about itself in out/logs/<role>.json)
 /// and, in *noticed, when a failure was noticed (unchanged if none). Throws rths::Error if a

@@ -10,7 +10,7 @@
 
 #include "lockstep/protocol.h"
 #include "lockstep/transport.h"
-#include "lockstep/transport.h"
+#include "rths/handshake_t.hpp"
 
 namespace rths::supervisor {
 
