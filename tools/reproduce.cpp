@@ -218,6 +218,8 @@ int main(int argc, char** argv) {
   rths::report::ReproduceOptions opts;
   opts.out_dir = o.out.empty() ? rths::io::NewOutputFolder(fmt::format("reproduce-{}{}", o.name, o.quick ? "-quick" : ""))
                                : fs::path(o.out);
+  // Absolute: run folders' scenario files name the study's own files relative to themselves.
+  opts.out_dir = fs::absolute(opts.out_dir).lexically_normal();
   opts.quick = o.quick;
   opts.plant = o.plant;
   opts.jobs = o.jobs;
