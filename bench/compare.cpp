@@ -29,11 +29,13 @@
 // differs and no file is on one side only.
 //
 //   build/bin/bench-compare --outputs --other DIR [--full] [--only reproduce,design,real_data,rig]
-//       [--out DIR] [--no-run] [--other-set "--set KEY=VALUE"] [--this DIR]
+//       [--out DIR] [--no-run] [--other-set "--set KEY=VALUE"] [--this DIR] [--side both|this|other]
 //
 // --no-run compares OUT/this and OUT/other as they are (e.g. after doctoring a file); --other-set
 // adds arguments to the other side's reproduce, design and rig runs (to see a difference caught);
 // --this takes another built checkout as this side (e.g. --this D --other D: one commit twice).
+// --side this|other runs one side only and compares with the other side's folder as it is (the
+// older checkout's outputs made once, while the change is still being built).
 //
 // DIR is a built checkout (its ./rths and build/bin), e.g.
 //   git worktree add --detach /tmp/old COMMIT && cmake -S /tmp/old -B /tmp/old/build -G Ninja
@@ -170,6 +172,8 @@ int main(int argc, char** argv) {
   app.add_flag("--no-run", [&](std::int64_t) { oo.run = false; }, "--outputs: compare OUT/this and OUT/other as they are");
   std::string this_dir;
   app.add_option("--this", this_dir, "--outputs: the checkout taken as this one (default: this program's)");
+  app.add_option("--side", oo.side, "--outputs: run both sides, or only 'this' or 'other' (then compare)")
+      ->capture_default_str();
   app.add_option("--other-set", oo.other_set, "--outputs: arguments for the other side's runs, e.g. \"--set K=V\"");
   CLI11_PARSE(app, argc, argv);
 

@@ -20,6 +20,7 @@
 #include <sstream>
 #include <string>
 #include <vector>
+#include <stdexcept>
 
 namespace outputs {
 
@@ -156,13 +157,15 @@ inline std::vector<std::string> Lines(const std::string& text) {
   return v;
 }
 
-/// JSON without the volatile keys, one key per line.
-inline std::string MaskedJson(const std::string& text, bool* masked) {
+/// JSON without the volatile keys (and `extra` keys), one key per line.
+inline std::string MaskedJson(const std::string& text, const std::vector<std::string>& extra, bool* masked) {
   auto j = nlohmann::json::parse(text, nullptr, false);
   if (j.is_discarded()) return text;
+  std::vector<std::string> keys = VolatileKeys();
+  keys.insert(keys.end(), extra.begin(), extra.end());
   const std::function<void(nlohmann::json&)> drop = [&](nlohmann::json& v) {
     if (v.is_object()) {
-      for (const std::string& k : VolatileKeys()) {
+      for (const std::string& k : keys) {
         if (v.contains(k)) v[k] = "<masked>", *masked = true;
       }
       for (auto& [k, x] : v.items()) drop(x);
@@ -204,14 +207,19 @@ inline std::vector<std::string> ProgressLast(const std::vector<std::string>& lin
   return rest;
 }
 
-inline Verdict CompareText(std::string a, std::string b, bool json, bool console, const std::vector<Mask>& masks) {
+/// `extra_json_keys`: keys masked in this JSON file beside VolatileKeys().
+inline Verdict CompareText(std::string a, std::string b, bool json, bool console, const std::vector<Mask>& masks,
+                           const std::vector<std::string>& extra_json_keys = {}) {
   Verdict v;
   if (json) {
     bool ma = false, mb = false;
-    a = MaskedJson(a, &ma), b = MaskedJson(b, &mb);
+    a = MaskedJson(a, extra_json_keys, &ma), b = MaskedJson(b, extra_json_keys, &mb);
     if (a == b) {
       v.kind = Verdict::kMasked;
       v.masks.insert("JSON keys " + fmt::format("{}", fmt::join(VolatileKeys(), ", ")));
+      if (!extra_json_keys.empty())
+        v.masks.insert(fmt::format("JSON keys {} (beside a scenario.toml the same after masking)",
+                                   fmt::join(extra_json_keys, ", ")));
       return v;
     }
   }
@@ -266,7 +274,16 @@ inline Verdict CompareFile(const fs::path& a, const fs::path& b, const fs::path&
   }
   if (!IsText(ext))
     return {Verdict::kDifferent, fmt::format("bytes differ ({} against {} bytes)", ta.size(), tb.size()), {}};
-  return CompareText(ta, tb, ext == ".json", ext == ".stdout" || ext == ".stderr", masks);
+  // A run folder's scenario_sha256 is the hash of its scenario.toml, whose first comment names the
+  // file it came from (a path in the checkout): when the two scenario.toml are the same after
+  // masking, so is what the hash stands for.
+  std::vector<std::string> extra;
+  const fs::path sa = a.parent_path() / "scenario.toml", sb = b.parent_path() / "scenario.toml";
+  if (ext == ".json" && fs::exists(sa) && fs::exists(sb) &&
+      CompareText(Slurp(sa), Slurp(sb), false, false, masks).kind != Verdict::kDifferent) {
+    extra.push_back("scenario_sha256");
+  }
+  return CompareText(ta, tb, ext == ".json", ext == ".stdout" || ext == ".stderr", masks, extra);
 }
 
 inline std::set<std::string> Files(const fs::path& dir) {
@@ -331,20 +348,24 @@ struct Options {
   bool run = true;        ///< false: compare OUT/this and OUT/other as they are
   std::string only;       ///< groups to run (reproduce,design,real_data,rig; "" for all)
   std::string other_set;  ///< --set arguments for the other side only (to show a difference is caught)
+  std::string side = "both";  ///< "this" or "other": run that side only (the other kept as it is)
 };
 
 /// Runs every command in both checkouts into OUT/this and OUT/other, then compares every file.
 inline int Run(const Options& o) {
   const fs::path a = o.out / "this", b = o.out / "other";
+  if (o.side != "both" && o.side != "this" && o.side != "other")
+    throw std::runtime_error("--side: '" + o.side + "' is not one of both, this, other");
+  const bool run_a = o.run && o.side != "other", run_b = o.run && o.side != "this";
+  if (run_a) fs::remove_all(a), fs::create_directories(a);
+  if (run_b) fs::remove_all(b), fs::create_directories(b);
   if (o.run) {
-    fs::remove_all(a), fs::remove_all(b);
-    fs::create_directories(a), fs::create_directories(b);
     const auto commands = Commands(o.mine, o.full, o.only);
     std::printf("bench-compare --outputs: %zu commands in %s (this) and %s (other), into %s\n", commands.size(),
                 o.mine.c_str(), o.other.c_str(), o.out.c_str());
     for (const Command& c : commands) {
-      const double x = RunOne(c, o.mine, a, "");
-      const double y = RunOne(c, o.other, b, o.other_set);
+      const double x = run_a ? RunOne(c, o.mine, a, "") : 0.0;
+      const double y = run_b ? RunOne(c, o.other, b, o.other_set) : 0.0;
       const std::string rc_a = Slurp(a / (c.name + ".rc")), rc_b = Slurp(b / (c.name + ".rc"));
       std::printf("  %-44s %7.1f s %7.1f s  exit %s / %s\n", c.name.c_str(), x, y,
                   rc_a.substr(0, rc_a.find('\n')).c_str(), rc_b.substr(0, rc_b.find('\n')).c_str());
