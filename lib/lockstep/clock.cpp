@@ -44,18 +44,9 @@ ClockParticipant::ClockParticipant(std::string name, RunIdentity id, LockstepCon
   SetAnswerChannel(kDesired, &desired_cache_);
   // The barrier of step k is the clock's inputs of step k+1 (wiring.h); only the last of them to
   // be sent (ack_t: the logger acknowledges step k once it holds the rest) wakes the clock.
-  const ResolvedRole& clock = wiring_.Clock();
-  for (int c = kDesired; c < kChannelCodes; ++c) {
-    if (!clock.reads[c]) continue;
-    const auto channel = static_cast<Channel>(c);
-    Subscribe(ChannelName(channel), [this, channel](const lcm::ReceiveBuffer* rbuf) {
-      if (finished()) return;
-      std::int64_t k = -1;
-      const Put put = boxes_.Add(channel, rbuf, id_.run_id, &k);
-      Count(channel, put, k);
-      if (put == Put::kNew && k_ >= 0 && wiring_.Clock().Waits(channel, k, k_ + 1)) CheckBarrier();
-    }, clock.wake[c]);
-  }
+  SubscribeInputs(wiring_.Clock(), &boxes_, [this](Channel channel, std::int64_t k, const lcm::ReceiveBuffer*) {
+    if (k_ >= 0 && wiring_.Clock().Waits(channel, k, k_ + 1)) CheckBarrier();
+  });
 }
 
 void ClockParticipant::OnHandshakeForClock(const rths::handshake_t& msg, SteadyClock::time_point now) {

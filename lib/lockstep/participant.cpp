@@ -78,6 +78,20 @@ void Participant::Subscribe(const char* channel, Handler handler, Wake wake) {
   }
 }
 
+void Participant::SubscribeInputs(const ResolvedRole& role, StepMailboxes* boxes, OnNewInput on_new) {
+  for (int c = kDesired; c < kChannelCodes; ++c) {
+    if (!role.reads[c]) continue;
+    const auto channel = static_cast<Channel>(c);
+    Subscribe(ChannelName(channel), [this, channel, boxes, on_new](const lcm::ReceiveBuffer* rbuf) {
+      if (finished()) return;
+      std::int64_t k = -1;
+      const Put put = boxes->Add(channel, rbuf, id_.run_id, &k);
+      Count(channel, put, k);
+      if (put == Put::kNew) on_new(channel, k, rbuf);
+    }, role.wake[c]);
+  }
+}
+
 void Participant::Attach(Channels* channels) {
   if (lcm_) throw std::runtime_error(name_ + ": Attach: already subscribed on an LCM instance");
   channels_ = channels;

@@ -27,7 +27,9 @@
 #include "lockstep/mailbox.h"
 #include "lockstep/protocol.h"
 #include "lockstep/realtime.h"
+#include "lockstep/step_mailboxes.h"
 #include "lockstep/want_list.h"
+#include "lockstep/wiring.h"
 #include "rths/handshake_t.hpp"
 #include "rths/repair_t.hpp"
 
@@ -125,13 +127,13 @@ class Participant {
   }
   /// Counts what a mailbox did with a message (duplicates, stale, foreign; repaired inputs).
   void Count(Channel channel, Put put, std::int64_t k);
-  /// Adds a message to a mailbox and counts it.
-  template <class Msg, int D>
-  Put Receive(StepMailbox<Msg, D>* box, Channel channel, const lcm::ReceiveBuffer* rbuf) {
-    const Put put = box->Add(rbuf, id_.run_id);
-    Count(channel, put, box->last_k());
-    return put;
-  }
+  /// Called for a step input new to its mailbox: its channel, its step k and its bytes.
+  using OnNewInput = std::function<void(Channel channel, std::int64_t k, const lcm::ReceiveBuffer* rbuf)>;
+  /// Subscribes to every channel `role` reads (wiring.h), each with the wake-up the step table
+  /// gives it: a message is dropped once this participant has finished, otherwise put in its
+  /// mailbox in `boxes` and counted (duplicate, stale, foreign, repaired); a new one is passed to
+  /// `on_new`. The one input path of every step participant and of the clock.
+  void SubscribeInputs(const ResolvedRole& role, StepMailboxes* boxes, OnNewInput on_new);
   /// Sends a repair_t for step k listing `wants` (remembered, to count what gets repaired).
   void SendRepair(std::int64_t k, const WantList& wants);
 

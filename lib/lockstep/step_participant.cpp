@@ -6,19 +6,10 @@ StepParticipant::StepParticipant(std::string name, RunIdentity id, LockstepConfi
                                  Faults faults, const ResolvedRole& wiring)
     : Participant(std::move(name), std::move(id), config, lcm, std::move(faults)), wiring_(wiring) {
   SetAnswerChannel(wiring_.row->answer, &cache_);
-  for (int c = kDesired; c < kChannelCodes; ++c) {
-    if (!wiring_.reads[c]) continue;
-    const auto channel = static_cast<Channel>(c);
-    Subscribe(ChannelName(channel), [this, channel](const lcm::ReceiveBuffer* rbuf) {
-      if (finished()) return;
-      std::int64_t k = -1;
-      const Put put = boxes_.Add(channel, rbuf, id_.run_id, &k);
-      Count(channel, put, k);
-      if (put != Put::kNew) return;
-      OnInput(channel, k, rbuf);
-      TryStep();
-    }, wiring_.wake[c]);
-  }
+  SubscribeInputs(wiring_, &boxes_, [this](Channel channel, std::int64_t k, const lcm::ReceiveBuffer* rbuf) {
+    OnInput(channel, k, rbuf);
+    TryStep();
+  });
 }
 
 bool StepParticipant::Gather(std::int64_t k, StepInputs* in) const {
