@@ -25,6 +25,7 @@
 #include <fmt/core.h>
 #include <nlohmann/json.hpp>
 
+#include "lockstep/step_table.h"
 #include "lockstep/transport.h"
 
 namespace fs = std::filesystem;
@@ -142,7 +143,8 @@ int main(int argc, char** argv) {
   std::ofstream(long_scen) << Shortened(scenario, 20.0, "");
   std::printf("time from kill -9 to the supervisor's exit (run torn down, summary written), %d kills each:\n",
               kills);
-  for (const char* role : {"integrator", "controller", "plant", "semiactive", "logger"}) {
+  for (const std::string_view name : rths::lockstep::kRoster) {
+    const std::string role(name);
     std::vector<double> t;
     for (int i = 0; i < kills; ++i) {
       const double s = TimeToNotice(bin, long_scen, tmp / "kill", role);
@@ -150,10 +152,10 @@ int main(int argc, char** argv) {
     }
     std::sort(t.begin(), t.end());
     if (t.empty()) {
-      std::printf("  %-11s  (could not kill it in time)\n", role);
+      std::printf("  %-11s  (could not kill it in time)\n", role.c_str());
       continue;
     }
-    std::printf("  %-11s  min %6.1f ms   median %6.1f ms   max %6.1f ms   (stall budget: 10000 ms)\n", role,
+    std::printf("  %-11s  min %6.1f ms   median %6.1f ms   max %6.1f ms   (stall budget: 10000 ms)\n", role.c_str(),
                 1e3 * t.front(), 1e3 * t[t.size() / 2], 1e3 * t.back());
   }
 
