@@ -179,22 +179,26 @@ RigRecord ReadRigRecord(const std::string& path, TimeAxis time) {
   return ParseRigRecord(text, path, time);
 }
 
-RigRecord ParseRigRecord(std::string_view text, const std::string& path, TimeAxis time) {
-  std::istringstream in{std::string(text)};
-  RigRecord rec;
-  rec.source = path;
-  std::string line;
-  std::size_t ln = 0;
+namespace {
 
+/// Where the header block of a rig record ended: its column names and the lines of note.
+struct RigHeader {
+  std::vector<std::string> cols;
+  std::size_t header_line = 0;  ///< the column line
+  std::size_t dt_line = 0;      ///< the '# dt_s:' line
+};
+
+/// Reads the magic line and the '# key: value' lines up to the column line into rec (dt_s,
+/// metadata). *ln: lines read.
+RigHeader ReadRigHeader(std::istream& in, const std::string& path, RigRecord* rec, std::size_t* ln) {
+  std::string line;
   if (!std::getline(in, line) || Trim(line, kLineWhitespace) != kMagic) {
     throw Error(Where(path, 1), fmt::format("not a rig record: the first line must be \"{}\"", kMagic));
   }
-  ln = 1;
-  std::size_t dt_line = 0;
-  std::vector<std::string> cols;
-  std::size_t header_line = 0;
+  *ln = 1;
+  RigHeader h;
   while (std::getline(in, line)) {
-    ++ln;
+    ++*ln;
     const std::string s(Trim(line, kLineWhitespace));
     if (s.empty()) continue;
     if (s[0] == '#') {
@@ -203,67 +207,84 @@ RigRecord ParseRigRecord(std::string_view text, const std::string& path, TimeAxi
       const std::string key(Trim(s.substr(1, colon - 1), kLineWhitespace));
       const std::string value(Trim(s.substr(colon + 1), kLineWhitespace));
       if (key == "dt_s") {
-        if (!ParseFinite(value, &rec.dt_s) || !DtInRange(rec.dt_s))
-          throw Error(Where(path, ln), fmt::format("dt_s must be a number in [{:g}, {:g}] s (got \"{}\")", kMinDtS,
-                                                  kMaxDtS, value));
-        dt_line = ln;
+        if (!ParseFinite(value, &rec->dt_s) || !DtInRange(rec->dt_s))
+          throw Error(Where(path, *ln), fmt::format("dt_s must be a number in [{:g}, {:g}] s (got \"{}\")", kMinDtS,
+                                                   kMaxDtS, value));
+        h.dt_line = *ln;
       } else {
-        rec.metadata.emplace_back(key, value);
+        rec->metadata.emplace_back(key, value);
       }
       continue;
     }
-    cols = SplitCsv(s);
-    header_line = ln;
+    h.cols = SplitCsv(s);
+    h.header_line = *ln;
     break;
   }
-  if (header_line == 0) throw Error(Where(path, ln), "no column header line (t_s,u_mm,y_mm,f_kN,i_A)");
-  static constexpr const char* kColumns = "required: t_s,u_mm,y_mm,f_kN and i_A or v_V (or both); optional r_mm";
-  if (dt_line == 0) throw Error(Where(path, header_line), "missing the '# dt_s: <step in s>' line before the columns");
+  if (h.header_line == 0) throw Error(Where(path, *ln), "no column header line (t_s,u_mm,y_mm,f_kN,i_A)");
+  if (h.dt_line == 0) throw Error(Where(path, h.header_line), "missing the '# dt_s: <step in s>' line before the columns");
+  return h;
+}
 
-  // Column map.
+/// Which vector of rec each known column fills (column index); unknown columns are warned about
+/// in rec->warnings; a missing required column throws.
+std::vector<std::pair<std::vector<double>*, std::size_t>> ColumnTargets(const RigHeader& h, const std::string& path,
+                                                                        RigRecord* rec) {
+  static constexpr const char* kColumns = "required: t_s,u_mm,y_mm,f_kN and i_A or v_V (or both); optional r_mm";
   static const std::vector<std::string> kRequired{"t_s", "u_mm", "y_mm", "f_kN"};
+  const auto& cols = h.cols;
   std::map<std::string, std::size_t> index;
   for (std::size_t c = 0; c < cols.size(); ++c) {
     if (index.count(cols[c]))
-      throw Error(Where(path, header_line), fmt::format("column \"{}\" appears twice", cols[c]));
+      throw Error(Where(path, h.header_line), fmt::format("column \"{}\" appears twice", cols[c]));
     index[cols[c]] = c;
     const bool known = cols[c] == "r_mm" || cols[c] == "i_A" || cols[c] == "v_V" || std::find(kRequired.begin(), kRequired.end(), cols[c]) != kRequired.end();
     if (!known)
-      rec.warnings.push_back(fmt::format("{}: unknown column \"{}\" ignored", Where(path, header_line), cols[c]));
+      rec->warnings.push_back(fmt::format("{}: unknown column \"{}\" ignored", Where(path, h.header_line), cols[c]));
   }
   for (const auto& name : kRequired) {
     if (!index.count(name)) {
-      throw Error(Where(path, header_line),
+      throw Error(Where(path, h.header_line),
                   fmt::format("missing column \"{}\" ({})", name, kColumns));
     }
   }
   if (!index.count("i_A") && !index.count("v_V"))
-    throw Error(Where(path, header_line),
+    throw Error(Where(path, h.header_line),
                 fmt::format("missing the damper command: a column \"i_A\" (current) or \"v_V\" (voltage) ({})", kColumns));
-  const bool has_r = index.count("r_mm") > 0;
   std::vector<std::pair<std::vector<double>*, std::size_t>> targets{
-      {&rec.t_s, index["t_s"]}, {&rec.u_mm, index["u_mm"]}, {&rec.y_mm, index["y_mm"]},
-      {&rec.f_kN, index["f_kN"]}};
-  if (index.count("i_A")) targets.emplace_back(&rec.i_A, index["i_A"]);
-  if (has_r) targets.emplace_back(&rec.r_mm, index["r_mm"]);
-  if (index.count("v_V")) targets.emplace_back(&rec.v_V, index["v_V"]);
+      {&rec->t_s, index["t_s"]}, {&rec->u_mm, index["u_mm"]}, {&rec->y_mm, index["y_mm"]},
+      {&rec->f_kN, index["f_kN"]}};
+  if (index.count("i_A")) targets.emplace_back(&rec->i_A, index["i_A"]);
+  if (index.count("r_mm")) targets.emplace_back(&rec->r_mm, index["r_mm"]);
+  if (index.count("v_V")) targets.emplace_back(&rec->v_V, index["v_V"]);
+  return targets;
+}
+
+}  // namespace
+
+RigRecord ParseRigRecord(std::string_view text, const std::string& path, TimeAxis time) {
+  std::istringstream in{std::string(text)};
+  RigRecord rec;
+  rec.source = path;
+  std::size_t ln = 0;
+  const RigHeader h = ReadRigHeader(in, path, &rec, &ln);
+  const auto targets = ColumnTargets(h, path, &rec);
 
   std::vector<std::size_t> row_line;
-  while (std::getline(in, line)) {
+  for (std::string line; std::getline(in, line);) {
     ++ln;
     const std::string s(Trim(line, kLineWhitespace));
     if (s.empty() || s[0] == '#') continue;
     const auto f = SplitCsv(s);
-    if (f.size() != cols.size()) {
+    if (f.size() != h.cols.size()) {
       throw Error(Where(path, ln), fmt::format("{} fields, expected {} (one per column of line {})", f.size(),
-                                               cols.size(), header_line));
+                                               h.cols.size(), h.header_line));
     }
     for (auto& [vec, c] : targets) {
       double v = 0.0;
       if (!ParseFinite(f[c], &v)) {
-        throw Error(Where(path, ln), fmt::format("column {}: \"{}\" is not a finite number", cols[c], f[c]));
+        throw Error(Where(path, ln), fmt::format("column {}: \"{}\" is not a finite number", h.cols[c], f[c]));
       }
-      if (const auto problem = OutOfBounds(cols[c], v); !problem.empty()) throw Error(Where(path, ln), problem);
+      if (const auto problem = OutOfBounds(h.cols[c], v); !problem.empty()) throw Error(Where(path, ln), problem);
       vec->push_back(v);
     }
     row_line.push_back(ln);
@@ -272,7 +293,7 @@ RigRecord ParseRigRecord(std::string_view text, const std::string& path, TimeAxi
   if (time == TimeAxis::kHeader) {
     TimeFromHeader(&rec, line_of);
   } else {
-    CheckTime(rec.t_s, rec.dt_s, Where(path, dt_line), line_of);
+    CheckTime(rec.t_s, rec.dt_s, Where(path, h.dt_line), line_of);
   }
   CheckDuration(rec.size(), rec.dt_s, Where(path, row_line.empty() ? ln : row_line.back()));
   return rec;

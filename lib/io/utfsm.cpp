@@ -6,6 +6,8 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <tuple>
+#include <utility>
 
 #include <fmt/format.h>
 
@@ -41,17 +43,12 @@ double Mean(const std::vector<double>& v, std::size_t a, std::size_t b) {
   return s / static_cast<double>(b - a);
 }
 
-}  // namespace
-
-RigRecord ReadUtfsmActuator(const std::string& path, const UtfsmActuatorOptions& o) {
-  if (!(o.start_threshold_mm > 0.0)) throw Error(path, "start_threshold_mm must be > 0");
-  std::ifstream in(path);
-  if (!in) throw Error(path, "cannot open the DAQ export");
+/// The DAQ export's header: "Header Size: H" first, H lines in all, the last naming the columns.
+/// Returns the sampling interval [s]; *ln is the number of lines read.
+double ReadUtfsmHeader(std::istream& in, const std::string& path, std::size_t* ln) {
   std::string line;
-  std::size_t ln = 0;
-  // Header block: "Header Size: H" first, H lines in all, then the column line.
   if (!std::getline(in, line)) throw Error(Where(path, 1), "empty file");
-  ++ln;
+  *ln = 1;
   const auto colon = line.find(':');
   double hsize = 0.0;
   if (colon == std::string::npos || Trim(line.substr(0, colon), kLineWhitespace) != "Header Size" ||
@@ -59,21 +56,32 @@ RigRecord ReadUtfsmActuator(const std::string& path, const UtfsmActuatorOptions&
     throw Error(Where(path, 1), "not a DAQ export: the first line must be 'Header Size: <lines>' (1 to 10000)");
   double dt = 0.0;
   std::string columns;
-  while (ln < static_cast<std::size_t>(hsize) && std::getline(in, line)) {
-    ++ln;
+  while (*ln < static_cast<std::size_t>(hsize) && std::getline(in, line)) {
+    ++*ln;
     const auto c = line.find(':');
     if (c != std::string::npos && Trim(line.substr(0, c), kLineWhitespace) == "Sampling Interval" &&
         (!ParseFinite(line.substr(c + 1), &dt) || dt < kMinDtS || dt > kMaxDtS))
-      throw Error(Where(path, ln), fmt::format("bad Sampling Interval (a number of seconds in [{:g}, {:g}])", kMinDtS,
-                                               kMaxDtS));
+      throw Error(Where(path, *ln), fmt::format("bad Sampling Interval (a number of seconds in [{:g}, {:g}])", kMinDtS,
+                                                kMaxDtS));
     columns = line;
   }
-  if (!(dt > 0.0)) throw Error(Where(path, ln), "no 'Sampling Interval' in the header");
+  if (!(dt > 0.0)) throw Error(Where(path, *ln), "no 'Sampling Interval' in the header");
   if (columns.find("CHANNEL0") == std::string::npos || columns.find("CHANNEL2") == std::string::npos) {
-    throw Error(Where(path, ln), "expected the header's last line to name the columns 'Sample Number, Date/Time, "
-                                 "CHANNEL0, CHANNEL1, CHANNEL2'");
+    throw Error(Where(path, *ln), "expected the header's last line to name the columns 'Sample Number, Date/Time, "
+                                  "CHANNEL0, CHANNEL1, CHANNEL2'");
   }
-  std::vector<double> y, f, u;
+  return dt;
+}
+
+/// The export's samples, converted: y [mm] = 10 CHANNEL0, f [kN] = 9.80665 CHANNEL1 (9806.65 N/V),
+/// u [mm] = 10 CHANNEL2, each checked against the rig record's bounds.
+struct UtfsmSamples {
+  std::vector<double> y_mm, f_kN, u_mm;
+};
+
+UtfsmSamples ReadUtfsmRows(std::istream& in, const std::string& path, std::size_t ln) {
+  UtfsmSamples s;
+  std::string line;
   while (std::getline(in, line)) {
     ++ln;
     if (Trim(line, kLineWhitespace).empty()) continue;
@@ -85,40 +93,52 @@ RigRecord ReadUtfsmActuator(const std::string& path, const UtfsmActuatorOptions&
     if (fields.size() < 5 || !ParseFinite(fields[2], &c0) || !ParseFinite(fields[3], &c1) ||
         !ParseFinite(fields[4], &c2))
       throw Error(Where(path, ln), "expected 'sample, date/time, CHANNEL0, CHANNEL1, CHANNEL2' with numbers");
-    y.push_back(10.0 * c0);      // mm
-    f.push_back(9.80665 * c1);   // kN (9806.65 N/V)
-    u.push_back(10.0 * c2);      // mm
-    CheckBound(path, ln, "y_mm (10 CHANNEL0)", y.back(), kMaxAbsDisplacementMm, "mm");
-    CheckBound(path, ln, "f_kN (9.80665 CHANNEL1)", f.back(), kMaxAbsForceKN, "kN");
-    CheckBound(path, ln, "u_mm (10 CHANNEL2)", u.back(), kMaxAbsDisplacementMm, "mm");
+    s.y_mm.push_back(10.0 * c0);
+    s.f_kN.push_back(9.80665 * c1);
+    s.u_mm.push_back(10.0 * c2);
+    CheckBound(path, ln, "y_mm (10 CHANNEL0)", s.y_mm.back(), kMaxAbsDisplacementMm, "mm");
+    CheckBound(path, ln, "f_kN (9.80665 CHANNEL1)", s.f_kN.back(), kMaxAbsForceKN, "kN");
+    CheckBound(path, ln, "u_mm (10 CHANNEL2)", s.u_mm.back(), kMaxAbsDisplacementMm, "mm");
   }
-  if (u.empty()) throw Error(path, "no data rows");
+  if (s.u_mm.empty()) throw Error(path, "no data rows");
+  return s;
+}
 
-  // Chirp start/end on u relative to a first idle estimate (the first 0.5 s), then the idle
-  // stretch proper and its means.
-  const auto n0 = std::min<std::size_t>(u.size(), std::max<std::size_t>(1, static_cast<std::size_t>(0.5 / dt)));
-  const double u0 = Mean(u, 0, n0);
+/// The samples [start, end) from the first to the last with |u - u0| > threshold; start = u.size()
+/// if there is none.
+std::pair<std::size_t, std::size_t> ChirpSpan(const std::vector<double>& u, double u0, double threshold_mm) {
   std::size_t start = u.size(), end = 0;
   for (std::size_t k = 0; k < u.size(); ++k) {
-    if (std::abs(u[k] - u0) > o.start_threshold_mm) {
+    if (std::abs(u[k] - u0) > threshold_mm) {
       start = std::min(start, k);
       end = k + 1;
     }
   }
+  return {start, end};
+}
+
+}  // namespace
+
+RigRecord ReadUtfsmActuator(const std::string& path, const UtfsmActuatorOptions& o) {
+  if (!(o.start_threshold_mm > 0.0)) throw Error(path, "start_threshold_mm must be > 0");
+  std::ifstream in(path);
+  if (!in) throw Error(path, "cannot open the DAQ export");
+  std::size_t ln = 0;
+  const double dt = ReadUtfsmHeader(in, path, &ln);
+  const UtfsmSamples x = ReadUtfsmRows(in, path, ln);
+  const std::vector<double>&u = x.u_mm, &y = x.y_mm, &f = x.f_kN;
+
+  // Chirp start/end on u relative to a first idle estimate (the first 0.5 s), then the idle
+  // stretch proper and its means, then start and end again with the final offset.
+  const auto n0 = std::min<std::size_t>(u.size(), std::max<std::size_t>(1, static_cast<std::size_t>(0.5 / dt)));
+  auto [start, end] = ChirpSpan(u, Mean(u, 0, n0), o.start_threshold_mm);
   if (start == u.size()) throw Error(path, fmt::format("|u| never exceeds {} mm: no chirp found", o.start_threshold_mm));
   const auto one_s = static_cast<std::size_t>(std::lround(1.0 / dt));
   std::size_t idle_end = start > one_s ? start - one_s : 0;
   if (static_cast<double>(idle_end) * dt < 0.5) idle_end = start / 2;
   if (idle_end == 0) throw Error(path, "no idle stretch before the chirp to take the offsets from");
   const double mu = Mean(u, 0, idle_end), my = Mean(y, 0, idle_end), mf = Mean(f, 0, idle_end);
-  // Re-detect start and end with the final offset.
-  start = u.size(), end = 0;
-  for (std::size_t k = 0; k < u.size(); ++k) {
-    if (std::abs(u[k] - mu) > o.start_threshold_mm) {
-      start = std::min(start, k);
-      end = k + 1;
-    }
-  }
+  std::tie(start, end) = ChirpSpan(u, mu, o.start_threshold_mm);
 
   RigRecord rec;
   rec.source = path;
