@@ -19,7 +19,7 @@
 #include "core/progress.h"
 #include "diagnosis/diagnosis.h"
 #include "diagnosis/model_file.h"
-#include "diagnosis/report.h"
+#include "report/diagnosis_page.h"
 #include "io/output_folder.h"
 #include "io/rig_record.h"
 
@@ -96,7 +96,7 @@ int main(int argc, char** argv) {
     }
     std::string report_note;
     try {
-      rths::diagnosis::WriteReport(r, traces, dir);
+      rths::report::WriteDiagnosisReport(r, traces, dir);
     } catch (const std::exception& e) {
       report_note = fmt::format("warning: report.html: {}\n", e.what());
     }

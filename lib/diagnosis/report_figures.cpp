@@ -1,9 +1,8 @@
-#include "diagnosis/report.h"
+// The figures of the diagnosis report (diagnosis/report_figures.h).
 #include "diagnosis/report_figures.h"
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 
 #include <fmt/format.h>
 
@@ -17,17 +16,6 @@ namespace rths::diagnosis {
 namespace fs = std::filesystem;
 
 namespace {
-
-std::string Esc(const std::string& s) {
-  std::string o;
-  for (char c : s) {
-    if (c == '<') o += "&lt;";
-    else if (c == '>') o += "&gt;";
-    else if (c == '&') o += "&amp;";
-    else o += c;
-  }
-  return o;
-}
 
 std::vector<double> Residual(const std::vector<double>& m, const std::vector<double>& p, std::size_t first) {
   std::vector<double> e;
@@ -274,132 +262,6 @@ io::Figure TraceFigure(const Traces::Record& t, const std::string& ch) {
   fig.panel_height_px = 280;
   KeyOutside(&fig);
   return fig;
-}
-
-namespace {
-
-/// The plots of the first test record as PNGs in dir; returns their names, *note says why some or all are missing.
-std::vector<std::string> WritePlots(const Result& r, const Traces& traces, const fs::path& dir, std::string* note) {
-  std::vector<std::string> pngs;
-  if (traces.test.empty()) {
-    *note = "<p>No traces: no plots.</p>\n";
-    return pngs;
-  }
-  if (!io::GnuplotAvailable()) {
-    *note = "<p>gnuplot is not installed (apt-get install gnuplot-nox): no plots.</p>\n";
-    return pngs;
-  }
-  const auto& t = traces.test[0];
-  const auto first = static_cast<std::size_t>(std::lround(r.options.warmup_s / t.dt_s));
-  std::vector<io::Figure> figs = {SpectrumFigure(t, "y", first), FrfFigure(t, first)};
-  if (!t.f_nom.empty()) figs.push_back(SpectrumFigure(t, "f", first));
-  figs.push_back(ConditionFigure(r));
-  figs.push_back(TraceFigure(t, "y"));
-  if (!t.f_nom.empty()) figs.push_back(TraceFigure(t, "f"));
-  for (const auto& f : figs) {
-    if (f.panels.empty()) continue;
-    try {
-      io::Plot(f, dir);
-      pngs.push_back(f.name + ".png");
-    } catch (const std::exception& e) {
-      *note += fmt::format("<p>plot {} failed: {}</p>\n", f.name, Esc(e.what()));
-    }
-  }
-  return pngs;
-}
-
-/// The head of the page: the verdict, the model, the records.
-std::string HeadHtml(const Result& r) {
-  std::string h;
-  h += "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>rths diagnose</title>\n<style>"
-       "body{font-family:sans-serif;max-width:1100px;margin:1em auto}table{border-collapse:collapse;margin:.5em 0}"
-       "td,th{border:1px solid #bbb;padding:2px 8px;text-align:right}th{background:#eee}td.l{text-align:left}"
-       ".sel{background:#dfd}</style></head><body>\n";
-  h += "<h1>Sim-to-real gap diagnosis</h1>\n";
-  h += fmt::format("<p><b>Verdict: {}</b></p>\n", Esc(fmt::format("{}", fmt::join(r.verdict, ", "))));
-  h += fmt::format("<p>Model: {}<br>Training records: {}<br>Test records: {}<br>dt = {} s, {} samples, runtime {:.2f} s</p>\n",
-                   Esc(r.model_source), Esc(fmt::format("{}", fmt::join(r.train, ", "))),
-                   Esc(fmt::format("{}", fmt::join(r.test, ", "))), r.dt_s, r.samples, r.runtime_s);
-  return h;
-}
-
-/// The gap per channel and the effects.
-std::string ChannelsAndEffectsHtml(const Result& r) {
-  std::string h;
-  h += "<h2>Gap per channel (test records)</h2>\n<table><tr><th>channel</th><th>NRMSE nominal [%]</th><th>train [%]</th>"
-       "<th>after [%]</th><th>noise floor rms</th><th>residual / floor</th><th>whiteness Q20</th><th>status</th></tr>\n";
-  for (const auto& c : r.channels) {
-    if (!c.diagnosed) {
-      h += fmt::format("<tr><td class=l>{}</td><td colspan=7 class=l>not diagnosed</td></tr>\n", c.channel);
-      continue;
-    }
-    h += fmt::format("<tr><td class=l>{}</td><td>{:.3f}</td><td>{:.3f}</td><td>{:.3f}</td><td>{:.4g} {}</td><td>{:.2f}</td>"
-                     "<td>{:.0f}</td><td class=l>{}</td></tr>\n",
-                     c.channel, c.gap_test_pct, c.gap_train_pct, c.after_test_pct, c.noise_rms, c.channel == "y" ? "mm" : "kN",
-                     c.floor_ratio, c.whiteness, c.status);
-  }
-  h += "</table>\n<h2>Effects (fitted on the training records, scored on the test records)</h2>\n"
-       "<table><tr><th>effect</th><th>channel</th><th>parameters</th><th>test NRMSE after [%]</th><th>shrink [%]</th>"
-       "<th>train NRMSE after [%]</th><th>selected</th></tr>\n";
-  for (const auto& e : r.effects) {
-    std::string ps;
-    for (const auto& [k, v] : e.params) ps += fmt::format("{} = {:.4g}<br>", k, v);
-    h += fmt::format("<tr{}><td class=l>{}</td><td>{}</td><td class=l>{}</td><td>{:.3f}</td><td>{:.1f}</td><td>{:.3f}</td>"
-                     "<td>{}</td></tr>\n",
-                     e.selected ? " class=sel" : "", e.name, e.channel, ps, e.test_nrmse_after, e.shrink_pct, e.train_nrmse_after,
-                     e.selected ? fmt::format("yes ({})", e.order + 1) : "no");
-  }
-  return h + "</table>\n";
-}
-
-/// Where: the frequency bands, the state conditions and the time windows.
-std::string WhereHtml(const Result& r) {
-  std::string h;
-  h += "<h2>Where: frequency bands (nominal residual, test records)</h2>\n<table><tr><th>channel</th><th>band [Hz]</th>"
-       "<th>residual share [%]</th><th>signal share [%]</th><th>residual / signal in band [%]</th><th>coherence</th>"
-       "<th>|H_meas / H_model|</th><th>phase diff [deg]</th></tr>\n";
-  for (const auto& b : r.bands) {
-    if (b.share_pct < 0.05 && b.signal_share_pct < 0.05) continue;
-    h += fmt::format("<tr><td class=l>{}</td><td>{:g}-{:g}</td><td>{:.1f}</td><td>{:.1f}</td><td>{:.2f}</td><td>{}</td><td>{}</td>"
-                     "<td>{}</td></tr>\n",
-                     b.channel, b.lo_hz, b.hi_hz, b.share_pct, b.signal_share_pct, b.rel_residual_pct,
-                     b.coherence >= 0 ? fmt::format("{:.3f}", b.coherence) : "",
-                     b.coherence >= 0 ? fmt::format("{:.3f}", b.gain_ratio) : "",
-                     b.coherence >= 0 ? fmt::format("{:.2f}", b.phase_diff_deg) : "");
-  }
-  h += "</table>\n<h2>Where: state conditions</h2>\n<table><tr><th>channel</th><th>condition</th><th>residual share [%]</th>"
-       "<th>sample share [%]</th><th>ratio</th><th>informative</th></tr>\n";
-  for (const auto& c : r.conditions)
-    h += fmt::format("<tr><td class=l>{}</td><td class=l>{}</td><td>{:.1f}</td><td>{:.1f}</td><td>{:.2f}</td><td class=l>{}</td></tr>\n",
-                     c.channel, c.name, c.share_pct, c.samples_pct, c.samples_pct > 0 ? c.share_pct / c.samples_pct : 0.0,
-                     c.informative         ? std::string("yes")
-                     : c.samples_pct <= 0.0 ? std::string("no: holds in no sample")
-                                            : fmt::format("no: holds in {:.0f} % of the samples (more than {:.0f} %)",
-                                                          c.samples_pct, r.options.max_condition_samples_pct));
-  h += "</table>\n<h2>Where: time windows (largest shares)</h2>\n<table><tr><th>channel</th><th>record</th><th>t0 [s]</th>"
-       "<th>t1 [s]</th><th>share [%]</th></tr>\n";
-  for (const auto& t : r.time)
-    h += fmt::format("<tr><td class=l>{}</td><td class=l>{}</td><td>{:.2f}</td><td>{:.2f}</td><td>{:.1f}</td></tr>\n", t.channel,
-                     Esc(t.record), t.t0_s, t.t1_s, t.share_pct);
-  return h + "</table>\n";
-}
-
-}  // namespace
-
-void WriteReport(const Result& r, const Traces& traces, const fs::path& dir) {
-  std::string plot_note;
-  const std::vector<std::string> pngs = WritePlots(r, traces, dir, &plot_note);
-  std::string h = HeadHtml(r) + ChannelsAndEffectsHtml(r) + WhereHtml(r);
-  if (!r.warnings.empty()) {
-    h += "<h2>Warnings</h2>\n<ul>\n";
-    for (const auto& w : r.warnings) h += "<li>" + Esc(w) + "</li>\n";
-    h += "</ul>\n";
-  }
-  h += "<h2>Plots</h2>\n" + plot_note;
-  for (const auto& p : pngs) h += fmt::format("<p><img src=\"{}\" alt=\"{}\" style=\"max-width:100%\"></p>\n", p, p);
-  h += "<p>Method: docs/diagnosis.md. JSON: diagnosis.json.</p>\n</body></html>\n";
-  std::ofstream f(dir / "report.html");
-  if (!(f << h)) throw Error((dir / "report.html").string(), "cannot write");
 }
 
 }  // namespace rths::diagnosis

@@ -30,6 +30,7 @@ th { font-weight: 600; white-space: nowrap; }
 figure { margin: 1em 0 2em 0; }
 figure img { max-width: 100%; border: 1px solid #ddd; }
 figcaption { color: #444; font-size: 0.95em; margin-top: 0.3em; }
+tr.sel td { background: #dfd; }
 pre { background: #f6f6f6; padding: 0.8em; overflow-x: auto; font-size: 0.9em; }
 )";
 

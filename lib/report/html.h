@@ -1,5 +1,5 @@
 #pragma once
-/// @file The small HTML writer of rths's pages (the run report, docs/report.md): escaping, a
+/// @file The small HTML writer of rths's pages (the run report, docs/report.md; the diagnosis page): escaping, a
 /// table row, the head of a page with the shared style sheet, and an atomic file write. Pages are
 /// self-contained: no JavaScript, no network.
 #include <filesystem>
@@ -15,7 +15,7 @@ std::string HtmlEscape(const std::string& text);
 std::string HtmlRow(const std::string& name, const std::string& value_html, const std::string& id = "");
 
 /// The start of a page up to and including `<body>`: doctype, UTF-8, the title (escaped here) and
-/// the shared style sheet (headings, tables, banners `.banner.failed|.note|.ok`, figures, `.where`).
+/// the shared style sheet (headings, tables, banners `.banner.failed|.note|.ok`, a selected row `tr.sel`, figures, `.where`).
 std::string HtmlHead(const std::string& title);
 
 /// Writes `text` to `path` through `path.tmp` and a rename, so that a reader never sees half a
