@@ -146,7 +146,7 @@ struct Split {
 };
 
 double TimeIntegrator(const rths::scenario::Scenario& s, const std::vector<Row>& rows) {
-  const auto structure = rths::models::StructureFromScenario(s.structure, s.path);
+  const auto structure = rths::models::StructureFromScenario(s.structure);
   const auto cd = rths::models::CentralDifference::Make(structure, s.run.dt_s);
   auto state = rths::models::MakeState(cd);
   rths::control::ExtrapolationState ex{};

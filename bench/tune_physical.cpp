@@ -59,7 +59,7 @@ struct Eval {
 };
 
 std::vector<double> Command(double seconds) {
-  return signal::MakeSignal(report::FrequencyExcitation(), kDt, static_cast<std::size_t>(std::lround(seconds / kDt)), "");
+  return signal::MakeSignal(report::FrequencyExcitation(), kDt, static_cast<std::size_t>(std::lround(seconds / kDt)));
 }
 
 // Experimental, not in the library: a high-passed load-pressure ("delta-P") feedback in the

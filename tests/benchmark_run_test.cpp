@@ -45,7 +45,8 @@ std::vector<double> ElCentro(std::size_t n) {
   g.file = kElCentro;
   g.file_dt_s = 0.02;
   g.scale = 0.4 * 9806.65;
-  return rths::signal::MakeSignal(g, kDt, n, "");
+  g.record = rths::signal::ReadHistoryFile(kElCentro, g.file_dt_s);
+  return rths::signal::MakeSignal(g, kDt, n);
 }
 
 /// A 3-story partitioned run: the numerical substructure, an ideal plant without a specimen.
@@ -196,6 +197,7 @@ TEST_CASE("a memq run with structure.reference_file: J1-J9 from its log, in summ
   // built here by hand from the log's columns and an independent integration of the reference.
   rths::scenario::Scenario s_ref = s;
   s_ref.structure.reference_file = kBuildings + "silva3_reference_case1.txt";
+  rths::scenario::ReadReferencedFiles(&s_ref);
   const rths::io::RunLog log = rths::io::ReadRunLog((dir / "log.lcm").string());
   const rths::signal::BenchmarkCriteria got = rths::io::BenchmarkCriteriaOfRun(log, s_ref);
   const rths::io::RunSignals sig = rths::io::SignalsFromRunLog(log, s.run.dt_s);

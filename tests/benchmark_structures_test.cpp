@@ -208,7 +208,8 @@ TEST_CASE("the iota line: read, written only when not ones, refused when short, 
   st.kind = StructureKind::kFile;
   st.file = (dir / "iota.txt").string();
   st.actuator_dof = 1;
-  const LinearStructure s = StructureFromScenario(st, "test.toml");
+  st.matrices = LoadStructureFile(st.file);  // the scenario loader's part
+  const LinearStructure s = StructureFromScenario(st);
   CHECK(s.iota(0) == 1.25);
   CHECK(s.iota(1) == 1.0);
   const double dt = 1e-3;
@@ -221,5 +222,6 @@ TEST_CASE("the iota line: read, written only when not ones, refused when short, 
   CHECK(state.abs_acc_prev(0) == doctest::Approx(state.acc_prev(0) + 1.25 * 1000.0).epsilon(1e-12));
   CHECK(state.abs_acc_prev(1) == doctest::Approx(state.acc_prev(1) + 1000.0).epsilon(1e-12));
   st.file = (dir / "ones.txt").string();
-  CHECK(StructureFromScenario(st, "test.toml").iota == Eigen::VectorXd::Ones(2));
+  st.matrices = LoadStructureFile(st.file);
+  CHECK(StructureFromScenario(st).iota == Eigen::VectorXd::Ones(2));
 }

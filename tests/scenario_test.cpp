@@ -14,6 +14,8 @@
 #include <vector>
 
 #include "core/error.h"
+#include "models/structure_file.h"
+#include "signal/history.h"
 #include "test_support.h"
 
 namespace fs = std::filesystem;
@@ -491,6 +493,7 @@ TEST_CASE("round trip of a scenario whose every field differs from its default: 
     CAPTURE(rig_mode);
     Scenario s = EveryFieldChanged(dir, rig_mode);
     s.path = (dir / "every.toml").string();
+    rths::scenario::ReadReferencedFiles(&s);  // as ParseScenario does: the desired record's rows
     rths::scenario::ValidateScenario(s);  // the test's scenario is itself valid
     // Every table differs from its default as a whole.
     const Scenario defaults;
@@ -528,7 +531,8 @@ TEST_CASE("round trip of a scenario whose every field differs from its default: 
 TEST_CASE("a field changed away from its default survives ToToml one at a time (no key silently dropped)") {
   // Each single change must show up in the text ToToml writes and come back from it.
   const fs::path dir = TempDir("one_field");
-  const Scenario changed = EveryFieldChanged(dir, true);
+  Scenario changed = EveryFieldChanged(dir, true);
+  rths::scenario::ReadReferencedFiles(&changed);  // as ParseScenario does: the desired record's rows
   const Scenario base;
   const std::string base_text = rths::scenario::ToToml(base);
   std::vector<std::pair<const char*, std::function<void(Scenario&)>>> edits = {
@@ -553,4 +557,74 @@ TEST_CASE("a field changed away from its default survives ToToml one at a time (
     back.sha256 = s.sha256;
     CHECK(back == s);
   }
+}
+
+TEST_CASE("the loader reads every file the scenario names, once, into the structs; components need no path") {
+  const fs::path dir = TempDir("referenced");
+  const std::string two = "n 2\nM kg\n1000 0\n0 1000\nK kN/mm\n2 -1\n-1 1\nC kN*s/mm\n0.01 0\n0 0.01\n";
+  WriteFile(dir / "two.txt", two);
+  WriteFile(dir / "ref.txt", two);
+  WriteFile(dir / "ground.txt", "# g\n0.0\n1.0\n-0.5\n");
+  WriteFile(dir / "desired.txt", "0 0\n0.5 2\n1 0\n");
+  const std::string text = R"(
+[structure]
+kind = "file"
+file = "two.txt"
+reference_file = "ref.txt"
+actuator_dof = 2
+[structure.ground]
+kind = "file"
+file = "ground.txt"
+file_dt_s = 0.01
+[structure.desired]
+kind = "file"
+file = "desired.txt"
+)";
+  WriteFile(dir / "x.toml", text);
+  const Scenario s = LoadScenario((dir / "x.toml").string());
+  const rths::models::StructureMatrices m = rths::models::LoadStructureFile((dir / "two.txt").string());
+  CHECK(s.structure.matrices == m);
+  CHECK(s.structure.reference == m);
+  CHECK(s.structure.ground.record.t == std::vector<double>{0.0, 0.01, 0.02});
+  CHECK(s.structure.ground.record.value == std::vector<double>{0.0, 1.0, -0.5});
+  CHECK(s.structure.desired.record.t == std::vector<double>{0.0, 0.5, 1.0});
+  CHECK(s.structure.desired.record.value == std::vector<double>{0.0, 2.0, 0.0});
+  // The paths stay (absolute); ToToml writes them, not the data, and reads back the same scenario.
+  CHECK(fs::equivalent(s.structure.file, dir / "two.txt"));
+  const std::string written = rths::scenario::ToToml(s);
+  CHECK(written.find((dir / "two.txt").string()) != std::string::npos);
+  Scenario back = ParseScenario(written, (dir / "y.toml").string());
+  back.path = s.path;
+  back.sha256 = s.sha256;
+  CHECK(back == s);
+  // The components take the data: with the files gone, the structure and the records still build.
+  for (const char* f : {"two.txt", "ref.txt", "ground.txt", "desired.txt"}) fs::remove(dir / f);
+  CHECK(rths::models::StructureFromScenario(s.structure).dofs() == 2);
+  const std::vector<double> ag = rths::signal::MakeSignal(s.structure.ground, 0.01, 4);
+  CHECK(ag == std::vector<double>{0.0, 1.0, -0.5, 0.0});
+
+  // Missing or bad files: the same errors as before, naming the scenario and key, or the file and line.
+  CheckContains(ErrorOf(text, (dir / "x.toml").string()),
+                {"x.toml: structure.file: file not found", (dir / "two.txt").string()});
+  WriteFile(dir / "two.txt", "n 2\nM kg\n1000 0\n");
+  WriteFile(dir / "ref.txt", two);
+  WriteFile(dir / "ground.txt", "0.0\n1.0\n");
+  WriteFile(dir / "desired.txt", "0 0\n1 0\n");
+  CheckContains(ErrorOf(text, (dir / "x.toml").string()), {(dir / "two.txt").string() + ":", "file ends inside M"});
+  WriteFile(dir / "ref.txt", "n 2\nM kg\n");
+  CheckContains(ErrorOf(text, (dir / "x.toml").string()),
+                {"x.toml: structure.reference_file: ", (dir / "ref.txt").string(), "file ends inside M"});
+  WriteFile(dir / "two.txt", two);
+  WriteFile(dir / "ref.txt", "n 1\nM kg\n1\nK kN/mm\n1\nC kN*s/mm\n0\n");
+  CheckContains(ErrorOf(text, (dir / "x.toml").string()),
+                {"x.toml: structure.reference_file: ref.txt has 1 DOFs but structure.file (two.txt) has 2"});
+  WriteFile(dir / "ref.txt", two);
+  WriteFile(dir / "ground.txt", "0.0\nabc\n");
+  CheckContains(ErrorOf(text, (dir / "x.toml").string()),
+                {(dir / "ground.txt").string() + ":2", "'abc' is not a finite number"});
+  WriteFile(dir / "ground.txt", "0.0\n1.0\n");
+  std::string three = text;
+  three.replace(three.find("actuator_dof = 2"), 16, "actuator_dof = 3");
+  CheckContains(ErrorOf(three, (dir / "x.toml").string()),
+                {"x.toml: structure.actuator_dof", "3 is out of range [1, 2]", (dir / "two.txt").string() + " has 2 DOFs"});
 }

@@ -428,21 +428,22 @@ TEST_CASE("history: MakeSignal dispatches on kind") {
   const double dt = 0.0005;
   rths::signal::SignalSpec spec;
   spec.kind = rths::signal::SignalKind::kZero;
-  CHECK(sig::MakeSignal(spec, dt, 5, "") == std::vector<double>(5, 0.0));
+  CHECK(sig::MakeSignal(spec, dt, 5) == std::vector<double>(5, 0.0));
 
   spec.kind = rths::signal::SignalKind::kBlwn;
   spec.band_hz = 15.0;
   spec.rms = 0.595;
   spec.seed = 4;
   spec.discard_s = 2.0;
-  CHECK(sig::MakeSignal(spec, dt, 3000, "") == sig::Blwn(15.0, 0.595, dt, 3000, 4, 2.0));
+  CHECK(sig::MakeSignal(spec, dt, 3000) == sig::Blwn(15.0, 0.595, dt, 3000, 4, 2.0));
 
   WriteFile("ramp.txt", "0\n1\n2\n");
   spec.kind = rths::signal::SignalKind::kFile;
-  spec.file = "ramp.txt";  // relative to the scenario folder
+  spec.file = "ramp.txt";
   spec.file_dt_s = 0.001;
   spec.scale = 10.0;
-  const auto x = sig::MakeSignal(spec, dt, 6, ScratchDir().string());
+  spec.record = sig::ReadHistoryFile((ScratchDir() / spec.file).string(), spec.file_dt_s);  // the loader's part
+  const auto x = sig::MakeSignal(spec, dt, 6);
   const std::vector<double> expect = {0.0, 5.0, 10.0, 15.0, 20.0, 0.0};
   for (std::size_t k = 0; k < 6; ++k) CHECK(x[k] == doctest::Approx(expect[k]).epsilon(1e-12));
 }

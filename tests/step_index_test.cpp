@@ -41,7 +41,7 @@ current_A = 1.25
   const std::int64_t n = s.steps();
   REQUIRE(log.CompleteSteps() == n);
 
-  const auto r = rths::signal::MakeSignal(s.structure.desired, s.run.dt_s, n, dir.string());
+  const auto r = rths::signal::MakeSignal(s.structure.desired, s.run.dt_s, n);
   const auto servo = rths::models::LinearServo::Make(s.plant.actuator, s.run.dt_s);
   rths::models::LinearServoState z;
   rths::control::ExtrapolationState ex;
@@ -96,7 +96,7 @@ mode = "passive_on"
   REQUIRE(log.CompleteSteps() == n);
 
   // Integrator offline: central difference driven by the logged forces.
-  const auto ag = rths::signal::MakeSignal(s.structure.ground, s.run.dt_s, n, dir.string());
+  const auto ag = rths::signal::MakeSignal(s.structure.ground, s.run.dt_s, n);
   const auto structure = rths::models::LinearStructure::Sdof(
       s.structure.mass_kg, s.structure.frequency_hz, s.structure.damping_ratio, s.structure.specimen_count);
   const auto cd = rths::models::CentralDifference::Make(structure, s.run.dt_s);

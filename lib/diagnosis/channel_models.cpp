@@ -8,6 +8,7 @@
 #include <toml++/toml.h>
 
 #include "core/error.h"
+#include "scenario/from_toml.h"
 #include "signal/butterworth.h"
 
 namespace rths::diagnosis {
@@ -25,7 +26,7 @@ NominalModel LoadModel(const std::string& path) {
   const auto* plant = tbl["plant"].as_table();
   const bool actuator_only = !tbl.contains("run") && !tbl.contains("structure") &&
                              (plant == nullptr || (!plant->contains("specimen") && !plant->contains("damper")));
-  const scenario::Scenario s = scenario::LoadScenario(path);
+  const scenario::Scenario s = scenario::ScenarioFromToml(tbl, path);  // the table parsed above: once
   NominalModel m;
   m.actuator = s.plant.actuator;
   m.damper = s.plant.damper;

@@ -78,8 +78,8 @@ NominalModel PaperModel();
 /// [plant.damper], current_dynamics) or a file written by `rths identify` (an actuator only).
 /// A file is taken as actuator-only when it has no [run] and no [structure] table and its
 /// [plant] table has neither `specimen` nor `damper`: then has_damper = false (the force channel
-/// is not diagnosed) and the rest is read with the scenario parser. Throws rths::Error naming the
-/// file and key.
+/// is not diagnosed) and the rest is read with the scenario parser (the file is opened and parsed
+/// once: scenario::ScenarioFromToml). Throws rths::Error naming the file and key.
 NominalModel LoadModel(const std::string& path);
 
 /// Zero-phase smoothing of y and its velocity (file comment, step 1).

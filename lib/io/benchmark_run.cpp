@@ -12,12 +12,8 @@ models::LinearStructure ReferenceStructure(const scenario::Scenario& s, int run_
   const std::string where = fmt::format("{}: structure.reference_file", s.path.empty() ? "<scenario text>" : s.path);
   const models::StructureConfig& st = s.structure;
   if (st.reference_file.empty()) throw Error(where, "not set: the criteria need a reference structure");
-  models::StructureMatrices m;
-  try {
-    m = models::LoadStructureFile(st.reference_file);
-  } catch (const Error& e) {
-    throw Error(where, e.what());
-  }
+  const models::StructureMatrices& m = st.reference;  // read by the scenario loader
+  if (m.M.rows() == 0) throw Error(where, fmt::format("{}: not read (scenario::LoadScenario reads it)", st.reference_file));
   if (m.M.rows() != run_dofs)
     throw Error(where, fmt::format("{} has {} DOFs but the run's structure has {}: they must match", st.reference_file,
                                    m.M.rows(), run_dofs));

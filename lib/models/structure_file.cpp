@@ -147,6 +147,13 @@ void WriteStructureFile(const std::string& path, const StructureMatrices& m, con
   if (!out.flush()) throw Error(path, "cannot write the structure file");
 }
 
+bool StructureMatrices::operator==(const StructureMatrices& o) const {
+  const auto same = [](const auto& a, const auto& b) {
+    return a.rows() == b.rows() && a.cols() == b.cols() && (a.size() == 0 || a == b);
+  };
+  return same(M, o.M) && same(K, o.K) && same(C, o.C) && same(iota, o.iota);
+}
+
 Eigen::VectorXd StructureMatrices::IotaOrOnes() const {
   return iota.size() ? iota : Eigen::VectorXd::Ones(M.rows());
 }
@@ -194,15 +201,17 @@ Modes ModalAnalysis(const StructureMatrices& m) {
   return out;
 }
 
-LinearStructure StructureFromScenario(const models::StructureConfig& st, const std::string& scenario_path) {
+LinearStructure StructureFromScenario(const models::StructureConfig& st) {
   if (st.kind != StructureKind::kFile) {
     return LinearStructure::Sdof(st.mass_kg, st.frequency_hz, st.damping_ratio, st.specimen_count);
   }
-  const StructureMatrices m = LoadStructureFile(st.file);
+  const StructureMatrices& m = st.matrices;
+  if (m.M.rows() == 0) {
+    throw Error("structure.file", fmt::format("{}: not read (scenario::LoadScenario reads it)", st.file));
+  }
   if (st.actuator_dof > m.M.rows()) {
-    throw Error(scenario_path + ": structure.actuator_dof",
-                fmt::format("{} is out of range [1, {}] ({} has {} DOFs)", st.actuator_dof, m.M.rows(), st.file,
-                            m.M.rows()));
+    throw Error("structure.actuator_dof", fmt::format("{} is out of range [1, {}] ({} has {} DOFs)", st.actuator_dof,
+                                                      m.M.rows(), st.file, m.M.rows()));
   }
   LinearStructure s = LinearStructure::Make(m.M, m.C, m.K, st.actuator_dof - 1, st.specimen_count);
   if (m.iota.size()) s.iota = m.iota;  // the file's ground influence (default ones, from Make)

@@ -42,7 +42,21 @@ enum class Derivatives { kExtrapolated, kCentral };
 inline constexpr std::array<Named<Derivatives>, 2> kDerivativesNames = {
     {{Derivatives::kExtrapolated, "extrapolated"}, {Derivatives::kCentral, "central"}}};
 
-/// Numerical substructure (procs/integrator).
+/// M [kN s^2/mm], K [kN/mm], C [kN s/mm], and the ground influence vector iota [-] (empty: ones).
+struct StructureMatrices {
+  Eigen::MatrixXd M, K, C;
+  Eigen::VectorXd iota;  ///< n entries, or empty for ones (a shear building)
+  /// iota if it is set, else ones (n = M.rows()).
+  Eigen::VectorXd IotaOrOnes() const;
+  /// Same sizes and the same values (empty matrices are equal).
+  bool operator==(const StructureMatrices& o) const;
+};
+
+/// Numerical substructure (procs/integrator). Config is parsed and every file it names is read
+/// once, at the edge: `file` and `reference_file` stay the paths the scenario names (ToToml writes
+/// them, the scenario's hash is of its text); `matrices` and `reference` hold what they contain,
+/// filled by the scenario loader (scenario::ReadReferencedFiles). Components take the data, never
+/// the paths.
 struct StructureConfig {
   StructureMode mode = StructureMode::kRths;  ///< "rths" (central difference, Eqs. 1-3) | "predefined" (r from a history)
   /// mode = "rths": "sdof" (mass, frequency, damping below) | "file" (M, K, C from `file`, a
@@ -66,15 +80,11 @@ struct StructureConfig {
   /// How the integrator gets r', r'', r''' in predefined mode: "extrapolated" (Eqs. 20-22, the
   /// causal RTHS path) | "central" (offline, non-causal central differences of the known record).
   Derivatives derivatives = Derivatives::kExtrapolated;
+  /// mode = "rths", kind = "file": the matrices of `file` (LoadStructureFile); empty otherwise.
+  StructureMatrices matrices{};
+  /// The matrices of `reference_file`; empty if there is none.
+  StructureMatrices reference{};
   bool operator==(const StructureConfig&) const = default;
-};
-
-/// M [kN s^2/mm], K [kN/mm], C [kN s/mm], and the ground influence vector iota [-] (empty: ones).
-struct StructureMatrices {
-  Eigen::MatrixXd M, K, C;
-  Eigen::VectorXd iota;  ///< n entries, or empty for ones (a shear building)
-  /// iota if it is set, else ones (n = M.rows()).
-  Eigen::VectorXd IotaOrOnes() const;
 };
 
 /// Reads a structure file; throws rths::Error naming the file, line and problem (missing or
@@ -105,10 +115,10 @@ struct Modes {
 };
 Modes ModalAnalysis(const StructureMatrices& m);
 
-/// The numerical substructure a scenario describes: the SDOF of [structure], or the matrices of
-/// structure.file (and its iota, carried into LinearStructure::iota) with the specimen on
-/// structure.actuator_dof (1-based). Throws rths::Error naming the scenario key or the structure
-/// file's line.
-LinearStructure StructureFromScenario(const models::StructureConfig& st, const std::string& scenario_path);
+/// The numerical substructure a scenario describes: the SDOF of [structure], or st.matrices (the
+/// structure file's, with its iota carried into LinearStructure::iota) with the specimen on
+/// structure.actuator_dof (1-based). Throws rths::Error naming "structure.file" if the matrices
+/// were not read, or "structure.actuator_dof" if it exceeds their DOFs (the loader checks both).
+LinearStructure StructureFromScenario(const models::StructureConfig& st);
 
 }  // namespace rths::models

@@ -55,7 +55,7 @@ lockstep::Faults FaultsOf(const scenario::Scenario& s, std::string_view role) {
 OutputBytes EstimateOutputBytes(const scenario::Scenario& s) {
   const int n_dof = s.structure.mode == models::StructureMode::kPredefined
                         ? 1
-                        : static_cast<int>(models::StructureFromScenario(s.structure, s.path).M.rows());
+                        : static_cast<int>(models::StructureFromScenario(s.structure).M.rows());
   const double steps = static_cast<double>(s.steps());
   const double log_step = static_cast<double>(LogBytesPerStep(n_dof));
   const double row = static_cast<double>(StoredBytesPerStep(n_dof)) - log_step;

@@ -1,7 +1,5 @@
 #include "participants/integrator.h"
 
-#include <filesystem>
-
 #include <fmt/format.h>
 
 #include "core/error.h"
@@ -12,14 +10,14 @@
 namespace rths::participants {
 
 namespace {
-/// The scenario's numerical substructure, its histories read for `n` steps.
+/// The scenario's numerical substructure, its histories made for `n` steps from the data the scenario
+/// loader read (never the files themselves).
 models::NumericalSubstructure MakeSubstructure(const scenario::Scenario& s, std::size_t n) {
-  const std::string dir = std::filesystem::path(s.path).parent_path().string();
   if (s.structure.mode == models::StructureMode::kPredefined) {
-    return models::NumericalSubstructure::Predefined(signal::MakeSignal(s.structure.desired, s.run.dt_s, n, dir));
+    return models::NumericalSubstructure::Predefined(signal::MakeSignal(s.structure.desired, s.run.dt_s, n));
   }
-  auto m = models::NumericalSubstructure::Integrated(models::StructureFromScenario(s.structure, s.path), s.run.dt_s, {});
-  m.ground_mm_s2 = signal::MakeSignal(s.structure.ground, s.run.dt_s, n, dir);  // after the structure's checks
+  auto m = models::NumericalSubstructure::Integrated(models::StructureFromScenario(s.structure), s.run.dt_s, {});
+  m.ground_mm_s2 = signal::MakeSignal(s.structure.ground, s.run.dt_s, n);  // after the structure's checks
   return m;
 }
 }  // namespace

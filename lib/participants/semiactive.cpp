@@ -14,7 +14,7 @@ Semiactive::Semiactive(const scenario::Scenario& s, lockstep::RunIdentity id, lc
     const control::ClippedOptimalOptions o{s.semiactive.r_weight, s.semiactive.noise_ratio,
                                            s.semiactive.capacity_kN, s.semiactive.max_current_A};
     clipped_ = std::make_unique<control::ClippedOptimal>(control::DesignClippedOptimal(
-        models::StructureFromScenario(s.structure, s.path), s.run.dt_s, o));
+        models::StructureFromScenario(s.structure), s.run.dt_s, o));
   } else {
     schedule_.emplace(s.semiactive, s.run.dt_s);
   }

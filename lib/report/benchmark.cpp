@@ -175,7 +175,10 @@ scenario::Scenario BenchmarkScenario(const scenario::Scenario& base, const std::
   s.controller = controller;
   s.plant.benchmark.params = plant;
   s.plant.noise_seed = noise_seed;
-  if (!numerical_file.empty()) s.structure.file = numerical_file;
+  if (!numerical_file.empty()) {
+    s.structure.file = numerical_file;
+    scenario::ReadReferencedFiles(&s);
+  }
   return s;
 }
 

@@ -105,15 +105,14 @@ LoopResult RunBenchmarkLoop(const scenario::Scenario& s, const LoopOptions& o) {
   }
   const double dt = s.run.dt_s;
   const auto n = static_cast<std::size_t>(s.steps());
-  const std::string dir = std::filesystem::path(s.path).parent_path().string();
 
-  const models::LinearStructure st = models::StructureFromScenario(s.structure, s.path);
+  const models::LinearStructure st = models::StructureFromScenario(s.structure);
   const models::LinearStructure ref = io::ReferenceStructure(s, st.dofs());
   const int a = st.actuator_dof;
-  const std::vector<double> ground = signal::MakeSignal(s.structure.ground, dt, n, dir);
+  const std::vector<double> ground = signal::MakeSignal(s.structure.ground, dt, n);
   std::vector<double> ground_half;  // a_g at k dt/2 (rk4 stages)
   if (o.substructure == LoopIntegration::kRk4 || o.reference == LoopIntegration::kRk4) {
-    ground_half = signal::MakeSignal(s.structure.ground, 0.5 * dt, 2 * n + 1, dir);
+    ground_half = signal::MakeSignal(s.structure.ground, 0.5 * dt, 2 * n + 1);
   }
 
   const std::unique_ptr<models::Rig> rig = models::MakeRig(s.plant, dt);

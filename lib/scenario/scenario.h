@@ -1,5 +1,6 @@
 #pragma once
-/// @file Scenario: a TOML file parsed once, at the edge, into plain structs with defaults.
+/// @file Scenario: a TOML file parsed once, at the edge, into plain structs with defaults; every
+/// file it names (structure, reference structure, signal records) is read once there too.
 ///
 /// Units follow docs/units.md: paper units (mm, kN, s, A) everywhere; the only other edge
 /// unit is mass, given in kg in the file and converted to kN s^2/mm by the components.
@@ -34,7 +35,11 @@ struct RunConfig {
 
 /// Everything a run needs, gathered from one file: each table's struct lives beside the component
 /// that uses it (models, control, safety, lockstep); this library only reads, validates and
-/// writes them.
+/// writes them. Config is parsed and every file it names is read once, at the edge: the loader
+/// fills the data members (models::StructureConfig::matrices and reference,
+/// signal::SignalSpec::record) beside the paths, which stay as the file names them (ToToml writes
+/// them; `sha256` is the hash of the scenario text). Components (participants, the supervisor's
+/// estimates) take the data, never paths or environment variables; each process loads once.
 struct Scenario {
   std::string path;     ///< file it came from ("" if parsed from text)
   std::string sha256;   ///< hex SHA-256 of the file's bytes (the handshake compares these)
@@ -53,13 +58,23 @@ struct Scenario {
   bool operator==(const Scenario&) const = default;
 };
 
-/// Reads, hashes, parses and validates a scenario file. Throws rths::Error.
+/// Reads, hashes, parses and validates a scenario file, and reads every file it names
+/// (ReadReferencedFiles). Throws rths::Error.
 Scenario LoadScenario(const std::string& path);
-/// Parses and validates TOML text; `path` is used in messages and to resolve relative files.
+/// Parses and validates TOML text, then reads the files it names (ReadReferencedFiles) and makes
+/// their paths absolute; `path` is used in messages and to resolve relative files.
 Scenario ParseScenario(std::string_view toml_text, const std::string& path);
 /// Checks every range and cross-field limit (the second half of ParseScenario); for scenarios
 /// built or modified in code. Messages name s.path. Throws rths::Error.
 void ValidateScenario(const Scenario& s);
+/// Reads every file `s` names, once, into its data members: structure.matrices (structure.file, for
+/// mode "rths" and kind "file"), structure.reference (structure.reference_file), and the rows of
+/// structure.ground and structure.desired (kind "file"); the others are cleared. Relative paths are
+/// taken relative to s->path's folder. ParseScenario calls it; a scenario changed in code calls it
+/// after changing a path. Throws rths::Error: a structure or signal file's own error (naming the file
+/// and line), "<scenario>: structure.reference_file" (unreadable, or other DOFs than
+/// structure.file), "<scenario>: structure.actuator_dof" (beyond the structure's DOFs).
+void ReadReferencedFiles(Scenario* s);
 /// The scenario as TOML text with every key written out (ParseScenario of it gives back the same
 /// scenario). Used to store programmatic variants as files, so every run has a real file and hash.
 std::string ToToml(const Scenario& s);

@@ -4,7 +4,6 @@
 #include <charconv>
 #include <cmath>
 #include <numbers>
-#include <filesystem>
 #include <fstream>
 #include <string_view>
 
@@ -142,7 +141,14 @@ std::vector<double> LoadHistory(const std::string& path, double file_dt_s, doubl
   if (!(start_s >= 0.0) || !std::isfinite(start_s)) {
     throw Error(path, fmt::format("start_s = {}: allowed >= 0", start_s));
   }
+  return ResampleHistory(ReadHistoryFile(path, file_dt_s), file_dt_s, scale, dt_s, n, start_s);
+}
 
+HistoryRecord ReadHistoryFile(const std::string& path, double file_dt_s) {
+  if (!(file_dt_s >= 0.0) || !std::isfinite(file_dt_s)) {
+    throw Error(path, fmt::format("file_dt_s = {}: allowed > 0, or 0 for a file with a time column",
+                                  file_dt_s));
+  }
   const bool has_time = file_dt_s == 0.0;
   std::vector<Row> rows = ReadRows(path, has_time);
   if (has_time) {
@@ -150,6 +156,28 @@ std::vector<double> LoadHistory(const std::string& path, double file_dt_s, doubl
   } else {
     for (std::size_t j = 0; j < rows.size(); ++j) rows[j].t = static_cast<double>(j) * file_dt_s;
   }
+  HistoryRecord record;
+  record.t.reserve(rows.size());
+  record.value.reserve(rows.size());
+  for (const Row& r : rows) {
+    record.t.push_back(r.t);
+    record.value.push_back(r.value);
+  }
+  return record;
+}
+
+std::vector<double> ResampleHistory(const HistoryRecord& record, double file_dt_s, double scale, double dt_s,
+                                    std::size_t n, double start_s) {
+  if (record.t.empty() || record.t.size() != record.value.size()) {
+    throw Error("history", "no data rows (the record was not read: ReadHistoryFile)");
+  }
+  if (!(dt_s > 0.0) || !std::isfinite(dt_s)) throw Error("history", fmt::format("dt_s = {}: allowed > 0", dt_s));
+  if (!std::isfinite(scale)) throw Error("history", fmt::format("scale = {}: must be finite", scale));
+  if (!(start_s >= 0.0) || !std::isfinite(start_s)) {
+    throw Error("history", fmt::format("start_s = {}: allowed >= 0", start_s));
+  }
+  std::vector<Row> rows(record.t.size());
+  for (std::size_t j = 0; j < rows.size(); ++j) rows[j] = Row{record.t[j], record.value[j], 0};
   if (start_s > 0.0) {  // zeros at the file's own step before and after, then the delay
     const double first_step = rows.size() > 1 ? rows[1].t - rows[0].t : file_dt_s;
     const double last_step = rows.size() > 1 ? rows.back().t - rows[rows.size() - 2].t : file_dt_s;
@@ -186,20 +214,19 @@ std::vector<double> LoadHistory(const std::string& path, double file_dt_s, doubl
   return x;
 }
 
-std::vector<double> MakeSignal(const signal::SignalSpec& spec, double dt_s, std::size_t n,
-                               const std::string& scenario_dir) {
+std::vector<double> MakeSignal(const signal::SignalSpec& spec, double dt_s, std::size_t n) {
   std::vector<double> x;
   switch (spec.kind) {
     case SignalKind::kBlwn:
       x = Blwn(spec.band_hz, spec.rms, dt_s, n, spec.seed, spec.discard_s);
       break;
-    case SignalKind::kFile: {
-    if (spec.file.empty()) throw Error("signal.file", "empty path for kind = \"file\"");
-    std::filesystem::path p(spec.file);
-    if (p.is_relative() && !scenario_dir.empty()) p = std::filesystem::path(scenario_dir) / p;
-    x = LoadHistory(p.string(), spec.file_dt_s, spec.scale, dt_s, n, spec.start_s);
+    case SignalKind::kFile:
+      if (spec.record.t.empty()) {
+        throw Error(spec.file.empty() ? "signal.file" : spec.file,
+                    "not read: a kind = \"file\" signal needs the file's rows (scenario::LoadScenario reads them)");
+      }
+      x = ResampleHistory(spec.record, spec.file_dt_s, spec.scale, dt_s, n, spec.start_s);
       break;
-    }
     case SignalKind::kZero:
       x.assign(n, 0.0);
       break;

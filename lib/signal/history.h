@@ -15,7 +15,17 @@ enum class SignalKind { kBlwn, kFile, kZero };
 inline constexpr std::array<Named<SignalKind>, 3> kSignalKindNames = {
     {{SignalKind::kBlwn, "blwn"}, {SignalKind::kFile, "file"}, {SignalKind::kZero, "zero"}}};
 
+/// A time-history file's data rows as read (ReadHistoryFile): the time of each row [s] (the file's
+/// time column, or j file_dt_s for a one-column file) and its value in the file's unit.
+struct HistoryRecord {
+  std::vector<double> t;
+  std::vector<double> value;
+  bool operator==(const HistoryRecord&) const = default;
+};
+
 /// A time history generated or read at the edge (ground acceleration or desired displacement).
+/// Config is parsed and every file it names is read once, at the edge: `file` stays the path the
+/// scenario names (ToToml writes it), `record` holds its rows (scenario::ReadReferencedFiles).
 struct SignalSpec {
   SignalKind kind = SignalKind::kBlwn;  ///< "blwn" | "file" | "zero"
   // kind = "blwn": Gaussian white noise through an 8th-order Butterworth low-pass at band_hz,
@@ -35,10 +45,14 @@ struct SignalSpec {
   /// zeros before and after at the file's own step (the RTHS benchmark's ElCentroAccelNoScaling is
   /// our El Centro record with start_s = 5: 5 s of zeros, the record, then zeros).
   double start_s = 0.0;
+  /// kind = "file": the rows of `file`, read once by the scenario loader (ReadHistoryFile); empty
+  /// for the other kinds. MakeSignal resamples them.
+  HistoryRecord record{};
   bool operator==(const SignalSpec&) const = default;
 };
 
-/// Reads a time history from a text file and resamples it to the run's step.
+/// Reads a time history from a text file and resamples it to the run's step (ReadHistoryFile, then
+/// ResampleHistory).
 ///
 /// Format: one data row per line; fields separated by whitespace or by commas (with optional
 /// whitespace around them); '#' starts a comment to the end of the line; blank lines are
@@ -56,16 +70,23 @@ struct SignalSpec {
 /// cannot be read or has no data rows; and for file_dt_s < 0, dt_s <= 0 or a non-finite scale.
 std::vector<double> LoadHistory(const std::string& path, double file_dt_s, double scale, double dt_s,
                                 std::size_t n, double start_s = 0.0);
+/// The rows of a time-history file (format and errors as LoadHistory; a one-column file's times are
+/// j file_dt_s). Throws rths::Error("path:line", ...) or rths::Error("path", ...).
+HistoryRecord ReadHistoryFile(const std::string& path, double file_dt_s);
+/// A record read by ReadHistoryFile resampled as LoadHistory describes (x_k = scale * v(k dt_s),
+/// start_s [s] the delay, file_dt_s [s] the pad step of a one-row record). Throws rths::Error("history", ...)
+/// for an empty record, dt_s <= 0, a non-finite scale or start_s < 0.
+std::vector<double> ResampleHistory(const HistoryRecord& record, double file_dt_s, double scale, double dt_s,
+                                    std::size_t n, double start_s);
 
 /// The n-sample record described by `spec` at step dt_s [s]:
 ///   kind "blwn": Blwn(band_hz, rms, dt_s, n, seed, discard_s) (signal/blwn.h);
-///   kind "file": LoadHistory(file, file_dt_s, scale, dt_s, n, start_s), a relative `file` being taken
-///                relative to `scenario_dir` (the scenario file's folder);
+///   kind "file": ResampleHistory(record, file_dt_s, scale, dt_s, n, start_s), the rows read by the
+///                scenario loader (an empty record: rths::Error naming the file);
 ///   kind "zero": n zeros.
 /// Then the first spec.taper_s seconds are faded in (ApplyTaper).
 /// Throws rths::Error for any other kind, and whatever the chosen generator throws.
-std::vector<double> MakeSignal(const signal::SignalSpec& spec, double dt_s, std::size_t n,
-                               const std::string& scenario_dir);
+std::vector<double> MakeSignal(const signal::SignalSpec& spec, double dt_s, std::size_t n);
 
 /// Fades a record in from zero over its first taper_s seconds with a raised cosine,
 /// w_i = (1 - cos(pi i / m)) / 2 for i < m = round(taper_s / dt_s): a record that starts

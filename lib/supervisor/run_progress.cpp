@@ -17,7 +17,7 @@ namespace {
 
 int DegreesOfFreedom(const scenario::Scenario& s) {
   if (s.structure.mode == models::StructureMode::kPredefined) return 1;
-  return static_cast<int>(models::StructureFromScenario(s.structure, s.path).M.rows());
+  return static_cast<int>(models::StructureFromScenario(s.structure).M.rows());
 }
 
 }  // namespace

@@ -1,0 +1,55 @@
+/// @file Every file a scenario names, read once, at the edge (ReadReferencedFiles): the structure
+/// file, the benchmark's reference structure, and the ground or desired records of kind "file".
+/// Components get this data, never the paths.
+#include <string>
+
+#include <fmt/format.h>
+
+#include "core/names.h"
+#include "scenario/walk.h"
+
+namespace rths::scenario {
+
+namespace {
+
+/// structure.file and structure.reference_file (mode "rths", kind "file"): the matrices, the
+/// reference's DOFs against the structure's, and structure.actuator_dof against them.
+void ReadStructureFiles(const std::string& path, const detail::Check& check, models::StructureConfig* st) {
+  st->matrices = {};
+  st->reference = {};
+  const bool has_file = st->mode == models::StructureMode::kRths && st->kind == models::StructureKind::kFile;
+  if (!st->reference_file.empty()) {
+    try {
+      st->reference = models::LoadStructureFile(detail::ResolveFile(path, st->reference_file).string());
+    } catch (const Error& e) {
+      check.Fail("structure.reference_file", e.what());
+    }
+  }
+  if (!has_file) return;
+  const std::string file = detail::ResolveFile(path, st->file).string();
+  st->matrices = models::LoadStructureFile(file);  // its own errors name the file and line
+  const auto dofs = st->matrices.M.rows();
+  if (!st->reference_file.empty() && st->reference.M.rows() != dofs) {
+    check.Fail("structure.reference_file", fmt::format("{} has {} DOFs but structure.file ({}) has {}: they must match",
+                                                       st->reference_file, st->reference.M.rows(), st->file, dofs));
+  }
+  if (st->actuator_dof > dofs) {
+    throw Error(path + ": structure.actuator_dof",
+                fmt::format("{} is out of range [1, {}] ({} has {} DOFs)", st->actuator_dof, dofs, file, dofs));
+  }
+}
+
+}  // namespace
+
+void ReadReferencedFiles(Scenario* s) {
+  const detail::Check check(detail::DisplayName(s->path));
+  ReadStructureFiles(s->path, check, &s->structure);
+  for (signal::SignalSpec* signal : {&s->structure.ground, &s->structure.desired}) {
+    signal->record = {};
+    if (signal->kind != signal::SignalKind::kFile) continue;
+    // The file's own errors name it and the line (signal::LoadHistory's messages).
+    signal->record = signal::ReadHistoryFile(detail::ResolveFile(s->path, signal->file).string(), signal->file_dt_s);
+  }
+}
+
+}  // namespace rths::scenario
