@@ -1,6 +1,6 @@
 // The benchmark's loop closed as the lockstep testbed or as the reference code closes it
-// (report/benchmark_loop.h, docs/benchmark.md "How the loop is closed").
-#include "report/benchmark_loop.h"
+// (studies/benchmark_loop.h, docs/benchmark.md "How the loop is closed").
+#include "studies/benchmark_loop.h"
 
 #include <cmath>
 #include <filesystem>
@@ -11,7 +11,7 @@
 
 #include "control/lti_controller.h"
 #include "core/error.h"
-#include "io/benchmark_run.h"
+#include "participants/benchmark_run.h"
 #include "models/ground_response.h"
 #include "models/rig.h"
 #include "models/structure.h"
@@ -19,7 +19,7 @@
 #include "signal/history.h"
 #include "signal/random.h"
 
-namespace rths::report {
+namespace rths::studies {
 
 namespace {
 
@@ -108,7 +108,7 @@ LoopResult RunBenchmarkLoop(const scenario::Scenario& s, const LoopOptions& o) {
   const std::string dir = std::filesystem::path(s.path).parent_path().string();
 
   const models::LinearStructure st = models::StructureFromScenario(s.structure, s.path);
-  const models::LinearStructure ref = io::ReferenceStructure(s, st.dofs());
+  const models::LinearStructure ref = participants::ReferenceStructure(s, st.dofs());
   const int a = st.actuator_dof;
   const std::vector<double> ground = signal::MakeSignal(s.structure.ground, dt, n, dir);
   std::vector<double> ground_half;  // a_g at k dt/2 (rk4 stages)
@@ -182,4 +182,4 @@ LoopResult RunBenchmarkLoop(const scenario::Scenario& s, const LoopOptions& o) {
   return out;
 }
 
-}  // namespace rths::report
+}  // namespace rths::studies

@@ -1,7 +1,8 @@
 // Table 2 (docs/experiments.md E3): tracking of predefined BLWN displacement histories, 36 lockstep
 // runs (3 conditions x 6 controllers x 2 bands), Eq. 31 on the logged r_k, y_k.
+#include "studies/table2.h"
+
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <ctime>
 #include <fstream>
@@ -11,11 +12,8 @@
 
 #include "core/error.h"
 #include "io/csv.h"
-#include "report/reproduce.h"
-#include "report/studies.h"
-#include "report/table2_extended.h"
 
-namespace rths::report {
+namespace rths::studies {
 
 namespace fs = std::filesystem;
 using io::CsvWriter;
@@ -197,6 +195,33 @@ std::string PlantDescription(const std::string& plant) {
          "piston) loaded by the MR damper (Eqs. 32-40) at the condition's current";
 }
 
+/// The section "Order of the controllers, best first": the paper's and ours per condition and band.
+void WriteOrder(std::ostream& md, const std::vector<Table2Row>& rows) {
+  md << "\n## Order of the controllers, best first\n\n"
+     << "Where ours differs from the paper's order it is a finding about the plant, not a failure "
+        "(docs/experiments.md E3; docs/models.md section 10: on a linear plant FF + LP falls behind the "
+        "polynomial and the lead at 0-15 Hz).\n\n"
+     << "| Condition | Band | Paper | Ours | Same order |\n|---|---|---|---|---|\n";
+  for (const char* cond : {"0.0A", "2.5A", "pulse"}) {
+    for (const char* band : {"0-5", "0-15"}) {
+      std::vector<const Table2Row*> sel;
+      for (const auto& r : rows) {
+        if (r.condition == cond && r.band == band) sel.push_back(&r);
+      }
+      auto paper = sel, ours = sel;
+      std::stable_sort(paper.begin(), paper.end(), [](auto* x, auto* y) { return x->paper_pct < y->paper_pct; });
+      std::stable_sort(ours.begin(), ours.end(), [](auto* x, auto* y) { return x->ours_pct < y->ours_pct; });
+      auto join = [](const std::vector<const Table2Row*>& v) {
+        std::string s;
+        for (auto* r : v) s += (s.empty() ? "" : " < ") + r->controller;
+        return s;
+      };
+      md << fmt::format("| {} | {} Hz | {} | {} | {} |\n", cond, band, join(paper), join(ours),
+                        join(paper) == join(ours) ? "yes" : "no");
+    }
+  }
+}
+
 void WriteMarkdown(const fs::path& file, const ReproduceOptions& opts, const std::vector<Table2Row>& rows,
                    const std::vector<Claim>& claims, double quick_s) {
   std::ofstream md(file);
@@ -228,44 +253,21 @@ void WriteMarkdown(const fs::path& file, const ReproduceOptions& opts, const std
   for (const auto& c : claims) {
     md << fmt::format("- **{}** {}.  \n  {}\n", c.holds ? "Holds:" : "Does not hold:", c.text, c.detail);
   }
-  md << "\n## Order of the controllers, best first\n\n"
-     << "Where ours differs from the paper's order it is a finding about the plant, not a failure "
-        "(docs/experiments.md E3; docs/models.md section 10: on a linear plant FF + LP falls behind the "
-        "polynomial and the lead at 0-15 Hz).\n\n"
-     << "| Condition | Band | Paper | Ours | Same order |\n|---|---|---|---|---|\n";
-  for (const char* cond : {"0.0A", "2.5A", "pulse"}) {
-    for (const char* band : {"0-5", "0-15"}) {
-      std::vector<const Table2Row*> sel;
-      for (const auto& r : rows) {
-        if (r.condition == cond && r.band == band) sel.push_back(&r);
-      }
-      auto paper = sel, ours = sel;
-      std::stable_sort(paper.begin(), paper.end(), [](auto* x, auto* y) { return x->paper_pct < y->paper_pct; });
-      std::stable_sort(ours.begin(), ours.end(), [](auto* x, auto* y) { return x->ours_pct < y->ours_pct; });
-      auto join = [](const std::vector<const Table2Row*>& v) {
-        std::string s;
-        for (auto* r : v) s += (s.empty() ? "" : " < ") + r->controller;
-        return s;
-      };
-      md << fmt::format("| {} | {} Hz | {} | {} | {} |\n", cond, band, join(paper), join(ours),
-                        join(paper) == join(ours) ? "yes" : "no");
-    }
-  }
+  WriteOrder(md, rows);
 }
 
 }  // namespace
 
-Table2Result ReproduceTable2(const ReproduceOptions& opts) {
-  const auto t0 = std::chrono::steady_clock::now();
-  PrepareOutDir(opts.out_dir);
-  RequirePlant(opts.plant, opts.out_dir);
-  const double quick_s = kQuickDurationS;
 
+namespace {
+
+/// The specs of the paper's 36 rows (condition x controller x band, in the paper's order) and the
+/// rows, in the same order.
+std::vector<RunSpec> Table2Specs(const ReproduceOptions& opts, std::vector<Table2Row>* rows) {
   std::vector<RunSpec> specs;
-  std::vector<Table2Row> rows;
   for (const auto& row : Table2Controllers()) {
     for (double band : kBands) {
-      const double duration = !opts.quick ? kFullDurationS : row.name == "None" ? kQuickNoneDurationS : quick_s;
+      const double duration = !opts.quick ? kFullDurationS : row.name == "None" ? kQuickNoneDurationS : kQuickDurationS;
       Table2Row r;
       r.condition = row.condition;
       r.controller = row.name;
@@ -276,117 +278,156 @@ Table2Result ReproduceTable2(const ReproduceOptions& opts) {
       r.run_dir = opts.out_dir / "runs" / Slug(fmt::format("{} {}hz {}", row.condition, r.band, row.name));
       specs.push_back({fmt::format("{} {} Hz {}", row.condition, r.band, row.name),
                        Table2Scenario(row, band, opts.plant, duration), r.run_dir});
-      rows.push_back(r);
+      rows->push_back(r);
     }
   }
-  const std::size_t n_paper = specs.size();
-  // --extended: the new runs (ats, ambc, pi_lead) after the paper's; none, ff and ff_lqg are the
-  // Table 2 rows' runs.
-  std::vector<Table2ExtendedRow> ext;
-  std::vector<std::size_t> ext_source;  // per extended row: its run's index in specs
-  std::optional<PiLeadDesign> pi_lead;
-  std::vector<double> durations;
-  for (const auto& r : rows) durations.push_back(r.duration_s);
-  if (opts.extended) {
-    pi_lead = DesignPiLead(models::ServoPreset("avg"), kTable2DtS);
-    if (opts.log) {
-      std::string text = pi_lead->Describe();
-      while (!text.empty() && text.back() == '\n') text.pop_back();
-      opts.log(text);
+  return specs;
+}
+
+/// --extended: its rows, and per row the index in the specs of the run it reads.
+struct ExtendedPlan {
+  std::vector<Table2ExtendedRow> rows;
+  std::vector<std::size_t> source;
+};
+
+/// The extended row of controller `c`: a Table 2 row's run (none, ff, ff_lqg), or a new run
+/// appended to `specs` (ats, ambc, pi_lead).
+Table2ExtendedRow ExtendedRow(const ReproduceOptions& opts, const Table2ExtendedController& c, double band,
+                              const std::vector<Table2Row>& rows, std::vector<RunSpec>* specs, ExtendedPlan* plan) {
+  Table2ExtendedRow e;
+  e.condition = c.condition;
+  e.band = BandText(band);
+  e.controller = c.name;
+  e.table2_row = c.table2_row;
+  if (!c.table2_row.empty()) {
+    std::size_t i = 0;
+    while (i < rows.size() &&
+           !(rows[i].condition == e.condition && rows[i].controller == c.table2_row && rows[i].band == e.band)) {
+      ++i;
     }
-    for (const char* cond : {"0.0A", "2.5A", "pulse"}) {
-      const auto ctrls = Table2ExtendedControllers(cond, *pi_lead);
-      for (double band : kBands) {
-        for (const auto& c : ctrls) {
-          Table2ExtendedRow e;
-          e.condition = cond;
-          e.band = BandText(band);
-          e.controller = c.name;
-          e.table2_row = c.table2_row;
-          if (!c.table2_row.empty()) {
-            std::size_t i = 0;
-            while (i < n_paper && !(rows[i].condition == e.condition && rows[i].controller == c.table2_row &&
-                                    rows[i].band == e.band)) {
-              ++i;
-            }
-            if (i == n_paper) throw Error("table2 --extended", "no Table 2 row " + c.table2_row);
-            e.duration_s = rows[i].duration_s;
-            e.run_dir = rows[i].run_dir;
-            ext_source.push_back(i);
-          } else {
-            e.duration_s = opts.quick ? quick_s : kFullDurationS;
-            e.run_dir = opts.out_dir / "runs" / Slug(fmt::format("{} {}hz {}", cond, e.band, c.name));
-            Table2Controller row{cond, c.name, 0.0, 0.0, "", "", c.controller};
-            ext_source.push_back(specs.size());
-            specs.push_back({fmt::format("{} {} Hz {}", cond, e.band, c.name),
-                             Table2Scenario(row, band, opts.plant, e.duration_s), e.run_dir});
-            durations.push_back(e.duration_s);
-          }
-          ext.push_back(e);
-        }
-      }
+    if (i == rows.size()) throw Error("table2 --extended", "no Table 2 row " + c.table2_row);
+    e.duration_s = rows[i].duration_s;
+    e.run_dir = rows[i].run_dir;
+    plan->source.push_back(i);
+    return e;
+  }
+  e.duration_s = opts.quick ? kQuickDurationS : kFullDurationS;
+  e.run_dir = opts.out_dir / "runs" / Slug(fmt::format("{} {}hz {}", c.condition, e.band, c.name));
+  Table2Controller row{c.condition, c.name, 0.0, 0.0, "", "", c.controller};
+  plan->source.push_back(specs->size());
+  specs->push_back({fmt::format("{} {} Hz {}", c.condition, e.band, c.name),
+                    Table2Scenario(row, band, opts.plant, e.duration_s), e.run_dir});
+  return e;
+}
+
+/// The extended table's rows, condition x band x controller; its new runs appended to `specs`,
+/// after the paper's.
+ExtendedPlan ExtendedSpecs(const ReproduceOptions& opts, const PiLeadDesign& pi_lead,
+                           const std::vector<Table2Row>& rows, std::vector<RunSpec>* specs) {
+  ExtendedPlan plan;
+  for (const char* cond : {"0.0A", "2.5A", "pulse"}) {
+    const auto ctrls = Table2ExtendedControllers(cond, pi_lead);
+    for (double band : kBands) {
+      for (const auto& c : ctrls) plan.rows.push_back(ExtendedRow(opts, c, band, rows, specs, &plan));
     }
   }
-  // Longest runs first, so that the threads finish together.
+  return plan;
+}
+
+/// The specs' indices, longest run first (stable), so that the threads finish together.
+std::vector<std::size_t> LongestFirst(const std::vector<RunSpec>& specs) {
   std::vector<std::size_t> order(specs.size());
   for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
-  std::stable_sort(order.begin(), order.end(),
-                   [&](std::size_t a, std::size_t b) { return durations[a] > durations[b]; });
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return specs[a].scenario.run.duration_s > specs[b].scenario.run.duration_s;
+  });
+  return order;
+}
+
+/// The table: Eq. 31 of each of the paper's rows (results[j] ran specs[order[j]]). Throws
+/// rths::Error naming every paper row that failed.
+void Table2Table(const std::vector<RunResult>& results, const std::vector<std::size_t>& order,
+                 const ReproduceOptions& opts, std::vector<Table2Row>* rows) {
+  std::vector<std::string> failed;
+  for (std::size_t j = 0; j < results.size(); ++j) {
+    if (order[j] >= rows->size()) continue;  // an extended run: its row says how it went
+    (*rows)[order[j]].ours_pct = results[j].tracking_pct;
+    if (!results[j].ok) failed.push_back(fmt::format("  {}: {}", results[j].label, results[j].error));
+  }
+  if (failed.empty()) return;
+  std::string msg = fmt::format("{} of {} runs failed (their folders are under {}):", failed.size(), rows->size(),
+                                (opts.out_dir / "runs").string());
+  for (const auto& f : failed) msg += "\n" + f;
+  throw Error("table2", msg);
+}
+
+void WriteCsv(const std::vector<Table2Row>& rows, const fs::path& file) {
+  CsvWriter csv(file, {"condition", "controller", "band_hz", "paper_pct", "ours_pct"});
+  for (const auto& r : rows) csv.Row({r.condition, r.controller, r.band, r.paper_text, FormatSig(r.ours_pct, 4)});
+  csv.Close();
+}
+
+/// --extended: how each row's run went (after any --set), its measurements and its files.
+std::vector<Table2ExtendedRow> FinishExtended(ExtendedPlan plan, const std::vector<std::size_t>& order,
+                                              const std::vector<RunSpec>& ordered,
+                                              const std::vector<RunResult>& results, const ReproduceOptions& opts,
+                                              const PiLeadDesign& pi_lead) {
+  std::vector<std::size_t> position(order.size());  // spec i ran as ordered[position[i]]
+  for (std::size_t j = 0; j < order.size(); ++j) position[order[j]] = j;
+  for (std::size_t i = 0; i < plan.rows.size(); ++i) {
+    const std::size_t j = position[plan.source[i]];
+    plan.rows[i].stopped = StoppedText(results[j]);
+    plan.rows[i].steps_planned = ordered[j].scenario.steps();
+    plan.rows[i].duration_s = ordered[j].scenario.run.duration_s;
+  }
+  MeasureExtendedRows(&plan.rows, opts.jobs);
+  WriteTable2Extended(opts, plan.rows, pi_lead);
+  return plan.rows;
+}
+
+PiLeadDesign LoggedPiLead(const ReproduceOptions& opts) {
+  PiLeadDesign pi_lead = DesignPiLead(models::ServoPreset("avg"), kTable2DtS);
+  if (opts.log) {
+    std::string text = pi_lead.Describe();
+    while (!text.empty() && text.back() == '\n') text.pop_back();
+    opts.log(text);
+  }
+  return pi_lead;
+}
+
+}  // namespace
+
+Table2Result ReproduceTable2(const ReproduceOptions& opts) {
+  const auto t0 = std::chrono::steady_clock::now();
+  PrepareOutDir(opts.out_dir);
+  RequirePlant(opts.plant, opts.out_dir);
+  Table2Result res;
+  std::vector<RunSpec> specs = Table2Specs(opts, &res.rows);
+  // --extended: the new runs (ats, ambc, pi_lead) after the paper's; none, ff and ff_lqg are the
+  // Table 2 rows' runs.
+  ExtendedPlan plan;
+  if (opts.extended) {
+    res.pi_lead = LoggedPiLead(opts);
+    plan = ExtendedSpecs(opts, *res.pi_lead, res.rows, &specs);
+  }
+  const std::vector<std::size_t> order = LongestFirst(specs);
   std::vector<RunSpec> ordered;
   for (std::size_t i : order) ordered.push_back(specs[i]);
-
-  Preflight(&ordered, opts.overrides, opts.log);
-  if (opts.log) {
-    opts.log(fmt::format("table2: {} lockstep runs on the {} plant, {} at a time", ordered.size(), opts.plant,
-                         opts.jobs));
-  }
-  const auto results = RunBatch(ordered, opts.jobs, opts.progress, [&](std::size_t done, std::size_t total, const RunResult& r) {
+  const std::string intro =
+      fmt::format("table2: {} lockstep runs on the {} plant, {} at a time", ordered.size(), opts.plant, opts.jobs);
+  const auto results = RunStudyBatch(&ordered, opts, intro, [&](std::size_t done, std::size_t total, const RunResult& r) {
     if (!opts.log) return;
     opts.log(r.ok ? fmt::format("  [{:2}/{}] {:<32} {:8.3f} %  ({:.1f} s)", done, total, r.label, r.tracking_pct,
                                 r.wall_s)
                   : fmt::format("  [{:2}/{}] {:<32} FAILED: {}", done, total, r.label, r.error));
   });
-  std::vector<std::string> failed;
-  std::vector<std::size_t> position(specs.size());  // spec i ran as ordered[position[i]]
-  for (std::size_t j = 0; j < results.size(); ++j) {
-    position[order[j]] = j;
-    if (order[j] >= n_paper) continue;  // an extended run: its row says how it went
-    Table2Row& row = rows[order[j]];
-    row.ours_pct = results[j].tracking_pct;
-    if (!results[j].ok) failed.push_back(fmt::format("  {}: {}", results[j].label, results[j].error));
-  }
-  if (!failed.empty()) {
-    std::string msg = fmt::format("{} of {} runs failed (their folders are under {}):", failed.size(),
-                                  n_paper, (opts.out_dir / "runs").string());
-    for (const auto& f : failed) msg += "\n" + f;
-    throw Error("table2", msg);
-  }
-
-  Table2Result res;
-  res.rows = rows;
-  res.claims = CheckTable2Claims(rows);
-  {
-    CsvWriter csv(opts.out_dir / "table2.csv", {"condition", "controller", "band_hz", "paper_pct", "ours_pct"});
-    for (const auto& r : rows) {
-      csv.Row({r.condition, r.controller, r.band, r.paper_text, FormatSig(r.ours_pct, 4)});
-    }
-    csv.Close();
-  }
-  WriteMarkdown(opts.out_dir / "table2.md", opts, rows, res.claims, quick_s);
-  if (opts.extended) {
-    for (std::size_t i = 0; i < ext.size(); ++i) {
-      const std::size_t j = position[ext_source[i]];
-      ext[i].stopped = StoppedText(results[j]);
-      ext[i].steps_planned = ordered[j].scenario.steps();  // after any --set
-      ext[i].duration_s = ordered[j].scenario.run.duration_s;
-    }
-    MeasureExtendedRows(&ext, opts.jobs);
-    WriteTable2Extended(opts, ext, *pi_lead);
-    res.extended = ext;
-    res.pi_lead = pi_lead;
-  }
-  res.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  Table2Table(results, order, opts, &res.rows);
+  res.claims = CheckTable2Claims(res.rows);
+  WriteCsv(res.rows, opts.out_dir / "table2.csv");
+  WriteMarkdown(opts.out_dir / "table2.md", opts, res.rows, res.claims, kQuickDurationS);
+  if (opts.extended) res.extended = FinishExtended(std::move(plan), order, ordered, results, opts, *res.pi_lead);
+  res.wall_s = SecondsSince(t0);
   return res;
 }
 
-}  // namespace rths::report
+}  // namespace rths::studies
