@@ -106,81 +106,93 @@ scenario::Scenario Table2Scenario(const Table2Controller& row, double band_hz, c
   return s;
 }
 
-std::vector<Claim> CheckTable2Claims(const std::vector<Table2Row>& rows) {
-  std::vector<Claim> claims;
-  auto ours = [&](const std::string& c, const std::string& n, const std::string& b) {
-    const Table2Row* r = Find(rows, c, n, b);
-    return r ? r->ours_pct : std::nan("");
-  };
+namespace {
+
+/// Our number of a row, NaN if the table has none.
+double Ours(const std::vector<Table2Row>& rows, const std::string& c, const std::string& n, const std::string& b) {
+  const Table2Row* r = Find(rows, c, n, b);
+  return r ? r->ours_pct : std::nan("");
+}
+
+Claim ProposedBeatsBaselines(const std::vector<Table2Row>& rows) {
+  auto ours = [&](const std::string& c, const std::string& n, const std::string& b) { return Ours(rows, c, n, b); };
   const std::map<std::string, std::vector<std::string>> names{
       {"0.0A", {"G_FF,0.0A", "None", "3rd Poly 8ms", "Lead Comp 8ms"}},
       {"2.5A", {"G_FF,2.5A", "None", "3rd Poly 10ms", "Lead Comp 10ms"}},
       {"pulse", {"G_FF,avgA", "None", "3rd Poly 9ms", "Lead Comp 9ms"}}};
+  Claim c{"(1) at 0-15 Hz the proposed FF for the condition (G_FF,0.0A; G_FF,2.5A; G_FF,avgA "
+          "under the pulse) beats None, the polynomial and the lead",
+          true, ""};
+  for (const char* cond : {"0.0A", "2.5A", "pulse"}) {
+    const auto& n = names.at(cond);
+    const double ff = ours(cond, n[0], "0-15");
+    std::string beaten, not_beaten;
+    for (std::size_t j = 1; j < n.size(); ++j) {
+      const double other = ours(cond, n[j], "0-15");
+      const bool beats = ff < other;
+      c.holds = c.holds && beats;
+      std::string& list = beats ? beaten : not_beaten;
+      list += fmt::format("{}{} {}", list.empty() ? "" : ", ", n[j], Pct(other));
+    }
+    std::string d = fmt::format("{}: {} {}", cond, n[0], Pct(ff));
+    if (!beaten.empty()) d += " beats " + beaten;
+    if (!not_beaten.empty()) d += (beaten.empty() ? " does not beat " : " but not ") + not_beaten;
+    c.detail += (c.detail.empty() ? "" : "; ") + d;
+  }
+  return c;
+}
 
-  {  // (1)
-    Claim c{"(1) at 0-15 Hz the proposed FF for the condition (G_FF,0.0A; G_FF,2.5A; G_FF,avgA "
-            "under the pulse) beats None, the polynomial and the lead",
-            true, ""};
-    for (const char* cond : {"0.0A", "2.5A", "pulse"}) {
-      const auto& n = names.at(cond);
-      const double ff = ours(cond, n[0], "0-15");
-      std::string beaten, not_beaten;
-      for (std::size_t j = 1; j < n.size(); ++j) {
-        const double other = ours(cond, n[j], "0-15");
-        const bool beats = ff < other;
-        c.holds = c.holds && beats;
-        std::string& list = beats ? beaten : not_beaten;
-        list += fmt::format("{}{} {}", list.empty() ? "" : ", ", n[j], Pct(other));
-      }
-      std::string d = fmt::format("{}: {} {}", cond, n[0], Pct(ff));
-      if (!beaten.empty()) d += " beats " + beaten;
-      if (!not_beaten.empty()) d += (beaten.empty() ? " does not beat " : " but not ") + not_beaten;
-      c.detail += (c.detail.empty() ? "" : "; ") + d;
-    }
-    claims.push_back(c);
+Claim LqgBeatsFfUnderPulse(const std::vector<Table2Row>& rows) {
+  auto ours = [&](const std::string& c, const std::string& n, const std::string& b) { return Ours(rows, c, n, b); };
+  Claim c{"(2) under the pulse, G_FF,avgA + LQG beats G_FF,avgA in both bands", true, ""};
+  for (const char* band : {"0-5", "0-15"}) {
+    const double lqg = ours("pulse", "G_FF,avgA + LQG", band), ff = ours("pulse", "G_FF,avgA", band);
+    c.holds = c.holds && lqg < ff;
+    c.detail += fmt::format("{}{} Hz: {} {} {}", c.detail.empty() ? "" : "; ", band, Pct(lqg),
+                            lqg < ff ? "<" : ">=", Pct(ff));
   }
-  {  // (2)
-    Claim c{"(2) under the pulse, G_FF,avgA + LQG beats G_FF,avgA in both bands", true, ""};
-    for (const char* band : {"0-5", "0-15"}) {
-      const double lqg = ours("pulse", "G_FF,avgA + LQG", band), ff = ours("pulse", "G_FF,avgA", band);
-      c.holds = c.holds && lqg < ff;
-      c.detail += fmt::format("{}{} Hz: {} {} {}", c.detail.empty() ? "" : "; ", band, Pct(lqg),
-                              lqg < ff ? "<" : ">=", Pct(ff));
+  return c;
+}
+
+Claim EveryCompensatorBeatsNone(const std::vector<Table2Row>& rows) {
+  auto ours = [&](const std::string& c, const std::string& n, const std::string& b) { return Ours(rows, c, n, b); };
+  Claim c{"(3) every compensator beats None", true, ""};
+  std::vector<std::string> fails;
+  for (const auto& r : rows) {
+    if (r.controller == "None") continue;
+    const double none = ours(r.condition, "None", r.band);
+    if (!(r.ours_pct < none)) {
+      c.holds = false;
+      fails.push_back(fmt::format("{} {} Hz {}: {} >= None {}", r.condition, r.band, r.controller,
+                                  Pct(r.ours_pct), Pct(none)));
     }
-    claims.push_back(c);
   }
-  {  // (3)
-    Claim c{"(3) every compensator beats None", true, ""};
-    std::vector<std::string> fails;
-    for (const auto& r : rows) {
-      if (r.controller == "None") continue;
-      const double none = ours(r.condition, "None", r.band);
-      if (!(r.ours_pct < none)) {
-        c.holds = false;
-        fails.push_back(fmt::format("{} {} Hz {}: {} >= None {}", r.condition, r.band, r.controller,
-                                    Pct(r.ours_pct), Pct(none)));
-      }
-    }
-    if (fails.empty()) {
-      c.detail = "every one of the 30 compensated rows is below its condition's None row";
-    } else {
-      for (const auto& f : fails) c.detail += (c.detail.empty() ? "" : "; ") + f;
-    }
-    claims.push_back(c);
+  if (fails.empty()) {
+    c.detail = "every one of the 30 compensated rows is below its condition's None row";
+  } else {
+    for (const auto& f : fails) c.detail += (c.detail.empty() ? "" : "; ") + f;
   }
-  {  // (4)
-    Claim c{"(4) the \"None\" rows within 2.5 points of the paper", true, ""};
-    for (const auto& r : rows) {
-      if (r.controller != "None") continue;
-      const double diff = r.ours_pct - r.paper_pct;
-      const bool ok = std::abs(diff) <= 2.5;
-      c.holds = c.holds && ok;
-      c.detail += fmt::format("{}{} {} Hz: {} vs {} ({:+.1f}{})", c.detail.empty() ? "" : "; ", r.condition,
-                              r.band, Pct(r.ours_pct), r.paper_text, diff, ok ? "" : ", outside");
-    }
-    claims.push_back(c);
+  return c;
+}
+
+Claim NoneRowsMatchPaper(const std::vector<Table2Row>& rows) {
+  Claim c{"(4) the \"None\" rows within 2.5 points of the paper", true, ""};
+  for (const auto& r : rows) {
+    if (r.controller != "None") continue;
+    const double diff = r.ours_pct - r.paper_pct;
+    const bool ok = std::abs(diff) <= 2.5;
+    c.holds = c.holds && ok;
+    c.detail += fmt::format("{}{} {} Hz: {} vs {} ({:+.1f}{})", c.detail.empty() ? "" : "; ", r.condition,
+                            r.band, Pct(r.ours_pct), r.paper_text, diff, ok ? "" : ", outside");
   }
-  return claims;
+  return c;
+}
+
+}  // namespace
+
+std::vector<Claim> CheckTable2Claims(const std::vector<Table2Row>& rows) {
+  return {ProposedBeatsBaselines(rows), LqgBeatsFfUnderPulse(rows), EveryCompensatorBeatsNone(rows),
+          NoneRowsMatchPaper(rows)};
 }
 
 namespace {
