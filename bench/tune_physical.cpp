@@ -4,7 +4,7 @@
 //
 //   build/bin/bench-tune_physical [--seconds S] [--cvode] [--iters N] [--free LIST] [--PARAM V ...]
 //
-// One evaluation is E1 exactly as `rths reproduce fig6` does it (lib/report/frequency.cpp), minus
+// One evaluation is E1 exactly as `rths reproduce fig6` does it (lib/studies/fig6.cpp), minus
 // the lockstep transport, which does not change the numbers (u_k = r_k with no controller; the
 // plant holds u_k over [t_k, t_{k+1}) and y_k is read at t_k):
 //   - u = BLWN 0-50 Hz, RMS 0.254 mm, seed 1, discard 2 s, faded in over 0.5 s (MakeSignal of
@@ -38,7 +38,7 @@
 
 #include "ident/identify.h"
 #include "models/servo_physical.h"
-#include "report/reproduce.h"
+#include "studies/frequency.h"
 #include "scenario/scenario.h"
 #include "signal/history.h"
 
@@ -59,7 +59,7 @@ struct Eval {
 };
 
 std::vector<double> Command(double seconds) {
-  return signal::MakeSignal(report::FrequencyExcitation(), kDt, static_cast<std::size_t>(std::lround(seconds / kDt)));
+  return signal::MakeSignal(studies::FrequencyExcitation(), kDt, static_cast<std::size_t>(std::lround(seconds / kDt)));
 }
 
 // Experimental, not in the library: a high-passed load-pressure ("delta-P") feedback in the

@@ -1,4 +1,4 @@
-// report/benchmark_loop: the benchmark's loop in one process, closed as the lockstep testbed closes
+// studies/benchmark_loop: the benchmark's loop in one process, closed as the lockstep testbed closes
 // it (then J1-J9 equal a memq run's, bit for bit) or as the benchmark's reference code does (RK4,
 // the force's unit delay, the converters), and the example scenarios shipped in scenarios/benchmark.
 #include <doctest/doctest.h>
@@ -7,15 +7,15 @@
 #include <string>
 
 #include "core/error.h"
-#include "io/benchmark_run.h"
-#include "report/benchmark_loop.h"
+#include "participants/benchmark_run.h"
+#include "studies/benchmark_loop.h"
 #include "scenario/scenario.h"
 #include "test_support.h"
 
 namespace fs = std::filesystem;
-using rths::report::LoopIntegration;
-using rths::report::LoopOptions;
-using rths::report::RunBenchmarkLoop;
+using rths::studies::LoopIntegration;
+using rths::studies::LoopOptions;
+using rths::studies::RunBenchmarkLoop;
 
 namespace {
 
@@ -51,8 +51,8 @@ TEST_CASE("closed as the lockstep closes it, the loop gives a memq run's J1-J9 b
     const fs::path dir = rths_test::TempDir(std::string("loop_") + kind);
     const rths_test::MemqRun run = rths_test::RunMemq({s}, dir);
     REQUIRE(run.code == 0);
-    const auto lockstep = rths::io::BenchmarkCriteriaOfRun((dir / "log.lcm").string(), s);
-    const auto loop = RunBenchmarkLoop(s, rths::report::LockstepLoop());
+    const auto lockstep = rths::participants::BenchmarkCriteriaOfRun((dir / "log.lcm").string(), s);
+    const auto loop = RunBenchmarkLoop(s, rths::studies::LockstepLoop());
     CheckEqual(loop.j, lockstep);
     CHECK(loop.steps == s.steps());
   }
@@ -60,15 +60,15 @@ TEST_CASE("closed as the lockstep closes it, the loop gives a memq run's J1-J9 b
 
 TEST_CASE("each difference of the reference code changes the criteria, and J1 stays the controller's") {
   const rths::scenario::Scenario s = Example(1, 15.0);
-  const auto lockstep = RunBenchmarkLoop(s, rths::report::LockstepLoop()).j;
-  LoopOptions rk4 = rths::report::LockstepLoop();
+  const auto lockstep = RunBenchmarkLoop(s, rths::studies::LockstepLoop()).j;
+  LoopOptions rk4 = rths::studies::LockstepLoop();
   rk4.substructure = LoopIntegration::kRk4;
   rk4.reference = LoopIntegration::kRk4;
   const auto continuous = RunBenchmarkLoop(s, rk4).j;
   LoopOptions delayed = rk4;
   delayed.force_delay_steps = 1;
   const auto with_delay = RunBenchmarkLoop(s, delayed).j;
-  const auto reference_code = RunBenchmarkLoop(s, rths::report::ReferenceCodeLoop()).j;
+  const auto reference_code = RunBenchmarkLoop(s, rths::studies::ReferenceCodeLoop()).j;
   MESSAGE("J4: lockstep " << lockstep.J4_pct << ", rk4 " << continuous.J4_pct << ", + unit delay "
                           << with_delay.J4_pct << ", + converters " << reference_code.J4_pct);
   // The measured tracking delay is the controller's (4.6 ms on the nominal plant) whichever way.
@@ -87,5 +87,5 @@ TEST_CASE("the loop refuses what it cannot run") {
   CHECK_THROWS_AS(RunBenchmarkLoop(s, {}), rths::Error);
   rths::scenario::Scenario t = Example(1, 1.0);
   t.controller.kind = rths::control::ControllerKind::kNone;
-  CHECK_THROWS_AS(RunBenchmarkLoop(t, rths::report::ReferenceCodeLoop()), rths::Error);
+  CHECK_THROWS_AS(RunBenchmarkLoop(t, rths::studies::ReferenceCodeLoop()), rths::Error);
 }

@@ -1,4 +1,4 @@
-// io/benchmark_run + the glue around it (issue 14): the reference structure integrated offline
+// participants/benchmark_run + the glue around it (issue 14): the reference structure integrated offline
 // under a run's ground acceleration and J1-J9 from the run's log, in summary.json, in `rths run`'s
 // lines and in `rths report`; structure.reference_file in the scenario; and the partition itself:
 // a hand-made numerical + experimental co-simulation that reproduces the monolithic reference.
@@ -14,7 +14,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/error.h"
-#include "io/benchmark_run.h"
+#include "participants/benchmark_run.h"
 #include "models/ground_response.h"
 #include "io/plot.h"
 #include "models/benchmark_structures.h"
@@ -199,7 +199,7 @@ TEST_CASE("a memq run with structure.reference_file: J1-J9 from its log, in summ
   s_ref.structure.reference_file = kBuildings + "silva3_reference_case1.txt";
   rths::scenario::ReadReferencedFiles(&s_ref);
   const rths::io::RunLog log = rths::io::ReadRunLog((dir / "log.lcm").string());
-  const rths::signal::BenchmarkCriteria got = rths::io::BenchmarkCriteriaOfRun(log, s_ref);
+  const rths::signal::BenchmarkCriteria got = rths::participants::BenchmarkCriteriaOfRun(log, s_ref);
   const rths::io::RunSignals sig = rths::io::SignalsFromRunLog(log, s.run.dt_s);
   const rths::models::BenchmarkStructures b = rths::models::Silva3Structures();
   const auto ref = rths::models::LinearStructure::Make(b.reference.M, b.reference.C, b.reference.K, 0, 1.0);

@@ -1,4 +1,4 @@
-// `rths reproduce benchmark --quick` (report/benchmark_study.h, docs/benchmark.md): the
+// `rths reproduce benchmark --quick` (studies/benchmark.h, docs/benchmark.md): the
 // identification finds the plant's gain and lag, the CSVs have the issue's columns and rows (four
 // cases, eight controllers, the published row, the stable count, the loop closings), the example
 // controller leaves the published 4.6 ms, the model-based and adaptive compensators beat it, the
@@ -12,12 +12,12 @@
 #include <doctest/doctest.h>
 #include <fmt/format.h>
 
-#include "io/benchmark_run.h"
+#include "participants/benchmark_run.h"
 #include "io/csv.h"
 #include "io/run_log.h"
 #include "models/benchmark_structures.h"
 #include "models/structure_file.h"
-#include "report/benchmark_study.h"
+#include "studies/benchmark.h"
 #include "test_support.h"
 
 using namespace rths;
@@ -36,12 +36,12 @@ double Num(const std::string& s) {
 
 TEST_CASE("reproduce benchmark --quick: identification, benchmark.csv, controllers, perturbed plants, reruns") {
   const auto dir = TempDir("benchmark_quick");
-  report::ReproduceOptions o;
+  studies::ReproduceOptions o;
   o.out_dir = dir / "out";
   o.quick = true;
   o.jobs = 2;
   o.log = [](std::string_view line) { MESSAGE(std::string(line)); };
-  const report::BenchmarkResult res = report::ReproduceBenchmark(o);
+  const studies::BenchmarkResult res = studies::ReproduceBenchmark(o);
 
   // Identification: the 3-pole model has the plant's DC gain and low-frequency lag.
   const auto& id = res.id;
@@ -54,7 +54,7 @@ TEST_CASE("reproduce benchmark --quick: identification, benchmark.csv, controlle
 
   // benchmark.csv: the issue's columns, 4 cases x 8 controllers x (nominal + 2 perturbed).
   const auto csv = io::ReadCsvFile(o.out_dir / "benchmark.csv");
-  REQUIRE(csv.size() == 1 + 4 * 8 * (1 + report::kBenchmarkQuickPerturbed));
+  REQUIRE(csv.size() == 1 + 4 * 8 * (1 + studies::kBenchmarkQuickPerturbed));
   CHECK(csv[0] == std::vector<std::string>{"case", "controller", "run", "J1_ms", "J2_pct", "J3_pct", "J4_pct", "J5_pct",
                                            "J6_pct", "J7_pct", "J8_pct", "J9_pct", "stopped"});
   // case -> controller -> run -> J1..J9
@@ -119,14 +119,14 @@ TEST_CASE("reproduce benchmark --quick: identification, benchmark.csv, controlle
     CHECK(loops[i][1] == "lockstep");
     CHECK(loops[i + 3][1] == "reference code");
     CHECK(Num(loops[i + 3][6]) > Num(loops[i][6]));  // J4
-    // The lockstep closing is the lockstep run's (report/benchmark_loop.h).
+    // The lockstep closing is the lockstep run's (studies/benchmark_loop.h).
     const int c = static_cast<int>(Num(loops[i][0]));
     CHECK(Num(loops[i][6]) == doctest::Approx(j[c]["example_pi_lead"]["nominal"][3]).epsilon(1e-6));
   }
 
   // The perturbed plants are the seeded draws, written into their scenarios, with the numerical
   // substructure of the perturbed specimen (the reference code's KN = K - KE).
-  for (int i = 1; i <= report::kBenchmarkQuickPerturbed; ++i) {
+  for (int i = 1; i <= studies::kBenchmarkQuickPerturbed; ++i) {
     const auto run_dir = o.out_dir / "runs" / fmt::format("case3-ff-{}", i);
     const auto s = scenario::LoadScenario((run_dir / "scenario.toml").string());
     const auto p = models::PerturbedBenchmarkParams(models::BenchmarkPlantParams{}, i);
@@ -143,10 +143,10 @@ TEST_CASE("reproduce benchmark --quick: identification, benchmark.csv, controlle
   // A removed log comes back bit for bit: rerun ff-1's scenario and score it again.
   const auto rerun = dir / "rerun";
   const auto s = scenario::LoadScenario((o.out_dir / "runs" / "case3-ff-1" / "scenario.toml").string());
-  const auto r = report::RunBatch({{"rerun case3 ff 1", s, rerun}}, 1);
+  const auto r = studies::RunBatch({{"rerun case3 ff 1", s, rerun}}, 1);
   REQUIRE(r[0].ok);
-  const auto again = io::BenchmarkCriteriaOfRun((rerun / "log.lcm").string(), scenario::LoadScenario((rerun / "scenario.toml").string()));
-  const report::BenchmarkRow* row = nullptr;
+  const auto again = participants::BenchmarkCriteriaOfRun((rerun / "log.lcm").string(), scenario::LoadScenario((rerun / "scenario.toml").string()));
+  const studies::BenchmarkRow* row = nullptr;
   for (const auto& x : res.rows) {
     if (x.case_number == 3 && x.controller == "ff" && x.run == "1") row = &x;
   }

@@ -20,7 +20,7 @@
 #include "io/run_log.h"
 #include "models/rig.h"
 #include "models/servo_physical.h"
-#include "report/reproduce.h"
+#include "studies/frequency.h"
 #include "signal/history.h"
 #include "test_support.h"
 
@@ -226,11 +226,11 @@ TEST_CASE("(a) simulated small sines (CVODE, u held per step) give the linearisa
 }
 
 TEST_CASE("(a) E1 on the damper-loaded rig (16 s records): how close the identified models come to Eqs. 28-29") {
-  // E1 as `rths reproduce fig6 --quick` runs it (lib/report/frequency.cpp), without the lockstep:
+  // E1 as `rths reproduce fig6 --quick` runs it (lib/studies/fig6.cpp), without the lockstep:
   // BLWN 0-50 Hz, 0.254 mm RMS, seed 1, 2 s discarded, 0.5 s fade-in; u_k held over each step,
   // y_k read at t_k; the MR damper (Table 3) at a constant current; H1 and the ZOH-consistent
   // 3-pole fit over 0.5-40 Hz.
-  const std::vector<double> u = rths::signal::MakeSignal(rths::report::FrequencyExcitation(), kDt, 32000);
+  const std::vector<double> u = rths::signal::MakeSignal(rths::studies::FrequencyExcitation(), kDt, 32000);
   rths::ident::IdentifyOptions io;
   io.fit.poles = 3;
   io.fit.band_lo_hz = 0.5;

@@ -14,7 +14,9 @@
 #include "core/error.h"
 #include "io/csv.h"
 #include "io/plot.h"
-#include "report/figures.h"
+#include "studies/fig11.h"
+#include "studies/fig9.h"
+#include "studies/figures.h"
 #include "test_support.h"
 
 using namespace rths::io;
@@ -141,7 +143,7 @@ TEST_CASE("plot errors are clear") {
   CHECK_THROWS_AS(Plot(fig, dir), rths::Error);
 }
 
-// --- Figure conventions (io/plot.h, report/figures.h) --------------------------------------
+// --- Figure conventions (io/plot.h, studies/figures.h) ------------------------------------
 
 namespace {
 // Every "[unit]" of the axis labels of a figure.
@@ -248,11 +250,11 @@ TEST_CASE("a bar panel: filled boxes side by side over named categories") {
 }
 
 TEST_CASE("fig9's figure: every controller a distinct readable colour, the proposed G_FF,0.0A the most prominent") {
-  rths::report::Fig9Result res;
+  rths::studies::Fig9Result res;
   double v = 0.1;
-  for (double f : rths::report::Fig9FrequenciesHz()) {
-    for (const auto& c : rths::report::Fig9Controllers()) {
-      rths::report::Fig9Row row;
+  for (double f : rths::studies::Fig9FrequenciesHz()) {
+    for (const auto& c : rths::studies::Fig9Controllers()) {
+      rths::studies::Fig9Row row;
       row.f_hz = f;
       row.controller = c.name;
       row.rms_pct = v *= 1.1;
@@ -260,7 +262,7 @@ TEST_CASE("fig9's figure: every controller a distinct readable colour, the propo
       res.rows.push_back(row);
     }
   }
-  const Figure fig = rths::report::Fig9Figure(res, "physical", true);
+  const Figure fig = rths::studies::Fig9Figure(res, "physical", true);
   REQUIRE(fig.panels.size() == 1);
   const Panel& p = fig.panels[0];
   std::set<std::string> colors;
@@ -291,9 +293,9 @@ TEST_CASE("fig9's figure: every controller a distinct readable colour, the propo
 }
 
 TEST_CASE("fig11's stories figure: one legend beside the axes, accelerations in mm/s^2 like the logs") {
-  rths::report::Fig11Result res;
-  for (const auto& mode : rths::report::Fig11SemiactiveModes()) {
-    rths::report::Fig11Run n;
+  rths::studies::Fig11Result res;
+  for (const auto& mode : rths::studies::Fig11SemiactiveModes()) {
+    rths::studies::Fig11Run n;
     n.controller = "Numerical";
     n.semiactive = mode;
     for (int i = 0; i < 9; ++i) {
@@ -301,13 +303,13 @@ TEST_CASE("fig11's stories figure: one legend beside the axes, accelerations in 
       n.peak_abs_accel_mps2.push_back(1.5 + 0.1 * i);
     }
     res.numerical.push_back(n);
-    for (const auto& c : rths::report::Fig11Controllers()) {
-      rths::report::Fig11Run r = n;
+    for (const auto& c : rths::studies::Fig11Controllers()) {
+      rths::studies::Fig11Run r = n;
       r.controller = c.name;
       res.runs.push_back(r);
     }
   }
-  const Figure fig = rths::report::Fig11StoriesFigure(res);
+  const Figure fig = rths::studies::Fig11StoriesFigure(res);
   REQUIRE(fig.panels.size() == 2);
   const Panel& drift = fig.panels[0];
   const Panel& acc = fig.panels[1];

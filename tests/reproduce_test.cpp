@@ -1,4 +1,4 @@
-// `rths reproduce`: the library functions tools/reproduce.cpp calls (lib/report/reproduce.h),
+// `rths reproduce`: the library functions tools/reproduce.cpp calls (lib/studies/),
 // run here directly. fig5 against the E6 reference peaks; table2 --quick on the linear plant:
 // the file's shape (RFC 4180, exact header and names), its numbers against the paper's Table 2
 // and the independent computations of docs/experiments.md E3 / docs/models.md section 10, and the claims
@@ -18,11 +18,14 @@
 
 #include "core/error.h"
 #include "io/csv.h"
-#include "report/reproduce.h"
+#include "studies/fig5.h"
+#include "studies/fig6.h"
+#include "studies/fig78.h"
+#include "studies/table2.h"
 #include "scenario/scenario.h"
 #include "test_support.h"
 
-using namespace rths::report;
+using namespace rths::studies;
 using rths_test::TempDir;
 using rths_test::Slurp;
 using rths_test::Number;

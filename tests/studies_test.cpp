@@ -12,7 +12,9 @@
 
 #include "io/run_log.h"
 #include "io/csv.h"
-#include "report/studies.h"
+#include "studies/batch.h"
+#include "studies/fig11.h"
+#include "studies/fig9.h"
 #include "test_support.h"
 
 using namespace rths;
@@ -26,7 +28,7 @@ scenario::Scenario Base(const std::string& name) {
 
 // Writes the scenario into dir/scenario.toml and loads it back (a real file and hash).
 scenario::Scenario AsFile(const scenario::Scenario& s, const std::filesystem::path& dir) {
-  return report::WriteScenarioFile({"test", s, dir});
+  return studies::WriteScenarioFile({"test", s, dir});
 }
 
 bool SameBits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
@@ -64,12 +66,12 @@ TEST_CASE("ideal plant: y_k == r_k bit for bit, f_k the damper's force, determin
 TEST_CASE("fig9 --quick: fig9.csv with the exact header, 36 rows, the Table 2 names; the proposed FF best or "
           "within 10 % of best at f >= 5 Hz") {
   const auto dir = TempDir("fig9_quick");
-  report::ReproduceOptions o;
+  studies::ReproduceOptions o;
   o.out_dir = dir / "out";
   o.quick = true;
   o.jobs = 2;
   o.log = [](std::string_view line) { MESSAGE(std::string(line)); };
-  const auto res = report::ReproduceFig9(o);
+  const auto res = studies::ReproduceFig9(o);
   const auto csv = io::ReadCsvFile(o.out_dir / "fig9.csv");
   REQUIRE(csv.size() == 37);
   CHECK(csv[0] == std::vector<std::string>{"f_hz", "controller", "rms_pct", "stopped"});
@@ -101,19 +103,19 @@ TEST_CASE("fig9 --quick: fig9.csv with the exact header, 36 rows, the Table 2 na
 
 TEST_CASE("fig9: a parallel sweep gives the same numbers as the same runs one at a time") {
   const auto base = Base("fig9_base.toml");
-  const auto ctrls = report::Fig9Controllers();
+  const auto ctrls = studies::Fig9Controllers();
   std::vector<std::pair<double, std::size_t>> pairs{{5.0, 4}, {20.0, 1}, {1.0, 5}, {30.0, 2}};
-  std::vector<report::RunResult> results[2];
+  std::vector<studies::RunResult> results[2];
   std::vector<std::string> digests[2];
   for (int mode = 0; mode < 2; ++mode) {
     const auto dir = TempDir(fmt::format("fig9_par_{}", mode));
-    std::vector<report::RunSpec> specs;
+    std::vector<studies::RunSpec> specs;
     for (const auto& [f, c] : pairs) {
       specs.push_back({fmt::format("{} {}", f, ctrls[c].name),
-                       report::Fig9Scenario(base, f, ctrls[c], "physical", 1.0),
-                       dir / report::Slug(fmt::format("{} {}", f, ctrls[c].name))});
+                       studies::Fig9Scenario(base, f, ctrls[c], "physical", 1.0),
+                       dir / studies::Slug(fmt::format("{} {}", f, ctrls[c].name))});
     }
-    results[mode] = report::RunBatch(specs, mode == 0 ? 2 : 1);
+    results[mode] = studies::RunBatch(specs, mode == 0 ? 2 : 1);
     for (const auto& s : specs) digests[mode].push_back(io::PayloadDigest(io::ReadRunLog((s.dir / "log.lcm").string())));
   }
   for (std::size_t i = 0; i < pairs.size(); ++i) {
@@ -145,12 +147,12 @@ TEST_CASE("9-story lockstep regression: a short run's payload digest is identica
 
 TEST_CASE("fig11 --quick: fig11_summary.json with 9 runs, the exact keys and 9-element arrays") {
   const auto dir = TempDir("fig11_quick");
-  report::ReproduceOptions o;
+  studies::ReproduceOptions o;
   o.out_dir = dir / "out";
   o.quick = true;
   o.jobs = 2;
   o.log = [](std::string_view line) { MESSAGE(std::string(line)); };
-  report::ReproduceFig11(o);
+  studies::ReproduceFig11(o);
   std::ifstream in(o.out_dir / "fig11_summary.json");
   REQUIRE(in);
   const auto j = nlohmann::json::parse(in);

@@ -1,4 +1,4 @@
-// `rths reproduce table2 --extended` (lib/report/table2_extended.cpp; docs/reproduce_table2.md):
+// `rths reproduce table2 --extended` (lib/studies/table2_extended.cpp; docs/reproduce_table2.md):
 // the pi_lead design rule checked on the design model independently of the code that chose it;
 // a --quick extended run's table (every condition x band x controller, finite numbers or a stop
 // reason, the Table 2 rows it reuses equal to table2.csv's); the paper's 36 rows and their files
@@ -20,11 +20,11 @@
 #include "control/lti.h"
 #include "control/lti_controller.h"
 #include "io/csv.h"
-#include "report/reproduce.h"
+#include "studies/table2.h"
 #include "scenario/scenario.h"
 #include "test_support.h"
 
-using namespace rths::report;
+using namespace rths::studies;
 using rths_test::TempDir;
 using rths_test::Slurp;
 using rths_test::Number;

@@ -2,7 +2,7 @@
 //
 // Reproduces one figure or table of the paper (docs/experiments.md) into a new folder: CSV tables,
 // Markdown, PNG figures and, for the lockstep studies, every run's folder. The work is done by
-// lib/report (report/reproduce.h); this file parses options and prints.
+// lib/studies (one header per study); this file parses options and prints.
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -17,9 +17,13 @@
 #include "cli.h"
 #include "core/error.h"
 #include "io/output_folder.h"
-#include "report/reproduce.h"
-#include "report/benchmark_study.h"
-#include "report/studies.h"
+#include "studies/benchmark.h"
+#include "studies/fig11.h"
+#include "studies/fig5.h"
+#include "studies/fig6.h"
+#include "studies/fig78.h"
+#include "studies/fig9.h"
+#include "studies/table2.h"
 
 namespace fs = std::filesystem;
 
@@ -76,8 +80,8 @@ void AddOptions(CLI::App& app, Options* o) {
   app.add_flag("--compact", o->compact, "runs without signals.csv (as --set run.csv_every=0): log.lcm only, about 70 % of the size");
 }
 
-void Fig5(const Options& o, const rths::report::ReproduceOptions& opts) {
-  const auto r = rths::report::ReproduceFig5(opts);
+void Fig5(const Options& o, const rths::studies::ReproduceOptions& opts) {
+  const auto r = rths::studies::ReproduceFig5(opts);
   double worst = 0.0;
   for (std::size_t i = 0; i < r.current_A.size(); ++i) {
     worst = std::max(worst, std::abs(r.ours_peak_kN[i] / r.paper_peak_kN[i] - 1.0));
@@ -87,7 +91,7 @@ void Fig5(const Options& o, const rths::report::ReproduceOptions& opts) {
 }
 
 /// The extended table: Eq. 31 in both bands per condition and controller, and why a run stopped.
-void PrintTable2Extended(const rths::report::Table2Result& r) {
+void PrintTable2Extended(const rths::studies::Table2Result& r) {
   std::printf("\nextended table (Eq. 31 [%%]; table2_extended.md has the peaks, the second halves and the "
               "adaptive coefficients)\n%-6s %-8s %9s %9s  %s\n",
               "cond", "ctrl", "0-5 Hz", "0-15 Hz", "stopped");
@@ -106,8 +110,8 @@ void PrintTable2Extended(const rths::report::Table2Result& r) {
   }
 }
 
-void Table2(const Options& o, const rths::report::ReproduceOptions& opts) {
-  const auto r = rths::report::ReproduceTable2(opts);
+void Table2(const Options& o, const rths::studies::ReproduceOptions& opts) {
+  const auto r = rths::studies::ReproduceTable2(opts);
   std::printf("\n%-6s %-18s %7s %9s %7s %9s\n", "cond", "controller", "paper5", "ours5", "paper15", "ours15");
   for (std::size_t i = 0; i + 1 < r.rows.size(); i += 2) {
     const auto& a = r.rows[i];
@@ -120,20 +124,20 @@ void Table2(const Options& o, const rths::report::ReproduceOptions& opts) {
   if (o.extended) PrintTable2Extended(r);
 }
 
-void Fig9(const rths::report::ReproduceOptions& opts) {
-  const auto r = rths::report::ReproduceFig9(opts);  // report/studies.h; table in fig9.md
+void Fig9(const rths::studies::ReproduceOptions& opts) {
+  const auto r = rths::studies::ReproduceFig9(opts);  // studies/fig9.h; table in fig9.md
   std::printf("fig9: %zu runs in %.1f s; fig9.csv, fig9.md, fig9.png\n", r.rows.size(), r.wall_s);
 }
 
-void Fig11(const rths::report::ReproduceOptions& opts) {
-  const auto r = rths::report::ReproduceFig11(opts);  // report/studies.h; table in fig11.md
+void Fig11(const rths::studies::ReproduceOptions& opts) {
+  const auto r = rths::studies::ReproduceFig11(opts);  // studies/fig11.h; table in fig11.md
   std::printf("fig11: %zu RTHS + %zu numerical runs in %.1f s; fig11_summary.json, fig11.md, PNGs\n", r.runs.size(),
               r.numerical.size(), r.wall_s);
 }
 
-void Benchmark(const Options& o, const rths::report::ReproduceOptions& opts) {
-  const auto r = rths::report::ReproduceBenchmark(opts, o.keep_logs);  // report/benchmark_study.h
-  const auto& published = rths::report::PublishedExampleCriteria();
+void Benchmark(const Options& o, const rths::studies::ReproduceOptions& opts) {
+  const auto r = rths::studies::ReproduceBenchmark(opts, o.keep_logs);  // studies/benchmark.h
+  const auto& published = rths::studies::PublishedExampleCriteria();
   for (int c = 1; c <= 4; ++c) {
     std::printf("\ncase %d, nominal plant (J1 [ms], J2-J9 [%%]; benchmark.md has the perturbed spread)\n%-17s", c, "");
     for (int j = 1; j <= 9; ++j) std::printf(" %7s", fmt::format("J{}", j).c_str());
@@ -152,8 +156,8 @@ void Benchmark(const Options& o, const rths::report::ReproduceOptions& opts) {
               r.rows.size(), r.wall_s);
 }
 
-void Fig6(const Options& o, const rths::report::ReproduceOptions& opts) {
-  const auto r = rths::report::ReproduceFig6(opts);
+void Fig6(const Options& o, const rths::studies::ReproduceOptions& opts) {
+  const auto r = rths::studies::ReproduceFig6(opts);
   std::printf("\n%-5s %-3s %12s %12s %8s\n", "cond", "", "paper", "ours", "diff");
   for (const auto& m : r.models) {
     const auto q = m.fit.model.ToServoModel3();
@@ -166,14 +170,14 @@ void Fig6(const Options& o, const rths::report::ReproduceOptions& opts) {
   PrintCheck(r.verdict.holds, r.verdict.text, r.verdict.detail, Standing(o.name, o.plant, o.quick));
 }
 
-void Fig78(const Options& o, const rths::report::ReproduceOptions& opts) {
-  const auto r = rths::report::ReproduceFig78(opts, o.name);
+void Fig78(const Options& o, const rths::studies::ReproduceOptions& opts) {
+  const auto r = rths::studies::ReproduceFig78(opts, o.name);
   std::printf("\n");
   for (const auto& c : r.checks) PrintCheck(c.holds, c.text, c.detail, Standing(o.name, o.plant, o.quick));
 }
 
 /// Runs the study named o.name and prints its table and checks.
-void Reproduce(const Options& o, const rths::report::ReproduceOptions& opts) {
+void Reproduce(const Options& o, const rths::studies::ReproduceOptions& opts) {
   if (o.name == "fig5") {
     Fig5(o, opts);
   } else if (o.name == "table2") {
@@ -215,7 +219,7 @@ int main(int argc, char** argv) {
   if (const int code = rths::tools::ParseCommandLine(app, argc, argv); code >= 0) return code;
   if (const int code = CheckOptions(&o); code >= 0) return code;
 
-  rths::report::ReproduceOptions opts;
+  rths::studies::ReproduceOptions opts;
   opts.out_dir = o.out.empty() ? rths::io::NewOutputFolder(fmt::format("reproduce-{}{}", o.name, o.quick ? "-quick" : ""))
                                : fs::path(o.out);
   // Absolute: run folders' scenario files name the study's own files relative to themselves.

@@ -34,6 +34,100 @@ std::size_t AddColumn(RunSignals* s, std::string name, std::string unit, std::st
   return s->columns.size() - 1;
 }
 
+/// The fixed columns' indices in RunSignals::columns, and where the per-DOF blocks start.
+struct Layout {
+  std::size_t k, t, r, rd, rdd, rddd, acc_prev, vel_prev, ground, x0, a0;
+  std::size_t u, u_ff, u_fb, y, e, f, i_eff, i_cmd, f_des;
+};
+
+/// Adds every column but the adaptive coefficients, empty with room for n steps, in the order of
+/// RunSignals::columns.
+Layout AddColumns(RunSignals* s, int n_dof, std::size_t n) {
+  Layout l{};
+  l.k = AddColumn(s, "k", "", "step index k (t_k = k dt)", n);
+  l.t = AddColumn(s, "t_s", "s", "time of sample k, t_k = k dt", n);
+  l.r = AddColumn(s, "r_mm", "mm", "desired actuator displacement r_k (Eq. 20-22 predictions in rd/rdd/rddd)", n);
+  l.rd = AddColumn(s, "rd_mm_s", "mm/s", "predicted desired velocity r'_k (Eq. 21)", n);
+  l.rdd = AddColumn(s, "rdd_mm_s2", "mm/s^2", "extrapolated desired acceleration r''_k (Eq. 20)", n);
+  l.rddd = AddColumn(s, "rddd_mm_s3", "mm/s^3", "predicted desired jerk r'''_k (Eq. 22)", n);
+  l.acc_prev = AddColumn(s, "acc_prev_mm_s2", "mm/s^2", "central-difference acceleration one step back a_{k-1}", n);
+  l.vel_prev = AddColumn(s, "vel_prev_mm_s", "mm/s", "central-difference velocity one step back v_{k-1}", n);
+  l.ground = AddColumn(s, "ground_acc_mm_s2", "mm/s^2", "ground acceleration at sample k (0 in predefined mode)", n);
+  l.x0 = s->columns.size();
+  for (int i = 1; i <= n_dof; ++i)
+    AddColumn(s, fmt::format("x{}_mm", i), "mm",
+              fmt::format("structure displacement of DOF {} relative to ground at sample k", i), n);
+  l.a0 = s->columns.size();
+  for (int i = 1; i <= n_dof; ++i)
+    AddColumn(s, fmt::format("abs_acc{}_mm_s2", i), "mm/s^2",
+              fmt::format("absolute acceleration of DOF {} at sample k-1", i), n);
+  l.u = AddColumn(s, "u_mm", "mm", "actuator command u_k = u_FF + u_FB (held over [t_k, t_k+1))", n);
+  l.u_ff = AddColumn(s, "u_ff_mm", "mm", "feedforward part of the command u_FF", n);
+  l.u_fb = AddColumn(s, "u_fb_mm", "mm", "feedback part of the command u_FB", n);
+  l.y = AddColumn(s, "y_mm", "mm", "measured actuator displacement y_k (with sensor noise, if any)", n);
+  l.e = AddColumn(s, "e_mm", "mm", "tracking error e_k = r_k - y_k", n);
+  l.f = AddColumn(s, "f_kN", "kN", "measured specimen (damper) force f_k (with sensor noise, if any)", n);
+  l.i_eff = AddColumn(s, "i_eff_A", "A", "effective damper current at t_k (measured_t.current_A)", n);
+  l.i_cmd = AddColumn(s, "i_cmd_A", "A", "damper current command i_k (held over [t_k, t_k+1))", n);
+  l.f_des = AddColumn(s, "f_desired_kN", "kN", "clipped-optimal nominal force for one damper (0 for other modes)", n);
+  return l;
+}
+
+/// Appends step j of `log` to every column of `l`. Throws rths::Error if its n_dof is not n_dof.
+void AppendStep(const RunLog& log, std::size_t j, int n_dof, const Layout& l, RunSignals* s) {
+  const auto& d = log.desired[j];
+  const auto& c = log.command[j];
+  const auto& m = log.measured[j];
+  const auto& i = log.current[j];
+  if (d.n_dof != n_dof || static_cast<int>(d.x_mm.size()) != n_dof || static_cast<int>(d.abs_acc_mm_s2.size()) != n_dof)
+    throw Error(log.source,
+                fmt::format("RTHS_DESIRED k = {}: n_dof = {}, but step 0 has n_dof = {}", j, d.n_dof, n_dof));
+  const auto put = [&](std::size_t col, double v) { s->columns[col].values.push_back(v); };
+  put(l.k, static_cast<double>(j));
+  put(l.t, static_cast<double>(j) * s->dt_s);
+  put(l.r, d.r_mm);
+  put(l.rd, d.rd_mm_s);
+  put(l.rdd, d.rdd_mm_s2);
+  put(l.rddd, d.rddd_mm_s3);
+  put(l.acc_prev, d.acc_prev_mm_s2);
+  put(l.vel_prev, d.vel_prev_mm_s);
+  put(l.ground, d.ground_acc_mm_s2);
+  for (int q = 0; q < n_dof; ++q) {
+    put(l.x0 + static_cast<std::size_t>(q), d.x_mm[static_cast<std::size_t>(q)]);
+    put(l.a0 + static_cast<std::size_t>(q), d.abs_acc_mm_s2[static_cast<std::size_t>(q)]);
+  }
+  put(l.u, c.u_mm);
+  put(l.u_ff, c.u_ff_mm);
+  put(l.u_fb, c.u_fb_mm);
+  put(l.y, m.y_mm);
+  put(l.e, d.r_mm - m.y_mm);
+  put(l.f, m.f_kN);
+  put(l.i_eff, m.current_A);
+  put(l.i_cmd, i.i_cmd_A);
+  put(l.f_des, i.f_desired_kN);
+}
+
+/// An adaptive controller's coefficients (command_t.adapt: ats 3, ambc 4), one column each, at the
+/// end so that every other column keeps its place; NaN at a step that reported fewer.
+void AddAdaptColumns(const RunLog& log, std::size_t n, RunSignals* s) {
+  int n_adapt = 0;
+  for (std::size_t j = 0; j < n; ++j) n_adapt = std::max(n_adapt, std::min(log.command[j].n_adapt, 4));
+  static constexpr const char* kAdaptNames[4] = {"a0", "a1_s", "a2_s2", "a3_s3"};
+  static constexpr const char* kAdaptUnits[4] = {"", "s", "s^2", "s^3"};
+  for (int q = 0; q < n_adapt; ++q) {
+    const std::size_t col = AddColumn(s, kAdaptNames[q], kAdaptUnits[q],
+                                      fmt::format("adaptive controller's coefficient of the target's derivative {} "
+                                                  "(u = sum a_i x_t^(i); command_t.adapt[{}])",
+                                                  q, q),
+                                      n);
+    for (std::size_t j = 0; j < n; ++j) {
+      const auto& c = log.command[j];
+      s->columns[col].values.push_back(q < c.n_adapt && q < static_cast<int>(c.adapt.size()) ? c.adapt[q]
+                                                                                              : std::nan(""));
+    }
+  }
+}
+
 }  // namespace
 
 RunSignals SignalsFromRunLog(const RunLog& log, double dt_s) {
@@ -44,91 +138,18 @@ RunSignals SignalsFromRunLog(const RunLog& log, double dt_s) {
   const std::int64_t n_steps = log.CompleteSteps();
   const std::size_t n = static_cast<std::size_t>(n_steps > 0 ? n_steps : 0);
   const int n_dof = n > 0 ? log.desired[0].n_dof : 0;
-
-  // Column layout: fixed columns by index, then the per-DOF blocks.
-  const auto k = AddColumn(&s, "k", "", "step index k (t_k = k dt)", n);
-  const auto t = AddColumn(&s, "t_s", "s", "time of sample k, t_k = k dt", n);
-  const auto r = AddColumn(&s, "r_mm", "mm",
-                           "desired actuator displacement r_k (Eq. 20-22 predictions in rd/rdd/rddd)", n);
-  const auto rd = AddColumn(&s, "rd_mm_s", "mm/s", "predicted desired velocity r'_k (Eq. 21)", n);
-  const auto rdd = AddColumn(&s, "rdd_mm_s2", "mm/s^2", "extrapolated desired acceleration r''_k (Eq. 20)", n);
-  const auto rddd = AddColumn(&s, "rddd_mm_s3", "mm/s^3", "predicted desired jerk r'''_k (Eq. 22)", n);
-  const auto acc_prev = AddColumn(&s, "acc_prev_mm_s2", "mm/s^2",
-                                  "central-difference acceleration one step back a_{k-1}", n);
-  const auto vel_prev = AddColumn(&s, "vel_prev_mm_s", "mm/s",
-                                  "central-difference velocity one step back v_{k-1}", n);
-  const auto ground = AddColumn(&s, "ground_acc_mm_s2", "mm/s^2",
-                                "ground acceleration at sample k (0 in predefined mode)", n);
-  const std::size_t x0 = s.columns.size();
-  for (int i = 1; i <= n_dof; ++i)
-    AddColumn(&s, fmt::format("x{}_mm", i), "mm",
-              fmt::format("structure displacement of DOF {} relative to ground at sample k", i), n);
-  const std::size_t a0 = s.columns.size();
-  for (int i = 1; i <= n_dof; ++i)
-    AddColumn(&s, fmt::format("abs_acc{}_mm_s2", i), "mm/s^2",
-              fmt::format("absolute acceleration of DOF {} at sample k-1", i), n);
-  const auto u = AddColumn(&s, "u_mm", "mm", "actuator command u_k = u_FF + u_FB (held over [t_k, t_k+1))", n);
-  const auto u_ff = AddColumn(&s, "u_ff_mm", "mm", "feedforward part of the command u_FF", n);
-  const auto u_fb = AddColumn(&s, "u_fb_mm", "mm", "feedback part of the command u_FB", n);
-  const auto y = AddColumn(&s, "y_mm", "mm", "measured actuator displacement y_k (with sensor noise, if any)", n);
-  const auto e = AddColumn(&s, "e_mm", "mm", "tracking error e_k = r_k - y_k", n);
-  const auto f = AddColumn(&s, "f_kN", "kN", "measured specimen (damper) force f_k (with sensor noise, if any)", n);
-  const auto i_eff = AddColumn(&s, "i_eff_A", "A", "effective damper current at t_k (measured_t.current_A)", n);
-  const auto i_cmd = AddColumn(&s, "i_cmd_A", "A", "damper current command i_k (held over [t_k, t_k+1))", n);
-  const auto f_des = AddColumn(&s, "f_desired_kN", "kN",
-                               "clipped-optimal nominal force for one damper (0 for other modes)", n);
-
-  for (std::size_t j = 0; j < n; ++j) {
-    const auto& d = log.desired[j];
-    const auto& c = log.command[j];
-    const auto& m = log.measured[j];
-    const auto& i = log.current[j];
-    if (d.n_dof != n_dof || static_cast<int>(d.x_mm.size()) != n_dof ||
-        static_cast<int>(d.abs_acc_mm_s2.size()) != n_dof)
-      throw Error(log.source, fmt::format("RTHS_DESIRED k = {}: n_dof = {}, but step 0 has n_dof = {}", j,
-                                          d.n_dof, n_dof));
-    const auto put = [&](std::size_t col, double v) { s.columns[col].values.push_back(v); };
-    put(k, static_cast<double>(j));
-    put(t, static_cast<double>(j) * dt_s);
-    put(r, d.r_mm);
-    put(rd, d.rd_mm_s);
-    put(rdd, d.rdd_mm_s2);
-    put(rddd, d.rddd_mm_s3);
-    put(acc_prev, d.acc_prev_mm_s2);
-    put(vel_prev, d.vel_prev_mm_s);
-    put(ground, d.ground_acc_mm_s2);
-    for (int q = 0; q < n_dof; ++q) {
-      put(x0 + static_cast<std::size_t>(q), d.x_mm[static_cast<std::size_t>(q)]);
-      put(a0 + static_cast<std::size_t>(q), d.abs_acc_mm_s2[static_cast<std::size_t>(q)]);
-    }
-    put(u, c.u_mm);
-    put(u_ff, c.u_ff_mm);
-    put(u_fb, c.u_fb_mm);
-    put(y, m.y_mm);
-    put(e, d.r_mm - m.y_mm);
-    put(f, m.f_kN);
-    put(i_eff, m.current_A);
-    put(i_cmd, i.i_cmd_A);
-    put(f_des, i.f_desired_kN);
-  }
-  // An adaptive controller's coefficients (command_t.adapt: ats 3, ambc 4), one column each, at the
-  // end so that every other column keeps its place; NaN at a step that reported fewer.
-  int n_adapt = 0;
-  for (std::size_t j = 0; j < n; ++j) n_adapt = std::max(n_adapt, std::min(log.command[j].n_adapt, 4));
-  static constexpr const char* kAdaptNames[4] = {"a0", "a1_s", "a2_s2", "a3_s3"};
-  static constexpr const char* kAdaptUnits[4] = {"", "s", "s^2", "s^3"};
-  for (int q = 0; q < n_adapt; ++q) {
-    const std::size_t col = AddColumn(&s, kAdaptNames[q], kAdaptUnits[q],
-                                      fmt::format("adaptive controller's coefficient of the target's derivative {} "
-                                                  "(u = sum a_i x_t^(i); command_t.adapt[{}])",
-                                                  q, q),
-                                      n);
-    for (std::size_t j = 0; j < n; ++j) {
-      const auto& c = log.command[j];
-      s.columns[col].values.push_back(q < c.n_adapt && q < static_cast<int>(c.adapt.size()) ? c.adapt[q] : std::nan(""));
-    }
-  }
+  const Layout layout = AddColumns(&s, n_dof, n);
+  for (std::size_t j = 0; j < n; ++j) AppendStep(log, j, n_dof, layout, &s);
+  AddAdaptColumns(log, n, &s);
   return s;
+}
+
+RunSignals ReadRunSignals(const std::filesystem::path& run_dir) {
+  const std::string path = (run_dir / "log.lcm").string();
+  const RunLog log = ReadRunLog(path);
+  const double dt_s = log.StepS();
+  if (!(dt_s > 0.0)) throw Error(path, "no step size: no handshake in the log carries dt_s");
+  return SignalsFromRunLog(log, dt_s);
 }
 
 }  // namespace rths::io

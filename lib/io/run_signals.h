@@ -5,6 +5,7 @@
 /// exists there (k, t_s, r_mm, u_mm, u_ff_mm, u_fb_mm, y_mm, e_mm, f_kN, i_cmd_A, i_eff_A,
 /// ground_acc_mm_s2) and the message fields (lcmtypes/*.lcm) otherwise.
 #include <cstddef>
+#include <filesystem>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -41,5 +42,9 @@ struct RunSignals {
 /// Throws rths::Error (where = log.source) if dt_s is not finite and > 0, or if a step's n_dof
 /// differs from step 0's.
 RunSignals SignalsFromRunLog(const RunLog& log, double dt_s);
+
+/// The signals of run_dir/log.lcm (ReadRunLog) at the step its handshake carries (RunLog::StepS()).
+/// Throws rths::Error naming the file if it cannot be read or no handshake carries dt_s.
+RunSignals ReadRunSignals(const std::filesystem::path& run_dir);
 
 }  // namespace rths::io

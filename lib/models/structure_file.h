@@ -66,7 +66,7 @@ struct StructureConfig {
   /// mode = "rths", kind = "file", optional: the monolithic reference structure of a partitioned
   /// test (a structure file with as many DOFs as `file`; e.g. data/buildings/silva3_reference_case1.txt),
   /// integrated offline under the run's ground acceleration for the benchmark criteria J1-J9
-  /// (io/benchmark_run.h). "" for none. Relative to the scenario file's folder.
+  /// (participants/benchmark_run.h). "" for none. Relative to the scenario file's folder.
   std::string reference_file;
   int actuator_dof = 1;       ///< kind = "file": DOF the specimen acts on, 1-based (1 = first story)
   // kind = "sdof":

@@ -5,7 +5,7 @@
 
 #include <fmt/format.h>
 
-#include "io/benchmark_run.h"
+#include "participants/benchmark_run.h"
 
 namespace rths::participants {
 
@@ -137,7 +137,7 @@ void ReadLog(const std::string& log_path, const scenario::Scenario& scenario, Ru
     const io::RunLog log = io::ReadRunLog(log_path);
     ReadLog(log, s);
     try {
-      s->benchmark_criteria = io::BenchmarkCriteriaOfRun(log, scenario);
+      s->benchmark_criteria = BenchmarkCriteriaOfRun(log, scenario);
     } catch (const std::exception& e) {
       s->benchmark_error = e.what();
     }

@@ -35,7 +35,7 @@ struct RunSummary {
   std::int64_t duplicates_logged = 0;     ///< duplicate events in the log, all channels
   std::string log_error;          ///< why the log could not be read ("" if it could)
   /// The RTHS benchmark's J1-J9 over the logged steps (raw values), when the scenario has a
-  /// structure.reference_file (ReadLog with the scenario; io/benchmark_run.h).
+  /// structure.reference_file (ReadLog with the scenario; participants/benchmark_run.h).
   std::optional<signal::BenchmarkCriteria> benchmark_criteria;
   std::string benchmark_error;    ///< why they could not be computed ("" if they were or were not asked for)
 
@@ -72,7 +72,7 @@ struct RunSummary {
 /// (steps 0) if it cannot be read.
 void ReadLog(const std::string& log_path, RunSummary* s);
 /// ReadLog, then, if `scenario` has a structure.reference_file, the benchmark's J1-J9 over the
-/// log's complete steps (io::BenchmarkCriteriaOfRun) into benchmark_criteria, or why not into
+/// log's complete steps (BenchmarkCriteriaOfRun) into benchmark_criteria, or why not into
 /// benchmark_error (too few steps, a diverged run, ...; never thrown).
 void ReadLog(const std::string& log_path, const scenario::Scenario& scenario, RunSummary* s);
 

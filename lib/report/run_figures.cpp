@@ -10,7 +10,7 @@
 
 #include <fmt/format.h>
 
-#include "io/benchmark_run.h"
+#include "participants/benchmark_run.h"
 #include "report/html.h"
 #include "signal/benchmark_criteria.h"
 #include "signal/metrics.h"
@@ -455,7 +455,7 @@ BenchmarkSection Benchmark(const RunData& d, const RunReportOptions& o) {
   signal::BenchmarkSignals b;
   signal::BenchmarkCriteria c;
   try {
-    b = io::BenchmarkSignalsFromRun(d.signals, *d.scenario);
+    b = participants::BenchmarkSignalsFromRun(d.signals, *d.scenario);
     c = signal::BenchmarkCriteriaFrom(b);
   } catch (const std::exception& e) {
     out.note = std::string("no benchmark criteria J1-J9: ") + e.what();

@@ -45,7 +45,7 @@ struct BenchmarkSection {
   std::string table_html;  ///< the J1-J9 table ("" if none)
   std::string note;        ///< why there are no criteria ("" if there are)
 };
-/// The RTHS benchmark's J1-J9 table and figure (io/benchmark_run.h), for a scenario with
+/// The RTHS benchmark's J1-J9 table and figure (participants/benchmark_run.h), for a scenario with
 /// structure.reference_file; empty otherwise, or a note if they cannot be computed.
 BenchmarkSection Benchmark(const RunData& d, const RunReportOptions& o);
 

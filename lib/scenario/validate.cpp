@@ -74,7 +74,7 @@ void ValidateController(const control::ControllerConfig& c, double dt_s, const C
   }
 }
 
-/// structure.reference_file (the benchmark criteria's monolithic reference, io/benchmark_run.h):
+/// structure.reference_file (the benchmark criteria's monolithic reference, participants/benchmark_run.h):
 /// only beside a structure file, and present (ReadReferencedFiles reads it and compares its DOFs).
 void ValidateReferenceFile(const models::StructureConfig& st, const std::string& scenario_path, const Check& check) {
   const char* key = "structure.reference_file";

@@ -1,7 +1,7 @@
 #pragma once
 /// @file What a run is asked to be (RunRequest), what it became (RunResult) and how it can fail
 /// before it ends (RunError): the supervisor's interface, for `rths run`, the studies' batch
-/// runner (report/batch.h) and tests (docs/lockstep.md).
+/// runner (studies/batch.h) and tests (docs/lockstep.md).
 #include <algorithm>
 #include <csignal>
 #include <cstdint>

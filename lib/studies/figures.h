@@ -1,6 +1,5 @@
 #pragma once
-/// @file The reproductions' figures: one style for each controller in every figure, and the
-/// figure builders the tests check without running a study.
+/// @file The reproductions' figures: one style for each controller in every figure.
 ///
 /// Rules (io/plot.h): units of docs/units.md (displacement mm, force kN, velocity mm/s,
 /// acceleration mm/s^2, frequency Hz, time s, time lag ms); colours from io::ReadableColors(),
@@ -9,9 +8,8 @@
 #include <string>
 
 #include "io/plot.h"
-#include "report/studies.h"
 
-namespace rths::report {
+namespace rths::studies {
 
 /// How a controller's curve is drawn.
 struct CurveStyle {
@@ -32,13 +30,4 @@ CurveStyle ControllerStyle(const std::string& name, bool prominent = false, std:
 /// A series drawn `with` ("lines" or "linespoints") in `style`, titled `title`.
 io::Series StyledSeries(const std::string& title, const CurveStyle& style, const std::string& with = "lines");
 
-/// Fig. 9's figure from a result: RMS error against natural frequency, one curve per controller
-/// (G_FF,0.0A, the proposed, prominent), stopped pairs ringed.
-io::Figure Fig9Figure(const Fig9Result& res, const std::string& plant, bool quick);
-
-/// Fig. 11's stories figure from a result: peak story drift [mm] and peak absolute floor
-/// acceleration [mm/s^2] per story, for each semiactive mode, numerical (dashed) and RTHS with
-/// G_FF,avgA + LQG (solid); the legend beside the axes.
-io::Figure Fig11StoriesFigure(const Fig11Result& res);
-
-}  // namespace rths::report
+}  // namespace rths::studies

@@ -1,4 +1,4 @@
-#include "io/benchmark_run.h"
+#include "participants/benchmark_run.h"
 
 #include <fmt/format.h>
 
@@ -6,7 +6,7 @@
 #include "models/ground_response.h"
 #include "models/structure_file.h"
 
-namespace rths::io {
+namespace rths::participants {
 
 models::LinearStructure ReferenceStructure(const scenario::Scenario& s, int run_dofs) {
   const std::string where = fmt::format("{}: structure.reference_file", s.path.empty() ? "<scenario text>" : s.path);
@@ -25,7 +25,7 @@ models::LinearStructure ReferenceStructure(const scenario::Scenario& s, int run_
   return ref;
 }
 
-signal::BenchmarkSignals BenchmarkSignalsFromRun(const RunSignals& signals, const scenario::Scenario& s) {
+signal::BenchmarkSignals BenchmarkSignalsFromRun(const io::RunSignals& signals, const scenario::Scenario& s) {
   int dofs = 0;
   while (signals.Find(fmt::format("x{}_mm", dofs + 1))) ++dofs;
   if (dofs == 0) throw Error("benchmark criteria", "the run's signals have no structure displacement (x1_mm)");
@@ -44,16 +44,16 @@ signal::BenchmarkSignals BenchmarkSignalsFromRun(const RunSignals& signals, cons
   return b;
 }
 
-signal::BenchmarkCriteria BenchmarkCriteriaFromRun(const RunSignals& signals, const scenario::Scenario& s) {
+signal::BenchmarkCriteria BenchmarkCriteriaFromRun(const io::RunSignals& signals, const scenario::Scenario& s) {
   return signal::BenchmarkCriteriaFrom(BenchmarkSignalsFromRun(signals, s));
 }
 
-signal::BenchmarkCriteria BenchmarkCriteriaOfRun(const RunLog& log, const scenario::Scenario& s) {
-  return BenchmarkCriteriaFromRun(SignalsFromRunLog(log, s.run.dt_s), s);
+signal::BenchmarkCriteria BenchmarkCriteriaOfRun(const io::RunLog& log, const scenario::Scenario& s) {
+  return BenchmarkCriteriaFromRun(io::SignalsFromRunLog(log, s.run.dt_s), s);
 }
 
 signal::BenchmarkCriteria BenchmarkCriteriaOfRun(const std::string& log_path, const scenario::Scenario& s) {
-  return BenchmarkCriteriaOfRun(ReadRunLog(log_path), s);
+  return BenchmarkCriteriaOfRun(io::ReadRunLog(log_path), s);
 }
 
-}  // namespace rths::io
+}  // namespace rths::participants

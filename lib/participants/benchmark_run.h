@@ -3,6 +3,9 @@
 /// docs/benchmark.md): the monolithic reference structure (structure.reference_file) integrated
 /// offline under the ground acceleration the run's log holds, against what the run logged.
 ///
+/// In participants beside the run summary that scores every such run with it (run_summary.h); the
+/// run report and the benchmark study use it too.
+///
 /// Reference response: models::GroundResponse (models/ground_response.h) at the run's dt, driven by
 /// desired_t.ground_acc_mm_s2 of each logged step.
 ///
@@ -21,7 +24,7 @@
 #include "scenario/scenario.h"
 #include "signal/benchmark_criteria.h"
 
-namespace rths::io {
+namespace rths::participants {
 
 /// The monolithic reference structure a scenario names (structure.reference_file, with its iota),
 /// the specimen position at structure.actuator_dof (count 1; unused: no force). Throws
@@ -32,16 +35,16 @@ models::LinearStructure ReferenceStructure(const scenario::Scenario& s, int run_
 /// The criteria's records from a run's signals (columns y_mm, r_mm, ground_acc_mm_s2, x1_mm..xN_mm)
 /// and its scenario (reference_file, actuator_dof), the reference integrated at signals.dt_s.
 /// Throws rths::Error as ReferenceStructure, or if a column is missing.
-signal::BenchmarkSignals BenchmarkSignalsFromRun(const RunSignals& signals, const scenario::Scenario& s);
+signal::BenchmarkSignals BenchmarkSignalsFromRun(const io::RunSignals& signals, const scenario::Scenario& s);
 
 /// BenchmarkCriteriaFrom(BenchmarkSignalsFromRun(signals, s)). Throws rths::Error (too few steps,
 /// a diverged run, a reference floor that does not move, ...).
-signal::BenchmarkCriteria BenchmarkCriteriaFromRun(const RunSignals& signals, const scenario::Scenario& s);
+signal::BenchmarkCriteria BenchmarkCriteriaFromRun(const io::RunSignals& signals, const scenario::Scenario& s);
 
 /// J1-J9 of the run whose log is `log` and whose scenario is `s`: its complete steps
-/// (RunLog::CompleteSteps()) at s.run.dt_s. Throws rths::Error as BenchmarkCriteriaFromRun.
-signal::BenchmarkCriteria BenchmarkCriteriaOfRun(const RunLog& log, const scenario::Scenario& s);
-/// The same from the log file at `log_path` (ReadRunLog; its errors name the file).
+/// (io::RunLog::CompleteSteps()) at s.run.dt_s. Throws rths::Error as BenchmarkCriteriaFromRun.
+signal::BenchmarkCriteria BenchmarkCriteriaOfRun(const io::RunLog& log, const scenario::Scenario& s);
+/// The same from the log file at `log_path` (io::ReadRunLog; its errors name the file).
 signal::BenchmarkCriteria BenchmarkCriteriaOfRun(const std::string& log_path, const scenario::Scenario& s);
 
-}  // namespace rths::io
+}  // namespace rths::participants

@@ -16,7 +16,7 @@
 #include "scenario/scenario.h"
 #include "signal/benchmark_criteria.h"
 
-namespace rths::report {
+namespace rths::studies {
 
 /// One run to make.
 struct RunSpec {
@@ -41,23 +41,11 @@ struct RunResult {
   std::string benchmark_error;
 };
 
-/// A run's signals, read back from its log.lcm, per step k (docs/lockstep.md).
-struct Trace {
-  std::vector<double> r_mm;          ///< desired r_k
-  std::vector<double> u_mm;          ///< command u_k
-  std::vector<double> y_mm;          ///< measured y_k
-  std::vector<double> f_kN;          ///< measured force f_k
-  std::vector<double> current_A;     ///< effective current at t_k
-  std::vector<double> i_cmd_A;       ///< commanded current i_k
-};
-/// Reads the complete steps of dir/log.lcm. Throws rths::Error.
-Trace ReadTrace(const std::filesystem::path& run_dir);
-
 /// Writes spec.scenario into spec.dir/scenario.toml and loads it back (a real file and hash).
 scenario::Scenario WriteScenarioFile(const RunSpec& spec);
 
-/// Builds the controller, plant, semiactive and integrator of every scenario once, without
-/// running, and throws one rths::Error listing every run that cannot be built (e.g. a
+/// Validates every scenario and builds each of its participants but the logger once
+/// (participants::CheckBuildable: the roles of the step table), without running, and throws one rths::Error listing every run that cannot be built (e.g. a
 /// controller kind or plant that is not implemented yet) with the component's own message.
 void Preflight(const std::vector<RunSpec>& specs);
 /// Applies `overrides` (`--set KEY=VALUE`, scenario::WithOverrides) to every spec's scenario,
@@ -79,4 +67,4 @@ std::vector<RunResult> RunBatch(const std::vector<RunSpec>& specs, int jobs, Pro
 /// ("G_FF,0.0A + LP" -> "g_ff-0.0a-lp").
 std::string Slug(const std::string& label);
 
-}  // namespace rths::report
+}  // namespace rths::studies

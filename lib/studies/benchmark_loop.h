@@ -33,7 +33,7 @@
 #include "scenario/scenario.h"
 #include "signal/benchmark_criteria.h"
 
-namespace rths::report {
+namespace rths::studies {
 
 enum class LoopIntegration { kCentralDifference, kRk4 };
 
@@ -62,4 +62,4 @@ struct LoopResult {
 /// rths::Error naming the key for a scenario it cannot run, or if the loop diverges.
 LoopResult RunBenchmarkLoop(const scenario::Scenario& s, const LoopOptions& o);
 
-}  // namespace rths::report
+}  // namespace rths::studies

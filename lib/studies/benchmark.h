@@ -16,7 +16,7 @@
 ///      `perturbed` plants drawn from the benchmark's uncertainty (models::PerturbedBenchmarkParams,
 ///      seeds 1..perturbed); as in the reference code, the numerical substructure of a perturbed
 ///      run is the reference minus the perturbed specimen (its k_e, c_e); J1-J9 of every run;
-///   4. the loop: the example controller's nominal runs again through report/benchmark_loop, closed
+///   4. the loop: the example controller's nominal runs again through studies/benchmark_loop, closed
 ///      as the reference code closes it, one difference at a time, beside the published values.
 #include <array>
 #include <cstdint>
@@ -27,11 +27,11 @@
 #include "control/controller_config.h"
 #include "ident/identify.h"
 #include "models/benchmark_plant.h"
-#include "report/reproduce.h"
+#include "studies/study.h"
 #include "scenario/scenario.h"
 #include "signal/benchmark_criteria.h"
 
-namespace rths::report {
+namespace rths::studies {
 
 /// The study's loop rate: 4096 Hz (the benchmark's), dt = 1/4096 s exactly.
 inline constexpr double kBenchmarkDtS = 1.0 / 4096.0;
@@ -97,7 +97,7 @@ struct BenchmarkSpread {
   int n = 0;
 };
 
-/// One closing of the example controller's nominal loop (report/benchmark_loop.h).
+/// One closing of the example controller's nominal loop (studies/benchmark_loop.h).
 struct BenchmarkLoopRow {
   int case_number = 1;
   std::string variant;   ///< "lockstep", "rk4", "rk4 + unit delay", "reference code"
@@ -130,4 +130,4 @@ BenchmarkResult ReproduceBenchmark(const ReproduceOptions& opts, bool keep_logs 
 /// benchmark.md and benchmark.png for `res` into opts.out_dir (ReproduceBenchmark's outputs).
 void WriteBenchmarkOutputs(const BenchmarkResult& res, const ReproduceOptions& opts);
 
-}  // namespace rths::report
+}  // namespace rths::studies

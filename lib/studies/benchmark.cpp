@@ -1,6 +1,8 @@
 // The RTHS benchmark problem (Silva et al. 2020) as its reference code runs it, as a study:
 // identification, design, the four cases' nominal and perturbed El Centro runs, J1-J9, and the loop
-// closed as the reference code closes it (report/benchmark_study.h, docs/benchmark.md).
+// closed as the reference code closes it (studies/benchmark.h, docs/benchmark.md).
+#include "studies/benchmark.h"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -11,14 +13,12 @@
 #include <fmt/format.h>
 
 #include "core/error.h"
-#include "io/run_log.h"
+#include "io/run_signals.h"
 #include "io/source_tree.h"
 #include "models/benchmark_structures.h"
-#include "report/benchmark_loop.h"
-#include "report/benchmark_study.h"
-#include "report/figures.h"
+#include "studies/benchmark_loop.h"
 
-namespace rths::report {
+namespace rths::studies {
 
 namespace fs = std::filesystem;
 
@@ -52,21 +52,23 @@ BenchmarkIdentification Identify(const scenario::Scenario& base, const Reproduce
   const double duration = opts.quick ? 20.0 : 60.0;
   id.run_dir = opts.out_dir / "runs" / "identification";
   std::vector<RunSpec> specs{{"identification (BLWN, no controller)", IdentificationScenario(base, duration), id.run_dir}};
-  Preflight(&specs, opts.overrides, opts.log);
-  if (opts.log) {
-    opts.log(fmt::format("benchmark: identification record, BLWN 0-{:g} Hz command, RMS 1 mm, {:g} s, no controller",
-                         kBenchmarkIdBandHz, duration));
-  }
-  const auto results = RunBatch(specs, 1, opts.progress);
+  ReproduceOptions one = opts;  // one run
+  one.jobs = 1;
+  const auto results = RunStudyBatch(
+      &specs, one,
+      fmt::format("benchmark: identification record, BLWN 0-{:g} Hz command, RMS 1 mm, {:g} s, no controller",
+                  kBenchmarkIdBandHz, duration));
   if (!results[0].ok) throw Error("benchmark identification", results[0].error);
-  const Trace t = ReadTrace(id.run_dir);
-  ident::IdentifyOptions io;
-  io.fit.poles = 3;
-  io.fit.band_lo_hz = 0.5;
-  io.fit.band_hi_hz = kBenchmarkFitHiHz;
-  io.fit.zoh_dt_s = 0.0;  // a design model: the hold's half-sample lag included (as `rths identify`'s [controller] model)
+  const io::RunSignals t = io::ReadRunSignals(id.run_dir);
+  const std::vector<double>& u = t.At("u_mm").values;
+  const std::vector<double>& y = t.At("y_mm").values;
+  ident::IdentifyOptions fit_opts;
+  fit_opts.fit.poles = 3;
+  fit_opts.fit.band_lo_hz = 0.5;
+  fit_opts.fit.band_hi_hz = kBenchmarkFitHiHz;
+  fit_opts.fit.zoh_dt_s = 0.0;  // a design model: the hold's half-sample lag included (as `rths identify`'s [controller] model)
   const double dt = specs[0].scenario.run.dt_s;
-  id.fit = ident::Identify(t.u_mm, t.y_mm, dt, io);
+  id.fit = ident::Identify(u, y, dt, fit_opts);
   id.model = id.fit.fit.model.ToServoModel3();
   id.model.name = "custom";
   id.model_lag_ms = 1e3 * id.fit.fit.model.DcLagS();
@@ -76,9 +78,9 @@ BenchmarkIdentification Identify(const scenario::Scenario& base, const Reproduce
   id.plant_lag_ms = 1e3 * models::TimeLagS(plant, 1.0, false);
 
   {  // what `rths identify --out` writes, and its report
-    ident::IdentifyOptions zo = io;
+    ident::IdentifyOptions zo = fit_opts;
     zo.fit.zoh_dt_s = dt;
-    const ident::IdentifyResult zoh = ident::Identify(t.u_mm, t.y_mm, dt, zo);
+    const ident::IdentifyResult zoh = ident::Identify(u, y, dt, zo);
     std::ofstream(opts.out_dir / "identify.toml")
         << ident::ScenarioFragment(id.fit, zoh, "benchmark plant (nominal), BLWN identification record");
     std::ofstream(opts.out_dir / "identify.txt") << id.fit.Report();
@@ -110,7 +112,7 @@ BenchmarkSpread Spread(const std::vector<double>& v) {
   return s;
 }
 
-/// The example controller's nominal loop closed four ways (report/benchmark_loop.h).
+/// The example controller's nominal loop closed four ways (studies/benchmark_loop.h).
 std::vector<BenchmarkLoopRow> LoopComparison(int case_number, const scenario::Scenario& s) {
   LoopOptions rk4 = LockstepLoop();
   rk4.substructure = rk4.reference = LoopIntegration::kRk4;
@@ -182,9 +184,10 @@ scenario::Scenario BenchmarkScenario(const scenario::Scenario& base, const std::
   return s;
 }
 
-BenchmarkResult ReproduceBenchmark(const ReproduceOptions& opts, bool keep_logs) {
-  const auto t0 = std::chrono::steady_clock::now();
-  PrepareOutDir(opts.out_dir);
+namespace {
+
+/// The four cases' base scenarios (scenarios/benchmark/caseN_example.toml).
+std::vector<scenario::Scenario> LoadBases(const ReproduceOptions& opts) {
   std::vector<scenario::Scenario> bases;
   for (const models::BenchmarkCase& bc : models::kBenchmarkCases) {
     const fs::path file = io::FindSourceFile(fmt::format("scenarios/benchmark/case{}_example.toml", bc.number), opts.source_dir);
@@ -193,30 +196,30 @@ BenchmarkResult ReproduceBenchmark(const ReproduceOptions& opts, bool keep_logs)
       throw Error(file.string(), "plant.kind must be \"benchmark\" for this study");
     }
   }
+  return bases;
+}
 
-  BenchmarkResult res;
-  res.duration_s = bases[0].run.duration_s;
-  res.perturbed = opts.quick ? kBenchmarkQuickPerturbed : kBenchmarkFullPerturbed;
-  res.id = Identify(bases[0], opts);
-
-  // The perturbed plants (the same draws in every case) and, as the reference code builds them,
-  // each case's numerical substructure for the perturbed specimen.
+/// The specs: case-major, then controller, nominal first, then the perturbed plants 1..N (the same
+/// draws in every case) with, as the reference code builds them, each case's numerical
+/// substructure for the perturbed specimen (written under structures/); res->rows in the same order.
+std::vector<RunSpec> BenchmarkSpecs(const ReproduceOptions& opts, const std::vector<scenario::Scenario>& bases,
+                                    BenchmarkResult* res) {
   const models::BenchmarkPlantParams nominal = bases[0].plant.benchmark.params;
   std::vector<models::BenchmarkPlantParams> plants{nominal};
-  for (int i = 1; i <= res.perturbed; ++i) plants.push_back(models::PerturbedBenchmarkParams(nominal, i));
+  for (int i = 1; i <= res->perturbed; ++i) plants.push_back(models::PerturbedBenchmarkParams(nominal, i));
   fs::create_directories(opts.out_dir / "structures");
   std::vector<RunSpec> specs;
   for (const models::BenchmarkCase& bc : models::kBenchmarkCases) {
     std::vector<std::string> numerical(plants.size());
-    for (int i = 1; i <= res.perturbed; ++i) {
+    for (int i = 1; i <= res->perturbed; ++i) {
       const models::BenchmarkPlantParams& p = plants[i];
       numerical[i] = (opts.out_dir / "structures" / fmt::format("case{}_plant{}.txt", bc.number, i)).string();
       models::WriteSilva3NumericalFile(numerical[i], bc, {p.m_e_kg, p.k_e_N_per_m, p.zeta_e},
                                        fmt::format("For perturbed plant {} of `rths reproduce benchmark` (seed {}).", i, i));
     }
     for (const std::string& name : BenchmarkControllerNames()) {
-      const control::ControllerConfig c = BenchmarkController(name, res.id);
-      for (int i = 0; i <= res.perturbed; ++i) {
+      const control::ControllerConfig c = BenchmarkController(name, res->id);
+      for (int i = 0; i <= res->perturbed; ++i) {
         BenchmarkRow row;
         row.case_number = bc.number;
         row.controller = name;
@@ -228,65 +231,54 @@ BenchmarkResult ReproduceBenchmark(const ReproduceOptions& opts, bool keep_logs)
         // The same sensor noise for every controller on the same plant (common random numbers).
         specs.push_back({label, BenchmarkScenario(bases[bc.number - 1], label, c, row.plant, 100 + row.seed, numerical[i]),
                          row.run_dir});
-        res.rows.push_back(row);
+        res->rows.push_back(row);
       }
     }
   }
-  Preflight(&specs, opts.overrides, opts.log);
-  if (opts.log) {
-    opts.log(fmt::format("benchmark: {} lockstep runs (4 cases x {} controllers x nominal + {} perturbed plants) of "
-                         "{:g} s at 4096 Hz, {} at a time{}",
-                         specs.size(), BenchmarkControllerNames().size(), res.perturbed, res.duration_s, opts.jobs,
-                         keep_logs ? "" : "; logs are removed once scored, but for case 1's nominal runs"));
-  }
+  return specs;
+}
 
-  // J1-J9 come with each result (computed in the worker, from its log); then the log is dropped.
-  std::mutex mu;
-  const auto results = RunBatch(specs, opts.jobs, opts.progress, [&](std::size_t done, std::size_t total,
-                                                                     const RunResult& r) {
-    std::lock_guard<std::mutex> lock(mu);
-    auto it = std::find_if(res.rows.begin(), res.rows.end(), [&](const BenchmarkRow& row) { return row.run_dir == r.dir; });
-    if (it == res.rows.end()) return;
-    BenchmarkRow& row = *it;
-    row.steps = r.steps;
-    row.stopped = StoppedText(r);
-    row.criteria_ok = r.benchmark.has_value();
-    if (r.benchmark) row.j = *r.benchmark;
-    row.stable = r.ok && row.criteria_ok && std::isfinite(row.j.J2_pct) && std::isfinite(row.j.J4_pct);
-    if (!keep_logs && !(row.run == "nominal" && row.case_number == 1)) {
-      std::error_code ec;
-      fs::remove(r.dir / "log.lcm", ec);
-    }
-    if (opts.log) {
-      opts.log(fmt::format("  [{:3}/{}] {:<26} J1 {:>5.1f} ms  J2 {:>7.2f} %  J4 {:>7.2f} %  ({:.1f} s){}{}", done, total,
-                           r.label, row.j.J1_ms, row.j.J2_pct, row.j.J4_pct, r.wall_s,
-                           r.ok ? "" : "  STOPPED: " + row.stopped,
-                           row.criteria_ok ? "" : "  (no criteria: " + r.benchmark_error + ")"));
-    }
-  });
-  for (const auto& r : results) {
-    if (r.steps == 0 && !r.ok) throw Error("benchmark", fmt::format("{} did not run: {}", r.label, r.error));
+/// The table, one run at a time as it finishes: its row's J1-J9 (computed in the worker, from its
+/// log) and how it stopped; then the log is dropped (but for case 1's nominal runs, or keep_logs).
+void ScoreRun(const RunResult& r, bool keep_logs, BenchmarkResult* res, BenchmarkRow** scored) {
+  *scored = nullptr;
+  auto it = std::find_if(res->rows.begin(), res->rows.end(), [&](const BenchmarkRow& row) { return row.run_dir == r.dir; });
+  if (it == res->rows.end()) return;
+  BenchmarkRow& row = *it;
+  row.steps = r.steps;
+  row.stopped = StoppedText(r);
+  row.criteria_ok = r.benchmark.has_value();
+  if (r.benchmark) row.j = *r.benchmark;
+  row.stable = r.ok && row.criteria_ok && std::isfinite(row.j.J2_pct) && std::isfinite(row.j.J4_pct);
+  if (!keep_logs && !(row.run == "nominal" && row.case_number == 1)) {
+    std::error_code ec;
+    fs::remove(r.dir / "log.lcm", ec);
   }
+  *scored = &row;
+}
 
-  // Spread over the perturbed runs, per case and controller.
+/// Spread over the perturbed runs, per case and controller.
+void Spreads(BenchmarkResult* res) {
   const auto names = BenchmarkControllerNames();
-  res.spread.assign(4, std::vector<std::vector<BenchmarkSpread>>(names.size(), std::vector<BenchmarkSpread>(9)));
+  res->spread.assign(4, std::vector<std::vector<BenchmarkSpread>>(names.size(), std::vector<BenchmarkSpread>(9)));
   for (int cs = 1; cs <= 4; ++cs) {
     for (std::size_t c = 0; c < names.size(); ++c) {
       for (int j = 0; j < 9; ++j) {
         std::vector<double> v;
-        for (const auto& row : res.rows) {
+        for (const auto& row : res->rows) {
           if (row.case_number == cs && row.controller == names[c] && row.run != "nominal" && row.criteria_ok)
             v.push_back(row.j.At(j));
         }
-        res.spread[cs - 1][c][j] = Spread(v);
+        res->spread[cs - 1][c][j] = Spread(v);
       }
     }
   }
+}
 
-  // The example controller's nominal loop closed as the reference code closes it.
-  if (opts.log) opts.log("benchmark: the example controller's nominal loop closed as the reference code closes it");
-  std::vector<std::future<std::vector<BenchmarkLoopRow>>> loops;  // the four cases side by side
+/// The example controller's nominal loop of each case closed as the reference code closes it, the
+/// four cases side by side.
+std::vector<BenchmarkLoopRow> Loops(const std::vector<RunSpec>& specs) {
+  std::vector<std::future<std::vector<BenchmarkLoopRow>>> loops;
   for (const models::BenchmarkCase& bc : models::kBenchmarkCases) {
     const auto it = std::find_if(specs.begin(), specs.end(), [&](const RunSpec& sp) {
       return sp.label == fmt::format("case{} example_pi_lead nominal", bc.number);
@@ -294,11 +286,48 @@ BenchmarkResult ReproduceBenchmark(const ReproduceOptions& opts, bool keep_logs)
     const scenario::Scenario s = it->scenario;  // its files' paths are absolute
     loops.push_back(std::async(std::launch::async, [s, n = bc.number] { return LoopComparison(n, s); }));
   }
+  std::vector<BenchmarkLoopRow> rows;
   for (auto& f : loops)
-    for (BenchmarkLoopRow& l : f.get()) res.loops.push_back(std::move(l));
-  res.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    for (BenchmarkLoopRow& l : f.get()) rows.push_back(std::move(l));
+  return rows;
+}
+
+}  // namespace
+
+BenchmarkResult ReproduceBenchmark(const ReproduceOptions& opts, bool keep_logs) {
+  const auto t0 = std::chrono::steady_clock::now();
+  PrepareOutDir(opts.out_dir);
+  const std::vector<scenario::Scenario> bases = LoadBases(opts);
+  BenchmarkResult res;
+  res.duration_s = bases[0].run.duration_s;
+  res.perturbed = opts.quick ? kBenchmarkQuickPerturbed : kBenchmarkFullPerturbed;
+  res.id = Identify(bases[0], opts);
+  std::vector<RunSpec> specs = BenchmarkSpecs(opts, bases, &res);
+  const std::string intro =
+      fmt::format("benchmark: {} lockstep runs (4 cases x {} controllers x nominal + {} perturbed plants) of "
+                  "{:g} s at 4096 Hz, {} at a time{}",
+                  specs.size(), BenchmarkControllerNames().size(), res.perturbed, res.duration_s, opts.jobs,
+                  keep_logs ? "" : "; logs are removed once scored, but for case 1's nominal runs");
+  std::mutex mu;
+  const auto results = RunStudyBatch(&specs, opts, intro, [&](std::size_t done, std::size_t total, const RunResult& r) {
+    std::lock_guard<std::mutex> lock(mu);
+    BenchmarkRow* row = nullptr;
+    ScoreRun(r, keep_logs, &res, &row);
+    if (!row || !opts.log) return;
+    opts.log(fmt::format("  [{:3}/{}] {:<26} J1 {:>5.1f} ms  J2 {:>7.2f} %  J4 {:>7.2f} %  ({:.1f} s){}{}", done, total,
+                         r.label, row->j.J1_ms, row->j.J2_pct, row->j.J4_pct, r.wall_s,
+                         r.ok ? "" : "  STOPPED: " + row->stopped,
+                         row->criteria_ok ? "" : "  (no criteria: " + r.benchmark_error + ")"));
+  });
+  for (const auto& r : results) {
+    if (r.steps == 0 && !r.ok) throw Error("benchmark", fmt::format("{} did not run: {}", r.label, r.error));
+  }
+  Spreads(&res);
+  if (opts.log) opts.log("benchmark: the example controller's nominal loop closed as the reference code closes it");
+  res.loops = Loops(specs);
+  res.wall_s = SecondsSince(t0);
   WriteBenchmarkOutputs(res, opts);
   return res;
 }
 
-}  // namespace rths::report
+}  // namespace rths::studies

@@ -1,21 +1,21 @@
 // Fig. 9 (docs/experiments.md E4): SDOF RTHS parametric study. 6 natural frequencies x 6 controllers,
 // each pair one lockstep group (in-process, memq://), `jobs` at a time; Eq. 31 on r_k, y_k.
+#include "studies/fig9.h"
+
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <fstream>
 
 #include <fmt/format.h>
 
 #include "core/error.h"
-#include "io/run_log.h"
 #include "io/csv.h"
 #include "io/plot.h"
 #include "io/source_tree.h"
-#include "report/figures.h"
-#include "report/studies.h"
+#include "io/run_signals.h"
+#include "studies/figures.h"
 
-namespace rths::report {
+namespace rths::studies {
 
 namespace fs = std::filesystem;
 using io::Series;
@@ -26,19 +26,6 @@ using io::Plot;
 using io::GnuplotAvailable;
 using io::CsvWriter;
 using io::FormatSig;
-
-std::string StoppedText(const RunResult& r) {
-  if (r.ok) return "no";
-  std::string s = r.error;
-  // "integrator exited with code 6: <the monitor's reason>" -> the reason
-  if (const auto p = s.find("exited with code"); p != std::string::npos) {
-    if (const auto c = s.find(": ", p); c != std::string::npos) s = s.substr(c + 2);
-  }
-  for (char& ch : s) {
-    if (ch == '\n' || ch == '\r') ch = ' ';
-  }
-  return s.empty() ? "stopped" : s;
-}
 
 namespace {
 
@@ -126,16 +113,12 @@ Figure Fig9Figure(const Fig9Result& res, const std::string& plant, bool quick) {
   return fig;
 }
 
-Fig9Result ReproduceFig9(const ReproduceOptions& opts) {
-  const auto t0 = std::chrono::steady_clock::now();
-  PrepareOutDir(opts.out_dir);
-  if (opts.plant != "ideal") RequirePlant(opts.plant, opts.out_dir);
-  const fs::path base_file = io::FindSourceFile("scenarios/fig9_base.toml", opts.source_dir);
-  const scenario::Scenario base = scenario::LoadScenario(base_file.string());
-  const double duration = opts.quick ? kFig9QuickS : kFig9FullS;
+namespace {
 
+/// The specs: frequency-major, controllers in Fig9Controllers() order; res->rows in the same order.
+std::vector<RunSpec> Fig9Specs(const ReproduceOptions& opts, const scenario::Scenario& base, double duration,
+                               Fig9Result* res) {
   std::vector<RunSpec> specs;
-  Fig9Result res;
   for (double f : Fig9FrequenciesHz()) {
     for (const auto& c : Fig9Controllers()) {
       Fig9Row row;
@@ -144,42 +127,42 @@ Fig9Result ReproduceFig9(const ReproduceOptions& opts) {
       row.run_dir = opts.out_dir / "runs" / Slug(fmt::format("{}hz {}", FreqText(f), c.name));
       specs.push_back({fmt::format("{:>4} Hz {}", FreqText(f), c.name), Fig9Scenario(base, f, c, opts.plant, duration),
                        row.run_dir});
-      res.rows.push_back(row);
+      res->rows.push_back(row);
     }
   }
-  Preflight(&specs, opts.overrides, opts.log);
-  if (opts.log) {
-    opts.log(fmt::format("fig9: {} lockstep runs of {:g} s on the {} plant, {} at a time (base {})", specs.size(),
-                         duration, opts.plant, opts.jobs, base_file.string()));
-  }
-  const auto results = RunBatch(specs, opts.jobs, opts.progress, [&](std::size_t done, std::size_t total, const RunResult& r) {
-    if (!opts.log) return;
-    opts.log(fmt::format("  [{:2}/{}] {:<28} {:9.3f} %  ({:.1f} s){}", done, total, r.label, r.tracking_pct, r.wall_s,
-                         r.ok ? "" : "  STOPPED: " + StoppedText(r)));
-  });
+  return specs;
+}
+
+/// The table: each row's Eq. 31 error, how it stopped and its peaks (from its log).
+void Fig9Table(const std::vector<RunResult>& results, Fig9Result* res) {
   for (std::size_t j = 0; j < results.size(); ++j) {
-    Fig9Row& row = res.rows[j];
+    Fig9Row& row = res->rows[j];
     row.rms_pct = results[j].tracking_pct;
     row.stopped = StoppedText(results[j]);
     if (results[j].steps == 0 && !results[j].ok) {
       throw Error("fig9", fmt::format("{} did not run: {}", results[j].label, results[j].error));
     }
-    const Trace t = ReadTrace(row.run_dir);
-    for (std::size_t k = 0; k < t.r_mm.size(); ++k) {
-      row.peak_error_mm = std::max(row.peak_error_mm, std::abs(t.r_mm[k] - t.y_mm[k]));
-      row.peak_u_mm = std::max(row.peak_u_mm, std::abs(t.u_mm[k]));
-      row.peak_y_mm = std::max(row.peak_y_mm, std::abs(t.y_mm[k]));
-      row.peak_f_kN = std::max(row.peak_f_kN, std::abs(t.f_kN[k]));
+    const io::RunSignals s = io::ReadRunSignals(row.run_dir);
+    const auto& r = s.At("r_mm").values;
+    const auto& u = s.At("u_mm").values;
+    const auto& y = s.At("y_mm").values;
+    const auto& f = s.At("f_kN").values;
+    for (std::size_t k = 0; k < r.size(); ++k) {
+      row.peak_error_mm = std::max(row.peak_error_mm, std::abs(r[k] - y[k]));
+      row.peak_u_mm = std::max(row.peak_u_mm, std::abs(u[k]));
+      row.peak_y_mm = std::max(row.peak_y_mm, std::abs(y[k]));
+      row.peak_f_kN = std::max(row.peak_f_kN, std::abs(f[k]));
     }
   }
+}
 
+/// fig9.csv and, if gnuplot is there, fig9.png: one curve per controller, stopped pairs marked.
+void WriteCsvAndFigure(const Fig9Result& res, const ReproduceOptions& opts) {
   {
     CsvWriter csv(opts.out_dir / "fig9.csv", {"f_hz", "controller", "rms_pct", "stopped"});
     for (const auto& r : res.rows) csv.Row({FreqText(r.f_hz), r.controller, FormatSig(r.rms_pct, 4), r.stopped});
     csv.Close();
   }
-
-  // Figure: one curve per controller, stopped pairs marked.
   if (GnuplotAvailable(opts.gnuplot)) {
     Figure fig = Fig9Figure(res, opts.plant, opts.quick);
     fig.gnuplot = opts.gnuplot;
@@ -187,42 +170,66 @@ Fig9Result ReproduceFig9(const ReproduceOptions& opts) {
   } else if (opts.log) {
     opts.log("fig9: gnuplot not found, no fig9.png (apt-get install gnuplot-nox)");
   }
+}
 
-  res.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  {
-    const safety::SafetyConfig lim = base.safety;
-    std::ofstream md(opts.out_dir / "fig9.md");
-    md << "# Fig. 9: SDOF RTHS parametric study\n\n"
-       << fmt::format("Made by `rths reproduce fig9{} --plant {}`: {} runs of {:g} s in {:.0f} s wall time "
-                      "({} at a time).\n\n",
-                      opts.quick ? " --quick" : "", opts.plant, res.rows.size(), duration, res.wall_s, opts.jobs)
-       << "RMS tracking error (Eq. 31) [%]; * = stopped by the safety monitor (its error is over the "
-          "steps before the stop).\n\n| f_n [Hz] |";
-    for (const auto& c : Fig9Controllers()) md << " " << c.name << " |";
-    md << "\n|---:|";
-    for (std::size_t i = 0; i < Fig9Controllers().size(); ++i) md << "---:|";
-    md << "\n";
-    for (double f : Fig9FrequenciesHz()) {
-      md << "| " << FreqText(f) << " |";
-      for (const auto& r : res.rows) {
-        if (r.f_hz == f) md << " " << FormatSig(r.rms_pct, 3) << (r.stopped == "no" ? "" : "*") << " |";
-      }
-      md << "\n";
-    }
-    md << "\n## Peaks against the safety limits\n\n"
-       << fmt::format("Limits: stroke {} mm (|r|, |u|, |y|), force {} kN, |r - y| {} mm, divergence of the "
-                      "error peak ({}x per {} s window, {} windows, above {} mm).\n\n",
-                      lim.stroke_mm, lim.force_kN, lim.max_error_mm, lim.growth_factor, lim.growth_window_s,
-                      lim.growth_windows, lim.growth_floor_mm)
-       << "| f_n [Hz] | controller | RMS [%] | max abs(r - y) [mm] | max abs(u) [mm] | max abs(y) [mm] | max abs(f) [kN] | stopped |\n"
-       << "|---:|---|---:|---:|---:|---:|---:|---|\n";
+void WriteMarkdown(const Fig9Result& res, const ReproduceOptions& opts, const safety::SafetyConfig& lim,
+                   double duration) {
+  std::ofstream md(opts.out_dir / "fig9.md");
+  md << "# Fig. 9: SDOF RTHS parametric study\n\n"
+     << fmt::format("Made by `rths reproduce fig9{} --plant {}`: {} runs of {:g} s in {:.0f} s wall time "
+                    "({} at a time).\n\n",
+                    opts.quick ? " --quick" : "", opts.plant, res.rows.size(), duration, res.wall_s, opts.jobs)
+     << "RMS tracking error (Eq. 31) [%]; * = stopped by the safety monitor (its error is over the "
+        "steps before the stop).\n\n| f_n [Hz] |";
+  for (const auto& c : Fig9Controllers()) md << " " << c.name << " |";
+  md << "\n|---:|";
+  for (std::size_t i = 0; i < Fig9Controllers().size(); ++i) md << "---:|";
+  md << "\n";
+  for (double f : Fig9FrequenciesHz()) {
+    md << "| " << FreqText(f) << " |";
     for (const auto& r : res.rows) {
-      md << fmt::format("| {} | {} | {} | {} | {} | {} | {} | {} |\n", FreqText(r.f_hz), r.controller,
-                        FormatSig(r.rms_pct, 3), FormatSig(r.peak_error_mm, 3), FormatSig(r.peak_u_mm, 3),
-                        FormatSig(r.peak_y_mm, 3), FormatSig(r.peak_f_kN, 3), r.stopped);
+      if (r.f_hz == f) md << " " << FormatSig(r.rms_pct, 3) << (r.stopped == "no" ? "" : "*") << " |";
     }
+    md << "\n";
   }
+  md << "\n## Peaks against the safety limits\n\n"
+     << fmt::format("Limits: stroke {} mm (|r|, |u|, |y|), force {} kN, |r - y| {} mm, divergence of the "
+                    "error peak ({}x per {} s window, {} windows, above {} mm).\n\n",
+                    lim.stroke_mm, lim.force_kN, lim.max_error_mm, lim.growth_factor, lim.growth_window_s,
+                    lim.growth_windows, lim.growth_floor_mm)
+     << "| f_n [Hz] | controller | RMS [%] | max abs(r - y) [mm] | max abs(u) [mm] | max abs(y) [mm] | max abs(f) [kN] | stopped |\n"
+     << "|---:|---|---:|---:|---:|---:|---:|---|\n";
+  for (const auto& r : res.rows) {
+    md << fmt::format("| {} | {} | {} | {} | {} | {} | {} | {} |\n", FreqText(r.f_hz), r.controller,
+                      FormatSig(r.rms_pct, 3), FormatSig(r.peak_error_mm, 3), FormatSig(r.peak_u_mm, 3),
+                      FormatSig(r.peak_y_mm, 3), FormatSig(r.peak_f_kN, 3), r.stopped);
+  }
+}
+
+}  // namespace
+
+Fig9Result ReproduceFig9(const ReproduceOptions& opts) {
+  const auto t0 = std::chrono::steady_clock::now();
+  PrepareOutDir(opts.out_dir);
+  if (opts.plant != "ideal") RequirePlant(opts.plant, opts.out_dir);
+  const fs::path base_file = io::FindSourceFile("scenarios/fig9_base.toml", opts.source_dir);
+  const scenario::Scenario base = scenario::LoadScenario(base_file.string());
+  const double duration = opts.quick ? kFig9QuickS : kFig9FullS;
+
+  Fig9Result res;
+  std::vector<RunSpec> specs = Fig9Specs(opts, base, duration, &res);
+  const std::string intro = fmt::format("fig9: {} lockstep runs of {:g} s on the {} plant, {} at a time (base {})",
+                                        specs.size(), duration, opts.plant, opts.jobs, base_file.string());
+  const auto results = RunStudyBatch(&specs, opts, intro, [&](std::size_t done, std::size_t total, const RunResult& r) {
+    if (!opts.log) return;
+    opts.log(fmt::format("  [{:2}/{}] {:<28} {:9.3f} %  ({:.1f} s){}", done, total, r.label, r.tracking_pct, r.wall_s,
+                         r.ok ? "" : "  STOPPED: " + StoppedText(r)));
+  });
+  Fig9Table(results, &res);
+  WriteCsvAndFigure(res, opts);
+  res.wall_s = SecondsSince(t0);
+  WriteMarkdown(res, opts, base.safety, duration);
   return res;
 }
 
-}  // namespace rths::report
+}  // namespace rths::studies

@@ -1,7 +1,10 @@
-// The files of `rths reproduce benchmark` (report/benchmark_study.h): CSV tables, benchmark.md and
+// The files of `rths reproduce benchmark` (studies/benchmark.h): CSV tables, benchmark.md and
 // benchmark.png from a finished study.
+#include "studies/benchmark.h"
+
 #include <cmath>
 #include <fstream>
+#include <ostream>
 
 #include <fmt/format.h>
 
@@ -9,10 +12,8 @@
 #include "io/plot.h"
 #include "models/benchmark_plant.h"
 #include "models/benchmark_structures.h"
-#include "report/benchmark_study.h"
-#include "report/figures.h"
 
-namespace rths::report {
+namespace rths::studies {
 
 namespace fs = std::filesystem;
 
@@ -62,8 +63,8 @@ const BenchmarkRow* Nominal(const BenchmarkResult& res, int case_number, const s
   return nullptr;
 }
 
-void WriteCsvs(const BenchmarkResult& res, const fs::path& dir) {
-  const auto names = BenchmarkControllerNames();
+/// benchmark.csv: J1-J9 of every run.
+void WriteRunsCsv(const BenchmarkResult& res, const fs::path& dir) {
   {
     std::vector<std::string> header{"case", "controller", "run"};
     for (const char* n : kJNames) header.push_back(n);
@@ -77,6 +78,11 @@ void WriteCsvs(const BenchmarkResult& res, const fs::path& dir) {
     }
     csv.Close();
   }
+}
+
+/// benchmark_summary.csv: per case and controller, published, nominal, mean, std, min, max.
+void WriteSummaryCsv(const BenchmarkResult& res, const fs::path& dir) {
+  const auto names = BenchmarkControllerNames();
   {
     std::vector<std::string> header{"case", "controller", "statistic"};
     for (const char* n : kJNames) header.push_back(n);
@@ -105,6 +111,11 @@ void WriteCsvs(const BenchmarkResult& res, const fs::path& dir) {
     }
     csv.Close();
   }
+}
+
+/// benchmark_loop.csv and benchmark_plants.csv: the loop's closings and the perturbed plants.
+void WriteLoopAndPlantsCsv(const BenchmarkResult& res, const fs::path& dir) {
+  const auto names = BenchmarkControllerNames();
   {
     std::vector<std::string> header{"case", "loop", "closing"};
     for (const char* n : kJNames) header.push_back(n);
@@ -178,30 +189,9 @@ void WriteFigure(const BenchmarkResult& res, const ReproduceOptions& opts) {
   io::Plot(fig, opts.out_dir);
 }
 
-void WriteMarkdown(const BenchmarkResult& res, const ReproduceOptions& opts) {
+/// One section per case: the nominal plant's criteria, then the perturbed plants' spread.
+void WriteCaseSections(std::ostream& md, const BenchmarkResult& res) {
   const auto names = BenchmarkControllerNames();
-  const auto& id = res.id;
-  std::ofstream md(opts.out_dir / "benchmark.md");
-  md << "# The RTHS benchmark problem (Silva et al. 2020) as its reference code runs it: J1-J9\n\n"
-     << fmt::format("Made by `rths reproduce benchmark{}`: {} lockstep runs (4 partitioning cases x {} controllers x "
-                    "nominal + {} perturbed plants) of {:g} s (El Centro x 0.4 padded with 5 s of zeros, g = 9.81 "
-                    "m/s^2) at 4096 Hz in {:.0f} s wall time ({} at a time). Criteria: docs/benchmark.md; J1 [ms], "
-                    "J2-J9 [%]. J1 searches lags of 0-49 samples (0-11.96 ms): a run lagging more reads 12.0 ms.\n\n",
-                    opts.quick ? " --quick" : "", res.rows.size(), names.size(), res.perturbed, res.duration_s,
-                    res.wall_s, opts.jobs)
-     << "## Identification and design\n\n"
-     << fmt::format("A BLWN command (0-{:g} Hz, RMS 1 mm, no controller) through the nominal plant with its sensor "
-                    "noise; a 3-pole model of Eq. 15 fitted to G_yu over 0.5-{:g} Hz (identify.txt, identify.toml):\n\n"
-                    "    G(s) = {:.5g} / ((s + {:.5g})(s^2 + {:.5g} s + {:.5g}))\n\n"
-                    "DC gain {:.4f} (the plant: {:.4f}); low-frequency lag {:.2f} ms (the plant at 1 Hz: {:.2f} ms).\n\n",
-                    kBenchmarkIdBandHz, kBenchmarkFitHiHz, id.model.K, id.model.p, id.model.b, id.model.c,
-                    id.fit.fit.model.DcGain(), id.plant_dc_gain, id.model_lag_ms, id.plant_lag_ms)
-     << fmt::format("Controllers: `example_pi_lead`, the benchmark's example (C(s) = 2 + 95/s, T(s) = 50.83 (s + "
-                    "168.6)/(s + 8570.4), Tustin: an `lti` scenario, scenarios/benchmark/caseN_example.toml); `ff` "
-                    "and `ff_lqg` (default LQG weights) on the fitted model; `poly3` and `lead` compensating {:.1f} ms "
-                    "(max_delay_ms raised to {:g} ms); `ats` with OpenFresco's parameters; `ambc` from "
-                    "RobustAMBCvRTHS's initial model with its gains; `none`. None was tuned on these runs.\n\n",
-                    id.compensated_delay_ms, BenchmarkController("poly3", id).max_delay_ms);
   for (int cs = 1; cs <= 4; ++cs) {
     const models::BenchmarkCase& bc = models::kBenchmarkCases[cs - 1];
     md << fmt::format("## Case {} (floor mass {:g} kg, {:g} % damping)\n\nNominal plant:\n\n", cs, bc.floor_mass_kg,
@@ -231,6 +221,10 @@ void WriteMarkdown(const BenchmarkResult& res, const ReproduceOptions& opts) {
     }
     md << "\n";
   }
+}
+
+/// "How the loop is closed": the example controller's nominal loop closed four ways.
+void WriteLoopSection(std::ostream& md, const BenchmarkResult& res) {
   md << "## How the loop is closed (the example controller, nominal plant)\n\n"
      << "The same scenario closed in one process (report/benchmark_loop.h): `lockstep` as the testbed closes it "
         "(central difference, x_k+1 from the force measured at k; equal to the lockstep run above), then the "
@@ -248,6 +242,10 @@ void WriteMarkdown(const BenchmarkResult& res, const ReproduceOptions& opts) {
     for (int j = 0; j < 9; ++j) md << " " << JText(PublishedExampleCriteria()[cs - 1][j], j) << " |";
     md << "\n";
   }
+}
+
+/// The runs that stopped, and where the published values come from.
+void WriteStoppedAndPublished(std::ostream& md, const BenchmarkResult& res) {
   int stopped = 0;
   for (const auto& row : res.rows) stopped += row.stopped != "no";
   md << fmt::format("\n{} of {} runs stopped before the end (criteria over the steps they ran).\n", stopped,
@@ -266,10 +264,41 @@ void WriteMarkdown(const BenchmarkResult& res, const ReproduceOptions& opts) {
         "tuned to them; docs/benchmark.md explains the differences.\n";
 }
 
+void WriteMarkdown(const BenchmarkResult& res, const ReproduceOptions& opts) {
+  const auto names = BenchmarkControllerNames();
+  const auto& id = res.id;
+  std::ofstream md(opts.out_dir / "benchmark.md");
+  md << "# The RTHS benchmark problem (Silva et al. 2020) as its reference code runs it: J1-J9\n\n"
+     << fmt::format("Made by `rths reproduce benchmark{}`: {} lockstep runs (4 partitioning cases x {} controllers x "
+                    "nominal + {} perturbed plants) of {:g} s (El Centro x 0.4 padded with 5 s of zeros, g = 9.81 "
+                    "m/s^2) at 4096 Hz in {:.0f} s wall time ({} at a time). Criteria: docs/benchmark.md; J1 [ms], "
+                    "J2-J9 [%]. J1 searches lags of 0-49 samples (0-11.96 ms): a run lagging more reads 12.0 ms.\n\n",
+                    opts.quick ? " --quick" : "", res.rows.size(), names.size(), res.perturbed, res.duration_s,
+                    res.wall_s, opts.jobs)
+     << "## Identification and design\n\n"
+     << fmt::format("A BLWN command (0-{:g} Hz, RMS 1 mm, no controller) through the nominal plant with its sensor "
+                    "noise; a 3-pole model of Eq. 15 fitted to G_yu over 0.5-{:g} Hz (identify.txt, identify.toml):\n\n"
+                    "    G(s) = {:.5g} / ((s + {:.5g})(s^2 + {:.5g} s + {:.5g}))\n\n"
+                    "DC gain {:.4f} (the plant: {:.4f}); low-frequency lag {:.2f} ms (the plant at 1 Hz: {:.2f} ms).\n\n",
+                    kBenchmarkIdBandHz, kBenchmarkFitHiHz, id.model.K, id.model.p, id.model.b, id.model.c,
+                    id.fit.fit.model.DcGain(), id.plant_dc_gain, id.model_lag_ms, id.plant_lag_ms)
+     << fmt::format("Controllers: `example_pi_lead`, the benchmark's example (C(s) = 2 + 95/s, T(s) = 50.83 (s + "
+                    "168.6)/(s + 8570.4), Tustin: an `lti` scenario, scenarios/benchmark/caseN_example.toml); `ff` "
+                    "and `ff_lqg` (default LQG weights) on the fitted model; `poly3` and `lead` compensating {:.1f} ms "
+                    "(max_delay_ms raised to {:g} ms); `ats` with OpenFresco's parameters; `ambc` from "
+                    "RobustAMBCvRTHS's initial model with its gains; `none`. None was tuned on these runs.\n\n",
+                    id.compensated_delay_ms, BenchmarkController("poly3", id).max_delay_ms);
+  WriteCaseSections(md, res);
+  WriteLoopSection(md, res);
+  WriteStoppedAndPublished(md, res);
+}
+
 }  // namespace
 
 void WriteBenchmarkOutputs(const BenchmarkResult& res, const ReproduceOptions& opts) {
-  WriteCsvs(res, opts.out_dir);
+  WriteRunsCsv(res, opts.out_dir);
+  WriteSummaryCsv(res, opts.out_dir);
+  WriteLoopAndPlantsCsv(res, opts.out_dir);
   if (io::GnuplotAvailable(opts.gnuplot)) {
     WriteFigure(res, opts);
   } else if (opts.log) {
@@ -278,4 +307,4 @@ void WriteBenchmarkOutputs(const BenchmarkResult& res, const ReproduceOptions& o
   WriteMarkdown(res, opts);
 }
 
-}  // namespace rths::report
+}  // namespace rths::studies

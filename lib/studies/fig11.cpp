@@ -2,8 +2,9 @@
 // model of docs/models.md section 8) with 18 MR dampers at the first story under El Centro NS x 0.5;
 // 3 controllers x 3 semiactive modes of RTHS, plus the pure numerical simulation (plant.kind =
 // "ideal": the damper model driven by the desired motion) for each semiactive mode.
+#include "studies/fig11.h"
+
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <fstream>
 
@@ -15,11 +16,10 @@
 #include "io/csv.h"
 #include "io/plot.h"
 #include "io/source_tree.h"
-#include "report/figures.h"
-#include "report/studies.h"
+#include "studies/figures.h"
 #include "signal/metrics.h"
 
-namespace rths::report {
+namespace rths::studies {
 
 namespace fs = std::filesystem;
 using io::Series;
@@ -179,55 +179,46 @@ scenario::Scenario Fig11Scenario(const scenario::Scenario& base, const Fig11Cont
   return s;
 }
 
-Fig11Result ReproduceFig11(const ReproduceOptions& opts) {
-  const auto t0 = std::chrono::steady_clock::now();
-  PrepareOutDir(opts.out_dir);
-  if (opts.plant != "ideal") RequirePlant(opts.plant, opts.out_dir);
-  const fs::path base_file = io::FindSourceFile("scenarios/fig11_base.toml", opts.source_dir);
-  const scenario::Scenario base = scenario::LoadScenario(base_file.string());
-  const double duration = opts.quick ? kFig11QuickS : kFig11FullS;
-  const auto controllers = Fig11Controllers();
-  const auto modes = Fig11SemiactiveModes();
+namespace {
 
-  struct Item {
-    std::string controller, mode;
-  };
+/// Which controller and semiactive mode each spec runs.
+struct Item {
+  std::string controller, mode;
+};
+
+/// The specs: the numerical simulations first (they are the references), then the RTHS runs,
+/// controller-major; `items` in the same order.
+std::vector<RunSpec> Fig11Specs(const ReproduceOptions& opts, const scenario::Scenario& base, double duration,
+                                std::vector<Item>* items) {
   std::vector<RunSpec> specs;
-  std::vector<Item> items;
-  // The numerical simulations first (they are the references), then the RTHS runs.
-  for (const auto& mode : modes) {
+  for (const auto& mode : Fig11SemiactiveModes()) {
     Fig11Controller none{kNumerical, ControllerKind("none")};
     const fs::path dir = opts.out_dir / "runs" / Slug(fmt::format("numerical {}", mode));
     specs.push_back({fmt::format("Numerical / {}", mode), Fig11Scenario(base, none, mode, "ideal", duration), dir});
-    items.push_back({kNumerical, mode});
+    items->push_back({kNumerical, mode});
   }
-  for (const auto& c : controllers) {
-    for (const auto& mode : modes) {
+  for (const auto& c : Fig11Controllers()) {
+    for (const auto& mode : Fig11SemiactiveModes()) {
       const fs::path dir = opts.out_dir / "runs" / Slug(fmt::format("{} {}", c.name, mode));
       specs.push_back({fmt::format("{} / {}", c.name, mode), Fig11Scenario(base, c, mode, opts.plant, duration), dir});
-      items.push_back({c.name, mode});
+      items->push_back({c.name, mode});
     }
   }
-  Preflight(&specs, opts.overrides, opts.log);
-  if (opts.log) {
-    opts.log(fmt::format("fig11: {} lockstep runs of {:g} s (9 RTHS on the {} plant + 3 numerical), {} at a time "
-                         "(base {})",
-                         specs.size(), duration, opts.plant, opts.jobs, base_file.string()));
-  }
-  const auto results = RunBatch(specs, opts.jobs, opts.progress, [&](std::size_t done, std::size_t total, const RunResult& r) {
-    if (!opts.log) return;
-    opts.log(fmt::format("  [{:2}/{}] {:<36} peak f {:7.2f} kN ({:.1f} s){}", done, total, r.label, r.peak_force_kN,
-                         r.wall_s, r.ok ? "" : "  STOPPED: " + StoppedText(r)));
-  });
+  return specs;
+}
 
+/// The table: every run summarised from its log (its damper's signals into `traces`), its force
+/// against the numerical run of its mode.
+Fig11Result Fig11Table(const std::vector<RunSpec>& specs, const std::vector<Item>& items,
+                       const std::vector<RunResult>& results, double dt, std::vector<Fig11Trace>* traces) {
   Fig11Result res;
-  std::vector<Fig11Trace> traces(specs.size());
+  traces->assign(specs.size(), {});
   std::vector<Fig11Run> all;
   for (std::size_t j = 0; j < specs.size(); ++j) {
     if (results[j].steps == 0) {
       throw Error("fig11", fmt::format("{} did not run: {}", results[j].label, results[j].error));
     }
-    all.push_back(Summarise(specs[j].dir, items[j].controller, items[j].mode, results[j], base.run.dt_s, &traces[j]));
+    all.push_back(Summarise(specs[j].dir, items[j].controller, items[j].mode, results[j], dt, &(*traces)[j]));
   }
   auto numerical_index = [&](const std::string& mode) {
     for (std::size_t j = 0; j < items.size(); ++j) {
@@ -236,99 +227,131 @@ Fig11Result ReproduceFig11(const ReproduceOptions& opts) {
     return items.size();
   };
   for (std::size_t j = 0; j < all.size(); ++j) {
-    const std::size_t ni = numerical_index(items[j].mode);
-    const auto& ref = traces[ni].f_kN;
-    const auto& f = traces[j].f_kN;
+    const auto& ref = (*traces)[numerical_index(items[j].mode)].f_kN;
+    const auto& f = (*traces)[j].f_kN;
     const std::size_t n = std::min(ref.size(), f.size());
     all[j].force_rths_vs_numerical_nrmse_pct =
         n > 0 ? signal::RmsErrorPercent(std::span(ref.data(), n), std::span(f.data(), n)) : 0.0;
     (items[j].controller == kNumerical ? res.numerical : res.runs).push_back(all[j]);
   }
-
-  auto write_json = [&](const fs::path& file, const std::vector<Fig11Run>& runs) {
-    nlohmann::json j;
-    j["runs"] = nlohmann::json::array();
-    for (const auto& r : runs) j["runs"].push_back(ToJson(r));
-    std::ofstream out(file);
-    if (!out) throw Error(file.string(), "cannot open for writing");
-    out << j.dump(2) << "\n";
-  };
-  write_json(opts.out_dir / "fig11_summary.json", res.runs);
-  write_json(opts.out_dir / "fig11_numerical.json", res.numerical);
-
-  // Figures.
-  if (GnuplotAvailable(opts.gnuplot)) {
-    const std::size_t stride = opts.quick ? 2 : 4;
-    for (const auto& mode : modes) {
-      Figure fig;
-      fig.name = "fig11_damper_" + mode;
-      fig.gnuplot = opts.gnuplot;
-      fig.title = fmt::format("Fig. 11: damper at the first story, semiactive {}: RTHS with each controller on the {} "
-                              "plant vs the numerical simulation (ideal tracking)",
-                              mode, opts.plant);
-      fig.columns = 2;
-      fig.width_px = 1600;
-      fig.panel_height_px = 420;
-      Panel disp = MakePanel("Damper displacement", "Time [s]", "Displacement [mm]");
-      Panel force = MakePanel("Damper force (one of 18)", "Time [s]", "Force [kN]");
-      Panel fd = MakePanel("Force-displacement", "Displacement [mm]", "Force [kN]");
-      Panel fv = MakePanel("Force-velocity", "Velocity [mm/s]", "Force [kN]");
-      // One legend, beside the top right panel; the right column keeps the same margin.
-      for (Panel* p : {&disp, &force, &fd, &fv}) p->key = "off";
-      force.key = "outside right top";
-      // RTHS first, the numerical reference last (dashed, on top).
-      std::vector<std::size_t> order;
-      for (std::size_t j = 0; j < items.size(); ++j) {
-        if (items[j].mode == mode && items[j].controller != kNumerical) order.push_back(j);
-      }
-      for (std::size_t j = 0; j < items.size(); ++j) {
-        if (items[j].mode == mode && items[j].controller == kNumerical) order.push_back(j);
-      }
-      for (std::size_t j : order) {
-        const bool num = items[j].controller == kNumerical;
-        const std::string title = num ? "Numerical (ideal)" : items[j].controller;
-        const Series style = StyledSeries(title, ControllerStyle(items[j].controller));
-        const auto& tr = traces[j];
-        disp.series.push_back(Thin(style, tr.t, tr.y_mm, stride));
-        force.series.push_back(Thin(style, tr.t, tr.f_kN, stride));
-        fd.series.push_back(Thin(style, tr.y_mm, tr.f_kN, stride));
-        fv.series.push_back(Thin(style, tr.v_mm_s, tr.f_kN, stride));
-      }
-      force.right_margin_chars = fv.right_margin_chars = io::KeyMarginChars({&force});
-      fig.panels = {disp, force, fd, fv};
-      Plot(fig, opts.out_dir);
-    }
-    Figure stories = Fig11StoriesFigure(res);
-    stories.gnuplot = opts.gnuplot;
-    Plot(stories, opts.out_dir);
-  } else if (opts.log) {
-    opts.log("fig11: gnuplot not found, no PNGs (apt-get install gnuplot-nox)");
-  }
-
-  res.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  {
-    std::ofstream md(opts.out_dir / "fig11.md");
-    md << "# Fig. 11: 9-story building, El Centro NS x 0.5, semiactive MR dampers\n\n"
-       << fmt::format("Made by `rths reproduce fig11{} --plant {}`: {} runs of {:g} s in {:.0f} s wall time.\n\n",
-                      opts.quick ? " --quick" : "", opts.plant, specs.size(), duration, res.wall_s)
-       << "| controller | semiactive | stopped | peak drift story 1 [mm] | max peak drift [mm] | max peak abs. "
-          "acc. [m/s^2] | damper peak force [kN] | damper peak disp. [mm] | force vs numerical [%] | "
-          "accel. extrapolation err. [%] | velocity prediction err. [%] |\n"
-       << "|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|\n";
-    for (const auto* set : {&res.numerical, &res.runs}) {
-      for (const auto& r : *set) {
-        md << fmt::format("| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |\n", r.controller, r.semiactive,
-                          r.stopped, FormatSig(r.peak_drift_mm[0], 4),
-                          FormatSig(*std::max_element(r.peak_drift_mm.begin(), r.peak_drift_mm.end()), 4),
-                          FormatSig(*std::max_element(r.peak_abs_accel_mps2.begin(), r.peak_abs_accel_mps2.end()), 4),
-                          FormatSig(r.damper_peak_force_kN, 4), FormatSig(r.damper_peak_disp_mm, 4),
-                          FormatSig(r.force_rths_vs_numerical_nrmse_pct, 3),
-                          FormatSig(r.accel_extrapolation_rms_err_pct, 3),
-                          FormatSig(r.velocity_prediction_rms_err_pct, 3));
-      }
-    }
-  }
   return res;
 }
 
-}  // namespace rths::report
+void WriteJson(const fs::path& file, const std::vector<Fig11Run>& runs) {
+  nlohmann::json j;
+  j["runs"] = nlohmann::json::array();
+  for (const auto& r : runs) j["runs"].push_back(ToJson(r));
+  std::ofstream out(file);
+  if (!out) throw Error(file.string(), "cannot open for writing");
+  out << j.dump(2) << "\n";
+}
+
+/// fig11_damper_<mode>.png: the damper's histories and loops, RTHS with each controller against
+/// the numerical simulation.
+Figure DamperFigure(const std::string& mode, const std::vector<Item>& items, const std::vector<Fig11Trace>& traces,
+                    const ReproduceOptions& opts) {
+  const std::size_t stride = opts.quick ? 2 : 4;
+  Figure fig;
+  fig.name = "fig11_damper_" + mode;
+  fig.gnuplot = opts.gnuplot;
+  fig.title = fmt::format("Fig. 11: damper at the first story, semiactive {}: RTHS with each controller on the {} "
+                          "plant vs the numerical simulation (ideal tracking)",
+                          mode, opts.plant);
+  fig.columns = 2;
+  fig.width_px = 1600;
+  fig.panel_height_px = 420;
+  Panel disp = MakePanel("Damper displacement", "Time [s]", "Displacement [mm]");
+  Panel force = MakePanel("Damper force (one of 18)", "Time [s]", "Force [kN]");
+  Panel fd = MakePanel("Force-displacement", "Displacement [mm]", "Force [kN]");
+  Panel fv = MakePanel("Force-velocity", "Velocity [mm/s]", "Force [kN]");
+  // One legend, beside the top right panel; the right column keeps the same margin.
+  for (Panel* p : {&disp, &force, &fd, &fv}) p->key = "off";
+  force.key = "outside right top";
+  // RTHS first, the numerical reference last (dashed, on top).
+  std::vector<std::size_t> order;
+  for (std::size_t j = 0; j < items.size(); ++j) {
+    if (items[j].mode == mode && items[j].controller != kNumerical) order.push_back(j);
+  }
+  for (std::size_t j = 0; j < items.size(); ++j) {
+    if (items[j].mode == mode && items[j].controller == kNumerical) order.push_back(j);
+  }
+  for (std::size_t j : order) {
+    const bool num = items[j].controller == kNumerical;
+    const std::string title = num ? "Numerical (ideal)" : items[j].controller;
+    const Series style = StyledSeries(title, ControllerStyle(items[j].controller));
+    const auto& tr = traces[j];
+    disp.series.push_back(Thin(style, tr.t, tr.y_mm, stride));
+    force.series.push_back(Thin(style, tr.t, tr.f_kN, stride));
+    fd.series.push_back(Thin(style, tr.y_mm, tr.f_kN, stride));
+    fv.series.push_back(Thin(style, tr.v_mm_s, tr.f_kN, stride));
+  }
+  force.right_margin_chars = fv.right_margin_chars = io::KeyMarginChars({&force});
+  fig.panels = {disp, force, fd, fv};
+  return fig;
+}
+
+void WriteFigures(const Fig11Result& res, const std::vector<Item>& items, const std::vector<Fig11Trace>& traces,
+                  const ReproduceOptions& opts) {
+  if (!GnuplotAvailable(opts.gnuplot)) {
+    if (opts.log) opts.log("fig11: gnuplot not found, no PNGs (apt-get install gnuplot-nox)");
+    return;
+  }
+  for (const auto& mode : Fig11SemiactiveModes()) Plot(DamperFigure(mode, items, traces, opts), opts.out_dir);
+  Figure stories = Fig11StoriesFigure(res);
+  stories.gnuplot = opts.gnuplot;
+  Plot(stories, opts.out_dir);
+}
+
+void WriteMarkdown(const Fig11Result& res, const ReproduceOptions& opts, std::size_t n_runs, double duration) {
+  std::ofstream md(opts.out_dir / "fig11.md");
+  md << "# Fig. 11: 9-story building, El Centro NS x 0.5, semiactive MR dampers\n\n"
+     << fmt::format("Made by `rths reproduce fig11{} --plant {}`: {} runs of {:g} s in {:.0f} s wall time.\n\n",
+                    opts.quick ? " --quick" : "", opts.plant, n_runs, duration, res.wall_s)
+     << "| controller | semiactive | stopped | peak drift story 1 [mm] | max peak drift [mm] | max peak abs. "
+        "acc. [m/s^2] | damper peak force [kN] | damper peak disp. [mm] | force vs numerical [%] | "
+        "accel. extrapolation err. [%] | velocity prediction err. [%] |\n"
+     << "|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+  for (const auto* set : {&res.numerical, &res.runs}) {
+    for (const auto& r : *set) {
+      md << fmt::format("| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |\n", r.controller, r.semiactive,
+                        r.stopped, FormatSig(r.peak_drift_mm[0], 4),
+                        FormatSig(*std::max_element(r.peak_drift_mm.begin(), r.peak_drift_mm.end()), 4),
+                        FormatSig(*std::max_element(r.peak_abs_accel_mps2.begin(), r.peak_abs_accel_mps2.end()), 4),
+                        FormatSig(r.damper_peak_force_kN, 4), FormatSig(r.damper_peak_disp_mm, 4),
+                        FormatSig(r.force_rths_vs_numerical_nrmse_pct, 3),
+                        FormatSig(r.accel_extrapolation_rms_err_pct, 3), FormatSig(r.velocity_prediction_rms_err_pct, 3));
+    }
+  }
+}
+
+}  // namespace
+
+Fig11Result ReproduceFig11(const ReproduceOptions& opts) {
+  const auto t0 = std::chrono::steady_clock::now();
+  PrepareOutDir(opts.out_dir);
+  if (opts.plant != "ideal") RequirePlant(opts.plant, opts.out_dir);
+  const fs::path base_file = io::FindSourceFile("scenarios/fig11_base.toml", opts.source_dir);
+  const scenario::Scenario base = scenario::LoadScenario(base_file.string());
+  const double duration = opts.quick ? kFig11QuickS : kFig11FullS;
+
+  std::vector<Item> items;
+  std::vector<RunSpec> specs = Fig11Specs(opts, base, duration, &items);
+  const std::string intro = fmt::format(
+      "fig11: {} lockstep runs of {:g} s (9 RTHS on the {} plant + 3 numerical), {} at a time (base {})",
+      specs.size(), duration, opts.plant, opts.jobs, base_file.string());
+  const auto results = RunStudyBatch(&specs, opts, intro, [&](std::size_t done, std::size_t total, const RunResult& r) {
+    if (!opts.log) return;
+    opts.log(fmt::format("  [{:2}/{}] {:<36} peak f {:7.2f} kN ({:.1f} s){}", done, total, r.label, r.peak_force_kN,
+                         r.wall_s, r.ok ? "" : "  STOPPED: " + StoppedText(r)));
+  });
+  std::vector<Fig11Trace> traces;
+  Fig11Result res = Fig11Table(specs, items, results, base.run.dt_s, &traces);
+  WriteJson(opts.out_dir / "fig11_summary.json", res.runs);
+  WriteJson(opts.out_dir / "fig11_numerical.json", res.numerical);
+  WriteFigures(res, items, traces, opts);
+  res.wall_s = SecondsSince(t0);
+  WriteMarkdown(res, opts, specs.size(), duration);
+  return res;
+}
+
+}  // namespace rths::studies

@@ -1,6 +1,6 @@
 // The benchmark's loop closed as the lockstep testbed or as the reference code closes it
-// (report/benchmark_loop.h, docs/benchmark.md "How the loop is closed").
-#include "report/benchmark_loop.h"
+// (studies/benchmark_loop.h, docs/benchmark.md "How the loop is closed").
+#include "studies/benchmark_loop.h"
 
 #include <cmath>
 #include <filesystem>
@@ -11,7 +11,7 @@
 
 #include "control/lti_controller.h"
 #include "core/error.h"
-#include "io/benchmark_run.h"
+#include "participants/benchmark_run.h"
 #include "models/ground_response.h"
 #include "models/rig.h"
 #include "models/structure.h"
@@ -19,7 +19,7 @@
 #include "signal/history.h"
 #include "signal/random.h"
 
-namespace rths::report {
+namespace rths::studies {
 
 namespace {
 
@@ -92,7 +92,10 @@ LoopOptions ReferenceCodeLoop() {
   return {LoopIntegration::kRk4, 1, LoopIntegration::kRk4, std::ldexp(1.0, -18)};
 }
 
-LoopResult RunBenchmarkLoop(const scenario::Scenario& s, const LoopOptions& o) {
+namespace {
+
+/// Throws rths::Error naming the key unless the loop `o` can run scenario `s`.
+void CheckLoop(const scenario::Scenario& s, const LoopOptions& o) {
   const std::string& where = s.path.empty() ? std::string("<scenario>") : s.path;
   if (s.structure.mode != models::StructureMode::kRths || s.structure.kind != models::StructureKind::kFile ||
       s.structure.reference_file.empty()) {
@@ -103,11 +106,34 @@ LoopResult RunBenchmarkLoop(const scenario::Scenario& s, const LoopOptions& o) {
   if (o.quantise_m > 0.0 && s.controller.kind != control::ControllerKind::kLti) {
     throw Error(where + ": controller.kind", "the reference code's converters are modelled for an \"lti\" controller only");
   }
+}
+
+/// The reference structure's response x_r,i [mm] per floor over n steps: RK4 on the continuous
+/// structure with a_g at the half steps (ground_half), or models::GroundResponse (central difference).
+std::vector<std::vector<double>> ReferenceResponse(const models::LinearStructure& ref, LoopIntegration how, double dt,
+                                                   const std::vector<double>& ground,
+                                                   const std::vector<double>& ground_half, std::size_t n) {
+  if (how != LoopIntegration::kRk4) return models::GroundResponse(ref, dt, ground);
+  const ContinuousStructure cr = Continuous(ref);
+  Eigen::VectorXd z = Eigen::VectorXd::Zero(2 * ref.dofs());
+  std::vector<std::vector<double>> x_r(ref.dofs(), std::vector<double>(n));
+  for (std::size_t k = 0; k < n; ++k) {
+    for (int i = 0; i < ref.dofs(); ++i) x_r[i][k] = z(i);
+    const double ag[3] = {ground_half[2 * k], ground_half[2 * k + 1], ground_half[2 * k + 2]};
+    Rk4(cr, &z, dt, ag, 0.0);
+  }
+  return x_r;
+}
+
+}  // namespace
+
+LoopResult RunBenchmarkLoop(const scenario::Scenario& s, const LoopOptions& o) {
+  CheckLoop(s, o);
   const double dt = s.run.dt_s;
   const auto n = static_cast<std::size_t>(s.steps());
 
   const models::LinearStructure st = models::StructureFromScenario(s.structure);
-  const models::LinearStructure ref = io::ReferenceStructure(s, st.dofs());
+  const models::LinearStructure ref = participants::ReferenceStructure(s, st.dofs());
   const int a = st.actuator_dof;
   const std::vector<double> ground = signal::MakeSignal(s.structure.ground, dt, n);
   std::vector<double> ground_half;  // a_g at k dt/2 (rk4 stages)
@@ -165,20 +191,9 @@ LoopResult RunBenchmarkLoop(const scenario::Scenario& s, const LoopOptions& o) {
   }
   out.steps = static_cast<std::int64_t>(n);
 
-  if (o.reference == LoopIntegration::kRk4) {
-    const ContinuousStructure cr = Continuous(ref);
-    Eigen::VectorXd z = Eigen::VectorXd::Zero(2 * ref.dofs());
-    rec.x_r.assign(ref.dofs(), std::vector<double>(n));
-    for (std::size_t k = 0; k < n; ++k) {
-      for (int i = 0; i < ref.dofs(); ++i) rec.x_r[i][k] = z(i);
-      const double ag[3] = {ground_half[2 * k], ground_half[2 * k + 1], ground_half[2 * k + 2]};
-      Rk4(cr, &z, dt, ag, 0.0);
-    }
-  } else {
-    rec.x_r = models::GroundResponse(ref, dt, ground);
-  }
+  rec.x_r = ReferenceResponse(ref, o.reference, dt, ground, ground_half, n);
   out.j = signal::BenchmarkCriteriaFrom(rec);
   return out;
 }
 
-}  // namespace rths::report
+}  // namespace rths::studies

@@ -1,4 +1,4 @@
-#include "report/batch.h"
+#include "studies/batch.h"
 
 #include <algorithm>
 #include <atomic>
@@ -8,21 +8,16 @@
 #include <thread>
 
 #include <fmt/format.h>
-#include <lcm/lcm-cpp.hpp>
 #include <nlohmann/json.hpp>
 
 #include "core/error.h"
-#include "io/run_log.h"
-#include "lockstep/exit_code.h"
-#include "lockstep/protocol.h"
 #include "participants/factory.h"
-#include "participants/group.h"
 #include "participants/run_summary.h"
 #include "supervisor/run.h"
 #include "supervisor/scenario_file.h"
 #include "supervisor/summary_builder.h"
 
-namespace rths::report {
+namespace rths::studies {
 
 namespace fs = std::filesystem;
 
@@ -44,22 +39,6 @@ std::string Slug(const std::string& label) {
   return out.empty() ? "run" : out;
 }
 
-Trace ReadTrace(const fs::path& run_dir) {
-  const auto log = io::ReadRunLog((run_dir / "log.lcm").string());
-  const std::int64_t n = log.CompleteSteps();
-  Trace t;
-  for (auto* v : {&t.r_mm, &t.u_mm, &t.y_mm, &t.f_kN, &t.current_A, &t.i_cmd_A}) v->reserve(n);
-  for (std::int64_t k = 0; k < n; ++k) {
-    t.r_mm.push_back(log.desired[k].r_mm);
-    t.u_mm.push_back(log.command[k].u_mm);
-    t.y_mm.push_back(log.measured[k].y_mm);
-    t.f_kN.push_back(log.measured[k].f_kN);
-    t.current_A.push_back(log.measured[k].current_A);
-    t.i_cmd_A.push_back(log.current[k].i_cmd_A);
-  }
-  return t;
-}
-
 namespace {
 
 /// The first line of a study's scenario.toml.
@@ -76,15 +55,10 @@ scenario::Scenario WriteScenarioFile(const RunSpec& spec) {
 
 void Preflight(const std::vector<RunSpec>& specs) {
   std::vector<std::string> problems;
-  lcm::LCM lcm("memq://");
-  if (!lcm.good()) throw Error("reproduce", "cannot create a memq:// LCM instance");
   for (const auto& spec : specs) {
     try {
       scenario::ValidateScenario(spec.scenario);
-      const auto id = participants::IdentityOf(spec.scenario, 1);
-      for (const char* role : {"controller", "semiactive", "plant", "integrator"}) {
-        participants::MakeParticipant(role, spec.scenario, id, &lcm, "");
-      }
+      participants::CheckBuildable(spec.scenario);
     } catch (const std::exception& e) {
       problems.push_back(fmt::format("  {}: {}", spec.label, e.what()));
     }
@@ -205,4 +179,4 @@ std::vector<RunResult> RunBatch(const std::vector<RunSpec>& specs, int jobs, Pro
   return results;
 }
 
-}  // namespace rths::report
+}  // namespace rths::studies

@@ -1,4 +1,7 @@
-// What every reproduction shares: the output folder rule and the plant check.
+// What every reproduction shares: the output folder rule, the plant check, the batch step of the
+// skeleton (studies/study.h).
+#include "studies/study.h"
+
 #include <unistd.h>
 
 #include <atomic>
@@ -10,9 +13,9 @@
 
 #include "core/error.h"
 #include "io/output_folder.h"
-#include "report/reproduce.h"
+#include "io/run_signals.h"
 
-namespace rths::report {
+namespace rths::studies {
 
 namespace fs = std::filesystem;
 
@@ -23,6 +26,10 @@ std::string UtcStamp() {
   gmtime_r(&now, &tm);
   std::strftime(stamp, sizeof stamp, "%Y-%m-%d %H:%M UTC", &tm);
   return stamp;
+}
+
+double SecondsSince(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
 void PrepareOutDir(const fs::path& dir) {
@@ -65,7 +72,8 @@ void RequirePlant(const std::string& plant, const fs::path& scratch_parent) {
       problem = "the physics-based actuator failed in a 0.1 s probe: " + results[0].error;
     } else if (!results[1].ok) {
       problem = "the linear plant failed in a 0.1 s probe: " + results[1].error;
-    } else if (ReadTrace(results[0].dir).y_mm == ReadTrace(results[1].dir).y_mm) {
+    } else if (io::ReadRunSignals(results[0].dir).At("y_mm").values ==
+               io::ReadRunSignals(results[1].dir).At("y_mm").values) {
       problem = "this build's plant ignores plant.kind = \"physical\" (it gave the linear model's "
                 "numbers bit for bit): the physics-based actuator of docs/models.md section 5 is not "
                 "available yet";
@@ -79,6 +87,26 @@ void RequirePlant(const std::string& plant, const fs::path& scratch_parent) {
     throw Error("--plant physical", problem + ". Run with --plant linear (the three-pole models of "
                                               "Eqs. 28-30) until it is.");
   }
+}
+
+std::vector<RunResult> RunStudyBatch(std::vector<RunSpec>* specs, const ReproduceOptions& opts,
+                                     const std::string& intro, const Progress& on_run) {
+  Preflight(specs, opts.overrides, opts.log);
+  if (opts.log) opts.log(intro);
+  return RunBatch(*specs, opts.jobs, opts.progress, on_run);
+}
+
+std::string StoppedText(const RunResult& r) {
+  if (r.ok) return "no";
+  std::string s = r.error;
+  // "integrator exited with code 6: <the monitor's reason>" -> the reason
+  if (const auto p = s.find("exited with code"); p != std::string::npos) {
+    if (const auto c = s.find(": ", p); c != std::string::npos) s = s.substr(c + 2);
+  }
+  for (char& ch : s) {
+    if (ch == '\n' || ch == '\r') ch = ' ';
+  }
+  return s.empty() ? "stopped" : s;
 }
 
 control::ControllerConfig ControllerKind(const std::string& kind) {
@@ -99,4 +127,4 @@ control::ControllerConfig ControllerModel(const std::string& kind, const std::st
   return c;
 }
 
-}  // namespace rths::report
+}  // namespace rths::studies

@@ -1,5 +1,7 @@
 // Fig. 5 (docs/experiments.md E6): the 200-kN MR damper model (Eqs. 32-39, Table 3) under a prescribed
 // 25.4 mm, 1 Hz sine at six constant currents.
+#include "studies/fig5.h"
+
 #include <cmath>
 #include <numbers>
 
@@ -9,9 +11,8 @@
 #include "models/mr_damper.h"
 #include "io/csv.h"
 #include "io/plot.h"
-#include "report/reproduce.h"
 
-namespace rths::report {
+namespace rths::studies {
 
 namespace fs = std::filesystem;
 using io::Series;
@@ -67,17 +68,17 @@ const std::vector<double>& Fig5ReferencePeaksKn() {
   return peaks;
 }
 
-Fig5Result ReproduceFig5(const ReproduceOptions& opts) {
-  PrepareOutDir(opts.out_dir);
-  const double dt_s = 0.0005;  // 2 kHz, the paper's rate
+namespace {
+
+/// The table: the loops at every current and their peaks over cycles 2 and 3.
+Fig5Result SimulateLoops(const ReproduceOptions& opts, double dt_s, std::vector<Loop>* loops) {
   Fig5Result res;
   res.current_A = {0.0, 0.5, 1.0, 1.5, 2.0, 2.5};
   res.paper_peak_kN = Fig5ReferencePeaksKn();
-  std::vector<Loop> loops;
   for (double i : res.current_A) {
-    loops.push_back(Simulate(i, dt_s));
+    loops->push_back(Simulate(i, dt_s));
     double peak = 0.0;
-    const Loop& l = loops.back();
+    const Loop& l = loops->back();
     for (std::size_t k = 0; k < l.t_s.size(); ++k) {
       if (l.t_s[k] >= 1.0) peak = std::max(peak, std::abs(l.f_kN[k]));  // cycles 2 and 3
     }
@@ -88,29 +89,31 @@ Fig5Result ReproduceFig5(const ReproduceOptions& opts) {
                            100.0 * (peak / ref - 1.0)));
     }
   }
+  return res;
+}
 
+void WriteCsvs(const Fig5Result& res, const std::vector<Loop>& loops, const fs::path& dir) {
   {
-    CsvWriter csv(opts.out_dir / "fig5_peaks.csv", {"current_A", "paper_peak_kN", "ours_peak_kN"});
+    CsvWriter csv(dir / "fig5_peaks.csv", {"current_A", "paper_peak_kN", "ours_peak_kN"});
     for (std::size_t j = 0; j < res.current_A.size(); ++j) {
       csv.Row({fmt::format("{:.1f}", res.current_A[j]), fmt::format("{:.1f}", res.paper_peak_kN[j]),
                fmt::format("{:.3f}", res.ours_peak_kN[j])});
     }
     csv.Close();
   }
-  {
-    CsvWriter csv(opts.out_dir / "fig5_loops.csv", {"current_A", "t_s", "x_mm", "v_mm_s", "F_kN"});
-    for (std::size_t j = 0; j < loops.size(); ++j) {
-      const Loop& l = loops[j];
-      for (std::size_t k = 0; k < l.t_s.size(); ++k) {
-        csv.Row({fmt::format("{:.1f}", res.current_A[j]), fmt::format("{:.4f}", l.t_s[k]),
-                 fmt::format("{:.6g}", l.x_mm[k]), fmt::format("{:.6g}", l.v_mm_s[k]),
-                 fmt::format("{:.6g}", l.f_kN[k])});
-      }
+  CsvWriter csv(dir / "fig5_loops.csv", {"current_A", "t_s", "x_mm", "v_mm_s", "F_kN"});
+  for (std::size_t j = 0; j < loops.size(); ++j) {
+    const Loop& l = loops[j];
+    for (std::size_t k = 0; k < l.t_s.size(); ++k) {
+      csv.Row({fmt::format("{:.1f}", res.current_A[j]), fmt::format("{:.4f}", l.t_s[k]),
+               fmt::format("{:.6g}", l.x_mm[k]), fmt::format("{:.6g}", l.v_mm_s[k]), fmt::format("{:.6g}", l.f_kN[k])});
     }
-    csv.Close();
   }
+  csv.Close();
+}
 
-  // Force-time over the three cycles; the loops over cycles 2 and 3 (the start-up is left out).
+/// Force-time over the three cycles; the loops over cycles 2 and 3 (the start-up is left out).
+Figure Fig5Figure(const Fig5Result& res, const std::vector<Loop>& loops) {
   Figure fig;
   fig.name = "fig5";
   fig.title = "Fig. 5: MR damper model (Eqs. 32-39, Table 3), 25.4 mm 1 Hz sine";
@@ -144,9 +147,21 @@ Fig5Result ReproduceFig5(const ReproduceOptions& opts) {
     fv.series.push_back(c);
   }
   fig.panels = {ft, fx, fv};
+  return fig;
+}
+
+}  // namespace
+
+Fig5Result ReproduceFig5(const ReproduceOptions& opts) {
+  PrepareOutDir(opts.out_dir);
+  const double dt_s = 0.0005;  // 2 kHz, the paper's rate
+  std::vector<Loop> loops;
+  const Fig5Result res = SimulateLoops(opts, dt_s, &loops);
+  WriteCsvs(res, loops, opts.out_dir);
+  Figure fig = Fig5Figure(res, loops);
   fig.gnuplot = opts.gnuplot;
   Plot(fig, opts.out_dir);
   return res;
 }
 
-}  // namespace rths::report
+}  // namespace rths::studies

@@ -1,8 +1,8 @@
-#include "report/figures.h"
+#include "studies/figures.h"
 
 #include <fmt/format.h>
 
-namespace rths::report {
+namespace rths::studies {
 
 CurveStyle ControllerStyle(const std::string& name, bool prominent, std::size_t index) {
   CurveStyle s;
@@ -42,4 +42,4 @@ io::Series StyledSeries(const std::string& title, const CurveStyle& style, const
   return s;
 }
 
-}  // namespace rths::report
+}  // namespace rths::studies
