@@ -226,7 +226,7 @@ void WriteCaseSections(std::ostream& md, const BenchmarkResult& res) {
 /// "How the loop is closed": the example controller's nominal loop closed four ways.
 void WriteLoopSection(std::ostream& md, const BenchmarkResult& res) {
   md << "## How the loop is closed (the example controller, nominal plant)\n\n"
-     << "The same scenario closed in one process (report/benchmark_loop.h): `lockstep` as the testbed closes it "
+     << "The same scenario closed in one process (lib/studies/benchmark_loop.h): `lockstep` as the testbed closes it "
         "(central difference, x_k+1 from the force measured at k; equal to the lockstep run above), then the "
         "reference code's differences one at a time: the numerical substructure and the reference integrated "
         "continuously by RK4 (ode4), the measured force's unit delay, its converters (2^-18 m).\n\n"
