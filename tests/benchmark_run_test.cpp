@@ -19,7 +19,7 @@
 #include "io/plot.h"
 #include "models/benchmark_structures.h"
 #include "models/structure.h"
-#include "participants/run_summary.h"
+#include "supervisor/run_summary.h"
 #include "report/run_report.h"
 #include "signal/benchmark_criteria.h"
 #include "signal/history.h"
@@ -171,9 +171,9 @@ TEST_CASE("a memq run with structure.reference_file: J1-J9 from its log, in summ
   const fs::path file = WriteScenario(dir, Scenario(kBuildings + "silva3_numerical_case1.txt", 2.0));
   const auto s = rths::scenario::LoadScenario(file.string());
   REQUIRE(RunMemq({s}, dir).code == 0);
-  rths::participants::RunSummary sum;
+  rths::supervisor::RunSummary sum;
   sum.steps_expected = s.steps();
-  rths::participants::ReadLog((dir / "log.lcm").string(), s, &sum);
+  rths::supervisor::ReadLog((dir / "log.lcm").string(), s, &sum);
   CHECK(sum.log_error.empty());
   CHECK(sum.steps == s.steps());
   REQUIRE(sum.benchmark_criteria);
@@ -242,8 +242,8 @@ TEST_CASE("too few steps: the summary says why there are no criteria, the rest o
   const fs::path file = WriteScenario(dir, Scenario(kBuildings + "silva3_reference_case1.txt", 40 * kDt));
   const auto s = rths::scenario::LoadScenario(file.string());
   REQUIRE(RunMemq({s}, dir).code == 0);
-  rths::participants::RunSummary sum;
-  rths::participants::ReadLog((dir / "log.lcm").string(), s, &sum);
+  rths::supervisor::RunSummary sum;
+  rths::supervisor::ReadLog((dir / "log.lcm").string(), s, &sum);
   CHECK(sum.steps == 40);
   CHECK(sum.metrics);
   CHECK_FALSE(sum.benchmark_criteria);
@@ -255,8 +255,8 @@ TEST_CASE("too few steps: the summary says why there are no criteria, the rest o
   // Without a reference_file: no criteria and no error.
   rths::scenario::Scenario plain = s;
   plain.structure.reference_file.clear();
-  rths::participants::RunSummary sum2;
-  rths::participants::ReadLog((dir / "log.lcm").string(), plain, &sum2);
+  rths::supervisor::RunSummary sum2;
+  rths::supervisor::ReadLog((dir / "log.lcm").string(), plain, &sum2);
   CHECK_FALSE(sum2.benchmark_criteria);
   CHECK(sum2.benchmark_error.empty());
   CHECK_FALSE(sum2.ToJson().contains("benchmark_criteria_error"));

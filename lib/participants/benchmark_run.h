@@ -3,8 +3,8 @@
 /// docs/benchmark.md): the monolithic reference structure (structure.reference_file) integrated
 /// offline under the ground acceleration the run's log holds, against what the run logged.
 ///
-/// In participants beside the run summary that scores every such run with it (run_summary.h); the
-/// run report and the benchmark study use it too.
+/// In participants, below the users: the run summary that scores every such run with it
+/// (supervisor/run_summary.h), the run report and the benchmark study.
 ///
 /// Reference response: models::GroundResponse (models/ground_response.h) at the run's dt, driven by
 /// desired_t.ground_acc_mm_s2 of each logged step.

@@ -12,7 +12,7 @@
 
 #include "core/error.h"
 #include "participants/factory.h"
-#include "participants/run_summary.h"
+#include "supervisor/run_summary.h"
 #include "supervisor/run.h"
 #include "supervisor/scenario_file.h"
 #include "supervisor/summary_builder.h"
@@ -121,12 +121,12 @@ RunResult RunOne(const RunSpec& spec) {
   request.checks = false;  // Preflight did
   request.study = true;
   request.label = spec.label;
-  participants::RunSummary sum;
+  supervisor::RunSummary sum;
   try {
     sum = supervisor::Run(request).summary;
   } catch (const supervisor::RunError& e) {
     sum = e.summary();
-    if (fs::exists(spec.dir / "log.lcm")) participants::ReadLog((spec.dir / "log.lcm").string(), &sum);
+    if (fs::exists(spec.dir / "log.lcm")) supervisor::ReadLog((spec.dir / "log.lcm").string(), &sum);
     supervisor::MarkStudyFailure(e.what(), &sum);
     try {
       fs::create_directories(spec.dir);

@@ -13,7 +13,7 @@
 
 #include "core/error.h"
 #include "io/run_log.h"
-#include "participants/run_summary.h"
+#include "supervisor/run_summary.h"
 #include "scenario/scenario.h"
 #include "supervisor/disk.h"
 
@@ -86,7 +86,7 @@ struct RunRequest {
 
 /// A finished run (also one that failed: its summary says how).
 struct RunResult {
-  participants::RunSummary summary;   ///< as written to out/summary.json
+  RunSummary summary;   ///< as written to out/summary.json
   RunPlan plan;
   bool summary_written = false;       ///< false: the summary file could not be written (or none was asked for)
 };
@@ -96,14 +96,14 @@ struct RunResult {
 /// was known.
 class RunError : public Error {
  public:
-  RunError(int exit_code, const std::string& what, participants::RunSummary summary)
+  RunError(int exit_code, const std::string& what, RunSummary summary)
       : Error("", what), exit_code_(exit_code), summary_(std::move(summary)) {}
   int exit_code() const { return exit_code_; }
-  const participants::RunSummary& summary() const { return summary_; }
+  const RunSummary& summary() const { return summary_; }
 
  private:
   int exit_code_;
-  participants::RunSummary summary_;
+  RunSummary summary_;
 };
 
 }  // namespace rths::supervisor

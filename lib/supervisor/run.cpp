@@ -115,7 +115,7 @@ GroupEnd RunGroup(const RunRequest& r, const RunPlan& plan) {
   } catch (const std::exception& e) {
     std::error_code ec;
     if (plan.created_out && !r.study && !fs::exists(plan.out / "log.lcm")) fs::remove_all(plan.out, ec);
-    participants::RunSummary head = SummaryHead(r, plan);
+    RunSummary head = SummaryHead(r, plan);
     head.wall_s = std::chrono::duration<double>(Clock::now() - t0).count();
     throw RunError(lockstep::kExitLockstep, e.what(), head);
   }

@@ -7,8 +7,8 @@
 
 namespace rths::supervisor {
 
-participants::RunSummary SummaryHead(const RunRequest& request, const RunPlan& plan) {
-  participants::RunSummary sum;
+RunSummary SummaryHead(const RunRequest& request, const RunPlan& plan) {
+  RunSummary sum;
   sum.label = request.label;
   sum.scenario = plan.scenario_path;
   sum.scenario_sha256 = plan.scenario.sha256;
@@ -22,12 +22,12 @@ participants::RunSummary SummaryHead(const RunRequest& request, const RunPlan& p
   return sum;
 }
 
-participants::RunSummary BuildSummary(const RunRequest& request, const RunPlan& plan, const GroupEnd& end) {
-  participants::RunSummary sum = SummaryHead(request, plan);
+RunSummary BuildSummary(const RunRequest& request, const RunPlan& plan, const GroupEnd& end) {
+  RunSummary sum = SummaryHead(request, plan);
   sum.wall_s = end.wall_s;
-  participants::ReadLog((plan.out / "log.lcm").string(), plan.scenario, &sum);  // + J1-J9 with a reference_file
-  participants::SetOutcomes(end.outcomes, &sum);
-  participants::SetVerdict(participants::Judge(end.outcomes), end.interrupted, &sum);
+  ReadLog((plan.out / "log.lcm").string(), plan.scenario, &sum);  // + J1-J9 with a reference_file
+  SetOutcomes(end.outcomes, &sum);
+  SetVerdict(participants::Judge(end.outcomes), end.interrupted, &sum);
   if (sum.failure && end.noticed) {
     sum.failure->teardown_s = std::chrono::duration<double>(Clock::now() - *end.noticed).count();
   }
@@ -40,7 +40,7 @@ participants::RunSummary BuildSummary(const RunRequest& request, const RunPlan& 
   return sum;
 }
 
-std::string StudyError(const participants::RunSummary& sum) {
+std::string StudyError(const RunSummary& sum) {
   if (const auto* culprit = participants::RootCause(sum.participants)) {
     return fmt::format("{} exited with code {}: {}", culprit->role, culprit->exit_code, culprit->message);
   }
@@ -49,7 +49,7 @@ std::string StudyError(const participants::RunSummary& sum) {
   return "";
 }
 
-void MarkStudyFailure(const std::string& error, participants::RunSummary* sum) {
+void MarkStudyFailure(const std::string& error, RunSummary* sum) {
   sum->stopped = error;
   if (sum->status == "completed") {
     sum->status = "failed";

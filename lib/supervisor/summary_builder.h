@@ -8,7 +8,7 @@
 
 #include "lockstep/realtime.h"
 #include "participants/group.h"
-#include "participants/run_summary.h"
+#include "supervisor/run_summary.h"
 #include "supervisor/request.h"
 #include "supervisor/teardown.h"
 
@@ -25,20 +25,20 @@ struct GroupEnd {
 
 /// The summary's fields known before the run: label, scenario, hash, run id, transport, URL,
 /// steps expected, output estimate (`rths run` only: the URL and estimate).
-participants::RunSummary SummaryHead(const RunRequest& request, const RunPlan& plan);
+RunSummary SummaryHead(const RunRequest& request, const RunPlan& plan);
 
 /// The whole summary: the head, wall time, the log's steps and figures (J1-J9 with a
 /// reference_file), the outcomes and the verdict, the teardown time and, for a paced run, the
 /// real-time figures. A study's run that did not complete every step is marked failed (StudyError).
-participants::RunSummary BuildSummary(const RunRequest& request, const RunPlan& plan, const GroupEnd& end);
+RunSummary BuildSummary(const RunRequest& request, const RunPlan& plan, const GroupEnd& end);
 
 /// Why a study's run does not count ("" if it does): the participant to blame and its message,
 /// an unreadable log, or missing steps.
-std::string StudyError(const participants::RunSummary& sum);
+std::string StudyError(const RunSummary& sum);
 
 /// Marks a study's run that failed with `error`: "stopped" says why; a run the verdict judged
 /// completed becomes failed (exit code kExitLockstep), another verdict's status stands (a safety
 /// stop stays "stopped by the safety monitor", as in `rths run`).
-void MarkStudyFailure(const std::string& error, participants::RunSummary* sum);
+void MarkStudyFailure(const std::string& error, RunSummary* sum);
 
 }  // namespace rths::supervisor

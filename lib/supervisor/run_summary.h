@@ -16,7 +16,10 @@
 #include "scenario/scenario.h"
 #include "signal/benchmark_criteria.h"
 
-namespace rths::participants {
+namespace rths::supervisor {
+
+using participants::Outcome;
+using participants::Verdict;
 
 struct RunSummary {
   std::string label;              ///< a reproduction's run label ("" for `rths run`)
@@ -84,4 +87,4 @@ void SetOutcomes(const std::vector<Outcome>& outcomes, RunSummary* s);
 /// cannot say where: its step is then the first one the log does not hold (call ReadLog first).
 void SetVerdict(Verdict verdict, bool interrupted, RunSummary* s);
 
-}  // namespace rths::participants
+}  // namespace rths::supervisor

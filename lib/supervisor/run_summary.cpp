@@ -1,4 +1,4 @@
-#include "participants/run_summary.h"
+#include "supervisor/run_summary.h"
 
 #include <algorithm>
 #include <exception>
@@ -7,7 +7,9 @@
 
 #include "participants/benchmark_run.h"
 
-namespace rths::participants {
+namespace rths::supervisor {
+
+using participants::Judge;
 
 double RunSummary::steps_per_s() const {
   return (steps > 1 && stepping_s > 0) ? static_cast<double>(steps - 1) / stepping_s : 0.0;
@@ -193,4 +195,4 @@ void SetVerdict(Verdict verdict, bool interrupted, RunSummary* s) {
   if (verdict.failed) s->failure = RunSummary::Failure{verdict.role, verdict.step, verdict.what, verdict.exit_code, {}};
 }
 
-}  // namespace rths::participants
+}  // namespace rths::supervisor
