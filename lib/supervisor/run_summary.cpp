@@ -9,7 +9,9 @@
 
 namespace rths::supervisor {
 
+using participants::BenchmarkCriteriaOfRun;
 using participants::Judge;
+using participants::StatsToJson;
 
 double RunSummary::steps_per_s() const {
   return (steps > 1 && stepping_s > 0) ? static_cast<double>(steps - 1) / stepping_s : 0.0;
