@@ -136,6 +136,9 @@ public class JavaPlant implements LCMSubscriber {
     h.roster_names = new String[0];
     h.roster_sha256 = new String[0];
     h.reason = "";
+    // On the clock's host: our pid, so the supervisor notices at once if we die (docs/participant.md).
+    h.pid = (phase == 2) ? (int) ProcessHandle.current().pid() : 0;
+    h.heartbeat_s = 0;
     send("RTHS_HANDSHAKE", encode(h));
   }
 

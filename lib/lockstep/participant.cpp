@@ -247,6 +247,9 @@ void Participant::SendHandshake(Phase phase, std::int64_t k, const std::string& 
   }
   hs_out_.n_roster = static_cast<std::int32_t>(hs_out_.roster_names.size());
   hs_out_.reason = reason;
+  // On the clock's host (every built-in participant is): the clock watches our process (PeerWatch).
+  hs_out_.pid = phase == kHello ? static_cast<std::int32_t>(::getpid()) : 0;
+  hs_out_.heartbeat_s = 0;
   Encode(hs_out_, &hs_bytes_);
   const int copies = (phase == kAbort || phase == kGo || phase == kClose) ? kControlCopies : 1;
   for (int i = 0; i < copies; ++i) {

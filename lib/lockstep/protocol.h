@@ -31,6 +31,7 @@ enum Phase : std::int8_t {
   kDone = 5,     ///< clock: every step is committed; flush (repeated until every BYE is in)
   kBye = 6,      ///< participant: flushed; answered to every DONE while lingering
   kClose = 7,    ///< clock: every BYE is in; lingering participants exit
+  kHeartbeat = 8,  ///< participant: alive (every heartbeat_s it declared in HELLO; PeerWatch)
 };
 
 using SteadyClock = std::chrono::steady_clock;
