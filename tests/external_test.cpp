@@ -18,6 +18,7 @@
 #include "io/run_log.h"
 #include "participants/group.h"
 #include "scenario/scenario.h"
+#include "external_support.h"
 #include "test_support.h"
 
 namespace fs = std::filesystem;
@@ -26,85 +27,6 @@ using namespace rths_test;
 namespace {
 
 const char* kScenario = "[run]\nname = \"external_test\"\nduration_s = 0.5\n";
-
-std::string ReadFile(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-/// The payload digest of the same scenario run in one process (the reference).
-std::string ReferenceDigest(const fs::path& dir, const fs::path& scenario) {
-  const fs::path out = dir / "reference";
-  fs::create_directories(out);
-  const auto s = rths::scenario::LoadScenario(scenario.string());
-  REQUIRE(RunMemq({s}, out).code == 0);
-  return rths::io::PayloadDigest(rths::io::ReadRunLog((out / "log.lcm").string()));
-}
-
-/// Starts `rths run --external plant ARGS` in the background (prefix: e.g. "ip netns exec A"),
-/// waits for its printed block, then runs the user's plant with the printed URL and run id
-/// (plant_prefix, and URL rewritten by `fix_url`); returns the run's exit code.
-/// `plant_cmd` (optional): the user's plant command for (url, run id, scenario); default rths-plant.
-using PlantCommand = std::function<std::string(const std::string&, const std::string&, const std::string&)>;
-int RunWithExternalPlant(const fs::path& dir, const std::string& run_args, const std::string& run_prefix,
-                         const std::string& plant_prefix, const std::string& plant_url_override = "",
-                         const PlantCommand& plant_cmd = {}) {
-  const fs::path printed = dir / "run.out";
-  const std::string start = run_prefix + " " + std::string(RTHS_BIN_DIR) + "/rths-run --external plant " + run_args +
-                            " > " + printed.string() + " 2>&1 & echo $! > " + (dir / "run.pid").string();
-  REQUIRE(std::system(("(" + start + ")").c_str()) == 0);
-  std::string text;
-  for (int i = 0; i < 200 && text.find("waiting up to") == std::string::npos; ++i) {
-    ::usleep(50000);
-    text = ReadFile(printed);
-  }
-  REQUIRE_MESSAGE(text.find("waiting up to") != std::string::npos, text);
-  std::smatch m_url, m_id;
-  REQUIRE(std::regex_search(text, m_url, std::regex("lcm_url +(\\S+)")));
-  REQUIRE(std::regex_search(text, m_id, std::regex("run_id +([0-9]+)")));
-  const std::string url = plant_url_override.empty() ? m_url[1].str() : plant_url_override;
-  std::smatch m_sc;
-  REQUIRE(std::regex_search(text, m_sc, std::regex("scenario +(\\S+)")));
-  const std::string program = plant_cmd ? plant_cmd(url, m_id[1].str(), m_sc[1].str())
-                                        : std::string(RTHS_BIN_DIR) + "/rths-plant --scenario " + m_sc[1].str() +
-                                              " --lcm-url '" + url + "' --run-id " + m_id[1].str() + " --out " +
-                                              dir.string();
-  const std::string plant = plant_prefix + " timeout 60 " + program + " > " + (dir / "plant.out").string() + " 2>&1";
-  std::system(plant.c_str());
-  const std::string wait = "pid=$(cat " + (dir / "run.pid").string() +
-                           "); for i in $(seq 600); do kill -0 $pid 2>/dev/null || break; sleep 0.1; done";
-  std::system(wait.c_str());
-  const auto j = nlohmann::json::parse(ReadFile(dir / "out" / "summary.json"));
-  return j["exit_code"].get<int>();
-}
-
-/// A network namespace pair joined by a veth pair, removed on destruction (even if a check fails).
-struct NetnsPair {
-  std::string a, b, va, vb;
-  bool ok = false;
-  NetnsPair() {
-    const std::string id = std::to_string(::getpid() % 100000);
-    a = "rthsA" + id;
-    b = "rthsB" + id;
-    va = "rva" + id;
-    vb = "rvb" + id;
-    const int oct = 1 + ::getpid() % 250;
-    const std::string net = "10.213." + std::to_string(oct) + ".";
-    const std::string cmd =
-        "set -e; ip netns add " + a + "; ip netns add " + b + "; ip link add " + va + " type veth peer name " + vb +
-        "; ip link set " + va + " netns " + a + "; ip link set " + vb + " netns " + b +
-        "; ip -n " + a + " addr add " + net + "1/24 dev " + va + "; ip -n " + b + " addr add " + net + "2/24 dev " + vb +
-        "; for n in " + a + " " + b + "; do ip -n $n link set lo up; done; ip -n " + a + " link set " + va +
-        " up multicast on; ip -n " + b + " link set " + vb + " up multicast on; ip -n " + a +
-        " route add 224.0.0.0/4 dev " + va + "; ip -n " + b + " route add 224.0.0.0/4 dev " + vb;
-    ok = std::system(("bash -c '" + cmd + "' 2>" + (fs::temp_directory_path() / "rths_netns.err").string()).c_str()) == 0;
-  }
-  ~NetnsPair() {
-    std::system(("ip netns del " + a + " 2>/dev/null; ip netns del " + b + " 2>/dev/null").c_str());
-  }
-};
 
 }  // namespace
 

@@ -14,7 +14,6 @@
 #include "core/progress.h"
 #include "lockstep/exit_code.h"
 #include "lockstep/transport.h"
-#include "lockstep/transport.h"
 #include "report/run_report.h"
 #include "scenario/scenario.h"
 #include "supervisor/run.h"
@@ -31,7 +30,7 @@ void OnSignal(int) { g_interrupted = 1; }
 /// The command line.
 struct Options {
   std::string scenario_path, default_scenario = "scenarios/default.toml";
-  std::string out, transport = "udpm", bin_dir, url, external;
+  std::string out, transport, bin_dir, url, external;  ///< transport "": TransportOf
   bool quiet = false, skip_space_check = false, port_per_channel = false, realtime = false;
   bool compact = false, report = false;
   std::int64_t run_id = 0;
@@ -43,9 +42,11 @@ void AddOptions(CLI::App& app, Options* o) {
   app.add_option("scenario", o->scenario_path, "scenario TOML file (default: scenarios/default.toml)");
   app.add_option("--default-scenario", o->default_scenario, "used when no scenario is given")->group("");
   app.add_option("--out", o->out, "output folder (default: a new folder under runs/)");
-  app.add_option("--transport", o->transport, "udpm: one process per participant; memq: one process")
-      ->check(CLI::IsMember({"udpm", "memq"}))
-      ->capture_default_str();
+  app.add_option("--transport", o->transport,
+                 "udpm: one process per participant (the default); memq: one process; mixed: the built-in "
+                 "participants in one process, bridged to the --external ones on udpm (the default with "
+                 "--external; docs/lockstep.md, Transports)")
+      ->check(CLI::IsMember({"udpm", "memq", "mixed"}));
   app.add_option("--bin-dir", o->bin_dir, "where the rths-* programs are (default: next to this one)");
   app.add_flag("--quiet", o->quiet, "print only the output folder");
   app.add_option("--lcm-url", o->url,
@@ -73,12 +74,20 @@ void AddOptions(CLI::App& app, Options* o) {
   app.footer("Exit codes: 0 ok; 2 bad input or not enough disk (nothing ran); 3 a participant stopped "
              "answering (named); 4 stopped by an abort; 5 a participant's computation failed; 6 stopped "
              "by the safety monitor; 7 the output could not be written (disk full); 8 real-time mode: too many "
-             "consecutive deadline misses; 128+N a participant was killed by signal N; 130 interrupted.");
+             "consecutive deadline misses; 9 an external participant sent ABORT; 10 an external participant was lost "
+             "(heartbeats stopped, or its process ended unseen); 128+N a participant was killed by signal N; 130 "
+             "interrupted.");
   rths::tools::AddSetOption(app, &o->sets);
   app.add_flag("--compact", o->compact,
                "no signals.csv (as --set run.csv_every=0): log.lcm alone holds every step; `rths export` makes "
                "a CSV or .mat of it when needed");
   app.add_flag("--report", o->report, "at the end, write RUN_DIR/report.html with figures (as `rths report RUN_DIR`)");
+}
+
+/// The transport asked for, or the default: mixed with --external, else udpm.
+std::string TransportOf(const Options& o) {
+  if (!o.transport.empty()) return o.transport;
+  return o.external.empty() ? "udpm" : "mixed";
 }
 
 /// The roles of --external, checked; throws a message for the command line.
@@ -99,11 +108,13 @@ sup::ExternalRoles ExternalRolesOf(const Options& o) {
     if (!external.has(role)) external.roles.push_back(role);
   }
   if (!external.roles.empty()) {
-    if (o.transport != "udpm") {
-      throw std::runtime_error("--external needs the udpm transport (an external process cannot join memq, which "
-                               "lives inside one process)");
+    if (TransportOf(o) == "memq") {
+      throw std::runtime_error("--external needs the mixed (default) or udpm transport (an external process cannot "
+                               "join memq, which lives inside one process)");
     }
     external.join_timeout_s = o.join_timeout_s;
+  } else if (TransportOf(o) == "mixed") {
+    throw std::runtime_error("--transport mixed needs --external ROLE (the participants to bridge to on udpm)");
   }
   return external;
 }
@@ -111,13 +122,15 @@ sup::ExternalRoles ExternalRolesOf(const Options& o) {
 /// --lcm-url and --port-per-channel, checked against the transport; returns the URL to use ("":
 /// the supervisor picks one). Throws a message for the command line.
 std::string UrlOf(const Options& o) {
-  if (!o.url.empty() && o.transport != "udpm") throw std::runtime_error("--lcm-url needs the udpm transport");
+  if (!o.url.empty() && TransportOf(o) == "memq") throw std::runtime_error("--lcm-url needs the udpm or mixed transport");
   if (!o.url.empty() && o.url.rfind("udpm://", 0) != 0) {
     throw std::runtime_error(
         fmt::format("--lcm-url {}: must be a udpm:// URL (e.g. udpm://239.255.76.67:7667?ttl=0)", o.url));
   }
-  if (o.port_per_channel && o.transport != "udpm") {
-    throw std::runtime_error("--port-per-channel needs the udpm transport");
+  if (o.port_per_channel && TransportOf(o) != "udpm") {
+    throw std::runtime_error(o.external.empty() ? "--port-per-channel needs the udpm transport"
+                                                : "--port-per-channel needs --transport udpm (a mixed run, the "
+                                                  "default with --external, bridges on one port)");
   }
   if (o.url.empty()) return "";
   std::string why;
@@ -142,7 +155,7 @@ sup::RunRequest RequestOf(const Options& o) {
     r.scenario_header = o.scenario_path + " with";
     for (const auto& set : o.sets) r.scenario_header += " --set " + set;
   }
-  r.transport = o.transport;
+  r.transport = TransportOf(o);
   r.port_per_channel = o.port_per_channel;
   r.out = o.out;
   r.bin_dir = o.bin_dir.empty() ? fs::read_symlink("/proc/self/exe").parent_path() : fs::path(o.bin_dir);
@@ -161,7 +174,7 @@ void PrintHeader(const Options& o, const sup::RunPlan& plan) {
   std::string shown = o.scenario_path;  // as the user named it, with the overrides
   for (const auto& set : o.sets) shown += " --set " + set;
   std::printf("rths run: %s (%lld steps of %g s), transport %s\n", shown.c_str(), static_cast<long long>(s.steps()),
-              s.run.dt_s, o.transport.c_str());
+              s.run.dt_s, TransportOf(o).c_str());
   // log.lcm's size is exact; a CSV row's length depends on the numbers (%.17g), so its size is
   // a bound (a 20 s default run: 6.5 MB written of 11.8 MB at most).
   const auto& z = plan.sizes;
@@ -186,7 +199,10 @@ void PrintExternal(const sup::RunRequest& r, const sup::RunPlan& plan) {
   std::printf("  lcm_url          %s\n", url.c_str());
   std::printf("  port             %s\n", url.substr(url.rfind(':') + 1, url.find('?') - url.rfind(':') - 1).c_str());
   std::printf("  run_id           %lld\n", static_cast<long long>(plan.run_id));
-  std::printf("  scenario         %s\n", plan.scenario_path.c_str());
+  std::printf("  scenario         %s%s\n", plan.scenario_path.c_str(),
+              r.scenario_header.empty() ? ""
+                                        : "  (the scenario with your --set overrides: give your participant this "
+                                          "file; its hash is not the original's)");
   std::printf("  scenario_sha256  %s\n", s.sha256.c_str());
   std::printf("  steps            %lld of %g s each\n", static_cast<long long>(s.steps()), s.run.dt_s);
   std::printf("  built-in example %s/rths-%s --scenario %s --lcm-url '%s' --run-id %lld\n", r.bin_dir.c_str(),

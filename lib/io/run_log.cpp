@@ -20,7 +20,7 @@ namespace {
 /// Field kinds of the LCM wire format, to check a payload's shape before lcm-gen's decode()
 /// trusts it: decode() resizes arrays to the count in the payload before checking that the
 /// elements are there (a count of 2^31-1 asks for 16 GB) and takes string lengths < 1 as huge.
-enum class Wire { kI8, kI64, kF64, kString, kCount, kF64Array, kStringArray };
+enum class Wire { kI8, kI32, kI64, kF64, kString, kCount, kF64Array, kStringArray };
 
 /// What is wrong with `d` as the encoding of a message with fingerprint `hash` and fields `layout`
 /// (kCount gives the length of the arrays after it), or "" if nothing: too short, another type's
@@ -55,9 +55,10 @@ std::string WireProblem(const std::vector<std::uint8_t>& d, std::int64_t hash, c
   for (Wire w : layout) {
     switch (w) {
       case Wire::kI8:
+      case Wire::kI32:
       case Wire::kI64:
       case Wire::kF64: {
-        const std::size_t bytes = w == Wire::kI8 ? 1 : 8;
+        const std::size_t bytes = w == Wire::kI8 ? 1 : w == Wire::kI32 ? 4 : 8;
         if (left() < bytes) return fmt::format("the message ends inside a field ({} bytes)", n);
         pos += bytes;
         break;
@@ -90,7 +91,8 @@ std::string WireProblem(const std::vector<std::uint8_t>& d, std::int64_t hash, c
 // layout that no longer matches its type is caught at once).
 using enum Wire;
 const std::vector<Wire> kHandshakeLayout = {kI64, kI8,    kString,      kString,      kI64, kF64,
-                                                      kI64, kCount, kStringArray, kStringArray, kString};
+                                                      kI64, kCount, kStringArray, kStringArray, kString,
+                                                      kI32, kF64};
 const std::vector<Wire> kDesiredLayout = {kI64, kI64, kF64, kF64, kF64,      kF64,
                                                     kF64, kF64, kF64, kCount, kF64Array, kF64Array};
 const std::vector<Wire> kCommandLayout = {kI64, kI64, kF64, kF64, kF64, kCount, kF64Array};

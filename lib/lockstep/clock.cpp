@@ -37,6 +37,11 @@ ClockParticipant::ClockParticipant(std::string name, RunIdentity id, LockstepCon
     hello_[self] = true;
     bye_[self] = true;
   }
+  owner_.fill(-1);
+  for (int i = 0; i < kRosterSize; ++i) {
+    const ResolvedRole& r = wiring_.roles()[i];
+    if (!r.row->clock && r.row->answer != kNoChannel) owner_[r.row->answer] = i;
+  }
   start_ = SteadyClock::now();
   last_send_ = start_ - std::chrono::seconds(1);
   rt_.paced = timing_.pacing.enabled;
@@ -72,11 +77,19 @@ void ClockParticipant::OnHandshakeForClock(const rths::handshake_t& msg, SteadyC
       return;
     }
     hello_[i] = true;
+    peers_[i].hello = true;
+    peers_[i].pid = msg.pid;
+    peers_[i].heartbeat_s = msg.heartbeat_s;
+    watch_.Watch(i, msg.pid, msg.heartbeat_s, now);
     bool all = true;
     for (bool h : hello_) all = all && h;
     if (all) SendGo();
+  } else if (msg.phase == kHeartbeat) {
+    watch_.Beat(i, now);
   } else if (msg.phase == kBye && done_) {
     bye_[i] = true;
+    peers_[i].bye = true;
+    watch_.Forget(i);  // it may exit now
     bool all = true;
     for (bool b : bye_) all = all && b;
     if (all) {
@@ -84,12 +97,38 @@ void ClockParticipant::OnHandshakeForClock(const rths::handshake_t& msg, SteadyC
       Finish();
     }
   }
-  (void)now;
 }
 
 void ClockParticipant::OnRepairForClock(const rths::repair_t& msg) {
   const int i = RosterIndex(msg.participant);
-  if (i >= 0 && msg.k == k_) reported_[i] = true;
+  if (i < 0) return;
+  ++peers_[i].repair_requests;
+  if (msg.k == k_) reported_[i] = true;
+}
+
+void ClockParticipant::Count(Channel channel, Put put, std::int64_t k) {
+  Participant::Count(channel, put, k);
+  const int owner = owner_[channel];
+  if (owner < 0) return;
+  if (put == Put::kNew) ++peers_[owner].answers;
+  if (put == Put::kDuplicate) ++peers_[owner].duplicates;
+}
+
+void ClockParticipant::OnAbortFrom(const std::string& participant, const std::string& reason) {
+  const int i = RosterIndex(participant);
+  if (i < 0) return;
+  peers_[i].aborted = true;
+  peers_[i].abort_reason = reason;
+}
+
+void ClockParticipant::FailLost(const PeerLoss& loss) {
+  PeerObservation& p = peers_[loss.role];
+  p.lost = true;
+  p.loss = loss;
+  const std::string role(kRoster[loss.role]);
+  const std::string where = k_ < 0 ? "before step 0" : fmt::format("at step {}", k_);
+  OnStop();
+  Fail(kExitLockstep, fmt::format("{} was lost {}: {}", role, where, loss.what), true, k_, role);
 }
 
 void ClockParticipant::Lacks(std::int64_t k, WantList* out) const {
@@ -247,6 +286,15 @@ void ClockParticipant::FailStalled(SteadyClock::time_point now) {
   std::string reason = fmt::format("step {}: {} stopped answering: {} after {:.3g} s and {} re-requests", k_,
                                    JoinNames(silent), missing, Seconds(step_since_, now), rerequests_);
   if (!waiting.empty()) reason += fmt::format(" ({} only waited for it)", JoinNames(waiting));
+  if (silent.size() == 1) {
+    const PeerObservation& p = peers_[RosterIndex(silent.front())];
+    if (p.pid == 0 && p.heartbeat_s <= 0) {
+      reason += fmt::format("; it gave neither its pid nor a heartbeat period in its HELLO, so only the stall budget "
+                            "(lockstep.stall_budget_s = {:g} s) could tell it was gone (docs/participant.md, "
+                            "\"Liveness\")",
+                            timing_.stall_budget_s);
+    }
+  }
   Fail(kExitLockstep, reason, true, k_, silent.size() == 1 ? silent.front() : JoinNames(silent));
 }
 
@@ -259,6 +307,12 @@ SteadyClock::time_point ClockParticipant::PollDeadline() const {
 
 void ClockParticipant::Poll(SteadyClock::time_point now, bool idle) {
   if (finished()) return;
+  if (!done_) {
+    if (const std::optional<PeerLoss> loss = watch_.Check(now)) {
+      FailLost(*loss);
+      return;
+    }
+  }
   if (k_ < 0) {  // handshake
     if (idle && Seconds(start_, now) > timing_.handshake_timeout_s) {
       std::vector<std::string> missing;
@@ -314,6 +368,12 @@ void ClockParticipant::Poll(SteadyClock::time_point now, bool idle) {
   last_send_ = now;
   WantList wants;
   Lacks(k_, &wants);
+  std::array<bool, kRosterSize> listed{};
+  for (int w = 0; w < wants.size(); ++w) {
+    const int owner = owner_[wants.channel(w)];
+    if (owner >= 0 && !listed[owner]) ++peers_[owner].rerequests;
+    if (owner >= 0) listed[owner] = true;
+  }
   SendRepair(k_, wants);
 }
 

@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "lockstep/participant.h"
+#include "lockstep/peer_watch.h"
 #include "lockstep/step_mailboxes.h"
 #include "lockstep/step_table.h"
 #include "lockstep/wiring.h"
@@ -41,7 +42,12 @@ class ClockParticipant : public Participant {
   /// Step currently requested (-1 before GO).
   std::int64_t current_step() const { return k_; }
   const RealtimeStats* realtime() const override { return &rt_; }
+  /// What the clock saw of every participant of the roster (its own entry is empty).
+  const std::array<PeerObservation, kRosterSize>* peers() const override { return &peers_; }
   SteadyClock::time_point ReleaseAt() const override { return release_; }
+  SteadyClock::duration SpinBeforeRelease() const override {
+    return std::chrono::duration_cast<SteadyClock::duration>(std::chrono::duration<double>(timing_.pacing.spin_s));
+  }
 
  protected:
   /// Computes desired_t k into `*out`. `measured_prev` is measured_t k-1 (nullptr for k = 0).
@@ -60,6 +66,7 @@ class ClockParticipant : public Participant {
 
   void OnHandshakeForClock(const rths::handshake_t& msg, SteadyClock::time_point now) override;
   void OnRepairForClock(const rths::repair_t& msg) override;
+  void OnAbortFrom(const std::string& participant, const std::string& reason) override;
   /// The answers of step k the barrier lacks.
   void Lacks(std::int64_t k, WantList* out) const override;
 
@@ -71,6 +78,10 @@ class ClockParticipant : public Participant {
   void SendGo();
   /// Fails the run: step k_ has been incomplete for the whole stall budget.
   void FailStalled(SteadyClock::time_point now);
+  /// Fails the run: a watched participant has gone (PeerWatch).
+  void FailLost(const PeerLoss& loss);
+  /// Also counts, per participant, the answers the barrier received and their copies.
+  void Count(Channel channel, Put put, std::int64_t k) override;
   /// Counts step k_'s latency and, when paced, whether it met its deadline; false if the miss
   /// policy stopped the run.
   bool AccountStep(SteadyClock::time_point now);
@@ -88,6 +99,9 @@ class ClockParticipant : public Participant {
   rths::desired_t desired_{};
 
   std::array<bool, kRosterSize> hello_{};
+  PeerWatch watch_;
+  std::array<PeerObservation, kRosterSize> peers_{};
+  std::array<int, kChannelCodes> owner_{};  ///< roster index of the role answering each channel (-1: none)
   std::array<bool, kRosterSize> bye_{};
   /// Who sent a repair_t for the current step (alive, but lacking inputs).
   std::array<bool, kRosterSize> reported_{};

@@ -19,6 +19,12 @@ struct LockstepConfig {
   /// The clock's real-time pacing ([realtime]; off: as fast as the participants answer). Not a
   /// key of [lockstep]: filled in from [realtime] and run.dt_s.
   Pacing pacing;
+  /// Not keys of [lockstep] either: what a participant declares in its HELLO (docs/participant.md,
+  /// "Liveness"). Its pid, for the clock to watch: only on the clock's host (a participant process
+  /// gives it when its URL has ttl=0, in-process ones always; the clock ignores its own process's).
+  bool announce_pid = true;
+  /// The period of its HEARTBEATs [s] (0: none), e.g. from another host (`--heartbeat-s`).
+  double heartbeat_s = 0;
 
   /// The shortest wait before a first re-request [s].
   static constexpr double kMinRerequestS = 1e-3;

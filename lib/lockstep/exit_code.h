@@ -14,6 +14,10 @@ enum ExitCode : int {
   kExitSafety = 6,         ///< the safety monitor stopped the run (a limit was left)
   kExitOutput = 7,         ///< the run's output could not be written (disk full, I/O error)
   kExitRealtime = 8,       ///< real-time mode: the miss policy stopped the run (docs/realtime.md)
+  kExitExternalAbort = 9,  ///< an external participant (`--external`) stopped the run with ABORT
+  /// an external participant was lost: its heartbeats stopped, or its process ended with a status
+  /// rths could not read or with code 0 before the run's end (docs/participant.md, "Liveness")
+  kExitExternalLost = 10,
 };
 
 /// Of the tools that read a run's log: `rths log` (stats, digest, dump, compare) and `rths export`.

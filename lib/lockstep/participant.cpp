@@ -247,9 +247,13 @@ void Participant::SendHandshake(Phase phase, std::int64_t k, const std::string& 
   }
   hs_out_.n_roster = static_cast<std::int32_t>(hs_out_.roster_names.size());
   hs_out_.reason = reason;
-  // On the clock's host (every built-in participant is): the clock watches our process (PeerWatch).
-  hs_out_.pid = phase == kHello ? static_cast<std::int32_t>(::getpid()) : 0;
-  hs_out_.heartbeat_s = 0;
+  // On the clock's host: the clock watches our process (PeerWatch); else our heartbeats, if any.
+  hs_out_.pid = phase == kHello && timing_.announce_pid ? static_cast<std::int32_t>(::getpid()) : 0;
+  hs_out_.heartbeat_s = phase == kHello ? timing_.heartbeat_s : 0;
+  if (phase == kHello && !said_hello_) {
+    said_hello_ = true;
+    last_beat_ = SteadyClock::now();
+  }
   Encode(hs_out_, &hs_bytes_);
   const int copies = (phase == kAbort || phase == kGo || phase == kClose) ? kControlCopies : 1;
   for (int i = 0; i < copies; ++i) {
@@ -282,6 +286,7 @@ void Participant::OnHandshake(const lcm::ReceiveBuffer* rbuf) {
   if (hs_in_.participant == name_) return;  // our own message, looped back
   const auto now = SteadyClock::now();
   if (hs_in_.phase == kAbort) {
+    OnAbortFrom(hs_in_.participant, hs_in_.reason);
     OnStop();
     Fail(kExitPeerAbort, fmt::format("{} aborted the run: {}", hs_in_.participant, hs_in_.reason), false,
          hs_in_.k);
@@ -357,6 +362,10 @@ void Participant::OnRepair(const lcm::ReceiveBuffer* rbuf) {
 
 void Participant::Poll(SteadyClock::time_point now, bool idle) {
   if (finished_ || is_clock_) return;
+  if (said_hello_ && timing_.heartbeat_s > 0 && SecondsBetween(last_beat_, now) >= timing_.heartbeat_s) {
+    last_beat_ = now;
+    SendHandshake(kHeartbeat);
+  }
   if (lingering_) {
     if (SecondsBetween(linger_since_, now) > timing_.LingerS()) Finish();  // CLOSE was lost
     return;

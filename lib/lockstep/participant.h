@@ -25,6 +25,7 @@
 #include "lockstep/faults.h"
 #include "lockstep/link_stats.h"
 #include "lockstep/mailbox.h"
+#include "lockstep/peer_watch.h"
 #include "lockstep/protocol.h"
 #include "lockstep/realtime.h"
 #include "lockstep/step_mailboxes.h"
@@ -64,9 +65,14 @@ class Participant {
   double stepping_s() const { return stepping_s_; }
   /// Clock only: step latencies and deadline misses (nullptr for the others).
   virtual const RealtimeStats* realtime() const { return nullptr; }
+  /// Clock only: what it saw of every participant of the roster (nullptr for the others).
+  virtual const std::array<PeerObservation, kRosterSize>* peers() const { return nullptr; }
   /// Paced clock only: when the next step is to be released (the event loop sleeps until then
   /// with clock_nanosleep on CLOCK_MONOTONIC); time_point::max() if no release is pending.
   virtual SteadyClock::time_point ReleaseAt() const { return SteadyClock::time_point::max(); }
+  /// Paced clock only: how long before ReleaseAt() the event loop stops sleeping and busy-waits
+  /// ([realtime] spin_us; zero: it sleeps to the release).
+  virtual SteadyClock::duration SpinBeforeRelease() const { return {}; }
 
   /// Stops now, as if the supervisor had said ABORT (an interrupt): flushes, exit kExitPeerAbort.
   void Interrupt(const std::string& reason);
@@ -126,7 +132,7 @@ class Participant {
     PublishBytes(channel, *cache->Get(k));
   }
   /// Counts what a mailbox did with a message (duplicates, stale, foreign; repaired inputs).
-  void Count(Channel channel, Put put, std::int64_t k);
+  virtual void Count(Channel channel, Put put, std::int64_t k);
   /// Called for a step input new to its mailbox: its channel, its step k and its bytes.
   using OnNewInput = std::function<void(Channel channel, std::int64_t k, const lcm::ReceiveBuffer* rbuf)>;
   /// Subscribes to every channel `role` reads (wiring.h), each with the wake-up the step table
@@ -185,6 +191,8 @@ class Participant {
   virtual void OnHandshakeSeen(const lcm::ReceiveBuffer* /*rbuf*/, const rths::handshake_t& /*msg*/) {}
   /// Handshake messages addressed to the clock (HELLO, BYE).
   virtual void OnHandshakeForClock(const rths::handshake_t& /*msg*/, SteadyClock::time_point /*now*/) {}
+  /// An ABORT from another participant (before this one stops).
+  virtual void OnAbortFrom(const std::string& /*participant*/, const std::string& /*reason*/) {}
   /// A repair_t from another participant, seen by the clock (who is alive, what it lacks).
   virtual void OnRepairForClock(const rths::repair_t& /*msg*/) {}
 
@@ -213,6 +221,8 @@ class Participant {
   std::int64_t fail_step_ = -1;
   SteadyClock::time_point created_;
   SteadyClock::time_point last_clock_;
+  bool said_hello_ = false;
+  SteadyClock::time_point last_beat_;  ///< our last HEARTBEAT (or HELLO)
   std::int64_t last_clock_step_ = -1;  ///< the latest step the clock requested, as seen here
   rths::handshake_t hs_in_{};
   rths::handshake_t hs_out_{};

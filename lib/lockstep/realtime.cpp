@@ -48,7 +48,7 @@ double LatencyHistogram::Quantile(double q) const {
   return max_s_;
 }
 
-RealtimeSetup EnterRealtime(bool fifo, int priority, bool lock) {
+RealtimeSetup EnterRealtime(bool fifo, int priority, bool lock, int cpu) {
   RealtimeSetup r;
   r.tried = true;
   std::string note;
@@ -71,6 +71,18 @@ RealtimeSetup EnterRealtime(bool fifo, int priority, bool lock) {
       if (!note.empty()) note += "; ";
       note += fmt::format("mlockall not permitted ({}): needs CAP_IPC_LOCK (root has it unless it was dropped) or a memlock limit "
                           "(ulimit -l); memory may be paged",
+                          std::strerror(errno));
+    }
+  }
+  if (cpu >= 0) {
+    cpu_set_t set;
+    CPU_ZERO(&set);
+    CPU_SET(cpu, &set);
+    if (cpu < CPU_SETSIZE && ::sched_setaffinity(0, sizeof set, &set) == 0) {
+      r.cpu = cpu;
+    } else {
+      if (!note.empty()) note += "; ";
+      note += fmt::format("cannot pin to CPU {} ({}): is it online and allowed (taskset -pc $$)?", cpu,
                           std::strerror(errno));
     }
   }

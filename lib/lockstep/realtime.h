@@ -26,6 +26,12 @@ struct RealtimeConfig {
   bool sched_fifo = true;                  ///< try SCHED_FIFO for every participant process
   int priority = 80;                       ///< its SCHED_FIFO priority, [1, 99]
   bool lock_memory = true;                 ///< try mlockall(MCL_CURRENT | MCL_FUTURE)
+  /// Busy-wait the last spin_us [us] before each step's release instead of sleeping through it
+  /// (the wake-up's lateness is then the spin loop's, not the timer's), [0, 5000]; 0: off.
+  double spin_us = 0;
+  /// Pin every rths process of the run to this CPU (sched_setaffinity), [-1, 1023]; -1: no pinning.
+  /// A memq or mixed run is one process; on udpm each participant process is pinned to it.
+  int cpu = -1;
   bool operator==(const RealtimeConfig&) const = default;
 };
 
@@ -35,6 +41,7 @@ struct Pacing {
   double period_s = 0.0;  ///< dt [s]
   /// Stop the run (exit kExitRealtime) after this many consecutive misses; 0 = never.
   std::int64_t max_consecutive_misses = 0;
+  double spin_s = 0.0;  ///< busy-wait this long before each release [s] (RealtimeConfig::spin_us)
   bool operator==(const Pacing&) const = default;
 };
 
@@ -83,11 +90,17 @@ struct RealtimeSetup {
   bool fifo = false;        ///< running under SCHED_FIFO
   int priority = 0;         ///< ... at this priority
   bool memory_locked = false;
+  int cpu = -1;             ///< pinned to this CPU (-1: not pinned)
   std::string note;         ///< what was not permitted, and why ("" if everything worked)
 };
 
-/// Tries SCHED_FIFO at `priority` (if `fifo`) and mlockall(MCL_CURRENT | MCL_FUTURE) (if `lock`)
-/// for the calling process; says plainly what was not permitted (errno text and what grants it).
-RealtimeSetup EnterRealtime(bool fifo, int priority, bool lock);
+/// Tries SCHED_FIFO at `priority` (if `fifo`), mlockall(MCL_CURRENT | MCL_FUTURE) (if `lock`) and
+/// pinning to `cpu` (if >= 0) for the calling process; says plainly what was not permitted (errno
+/// text and what grants it).
+RealtimeSetup EnterRealtime(bool fifo, int priority, bool lock, int cpu = -1);
+/// EnterRealtime with the keys of a scenario's [realtime] table.
+inline RealtimeSetup EnterRealtime(const RealtimeConfig& r) {
+  return EnterRealtime(r.sched_fifo, r.priority, r.lock_memory, r.cpu);
+}
 
 }  // namespace rths::lockstep

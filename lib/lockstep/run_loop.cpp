@@ -35,10 +35,15 @@ int RunLoopWith(const std::function<int(int)>& handle, const std::vector<Partici
         for (Participant* p : participants) p->Tick(now, false);
       }
       // steady_clock is CLOCK_MONOTONIC (libstdc++ on Linux); a release already past returns at once.
-      const auto ns = std::chrono::duration_cast<std::chrono::nanoseconds>(release.time_since_epoch()).count();
+      // With a spin ([realtime] spin_us): sleep to `spin` before the release, then busy-wait.
+      SteadyClock::duration spin{};
+      for (const Participant* p : participants) spin = std::max(spin, p->SpinBeforeRelease());
+      const auto ns = std::chrono::duration_cast<std::chrono::nanoseconds>((release - spin).time_since_epoch()).count();
       const timespec ts{static_cast<time_t>(ns / 1000000000), static_cast<long>(ns % 1000000000)};
       while (::clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR) {
         if (stop && *stop) break;
+      }
+      while (spin.count() > 0 && SteadyClock::now() < release && !(stop && *stop)) {
       }
       const auto now = SteadyClock::now();
       for (Participant* p : participants) p->Tick(now, true);

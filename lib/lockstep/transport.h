@@ -169,6 +169,8 @@ class InprocChannels final : public Channels {
   static constexpr int kMaxBatch = 64;
   /// Messages published so far.
   std::int64_t sent() const { return sent_; }
+  /// Messages queued, not yet handed over.
+  std::size_t queued() const { return count_; }
 
  private:
   struct Message {

@@ -31,7 +31,7 @@ lockstep::RunIdentity IdentityOf(const scenario::Scenario& s, std::int64_t run_i
 
 lockstep::LockstepConfig LockstepOf(const scenario::Scenario& s) {
   lockstep::LockstepConfig c = s.lockstep;
-  c.pacing = {s.realtime.enabled, s.run.dt_s, s.realtime.max_consecutive_misses};
+  c.pacing = {s.realtime.enabled, s.run.dt_s, s.realtime.max_consecutive_misses, 1e-6 * s.realtime.spin_us};
   return c;
 }
 
@@ -119,6 +119,7 @@ struct RoleArgs {
   bool follow = false;
   double follow_idle_s = 2.0;
   bool realtime = false;
+  double heartbeat_s = 0;
 };
 
 /// Parses the command line of procs/<role>; -1 to go on, else the code to exit with.
@@ -132,6 +133,11 @@ int ParseRoleArgs(const std::string& name, int argc, char** argv, RoleArgs* a) {
                  "wait this long for the handshake instead of the scenario's lockstep.handshake_timeout_s "
                  "(rths run --external: time for the external participants to join) [s]")
       ->check(CLI::Range(0.1, 86400.0));
+  app.add_option("--heartbeat-s", a->heartbeat_s,
+                 "send a HEARTBEAT every S seconds from HELLO on, so that the clock notices within 5 S if this "
+                 "process goes (for a participant on another host, whose pid the clock cannot watch; "
+                 "docs/participant.md, Liveness) [s]")
+      ->check(CLI::Range(0.01, 60.0));
   app.add_flag("--follow", a->follow,
                "follow mode: no handshake, no clock; answer each step as soon as its inputs arrive (fed by "
                "lcm-logplayer from a recorded log, with that log's --run-id; docs/replay.md). Delivery is not "
@@ -208,8 +214,13 @@ int RoleMain(std::string_view role, int argc, char** argv) {
     // Not part of the handshake's identity (the hash is of the file): only how long to wait.
     if (a.handshake_timeout_s > 0) s.lockstep.handshake_timeout_s = a.handshake_timeout_s;
     if (a.realtime) s.realtime.enabled = true;  // pacing is not part of the identity either
+    // Liveness (not part of the identity): our pid means something to the clock only on its host,
+    // which a ttl=0 URL guarantees.
+    const auto url = lockstep::UdpmUrl::Parse(a.url);
+    s.lockstep.announce_pid = url && url->ttl == 0;
+    s.lockstep.heartbeat_s = a.heartbeat_s;
     if (s.realtime.enabled) {
-      o.realtime_setup = lockstep::EnterRealtime(s.realtime.sched_fifo, s.realtime.priority, s.realtime.lock_memory);
+      o.realtime_setup = lockstep::EnterRealtime(s.realtime);
       if (!o.realtime_setup.note.empty()) std::fprintf(stderr, "%s: %s\n", name.c_str(), o.realtime_setup.note.c_str());
     }
     RunOnTransport(role, s, a, &o);

@@ -1,5 +1,6 @@
 #include "participants/group.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <memory>
@@ -8,6 +9,7 @@
 
 #include "core/error.h"
 #include "lockstep/step_table.h"
+#include "lockstep/bridge.h"
 #include "lockstep/transport.h"
 #include "participants/factory.h"
 
@@ -52,6 +54,53 @@ nlohmann::json RealtimeToJson(const lockstep::RealtimeStats& r) {
           {"latency_histogram_us", bins}};
 }
 
+namespace {
+nlohmann::json PeerToJson(const lockstep::PeerObservation& p) {
+  nlohmann::json j = {{"pid", p.pid},
+                      {"heartbeat_s", p.heartbeat_s},
+                      {"hello", p.hello},
+                      {"bye", p.bye},
+                      {"aborted", p.aborted},
+                      {"abort_reason", p.abort_reason},
+                      {"answers", p.answers},
+                      {"duplicates", p.duplicates},
+                      {"rerequests", p.rerequests},
+                      {"repair_requests", p.repair_requests},
+                      {"lost", p.lost}};
+  if (p.lost) {
+    j["loss"] = {{"died", p.loss.died},         {"status_known", p.loss.status_known},
+                 {"exit_code", p.loss.exit_code}, {"signal", p.loss.signal},
+                 {"silent_s", p.loss.silent_s},  {"what", p.loss.what}};
+  }
+  return j;
+}
+
+lockstep::PeerObservation PeerFromJson(const nlohmann::json& j) {
+  lockstep::PeerObservation p;
+  p.pid = j.value("pid", 0);
+  p.heartbeat_s = j.value("heartbeat_s", 0.0);
+  p.hello = j.value("hello", false);
+  p.bye = j.value("bye", false);
+  p.aborted = j.value("aborted", false);
+  p.abort_reason = j.value("abort_reason", std::string());
+  p.answers = j.value("answers", std::int64_t{0});
+  p.duplicates = j.value("duplicates", std::int64_t{0});
+  p.rerequests = j.value("rerequests", std::int64_t{0});
+  p.repair_requests = j.value("repair_requests", std::int64_t{0});
+  p.lost = j.value("lost", false);
+  if (p.lost && j.contains("loss")) {
+    const auto& l = j.at("loss");
+    p.loss.died = l.value("died", false);
+    p.loss.status_known = l.value("status_known", false);
+    p.loss.exit_code = l.value("exit_code", 0);
+    p.loss.signal = l.value("signal", 0);
+    p.loss.silent_s = l.value("silent_s", 0.0);
+    p.loss.what = l.value("what", std::string());
+  }
+  return p;
+}
+}  // namespace
+
 Outcome OutcomeOf(const lockstep::Participant& p, Outcome o) {
   o.role = p.name();
   o.exit_code = p.exit_code();
@@ -62,6 +111,11 @@ Outcome OutcomeOf(const lockstep::Participant& p, Outcome o) {
   o.stats_known = true;
   o.stepping_s = p.stepping_s();
   if (const auto* rt = p.realtime()) o.realtime = *rt;
+  if (const auto* peers = p.peers()) {
+    for (int i = 0; i < lockstep::kRosterSize; ++i) {
+      if (lockstep::kRoster[i] != p.name()) o.peers[std::string(lockstep::kRoster[i])] = (*peers)[i];
+    }
+  }
   return o;
 }
 
@@ -77,7 +131,10 @@ nlohmann::json OutcomeToJson(const Outcome& o) {
                       {"killed_by_supervisor", o.killed_by_supervisor},
                       {"was_stopped", o.was_stopped}};
   if (o.stepping_s > 0) j["stepping_s"] = o.stepping_s;
-  if (o.external) j["external"] = true;
+  if (o.external) {
+    j["external"] = true;
+    j["observed"] = o.observed;
+  }
   if (o.realtime_setup.tried) {
     j["realtime_setup"] = {{"sched_fifo", o.realtime_setup.fifo},
                            {"priority", o.realtime_setup.priority},
@@ -86,6 +143,11 @@ nlohmann::json OutcomeToJson(const Outcome& o) {
   }
   if (const nlohmann::json rt = o.RealtimeJson(); !rt.is_null()) j["realtime"] = rt;
   if (o.stats_known) j["link"] = StatsToJson(o.stats);
+  if (!o.peers.empty()) {
+    nlohmann::json peers = nlohmann::json::object();
+    for (const auto& [role, p] : o.peers) peers[role] = PeerToJson(p);
+    j["peers"] = peers;
+  }
   return j;
 }
 
@@ -101,6 +163,10 @@ Outcome OutcomeFromJson(const nlohmann::json& j) {
   o.was_stopped = j.value("was_stopped", false);
   o.stepping_s = j.value("stepping_s", 0.0);
   o.external = j.value("external", false);
+  o.observed = j.value("observed", std::string());
+  if (j.contains("peers")) {
+    for (const auto& [role, p] : j.at("peers").items()) o.peers[role] = PeerFromJson(p);
+  }
   if (j.contains("realtime_setup")) {
     const auto& r = j.at("realtime_setup");
     o.realtime_setup.tried = true;
@@ -129,27 +195,31 @@ Outcome OutcomeFromJson(const nlohmann::json& j) {
   return o;
 }
 
-std::vector<Outcome> RunGroupInProcess(const std::vector<scenario::Scenario>& per_role,
-                                       std::int64_t run_id, const std::string& out_dir,
-                                       const std::vector<RoleFault>& faults,
-                                       const volatile std::sig_atomic_t* stop) {
+namespace {
+/// Builds the participants of `per_role` (one scenario, or one per role in kBuildOrder) but those
+/// in `skip`, attaches them to `channels` and runs them; their outcomes.
+std::vector<Outcome> RunGroupOn(lockstep::Channels* channels, const std::vector<scenario::Scenario>& per_role,
+                                const std::vector<std::string>& skip, std::int64_t run_id,
+                                const std::string& out_dir, const std::vector<RoleFault>& faults,
+                                const volatile std::sig_atomic_t* stop) {
   const auto& order = lockstep::kBuildOrder;  // the logger subscribes before anyone publishes
   if (per_role.size() != 1 && per_role.size() != order.size()) {
     throw Error("RunGroupInProcess", "give one scenario, or one per role");
   }
   for (const auto& s : per_role) {
     const lockstep::ProcessFault kind = s.faults.process_kind;
-    if (lockstep::EndsProcess(kind)) {
+    const bool elsewhere = std::find(skip.begin(), skip.end(), s.faults.process_role) != skip.end();
+    if (lockstep::EndsProcess(kind) && !elsewhere) {
       throw Error(s.path + ": faults.process.kind",
                   fmt::format("\"{}\" would take every participant down in one process (memq): use the "
                               "udpm transport (one process per participant)",
                               NameOf(lockstep::kProcessFaultNames, kind)));
     }
   }
-  lockstep::InprocChannels bus;
   std::vector<std::unique_ptr<lockstep::Participant>> owned;
   std::vector<lockstep::Participant*> group;
   for (std::size_t i = 0; i < order.size(); ++i) {
+    if (std::find(skip.begin(), skip.end(), order[i]) != skip.end()) continue;
     const auto& s = per_role[per_role.size() == 1 ? 0 : i];
     lockstep::Faults f = FaultsOf(s, order[i]);
     for (const auto& extra : faults) {
@@ -164,13 +234,30 @@ std::vector<Outcome> RunGroupInProcess(const std::vector<scenario::Scenario>& pe
       if (extra.faults.network.any()) f.network = extra.faults.network;
     }
     owned.push_back(MakeParticipant(order[i], s, IdentityOf(s, run_id), nullptr, out_dir, std::move(f)));
-    owned.back()->Attach(&bus);
+    owned.back()->Attach(channels);
     group.push_back(owned.back().get());
   }
-  lockstep::RunLoop(&bus, group, stop);
+  lockstep::RunLoop(channels, group, stop);
   std::vector<Outcome> outcomes;
   for (const auto* p : group) outcomes.push_back(OutcomeOf(*p));
   return outcomes;
+}
+}  // namespace
+
+std::vector<Outcome> RunGroupInProcess(const std::vector<scenario::Scenario>& per_role,
+                                       std::int64_t run_id, const std::string& out_dir,
+                                       const std::vector<RoleFault>& faults,
+                                       const volatile std::sig_atomic_t* stop) {
+  lockstep::InprocChannels bus;
+  return RunGroupOn(&bus, per_role, {}, run_id, out_dir, faults, stop);
+}
+
+std::vector<Outcome> RunMixedGroup(const scenario::Scenario& s, const std::vector<std::string>& external,
+                                   const std::string& udpm_url, std::int64_t run_id, const std::string& out_dir,
+                                   const volatile std::sig_atomic_t* stop) {
+  lockstep::BridgedChannels bridge(udpm_url, external, WiringOf(s));
+  if (!bridge.good()) throw Error("", bridge.error());
+  return RunGroupOn(&bridge, {s}, external, run_id, out_dir, {}, stop);
 }
 
 namespace {
@@ -249,8 +336,10 @@ Verdict Judge(const std::vector<Outcome>& outcomes) {
     return v;
   }
   v.exit_code = worst->exit_code;
-  v.what = fmt::format("{} exited with code {}{}{}", worst->role, worst->exit_code,
-                       worst->message.empty() ? "" : ": ", worst->message);
+  v.what = worst->external && !worst->message.empty()
+               ? worst->message
+               : fmt::format("{} exited with code {}{}{}", worst->role, worst->exit_code,
+                             worst->message.empty() ? "" : ": ", worst->message);
   return v;
 }
 

@@ -4,6 +4,7 @@
 /// many groups side by side (each group has its own instance, so they cannot cross-talk).
 /// Also how a run's outcomes are judged: who is to blame when it fails.
 #include <csignal>
+#include <map>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -38,8 +39,16 @@ struct Outcome {
   bool stats_known = false;
   lockstep::LinkStats stats;
   double stepping_s = 0;  ///< the clock: wall-clock time from GO to the last committed step [s]
-  bool external = false;  ///< run by the user (`rths run --external`): not started or watched by us
+  bool external = false;  ///< run by the user (`rths run --external`): not started by us
+  /// External: how its end was observed by the clock: "finished" (said BYE), "aborted" (sent ABORT
+  /// with `message` as reason), "killed" (its process died by `signal`), "exited" (its process
+  /// ended with `exit_code`), "lost" (heartbeats stopped, or an unreadable exit status), "silent"
+  /// (stopped answering: the stall budget), "stopped" (told to stop by another's failure),
+  /// "never joined" (no HELLO).
+  std::string observed;
   lockstep::RealtimeSetup realtime_setup;  ///< paced runs: SCHED_FIFO / mlockall achieved
+  /// The clock: what it saw of every participant of the roster (by role; empty for the others).
+  std::map<std::string, lockstep::PeerObservation> peers;
   /// The clock: step latencies and deadline misses (realtime.paced false for the others).
   lockstep::RealtimeStats realtime;
   /// ... as read back from a participant process's outcome file (RealtimeToJson), if any.
@@ -67,6 +76,20 @@ std::vector<Outcome> RunGroupInProcess(const std::vector<scenario::Scenario>& pe
                                        std::int64_t run_id, const std::string& out_dir,
                                        const std::vector<RoleFault>& faults = {},
                                        const volatile std::sig_atomic_t* stop = nullptr);
+
+/// The outcome of external participant `role` as the clock observed it (`clock`: the clock's
+/// outcome, nullptr if unknown): how it ended (Outcome::observed), the exit code that stands for
+/// it (its own 128 + signal or exit code when its process was watched; kExitExternalAbort,
+/// kExitExternalLost; kExitLockstep when it stopped answering; kExitPeerAbort when it was told to
+/// stop), the message, and its link counters as seen by the clock.
+Outcome ExternalOutcome(const std::string& role, const Outcome* clock);
+
+/// A mixed run (lockstep/bridge.h): every participant of `s` but the `external` roles in this
+/// process, on one in-process queue bridged to the external participants on `udpm_url` (a plain
+/// udpm:// URL). Throws as RunGroupInProcess, and if the bridge cannot open the URL.
+std::vector<Outcome> RunMixedGroup(const scenario::Scenario& s, const std::vector<std::string>& external,
+                                   const std::string& udpm_url, std::int64_t run_id, const std::string& out_dir,
+                                   const volatile std::sig_atomic_t* stop = nullptr);
 
 /// The outcome to blame for a failed run: one that failed on its own (a signal, an exception)
 /// before one that detected a failure (lockstep) before one that was told to stop; nullptr if

@@ -42,6 +42,8 @@ void RealtimeFields(V& v, lockstep::RealtimeConfig& r, const Context&) {
   v.Bool("sched_fifo", r.sched_fifo);
   v.Integer("priority", r.priority, Closed(1, 99));
   v.Bool("lock_memory", r.lock_memory);
+  v.Number("spin_us", r.spin_us, Closed(0.0, 5000.0));
+  v.Integer("cpu", r.cpu, Closed(-1, 1023));
 }
 
 template <typename V>

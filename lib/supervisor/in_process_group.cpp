@@ -5,13 +5,19 @@
 namespace rths::supervisor {
 
 std::vector<participants::Outcome> RunInProcessGroup(const scenario::Scenario& s, const ReplaySource* replay,
+                                                     const ExternalRoles* external, const std::string& udpm_url,
                                                      std::int64_t run_id, const std::string& out_dir,
                                                      const volatile std::sig_atomic_t* stop,
                                                      lockstep::RealtimeSetup* setup) {
   if (replay) return participants::RunReplay(s, *replay->record, replay->steps, replay->live, run_id, out_dir, stop);
   if (s.realtime.enabled) {
-    // Every participant runs on this thread: the set-up is this process's.
-    *setup = lockstep::EnterRealtime(s.realtime.sched_fifo, s.realtime.priority, s.realtime.lock_memory);
+    // Every built-in participant runs on this thread: the set-up is this process's.
+    *setup = lockstep::EnterRealtime(s.realtime);
+  }
+  if (external && !external->roles.empty()) {
+    scenario::Scenario mixed = s;
+    if (external->join_timeout_s > 0) mixed.lockstep.handshake_timeout_s = external->join_timeout_s;
+    return participants::RunMixedGroup(mixed, external->roles, udpm_url, run_id, out_dir, stop);
   }
   return participants::RunGroupInProcess({s}, run_id, out_dir, {}, stop);
 }

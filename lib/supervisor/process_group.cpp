@@ -203,12 +203,6 @@ std::vector<Outcome> RunProcessGroup(const ProcessGroupSpec& spec, volatile std:
   if (teardown.started()) *noticed = teardown.noticed();
   std::vector<Outcome> outcomes;
   for (auto& [pid, c] : children) outcomes.push_back(WithSelfReport(c.outcome, spec.out));
-  for (const auto& role : spec.external.roles) {
-    Outcome o;
-    o.role = role;
-    o.external = true;
-    outcomes.push_back(std::move(o));
-  }
   return outcomes;
 }
 

@@ -21,7 +21,7 @@ struct ProcessGroupSpec {
   std::filesystem::path out;              ///< output folder (out/logs/<role>.log and .json)
   std::filesystem::path bin_dir;          ///< where rths-<role> are
   std::string url;                        ///< the run's udpm URL
-  ExternalRoles external;                 ///< not started; listed as external outcomes
+  ExternalRoles external;                 ///< not started (their outcomes: participants::ExternalOutcome)
   std::vector<std::string> role_args;     ///< extra arguments for every participant
 };
 

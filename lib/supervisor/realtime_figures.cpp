@@ -1,5 +1,7 @@
 #include "supervisor/realtime_figures.h"
 
+#include <fmt/core.h>
+
 namespace rths::supervisor {
 
 nlohmann::json RealtimeFigures(const scenario::Scenario& s, const std::vector<participants::Outcome>& outcomes,
@@ -18,8 +20,8 @@ nlohmann::json RealtimeFigures(const scenario::Scenario& s, const std::vector<pa
     locked += r.memory_locked;
     if (!r.note.empty() && notes.find(r.note) == std::string::npos) notes += (notes.empty() ? "" : "; ") + who + ": " + r.note;
   };
-  if (transport == "memq") {
-    count(memq_setup, "rths run (memq: every participant)");
+  if (transport != "udpm") {
+    count(memq_setup, fmt::format("rths run ({}: every built-in participant)", transport));
   } else {
     for (const auto& o : outcomes) count(o.realtime_setup, o.role);
   }

@@ -39,7 +39,7 @@ struct ReplaySource {
 struct RunPlan {
   scenario::Scenario scenario;        ///< the scenario that runs (loaded back from the folder's file if written)
   std::string scenario_path;          ///< the file the participants read
-  std::string url;                    ///< udpm: the run's LCM URL; memq: "memq://"
+  std::string url;                    ///< udpm, mixed: the run's LCM URL; memq: "memq://"
   std::int64_t run_id = 0;
   std::filesystem::path out;          ///< the output folder
   OutputEstimate sizes;               ///< what the run will write
@@ -54,13 +54,16 @@ struct RunRequest {
   /// in full (scenario::ToToml) under the comment line "# <scenario_header>" and loaded back, so
   /// its hash is the file's, and the participants read that file.
   std::string scenario_header;
-  std::string transport = "udpm";     ///< "udpm": one process per participant; "memq": this process
+  /// "udpm": one process per participant; "memq": every participant in this process; "mixed":
+  /// the built-in participants in this process, bridged to the external ones on udpm
+  /// (lockstep/bridge.h; needs `external`).
+  std::string transport = "udpm";
   std::string lcm_url;                ///< udpm: "" picks udpm://239.255.76.67:<a free port>?ttl=0
   bool port_per_channel = false;      ///< udpm with a picked URL: a free port per channel
   std::filesystem::path out;          ///< the output folder ("" a new one under runs/)
   std::filesystem::path bin_dir;      ///< udpm: where the rths-<role> programs are
   std::int64_t run_id = 0;            ///< 0: a new random id
-  ExternalRoles external;             ///< udpm: roles the user runs
+  ExternalRoles external;             ///< udpm, mixed: roles the user runs
   std::vector<std::string> role_args; ///< udpm: extra arguments for every participant process
   /// Check before a byte is written that the scenario builds, the transport can carry it, the
   /// folder is new or empty and (check_disk_space) the disk has room. Off for a study's batch and a

@@ -7,11 +7,10 @@
 #include "core/names.h"
 #include "io/output_folder.h"
 #include "io/reserved_file.h"
-#include "lockstep/faults.h"
 #include "lockstep/exit_code.h"
 #include "lockstep/faults.h"
 #include "lockstep/protocol.h"
-#include "lockstep/transport.h"
+#include "lockstep/step_table.h"
 #include "lockstep/transport.h"
 #include "participants/factory.h"
 #include "supervisor/in_process_group.h"
@@ -52,12 +51,17 @@ RunPlan Plan(const RunRequest& r) {
   if (!r.checks) return plan;
   const scenario::Scenario& s = r.scenario;
   participants::CheckBuildable(s);
-  if (r.transport == "memq" && lockstep::EndsProcess(s.faults.process_kind)) {
+  if (r.transport != "udpm" && lockstep::EndsProcess(s.faults.process_kind) &&
+      !r.external.has(s.faults.process_role)) {
     throw Error(r.scenario_path + ": faults.process.kind",
-                fmt::format("\"{}\" would take every participant down with the one memq process: use --transport udpm",
-                            NameOf(lockstep::kProcessFaultNames, s.faults.process_kind)));
+                fmt::format("\"{}\" would take every participant down with the one {} process: use --transport udpm",
+                            NameOf(lockstep::kProcessFaultNames, s.faults.process_kind), r.transport));
   }
-  if (r.transport == "udpm") plan.url = UdpmUrl(r);
+  if (r.transport == "mixed" && (r.port_per_channel || lockstep::IsPortPerChannel(r.lcm_url))) {
+    throw Error("--port-per-channel", "a mixed run bridges its external participants on one udpm port: use "
+                                      "--transport udpm for a port per channel");
+  }
+  if (r.transport != "memq") plan.url = UdpmUrl(r);
   if (plan.out.empty()) plan.out = io::NewOutputFolder(s.run.name);
   io::RequireNewOrEmptyFolder(plan.out, "a previous run");
   plan.sizes = EstimateOutput(s);
@@ -102,9 +106,9 @@ GroupEnd RunGroup(const RunRequest& r, const RunPlan& plan) {
   try {
     if (r.on_start) r.on_start(plan);
     const RunProgress progress(plan.out / "log.lcm", plan.scenario, r.progress);
-    if (r.transport == "memq") {
-      end.outcomes = RunInProcessGroup(plan.scenario, r.replay ? &*r.replay : nullptr, plan.run_id,
-                                       plan.out.string(), interrupted, &end.memq_setup);
+    if (r.transport == "memq" || r.transport == "mixed") {
+      end.outcomes = RunInProcessGroup(plan.scenario, r.replay ? &*r.replay : nullptr, &r.external, plan.url,
+                                       plan.run_id, plan.out.string(), interrupted, &end.memq_setup);
     } else {
       const ProcessGroupSpec spec{plan.scenario_path, plan.run_id, plan.out,   r.bin_dir,
                                   plan.url,           r.external,  r.role_args};
@@ -121,6 +125,14 @@ GroupEnd RunGroup(const RunRequest& r, const RunPlan& plan) {
   }
   end.wall_s = std::chrono::duration<double>(Clock::now() - t0).count();
   end.interrupted = *interrupted != 0;
+  // The user's participants, as the clock saw them.
+  const participants::Outcome* clock = nullptr;
+  for (const auto& o : end.outcomes) {
+    if (o.role == lockstep::kClockRole) clock = &o;
+  }
+  std::vector<participants::Outcome> external;
+  for (const auto& role : r.external.roles) external.push_back(participants::ExternalOutcome(role, clock));
+  end.outcomes.insert(end.outcomes.end(), external.begin(), external.end());
   return end;
 }
 
