@@ -45,6 +45,7 @@
 #include <lcm/lcm-cpp.hpp>
 #include <nlohmann/json.hpp>
 
+#include "external_run.h"
 #include "lockstep/transport.h"
 
 namespace fs = std::filesystem;
@@ -279,6 +280,7 @@ int main(int argc, char** argv) {
   const std::string one = fmt::format("udpm://239.255.76.67:{}?ttl=0", port);
   const std::string per = fmt::format("udpm://239.255.76.67:{}?ttl=0&port_per_channel=1", port);
   std::vector<double> c00, c10, c30, s_one, s_per, p00, p_later, r_one, r_per, r_memq, cpu_one, cpu_per, cpu_memq, gain;
+  std::vector<double> r_mixed;  // mixed run (rths run --external plant) with rths-plant as the external plant
   for (int r = 0; r < repeat; ++r) {
     c00.push_back(PingPongCpu(one, false, 0, 0, round_trips));
     c10.push_back(PingPongCpu(one, false, 1, 0, round_trips));
@@ -290,6 +292,11 @@ int main(int argc, char** argv) {
     const Run a = LockstepRun(bin, scen, "--transport udpm", tmp / "one", steps);
     const Run b = LockstepRun(bin, scen, "--transport udpm --port-per-channel", tmp / "per", steps);
     const Run m = LockstepRun(bin, scen, "--transport memq", tmp / "memq", steps);
+    double mixed_rate = 0;
+    if (rths_bench::RunWithExternalPlant(bin, "--quiet", scen, tmp / "mixed", "builtin", steps, dt, port + 16) == 0) {
+      mixed_rate = nlohmann::json::parse(std::ifstream(tmp / "mixed" / "summary.json"))["steps_per_s"].get<double>();
+    }
+    r_mixed.push_back(mixed_rate);
     r_one.push_back(a.steps_per_s);
     r_per.push_back(b.steps_per_s);
     r_memq.push_back(m.steps_per_s);
@@ -336,8 +343,12 @@ int main(int argc, char** argv) {
               per_rate, per_rate / bound_per, us(Median(cpu_per)), Median(gain));
   std::printf("lockstep memq (1 process)        %8.0f steps/s = %.2f x port per channel; CPU %6.1f us/step\n", memq_rate,
               per_rate > 0 ? memq_rate / per_rate : 0.0, us(Median(cpu_memq)));
-  std::printf("per repeat (one port / port per channel / memq steps/s):");
-  for (int r = 0; r < repeat; ++r) std::printf(" %.0f/%.0f/%.0f", r_one[r], r_per[r], r_memq[r]);
+  const double mixed_rate = Median(r_mixed);
+  std::printf("lockstep mixed (external plant)  %8.0f steps/s = %.2f x udpm one port (rths-plant on udpm, the rest "
+              "in 1 process)\n",
+              mixed_rate, one_rate > 0 ? mixed_rate / one_rate : 0.0);
+  std::printf("per repeat (one port / port per channel / memq / mixed steps/s):");
+  for (int r = 0; r < repeat; ++r) std::printf(" %.0f/%.0f/%.0f/%.0f", r_one[r], r_per[r], r_memq[r], r_mixed[r]);
   std::printf("\ntarget >= 8000 steps/s on udpm with a port per channel: %s\n", per_rate >= 8000 ? "met" : "NOT met");
   fs::remove_all(tmp);
   return 0;

@@ -4,6 +4,15 @@
 // this host achieved now (docs/realtime.md).
 //
 //   build/bin/bench-realtime [--seconds S] [--scenario FILE] [--out DIR] [--transports memq,udpm]
+//                            [--spin-us US] [--cpu N] [--linear-plant]
+//
+// A transport "mixed:PLANT" is a mixed run (the built-in participants in one process, bridged on
+// udpm) with an external plant: builtin (rths-plant), java (examples/java_plant), python
+// (examples/python_plant); e.g. --transports memq,mixed:java,mixed:python,udpm. The Java and
+// Python plants model the linear servo without a specimen: --linear-plant sets every row's
+// scenario to that plant (plant.kind = "linear", actuator = "avg", specimen = "none"), so the
+// rows compare like with like. --spin-us and --cpu set [realtime] spin_us and cpu for every row.
+// Each row's miss rate is also given as a ratio to the host's own (the "sleep" row).
 //
 // First, the host's own wake-up lateness (a cyclictest-like loop that only sleeps to absolute
 // deadlines, at most 20 s): misses that this row shows too are the host's, not rths's.
@@ -29,6 +38,7 @@
 #include <fmt/core.h>
 #include <nlohmann/json.hpp>
 
+#include "external_run.h"
 #include "io/output_folder.h"
 #include "lockstep/realtime.h"
 #include "io/plot.h"
@@ -77,15 +87,28 @@ int main(int argc, char** argv) {
   app.add_option("--seconds", seconds, "simulated (= wall) seconds per run")->capture_default_str();
   app.add_option("--scenario", scenario_path, "scenario to pace")->capture_default_str();
   app.add_option("--out", out_arg, "output folder (default: runs/<time>-bench-realtime)");
-  app.add_option("--transports", transports_arg, "comma-separated: memq, udpm")->capture_default_str();
+  app.add_option("--transports", transports_arg, "comma-separated: memq, udpm, mixed:builtin|java|python")
+      ->capture_default_str();
+  double spin_us = 0;
+  int cpu = -1;
+  bool linear_plant = false;
+  app.add_option("--spin-us", spin_us, "[realtime] spin_us of every run (busy-wait before each release)")
+      ->capture_default_str();
+  app.add_option("--cpu", cpu, "[realtime] cpu of every run (-1: no pinning)")->capture_default_str();
+  app.add_flag("--linear-plant", linear_plant, "every row on the linear servo without a specimen (as the Java and "
+                                               "Python plants model)");
   CLI11_PARSE(app, argc, argv);
 
   const fs::path bin_dir = fs::read_symlink("/proc/self/exe").parent_path();
   fs::path out = out_arg;
   if (out.empty()) out = rths::io::NewOutputFolder("bench-realtime");
   fs::create_directories(out);
-  rths::scenario::Scenario s = rths::scenario::LoadScenario(scenario_path);
+  std::vector<std::string> sets;
+  if (linear_plant) sets = {"plant.kind=\"linear\"", "plant.actuator=\"avg\"", "plant.specimen=\"none\""};
+  rths::scenario::Scenario s = rths::scenario::LoadScenario(scenario_path, sets);
   s.run.duration_s = seconds;
+  s.realtime.spin_us = spin_us;
+  s.realtime.cpu = cpu;
   s.run.name = "bench_realtime";
   // Written next to the original, so relative paths in it (structure or record files) still resolve.
   const fs::path paced = fs::path(scenario_path).parent_path() / fmt::format(".bench-realtime-{}.toml", ::getpid());
@@ -95,17 +118,22 @@ int main(int argc, char** argv) {
   std::stringstream ss(transports_arg);
   for (std::string t; std::getline(ss, t, ',');) transports.push_back(t);
 
-  std::printf("bench-realtime: %s paced at %g Hz for %g s per transport, on %ld CPUs\n", scenario_path.c_str(),
-              1.0 / s.run.dt_s, seconds, static_cast<long>(std::thread::hardware_concurrency()));
-  std::printf("%-6s %8s %8s %9s %10s %8s %10s %8s  %s\n", "", "steps", "misses", "miss %", "p50 us", "p99 us",
-              "p99.9 us", "max us", "set-up");
+  std::printf("bench-realtime: %s%s paced at %g Hz for %g s per transport, on %ld CPUs, spin_us %g, cpu %d\n",
+              scenario_path.c_str(), linear_plant ? " (linear plant, no specimen)" : "", 1.0 / s.run.dt_s, seconds,
+              static_cast<long>(std::thread::hardware_concurrency()), spin_us, cpu);
+  std::printf("%-14s %8s %8s %9s %8s %10s %8s %10s %8s  %s\n", "", "steps", "misses", "miss %", "x host", "p50 us",
+              "p99 us", "p99.9 us", "max us", "set-up");
+  double host_miss = 0;  // the host's own miss fraction (at least one miss in its steps)
   {
     std::int64_t missed = 0;
     const auto h = WakeUpBaseline(s.run.dt_s, std::min(seconds, 20.0), s, &missed);
-    std::printf("%-6s %8lld %8lld %8.4f%% %10.0f %8.0f %10.0f %8.0f  wake-up lateness alone (no work; cyclictest-like)\n",
+    const double n = static_cast<double>(std::max<std::int64_t>(h.count(), 1));
+    host_miss = static_cast<double>(std::max<std::int64_t>(missed, 1)) / n;
+    std::printf("%-14s %8lld %8lld %8.4f%% %8s %10.0f %8.0f %10.0f %8.0f  wake-up lateness alone (no work; "
+                "cyclictest-like)%s\n",
                 "sleep", static_cast<long long>(h.count()), static_cast<long long>(missed),
-                100.0 * static_cast<double>(missed) / static_cast<double>(std::max<std::int64_t>(h.count(), 1)),
-                1e6 * h.Quantile(0.5), 1e6 * h.Quantile(0.99), 1e6 * h.Quantile(0.999), 1e6 * h.max_s());
+                100.0 * static_cast<double>(missed) / n, "1", 1e6 * h.Quantile(0.5), 1e6 * h.Quantile(0.99),
+                1e6 * h.Quantile(0.999), 1e6 * h.max_s(), missed == 0 ? " (0 misses: ratios use 1)" : "");
   }
   rths::io::Figure fig;
   fig.name = "latency";
@@ -115,31 +143,40 @@ int main(int argc, char** argv) {
   panel.log_x = true;
   panel.log_y = true;
   int code = 0;
+  int port = 21000 + ::getpid() % 4000 * 2;
   for (const auto& t : transports) {
-    const fs::path dir = out / t;
-    const std::string cmd = fmt::format("{}/rths-run --realtime --quiet --transport {} --out {} {} > {}/stdout.txt 2>&1",
-                                        bin_dir.string(), t, dir.string(), paced.string(), out.string());
-    const int rc = std::system(cmd.c_str());
+    const bool mixed = t.rfind("mixed:", 0) == 0;
+    const fs::path dir = out / (mixed ? "mixed_" + t.substr(6) : t);
+    int rc = 0;
+    if (mixed) {
+      rc = rths_bench::RunWithExternalPlant(bin_dir, "--realtime --quiet", paced, dir, t.substr(6), s.steps(),
+                                            s.run.dt_s, port++);
+    } else {
+      const std::string cmd = fmt::format("{}/rths-run --realtime --quiet --transport {} --out {} {} > {}/stdout.txt 2>&1",
+                                          bin_dir.string(), t, dir.string(), paced.string(), out.string());
+      rc = std::system(cmd.c_str());
+    }
     nlohmann::json j;
     try {
       std::ifstream in(dir / "summary.json");
       j = nlohmann::json::parse(in);
     } catch (const std::exception& e) {
-      std::printf("%-6s run failed (exit %d): %s\n", t.c_str(), rc, e.what());
+      std::printf("%-14s run failed (exit %d): %s\n", t.c_str(), rc, e.what());
       code = 1;
       continue;
     }
     if (!j.contains("realtime") || !j["realtime"].contains("steps")) {
-      std::printf("%-6s run failed: %s\n", t.c_str(), j.value("stopped", std::string("no realtime figures")).c_str());
+      std::printf("%-14s run failed: %s\n", t.c_str(), j.value("stopped", std::string("no realtime figures")).c_str());
       code = 1;
       continue;
     }
     const auto& rt = j["realtime"];
     const auto steps = rt["steps"].get<std::int64_t>();
     const auto misses = rt["deadline_misses"].get<std::int64_t>();
-    std::printf("%-6s %8lld %8lld %8.4f%% %10.0f %8.0f %10.0f %8.0f  FIFO %d/%d, locked %d/%d%s\n", t.c_str(),
+    std::printf("%-14s %8lld %8lld %8.4f%% %8.1f %10.0f %8.0f %10.0f %8.0f  FIFO %d/%d, locked %d/%d%s\n", t.c_str(),
                 static_cast<long long>(steps), static_cast<long long>(misses),
-                100.0 * rt["miss_fraction"].get<double>(), rt["latency_p50_us"].get<double>(),
+                100.0 * rt["miss_fraction"].get<double>(), rt["miss_fraction"].get<double>() / host_miss,
+                rt["latency_p50_us"].get<double>(),
                 rt["latency_p99_us"].get<double>(), rt["latency_p999_us"].get<double>(),
                 rt["latency_max_us"].get<double>(), rt["sched_fifo_processes"].get<int>(),
                 rt["processes"].get<int>(), rt["memory_locked_processes"].get<int>(), rt["processes"].get<int>(),

@@ -44,7 +44,7 @@ double KillPlantAndWait(const fs::path& dir, const PrintedRun& run, pid_t plant)
   }
   REQUIRE(::kill(plant, SIGKILL) == 0);
   const auto killed = std::chrono::steady_clock::now();
-  while (::kill(run.pid, 0) == 0) ::usleep(5000);
+  while (!Exited(run.pid)) ::usleep(5000);
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - killed).count();
 }
 
@@ -86,8 +86,8 @@ TEST_CASE("kill -9 of an external plant on this host: noticed through its pid, n
     const PrintedRun run = StartExternalRun(dir, RunArgs(dir, scenario, transport + " --set lockstep.stall_budget_s=600"));
     const pid_t plant = StartPlant(dir, run, run.url);
     const double took_s = KillPlantAndWait(dir, run, plant);
-    MESSAGE("the run exited " << took_s << " s after kill -9 of the plant (" << (transport.empty() ? "mixed" : "udpm")
-                              << ")");
+    MESSAGE("the run exited " << took_s << " s after kill -9 of the plant ("
+                              << std::string(transport.empty() ? "mixed" : "udpm") << ")");
     const auto j = WaitExternalRun(run, dir / "out");
     CHECK(j["exit_code"] == 128 + SIGKILL);
     CHECK(j["stopped"].get<std::string>().find("plant was killed by signal 9") != std::string::npos);
@@ -154,4 +154,20 @@ TEST_CASE("a participant from another host (no pid): lost after 5 missed heartbe
     CHECK(stopped.find("neither its pid nor a heartbeat") != std::string::npos);
     CHECK(j["participants"]["plant"]["observed"] == "silent");
   }
+}
+
+TEST_CASE("the README's external example with --set: the printed scenario is the run's own, and it joins") {
+  if (!UdpmAvailable()) FAIL("udpm cannot run on this host: " << rths::lockstep::CheckMulticastRoute());
+  const auto dir = TempDir("external_set");
+  const fs::path scenario = WriteScenario(dir, "[run]\nname = \"set\"\nduration_s = 0.5\n");
+  const PrintedRun run = StartExternalRun(dir, RunArgs(dir, scenario, "--set run.duration_s=0.25"));
+  CHECK(run.scenario == (dir / "out" / "scenario.toml").string());  // not the original file
+  const std::string plant = "timeout 60 " + BuiltInPlant(run.url, run.run_id, run.scenario, dir) + " > " +
+                            (dir / "plant.out").string() + " 2>&1";
+  CHECK(std::system(plant.c_str()) == 0);
+  const auto j = WaitExternalRun(run, dir / "out");
+  CHECK(j["exit_code"] == 0);
+  CHECK(j["steps"] == 500);
+  // The original file's hash is refused, as the printed line warns.
+  CHECK(ReadFile(dir / "run.out").find("give your participant this file") != std::string::npos);
 }

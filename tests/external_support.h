@@ -70,9 +70,18 @@ inline PrintedRun StartExternalRun(const fs::path& dir, const std::string& run_a
   return r;
 }
 
+/// Whether process `pid` (not our child) has exited: gone, or a zombie its new parent has not
+/// reaped yet (that can take a while).
+inline bool Exited(pid_t pid) {
+  if (::kill(pid, 0) != 0) return true;
+  const std::string stat = ReadFile("/proc/" + std::to_string(pid) + "/stat");
+  const std::size_t close = stat.rfind(')');
+  return close == std::string::npos || stat.compare(close + 2, 1, "Z") == 0;
+}
+
 /// Waits (at most 60 s) for the backgrounded run to exit; its summary.json in `out`.
 inline nlohmann::json WaitExternalRun(const PrintedRun& run, const fs::path& out) {
-  for (int i = 0; i < 600 && ::kill(run.pid, 0) == 0; ++i) ::usleep(100000);
+  for (int i = 0; i < 600 && !Exited(run.pid); ++i) ::usleep(100000);
   return nlohmann::json::parse(ReadFile(out / "summary.json"));
 }
 

@@ -180,6 +180,7 @@ Outcome WithSelfReport(Outcome o, const fs::path& out) {
       o.stepping_s = self.stepping_s;
       o.realtime_setup = self.realtime_setup;
       o.realtime_json = self.realtime_json;
+      o.peers = self.peers;
     }
   } catch (const std::exception&) {
     // a partial file (the disk filled up): keep what the exit status says
