@@ -118,13 +118,15 @@ struct Mask {
 /// command twice in one checkout: --this D --other D): the run id, wall times and rates, the step
 /// latencies (the clock measures them on every run, paced or not), the diagnosis' runtime and
 /// "link", the udpm transport's counters of re-requested, repaired and duplicate messages (they
-/// follow the host's timing; the payloads do not: log.lcm is compared by payload).
+/// follow the host's timing; the payloads do not: log.lcm is compared by payload), and the clock's
+/// "peers" (each participant's pid and those counters as the clock saw them).
 inline const std::vector<std::string>& VolatileKeys() {
   static const std::vector<std::string> keys = {"run_id",
                                                 "wall_s",
                                                 "stepping_s",
                                                 "steps_per_s",
                                                 "link",
+                                                "peers",
                                                 "latency_histogram_us",
                                                 "latency_max_us",
                                                 "latency_p50_us",

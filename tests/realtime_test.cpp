@@ -4,6 +4,8 @@
 // what absolute deadlines guarantee (a paced run cannot finish before its simulated duration).
 #include <doctest/doctest.h>
 
+#include <thread>
+
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -159,7 +161,10 @@ TEST_CASE("[realtime] is validated like every table, naming file, key and range"
                            {"[realtime]\npriority = 100\n", "realtime.priority"},
                            {"[realtime]\nmax_consecutive_misses = -1\n", "realtime.max_consecutive_misses"},
                            {"[realtime]\nenabled = 1\n", "realtime.enabled"},
-                           {"[realtime]\ndeadline_ms = 1\n", "deadline_ms"}}) {
+                           {"[realtime]\ndeadline_ms = 1\n", "deadline_ms"},
+                           {"[realtime]\nspin_us = -1\n", "realtime.spin_us"},
+                           {"[realtime]\nspin_us = 6000\n", "realtime.spin_us"},
+                           {"[realtime]\ncpu = -2\n", "realtime.cpu"}}) {
     CAPTURE(text);
     const fs::path p = WriteScenario(dir, text);
     try {
@@ -173,13 +178,46 @@ TEST_CASE("[realtime] is validated like every table, naming file, key and range"
   }
   // The defaults round-trip through ToToml.
   const auto s = rths::scenario::ParseScenario("[realtime]\nenabled = true\nmax_consecutive_misses = 7\npriority = 42\n"
-                                               "sched_fifo = false\nlock_memory = false\n", "x.toml");
+                                               "sched_fifo = false\nlock_memory = false\nspin_us = 150\ncpu = 1\n",
+                                               "x.toml");
   const auto t = rths::scenario::ParseScenario(rths::scenario::ToToml(s), "y.toml");
   CHECK(t.realtime.enabled);
   CHECK(t.realtime.max_consecutive_misses == 7);
   CHECK(t.realtime.priority == 42);
   CHECK_FALSE(t.realtime.sched_fifo);
   CHECK_FALSE(t.realtime.lock_memory);
+  CHECK(t.realtime.spin_us == 150);
+  CHECK(t.realtime.cpu == 1);
+}
+
+TEST_CASE("[realtime] spin_us: a paced run that busy-waits before each release gives the same payloads; cpu pins") {
+  const auto dir = TempDir("spin");
+  auto paced = rths::scenario::LoadScenario(WriteScenario(dir, kPaced).string());
+  paced.realtime.spin_us = 300;  // of a 500 us period
+  auto free_running = paced;
+  free_running.realtime.enabled = false;
+  const std::int64_t n = paced.steps();
+  fs::create_directories(dir / "spin");
+  fs::create_directories(dir / "free");
+  const auto outcomes = rths::participants::RunGroupInProcess({paced}, 7, (dir / "spin").string());
+  rths::participants::RunGroupInProcess({free_running}, 8, (dir / "free").string());
+  for (const auto& o : outcomes) {
+    CHECK(o.exit_code == 0);
+    // Spinning ends at the release, never before: the last step cannot start before (n-1) dt.
+    if (o.role == "integrator") CHECK(o.stepping_s >= (n - 1) * paced.run.dt_s);
+  }
+  CHECK(rths::io::PayloadDigest(rths::io::ReadRunLog((dir / "spin" / "log.lcm").string())) ==
+        rths::io::PayloadDigest(rths::io::ReadRunLog((dir / "free" / "log.lcm").string())));
+  // Pinning, on a thread of its own (affinity is per thread): CPU 0 exists; CPU 1023 does not here.
+  rths::lockstep::RealtimeSetup pinned, impossible;
+  std::thread([&] {
+    pinned = rths::lockstep::EnterRealtime(false, 1, false, 0);
+    impossible = rths::lockstep::EnterRealtime(false, 1, false, 1023);
+  }).join();
+  CHECK(pinned.cpu == 0);
+  CHECK(pinned.note.empty());
+  CHECK(impossible.cpu == -1);
+  CHECK(impossible.note.find("cannot pin to CPU 1023") != std::string::npos);
 }
 
 TEST_CASE("rths run --realtime (udpm): summary and terminal report latency, misses and the set-up") {

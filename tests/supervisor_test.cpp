@@ -31,7 +31,8 @@ nlohmann::json Summary(const fs::path& run) { return nlohmann::json::parse(std::
 /// stepping times, the clock's step latencies, the teardown time, the link counters (a loaded host
 /// re-requests, on memq too) and, on udpm, the URL (its port).
 nlohmann::json Comparable(nlohmann::json j, bool udpm) {
-  std::vector<std::string> drop = {"run_id", "wall_s", "stepping_s", "steps_per_s", "teardown_s", "realtime", "link"};
+  std::vector<std::string> drop = {"run_id", "wall_s", "stepping_s", "steps_per_s", "teardown_s", "realtime", "link",
+                                   "peers"};
   if (udpm) drop.push_back("lcm_url");
   if (j.is_object()) {
     for (const auto& key : drop) j.erase(key);

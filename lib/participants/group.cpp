@@ -139,6 +139,7 @@ nlohmann::json OutcomeToJson(const Outcome& o) {
     j["realtime_setup"] = {{"sched_fifo", o.realtime_setup.fifo},
                            {"priority", o.realtime_setup.priority},
                            {"memory_locked", o.realtime_setup.memory_locked},
+                           {"cpu", o.realtime_setup.cpu},
                            {"note", o.realtime_setup.note}};
   }
   if (const nlohmann::json rt = o.RealtimeJson(); !rt.is_null()) j["realtime"] = rt;
@@ -173,6 +174,7 @@ Outcome OutcomeFromJson(const nlohmann::json& j) {
     o.realtime_setup.fifo = r.value("sched_fifo", false);
     o.realtime_setup.priority = r.value("priority", 0);
     o.realtime_setup.memory_locked = r.value("memory_locked", false);
+    o.realtime_setup.cpu = r.value("cpu", -1);
     o.realtime_setup.note = r.value("note", std::string());
   }
   if (j.contains("realtime")) o.realtime_json = j.at("realtime");
