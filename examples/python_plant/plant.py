@@ -310,7 +310,7 @@ def open_lcm(url, which):
             return lcm.LCM(url), "the lcm module"
         except ImportError:
             if which == "lcm":
-                raise SystemExit("plant: --transport lcm: the lcm Python module is not installed")
+                raise ValueError("--transport lcm: the lcm Python module is not installed")
     sys.path.insert(0, HERE)
     import lcm_udpm
     return lcm_udpm.LcmUdpm(url), "lcm_udpm.py (no lcm module)"
@@ -372,7 +372,7 @@ def main():
         return 2
     if warnings:
         print("plant: warning: this example models only the linear servo with no specimen, noise or effects; "
-              f"the scenario sets {', '.join(warnings)}: its y will differ from the built-in plant's", file=sys.stderr)
+              f"the scenario sets {', '.join(warnings)}: its answers will differ from the built-in plant's", file=sys.stderr)
     try:
         lc, transport = open_lcm(a.lcm_url, a.transport)
     except (OSError, ValueError) as e:
