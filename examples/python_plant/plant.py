@@ -34,6 +34,7 @@ import hashlib
 import math
 import os
 import signal
+import struct
 import sys
 import time
 
@@ -130,6 +131,15 @@ class LinearServo:
         self.z = [row[0] * z0 + row[1] * z1 + row[2] * z2 + g * u_mm for row, g in zip(self.phi, self.gamma)]
 
 
+def decode(msg_type, channel, data):
+    """msg_type.decode(data), with an error that says what to do when the types are stale."""
+    try:
+        return msg_type.decode(data)
+    except (ValueError, struct.error) as e:
+        raise ValueError(f"{channel}: cannot decode an rths.{msg_type.__name__} ({e}): generate the types "
+                         "again from this checkout's lcmtypes/*.lcm (lcm-gen --python)") from None
+
+
 # --- the participant -------------------------------------------------------------------------
 
 class PlantParticipant:
@@ -205,7 +215,7 @@ class PlantParticipant:
     # Handlers: callback(channel, data) for the lcm module and for lcm_udpm.py alike.
 
     def on_handshake(self, channel, data):
-        h = handshake_t.decode(data)
+        h = decode(handshake_t, channel, data)
         if h.run_id != self.run_id or h.participant == ROLE:
             return  # another run, or our own echo
         if h.phase == ABORT:
@@ -227,7 +237,7 @@ class PlantParticipant:
             self.exit_code = 0
 
     def on_desired(self, channel, data):
-        d = desired_t.decode(data)
+        d = decode(desired_t, channel, data)
         if d.run_id != self.run_id:
             return
         self.last_clock = time.monotonic()
@@ -235,19 +245,19 @@ class PlantParticipant:
             self.start()  # GO was lost: the clock is already stepping
 
     def on_command(self, channel, data):
-        c = command_t.decode(data)
+        c = decode(command_t, channel, data)
         if c.run_id == self.run_id and c.k >= self.next - 1:
             self.command.setdefault(c.k, c.u_mm)
         self.try_step()
 
     def on_current(self, channel, data):
-        c = current_t.decode(data)
+        c = decode(current_t, channel, data)
         if c.run_id == self.run_id and c.k >= self.next - 1:
             self.current.setdefault(c.k, c.i_cmd_A)
         self.try_step()
 
     def on_repair(self, channel, data):
-        r = repair_t.decode(data)
+        r = decode(repair_t, channel, data)
         if r.run_id != self.run_id or r.participant == ROLE:
             return
         for ch, k in zip(r.want_channel, r.want_k):  # re-send our cached answers, byte for byte
