@@ -153,8 +153,8 @@ TEST_CASE("a plant written in Python (examples/python_plant) joins with --extern
   REQUIRE(RunMemq({rths::scenario::LoadScenario(scenario.string())}, ref).code == 0);
   // Steps and dt come from the scenario file (tomllib); a HEARTBEAT every 0.2 s is declared.
   const PlantCommand python = [&](const std::string& url, const std::string& id, const std::string& sc) {
-    return "env PYTHONPATH=" + types.string() + " /usr/bin/python3 " + script.string() + " --transport own --lcm-url '" +
-           url + "' --run-id " + id + " --scenario " + sc + " --heartbeat-s 0.2";
+    return "env PYTHONPATH=" + types.string() + " /usr/bin/python3 " + script.string() +
+           " --transport own --lcm-url '" + url + "' --run-id " + id + " --scenario " + sc + " --heartbeat-s 0.2";
   };
   REQUIRE(RunWithExternalPlant(dir, "--join-timeout-s 60 --out " + (dir / "out").string() + " " + scenario.string(), "",
                                "", "", python) == 0);

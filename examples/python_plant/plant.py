@@ -345,9 +345,13 @@ def read_scenario(path, steps, dt_s):
     actuator = plant.get("actuator", "avg")
     if isinstance(actuator, str):
         if actuator not in SERVO_PRESETS:
-            raise SystemExit(f"plant: [plant] actuator = \"{actuator}\": allowed \"0.0A\", \"2.5A\", \"avg\" or {{K, p, b, c}}")
+            raise ValueError(f"[plant] actuator = \"{actuator}\": allowed \"0.0A\", \"2.5A\", \"avg\" "
+                             "or a table {K, p, b, c}")
         servo = SERVO_PRESETS[actuator]
     else:
+        missing = [key for key in ("K", "p", "b", "c") if key not in actuator]
+        if missing:
+            raise ValueError(f"[plant] actuator: the table lacks {', '.join(missing)} (it needs K, p, b, c)")
         servo = tuple(float(actuator[key]) for key in ("K", "p", "b", "c"))
     warnings = []
     if plant.get("kind", "linear") != "linear":
@@ -382,7 +386,8 @@ def main():
         return 2
     if warnings:
         print("plant: warning: this example models only the linear servo with no specimen, noise or effects; "
-              f"the scenario sets {', '.join(warnings)}: its answers will differ from the built-in plant's", file=sys.stderr)
+              f"the scenario sets {', '.join(warnings)}: its answers will differ from the built-in plant's",
+              file=sys.stderr)
     try:
         lc, transport = open_lcm(a.lcm_url, a.transport)
     except (OSError, ValueError) as e:
