@@ -25,8 +25,10 @@ in Java): HELLO on REQUEST with the SHA-256 of the scenario file and our pid; st
 the clock's first desired_t or repair_t); measured_t 0 at rest; measured_t k from command_t k-1 and
 current_t k-1; the last four answers kept as bytes and re-sent unchanged when a repair_t wants
 them; what we lack asked for when the clock re-requests; BYE on every DONE, exit on CLOSE (or
-after a short linger). Exit codes: 0 done, 2 bad use, 3 the clock was silent too long, 4 someone
-else aborted the run, 5 we failed ourselves (after sending ABORT with the reason).
+after a short linger); our pid in HELLO when the URL has ttl=0 (the clock's host). Exit codes: 0
+done, 2 bad use, 3 the clock was silent too long (running: after sending ABORT), 4 someone else
+aborted the run, 5 we failed ourselves (after sending ABORT with the reason). The times come from
+the scenario's [lockstep] as rths's own participants use them (class Timing).
 """
 
 import argparse
@@ -46,6 +48,9 @@ except ImportError:
     tomllib = None
 
 HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, HERE)
+import lcm_udpm  # noqa: E402 (beside this file: our own udpm transport and URL parser)
+
 # The generated types: PYTHONPATH, else the default build tree of this checkout.
 sys.path.append(os.path.join(HERE, "..", "..", "build", "examples", "python_plant"))
 try:
@@ -67,7 +72,17 @@ SERVO_PRESETS = {
     "2.5A": (1.613e7, 134.2, 324.6, 1.211e5),  # Eq. 29
     "avg": (1.600e7, 151.7, 250.4, 1.061e5),  # Eq. 30
 }
-LINGER_S = 1.0  # after DONE: exit at most this long after, if CLOSE is lost [s]
+
+
+class Timing:
+    """The scenario's [lockstep] times, with rths's defaults (lib/lockstep/config.h) [s]."""
+
+    def __init__(self, lockstep):
+        stall_budget_s = float(lockstep.get("stall_budget_s", 10.0))
+        rerequest_s = float(lockstep.get("rerequest_ms", 100.0)) / 1000.0
+        self.handshake_s = float(lockstep.get("handshake_timeout_s", 20.0))  # no GO and a silent clock: give up
+        self.watchdog_s = stall_budget_s + 2.0  # running, and the clock silent this long: give up
+        self.linger_s = min(stall_budget_s, max(0.5, 10.0 * rerequest_s))  # after BYE, if CLOSE is lost
 
 
 # --- the model -------------------------------------------------------------------------------
@@ -143,11 +158,12 @@ def decode(msg_type, channel, data):
 # --- the participant -------------------------------------------------------------------------
 
 class PlantParticipant:
-    def __init__(self, lc, run_id, n_steps, dt_s, sha256, servo, heartbeat_s):
+    def __init__(self, lc, run_id, n_steps, dt_s, sha256, servo, heartbeat_s, announce_pid):
         self.lc = lc
         self.run_id, self.n_steps, self.dt_s, self.sha256 = run_id, n_steps, dt_s, sha256
         self.servo = servo
         self.heartbeat_s = heartbeat_s
+        self.announce_pid = announce_pid
         self.command = {}  # k -> u_k [mm], first copy wins
         self.current = {}  # k -> i_k [A]
         self.cache = [None] * 4  # bytes of measured_t k at slot k % 4
@@ -156,7 +172,7 @@ class PlantParticipant:
         self.running = False
         self.done = False
         self.exit_code = None
-        self.last_clock = time.monotonic()  # last sign of life from the clock
+        self.last_clock = time.monotonic()  # last sign of life from the clock (or our start)
         self.hello_sent = False
         for channel, handler in (("RTHS_HANDSHAKE", self.on_handshake), ("RTHS_DESIRED", self.on_desired),
                                  ("RTHS_COMMAND", self.on_command), ("RTHS_CURRENT", self.on_current),
@@ -169,21 +185,21 @@ class PlantParticipant:
         h.scenario_sha256, h.n_steps, h.dt_s, h.k = self.sha256, self.n_steps, self.dt_s, k
         h.n_roster, h.roster_names, h.roster_sha256 = 0, [], []
         h.reason = reason
-        # On the clock's host our pid lets the supervisor notice at once if we die; heartbeat_s > 0
-        # promises a HEARTBEAT every heartbeat_s (for a participant on another host).
-        h.pid = os.getpid() if phase == HELLO else 0
+        # On the clock's host (a ttl=0 URL) our pid lets the supervisor notice at once if we die;
+        # heartbeat_s > 0 promises a HEARTBEAT every heartbeat_s (for a participant on another host).
+        h.pid = os.getpid() if phase == HELLO and self.announce_pid else 0
         h.heartbeat_s = self.heartbeat_s if phase == HELLO else 0.0
         self.lc.publish("RTHS_HANDSHAKE", h.encode())
 
-    def abort(self, reason):
-        """Our own failure: ABORT (three copies, like the clock's) and exit 5."""
+    def abort(self, reason, exit_code=5):
+        """Our own failure (exit 5), or a silent clock (exit 3): ABORT in three copies, like the clock's."""
         print(f"plant: {reason}", file=sys.stderr)
         try:
             for _ in range(3):
                 self.handshake(ABORT, self.next - 1 if self.running or self.done else -1, f"plant: {reason}")
         except OSError as e:
             print(f"plant: cannot send ABORT: {e}", file=sys.stderr)
-        self.exit_code = 5
+        self.exit_code = exit_code
 
     def publish_measured(self, k, current_A):
         """measured_t k: the sensors at t_k (y = z[0]; no specimen: f = 0 kN), cached as bytes."""
@@ -246,14 +262,16 @@ class PlantParticipant:
 
     def on_command(self, channel, data):
         c = decode(command_t, channel, data)
-        if c.run_id == self.run_id and c.k >= self.next - 1:
-            self.command.setdefault(c.k, c.u_mm)
+        if c.run_id == self.run_id and c.k >= self.next - 1 and c.k not in self.command:
+            self.command[c.k] = c.u_mm  # the first copy of a new step: the clock asked for it
+            self.last_clock = time.monotonic()
         self.try_step()
 
     def on_current(self, channel, data):
         c = decode(current_t, channel, data)
-        if c.run_id == self.run_id and c.k >= self.next - 1:
-            self.current.setdefault(c.k, c.i_cmd_A)
+        if c.run_id == self.run_id and c.k >= self.next - 1 and c.k not in self.current:
+            self.current[c.k] = c.i_cmd_A
+            self.last_clock = time.monotonic()
         self.try_step()
 
     def on_repair(self, channel, data):
@@ -283,7 +301,7 @@ class PlantParticipant:
         out.want_k = [k for _, k in wants]
         self.lc.publish("RTHS_REPAIR", out.encode())
 
-    def run(self, watchdog_s):
+    def run(self, timing):
         """The event loop: messages, HEARTBEATs, the linger after DONE and the watchdog on the clock."""
         next_beat = None
         done_since = None
@@ -294,19 +312,27 @@ class PlantParticipant:
                 wait_s = min(wait_s, max(0.0, next_beat - now))
             self.lc.handle_timeout(int(wait_s * 1000))
             now = time.monotonic()
-            if self.heartbeat_s > 0 and self.hello_sent:
+            if self.heartbeat_s > 0 and self.hello_sent:  # from HELLO until we exit, lingering included
                 if next_beat is None:
                     next_beat = now + self.heartbeat_s
                 elif now >= next_beat:
                     self.handshake(HEARTBEAT, -1)
                     next_beat = max(next_beat + self.heartbeat_s, now)
-            if self.done and done_since is None:
-                done_since = now
-            if done_since is not None and now - done_since > LINGER_S:
-                self.exit_code = 0  # CLOSE was lost
-            if done_since is None and now - self.last_clock > watchdog_s:
-                print(f"plant: the clock ({CLOCK}) has been silent for {watchdog_s:g} s; giving up", file=sys.stderr)
-                self.exit_code = 3
+            silent_s = now - self.last_clock
+            if self.done:
+                if done_since is None:
+                    done_since = now
+                if now - done_since > timing.linger_s:
+                    self.exit_code = 0  # CLOSE was lost
+            elif not self.running:
+                # Before GO the clock sends REQUEST every 0.1 s and judges the handshake itself.
+                if silent_s > timing.handshake_s:
+                    print(f"plant: no GO from the clock ({CLOCK}): nothing heard from it for {timing.handshake_s:g} s; "
+                          "is it running on the same LCM URL and run id?", file=sys.stderr)
+                    self.exit_code = 3
+            elif silent_s > timing.watchdog_s:
+                self.abort(f"step {self.next - 1}: the clock ({CLOCK}) stopped answering: silent for {silent_s:.3g} s",
+                           exit_code=3)
         return self.exit_code
 
 
@@ -321,20 +347,18 @@ def open_lcm(url, which):
         except ImportError:
             if which == "lcm":
                 raise ValueError("--transport lcm: the lcm Python module is not installed")
-    sys.path.insert(0, HERE)
-    import lcm_udpm
     return lcm_udpm.LcmUdpm(url), "lcm_udpm.py (no lcm module)"
 
 
 def read_scenario(path, steps, dt_s):
-    """(sha256 hex, n_steps, dt_s, (K, p, b, c), watchdog_s, warnings) of the scenario file."""
+    """(sha256 hex, n_steps, dt_s, (K, p, b, c), Timing, warnings) of the scenario file."""
     with open(path, "rb") as f:
         raw = f.read()
     sha256 = hashlib.sha256(raw).hexdigest()  # of the file's bytes, as every participant hashes it
     if tomllib is None:
         if steps is None or dt_s is None:
             raise SystemExit("plant: this Python has no tomllib (3.11+) to read the scenario: give --steps and --dt")
-        return sha256, steps, dt_s, SERVO_PRESETS["avg"], 12.0, []
+        return sha256, steps, dt_s, SERVO_PRESETS["avg"], Timing({}), []
     doc = tomllib.loads(raw.decode("utf-8"))
     run = doc.get("run", {})
     if dt_s is None:
@@ -361,8 +385,7 @@ def read_scenario(path, steps, dt_s):
     for key in ("noise_y_mm_rms", "noise_f_kN_rms", "current_dynamics", "unmodelled", "effects", "physical"):
         if plant.get(key):
             warnings.append(f"[plant] {key}")
-    watchdog_s = float(doc.get("lockstep", {}).get("stall_budget_s", 10.0)) + 2.0
-    return sha256, steps, dt_s, servo, watchdog_s, warnings
+    return sha256, steps, dt_s, servo, Timing(doc.get("lockstep", {})), warnings
 
 
 def main():
@@ -380,7 +403,7 @@ def main():
     if a.heartbeat_s < 0:
         ap.error("--heartbeat-s must be >= 0")
     try:
-        sha256, n_steps, dt_s, (K, p, b, c), watchdog_s, warnings = read_scenario(a.scenario, a.steps, a.dt)
+        sha256, n_steps, dt_s, (K, p, b, c), timing, warnings = read_scenario(a.scenario, a.steps, a.dt)
     except (OSError, ValueError, KeyError) as e:
         print(f"plant: cannot read the scenario {a.scenario}: {e}", file=sys.stderr)
         return 2
@@ -389,19 +412,27 @@ def main():
               f"the scenario sets {', '.join(warnings)}: its answers will differ from the built-in plant's",
               file=sys.stderr)
     try:
+        _, _, ttl = lcm_udpm.parse_udpm_url(a.lcm_url)  # the same URL rules for either transport
         lc, transport = open_lcm(a.lcm_url, a.transport)
     except (OSError, ValueError) as e:
         print(f"plant: {e}", file=sys.stderr)
         return 2
+    # Our pid means something to the clock only on its host: ttl=0 guarantees that (as rths's own
+    # participants decide). From another host, --heartbeat-s is how the clock sees us alive.
+    announce_pid = ttl == 0
+    if not announce_pid and a.heartbeat_s == 0:
+        print("plant: note: with ttl > 0 the clock may be on another host; --heartbeat-s 0.2 lets it notice "
+              "at once if this plant dies", file=sys.stderr)
     print(f"plant: {n_steps} steps of {dt_s:g} s, G(s) = {K:g} / ((s + {p:g})(s^2 + {b:g} s + {c:g})), "
           f"over {transport}", file=sys.stderr)
-    plant = PlantParticipant(lc, a.run_id, n_steps, dt_s, sha256, LinearServo(K, p, b, c, dt_s), a.heartbeat_s)
+    plant = PlantParticipant(lc, a.run_id, n_steps, dt_s, sha256, LinearServo(K, p, b, c, dt_s), a.heartbeat_s,
+                             announce_pid)
 
     def on_term(signum, frame):
         raise KeyboardInterrupt
     signal.signal(signal.SIGTERM, on_term)
     try:
-        code = plant.run(watchdog_s)
+        code = plant.run(timing)
     except KeyboardInterrupt:
         plant.abort("stopped by a signal")
         code = plant.exit_code
