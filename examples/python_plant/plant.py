@@ -56,9 +56,10 @@ sys.path.append(os.path.join(HERE, "..", "..", "build", "examples", "python_plan
 try:
     from rths import command_t, current_t, desired_t, handshake_t, measured_t, repair_t
 except ImportError as e:
-    sys.exit(f"plant: cannot import the message types ({e}): generate them with\n"
-             f"  lcm-gen --python --ppath DIR lcmtypes/*.lcm\n"
-             f"and set PYTHONPATH=DIR (the build does this into build/examples/python_plant)")
+    print(f"plant: cannot import the message types ({e}): generate them with\n"
+          f"  lcm-gen --python --ppath DIR lcmtypes/*.lcm\n"
+          f"and set PYTHONPATH=DIR (the build does this into build/examples/python_plant)", file=sys.stderr)
+    sys.exit(2)
 
 # handshake_t.phase (lcmtypes/handshake_t.lcm)
 REQUEST, HELLO, GO, ABORT, DONE, BYE, CLOSE, HEARTBEAT = 1, 2, 3, 4, 5, 6, 7, 8
