@@ -203,7 +203,10 @@ class PlantParticipant:
         self.exit_code = exit_code
 
     def publish_measured(self, k, current_A):
-        """measured_t k: the sensors at t_k (y = z[0]; no specimen: f = 0 kN), cached as bytes."""
+        """measured_t k: the sensors at t_k (y = z[0]; no specimen: f = 0 kN), cached as bytes.
+        current_A is the commanded current held over the last step, i_{k-1} [A], as rths's linear
+        plant without a specimen reports it (checked with [semiactive] mode "passive_off" and
+        "passive_on")."""
         m = measured_t()
         m.run_id, m.k = self.run_id, k
         m.y_mm, m.f_kN, m.current_A = self.servo.y_mm(), 0.0, current_A
@@ -378,14 +381,20 @@ def read_scenario(path, steps, dt_s):
         if missing:
             raise ValueError(f"[plant] actuator: the table lacks {', '.join(missing)} (it needs K, p, b, c)")
         servo = tuple(float(actuator[key]) for key in ("K", "p", "b", "c"))
+    # What this example does not model (a scenario rths wrote back, RUN/scenario.toml, lists every
+    # key with its default: only values that change the answers count).
     warnings = []
     if plant.get("kind", "linear") != "linear":
         warnings.append(f"[plant] kind = \"{plant['kind']}\"")
     if plant.get("specimen", "mr_damper") != "none":
         warnings.append(f"[plant] specimen = \"{plant.get('specimen', 'mr_damper')}\"")
-    for key in ("noise_y_mm_rms", "noise_f_kN_rms", "current_dynamics", "unmodelled", "effects", "physical"):
-        if plant.get(key):
+    for key in ("noise_y_mm_rms", "noise_f_kN_rms"):
+        if plant.get(key, 0):
             warnings.append(f"[plant] {key}")
+    if any(plant.get("unmodelled", {}).values()):
+        warnings.append("[plant.unmodelled]")
+    if plant.get("effects"):
+        warnings.append("[plant.effects]")
     return sha256, steps, dt_s, servo, Timing(doc.get("lockstep", {})), warnings
 
 
