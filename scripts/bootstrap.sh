@@ -21,6 +21,7 @@ packages=(
   chromium                         # the test that screenshots a run report headless
   unzip                            # the test that lists the Java types jar
   bsdutils util-linux mount        # script (a terminal for cli_test), unshare and mount (reliability_test)
+  python3 python3-numpy            # examples/python_plant (a plant participant in Python) and its test
 )
 missing=()
 for p in "${packages[@]}"; do
