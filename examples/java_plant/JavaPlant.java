@@ -232,7 +232,8 @@ public class JavaPlant implements LCMSubscriber {
           if (!r.participant.equals("integrator")) return;
           lastClockMs = System.currentTimeMillis();
           if (!done) start();
-          if (next > r.k || next >= nSteps) return;
+          // The barrier of step k holds measured_t k+1: up to next = k+1 we may lack inputs it needs.
+          if (next > r.k + 1 || next >= nSteps) return;
           // The clock re-requests step k: say which inputs of measured_t next we lack.
           java.util.List<long[]> wants = new java.util.ArrayList<>();
           if (!command.containsKey(next - 1)) wants.add(new long[] {CH_COMMAND, next - 1});
