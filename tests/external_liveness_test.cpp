@@ -171,3 +171,25 @@ TEST_CASE("the README's external example with --set: the printed scenario is the
   // The original file's hash is refused, as the printed line warns.
   CHECK(ReadFile(dir / "run.out").find("give your participant this file") != std::string::npos);
 }
+
+TEST_CASE("rths replay --live plant --external plant: the user's plant, replayed, reproduces the recording") {
+  if (!UdpmAvailable()) FAIL("udpm cannot run on this host: " << rths::lockstep::CheckMulticastRoute());
+  const auto dir = TempDir("replay_external");
+  const fs::path scenario = WriteScenario(dir, "[run]\nname = \"replay_ext\"\nduration_s = 0.5\n");
+  const fs::path recorded = dir / "recorded";
+  fs::create_directories(recorded);
+  REQUIRE(RunMemq({rths::scenario::LoadScenario(scenario.string())}, recorded).code == 0);
+  fs::copy_file(scenario, recorded / "scenario.toml");
+  const PrintedRun run = StartExternalRun(
+      dir, recorded.string() + " --live plant --external plant --join-timeout-s 30 --out " + (dir / "out").string(),
+      "", "rths-replay");
+  CHECK(run.scenario == (recorded / "scenario.toml").string());
+  const std::string plant = "timeout 60 " + BuiltInPlant(run.url, run.run_id, run.scenario, dir) + " > " +
+                            (dir / "plant.out").string() + " 2>&1";
+  CHECK(std::system(plant.c_str()) == 0);
+  for (int i = 0; i < 600 && !Exited(run.pid); ++i) ::usleep(100000);
+  const auto j = nlohmann::json::parse(ReadFile(dir / "out" / "replay.json"));
+  CAPTURE(ReadFile(dir / "run.out"));
+  CHECK(j["identical"] == true);
+  CHECK(ReadFile(dir / "run.out").find("identical: the live outputs reproduce the recording") != std::string::npos);
+}

@@ -48,11 +48,12 @@ struct PrintedRun {
   pid_t pid = 0;  ///< of the backgrounded `rths run` (its shell's child)
 };
 
-/// Starts `rths run --external plant ARGS` in the background (prefix: e.g. "ip netns exec A")
-/// and waits for its printed block.
-inline PrintedRun StartExternalRun(const fs::path& dir, const std::string& run_args, const std::string& run_prefix = "") {
+/// Starts `rths run --external plant ARGS` (or `command` ARGS, e.g. "rths-replay") in the
+/// background (prefix: e.g. "ip netns exec A") and waits for its printed block.
+inline PrintedRun StartExternalRun(const fs::path& dir, const std::string& run_args, const std::string& run_prefix = "",
+                                   const std::string& command = "rths-run --external plant") {
   const fs::path printed = dir / "run.out";
-  const std::string start = run_prefix + " " + std::string(RTHS_BIN_DIR) + "/rths-run --external plant " + run_args +
+  const std::string start = run_prefix + " " + std::string(RTHS_BIN_DIR) + "/" + command + " " + run_args +
                             " > " + printed.string() + " 2>&1 & echo $! > " + (dir / "run.pid").string();
   REQUIRE(std::system(("(" + start + ")").c_str()) == 0);
   std::string text;

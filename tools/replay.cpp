@@ -20,6 +20,7 @@
 #include <fmt/core.h>
 
 #include "cli.h"
+#include "external_block.h"
 #include "core/error.h"
 #include "io/output_folder.h"
 #include "io/run_log.h"
@@ -38,8 +39,9 @@ volatile std::sig_atomic_t g_interrupted = 0;
 void OnSignal(int) { g_interrupted = 1; }
 
 struct Options {
-  std::string run_dir, live, out, scenario;
+  std::string run_dir, live, out, scenario, external, url;
   std::int64_t steps = 0;
+  double join_timeout_s = 120.0;
 };
 
 /// What the replay will be, checked before anything runs.
@@ -64,6 +66,14 @@ void AddOptions(CLI::App& app, Options* o) {
                  "here to see what it changes");
   app.add_option("--steps", o->steps, "replay only the first N steps (default: every complete step)")
       ->check(CLI::Range(std::int64_t{1}, std::int64_t{1} << 40));
+  app.add_option("--external", o->external,
+                 "ROLE[,ROLE...]: live roles the user runs (controller, plant, semiactive; also named by --live): "
+                 "the replay waits for them on udpm, bridged to the rest in this process (docs/replay.md)");
+  app.add_option("--join-timeout-s", o->join_timeout_s,
+                 "with --external: how long to wait for the external participants to say HELLO [s]")
+      ->check(CLI::Range(0.1, 86400.0))
+      ->capture_default_str();
+  app.add_option("--lcm-url", o->url, "with --external: the udpm URL (default: udpm://239.255.76.67:<a free port>?ttl=0)");
   app.footer("Exit codes: 0 the live outputs are identical to the recording; 1 they differ (first differing step, "
              "RMS and peak per field); 2 bad input (nothing ran); 3-7 the replay run failed (as rths run).");
 }
@@ -207,13 +217,24 @@ int main(int argc, char** argv) {
   sup::RunRequest request;
   request.scenario = r.s;
   request.scenario_path = r.scenario_path;
-  request.transport = "memq";
+  try {
+    request.external = rths::tools::ParseExternalRoles(o.external, o.join_timeout_s);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "rths replay: %s\n", e.what());
+    return rths::lockstep::kLogBadInput;
+  }
+  request.transport = request.external.roles.empty() ? "memq" : "mixed";
+  request.lcm_url = o.url;
+  request.bin_dir = fs::read_symlink("/proc/self/exe").parent_path();
   request.out = r.out;
   request.checks = false;  // Prepare did
   request.replay = sup::ReplaySource{&r.record, r.steps, r.live};
   request.summary_file = "";  // replay.json instead
   request.interrupted = &g_interrupted;
-  request.on_start = [&](const sup::RunPlan&) { PrintHeader(o, r); };
+  request.on_start = [&](const sup::RunPlan& plan) {
+    PrintHeader(o, r);
+    if (!request.external.roles.empty()) rths::tools::PrintExternal(request, plan, r.steps);
+  };
   sup::RunResult result;
   try {
     result = sup::Run(request);

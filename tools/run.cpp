@@ -18,6 +18,7 @@
 #include "scenario/scenario.h"
 #include "supervisor/run.h"
 #include "cli.h"
+#include "external_block.h"
 
 namespace fs = std::filesystem;
 namespace sup = rths::supervisor;
@@ -90,29 +91,14 @@ std::string TransportOf(const Options& o) {
   return o.external.empty() ? "udpm" : "mixed";
 }
 
-/// The roles of --external, checked; throws a message for the command line.
+/// The roles of --external, checked against the transport; throws a message for the command line.
 sup::ExternalRoles ExternalRolesOf(const Options& o) {
-  sup::ExternalRoles external;
-  std::stringstream ss(o.external);
-  for (std::string role; std::getline(ss, role, ',');) {
-    if (role.empty()) continue;
-    if (role == "integrator" || role == "logger") {
-      throw std::runtime_error(fmt::format(
-          "--external {}: the {} cannot be external ({}); allowed: controller, plant, semiactive", role, role,
-          role == "integrator" ? "it is the run's clock" : "the run's record must be written by rths"));
-    }
-    if (role != "controller" && role != "plant" && role != "semiactive") {
-      throw std::runtime_error(
-          fmt::format("--external {}: unknown role; allowed: controller, plant, semiactive", role));
-    }
-    if (!external.has(role)) external.roles.push_back(role);
-  }
+  sup::ExternalRoles external = rths::tools::ParseExternalRoles(o.external, o.join_timeout_s);
   if (!external.roles.empty()) {
     if (TransportOf(o) == "memq") {
       throw std::runtime_error("--external needs the mixed (default) or udpm transport (an external process cannot "
                                "join memq, which lives inside one process)");
     }
-    external.join_timeout_s = o.join_timeout_s;
   } else if (TransportOf(o) == "mixed") {
     throw std::runtime_error("--transport mixed needs --external ROLE (the participants to bridge to on udpm)");
   }
@@ -189,29 +175,6 @@ void PrintHeader(const Options& o, const sup::RunPlan& plan) {
   }
 }
 
-/// Always printed (also with --quiet): what the user's participants need to join.
-void PrintExternal(const sup::RunRequest& r, const sup::RunPlan& plan) {
-  const auto& s = plan.scenario;
-  const std::string& url = plan.url;
-  std::string roles;
-  for (const auto& role : r.external.roles) roles += (roles.empty() ? "" : ",") + role;
-  std::printf("external: %s\n", roles.c_str());
-  std::printf("  lcm_url          %s\n", url.c_str());
-  std::printf("  port             %s\n", url.substr(url.rfind(':') + 1, url.find('?') - url.rfind(':') - 1).c_str());
-  std::printf("  run_id           %lld\n", static_cast<long long>(plan.run_id));
-  std::printf("  scenario         %s%s\n", plan.scenario_path.c_str(),
-              r.scenario_header.empty() ? ""
-                                        : "  (the scenario with your --set overrides: give your participant this "
-                                          "file; its hash is not the original's)");
-  std::printf("  scenario_sha256  %s\n", s.sha256.c_str());
-  std::printf("  steps            %lld of %g s each\n", static_cast<long long>(s.steps()), s.run.dt_s);
-  std::printf("  built-in example %s/rths-%s --scenario %s --lcm-url '%s' --run-id %lld\n", r.bin_dir.c_str(),
-              r.external.roles.front().c_str(), plan.scenario_path.c_str(), url.c_str(),
-              static_cast<long long>(plan.run_id));
-  std::printf("waiting up to %g s for %s to say HELLO (docs/participant.md)\n", r.external.join_timeout_s,
-              roles.c_str());
-}
-
 /// The report of what was logged (also of a run that stopped: its complete steps). A report that
 /// cannot be made is a warning; the run's exit code stays the run's.
 void WriteReport(const fs::path& out) {
@@ -278,7 +241,7 @@ int main(int argc, char** argv) {
   std::signal(SIGTERM, OnSignal);
   request.on_start = [&](const sup::RunPlan& plan) {
     if (!o.quiet) PrintHeader(o, plan);
-    if (!request.external.roles.empty()) PrintExternal(request, plan);
+    if (!request.external.roles.empty()) rths::tools::PrintExternal(request, plan, plan.scenario.steps());
     std::fflush(stdout);
   };
   try {

@@ -1,5 +1,7 @@
 #include "participants/replay.h"
 
+#include "lockstep/bridge.h"
+
 #include <algorithm>
 #include <memory>
 
@@ -70,13 +72,18 @@ const char* AnswerChannelOf(std::string_view role) {
 
 std::vector<Outcome> RunReplay(const scenario::Scenario& s, const io::RunLog& record, std::int64_t steps,
                                const std::vector<std::string>& live, std::int64_t run_id, const std::string& out_dir,
-                               const volatile std::sig_atomic_t* stop) {
+                               const volatile std::sig_atomic_t* stop, const std::vector<std::string>& external,
+                               const std::string& udpm_url) {
   for (const auto& role : live) AnswerChannelOf(role);  // throws for an unknown role
+  for (const auto& role : external) {
+    if (std::find(live.begin(), live.end(), role) == live.end()) {
+      throw Error("--external", fmt::format("{} is not live: an external role must also be named by --live", role));
+    }
+  }
   if (steps <= 0 || steps > record.CompleteSteps()) {
     throw Error(record.source, fmt::format("cannot replay {} steps: the log holds {} complete steps", steps,
                                            record.CompleteSteps()));
   }
-  lockstep::InprocChannels bus;
   lockstep::RunIdentity id = IdentityOf(s, run_id);
   id.n_steps = steps;
   const lockstep::LockstepConfig config = LockstepOf(s);
@@ -91,8 +98,17 @@ std::vector<Outcome> RunReplay(const scenario::Scenario& s, const io::RunLog& re
     }
   }
   wiring = lockstep::Wiring::Resolve(variants);
+  std::unique_ptr<lockstep::Channels> bus;
+  if (external.empty()) {
+    bus = std::make_unique<lockstep::InprocChannels>();
+  } else {
+    auto bridge = std::make_unique<lockstep::BridgedChannels>(udpm_url, external, wiring);
+    if (!bridge->good()) throw Error("", bridge->error());
+    bus = std::move(bridge);
+  }
   std::vector<std::unique_ptr<lockstep::Participant>> owned;
   for (std::string_view role : lockstep::kBuildOrder) {
+    if (std::find(external.begin(), external.end(), role) != external.end()) continue;  // the user's
     if (IsLive(live, role)) {
       owned.push_back(MakeParticipant(role, s, id, nullptr, out_dir, {}, wiring));
     } else if (role == "integrator") {
@@ -107,8 +123,8 @@ std::vector<Outcome> RunReplay(const scenario::Scenario& s, const io::RunLog& re
   }
   std::vector<lockstep::Participant*> group;
   for (auto& p : owned) group.push_back(p.get());
-  for (auto* p : group) p->Attach(&bus);
-  lockstep::RunLoop(&bus, group, stop);
+  for (auto* p : group) p->Attach(bus.get());
+  lockstep::RunLoop(bus.get(), group, stop);
   std::vector<Outcome> outcomes;
   for (const auto* p : group) outcomes.push_back(OutcomeOf(*p));
   return outcomes;

@@ -22,12 +22,15 @@ namespace rths::participants {
 /// live in a replay (the logger always is).
 const char* AnswerChannelOf(std::string_view role);
 
-/// Replays steps 0..steps-1 of `record` (steps <= record.CompleteSteps()) in this process on
-/// memq://, with the roles in `live` built from `s`, the others fed from the record; the new log
-/// goes to `out_dir`. Throws rths::Error (unknown role, a recorded step missing, unwritable
-/// output).
+/// Replays steps 0..steps-1 of `record` (steps <= record.CompleteSteps()) in this process on the
+/// in-process queue, with the roles in `live` built from `s`, the others fed from the record; the
+/// new log goes to `out_dir`. The live roles in `external` are not built: the user runs them, and
+/// the queue is bridged to them on `udpm_url` (lockstep/bridge.h). Throws rths::Error (unknown
+/// role, an external role that is not live, a recorded step missing, unwritable output, a bridge
+/// that cannot open the URL).
 std::vector<Outcome> RunReplay(const scenario::Scenario& s, const io::RunLog& record, std::int64_t steps,
                                const std::vector<std::string>& live, std::int64_t run_id, const std::string& out_dir,
-                               const volatile std::sig_atomic_t* stop = nullptr);
+                               const volatile std::sig_atomic_t* stop = nullptr,
+                               const std::vector<std::string>& external = {}, const std::string& udpm_url = "");
 
 }  // namespace rths::participants

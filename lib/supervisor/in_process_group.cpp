@@ -9,16 +9,18 @@ std::vector<participants::Outcome> RunInProcessGroup(const scenario::Scenario& s
                                                      std::int64_t run_id, const std::string& out_dir,
                                                      const volatile std::sig_atomic_t* stop,
                                                      lockstep::RealtimeSetup* setup) {
-  if (replay) return participants::RunReplay(s, *replay->record, replay->steps, replay->live, run_id, out_dir, stop);
+  const bool bridged = external && !external->roles.empty();
+  scenario::Scenario joined = s;  // how long the user's participants may take to say HELLO
+  if (bridged && external->join_timeout_s > 0) joined.lockstep.handshake_timeout_s = external->join_timeout_s;
+  if (replay) {
+    return participants::RunReplay(joined, *replay->record, replay->steps, replay->live, run_id, out_dir, stop,
+                                   bridged ? external->roles : std::vector<std::string>{}, udpm_url);
+  }
   if (s.realtime.enabled) {
     // Every built-in participant runs on this thread: the set-up is this process's.
     *setup = lockstep::EnterRealtime(s.realtime);
   }
-  if (external && !external->roles.empty()) {
-    scenario::Scenario mixed = s;
-    if (external->join_timeout_s > 0) mixed.lockstep.handshake_timeout_s = external->join_timeout_s;
-    return participants::RunMixedGroup(mixed, external->roles, udpm_url, run_id, out_dir, stop);
-  }
+  if (bridged) return participants::RunMixedGroup(joined, external->roles, udpm_url, run_id, out_dir, stop);
   return participants::RunGroupInProcess({s}, run_id, out_dir, {}, stop);
 }
 

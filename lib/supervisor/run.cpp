@@ -48,7 +48,10 @@ RunPlan Plan(const RunRequest& r) {
   plan.url = "memq://";
   plan.run_id = r.run_id > 0 ? r.run_id : lockstep::NewRunId();
   plan.out = r.out;
-  if (!r.checks) return plan;
+  if (!r.checks) {
+    if (r.transport != "memq") plan.url = UdpmUrl(r);
+    return plan;
+  }
   const scenario::Scenario& s = r.scenario;
   participants::CheckBuildable(s);
   if (r.transport != "udpm" && lockstep::EndsProcess(s.faults.process_kind) &&
