@@ -313,23 +313,8 @@ void ClockParticipant::Poll(SteadyClock::time_point now, bool idle) {
       return;
     }
   }
-  if (k_ < 0) {  // handshake
-    if (idle && Seconds(start_, now) > timing_.handshake_timeout_s) {
-      std::vector<std::string> missing;
-      for (int i = 0; i < kRosterSize; ++i) {
-        if (!hello_[i]) missing.emplace_back(kRoster[i]);
-      }
-      Fail(kExitLockstep,
-           fmt::format("no HELLO from {} within {:g} s: not started, crashed, or on another LCM "
-                       "URL / run id",
-                       JoinNames(missing), timing_.handshake_timeout_s),
-           true, -1, missing.size() == 1 ? missing.front() : JoinNames(missing));
-      return;
-    }
-    if (Seconds(last_send_, now) >= kHandshakeRepeatS) {
-      SendHandshake(kRequest);
-      last_send_ = now;
-    }
+  if (k_ < 0) {
+    PollHandshake(now, idle);
     return;
   }
   if (release_ != SteadyClock::time_point::max()) {  // paced: step k_ is complete, k_+1 not yet due
@@ -340,22 +325,7 @@ void ClockParticipant::Poll(SteadyClock::time_point now, bool idle) {
   }
   if (Stalled(k_)) return;
   if (done_) {
-    if (idle && Seconds(step_since_, now) > timing_.stall_budget_s) {
-      std::vector<std::string> missing;
-      for (int i = 0; i < kRosterSize; ++i) {
-        if (!bye_[i]) missing.emplace_back(kRoster[i]);
-      }
-      std::fprintf(stderr, "%s: every step committed, but no BYE from %s within %g s\n", name_.c_str(),
-                   JoinNames(missing).c_str(), timing_.stall_budget_s);
-      SendHandshake(kClose, id_.n_steps);
-      Finish();
-      return;
-    }
-    if (Seconds(last_send_, now) >= timing_.RerequestAfterS(rerequests_ + 1, typical_step_s_)) {
-      ++rerequests_;
-      last_send_ = now;
-      SendHandshake(kDone, id_.n_steps);
-    }
+    PollDone(now, idle);
     return;
   }
   if (idle && Seconds(step_since_, now) > timing_.stall_budget_s) {
@@ -375,6 +345,44 @@ void ClockParticipant::Poll(SteadyClock::time_point now, bool idle) {
     if (owner >= 0) listed[owner] = true;
   }
   SendRepair(k_, wants);
+}
+
+void ClockParticipant::PollHandshake(SteadyClock::time_point now, bool idle) {
+  if (idle && Seconds(start_, now) > timing_.handshake_timeout_s) {
+    std::vector<std::string> missing;
+    for (int i = 0; i < kRosterSize; ++i) {
+      if (!hello_[i]) missing.emplace_back(kRoster[i]);
+    }
+    Fail(kExitLockstep,
+         fmt::format("no HELLO from {} within {:g} s: not started, crashed, or on another LCM "
+                     "URL / run id",
+                     JoinNames(missing), timing_.handshake_timeout_s),
+         true, -1, missing.size() == 1 ? missing.front() : JoinNames(missing));
+    return;
+  }
+  if (Seconds(last_send_, now) >= kHandshakeRepeatS) {
+    SendHandshake(kRequest);
+    last_send_ = now;
+  }
+}
+
+void ClockParticipant::PollDone(SteadyClock::time_point now, bool idle) {
+  if (idle && Seconds(step_since_, now) > timing_.stall_budget_s) {
+    std::vector<std::string> missing;
+    for (int i = 0; i < kRosterSize; ++i) {
+      if (!bye_[i]) missing.emplace_back(kRoster[i]);
+    }
+    std::fprintf(stderr, "%s: every step committed, but no BYE from %s within %g s\n", name_.c_str(),
+                 JoinNames(missing).c_str(), timing_.stall_budget_s);
+    SendHandshake(kClose, id_.n_steps);
+    Finish();
+    return;
+  }
+  if (Seconds(last_send_, now) >= timing_.RerequestAfterS(rerequests_ + 1, typical_step_s_)) {
+    ++rerequests_;
+    last_send_ = now;
+    SendHandshake(kDone, id_.n_steps);
+  }
 }
 
 }  // namespace rths::lockstep

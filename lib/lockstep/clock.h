@@ -78,6 +78,10 @@ class ClockParticipant : public Participant {
   void SendGo();
   /// Fails the run: step k_ has been incomplete for the whole stall budget.
   void FailStalled(SteadyClock::time_point now);
+  /// Before GO: REQUEST every 0.1 s; names who did not say HELLO after the handshake timeout.
+  void PollHandshake(SteadyClock::time_point now, bool idle);
+  /// After DONE: DONE again until every BYE is in, then CLOSE (also after the stall budget).
+  void PollDone(SteadyClock::time_point now, bool idle);
   /// Fails the run: a watched participant has gone (PeerWatch).
   void FailLost(const PeerLoss& loss);
   /// Also counts, per participant, the answers the barrier received and their copies.
