@@ -122,7 +122,7 @@ function code = octave_plant(lcm_url, run_id, scenario_path, varargin)
   watchdog_s = sc.stall_budget_s + 2;               % give up on a silent clock (docs/participant.md)
   linger_s = max(0.5, 10 * sc.rerequest_ms / 1000); % wait this long for CLOSE after BYE
   P.t0 = tic;
-  P.last_clock_s = 0;
+  P.last_heard_s = 0;
   P.next_beat_s = inf;                              % first HEARTBEAT: heartbeat_s after the first HELLO
   done_since_s = -1;
   wait_ms = int64(10);
@@ -141,7 +141,7 @@ function code = octave_plant(lcm_url, run_id, scenario_path, varargin)
       if P.code < 0 && done_since_s >= 0 && now_s - done_since_s > linger_s
         P.code = 0;                                 % CLOSE was lost: the run is over anyway
       end
-      if P.code < 0 && done_since_s < 0 && now_s - P.last_clock_s > watchdog_s
+      if P.code < 0 && done_since_s < 0 && now_s - P.last_heard_s > watchdog_s
         fprintf(2, 'octave_plant: the clock (integrator) has been silent for %.0f s; giving up\n', watchdog_s);
         P.code = 3;
       end
@@ -166,23 +166,27 @@ end
 function P = on_message(P, channel, data)
 % One message from the aggregator. `data` is the LCM payload (int8 column: fingerprint, then the
 % fields; every rths type starts with int64 run_id, so bytes 9..16 are its run id, big-endian).
-  if numel(data) < 16 || ~isequal(data(9:16), P.rid_bytes)
-    return;                                          % another run's message
+  if numel(data) < 16 || ~all(data(9:16) == P.rid_bytes)
+    return;                                          % another run's message (all(==): isequal costs 10x)
   end
   switch channel
     case 'RTHS_COMMAND'
+      % The step messages also show that the clock is alive: command_t and current_t k exist only
+      % because it published desired_t k (we stop listening to RTHS_DESIRED once we run).
+      P.last_heard_s = toc(P.t0);
       c = javaObject('rths.command_t', data);
       P = hold_input(P, 'cmd', c.k, c.u_mm);
       P = try_step(P);
     case 'RTHS_CURRENT'
+      P.last_heard_s = toc(P.t0);
       c = javaObject('rths.current_t', data);
       P = hold_input(P, 'cur', c.k, c.i_cmd_A);
       P = try_step(P);
     case 'RTHS_HANDSHAKE'
       P = on_handshake(P, javaObject('rths.handshake_t', data));
     case 'RTHS_DESIRED'
-      P.last_clock_s = toc(P.t0);                    % the clock is stepping: GO was lost
-      if ~P.done, P = start(P); end
+      P.last_heard_s = toc(P.t0);
+      if ~P.done, P = start(P); end                   % the clock is stepping: GO was lost
     case 'RTHS_REPAIR'
       P = on_repair(P, javaObject('rths.repair_t', data));
   end
@@ -246,7 +250,7 @@ function P = on_handshake(P, h)
     return;
   end
   if ~strcmp(who, 'integrator'), return; end
-  P.last_clock_s = toc(P.t0);
+  P.last_heard_s = toc(P.t0);
   switch phase
     case 1                                            % REQUEST -> HELLO
       if ~P.running && ~P.done
@@ -283,7 +287,7 @@ function P = on_repair(P, r)
     end
   end
   if ~strcmp(who, 'integrator'), return; end
-  P.last_clock_s = toc(P.t0);
+  P.last_heard_s = toc(P.t0);
   if ~P.done, P = start(P); end
   % The clock re-requests step k; its barrier holds measured_t k and k+1 (docs/lockstep.md,
   % "Repair", 3). If the next measured_t we owe is one of those, say which of its inputs we lack.
