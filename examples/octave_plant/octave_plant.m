@@ -44,7 +44,7 @@ function code = octave_plant(lcm_url, run_id, scenario_path, varargin)
     return;
   end
   here = fileparts(mfilename('fullpath'));
-  opt = struct('heartbeat_s', 0, 'lcm_jar', '/usr/share/java/lcm.jar', ...
+  opt = struct('heartbeat_s', 0, 'codec', 'java', 'lcm_jar', '/usr/share/java/lcm.jar', ...
                'types_jar', fullfile(here, '..', '..', 'build', 'rths_lcmtypes.jar'));
   for i = 1:2:numel(varargin)
     name = lower(varargin{i});
@@ -53,6 +53,10 @@ function code = octave_plant(lcm_url, run_id, scenario_path, varargin)
       return;
     end
     opt.(name) = varargin{i + 1};
+  end
+  if ~any(strcmp(opt.codec, {'java', 'octave'}))
+    fprintf(2, 'octave_plant: codec must be ''java'' or ''octave'' (got "%s")\n', opt.codec);
+    return;
   end
   [rid, ok] = parse_run_id(run_id);
   if ~ok
@@ -107,6 +111,22 @@ function code = octave_plant(lcm_url, run_id, scenario_path, varargin)
   P.meas = javaObject('rths.measured_t');           % reused: filled and encoded once per step
   P.meas.run_id = rid;
   P.meas.f_kN = 0;                                  % no specimen: the load cell reads 0 kN
+  % The per-step messages (command_t, current_t in, measured_t out) through the lcm-gen classes
+  % ('java', as MATLAB users do), or read and written by byte position ('octave', faster).
+  P.java_codec = ~strcmp(opt.codec, 'octave');
+  P.meas.k = int64(0);  P.meas.y_mm = 0;  P.meas.current_A = 0;
+  head = encode(P, P.meas);
+  P.meas_head = head(1:16)';                        % fingerprint + run_id of measured_t
+  P.fp_command = fingerprint(P, 'rths.command_t');
+  P.fp_current = fingerprint(P, 'rths.current_t');
+  if ~P.java_codec && ~codec_matches(P)
+    why = 'the ''octave'' codec does not match this rths_lcmtypes.jar (use ''codec'', ''java'')';
+    fprintf(2, 'octave_plant: %s\n', why);
+    send_handshake(P, 4, -1, ['plant (octave_plant): ', why]);
+    P.lc.close();
+    code = 5;
+    return;
+  end
   P.next = 0;                                       % the next measured_t k to publish
   P.running = false;
   P.done = false;
@@ -174,32 +194,63 @@ function P = on_message(P, channel, data)
       % The step messages also show that the clock is alive: command_t and current_t k exist only
       % because it published desired_t k (we stop listening to RTHS_DESIRED once we run).
       P.last_heard_s = toc(P.t0);
-      c = javaObject('rths.command_t', data);
-      P = hold_input(P, 'cmd', c.k, c.u_mm);
-      P = try_step(P);
+      if P.java_codec
+        try
+          c = javaObject('rths.command_t', data);
+        catch
+          return;                                       % not our version of command_t: ignore
+        end
+        k = c.k;
+        u_mm = c.u_mm;
+      else
+        if ~all(data(1:8) == P.fp_command), return; end     % not our version of command_t
+        k = double(typecast(data(24:-1:17), 'int64'));    % bytes 17-24: k (big-endian)
+        u_mm = typecast(data(32:-1:25), 'double');        % bytes 25-32: u_mm
+      end
+      s = mod(k, 4) + 1;
+      if k >= P.next - 1 && k <= P.next + 2 && P.cmd_k(s) ~= k   % first copy wins; old steps ignored
+        P.cmd_k(s) = k;
+        P.cmd_u_mm(s) = u_mm;
+        P = try_step(P);
+      end
     case 'RTHS_CURRENT'
       P.last_heard_s = toc(P.t0);
-      c = javaObject('rths.current_t', data);
-      P = hold_input(P, 'cur', c.k, c.i_cmd_A);
-      P = try_step(P);
+      if P.java_codec
+        try
+          c = javaObject('rths.current_t', data);
+        catch
+          return;                                       % not our version of current_t: ignore
+        end
+        k = c.k;
+        i_A = c.i_cmd_A;
+      else
+        if ~all(data(1:8) == P.fp_current), return; end
+        k = double(typecast(data(24:-1:17), 'int64'));    % bytes 17-24: k
+        i_A = typecast(data(32:-1:25), 'double');         % bytes 25-32: i_cmd_A
+      end
+      s = mod(k, 4) + 1;
+      if k >= P.next - 1 && k <= P.next + 2 && P.cur_k(s) ~= k
+        P.cur_k(s) = k;
+        P.cur_i_A(s) = i_A;
+        P = try_step(P);
+      end
     case 'RTHS_HANDSHAKE'
-      P = on_handshake(P, javaObject('rths.handshake_t', data));
+      try
+        h = javaObject('rths.handshake_t', data);
+      catch
+        return;                                         % a bad message: ignore it
+      end
+      P = on_handshake(P, h);
     case 'RTHS_DESIRED'
       P.last_heard_s = toc(P.t0);
       if ~P.done, P = start(P); end                   % the clock is stepping: GO was lost
     case 'RTHS_REPAIR'
-      P = on_repair(P, javaObject('rths.repair_t', data));
-  end
-end
-
-function P = hold_input(P, which, k, value)
-% Keeps the first copy of command_t / current_t k; ignores duplicates and steps left behind.
-  if k < P.next - 1 || k > P.next + 2, return; end
-  s = mod(k, 4) + 1;
-  if strcmp(which, 'cmd')
-    if P.cmd_k(s) ~= k, P.cmd_k(s) = k; P.cmd_u_mm(s) = value; end
-  else
-    if P.cur_k(s) ~= k, P.cur_k(s) = k; P.cur_i_A(s) = value; end
+      try
+        r = javaObject('rths.repair_t', data);
+      catch
+        return;
+      end
+      P = on_repair(P, r);
   end
 end
 
@@ -230,14 +281,47 @@ end
 function P = publish_measured(P, k, current_A)
 % measured_t k: y_k = z(1) [mm], f_k = 0 [kN], the damper current held over the step [A]. Encoded
 % once; the bytes are cached for repairs and published.
-  P.meas.k = int64(k);
-  P.meas.y_mm = P.z(1);
-  P.meas.current_A = current_A;
-  bytes = encode(P, P.meas);
+  if P.java_codec
+    P.meas.k = int64(k);
+    P.meas.y_mm = P.z(1);
+    P.meas.current_A = current_A;
+    bytes = encode(P, P.meas);
+  else
+    bytes = encode_measured(P.meas_head, k, P.z(1), current_A);
+  end
   s = mod(k, 4) + 1;
   P.cache{s} = bytes;
   P.cache_k(s) = k;
-  send(P, 'RTHS_MEASURED', bytes);
+  P.lc.publish('RTHS_MEASURED', bytes, int32(0), int32(numel(bytes)));
+end
+
+function bytes = encode_measured(head, k, y_mm, current_A)
+% The 'octave' codec: measured_t's wire format written directly (lcmtypes/measured_t.lcm): head =
+% fingerprint and run_id (16 bytes, taken from a Java encoding), then k (int64), y_mm, f_kN = 0,
+% current_A (doubles), each big-endian. Checked against msg.encode() at start (codec_matches).
+  % (x86/ARM hosts are little-endian: reversing the bytes of typecast() gives big-endian; reversing
+  % the 24 bytes of [current_A, f, y_mm] gives y_mm, f, current_A each big-endian. swapbytes() would
+  % do the same, but costs 60 us a call in Octave.)
+  kb = typecast(int64(k), 'int8');
+  vb = typecast([current_A, 0, y_mm], 'int8');
+  bytes = [head, kb(8:-1:1), vb(24:-1:1)];
+end
+
+function ok = codec_matches(P)
+% The 'octave' codec reads and writes bytes by position: prove it against the lcm-gen classes in
+% use (a changed type, or a big-endian host, stops here instead of corrupting the run).
+  P.meas.k = int64(123456789);  P.meas.y_mm = pi;  P.meas.current_A = 0.5;
+  ok = isequal(encode(P, P.meas)', encode_measured(P.meas_head, 123456789, pi, 0.5));
+  c = javaObject('rths.command_t');
+  c.run_id = P.run_id;  c.k = int64(987654321);  c.u_mm = -exp(1);  c.n_adapt = int32(0);
+  b = encode(P, c);
+  ok = ok && all(b(1:8) == P.fp_command) && typecast(b(24:-1:17), 'int64') == 987654321 && ...
+       typecast(b(32:-1:25), 'double') == -exp(1);
+  c = javaObject('rths.current_t');
+  c.run_id = P.run_id;  c.k = int64(55);  c.i_cmd_A = 1.25;
+  b = encode(P, c);
+  ok = ok && all(b(1:8) == P.fp_current) && typecast(b(24:-1:17), 'int64') == 55 && ...
+       typecast(b(32:-1:25), 'double') == 1.25;
 end
 
 function P = on_handshake(P, h)
@@ -339,6 +423,14 @@ function send_handshake(P, phase, k, reason)
   for i = 1:copies
     send(P, 'RTHS_HANDSHAKE', bytes);
   end
+end
+
+function fp = fingerprint(P, class_name)
+% The 8-byte LCM fingerprint that starts every encoded message of this type.
+  m = javaObject(class_name);
+  m.run_id = int64(0);
+  b = encode(P, m);
+  fp = b(1:8);
 end
 
 function bytes = encode(P, msg)
