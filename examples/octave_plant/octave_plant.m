@@ -2,7 +2,7 @@ function code = octave_plant(lcm_url, run_id, scenario_path, varargin)
 % OCTAVE_PLANT  An rths plant participant in GNU Octave (or MATLAB), over LCM's Java classes.
 %
 %   code = octave_plant(lcm_url, run_id, scenario_path)
-%   code = octave_plant(lcm_url, run_id, scenario_path, 'heartbeat_s', 0.5, ...
+%   code = octave_plant(lcm_url, run_id, scenario_path, 'heartbeat_s', 0.5, 'codec', 'octave', ...
 %                       'types_jar', 'build/rths_lcmtypes.jar', 'lcm_jar', '/usr/share/java/lcm.jar')
 %
 % Plays the role "plant" of docs/participant.md: the linear servohydraulic actuator of Phillips &
@@ -14,6 +14,12 @@ function code = octave_plant(lcm_url, run_id, scenario_path, varargin)
 %   run_id         the printed run id, AS A STRING (a 63-bit integer does not fit in a double), or int64
 %   scenario_path  the printed scenario file: its SHA-256 goes into HELLO, and [run] duration_s,
 %                  [run] dt_s, [plant] and [lockstep] are read from it
+%   'heartbeat_s'  send a HEARTBEAT (handshake phase 8) every S seconds from HELLO on (default 0: none)
+%   'codec'        'java' (default): every message through the lcm-gen classes, as MATLAB users do;
+%                  'octave': command_t, current_t and measured_t read and written by byte position
+%                  (checked against the classes at start), about 15 % less time per step
+%   'types_jar'    the lcm-gen --java types (default: build/rths_lcmtypes.jar of this source tree)
+%   'lcm_jar'      LCM's Java classes (default: Debian's liblcm-java, /usr/share/java/lcm.jar)
 %
 % Returns the exit code of docs/lockstep.md: 0 the run completed; 2 bad arguments or a scenario this
 % plant does not implement (it says so in an ABORT); 3 the clock fell silent; 4 another participant
@@ -36,11 +42,14 @@ function code = octave_plant(lcm_url, run_id, scenario_path, varargin)
 %    an int64, which Octave hands to Java exactly.
 %  - Pass Java int/long arguments as int32/int64: with doubles Octave's method lookup is ~5x slower.
 %  - In Octave, `lcm.lcm.LCM(...)` would call Octave's lcm() (least common multiple): use javaObject.
+%  - Octave cannot set a Java byte field (handshake_t.phase), and hands a 1-element vector to a Java
+%    array field as an empty array (repair_t.want_*): see send_handshake and on_repair.
+%  - isequal() and swapbytes() are m-files in Octave, 10x dearer than all(a == b) and indexing.
 
   code = 2;
   if nargin < 3
     fprintf(2, ['usage: octave_plant(lcm_url, run_id, scenario_path [, ''heartbeat_s'', S, ', ...
-                '''types_jar'', JAR, ''lcm_jar'', JAR])\n']);
+                '''codec'', ''java''|''octave'', ''types_jar'', JAR, ''lcm_jar'', JAR])\n']);
     return;
   end
   here = fileparts(mfilename('fullpath'));
