@@ -159,7 +159,67 @@ function code = octave_plant(lcm_url, run_id, scenario_path, varargin)
     while P.code < 0
       msg = P.agg.getNextMessage(wait_ms);          % [] after wait_ms without a message
       if ~isempty(msg)
-        P = on_message(P, char(msg.channel), msg.data);
+        channel = char(msg.channel);
+        data = msg.data;                            % int8 column: the fingerprint, then the fields
+        % Every rths type starts with int64 run_id: bytes 9..16 (big-endian) tell our run's
+        % messages from others'. (all(a == b): isequal() is an m-file, 10x dearer.)
+        if numel(data) >= 16 && all(data(9:16) == P.rid_bytes)
+          % command_t and current_t, the two messages of every step, are handled here rather than
+          % in a function: in Octave a function call that updates P costs 10-20 us. They also show
+          % that the clock is alive: command_t and current_t k exist only because it published
+          % desired_t k (we stop listening to RTHS_DESIRED once we run).
+          switch channel
+            case 'RTHS_COMMAND'
+              P.last_heard_s = toc(P.t0);
+              k = -Inf;                             % stays so for a message that is not ours
+              if P.java_codec
+                try
+                  c = javaObject('rths.command_t', data);
+                  k = c.k;
+                  u_mm = c.u_mm;
+                catch                               % another version of command_t: ignored
+                end
+              elseif all(data(1:8) == P.fp_command)
+                k = double(typecast(data(24:-1:17), 'int64'));  % bytes 17-24: k (big-endian)
+                u_mm = typecast(data(32:-1:25), 'double');      % bytes 25-32: u_mm
+              end
+              s = mod(k, 4) + 1;
+              if k >= P.next - 1 && k <= P.next + 2 && P.cmd_k(s) ~= k  % first copy wins; old steps ignored
+                P.cmd_k(s) = k;
+                P.cmd_u_mm(s) = u_mm;
+              end
+            case 'RTHS_CURRENT'
+              P.last_heard_s = toc(P.t0);
+              k = -Inf;
+              if P.java_codec
+                try
+                  c = javaObject('rths.current_t', data);
+                  k = c.k;
+                  i_A = c.i_cmd_A;
+                catch
+                end
+              elseif all(data(1:8) == P.fp_current)
+                k = double(typecast(data(24:-1:17), 'int64'));  % bytes 17-24: k
+                i_A = typecast(data(32:-1:25), 'double');       % bytes 25-32: i_cmd_A
+              end
+              s = mod(k, 4) + 1;
+              if k >= P.next - 1 && k <= P.next + 2 && P.cur_k(s) ~= k
+                P.cur_k(s) = k;
+                P.cur_i_A(s) = i_A;
+              end
+            otherwise
+              P = on_message(P, channel, data);     % RTHS_HANDSHAKE, RTHS_DESIRED, RTHS_REPAIR
+          end
+          % measured_t next from command_t next-1 (u, mm) and current_t next-1 (i, A), held over
+          % [t_{next-1}, t_next) (zero-order hold), as soon as both are in.
+          while P.running && P.next < P.n_steps
+            s = mod(P.next - 1, 4) + 1;
+            if P.cmd_k(s) ~= P.next - 1 || P.cur_k(s) ~= P.next - 1, break; end
+            P.z = P.Phi * P.z + P.Gamma * P.cmd_u_mm(s);  % Eq. 30, ZOH
+            P = publish_measured(P, P.next, P.cur_i_A(s));
+            P.next = P.next + 1;
+          end
+        end
       end
       now_s = toc(P.t0);
       if now_s >= P.next_beat_s
@@ -193,56 +253,8 @@ end
 % Messages
 
 function P = on_message(P, channel, data)
-% One message from the aggregator. `data` is the LCM payload (int8 column: fingerprint, then the
-% fields; every rths type starts with int64 run_id, so bytes 9..16 are its run id, big-endian).
-  if numel(data) < 16 || ~all(data(9:16) == P.rid_bytes)
-    return;                                          % another run's message (all(==): isequal costs 10x)
-  end
+% A message of our run on the other channels (the step messages are handled in the main loop).
   switch channel
-    case 'RTHS_COMMAND'
-      % The step messages also show that the clock is alive: command_t and current_t k exist only
-      % because it published desired_t k (we stop listening to RTHS_DESIRED once we run).
-      P.last_heard_s = toc(P.t0);
-      if P.java_codec
-        try
-          c = javaObject('rths.command_t', data);
-        catch
-          return;                                       % not our version of command_t: ignore
-        end
-        k = c.k;
-        u_mm = c.u_mm;
-      else
-        if ~all(data(1:8) == P.fp_command), return; end     % not our version of command_t
-        k = double(typecast(data(24:-1:17), 'int64'));    % bytes 17-24: k (big-endian)
-        u_mm = typecast(data(32:-1:25), 'double');        % bytes 25-32: u_mm
-      end
-      s = mod(k, 4) + 1;
-      if k >= P.next - 1 && k <= P.next + 2 && P.cmd_k(s) ~= k   % first copy wins; old steps ignored
-        P.cmd_k(s) = k;
-        P.cmd_u_mm(s) = u_mm;
-        P = try_step(P);
-      end
-    case 'RTHS_CURRENT'
-      P.last_heard_s = toc(P.t0);
-      if P.java_codec
-        try
-          c = javaObject('rths.current_t', data);
-        catch
-          return;                                       % not our version of current_t: ignore
-        end
-        k = c.k;
-        i_A = c.i_cmd_A;
-      else
-        if ~all(data(1:8) == P.fp_current), return; end
-        k = double(typecast(data(24:-1:17), 'int64'));    % bytes 17-24: k
-        i_A = typecast(data(32:-1:25), 'double');         % bytes 25-32: i_cmd_A
-      end
-      s = mod(k, 4) + 1;
-      if k >= P.next - 1 && k <= P.next + 2 && P.cur_k(s) ~= k
-        P.cur_k(s) = k;
-        P.cur_i_A(s) = i_A;
-        P = try_step(P);
-      end
     case 'RTHS_HANDSHAKE'
       try
         h = javaObject('rths.handshake_t', data);
@@ -272,18 +284,6 @@ function P = start(P)
   if P.listening_desired
     P.lc.unsubscribe('RTHS_DESIRED', P.agg);         % its only use was the implicit GO
     P.listening_desired = false;
-  end
-end
-
-function P = try_step(P)
-% measured_t next from command_t next-1 (u, mm) and current_t next-1 (i, A), held over
-% [t_{next-1}, t_next) (zero-order hold), once both are in.
-  while P.running && P.next < P.n_steps
-    s = mod(P.next - 1, 4) + 1;
-    if P.cmd_k(s) ~= P.next - 1 || P.cur_k(s) ~= P.next - 1, return; end
-    P.z = P.Phi * P.z + P.Gamma * P.cmd_u_mm(s);     % Eq. 30, ZOH
-    P = publish_measured(P, P.next, P.cur_i_A(s));
-    P.next = P.next + 1;
   end
 end
 
