@@ -91,7 +91,12 @@ function code = octave_plant(lcm_url, run_id, scenario_path, varargin)
   P.run_id = rid;                                   % int64, exact
   P.rid_bytes = big_endian(rid);                    % the same, as the 8 bytes of the wire format
   P.sha256 = sha256_of_file(scenario_path);
-  [sc, why] = read_scenario(scenario_path);
+  try
+    [sc, why] = read_scenario(scenario_path);
+  catch err
+    fprintf(2, 'octave_plant: %s: %s\n', scenario_path, err.message);
+    return;  % code 2
+  end
   P.n_steps = sc.n_steps;
   P.dt_s = sc.dt_s;
   P.heartbeat_s = opt.heartbeat_s;
@@ -175,7 +180,7 @@ function code = octave_plant(lcm_url, run_id, scenario_path, varargin)
               if P.java_codec
                 try
                   c = javaObject('rths.command_t', data);
-                  k = c.k;
+                  k = double(c.k);                  % (MATLAB returns a Java long as int64)
                   u_mm = c.u_mm;
                 catch                               % another version of command_t: ignored
                 end
@@ -194,7 +199,7 @@ function code = octave_plant(lcm_url, run_id, scenario_path, varargin)
               if P.java_codec
                 try
                   c = javaObject('rths.current_t', data);
-                  k = c.k;
+                  k = double(c.k);                  % (MATLAB returns a Java long as int64)
                   i_A = c.i_cmd_A;
                 catch
                 end
@@ -564,7 +569,7 @@ function v = toml_number(t, key, default)
   raw = toml_value(t, key, '');
   if isempty(raw), v = default; return; end
   v = str2double(strrep(raw, '_', ''));
-  if isnan(v), error('octave_plant: scenario key %s = %s is not a number', key, raw); end
+  if isnan(v), error('scenario key %s = %s is not a number', key, raw); end
 end
 
 function v = toml_string(t, key, default)
