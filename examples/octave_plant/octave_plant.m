@@ -100,7 +100,9 @@ function code = octave_plant(lcm_url, run_id, scenario_path, varargin)
   P.n_steps = sc.n_steps;
   P.dt_s = sc.dt_s;
   P.heartbeat_s = opt.heartbeat_s;
-  P.pid = int32(process_id());
+  % Our pid lets the clock watch this process, but only on its own host: a URL with ttl=0 (LCM's
+  % default) keeps us there. From another host, give 'heartbeat_s' instead (docs/participant.md).
+  P.pid = int32(process_id() * isempty(regexp(lcm_url, 'ttl=0*[1-9]', 'once')));
 
   P.lc = javaObject('lcm.lcm.LCM', {lcm_url});      % {url}: the constructor is LCM(String... urls)
   P.enc_bytes = javaObject('java.io.ByteArrayOutputStream');
@@ -153,8 +155,11 @@ function code = octave_plant(lcm_url, run_id, scenario_path, varargin)
   end
   P.listening_desired = true;                       % RTHS_DESIRED only matters until we start
 
-  watchdog_s = sc.stall_budget_s + 2;               % give up on a silent clock (docs/participant.md)
-  linger_s = max(0.5, 10 * sc.rerequest_ms / 1000); % wait this long for CLOSE after BYE
+  % Give up on a silent clock after stall_budget_s + 2 s, or, before its first REQUEST, after the
+  % handshake timeout; wait for CLOSE after BYE as rths does (docs/participant.md, "The handshake").
+  watchdog_s = sc.stall_budget_s + 2;
+  linger_s = min(sc.stall_budget_s, max(0.5, 10 * sc.rerequest_ms / 1000));
+  P.heard_request = false;
   P.t0 = tic;
   P.last_heard_s = 0;
   P.next_beat_s = inf;                              % first HEARTBEAT: heartbeat_s after the first HELLO
@@ -170,12 +175,11 @@ function code = octave_plant(lcm_url, run_id, scenario_path, varargin)
         % messages from others'. (all(a == b): isequal() is an m-file, 10x dearer.)
         if numel(data) >= 16 && all(data(9:16) == P.rid_bytes)
           % command_t and current_t, the two messages of every step, are handled here rather than
-          % in a function: in Octave a function call that updates P costs 10-20 us. They also show
-          % that the clock is alive: command_t and current_t k exist only because it published
-          % desired_t k (we stop listening to RTHS_DESIRED once we run).
+          % in a function: in Octave a function call that updates P costs 10-20 us. The first copy
+          % of each also shows that the clock is alive: command_t and current_t k exist only
+          % because it published desired_t k (we stop listening to RTHS_DESIRED once we run).
           switch channel
             case 'RTHS_COMMAND'
-              P.last_heard_s = toc(P.t0);
               k = -Inf;                             % stays so for a message that is not ours
               if P.java_codec
                 try
@@ -190,11 +194,11 @@ function code = octave_plant(lcm_url, run_id, scenario_path, varargin)
               end
               s = mod(k, 4) + 1;
               if k >= P.next - 1 && k <= P.next + 2 && P.cmd_k(s) ~= k  % first copy wins; old steps ignored
+                P.last_heard_s = toc(P.t0);
                 P.cmd_k(s) = k;
                 P.cmd_u_mm(s) = u_mm;
               end
             case 'RTHS_CURRENT'
-              P.last_heard_s = toc(P.t0);
               k = -Inf;
               if P.java_codec
                 try
@@ -209,6 +213,7 @@ function code = octave_plant(lcm_url, run_id, scenario_path, varargin)
               end
               s = mod(k, 4) + 1;
               if k >= P.next - 1 && k <= P.next + 2 && P.cur_k(s) ~= k
+                P.last_heard_s = toc(P.t0);
                 P.cur_k(s) = k;
                 P.cur_i_A(s) = i_A;
               end
@@ -235,17 +240,21 @@ function code = octave_plant(lcm_url, run_id, scenario_path, varargin)
       if P.code < 0 && done_since_s >= 0 && now_s - done_since_s > linger_s
         P.code = 0;                                 % CLOSE was lost: the run is over anyway
       end
-      if P.code < 0 && done_since_s < 0 && now_s - P.last_heard_s > watchdog_s
-        fprintf(2, 'octave_plant: the clock (integrator) has been silent for %.0f s; giving up\n', watchdog_s);
+      silent_s = now_s - P.last_heard_s;
+      if P.code < 0 && done_since_s < 0 && ((P.heard_request && silent_s > watchdog_s) || ...
+                                            (~P.heard_request && silent_s > sc.handshake_timeout_s))
+        reason = sprintf('plant (octave_plant): the clock (integrator) has been silent for %.0f s', silent_s);
+        fprintf(2, 'octave_plant: %s; giving up\n', reason);
+        send_handshake(P, 4, max(P.next - 1, -1), reason);  % k: the step being run, -1 before step 0
         P.code = 3;
       end
     end
   catch err
     % Our own failure (a publish that failed, a bug): tell the run why, then stop with 5.
-    reason = sprintf('plant (octave_plant) failed at step %d: %s', P.next, err.message);
+    reason = sprintf('plant (octave_plant) failed at step %d: %s', max(P.next - 1, -1), err.message);
     fprintf(2, 'octave_plant: %s\n', reason);
     try
-      send_handshake(P, 4, P.next, reason);
+      send_handshake(P, 4, max(P.next - 1, -1), reason);
     catch
     end
     P.code = 5;
@@ -351,6 +360,7 @@ function P = on_handshake(P, h)
   P.last_heard_s = toc(P.t0);
   switch phase
     case 1                                            % REQUEST -> HELLO
+      P.heard_request = true;
       if ~P.running && ~P.done
         send_handshake(P, 2, -1, '');
         if P.heartbeat_s > 0 && isinf(P.next_beat_s)
@@ -490,6 +500,7 @@ function [sc, why] = read_scenario(path)
   sc.n_steps = round(duration_s / sc.dt_s);
   sc.stall_budget_s = toml_number(t, 'lockstep.stall_budget_s', 10.0);
   sc.rerequest_ms = toml_number(t, 'lockstep.rerequest_ms', 100.0);
+  sc.handshake_timeout_s = toml_number(t, 'lockstep.handshake_timeout_s', 20.0);
   kind = toml_string(t, 'plant.kind', 'linear');
   specimen = toml_string(t, 'plant.specimen', 'mr_damper');
   actuator = toml_value(t, 'plant.actuator', '"avg"');
