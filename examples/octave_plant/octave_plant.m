@@ -31,12 +31,11 @@ function code = octave_plant(lcm_url, run_id, scenario_path, varargin)
 %
 % Protocol (docs/lockstep.md, docs/participant.md; the same steps as examples/java_plant/JavaPlant.java):
 % HELLO on the clock's REQUEST (with the scenario's SHA-256, n_steps, dt and, on a ttl=0 URL, our
-% pid); start on GO,
-% or on the clock's first desired_t or repair_t if GO was lost; measured_t 0 at rest; measured_t k
-% from command_t k-1 and current_t k-1; the bytes of the last four answers kept and re-sent
-% unchanged when a repair_t wants them; what we lack asked for when the clock re-requests a step;
-% BYE on every DONE, return on CLOSE (or after a short linger); HEARTBEATs if asked for; ABORT
-% naming the clock when it has been silent too long.
+% pid); start on GO, or on the clock's first desired_t or repair_t if GO was lost; measured_t 0 at
+% rest; measured_t k from command_t k-1 and current_t k-1; the bytes of the last four answers kept
+% and re-sent unchanged when a repair_t wants them; what we lack asked for when the clock
+% re-requests a step; BYE on every DONE, return on CLOSE (or after a short linger); HEARTBEATs if
+% asked for; an ABORT naming the clock when it has been silent too long.
 %
 % Octave/MATLAB notes, each of which costs time if ignored (README.md has the measurements):
 %  - Java long fields come back as doubles: exact for k, not for run_id. So run_id is compared on
