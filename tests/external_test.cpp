@@ -191,7 +191,8 @@ TEST_CASE("a plant written in Octave (examples/octave_plant) joins with --extern
   if (!UdpmAvailable()) FAIL("udpm cannot run on this host: " << rths::lockstep::CheckMulticastRoute());
   const auto dir = TempDir("octave");
   // 1000 steps: the plant reads n_steps = round(duration_s / dt_s) from the file. Measured on a
-  // loaded 2-core VM: about 600-1200 steps/s, so the test takes ~5 s (Octave and the JVM start in ~1 s).
+  // loaded 2-core VM: 1000-1900 steps/s (the default mixed transport), and Octave with its JVM
+  // starts in about 1 s, so the plant is done in about 1.5 s and the test in a few seconds.
   const fs::path scenario = WriteScenario(
       dir, "[run]\nname = \"octave_plant\"\nduration_s = 0.5\n[plant]\nkind = \"linear\"\nactuator = \"avg\"\n"
            "specimen = \"none\"\n");
