@@ -113,6 +113,7 @@ const char* PhaseName(int phase) {
     case rths::lockstep::kDone: return "DONE";
     case rths::lockstep::kBye: return "BYE";
     case rths::lockstep::kClose: return "CLOSE";
+    case rths::lockstep::kHeartbeat: return "HEARTBEAT";
     default: return "?";
   }
 }

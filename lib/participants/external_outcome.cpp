@@ -25,16 +25,16 @@ Outcome ExternalOutcome(const std::string& role, const Outcome* clock) {
   o.stats.repair_requests = p.repair_requests;
   o.stats.duplicates = p.duplicates;
   o.step = clock->step;
-  if (!p.hello) {
-    o.observed = "never joined";
-    o.exit_code = clock->culprit == role ? lockstep::kExitLockstep : 0;
-    o.message = clock->culprit == role ? clock->message : "";
-    return o;
-  }
   if (p.aborted) {
     o.observed = "aborted";
     o.exit_code = lockstep::kExitExternalAbort;
     o.message = fmt::format("{} (external) aborted the run: {}", role, p.abort_reason);
+    return o;
+  }
+  if (!p.hello) {
+    o.observed = "never joined";
+    o.exit_code = clock->culprit == role ? lockstep::kExitLockstep : 0;
+    o.message = clock->culprit == role ? clock->message : "";
     return o;
   }
   if (p.lost) {

@@ -19,6 +19,7 @@
 #include "supervisor/run_progress.h"
 #include "supervisor/scenario_file.h"
 #include "supervisor/summary_builder.h"
+#include "supervisor/teardown.h"
 
 namespace rths::supervisor {
 
@@ -112,6 +113,8 @@ GroupEnd RunGroup(const RunRequest& r, const RunPlan& plan) {
     if (r.transport == "memq" || r.transport == "mixed") {
       end.outcomes = RunInProcessGroup(plan.scenario, r.replay ? &*r.replay : nullptr, &r.external, plan.url,
                                        plan.run_id, plan.out.string(), interrupted, &end.memq_setup);
+      // The built-in participants stopped at the interrupt; the external ones hear it here.
+      if (r.transport == "mixed" && *interrupted) BroadcastAbort(plan.url, plan.run_id, "interrupted by the user");
     } else {
       const ProcessGroupSpec spec{plan.scenario_path, plan.run_id, plan.out,   r.bin_dir,
                                   plan.url,           r.external,  r.role_args};
