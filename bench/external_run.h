@@ -34,11 +34,12 @@ inline const std::map<std::string, std::string>& ExternalPlants() {
 }
 
 /// Runs `{bin}/rths-run RUN_ARGS --external plant --lcm-url URL --run-id ID --out OUT SCENARIO`
-/// with `plant` (a key of ExternalPlants()) as the plant; the run's exit code (its summary is in
-/// OUT/summary.json), or -1 if the plant is unknown or the run never waited for it.
+/// with `plant` (a key of ExternalPlants()) as the plant, started behind `plant_prefix` (e.g.
+/// "chrt -f 70"); the run's exit code (its summary is in OUT/summary.json), or -1 if the plant is
+/// unknown or the run never waited for it.
 inline int RunWithExternalPlant(const fs::path& bin, const std::string& run_args, const fs::path& scenario,
                                 const fs::path& out, const std::string& plant, std::int64_t steps, double dt,
-                                int port) {
+                                int port, const std::string& plant_prefix = "") {
   const auto it = ExternalPlants().find(plant);
   if (it == ExternalPlants().end()) return -1;
   fs::remove_all(out);
@@ -64,7 +65,7 @@ inline int RunWithExternalPlant(const fs::path& bin, const std::string& run_args
   const std::string cmd = fmt::format(fmt::runtime(it->second), fmt::arg("bin", bin.string()), fmt::arg("url", url),
                                       fmt::arg("run_id", run_id), fmt::arg("scenario", scenario.string()),
                                       fmt::arg("steps", steps), fmt::arg("dt", dt), fmt::arg("out", out.string()));
-  std::system((cmd + " > " + out.string() + ".plant.txt 2>&1").c_str());
+  std::system((plant_prefix + " " + cmd + " > " + out.string() + ".plant.txt 2>&1").c_str());
   pid_t pid = 0;
   std::ifstream(pid_file) >> pid;
   for (int i = 0; i < 6000 && pid > 0 && ::kill(pid, 0) == 0; ++i) ::usleep(10000);

@@ -4,7 +4,7 @@
 // this host achieved now (docs/realtime.md).
 //
 //   build/bin/bench-realtime [--seconds S] [--scenario FILE] [--out DIR] [--transports memq,udpm]
-//                            [--spin-us US] [--cpu N] [--linear-plant]
+//                            [--spin-us US] [--cpu N] [--linear-plant] [--external-priority P]
 //
 // A transport "mixed:PLANT" is a mixed run (the built-in participants in one process, bridged on
 // udpm) with an external plant: builtin (rths-plant), java (examples/java_plant), python
@@ -95,6 +95,11 @@ int main(int argc, char** argv) {
   app.add_option("--spin-us", spin_us, "[realtime] spin_us of every run (busy-wait before each release)")
       ->capture_default_str();
   app.add_option("--cpu", cpu, "[realtime] cpu of every run (-1: no pinning)")->capture_default_str();
+  int external_priority = 0;
+  app.add_option("--external-priority", external_priority,
+                 "run the external plants of mixed rows under SCHED_FIFO at this priority (chrt -f), as a lab "
+                 "would run its own participant; 0: the normal scheduler")
+      ->check(CLI::Range(0, 99));
   app.add_flag("--linear-plant", linear_plant, "every row on the linear servo without a specimen (as the Java and "
                                                "Python plants model)");
   CLI11_PARSE(app, argc, argv);
@@ -118,9 +123,11 @@ int main(int argc, char** argv) {
   std::stringstream ss(transports_arg);
   for (std::string t; std::getline(ss, t, ',');) transports.push_back(t);
 
-  std::printf("bench-realtime: %s%s paced at %g Hz for %g s per transport, on %ld CPUs, spin_us %g, cpu %d\n",
+  std::printf("bench-realtime: %s%s paced at %g Hz for %g s per transport, on %ld CPUs, spin_us %g, cpu %d, external "
+              "plants %s\n",
               scenario_path.c_str(), linear_plant ? " (linear plant, no specimen)" : "", 1.0 / s.run.dt_s, seconds,
-              static_cast<long>(std::thread::hardware_concurrency()), spin_us, cpu);
+              static_cast<long>(std::thread::hardware_concurrency()), spin_us, cpu,
+              external_priority > 0 ? fmt::format("SCHED_FIFO {}", external_priority).c_str() : "normal scheduler");
   std::printf("%-14s %8s %8s %9s %8s %10s %8s %10s %8s  %s\n", "", "steps", "misses", "miss %", "x host", "p50 us",
               "p99 us", "p99.9 us", "max us", "set-up");
   double host_miss = 0;  // the host's own miss fraction (at least one miss in its steps)
@@ -150,7 +157,8 @@ int main(int argc, char** argv) {
     int rc = 0;
     if (mixed) {
       rc = rths_bench::RunWithExternalPlant(bin_dir, "--realtime --quiet", paced, dir, t.substr(6), s.steps(),
-                                            s.run.dt_s, port++);
+                                            s.run.dt_s, port++,
+                                            external_priority > 0 ? fmt::format("chrt -f {}", external_priority) : "");
     } else {
       const std::string cmd = fmt::format("{}/rths-run --realtime --quiet --transport {} --out {} {} > {}/stdout.txt 2>&1",
                                           bin_dir.string(), t, dir.string(), paced.string(), out.string());
