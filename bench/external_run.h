@@ -27,7 +27,7 @@ inline const std::map<std::string, std::string>& ExternalPlants() {
       {"builtin", "{bin}/rths-plant --scenario {scenario} --lcm-url '{url}' --run-id {run_id} --out {out}/plant"},
       {"java", "java -cp /usr/share/java/lcm.jar:{bin}/../rths_lcmtypes.jar:{bin}/../examples/java_plant JavaPlant "
                "--lcm-url '{url}' --run-id {run_id} --scenario {scenario} --steps {steps} --dt {dt}"},
-      {"python", "PYTHONPATH={bin}/../examples/python_plant /usr/bin/python3 {bin}/../../examples/python_plant/plant.py "
+      {"python", "env PYTHONPATH={bin}/../examples/python_plant /usr/bin/python3 {bin}/../../examples/python_plant/plant.py "
                  "--lcm-url '{url}' --run-id {run_id} --scenario {scenario}"},
   };
   return plants;
