@@ -27,9 +27,11 @@ namespace {
 /// A run long enough (20 s simulated) that the plant is killed while it runs.
 const char* kLong = "[run]\nname = \"liveness\"\nduration_s = 20\n";
 
-/// Starts the built-in plant in the background as the user's participant; its pid.
-pid_t StartPlant(const fs::path& dir, const PrintedRun& run, const std::string& url, const std::string& extra = "") {
-  const std::string cmd = "(" + BuiltInPlant(url, run.run_id, run.scenario, dir, extra) + " > " +
+/// Starts the built-in plant in the background as the user's participant (behind `prefix`, e.g.
+/// "ip netns exec B", which execs it); its pid.
+pid_t StartPlant(const fs::path& dir, const PrintedRun& run, const std::string& url, const std::string& extra = "",
+                 const std::string& prefix = "") {
+  const std::string cmd = "(" + prefix + " " + BuiltInPlant(url, run.run_id, run.scenario, dir, extra) + " > " +
                           (dir / "plant.out").string() + " 2>&1 & echo $! > " + (dir / "plant.pid").string() + ")";
   REQUIRE(std::system(cmd.c_str()) == 0);
   return static_cast<pid_t>(std::stol(ReadFile(dir / "plant.pid")));
@@ -139,6 +141,24 @@ TEST_CASE("a participant from another host (no pid): lost after 5 missed heartbe
     CHECK(peer["loss"]["died"] == false);
     CHECK(j["participants"]["plant"]["observed"] == "lost");
     CHECK(j["stopped"].get<std::string>().find("no HEARTBEAT for") != std::string::npos);
+  }
+  SUBCASE("the plant in another network namespace over a veth pair, beating every 0.1 s: lost, exit 10") {
+    NetnsPair ns;
+    if (!ns.ok) {
+      FAIL("cannot create network namespaces and a veth pair (needs root / CAP_NET_ADMIN): "
+           << ReadFile(fs::temp_directory_path() / "rths_netns.err"));
+    }
+    const auto dir = TempDir("heartbeat_netns");
+    const fs::path scenario = WriteScenario(dir, kLong);
+    const PrintedRun run = StartExternalRun(
+        dir, RunArgs(dir, scenario, "--lcm-url '" + url + "' --set lockstep.stall_budget_s=600"), "ip netns exec " + ns.a);
+    const pid_t plant = StartPlant(dir, run, url, "--heartbeat-s 0.1", "ip netns exec " + ns.b);
+    const double took_s = KillPlantAndWait(dir, run, plant);
+    MESSAGE("the run exited " << took_s << " s after kill -9 of a plant in another namespace beating every 0.1 s");
+    const auto j = WaitExternalRun(run, dir / "out");
+    CHECK(j["exit_code"] == rths::lockstep::kExitExternalLost);
+    CHECK(j["participants"]["integrator"]["peers"]["plant"]["pid"] == 0);
+    CHECK(j["participants"]["plant"]["observed"] == "lost");
   }
   SUBCASE("neither pid nor heartbeat: the stall budget, and the message says why it took that long") {
     const auto dir = TempDir("no_liveness");
