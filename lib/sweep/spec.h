@@ -1,0 +1,86 @@
+#pragma once
+/// @file A sweep's SPEC (`rths sweep SPEC.toml`, issue 28): which runs a study of the user's own
+/// makes, and how run i's scenario follows from the SPEC and i alone, so that any run can be
+/// re-made by itself, bit for bit, on a laptop or on any node of a cluster.
+///
+///     [sweep]
+///     name = "lqg_noise"              # label of the sweep's output folder
+///     base = "../default.toml"        # the scenario every run starts from (relative to the SPEC)
+///     seed = 1                        # the sweep's seed: every draw derives from it and the run index
+///     draws = 100                     # runs per grid point with fresh [draw] values (0: no [draw])
+///     record = ["tracking_nrmse_pct", "peak_force_kN", "status"]   # summary.json fields per run
+///     [cases]
+///     files = ["case1.toml", "case2.toml"]   # optional: whole scenarios, each in place of `base`
+///     [grid]                                   # every combination of these --set values
+///     "controller.kind" = ["ff", "ff_lqg"]
+///     "controller.lqg.q" = [1e2, 1e3, 1e4]
+///     [draw]                                   # drawn anew for each run
+///     "structure.damping_ratio" = { dist = "normal", mean = 0.02, std = 0.002 }
+///     "plant.noise_seed" = { dist = "seed" }
+///
+/// Run order (index 0 .. runs()-1): case (slowest), then the grid's combinations (keys in sorted
+/// order, the first key slowest), then the draw (fastest). Run i's values are `--set KEY=VALUE`
+/// overrides of its case's file (scenario::LoadScenario(path, sets)); each drawn key has a random
+/// stream of its own, seeded from (seed, i, key) by SplitMix64, with normal deviates by the
+/// Box-Muller transform written here (std::normal_distribution differs between libraries): the
+/// same SPEC and index give the same scenario on every machine, whatever else the sweep holds.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace rths::sweep {
+
+/// A distribution of a [draw] key.
+struct Draw {
+  std::string key;      ///< dotted scenario key, e.g. "structure.damping_ratio"
+  std::string dist;     ///< "normal" (mean, std), "uniform" (lo, hi), "lognormal" (mu, sigma of log), "seed"
+  double a = 0, b = 0;  ///< the parameters, in that order
+};
+
+/// One [grid] axis: a key and its values as TOML literals ("\"ff\"", "1000.0", "true").
+struct Axis {
+  std::string key;
+  std::vector<std::string> values;
+};
+
+/// A parsed, validated SPEC (paths absolute).
+struct Spec {
+  std::string path;                 ///< the SPEC file
+  std::string name = "sweep";
+  std::vector<std::string> cases;   ///< scenario files: [cases] files, or the one `base`
+  std::uint64_t seed = 1;
+  std::int64_t draws = 0;           ///< runs per grid point (0: one, without draws)
+  std::vector<std::string> record;  ///< summary.json fields recorded per run
+  std::vector<Axis> grid;           ///< sorted by key
+  std::vector<Draw> draw;           ///< sorted by key
+
+  /// Grid combinations (1 without a grid).
+  std::int64_t combinations() const;
+  /// Runs of the sweep: cases x combinations x max(draws, 1).
+  std::int64_t runs() const;
+};
+
+/// One run of a sweep, as the SPEC and its index define it.
+struct RunPoint {
+  std::int64_t index = 0;
+  std::int64_t case_index = 0, combination = 0, draw = 0;
+  std::string scenario;             ///< the case's file
+  std::vector<std::string> sets;    ///< "KEY=VALUE": grid values, then drawn values (key order)
+};
+
+/// The largest sweep accepted (runs()).
+inline constexpr std::int64_t kMaxRuns = 10'000'000;
+
+/// Parses and validates SPEC text (`path` names it in errors and anchors relative paths). Throws
+/// rths::Error naming the file, the key and the allowed values.
+Spec ParseSpec(const std::string& text, const std::string& path);
+/// Reads and parses a SPEC file; throws rths::Error (unreadable file, as ParseSpec).
+Spec LoadSpec(const std::string& path);
+/// Run `index` (0 <= index < spec.runs(); throws rths::Error otherwise).
+RunPoint PointOf(const Spec& spec, std::int64_t index);
+
+/// SplitMix64 (Steele, Lea and Flood 2014): the next value of the sequence after `state`,
+/// advancing it. A seed mixer with good avalanche, used to derive each run's streams.
+std::uint64_t SplitMix64(std::uint64_t* state);
+
+}  // namespace rths::sweep

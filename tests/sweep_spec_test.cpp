@@ -1,0 +1,168 @@
+// A sweep's SPEC (lib/sweep/spec.h): the run count and order, run i's scenario from the SPEC and i
+// alone (the same values whatever else the sweep draws), the draws' distributions, and errors
+// that name the file, the key and what is allowed.
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <set>
+#include <string>
+
+#include "core/error.h"
+#include "scenario/scenario.h"
+#include "sweep/spec.h"
+#include "test_support.h"
+
+namespace fs = std::filesystem;
+using rths::sweep::ParseSpec;
+using rths::sweep::PointOf;
+
+namespace {
+
+const char* kSpec = R"(
+[sweep]
+name = "lqg"
+base = "../scenarios/default.toml"
+seed = 7
+draws = 3
+record = ["tracking_nrmse_pct", "status"]
+[grid]
+"controller.kind" = ["ff", "lti"]
+"plant.noise_y_mm_rms" = [0.0, 0.01, 2e-2]
+[draw]
+"structure.damping_ratio" = { dist = "normal", mean = 0.02, std = 0.002 }
+"plant.noise_seed" = { dist = "seed" }
+)";
+
+double ValueOf(const std::string& set) { return std::stod(set.substr(set.find('=') + 1)); }
+
+}  // namespace
+
+TEST_CASE("runs and their order: case, grid combination (sorted keys, the last fastest), draw") {
+  const auto spec = ParseSpec(kSpec, "/x/sweeps/lqg.toml");
+  CHECK(spec.cases == std::vector<std::string>{"/x/scenarios/default.toml"});
+  CHECK(spec.combinations() == 6);
+  CHECK(spec.runs() == 18);
+  CHECK(spec.record == std::vector<std::string>{"tracking_nrmse_pct", "status"});
+  const auto p0 = PointOf(spec, 0);
+  CHECK(p0.sets[0] == "controller.kind=\"ff\"");
+  CHECK(p0.sets[1] == "plant.noise_y_mm_rms=0.0");
+  const auto p5 = PointOf(spec, 5);  // combination 1, draw 2
+  CHECK(p5.combination == 1);
+  CHECK(p5.draw == 2);
+  CHECK(p5.sets[1] == "plant.noise_y_mm_rms=0.01");
+  const auto p17 = PointOf(spec, 17);
+  CHECK(p17.sets[0] == "controller.kind=\"lti\"");
+  CHECK(p17.sets[1] == "plant.noise_y_mm_rms=0.02");
+  CHECK(p17.sets.size() == 4);  // two grid values, then the two drawn keys in sorted order
+  CHECK(p17.sets[2].rfind("plant.noise_seed=", 0) == 0);
+  CHECK(p17.sets[3].rfind("structure.damping_ratio=", 0) == 0);
+  CHECK_THROWS_AS(PointOf(spec, 18), rths::Error);
+  CHECK_THROWS_AS(PointOf(spec, -1), rths::Error);
+}
+
+TEST_CASE("run i is made from the SPEC and i alone: another grid or another drawn key leaves its draws alone") {
+  const auto spec = ParseSpec(kSpec, "/x/sweeps/lqg.toml");
+  // Twice the same: deterministic.
+  CHECK(PointOf(spec, 11).sets == PointOf(spec, 11).sets);
+  // Different runs draw differently.
+  CHECK(PointOf(spec, 11).sets[3] != PointOf(spec, 12).sets[3]);
+  // A third drawn key does not change the other keys' values of the same run.
+  std::string more = kSpec;
+  more += "\"structure.frequency_hz\" = { dist = \"uniform\", lo = 4.0, hi = 6.0 }\n";
+  const auto spec2 = ParseSpec(more, "/x/sweeps/lqg.toml");
+  const auto a = PointOf(spec, 11), b = PointOf(spec2, 11);
+  CHECK(b.sets.size() == 5);
+  CHECK(a.sets[2] == b.sets[2]);  // plant.noise_seed
+  CHECK(a.sets[3] == b.sets[3]);  // structure.damping_ratio (structure.frequency_hz sorts after it)
+  // Another sweep seed: other draws.
+  std::string reseeded = kSpec;
+  reseeded.replace(reseeded.find("seed = 7"), 8, "seed = 8");
+  CHECK(PointOf(ParseSpec(reseeded, "/x/s.toml"), 11).sets[3] != a.sets[3]);
+}
+
+TEST_CASE("the draws follow their distributions, and a drawn value reads back as the same double") {
+  const auto spec = ParseSpec(R"(
+[sweep]
+base = "b.toml"
+draws = 20000
+[draw]
+"a" = { dist = "normal", mean = 0.02, std = 0.002 }
+"b" = { dist = "uniform", lo = 4.0, hi = 6.0 }
+"c" = { dist = "lognormal", mu = 0.0, sigma = 0.1 }
+"d" = { dist = "seed" }
+)",
+                              "/x/s.toml");
+  double sum_a = 0, sum2_a = 0, min_b = 1e9, max_b = -1e9, sum_log_c = 0;
+  std::set<std::string> seeds;
+  const int n = 20000;
+  for (int i = 0; i < n; ++i) {
+    const auto p = PointOf(spec, i);
+    const double a = ValueOf(p.sets[0]), b = ValueOf(p.sets[1]), c = ValueOf(p.sets[2]);
+    sum_a += a;
+    sum2_a += a * a;
+    min_b = std::min(min_b, b);
+    max_b = std::max(max_b, b);
+    sum_log_c += std::log(c);
+    seeds.insert(p.sets[3]);
+  }
+  const double mean = sum_a / n, sd = std::sqrt(sum2_a / n - mean * mean);
+  // Sampling error of the mean: 0.002 / sqrt(20000) = 1.4e-5; allow 5 of them.
+  CHECK(std::abs(mean - 0.02) < 7e-5);
+  CHECK(std::abs(sd - 0.002) < 1e-4);  // sd of the sd ~ 0.002 / sqrt(40000) = 1e-5
+  CHECK(min_b >= 4.0);
+  CHECK(max_b < 6.0);
+  CHECK(max_b - min_b > 1.99);
+  CHECK(std::abs(sum_log_c / n) < 5 * 0.1 / std::sqrt(n));
+  CHECK(seeds.size() > n - 5);  // distinct seeds (a few collisions in 2^31 are allowed)
+  // The literal of a drawn double is the double.
+  const auto p = PointOf(spec, 3);
+  CHECK(ValueOf(p.sets[0]) == std::stod(p.sets[0].substr(2)));
+}
+
+TEST_CASE("a run's sets apply to its scenario: the default scenario with the run's values") {
+  const auto dir = rths_test::TempDir("sweep_spec");
+  const fs::path spec_file = dir / "s.toml";
+  {
+    std::ofstream(spec_file) << "[sweep]\nbase = \"" << (fs::path(RTHS_SOURCE_DIR) / "scenarios" / "default.toml").string()
+                             << "\"\n[grid]\n\"controller.kind\" = [\"none\", \"ff\"]\n\"run.duration_s\" = [0.5]\n";
+  }
+  const auto spec = rths::sweep::LoadSpec(spec_file.string());
+  const auto p = PointOf(spec, 0);
+  const auto s = rths::scenario::LoadScenario(p.scenario, p.sets);
+  CHECK(s.run.duration_s == 0.5);
+  CHECK(s.steps() == 1000);
+}
+
+TEST_CASE("bad SPECs are refused naming the file, the key and what is allowed") {
+  const std::string f = "/x/bad.toml";
+  auto refused = [&](const std::string& text, const std::string& needle) {
+    CAPTURE(text);
+    try {
+      ParseSpec(text, f);
+      FAIL("accepted");
+    } catch (const rths::Error& e) {
+      const std::string what = e.what();
+      CAPTURE(what);
+      CHECK(what.find(f) != std::string::npos);
+      CHECK(what.find(needle) != std::string::npos);
+    }
+  };
+  refused("", "needs a [sweep] table");
+  refused("[sweep]\nseed = 1\n", "sweep.base");
+  refused("[sweep]\nbase = \"b\"\nspeed = 1\n", "unknown key; allowed: name, base, seed, draws, record");
+  refused("[sweep]\nbase = \"b\"\n[grids]\n", "unknown table");
+  refused("[sweep]\nbase = \"b\"\n[grid]\n\"a.b\" = []\n", "non-empty array");
+  refused("[sweep]\nbase = \"b\"\n[grid]\n\"a.b\" = [[1]]\n", "values must be");
+  refused("[sweep]\nbase = \"b\"\ndraws = 2\n[draw]\n\"a\" = { dist = \"beta\" }\n", "allowed \"normal\"");
+  refused("[sweep]\nbase = \"b\"\ndraws = 2\n[draw]\n\"a\" = { dist = \"normal\", mean = 0.0, std = -1.0 }\n",
+          "out of range [0, inf)");
+  refused("[sweep]\nbase = \"b\"\ndraws = 2\n[draw]\n\"a\" = { dist = \"uniform\", lo = 1.0, hi = 1.0 }\n",
+          "lo < hi");
+  refused("[sweep]\nbase = \"b\"\n[draw]\n\"a\" = { dist = \"seed\" }\n", "sweep.draws >= 1");
+  refused("[sweep]\nbase = \"b\"\ndraws = 3\n", "needs a [draw] table");
+  refused("[sweep]\nbase = \"b\"\n[cases]\nfiles = [\"c\"]\n", "not both");
+  refused("[sweep]\nbase = \"b\"\ndraws = 100000\n[draw]\n\"a\" = { dist = \"seed\" }\n[grid]\n\"k\" = "
+          "[1,2,3,4,5,6,7,8,9,10,11]\n\"l\" = [1,2,3,4,5,6,7,8,9,10]\n",
+          "more than the");
+}
