@@ -1,0 +1,158 @@
+#include "sweep/run_sweep.h"
+
+#include <fstream>
+#include <map>
+#include <sstream>
+
+#include <fmt/core.h>
+#include <nlohmann/json.hpp>
+
+#include "core/error.h"
+#include "io/reserved_file.h"
+#include "scenario/scenario.h"
+#include "studies/batch.h"
+
+namespace rths::sweep {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+fs::path RowPath(const fs::path& out, std::int64_t i) { return out / "rows" / fmt::format("{}.json", i); }
+
+nlohmann::json ReadJson(const fs::path& p) {
+  std::ifstream in(p);
+  if (!in) return nullptr;
+  try {
+    return nlohmann::json::parse(in);
+  } catch (const std::exception&) {
+    return nullptr;
+  }
+}
+
+/// The value of a dotted field of summary.json ("benchmark_criteria.J1"); null if absent.
+nlohmann::json Field(const nlohmann::json& summary, const std::string& dotted) {
+  const nlohmann::json* j = &summary;
+  std::stringstream ss(dotted);
+  for (std::string part; std::getline(ss, part, '.');) {
+    if (!j->is_object() || !j->contains(part)) return nullptr;
+    j = &(*j)[part];
+  }
+  return *j;
+}
+
+/// A --set value (a TOML literal) as JSON: a string without its quotes, a boolean, or a number.
+nlohmann::json ValueOf(const std::string& literal) {
+  if (literal.size() >= 2 && literal.front() == '"') {
+    std::string out;
+    for (std::size_t i = 1; i + 1 < literal.size(); ++i) {
+      if (literal[i] == '\\' && i + 2 < literal.size()) ++i;
+      out += literal[i];
+    }
+    return out;
+  }
+  if (literal == "true" || literal == "false") return literal == "true";
+  if (literal.find_first_of(".eEn") == std::string::npos) return std::stoll(literal);
+  return std::stod(literal);  // the shortest text of a double reads back as that double
+}
+
+/// Run i's row: its index, status, scenario hash, the values it was given and the recorded fields.
+nlohmann::json Row(const Spec& spec, const RunPoint& p, const std::string& status, const nlohmann::json& summary) {
+  nlohmann::json row = {{"index", p.index}, {"status", status}};
+  row["scenario_sha256"] = summary.is_object() ? summary.value("scenario_sha256", std::string()) : "";
+  for (const std::string& set : p.sets) {
+    const std::size_t eq = set.find('=');
+    row["set"][set.substr(0, eq)] = ValueOf(set.substr(eq + 1));
+  }
+  for (const std::string& f : spec.record) row["record"][f] = summary.is_object() ? Field(summary, f) : nullptr;
+  return row;
+}
+
+std::string Cell(const nlohmann::json& v) {
+  if (v.is_null()) return "";
+  if (v.is_number_float()) return fmt::format("{:.17g}", v.get<double>());
+  std::string s = v.is_string() ? v.get<std::string>() : v.dump();
+  if (s.find_first_of(",\"\n") == std::string::npos) return s;
+  std::string q = "\"";
+  for (const char c : s) q += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return q + "\"";
+}
+
+/// DIR/table.csv from every row present in DIR/rows.
+void WriteTable(const Spec& spec, const fs::path& out, const fs::path& table) {
+  std::ostringstream csv;
+  const auto columns = TableColumns(spec);
+  for (std::size_t c = 0; c < columns.size(); ++c) csv << (c ? "," : "") << columns[c];
+  csv << "\n";
+  for (std::int64_t i = 0; i < spec.runs(); ++i) {
+    const nlohmann::json row = ReadJson(RowPath(out, i));
+    if (row.is_null()) continue;
+    csv << row["index"].get<std::int64_t>() << "," << Cell(row["status"]) << "," << Cell(row["scenario_sha256"]);
+    for (const Axis& a : spec.grid) csv << "," << Cell(row["set"].value(a.key, nlohmann::json()));
+    for (const Draw& d : spec.draw) csv << "," << Cell(row["set"].value(d.key, nlohmann::json()));
+    for (const std::string& f : spec.record) csv << "," << Cell(row["record"].value(f, nlohmann::json()));
+    csv << "\n";
+  }
+  if (!io::OverwriteFile(table.string(), csv.str())) throw Error(table.string(), "cannot write the sweep's table");
+}
+
+}  // namespace
+
+std::vector<std::string> TableColumns(const Spec& spec) {
+  std::vector<std::string> c = {"index", "status", "scenario_sha256"};
+  for (const Axis& a : spec.grid) c.push_back(a.key);
+  for (const Draw& d : spec.draw) c.push_back(d.key);
+  for (const std::string& f : spec.record) c.push_back(f);
+  return c;
+}
+
+SweepOutcome RunSweep(const Spec& spec, const SweepOptions& o) {
+  fs::create_directories(o.out / "rows");
+  fs::create_directories(o.out / "runs");
+  SweepOutcome outcome;
+  std::vector<std::int64_t> todo;
+  const std::int64_t first = o.only.value_or(0), last = o.only ? *o.only + 1 : spec.runs();
+  for (std::int64_t i = first; i < last; ++i) {
+    PointOf(spec, i);  // throws for an index out of range
+    if (o.resume && !ReadJson(RowPath(o.out, i)).is_null()) {
+      ++outcome.skipped;
+      continue;
+    }
+    todo.push_back(i);
+  }
+  std::vector<studies::RunSpec> specs;
+  std::vector<RunPoint> points;
+  for (const std::int64_t i : todo) {
+    const RunPoint p = PointOf(spec, i);
+    const fs::path dir = o.out / "runs" / std::to_string(i);
+    fs::remove_all(dir);  // what an interrupted attempt left
+    try {
+      specs.push_back({fmt::format("run {}", i), scenario::LoadScenario(p.scenario, p.sets), dir});
+      points.push_back(p);
+    } catch (const std::exception& e) {  // e.g. a drawn value out of the key's range: a row, not a crash
+      io::OverwriteFile(RowPath(o.out, i).string(),
+                        Row(spec, p, fmt::format("invalid: {}", e.what()), nullptr).dump(2) + "\n");
+      ++outcome.ran;
+      ++outcome.failed;
+    }
+  }
+  const auto results = studies::RunBatch(specs, std::max(1, o.jobs), o.progress);
+  for (std::size_t r = 0; r < results.size(); ++r) {
+    const nlohmann::json summary = ReadJson(results[r].dir / "summary.json");
+    const std::string status =
+        results[r].ok ? "completed" : fmt::format("failed: {}", results[r].error.empty() ? "no summary" : results[r].error);
+    if (!o.keep_logs) {
+      std::error_code ec;
+      fs::remove(results[r].dir / "log.lcm", ec);
+      fs::remove(results[r].dir / "signals.csv", ec);
+    }
+    io::OverwriteFile(RowPath(o.out, points[r].index).string(), Row(spec, points[r], status, summary).dump(2) + "\n");
+    ++outcome.ran;
+    if (!results[r].ok) ++outcome.failed;
+  }
+  outcome.table = o.out / "table.csv";
+  WriteTable(spec, o.out, outcome.table);
+  return outcome;
+}
+
+}  // namespace rths::sweep

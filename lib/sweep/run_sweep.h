@@ -1,0 +1,43 @@
+#pragma once
+/// @file The local executor of a sweep (`rths sweep SPEC`, issue 28): the SPEC's runs (or one of
+/// them, or those a previous attempt left undone), `jobs` at a time on this machine
+/// (studies::RunBatch: each run a memq group in this process), one row per run written as it
+/// ends, and the table of every row.
+///
+/// Folder layout (DIR): DIR/runs/<i>/ (scenario.toml, summary.json; log.lcm and signals.csv only
+/// with keep_logs), DIR/rows/<i>.json (the run's row, written once the run has ended, whatever its
+/// status), DIR/table.csv (every row present, by index).
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/progress.h"
+#include "sweep/spec.h"
+
+namespace rths::sweep {
+
+struct SweepOptions {
+  std::filesystem::path out;          ///< DIR (created)
+  int jobs = 1;                       ///< runs at a time, >= 1
+  std::optional<std::int64_t> only;   ///< run only this index (re-made alone, bit for bit)
+  bool resume = false;                ///< skip runs whose row is already in DIR/rows
+  bool keep_logs = false;             ///< keep each run's log.lcm and signals.csv
+  ProgressLine* progress = nullptr;   ///< progress with ETA (optional)
+};
+
+struct SweepOutcome {
+  std::int64_t ran = 0, skipped = 0, failed = 0;  ///< this call's runs; rows already there; rows not "completed"
+  std::filesystem::path table;                    ///< DIR/table.csv
+};
+
+/// Runs the sweep's runs as `o` says and writes their rows and the table. A run that cannot be
+/// built (a drawn value out of range) or fails is a row with its status, never an exception; an
+/// unwritable DIR throws rths::Error.
+SweepOutcome RunSweep(const Spec& spec, const SweepOptions& o);
+
+/// The table's columns: index, status, scenario_sha256, each grid and drawn key, each recorded field.
+std::vector<std::string> TableColumns(const Spec& spec);
+
+}  // namespace rths::sweep
