@@ -112,8 +112,12 @@ SweepOutcome RunSweep(const Spec& spec, const SweepOptions& o) {
   SweepOutcome outcome;
   std::vector<std::int64_t> todo;
   const std::int64_t first = o.only.value_or(0), last = o.only ? *o.only + 1 : spec.runs();
+  if (o.chunks < 1 || o.chunk < 0 || o.chunk >= o.chunks) {
+    throw Error("--chunk", fmt::format("{} of {}: needs 0 <= chunk < chunks", o.chunk, o.chunks));
+  }
   for (std::int64_t i = first; i < last; ++i) {
     PointOf(spec, i);  // throws for an index out of range
+    if (i % o.chunks != o.chunk) continue;
     if (o.resume && !ReadJson(RowPath(o.out, i)).is_null()) {
       ++outcome.skipped;
       continue;

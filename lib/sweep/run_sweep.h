@@ -22,6 +22,8 @@ struct SweepOptions {
   std::filesystem::path out;          ///< DIR (created)
   int jobs = 1;                       ///< runs at a time, >= 1
   std::optional<std::int64_t> only;   ///< run only this index (re-made alone, bit for bit)
+  /// Run only the indices i with i % chunks == chunk (one task of a job array), 0 <= chunk < chunks.
+  std::int64_t chunk = 0, chunks = 1;
   bool resume = false;                ///< skip runs whose row is already in DIR/rows
   bool keep_logs = false;             ///< keep each run's log.lcm and signals.csv
   ProgressLine* progress = nullptr;   ///< progress with ETA (optional)
