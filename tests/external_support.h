@@ -7,7 +7,9 @@
 #include <signal.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -110,6 +112,38 @@ inline int RunWithExternalPlant(const fs::path& dir, const std::string& run_args
   return WaitExternalRun(run, dir / "out")["exit_code"].get<int>();
 }
 
+/// Runs the linear servo without a specimen (0.5 s, 1000 steps) with `plant` as the external
+/// plant, and in one process with the built-in plant; checks the run completed (else shows what
+/// the plant printed), its log is complete, f is 0 and the current the same in both, and the
+/// actuator moves; returns the peak |y difference| over the run [mm].
+inline double ExternalLinearPlantDeviation(const fs::path& dir, const std::string& name, const PlantCommand& plant) {
+  const fs::path scenario = WriteScenario(dir, "[run]\nname = \"" + name +
+                                                   "\"\nduration_s = 0.5\n[plant]\nkind = \"linear\"\nactuator = "
+                                                   "\"avg\"\nspecimen = \"none\"\n");
+  const fs::path ref = dir / "reference";
+  fs::create_directories(ref);
+  REQUIRE(RunMemq({rths::scenario::LoadScenario(scenario.string())}, ref).code == 0);
+  const int code = RunWithExternalPlant(dir, "--join-timeout-s 60 --out " + (dir / "out").string() + " " +
+                                                 scenario.string(),
+                                        "", "", "", plant);
+  REQUIRE_MESSAGE(code == 0, "the plant said:\n" << ReadFile(dir / "plant.out"));
+  const auto j = nlohmann::json::parse(ReadFile(dir / "out" / "summary.json"));
+  CHECK(j["participants"]["plant"]["external"] == true);
+  const auto a = rths::io::ReadRunLog((ref / "log.lcm").string());
+  const auto b = rths::io::ReadRunLog((dir / "out" / "log.lcm").string());
+  REQUIRE(b.Complete());
+  REQUIRE(b.CompleteSteps() == 1000);
+  double peak_dy = 0, peak_y = 0;
+  for (std::int64_t k = 0; k < 1000; ++k) {
+    peak_dy = std::max(peak_dy, std::abs(a.measured[k].y_mm - b.measured[k].y_mm));
+    peak_y = std::max(peak_y, std::abs(a.measured[k].y_mm));
+    CHECK(b.measured[k].f_kN == 0.0);
+    CHECK(b.measured[k].current_A == a.measured[k].current_A);
+  }
+  CHECK(peak_y > 0.1);  // the test moves the actuator
+  return peak_dy;
+}
+
 /// A network namespace pair joined by a veth pair, removed on destruction (even if a check fails).
 struct NetnsPair {
   std::string a, b, va, vb;
@@ -129,8 +163,13 @@ struct NetnsPair {
         "; for n in " + a + " " + b + "; do ip -n $n link set lo up; done; ip -n " + a + " link set " + va +
         " up multicast on; ip -n " + b + " link set " + vb + " up multicast on; ip -n " + a +
         " route add 224.0.0.0/4 dev " + va + "; ip -n " + b + " route add 224.0.0.0/4 dev " + vb;
-    ok = std::system(("bash -c '" + cmd + "' 2>" + (fs::temp_directory_path() / "rths_netns.err").string()).c_str()) == 0;
+    ok = std::system(("bash -c '" + cmd + "' 2>" + ErrorFile().string()).c_str()) == 0;
   }
+  /// Why the pair could not be made (for a failed ok).
+  static std::string Error() {
+    return "cannot create network namespaces and a veth pair (needs root / CAP_NET_ADMIN): " + ReadFile(ErrorFile());
+  }
+  static fs::path ErrorFile() { return fs::temp_directory_path() / "rths_netns.err"; }
   ~NetnsPair() {
     std::system(("ip netns del " + a + " 2>/dev/null; ip netns del " + b + " 2>/dev/null").c_str());
   }

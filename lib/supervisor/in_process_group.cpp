@@ -1,5 +1,7 @@
 #include "supervisor/in_process_group.h"
 
+#include <optional>
+
 #include "participants/replay.h"
 
 namespace rths::supervisor {
@@ -10,8 +12,13 @@ std::vector<participants::Outcome> RunInProcessGroup(const scenario::Scenario& s
                                                      const volatile std::sig_atomic_t* stop,
                                                      lockstep::RealtimeSetup* setup) {
   const bool bridged = external && !external->roles.empty();
-  scenario::Scenario joined = s;  // how long the user's participants may take to say HELLO
-  if (bridged && external->join_timeout_s > 0) joined.lockstep.handshake_timeout_s = external->join_timeout_s;
+  // How long the user's participants may take to say HELLO: a copy of the scenario only then.
+  std::optional<scenario::Scenario> waiting;
+  if (bridged && external->join_timeout_s > 0) {
+    waiting = s;
+    waiting->lockstep.handshake_timeout_s = external->join_timeout_s;
+  }
+  const scenario::Scenario& joined = waiting ? *waiting : s;
   if (replay) {
     return participants::RunReplay(joined, *replay->record, replay->steps, replay->live, run_id, out_dir, stop,
                                    bridged ? external->roles : std::vector<std::string>{}, udpm_url);
