@@ -1,9 +1,14 @@
 // rths-sweep: a study of the user's own (issue 28): the runs a SPEC defines (lib/sweep/spec.h), on
-// this machine, `--jobs` at a time, one row per run and a table (lib/sweep/run_sweep.h).
+// this machine `--jobs` at a time (lib/sweep/run_sweep.h) or as a Slurm job array
+// (lib/sweep/slurm.h), one row per run and a table.
 //
-//   rths sweep SPEC.toml [--out DIR] [--jobs N] [--only INDEX] [--resume] [--keep-logs] [--chunk C --chunks N]
-//
-// The Slurm executor, the HDF5 table, the per-group summary and the plots are not built yet.
+//   rths sweep SPEC.toml [--out DIR] [--jobs N] [--only INDEX] [--resume] [--keep-logs]
+//   rths sweep SPEC.toml --executor slurm --out DIR [--partition P] [--time T] [--account A]
+//                        [--runs-per-task R] [--cpus-per-task C] [--retries N] [--detach] [--resume]
+//   rths sweep --collect DIR [--retries N]
+//   rths sweep SPEC.toml --out DIR --task --chunk C --chunks N   (what one array task runs)
+#include <unistd.h>
+
 #include <cstdio>
 #include <string>
 #include <thread>
@@ -15,51 +20,139 @@
 #include "io/output_folder.h"
 #include "lockstep/exit_code.h"
 #include "sweep/run_sweep.h"
+#include "sweep/slurm.h"
+
+namespace {
+
+struct Args {
+  std::string spec_path, out, executor = "local", collect;
+  int jobs = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  std::int64_t only = -1, chunk = 0, chunks = 1;
+  bool resume = false, keep_logs = false, task = false, detach = false;
+  // Slurm: flags override the SPEC's [slurm]; unset (empty, -1) keeps it.
+  std::string partition, time, account;
+  std::int64_t runs_per_task = -1;
+  int cpus_per_task = -1, retries = -1;
+  double poll_s = 2.0;
+};
+
+std::string SelfPath() {
+  std::error_code ec;
+  const auto p = std::filesystem::read_symlink("/proc/self/exe", ec);
+  if (ec) throw rths::Error("--executor slurm", "cannot find this program's path (/proc/self/exe)");
+  return p.string();
+}
+
+rths::sweep::SlurmRunOptions SlurmOptions(const Args& a, const rths::sweep::Spec* spec) {
+  rths::sweep::SlurmRunOptions o;
+  o.out = std::filesystem::absolute(a.out.empty() ? a.collect : a.out);
+  if (spec) o.settings = spec->slurm;
+  if (!a.partition.empty()) o.settings.partition = a.partition;
+  if (!a.time.empty()) o.settings.time = a.time;
+  if (!a.account.empty()) o.settings.account = a.account;
+  if (a.runs_per_task > 0) o.settings.runs_per_task = a.runs_per_task;
+  if (a.cpus_per_task > 0) o.settings.cpus_per_task = a.cpus_per_task;
+  if (a.retries >= 0) o.settings.retries = a.retries;
+  o.sweep_program = SelfPath();
+  o.programs.sbatch = rths::tools::ProgramOnPath("sbatch");
+  o.programs.squeue = rths::tools::ProgramOnPath("squeue");
+  o.programs.scontrol = rths::tools::ProgramOnPath("scontrol");
+  o.keep_logs = a.keep_logs;
+  o.detach = a.detach;
+  o.resume = a.resume;
+  o.poll_s = a.poll_s;
+  o.say = [](const std::string& line) {
+    std::printf("%s\n", line.c_str());
+    std::fflush(stdout);
+  };
+  return o;
+}
+
+int Report(const rths::sweep::SlurmOutcome& r, const std::string& out) {
+  if (r.detached) {
+    std::printf("detached: collect the sweep with: rths sweep --collect %s\n", out.c_str());
+    return 0;
+  }
+  std::printf("rows %lld/%lld, not completed %lld, array tasks still failing %zu\ntable: %s\n",
+              static_cast<long long>(r.rows), static_cast<long long>(r.runs), static_cast<long long>(r.not_completed),
+              r.failed_tasks.size(), r.table.string().c_str());
+  return r.rows < r.runs || r.not_completed > 0 ? 1 : 0;
+}
+
+int RunLocal(const Args& a, const rths::sweep::Spec& spec) {
+  rths::sweep::SweepOptions o;
+  o.out = a.out.empty() ? rths::io::NewOutputFolder("sweep-" + spec.name) : std::filesystem::path(a.out);
+  o.jobs = a.jobs;
+  if (a.only >= 0) o.only = a.only;
+  o.resume = a.resume || a.task;
+  o.keep_logs = a.keep_logs;
+  o.chunk = a.chunk;
+  o.chunks = a.chunks;
+  o.write_table = !a.task;
+  rths::ProgressLine line("rths sweep", !a.task && rths::ProgressLine::StderrIsTerminal());
+  o.progress = &line;
+  std::printf("rths sweep: %s: %lld runs (%zu cases x %lld grid points x %lld draws), %d at a time\n",
+              spec.path.c_str(), static_cast<long long>(spec.runs()), spec.cases.size(),
+              static_cast<long long>(spec.combinations()), static_cast<long long>(std::max<std::int64_t>(spec.draws, 1)),
+              a.jobs);
+  std::fflush(stdout);
+  const auto r = rths::sweep::RunSweep(spec, o);
+  std::printf("ran %lld, skipped %lld (rows already there), not completed %lld\n", static_cast<long long>(r.ran),
+              static_cast<long long>(r.skipped), static_cast<long long>(r.failed));
+  if (!r.table.empty()) std::printf("table: %s\n", r.table.string().c_str());
+  return r.failed > 0 ? 1 : 0;
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"rths sweep: run a SPEC's grid, cases and random draws on this machine; a row per run and a table"};
+  CLI::App app{"rths sweep: run a SPEC's grid, cases and random draws on this machine or on Slurm; a row per run and a table"};
   rths::tools::NameCommand(app, "sweep");
-  std::string spec_path, out;
-  int jobs = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-  std::int64_t only = -1;
-  bool resume = false, keep_logs = false;
-  std::int64_t chunk = 0, chunks = 1;
-  app.add_option("spec", spec_path, "the sweep's SPEC (TOML; lib/sweep/spec.h)")->required();
-  app.add_option("--out", out, "output folder (default: runs/<time>-sweep-<name>)");
-  app.add_option("--jobs", jobs, "runs at a time (default: every core)")->check(CLI::Range(1, 4096));
-  app.add_option("--only", only, "make run INDEX alone (bit for bit as in the whole sweep)")
+  Args a;
+  app.add_option("spec", a.spec_path, "the sweep's SPEC (TOML; lib/sweep/spec.h)");
+  app.add_option("--out", a.out, "output folder (default: runs/<time>-sweep-<name>; with slurm: required, shared with the nodes)");
+  app.add_option("--executor", a.executor, "where the runs run: local (this machine) or slurm (a job array)")
+      ->check(CLI::IsMember({"local", "slurm"}));
+  app.add_option("--jobs", a.jobs, "local: runs at a time (default: every core)")->check(CLI::Range(1, 4096));
+  app.add_option("--only", a.only, "make run INDEX alone (bit for bit as in the whole sweep)")
       ->check(CLI::Range(std::int64_t{0}, std::int64_t{1} << 40));
-  app.add_flag("--resume", resume, "skip the runs whose row is already in OUT/rows (needs --out)");
-  app.add_flag("--keep-logs", keep_logs, "keep every run's log.lcm and signals.csv");
-  app.add_option("--chunk", chunk, "run only the indices i with i % CHUNKS == CHUNK (one task of a job array)")
+  app.add_flag("--resume", a.resume, "run (local) or submit (slurm) only the runs with no row in OUT/rows yet");
+  app.add_flag("--keep-logs", a.keep_logs, "keep every run's log.lcm and signals.csv");
+  app.add_option("--chunk", a.chunk, "run only the indices i with i % CHUNKS == CHUNK (one task of a job array)")
       ->check(CLI::Range(std::int64_t{0}, std::int64_t{1} << 40));
-  app.add_option("--chunks", chunks, "the number of chunks the sweep is split into")
+  app.add_option("--chunks", a.chunks, "the number of chunks the sweep is split into")
       ->check(CLI::Range(std::int64_t{1}, std::int64_t{1} << 40));
-  app.footer("Exit codes: 0 every run completed; 1 some runs did not (their rows say why); 2 bad input.");
+  app.add_flag("--task", a.task, "run as one array task: --resume, no table, no progress line");
+  app.add_option("--partition", a.partition, "slurm: sbatch --partition (overrides the SPEC's [slurm])");
+  app.add_option("--time", a.time, "slurm: time limit per array task, e.g. 00:30:00");
+  app.add_option("--account", a.account, "slurm: sbatch --account");
+  app.add_option("--runs-per-task", a.runs_per_task, "slurm: runs per array task (default 25, at most 1000 tasks)")
+      ->check(CLI::Range(std::int64_t{1}, rths::sweep::kMaxRuns));
+  app.add_option("--cpus-per-task", a.cpus_per_task, "slurm: cores per array task (its runs at a time)")
+      ->check(CLI::Range(1, 4096));
+  app.add_option("--retries", a.retries, "slurm: times a task that left runs without rows is submitted again (default 1)")
+      ->check(CLI::Range(0, 100));
+  app.add_flag("--detach", a.detach, "slurm: submit and return; then `rths sweep --collect OUT`");
+  app.add_option("--collect", a.collect, "slurm: wait for a detached sweep in DIR, retry, write its table");
+  app.add_option("--poll-s", a.poll_s, "slurm: seconds between squeue calls while waiting")->check(CLI::Range(0.05, 600.0));
+  app.footer("Exit codes: 0 every run completed; 1 some runs did not (their rows, or the missing tasks, say why); 2 bad input.");
   if (const int code = rths::tools::ParseCommandLine(app, argc, argv); code >= 0) return code;
   try {
-    const rths::sweep::Spec spec = rths::sweep::LoadSpec(spec_path);
-    if (resume && out.empty()) throw rths::Error("--resume", "needs --out DIR, the sweep's folder to resume");
-    rths::sweep::SweepOptions o;
-    o.out = out.empty() ? rths::io::NewOutputFolder("sweep-" + spec.name) : std::filesystem::path(out);
-    o.jobs = jobs;
-    if (only >= 0) o.only = only;
-    o.resume = resume;
-    o.keep_logs = keep_logs;
-    o.chunk = chunk;
-    o.chunks = chunks;
-    rths::ProgressLine line("rths sweep");
-    o.progress = &line;
-    std::printf("rths sweep: %s: %lld runs (%zu cases x %lld grid points x %lld draws), %d at a time\n",
-                spec_path.c_str(), static_cast<long long>(spec.runs()), spec.cases.size(),
-                static_cast<long long>(spec.combinations()), static_cast<long long>(std::max<std::int64_t>(spec.draws, 1)),
-                jobs);
+    if (!a.collect.empty()) {
+      if (!a.spec_path.empty()) throw rths::Error("--collect", "takes the sweep's folder only, not a SPEC");
+      return Report(rths::sweep::CollectSweep(SlurmOptions(a, nullptr), a.retries), a.collect);
+    }
+    if (a.spec_path.empty()) throw rths::Error("rths sweep", "needs a SPEC (or --collect DIR)");
+    const rths::sweep::Spec spec = rths::sweep::LoadSpec(a.spec_path);
+    if (a.resume && a.out.empty()) throw rths::Error("--resume", "needs --out DIR, the sweep's folder to resume");
+    if (a.executor == "local") return RunLocal(a, spec);
+    if (a.out.empty()) throw rths::Error("--executor slurm", "needs --out DIR on a filesystem the compute nodes share");
+    if (a.only >= 0 || a.task || a.chunks != 1) {
+      throw rths::Error("--executor slurm", "--only, --task and --chunk/--chunks are for the local executor");
+    }
+    std::printf("rths sweep: %s: %lld runs on Slurm\n", spec.path.c_str(), static_cast<long long>(spec.runs()));
     std::fflush(stdout);
-    const auto r = rths::sweep::RunSweep(spec, o);
-    std::printf("ran %lld, skipped %lld (rows already there), not completed %lld\ntable: %s\n",
-                static_cast<long long>(r.ran), static_cast<long long>(r.skipped), static_cast<long long>(r.failed),
-                r.table.string().c_str());
-    return r.failed > 0 ? 1 : 0;
+    return Report(rths::sweep::RunSweepOnSlurm(spec, SlurmOptions(a, &spec)), a.out);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "rths sweep: %s\n", e.what());
     return rths::lockstep::kExitUsage;

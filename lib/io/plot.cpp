@@ -1,8 +1,5 @@
 #include "io/plot.h"
 
-#include <sys/wait.h>
-#include <unistd.h>
-
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
@@ -15,6 +12,7 @@
 #include <fmt/format.h>
 
 #include "core/error.h"
+#include "io/command.h"
 
 namespace rths::io {
 
@@ -30,60 +28,6 @@ bool ValidName(const std::string& s) {
     if (!ok) return false;
   }
   return true;
-}
-
-/// Folders a program named without a path is looked for in: the system's own. The user's PATH is
-/// read by the main program, which passes a path (tools/cli.h ProgramOnPath).
-constexpr const char* kProgramDirs[] = {"/usr/local/bin", "/usr/bin", "/bin"};
-
-std::string FindProgram(const std::string& program) {
-  if (program.find('/') != std::string::npos) {
-    return ::access(program.c_str(), X_OK) == 0 ? program : "";
-  }
-  for (const char* dir : kProgramDirs) {
-    const std::string candidate = std::string(dir) + "/" + program;
-    if (::access(candidate.c_str(), X_OK) == 0 && fs::is_regular_file(candidate)) return candidate;
-  }
-  return "";
-}
-
-// Runs `exe script` in `dir`; returns the exit status and everything it printed.
-int RunIn(const fs::path& dir, const std::string& exe, const std::string& script, std::string* output) {
-  int pipefd[2];
-  if (::pipe(pipefd) != 0) throw Error("gnuplot", "pipe failed");
-  const pid_t pid = ::fork();
-  if (pid < 0) {
-    ::close(pipefd[0]);
-    ::close(pipefd[1]);
-    throw Error("gnuplot", "fork failed");
-  }
-  if (pid == 0) {
-    ::dup2(pipefd[1], 1);
-    ::dup2(pipefd[1], 2);
-    ::close(pipefd[0]);
-    ::close(pipefd[1]);
-    if (::chdir(dir.c_str()) != 0) ::_exit(126);
-    ::execl(exe.c_str(), exe.c_str(), script.c_str(), static_cast<char*>(nullptr));
-    ::_exit(127);
-  }
-  ::close(pipefd[1]);
-  char buf[4096];
-  for (;;) {
-    const ssize_t got = ::read(pipefd[0], buf, sizeof buf);
-    if (got > 0) {
-      output->append(buf, static_cast<std::size_t>(got));
-    } else if (got < 0 && errno == EINTR) {
-      continue;
-    } else {
-      break;
-    }
-  }
-  ::close(pipefd[0]);
-  int status = 0;
-  while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
-  }
-  if (WIFEXITED(status)) return WEXITSTATUS(status);
-  return 128 + (WIFSIGNALED(status) ? WTERMSIG(status) : 0);
 }
 
 std::string Num(double v) { return fmt::format("{:.10g}", v); }
@@ -330,8 +274,9 @@ PlotFiles Plot(const Figure& fig, const fs::path& dir) {
 
   std::error_code ec;
   fs::remove(files.png, ec);
-  std::string output;
-  const int code = RunIn(dir, exe, fig.name + ".gp", &output);
+  const CommandResult run = RunCommand({exe, fig.name + ".gp"}, dir);
+  const int code = run.status;
+  const std::string& output = run.output;
   if (code == 127) throw Error(where, fmt::format("cannot run {}: install gnuplot (apt-get install gnuplot-nox)", exe));
   if (code != 0) {
     throw Error(where, fmt::format("gnuplot failed (exit {}) on {}:\n{}", code, files.gp.string(), output));

@@ -78,8 +78,10 @@ std::string Cell(const nlohmann::json& v) {
   return q + "\"";
 }
 
-/// DIR/table.csv from every row present in DIR/rows.
-void WriteTable(const Spec& spec, const fs::path& out, const fs::path& table) {
+}  // namespace
+
+fs::path WriteTable(const Spec& spec, const fs::path& out) {
+  const fs::path table = out / "table.csv";
   std::ostringstream csv;
   const auto columns = TableColumns(spec);
   for (std::size_t c = 0; c < columns.size(); ++c) csv << (c ? "," : "") << columns[c];
@@ -94,9 +96,16 @@ void WriteTable(const Spec& spec, const fs::path& out, const fs::path& table) {
     csv << "\n";
   }
   if (!io::OverwriteFile(table.string(), csv.str())) throw Error(table.string(), "cannot write the sweep's table");
+  return table;
 }
 
-}  // namespace
+std::vector<std::int64_t> MissingRows(const Spec& spec, const fs::path& out, std::int64_t chunk, std::int64_t chunks) {
+  std::vector<std::int64_t> missing;
+  for (std::int64_t i = chunk; i < spec.runs(); i += chunks) {
+    if (ReadJson(RowPath(out, i)).is_null()) missing.push_back(i);
+  }
+  return missing;
+}
 
 std::vector<std::string> TableColumns(const Spec& spec) {
   std::vector<std::string> c = {"index", "status", "scenario_sha256"};
@@ -154,8 +163,7 @@ SweepOutcome RunSweep(const Spec& spec, const SweepOptions& o) {
     ++outcome.ran;
     if (!results[r].ok) ++outcome.failed;
   }
-  outcome.table = o.out / "table.csv";
-  WriteTable(spec, o.out, outcome.table);
+  if (o.write_table) outcome.table = WriteTable(spec, o.out);
   return outcome;
 }
 

@@ -26,6 +26,7 @@ struct SweepOptions {
   std::int64_t chunk = 0, chunks = 1;
   bool resume = false;                ///< skip runs whose row is already in DIR/rows
   bool keep_logs = false;             ///< keep each run's log.lcm and signals.csv
+  bool write_table = true;            ///< write the table at the end (not in an array task: the collector does)
   ProgressLine* progress = nullptr;   ///< progress with ETA (optional)
 };
 
@@ -38,6 +39,14 @@ struct SweepOutcome {
 /// built (a drawn value out of range) or fails is a row with its status, never an exception; an
 /// unwritable DIR throws rths::Error.
 SweepOutcome RunSweep(const Spec& spec, const SweepOptions& o);
+
+/// Writes DIR/table.csv from every row present in DIR/rows, by index; returns its path. Throws
+/// rths::Error if it cannot be written.
+std::filesystem::path WriteTable(const Spec& spec, const std::filesystem::path& out);
+
+/// The indices i of chunk `chunk` of `chunks` (i % chunks == chunk) with no row in DIR/rows.
+std::vector<std::int64_t> MissingRows(const Spec& spec, const std::filesystem::path& out, std::int64_t chunk,
+                                      std::int64_t chunks);
 
 /// The table's columns: index, status, scenario_sha256, each grid and drawn key, each recorded field.
 std::vector<std::string> TableColumns(const Spec& spec);

@@ -138,6 +138,37 @@ void ParseSweepTable(const toml::table& root, const std::string& path, Spec* spe
   if (const auto base = (*sweep)["base"].value<std::string>()) spec->cases.push_back(Resolve(path, *base));
 }
 
+void ParseSlurmTable(const toml::table& slurm, const std::string& path, SlurmSettings* out) {
+  for (const auto& [k, v] : slurm) {
+    const std::string key(k.str());
+    const std::string where = path + ": slurm." + key;
+    if (key == "partition" || key == "time" || key == "account") {
+      const auto s = v.value<std::string>();
+      if (!s) throw Error(where, "must be a string");
+      (key == "partition" ? out->partition : key == "time" ? out->time : out->account) = *s;
+    } else if (key == "runs_per_task" || key == "cpus_per_task" || key == "retries") {
+      const auto n = v.value<std::int64_t>();
+      const std::int64_t hi = key == "runs_per_task" ? kMaxRuns : key == "cpus_per_task" ? 4096 : 100;
+      const std::int64_t lo = key == "retries" ? 0 : 1;
+      if (!n || *n < lo || *n > hi) throw Error(where, fmt::format("must be an integer in [{}, {}]", lo, hi));
+      if (key == "runs_per_task") out->runs_per_task = *n;
+      if (key == "cpus_per_task") out->cpus_per_task = static_cast<int>(*n);
+      if (key == "retries") out->retries = static_cast<int>(*n);
+    } else if (key == "sbatch_args") {
+      const auto* a = v.as_array();
+      if (!a) throw Error(where, "must be an array of sbatch options, e.g. [\"--qos=short\"]");
+      for (const auto& x : *a) {
+        const auto s = x.value<std::string>();
+        if (!s || s->rfind("-", 0) != 0) throw Error(where, "each entry must be one sbatch option starting with '-'");
+        out->sbatch_args.push_back(*s);
+      }
+    } else {
+      throw Error(where, "unknown key; allowed: partition, time, account, runs_per_task, cpus_per_task, retries, "
+                         "sbatch_args");
+    }
+  }
+}
+
 }  // namespace
 
 std::uint64_t SplitMix64(std::uint64_t* state) {
@@ -166,8 +197,8 @@ Spec ParseSpec(const std::string& text, const std::string& path) {
   }
   for (const auto& [k, v] : root) {
     const std::string key(k.str());
-    if (key != "sweep" && key != "cases" && key != "grid" && key != "draw") {
-      throw Error(path + ": " + key, "unknown table; allowed: [sweep], [cases], [grid], [draw]");
+    if (key != "sweep" && key != "cases" && key != "grid" && key != "draw" && key != "slurm") {
+      throw Error(path + ": " + key, "unknown table; allowed: [sweep], [cases], [grid], [draw], [slurm]");
     }
   }
   Spec spec;
@@ -203,6 +234,7 @@ Spec ParseSpec(const std::string& text, const std::string& path) {
       spec.draw.push_back(ParseDraw(std::string(k.str()), v, fmt::format("{}: draw.\"{}\"", path, k.str())));
     }
   }
+  if (const auto* slurm = root["slurm"].as_table()) ParseSlurmTable(*slurm, path, &spec.slurm);
   if (!spec.draw.empty() && spec.draws == 0) {
     throw Error(path + ": sweep.draws", "[draw] needs sweep.draws >= 1 (the runs per grid point)");
   }

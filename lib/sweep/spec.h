@@ -17,6 +17,10 @@
 ///     [draw]                                   # drawn anew for each run
 ///     "structure.damping_ratio" = { dist = "normal", mean = 0.02, std = 0.002 }
 ///     "plant.noise_seed" = { dist = "seed" }
+///     [slurm]                                  # optional: for --executor slurm (lib/sweep/slurm.h)
+///     partition = "normal"
+///     time = "00:30:00"                        # per array task
+///     runs_per_task = 25
 ///
 /// Run order (index 0 .. runs()-1): case (slowest), then the grid's combinations (keys in sorted
 /// order, the first key slowest), then the draw (fastest). Run i's values are `--set KEY=VALUE`
@@ -43,6 +47,18 @@ struct Axis {
   std::vector<std::string> values;
 };
 
+/// `[slurm]`: how `rths sweep --executor slurm` submits the sweep (lib/sweep/slurm.h); flags of
+/// the same names override it. Empty strings leave sbatch's (the cluster's) defaults.
+struct SlurmSettings {
+  std::string partition;              ///< sbatch --partition
+  std::string time;                   ///< sbatch --time per array task, e.g. "00:30:00"
+  std::string account;                ///< sbatch --account
+  std::int64_t runs_per_task = 0;     ///< runs per array task (0: 25, raised to keep <= 1000 tasks)
+  int cpus_per_task = 1;              ///< sbatch --cpus-per-task; each task runs that many runs at a time
+  int retries = 1;                    ///< times a task whose runs left no row is submitted again
+  std::vector<std::string> sbatch_args;  ///< more sbatch options, e.g. ["--qos=short", "--mem=2G"]
+};
+
 /// A parsed, validated SPEC (paths absolute).
 struct Spec {
   std::string path;                 ///< the SPEC file
@@ -53,6 +69,7 @@ struct Spec {
   std::vector<std::string> record;  ///< summary.json fields recorded per run
   std::vector<Axis> grid;           ///< sorted by key
   std::vector<Draw> draw;           ///< sorted by key
+  SlurmSettings slurm;              ///< [slurm]
 
   /// Grid combinations (1 without a grid).
   std::int64_t combinations() const;

@@ -1,0 +1,78 @@
+#pragma once
+/// @file The Slurm executor of a sweep (`rths sweep SPEC --executor slurm`, issue 28): the sweep's
+/// runs as one job array, Slurm doing all the scheduling; no daemon of ours.
+///
+/// The runs are split into T chunks (runs_per_task each, T <= kMaxArrayTasks); array task c runs
+/// the indices i with i % T == c by calling this same program on the compute node:
+///
+///     rths-sweep SPEC --out DIR --task --chunk c --chunks T --jobs $SLURM_CPUS_PER_TASK
+///
+/// which writes DIR/rows/<i>.json as each run ends (lib/sweep/run_sweep.h) and skips rows already
+/// there. DIR must therefore be on a filesystem the compute nodes share with the submitting host
+/// (docs/cluster.md). The rows are the only record of what is done: a task that was cancelled,
+/// timed out or lost its node leaves rows missing; the collector finds them, names the task with
+/// what Slurm says of it (scontrol: state, exit code) and its output file, and submits those
+/// tasks again (`retries` times). The table is written once every task has ended.
+///
+/// Files: DIR/slurm/task.sh (the array's batch script), DIR/slurm/task-<job>_<c>.out (each task's
+/// output), DIR/slurm/sweep.json (the SPEC's path, T, the jobs submitted, retries left: what
+/// `rths sweep --collect DIR` needs after `--detach`).
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "sweep/spec.h"
+
+namespace rths::sweep {
+
+/// The most array tasks one sweep submits (Slurm's default MaxArraySize is 1001).
+inline constexpr std::int64_t kMaxArrayTasks = 1000;
+/// Runs per array task when neither the SPEC nor a flag says.
+inline constexpr std::int64_t kDefaultRunsPerTask = 25;
+
+/// The Slurm commands, as paths (the main program finds them on PATH: `module load slurm`).
+struct SlurmPrograms {
+  std::string sbatch = "sbatch", squeue = "squeue", scontrol = "scontrol";
+};
+
+struct SlurmRunOptions {
+  std::filesystem::path out;           ///< DIR, shared with the compute nodes (created)
+  SlurmSettings settings;              ///< the SPEC's [slurm], flags applied
+  std::string sweep_program;           ///< absolute path of rths-sweep, as the compute nodes see it
+  SlurmPrograms programs;
+  bool keep_logs = false;              ///< passed to the tasks
+  bool resume = false;                 ///< DIR may hold rows already (else it must have none)
+  bool detach = false;                 ///< submit, write sweep.json and return
+  double poll_s = 2.0;                 ///< squeue every poll_s while waiting [s]
+  std::function<void(const std::string&)> say;  ///< progress and failures, a line each (optional)
+};
+
+struct SlurmOutcome {
+  std::int64_t runs = 0;               ///< the sweep's runs
+  std::int64_t rows = 0;               ///< rows present at the end
+  std::int64_t not_completed = 0;      ///< rows whose status is not "completed"
+  std::int64_t chunks = 0;             ///< T
+  std::vector<std::int64_t> failed_tasks;  ///< array tasks whose runs still lack rows
+  std::vector<std::string> job_ids;    ///< every submission of this call, in order
+  bool detached = false;
+  std::filesystem::path table;         ///< DIR/table.csv (not written when detached)
+};
+
+/// The chunk count T for `runs` runs: ceil(runs / runs_per_task) (kDefaultRunsPerTask when 0),
+/// at most kMaxArrayTasks.
+std::int64_t ChunkCount(std::int64_t runs, std::int64_t runs_per_task);
+
+/// Submits the array tasks whose runs have no row in DIR/rows yet (every task of a new DIR; only
+/// the unfinished ones of a resumed one), then, unless detached, waits, submits failed tasks
+/// again up to settings.retries times and writes the table. Throws rths::Error if sbatch refuses
+/// the job (with its message) or DIR cannot be written.
+SlurmOutcome RunSweepOnSlurm(const Spec& spec, const SlurmRunOptions& o);
+
+/// `rths sweep --collect DIR`: for a sweep submitted with --detach, waits for its last job,
+/// submits failed tasks again (the retries sweep.json has left, or `retries` if >= 0) and writes
+/// the table. o.out is DIR; o.settings is taken from sweep.json.
+SlurmOutcome CollectSweep(SlurmRunOptions o, int retries = -1);
+
+}  // namespace rths::sweep

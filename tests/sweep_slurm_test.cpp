@@ -1,0 +1,130 @@
+// A sweep on a real Slurm (issue 28): a one-node cluster started here (tests/slurm/one_node.sh:
+// Debian's munged, slurmctld and slurmd, configured in a temp folder, no cgroups), 40 runs in 8
+// array tasks through `rths sweep --executor slurm`, the table equal byte for byte to the local
+// executor's; one array task cancelled makes its runs fail visibly, and a retry, then --resume,
+// complete them. The daemons are stopped whatever happens.
+#include <doctest/doctest.h>
+
+#include <chrono>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "io/command.h"
+#include "sweep/run_sweep.h"
+#include "test_support.h"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+const std::string kScript = std::string(RTHS_SOURCE_DIR) + "/tests/slurm/one_node.sh";
+
+/// The cluster of one test; stopped by the destructor.
+struct OneNodeSlurm {
+  fs::path dir;
+  bool up = false;
+  std::string log;
+  explicit OneNodeSlurm(fs::path d) : dir(std::move(d)) {
+    const auto r = rths::io::RunCommand({"/bin/bash", kScript, "start", dir.string()});
+    log = r.output;
+    up = r.status == 0;
+    if (up) ::setenv("SLURM_CONF", (dir / "slurm.conf").c_str(), 1);
+  }
+  ~OneNodeSlurm() {
+    rths::io::RunCommand({"/bin/bash", kScript, "stop", dir.string()});
+    ::unsetenv("SLURM_CONF");
+  }
+};
+
+rths::io::CommandResult Sweep(const std::vector<std::string>& args) {
+  std::vector<std::string> argv = {std::string(RTHS_BIN_DIR) + "/rths-sweep"};
+  argv.insert(argv.end(), args.begin(), args.end());
+  return rths::io::RunCommand(argv);
+}
+
+double Seconds(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+}  // namespace
+
+TEST_CASE("a sweep on a one-node Slurm: the local table, a cancelled task seen, retried and resumed" *
+          doctest::skip(!rths_test::IsRoot())) {
+  for (const char* tool : {"munged", "slurmctld", "slurmd"}) {
+    REQUIRE_MESSAGE(!rths::io::FindProgram(tool).empty(),
+                    tool << " is not installed: apt-get install slurmctld slurmd slurm-client munge "
+                            "(scripts/bootstrap.sh installs them)");
+  }
+  for (const char* tool : {"sbatch", "squeue", "scontrol", "scancel"}) rths_test::RequireTool(tool, "slurm-client");
+  rths_test::RequireBuilt("rths-sweep");
+  const fs::path dir = rths_test::TempDir("sweep_slurm");
+  const fs::path base = rths_test::WriteScenario(dir, "[run]\nname = \"sweep_base\"\nduration_s = 0.05\n");
+  const fs::path spec_path = dir / "spec.toml";
+  std::ofstream(spec_path) << "[sweep]\nname = \"slurm_ci\"\nbase = \"" << base.string() << "\"\nseed = 11\ndraws = 5\n"
+                           << "record = [\"tracking_nrmse_pct\", \"peak_force_kN\", \"steps\", \"status\"]\n"
+                           << "[grid]\n\"controller.kind\" = [\"none\", \"ff\"]\n"
+                           << "\"structure.damping_ratio\" = [0.02, 0.05, 0.1, 0.2]\n"
+                           << "[draw]\n\"plant.noise_seed\" = { dist = \"seed\" }\n"
+                           << "\"structure.frequency_hz\" = { dist = \"normal\", mean = 1.0, std = 0.1 }\n"
+                           << "[slurm]\nruns_per_task = 5\nretries = 0\n";
+  const auto spec = rths::sweep::LoadSpec(spec_path.string());
+  REQUIRE(spec.runs() == 40);
+
+  // The local executor's table.
+  rths::sweep::SweepOptions local;
+  local.out = dir / "local";
+  local.jobs = 2;
+  auto t0 = std::chrono::steady_clock::now();
+  REQUIRE(rths::sweep::RunSweep(spec, local).failed == 0);
+  const double local_s = Seconds(t0);
+  const std::string local_table = rths_test::Slurp(local.out / "table.csv");
+
+  OneNodeSlurm slurm(dir / "cluster");
+  REQUIRE_MESSAGE(slurm.up, "the one-node Slurm did not start: " << slurm.log);
+
+  // 1. The whole sweep, 8 array tasks: the same table, byte for byte.
+  t0 = std::chrono::steady_clock::now();
+  auto r = Sweep({spec_path.string(), "--executor", "slurm", "--out", (dir / "s1").string(), "--poll-s", "0.2"});
+  const double slurm_s = Seconds(t0);
+  INFO(r.output);
+  REQUIRE(r.status == 0);
+  CHECK(r.output.find("array tasks 0-7 of 8") != std::string::npos);
+  CHECK(rths_test::Slurp(dir / "s1" / "table.csv") == local_table);
+  MESSAGE("40 runs: local (2 at a time) " << local_s << " s; Slurm, 8 array tasks on 2 cores " << slurm_s
+                                          << " s: about " << (slurm_s - local_s) / 4.0 << " s per task round");
+
+  // 2. Detached; task 7 cancelled before it runs: its five runs have no row, and the collector says so.
+  const fs::path s2 = dir / "s2";
+  r = Sweep({spec_path.string(), "--executor", "slurm", "--out", s2.string(), "--detach"});
+  REQUIRE(r.status == 0);
+  const auto state = nlohmann::json::parse(rths_test::Slurp(s2 / "slurm" / "sweep.json"));
+  const std::string job = state["jobs"].back().get<std::string>();
+  const auto cancel = rths::io::RunCommand({rths::io::FindProgram("scancel"), job + "_7"});
+  REQUIRE_MESSAGE(cancel.status == 0, cancel.output);
+  r = Sweep({"--collect", s2.string(), "--retries", "0", "--poll-s", "0.2"});
+  INFO(r.output);
+  CHECK(r.status == 1);
+  CHECK(r.output.find("array task 7 of job " + job + ": 5 of its 5 runs have no row") != std::string::npos);
+  CHECK(r.output.find("rows 35/40") != std::string::npos);
+  // 3. A retry submits task 7 alone and completes the table.
+  r = Sweep({"--collect", s2.string(), "--retries", "1", "--poll-s", "0.2"});
+  INFO(r.output);
+  CHECK(r.status == 0);
+  CHECK(r.output.find("submitted array tasks 7 again") != std::string::npos);
+  CHECK(rths_test::Slurp(s2 / "table.csv") == local_table);
+  // 4. Rows lost from task 3: without --resume the folder is refused; with it only task 3 runs.
+  fs::remove(s2 / "rows" / "3.json");
+  fs::remove(s2 / "rows" / "27.json");
+  r = Sweep({spec_path.string(), "--executor", "slurm", "--out", s2.string()});
+  CHECK(r.status == 2);
+  CHECK(r.output.find("--resume") != std::string::npos);
+  r = Sweep({spec_path.string(), "--executor", "slurm", "--out", s2.string(), "--resume", "--poll-s", "0.2"});
+  INFO(r.output);
+  CHECK(r.status == 0);
+  CHECK(r.output.find("array tasks 3 of 8") != std::string::npos);
+  CHECK(rths_test::Slurp(s2 / "table.csv") == local_table);
+}
