@@ -17,6 +17,7 @@ packages=(
   default-jdk-headless liblcm-java # the Java types jar (lcm-spy, MATLAB) and examples/java_plant
   clang-14 libclang-rt-14-dev      # libFuzzer + ASan/UBSan for the fuzz targets (fuzz/, build-fuzz/)
   libmatio-dev                     # .mat export (rths export): MATLAB v5, and v7.3 through HDF5
+  libhdf5-dev python3-h5py         # a sweep's table.h5 (lib/sweep/table.h) and the test that reads it in Python
   octave                           # the test that loads an exported .mat in GNU Octave
   chromium                         # the test that screenshots a run report headless
   unzip                            # the test that lists the Java types jar

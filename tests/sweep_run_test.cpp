@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/error.h"
+#include "io/command.h"
 #include "sweep/run_sweep.h"
 #include "test_support.h"
 
@@ -120,4 +121,58 @@ TEST_CASE("a drawn value out of its key's range is a row with its status, not a 
     }
   }
   CHECK(invalid == r.failed);
+}
+
+TEST_CASE("the results: table.h5 holds table.csv's columns (read by Python's h5py), summary.csv per group, plots") {
+  rths_test::RequireFile("/usr/bin/python3", "python3");
+  const auto dir = rths_test::TempDir("sweep_results");
+  const auto spec = SmallSpec(dir, 1.0);  // some rows invalid: null cells and failures in the summary
+  rths::sweep::SweepOptions o;
+  o.out = dir / "out";
+  o.jobs = 2;
+  const auto r = rths::sweep::RunSweep(spec, o);
+  REQUIRE(r.failed > 0);
+  REQUIRE(r.failed < 4);
+  // Python writes table.h5 back out as CSV, each float as its shortest round-trip text (repr),
+  // strings decoded, NaN as an empty cell: it must be table.csv byte for byte.
+  const fs::path py = dir / "h5_to_csv.py";
+  std::ofstream(py) << "import sys, math, h5py\n"
+                       "g = h5py.File(sys.argv[1], 'r')['runs']\n"
+                       "cols = list(g.attrs['columns'])\n"
+                       "def cell(d, i):\n"
+                       "    if d.dtype.kind == 'O':\n"
+                       "        s = d.asstr()[i]\n"
+                       "        return '\"' + s.replace('\"', '\"\"') + '\"' if any(c in s for c in ',\"\\n') else s\n"
+                       "    v = d[i]\n"
+                       "    if d.dtype.kind == 'f':\n"
+                       "        return '' if math.isnan(v) else (repr(float(v)) if v != int(v) or abs(v) >= 1e16 else str(int(v)))\n"
+                       "    return str(int(v))\n"
+                       "n = len(g[cols[0]])\n"
+                       "print(','.join(cols))\n"
+                       "for i in range(n): print(','.join(cell(g[c], i) for c in cols))\n";
+  const auto got = rths::io::RunCommand({"/usr/bin/python3", py.string(), (o.out / "table.h5").string(), "-"});
+  INFO(got.output);
+  REQUIRE_MESSAGE(got.output.find("No module named 'h5py'") == std::string::npos,
+                  "h5py is not installed: apt-get install python3-h5py (scripts/bootstrap.sh installs it)");
+  REQUIRE(got.status == 0);
+  CHECK(got.output == Read(r.table));
+  // summary.csv: a line per group (controller) and numeric field; the failures counted.
+  const std::string summary = Read(o.out / "summary.csv");
+  CHECK(summary.rfind("case,controller.kind,field,runs,failures,n,mean,std,min,max\n", 0) == 0);
+  int lines = 0, failures = 0;
+  std::istringstream in(summary);
+  std::string line;
+  std::getline(in, line);
+  while (std::getline(in, line)) {
+    ++lines;
+    std::vector<std::string> cells;
+    std::stringstream ss(line);
+    for (std::string c; std::getline(ss, c, ',');) cells.push_back(c);
+    REQUIRE(cells.size() >= 7);
+    CHECK(cells[3] == "2");  // two draws per controller
+    if (cells[2] == "steps") failures += std::stoi(cells[4]);
+  }
+  CHECK(lines == 6);  // 2 groups x 3 fields
+  CHECK(failures == r.failed);
+  CHECK(fs::file_size(o.out / "plots" / "tracking_nrmse_pct.png") > 1000);
 }

@@ -11,6 +11,7 @@
 #include "io/reserved_file.h"
 #include "scenario/scenario.h"
 #include "studies/batch.h"
+#include "sweep/table.h"
 
 namespace rths::sweep {
 
@@ -19,16 +20,6 @@ namespace fs = std::filesystem;
 namespace {
 
 fs::path RowPath(const fs::path& out, std::int64_t i) { return out / "rows" / fmt::format("{}.json", i); }
-
-nlohmann::json ReadJson(const fs::path& p) {
-  std::ifstream in(p);
-  if (!in) return nullptr;
-  try {
-    return nlohmann::json::parse(in);
-  } catch (const std::exception&) {
-    return nullptr;
-  }
-}
 
 /// The value of a dotted field of summary.json ("benchmark_criteria.J1"); null if absent.
 nlohmann::json Field(const nlohmann::json& summary, const std::string& dotted) {
@@ -68,51 +59,28 @@ nlohmann::json Row(const Spec& spec, const RunPoint& p, const std::string& statu
   return row;
 }
 
-std::string Cell(const nlohmann::json& v) {
-  if (v.is_null()) return "";
-  if (v.is_number_float()) return fmt::format("{:.17g}", v.get<double>());
-  std::string s = v.is_string() ? v.get<std::string>() : v.dump();
-  if (s.find_first_of(",\"\n") == std::string::npos) return s;
-  std::string q = "\"";
-  for (const char c : s) q += c == '"' ? std::string("\"\"") : std::string(1, c);
-  return q + "\"";
-}
-
 }  // namespace
 
 fs::path WriteTable(const Spec& spec, const fs::path& out) {
-  const fs::path table = out / "table.csv";
-  std::ostringstream csv;
-  const auto columns = TableColumns(spec);
-  for (std::size_t c = 0; c < columns.size(); ++c) csv << (c ? "," : "") << columns[c];
-  csv << "\n";
-  for (std::int64_t i = 0; i < spec.runs(); ++i) {
-    const nlohmann::json row = ReadJson(RowPath(out, i));
-    if (row.is_null()) continue;
-    csv << row["index"].get<std::int64_t>() << "," << Cell(row["status"]) << "," << Cell(row["scenario_sha256"]);
-    for (const Axis& a : spec.grid) csv << "," << Cell(row["set"].value(a.key, nlohmann::json()));
-    for (const Draw& d : spec.draw) csv << "," << Cell(row["set"].value(d.key, nlohmann::json()));
-    for (const std::string& f : spec.record) csv << "," << Cell(row["record"].value(f, nlohmann::json()));
-    csv << "\n";
+  const Table t = ReadTable(spec, out);
+  WriteCsv(t, out / "table.csv");
+  WriteHdf5(spec, t, out / "table.h5");
+  WriteGroupSummary(spec, t, out / "summary.csv");
+  try {
+    WritePlots(spec, t, out / "plots");
+  } catch (const std::exception& e) {  // the table is the result; a figure that fails is not
+    fs::create_directories(out / "plots");
+    io::OverwriteFile((out / "plots" / "FAILED.txt").string(), std::string(e.what()) + "\n");
   }
-  if (!io::OverwriteFile(table.string(), csv.str())) throw Error(table.string(), "cannot write the sweep's table");
-  return table;
+  return out / "table.csv";
 }
 
 std::vector<std::int64_t> MissingRows(const Spec& spec, const fs::path& out, std::int64_t chunk, std::int64_t chunks) {
   std::vector<std::int64_t> missing;
   for (std::int64_t i = chunk; i < spec.runs(); i += chunks) {
-    if (ReadJson(RowPath(out, i)).is_null()) missing.push_back(i);
+    if (ReadJsonFile(RowPath(out, i)).is_null()) missing.push_back(i);
   }
   return missing;
-}
-
-std::vector<std::string> TableColumns(const Spec& spec) {
-  std::vector<std::string> c = {"index", "status", "scenario_sha256"};
-  for (const Axis& a : spec.grid) c.push_back(a.key);
-  for (const Draw& d : spec.draw) c.push_back(d.key);
-  for (const std::string& f : spec.record) c.push_back(f);
-  return c;
 }
 
 SweepOutcome RunSweep(const Spec& spec, const SweepOptions& o) {
@@ -127,7 +95,7 @@ SweepOutcome RunSweep(const Spec& spec, const SweepOptions& o) {
   for (std::int64_t i = first; i < last; ++i) {
     PointOf(spec, i);  // throws for an index out of range
     if (i % o.chunks != o.chunk) continue;
-    if (o.resume && !ReadJson(RowPath(o.out, i)).is_null()) {
+    if (o.resume && !ReadJsonFile(RowPath(o.out, i)).is_null()) {
       ++outcome.skipped;
       continue;
     }
@@ -151,7 +119,7 @@ SweepOutcome RunSweep(const Spec& spec, const SweepOptions& o) {
   }
   const auto results = studies::RunBatch(specs, std::max(1, o.jobs), o.progress);
   for (std::size_t r = 0; r < results.size(); ++r) {
-    const nlohmann::json summary = ReadJson(results[r].dir / "summary.json");
+    const nlohmann::json summary = ReadJsonFile(results[r].dir / "summary.json");
     const std::string status =
         results[r].ok ? "completed" : fmt::format("failed: {}", results[r].error.empty() ? "no summary" : results[r].error);
     if (!o.keep_logs) {

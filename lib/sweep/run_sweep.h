@@ -48,7 +48,4 @@ std::filesystem::path WriteTable(const Spec& spec, const std::filesystem::path& 
 std::vector<std::int64_t> MissingRows(const Spec& spec, const std::filesystem::path& out, std::int64_t chunk,
                                       std::int64_t chunks);
 
-/// The table's columns: index, status, scenario_sha256, each grid and drawn key, each recorded field.
-std::vector<std::string> TableColumns(const Spec& spec);
-
 }  // namespace rths::sweep

@@ -14,6 +14,7 @@
 #include "io/command.h"
 #include "io/reserved_file.h"
 #include "sweep/run_sweep.h"
+#include "sweep/table.h"
 
 namespace rths::sweep {
 
@@ -231,16 +232,9 @@ SlurmOutcome Finish(const Spec& spec, State s, const SlurmRunOptions& o, SlurmOu
   }
   Save(o.out, s);
   outcome.table = WriteTable(spec, o.out);
-  outcome.rows = CountRows(o.out);
-  for (std::int64_t i = 0; i < spec.runs(); ++i) {
-    std::ifstream in(o.out / "rows" / fmt::format("{}.json", i));
-    if (!in) continue;
-    try {
-      if (nlohmann::json::parse(in).value("status", std::string()) != "completed") ++outcome.not_completed;
-    } catch (const std::exception&) {
-      ++outcome.not_completed;
-    }
-  }
+  const Table table = ReadTable(spec, o.out);
+  outcome.rows = static_cast<std::int64_t>(table.rows.size());
+  for (const auto& row : table.rows) outcome.not_completed += row[1] != "completed";
   return outcome;
 }
 

@@ -1,0 +1,310 @@
+#include "sweep/table.h"
+
+#include <hdf5.h>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <sstream>
+
+#include <fmt/core.h>
+
+#include "core/error.h"
+#include "io/plot.h"
+#include "io/reserved_file.h"
+
+namespace rths::sweep {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string Cell(const nlohmann::json& v) {
+  if (v.is_null()) return "";
+  if (v.is_number_float()) return fmt::format("{}", v.get<double>());  // the shortest text that reads back bit for bit
+  std::string s = v.is_string() ? v.get<std::string>() : v.dump();
+  if (s.find_first_of(",\"\n") == std::string::npos) return s;
+  std::string q = "\"";
+  for (const char c : s) q += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return q + "\"";
+}
+
+/// How a column is stored in HDF5.
+enum class Kind { kInt, kFloat, kText };
+
+Kind KindOf(const Table& t, std::size_t c) {
+  bool any_null = false, all_int = true, all_num = true;
+  for (const auto& row : t.rows) {
+    const nlohmann::json& v = row[c];
+    if (v.is_null()) {
+      any_null = true;
+      continue;
+    }
+    const bool num = v.is_number() || v.is_boolean();
+    all_num = all_num && num;
+    all_int = all_int && (v.is_number_integer() || v.is_boolean());
+  }
+  if (!all_num) return Kind::kText;
+  return all_int && !any_null ? Kind::kInt : Kind::kFloat;
+}
+
+double AsDouble(const nlohmann::json& v) {
+  if (v.is_boolean()) return v.get<bool>() ? 1.0 : 0.0;
+  if (v.is_number()) return v.get<double>();
+  return std::numeric_limits<double>::quiet_NaN();
+}
+
+/// Closes an HDF5 handle at scope exit.
+struct H5Handle {
+  hid_t id;
+  herr_t (*close)(hid_t);
+  ~H5Handle() {
+    if (id >= 0) close(id);
+  }
+};
+
+void Check(bool ok, const fs::path& file, const std::string& what) {
+  if (!ok) throw Error(file.string(), fmt::format("HDF5 could not {}", what));
+}
+
+/// A variable-length UTF-8 string type.
+hid_t TextType() {
+  const hid_t type = H5Tcopy(H5T_C_S1);
+  H5Tset_size(type, H5T_VARIABLE);
+  H5Tset_cset(type, H5T_CSET_UTF8);
+  return type;
+}
+
+void WriteStrings(hid_t where, const std::string& name, const std::vector<std::string>& values, bool attribute,
+                  const fs::path& file) {
+  std::vector<const char*> ptrs;
+  for (const std::string& s : values) ptrs.push_back(s.c_str());
+  const hsize_t n = values.size();
+  H5Handle space{H5Screate_simple(1, &n, nullptr), H5Sclose};
+  H5Handle type{TextType(), H5Tclose};
+  if (attribute) {
+    H5Handle a{H5Acreate2(where, name.c_str(), type.id, space.id, H5P_DEFAULT, H5P_DEFAULT), H5Aclose};
+    Check(a.id >= 0 && H5Awrite(a.id, type.id, ptrs.data()) >= 0, file, "write attribute " + name);
+    return;
+  }
+  H5Handle d{H5Dcreate2(where, name.c_str(), type.id, space.id, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Dclose};
+  Check(d.id >= 0 && H5Dwrite(d.id, type.id, H5S_ALL, H5S_ALL, H5P_DEFAULT, ptrs.data()) >= 0, file,
+        "write column " + name);
+}
+
+template <typename T>
+void WriteNumbers(hid_t group, const std::string& name, const std::vector<T>& values, hid_t file_type, hid_t mem_type,
+                  const fs::path& file) {
+  const hsize_t n = values.size();
+  H5Handle space{H5Screate_simple(1, &n, nullptr), H5Sclose};
+  H5Handle d{H5Dcreate2(group, name.c_str(), file_type, space.id, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Dclose};
+  Check(d.id >= 0 && H5Dwrite(d.id, mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, values.data()) >= 0, file,
+        "write column " + name);
+}
+
+/// The columns that hold a recorded field with at least one number (the summary's and plots' fields).
+std::vector<std::size_t> NumericFields(const Spec& spec, const Table& t) {
+  std::vector<std::size_t> out;
+  const std::size_t first = t.columns.size() - spec.record.size();
+  for (std::size_t c = first; c < t.columns.size(); ++c) {
+    const bool any = std::any_of(t.rows.begin(), t.rows.end(), [&](const auto& r) { return r[c].is_number(); });
+    if (any && KindOf(t, c) != Kind::kText) out.push_back(c);
+  }
+  return out;
+}
+
+bool Completed(const std::vector<nlohmann::json>& row) { return row[1] == "completed"; }
+
+}  // namespace
+
+std::vector<std::string> TableColumns(const Spec& spec) {
+  std::vector<std::string> c = {"index", "status", "scenario_sha256"};
+  for (const Axis& a : spec.grid) c.push_back(a.key);
+  for (const Draw& d : spec.draw) c.push_back(d.key);
+  for (const std::string& f : spec.record) c.push_back(f);
+  return c;
+}
+
+nlohmann::json ReadJsonFile(const fs::path& file) {
+  std::ifstream in(file);
+  if (!in) return nullptr;
+  try {
+    return nlohmann::json::parse(in);
+  } catch (const std::exception&) {
+    return nullptr;
+  }
+}
+
+Table ReadTable(const Spec& spec, const fs::path& out) {
+  Table t;
+  t.columns = TableColumns(spec);
+  const std::int64_t per_draw = std::max<std::int64_t>(spec.draws, 1);
+  for (std::int64_t i = 0; i < spec.runs(); ++i) {
+    const nlohmann::json row = ReadJsonFile(out / "rows" / fmt::format("{}.json", i));
+    if (!row.is_object()) continue;
+    std::vector<nlohmann::json> cells = {row.value("index", i), row.value("status", std::string()),
+                                         row.value("scenario_sha256", std::string())};
+    const nlohmann::json set = row.value("set", nlohmann::json::object());
+    const nlohmann::json record = row.value("record", nlohmann::json::object());
+    for (const Axis& a : spec.grid) cells.push_back(set.value(a.key, nlohmann::json()));
+    for (const Draw& d : spec.draw) cells.push_back(set.value(d.key, nlohmann::json()));
+    for (const std::string& f : spec.record) cells.push_back(record.value(f, nlohmann::json()));
+    t.rows.push_back(std::move(cells));
+    t.group.push_back(i / per_draw);
+  }
+  return t;
+}
+
+void WriteCsv(const Table& t, const fs::path& file) {
+  std::ostringstream csv;
+  for (std::size_t c = 0; c < t.columns.size(); ++c) csv << (c ? "," : "") << t.columns[c];
+  csv << "\n";
+  for (const auto& row : t.rows) {
+    for (std::size_t c = 0; c < row.size(); ++c) csv << (c ? "," : "") << Cell(row[c]);
+    csv << "\n";
+  }
+  if (!io::OverwriteFile(file.string(), csv.str())) throw Error(file.string(), "cannot write the sweep's table");
+}
+
+void WriteHdf5(const Spec& spec, const Table& t, const fs::path& file) {
+  H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);  // errors become exceptions, not prints
+  const fs::path tmp = file.string() + ".partial";
+  {
+    H5Handle f{H5Fcreate(tmp.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT), H5Fclose};
+    Check(f.id >= 0, tmp, "create the file");
+    WriteStrings(f.id, "sweep", {spec.name}, true, file);
+    WriteStrings(f.id, "spec", {spec.path}, true, file);
+    H5Handle g{H5Gcreate2(f.id, "runs", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose};
+    Check(g.id >= 0, file, "create the group /runs");
+    WriteStrings(g.id, "columns", t.columns, true, file);
+    for (std::size_t c = 0; c < t.columns.size(); ++c) {
+      const Kind kind = KindOf(t, c);
+      if (kind == Kind::kInt) {
+        std::vector<std::int64_t> v;
+        for (const auto& row : t.rows) v.push_back(row[c].is_boolean() ? row[c].get<bool>() : row[c].get<std::int64_t>());
+        WriteNumbers(g.id, t.columns[c], v, H5T_STD_I64LE, H5T_NATIVE_INT64, file);
+      } else if (kind == Kind::kFloat) {
+        std::vector<double> v;
+        for (const auto& row : t.rows) v.push_back(AsDouble(row[c]));
+        WriteNumbers(g.id, t.columns[c], v, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, file);
+      } else {
+        std::vector<std::string> v;
+        for (const auto& row : t.rows) v.push_back(row[c].is_string() ? row[c].get<std::string>() : Cell(row[c]));
+        WriteStrings(g.id, t.columns[c], v, false, file);
+      }
+    }
+  }
+  std::error_code ec;
+  fs::rename(tmp, file, ec);
+  if (ec) throw Error(file.string(), "cannot write the sweep's HDF5 table: " + ec.message());
+}
+
+void WriteGroupSummary(const Spec& spec, const Table& t, const fs::path& file) {
+  std::ostringstream csv;
+  csv << "case";
+  for (const Axis& a : spec.grid) csv << "," << a.key;
+  csv << ",field,runs,failures,n,mean,std,min,max\n";
+  const auto fields = NumericFields(spec, t);
+  std::map<std::int64_t, std::vector<std::size_t>> groups;  // group -> rows
+  for (std::size_t r = 0; r < t.rows.size(); ++r) groups[t.group[r]].push_back(r);
+  for (const auto& [group, rows] : groups) {
+    const auto& first = t.rows[rows.front()];
+    const RunPoint p = PointOf(spec, first[0].get<std::int64_t>());
+    std::string key = Cell(fs::path(p.scenario).filename().string());
+    for (std::size_t a = 0; a < spec.grid.size(); ++a) key += "," + Cell(first[3 + a]);
+    std::int64_t failures = 0;
+    for (const std::size_t r : rows) failures += !Completed(t.rows[r]);
+    for (const std::size_t c : fields) {
+      std::vector<double> v;
+      for (const std::size_t r : rows) {
+        const double x = AsDouble(t.rows[r][c]);
+        if (Completed(t.rows[r]) && std::isfinite(x)) v.push_back(x);
+      }
+      double mean = 0, var = 0;
+      for (const double x : v) mean += x / static_cast<double>(v.size());
+      for (const double x : v) var += (x - mean) * (x - mean);
+      const double sd = v.size() > 1 ? std::sqrt(var / static_cast<double>(v.size() - 1)) : 0.0;
+      const auto [lo, hi] = v.empty() ? std::pair(0.0, 0.0) : std::pair(*std::min_element(v.begin(), v.end()),
+                                                                         *std::max_element(v.begin(), v.end()));
+      if (v.empty()) {
+        csv << fmt::format("{},{},{},{},0,,,,\n", key, Cell(t.columns[c]), rows.size(), failures);
+      } else {
+        csv << fmt::format("{},{},{},{},{},{},{},{},{}\n", key, Cell(t.columns[c]), rows.size(),
+                           failures, v.size(), mean, sd, lo, hi);
+      }
+    }
+  }
+  if (!io::OverwriteFile(file.string(), csv.str())) throw Error(file.string(), "cannot write the sweep's summary");
+}
+
+std::vector<fs::path> WritePlots(const Spec& spec, const Table& t, const fs::path& dir) {
+  std::vector<fs::path> pngs;
+  if (!io::GnuplotAvailable("gnuplot")) return pngs;
+  // The axes: the case (when there are several), each grid key, each drawn key.
+  struct AxisColumn {
+    std::string name;
+    std::vector<std::string> labels;  // per row
+  };
+  std::vector<AxisColumn> axes;
+  if (spec.cases.size() > 1) {
+    AxisColumn a{"case", {}};
+    for (const auto& row : t.rows) a.labels.push_back(fs::path(PointOf(spec, row[0].get<std::int64_t>()).scenario).stem());
+    axes.push_back(std::move(a));
+  }
+  for (std::size_t k = 0; k < spec.grid.size() + spec.draw.size(); ++k) {
+    if (k >= spec.grid.size() && spec.draw[k - spec.grid.size()].dist == "seed") continue;  // a seed is no axis
+    AxisColumn a{t.columns[3 + k], {}};
+    for (const auto& row : t.rows) a.labels.push_back(Cell(row[3 + k]));
+    axes.push_back(std::move(a));
+  }
+  for (const std::size_t c : NumericFields(spec, t)) {
+    io::Figure fig;
+    fig.name = t.columns[c];
+    for (char& ch : fig.name) {
+      if (!std::isalnum(static_cast<unsigned char>(ch)) && ch != '-' && ch != '_' && ch != '.') ch = '_';
+    }
+    fig.title = fmt::format("{}: {} against each axis (completed runs)", spec.name, t.columns[c]);
+    fig.columns = axes.size() > 1 ? 2 : 1;
+    for (const AxisColumn& a : axes) {
+      io::Panel p = io::MakePanel("", a.name, t.columns[c]);
+      p.key = "off";
+      io::Series s = io::MakeSeries("");
+      s.with = "points";
+      // Numeric axis values are plotted at their value; text values (a case, a controller) at
+      // 0, 1, 2, ... in order of first appearance, labelled.
+      std::map<std::string, double> category;
+      bool numeric = true;
+      for (const std::string& l : a.labels) {
+        char* end = nullptr;
+        std::strtod(l.c_str(), &end);
+        numeric = numeric && !l.empty() && end && *end == '\0';
+      }
+      for (std::size_t r = 0; r < t.rows.size(); ++r) {
+        if (!Completed(t.rows[r])) continue;
+        double x = 0;
+        if (numeric) {
+          x = std::strtod(a.labels[r].c_str(), nullptr);
+        } else {
+          auto [it, fresh] = category.emplace(a.labels[r], static_cast<double>(category.size()));
+          if (fresh) p.x_tics.emplace_back(it->second, a.labels[r]);
+          x = it->second;
+        }
+        s.x.push_back(x);
+        s.y.push_back(AsDouble(t.rows[r][c]));
+      }
+      if (!numeric) p.x_range = std::pair(-0.5, static_cast<double>(category.size()) - 0.5);
+      p.series.push_back(std::move(s));
+      fig.panels.push_back(std::move(p));
+    }
+    const bool drawable = std::all_of(fig.panels.begin(), fig.panels.end(), [](const io::Panel& p) {
+      return std::any_of(p.series[0].y.begin(), p.series[0].y.end(), [](double y) { return std::isfinite(y); });
+    });
+    if (fig.panels.empty() || !drawable) continue;
+    pngs.push_back(io::Plot(fig, dir).png);
+  }
+  return pngs;
+}
+
+}  // namespace rths::sweep
