@@ -123,7 +123,9 @@ std::vector<std::string> TableColumns(const Spec& spec) {
   std::vector<std::string> c = {"index", "status", "scenario_sha256"};
   for (const Axis& a : spec.grid) c.push_back(a.key);
   for (const Draw& d : spec.draw) c.push_back(d.key);
-  for (const std::string& f : spec.record) c.push_back(f);
+  for (const std::string& f : spec.record) {  // "status" is the sweep's: summary.json's becomes "summary.status"
+    c.push_back(std::find(c.begin(), c.end(), f) == c.end() ? f : "summary." + f);
+  }
   return c;
 }
 

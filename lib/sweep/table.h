@@ -34,7 +34,8 @@ struct Table {
   std::vector<std::int64_t> group;                ///< per row: case x combination index (the draws' group)
 };
 
-/// The table's columns: index, status, scenario_sha256, each grid key, each drawn key, each recorded field.
+/// The table's columns: index, status, scenario_sha256, each grid key, each drawn key, each recorded
+/// field (named "summary.<field>" where its name is already a column's, e.g. summary.json's "status").
 std::vector<std::string> TableColumns(const Spec& spec);
 
 /// A JSON file (a row, a summary.json); null if absent or malformed.
