@@ -9,6 +9,7 @@
 #include <string>
 
 #include "core/error.h"
+#include "models/benchmark_plant.h"
 #include "scenario/scenario.h"
 #include "sweep/spec.h"
 #include "test_support.h"
@@ -165,4 +166,62 @@ TEST_CASE("bad SPECs are refused naming the file, the key and what is allowed") 
   refused("[sweep]\nbase = \"b\"\ndraws = 100000\n[draw]\n\"a\" = { dist = \"seed\" }\n[grid]\n\"k\" = "
           "[1,2,3,4,5,6,7,8,9,10,11]\n\"l\" = [1,2,3,4,5,6,7,8,9,10]\n",
           "more than the");
+}
+
+TEST_CASE("the named draw benchmark_plant: the benchmark's perturbed plant and, with it, its numerical substructure") {
+  const auto dir = rths_test::TempDir("sweep_bench_draw");
+  const fs::path spec_file = dir / "s.toml";
+  const fs::path cases = fs::path(RTHS_SOURCE_DIR) / "scenarios" / "benchmark";
+  std::ofstream(spec_file) << "[sweep]\nseed = 5\ndraws = 3\n[cases]\nfiles = [\"" << (cases / "case1_example.toml").string()
+                           << "\", \"" << (cases / "case3_example.toml").string() << "\"]\n"
+                           << "[draw]\n\"plant.benchmark\" = { dist = \"benchmark_plant\" }\n";
+  const auto spec = rths::sweep::LoadSpec(spec_file.string());
+  REQUIRE(spec.runs() == 6);
+  CHECK(rths::sweep::DrawColumns(spec.draw[0]) ==
+        std::vector<std::string>{"plant.benchmark.b1", "plant.benchmark.b2", "plant.benchmark.a3",
+                                 "plant.benchmark.k_e_N_per_m"});
+  const rths::models::BenchmarkPlantParams nominal;
+  std::set<double> k_e;
+  for (std::int64_t i = 0; i < spec.runs(); ++i) {
+    const auto p = PointOf(spec, i);
+    REQUIRE(p.sets.size() == 5);
+    CHECK(p.sets[4] == "structure.subtract_specimen=true");
+    const auto s = rths::scenario::LoadScenario(p.scenario, p.sets);
+    const auto& b = s.plant.benchmark.params;
+    k_e.insert(b.k_e_N_per_m);
+    CHECK(b.b1 == ValueOf(p.sets[0]));
+    CHECK(b.k_e_N_per_m == ValueOf(p.sets[3]));
+    CHECK(b.b1 != nominal.b1);
+    CHECK(b.gain == nominal.gain);  // only b1, b2, a3 and k_e are uncertain
+    // Within about 4 sigma of the benchmark's uncertainty (b1 425 +- 3.3, k_e 1.19e6 +- 5e4 N/m).
+    CHECK(std::abs(b.b1 - 425.0) < 4 * 3.3);
+    CHECK(std::abs(b.k_e_N_per_m - 1.19e6) < 4 * 5e4);
+    // The numerical substructure is the reference minus this plant's specimen at floor 1.
+    const auto& st = s.structure;
+    CHECK(st.matrices.K(0, 0) == doctest::Approx(st.reference.K(0, 0) - 1e-6 * b.k_e_N_per_m).epsilon(1e-14));
+    CHECK(st.matrices.M(0, 0) == doctest::Approx(st.reference.M(0, 0) - 1e-6 * b.m_e_kg).epsilon(1e-14));
+    CHECK(st.matrices.K(1, 1) == st.reference.K(1, 1));
+    CHECK(st.matrices.iota(0) == doctest::Approx(st.reference.M(0, 0) / st.matrices.M(0, 0)).epsilon(1e-14));
+  }
+  CHECK(k_e.size() == 6);  // a plant of its own per run
+  CHECK(PointOf(spec, 4).sets == PointOf(spec, 4).sets);
+  // The key is the plant's table, nothing else.
+  CHECK_THROWS_WITH_AS(ParseSpec("[sweep]\nbase = \"x.toml\"\ndraws = 1\n[draw]\n\"plant.gain\" = { dist = \"benchmark_plant\" }\n",
+                                 "s.toml"),
+                       doctest::Contains("plant.benchmark"), rths::Error);
+}
+
+TEST_CASE("structure.subtract_specimen: the nominal plant's numerical substructure is the repository's file") {
+  const fs::path file = fs::path(RTHS_SOURCE_DIR) / "scenarios" / "benchmark" / "case2_example.toml";
+  const auto with_file = rths::scenario::LoadScenario(file.string());
+  const auto subtracted = rths::scenario::LoadScenario(file.string(), {"structure.subtract_specimen=true"});
+  const auto& a = with_file.structure.matrices;
+  const auto& b = subtracted.structure.matrices;
+  CHECK((a.M - b.M).cwiseAbs().maxCoeff() <= 1e-15 * a.M.cwiseAbs().maxCoeff());
+  CHECK((a.K - b.K).cwiseAbs().maxCoeff() <= 1e-15 * a.K.cwiseAbs().maxCoeff());
+  CHECK((a.C - b.C).cwiseAbs().maxCoeff() <= 1e-14 * a.C.cwiseAbs().maxCoeff());
+  CHECK((a.IotaOrOnes() - b.IotaOrOnes()).cwiseAbs().maxCoeff() <= 1e-14);
+  // Refused where there is no benchmark specimen to subtract.
+  const std::string e = rths_test::ParseError("[structure]\nsubtract_specimen = true\n");
+  CHECK(e.find("structure.subtract_specimen") != std::string::npos);
 }

@@ -24,6 +24,13 @@
 
 namespace {
 
+void WarnAbsent(const std::vector<std::string>& fields) {
+  for (const std::string& f : fields) {
+    std::fprintf(stderr, "rths sweep: warning: no completed run's summary.json has the recorded field \"%s\" "
+                         "(misspelt? docs/sweeps.md lists the fields)\n", f.c_str());
+  }
+}
+
 struct Args {
   std::string spec_path, out, executor = "local", collect;
   int jobs = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
@@ -69,6 +76,7 @@ rths::sweep::SlurmRunOptions SlurmOptions(const Args& a, const rths::sweep::Spec
 }
 
 int Report(const rths::sweep::SlurmOutcome& r, const std::string& out) {
+  WarnAbsent(r.absent_fields);
   if (r.detached) {
     std::printf("detached: collect the sweep with: rths sweep --collect %s\n", out.c_str());
     return 0;
@@ -97,10 +105,16 @@ int RunLocal(const Args& a, const rths::sweep::Spec& spec) {
               a.jobs);
   std::fflush(stdout);
   const auto r = rths::sweep::RunSweep(spec, o);
-  std::printf("ran %lld, skipped %lld (rows already there), not completed %lld\n", static_cast<long long>(r.ran),
-              static_cast<long long>(r.skipped), static_cast<long long>(r.failed));
-  if (!r.table.empty()) std::printf("table: %s\n", r.table.string().c_str());
-  return r.failed > 0 ? 1 : 0;
+  std::printf("ran %lld (not completed %lld), skipped %lld (rows already there)\n", static_cast<long long>(r.ran),
+              static_cast<long long>(r.failed), static_cast<long long>(r.skipped));
+  if (r.table.empty()) return r.failed > 0 ? 1 : 0;
+  WarnAbsent(r.absent_fields);
+  std::printf("rows %lld/%lld, not completed %lld\ntable: %s (and table.h5, summary.csv, plots/)\n",
+              static_cast<long long>(r.rows), static_cast<long long>(spec.runs()),
+              static_cast<long long>(r.not_completed), r.table.string().c_str());
+  // The exit code speaks for the whole sweep (rows of earlier attempts too), or for the one run asked.
+  if (a.only >= 0 || a.chunks > 1) return r.failed > 0 ? 1 : 0;
+  return r.not_completed > 0 || r.rows < spec.runs() ? 1 : 0;
 }
 
 }  // namespace

@@ -34,14 +34,29 @@ const BenchmarkCase& BenchmarkCaseNumber(int number) {
   return kBenchmarkCases[number - 1];
 }
 
-BenchmarkStructures Silva3Structures(const BenchmarkSpecimen& e, const BenchmarkCase& c) {
+StructureMatrices SubtractSpecimen(const StructureMatrices& reference, const BenchmarkSpecimen& e, int dof) {
   if (!(e.m_e_kg > 0.0) || !std::isfinite(e.m_e_kg))
-    throw Error("Silva3Structures: m_e_kg", fmt::format("{} is out of range (0, inf)", e.m_e_kg));
+    throw Error("specimen: m_e_kg", fmt::format("{} is out of range (0, inf)", e.m_e_kg));
   if (!(e.k_e_N_per_m > 0.0) || !std::isfinite(e.k_e_N_per_m))
-    throw Error("Silva3Structures: k_e_N_per_m", fmt::format("{} is out of range (0, inf)", e.k_e_N_per_m));
+    throw Error("specimen: k_e_N_per_m", fmt::format("{} is out of range (0, inf)", e.k_e_N_per_m));
   if (!(e.zeta_e >= 0.0) || !std::isfinite(e.zeta_e))
-    throw Error("Silva3Structures: zeta_e", fmt::format("{} is out of range [0, inf)", e.zeta_e));
+    throw Error("specimen: zeta_e", fmt::format("{} is out of range [0, inf)", e.zeta_e));
+  const auto n = reference.M.rows();
+  if (dof < 1 || dof > n) throw Error("specimen: dof", fmt::format("{} is out of range [1, {}]", dof, n));
+  const auto d = dof - 1;
+  StructureMatrices out = reference;
+  out.M(d, d) -= e.m_e_kg * kKgToProject;
+  out.K(d, d) -= e.k_e_N_per_m * kNPerMToProject;
+  out.C(d, d) -= e.c_e_N_s_per_m() * kNsPerMToProject;
+  if (!PositiveDefinite(out.M) || !PositiveDefinite(out.K))
+    throw Error("specimen", "subtracting the experimental substructure leaves M_n or K_n not positive definite");
+  const Eigen::VectorXd load = reference.M * reference.IotaOrOnes();  // M_ref iota_ref
+  const bool diagonal = out.M.isDiagonal(0.0);
+  out.iota = diagonal ? Eigen::VectorXd(load.cwiseQuotient(out.M.diagonal())) : Eigen::VectorXd(out.M.ldlt().solve(load));
+  return out;
+}
 
+BenchmarkStructures Silva3Structures(const BenchmarkSpecimen& e, const BenchmarkCase& c) {
   BenchmarkStructures b;
   StructureMatrices& r = b.reference;
   r.M = Eigen::MatrixXd::Identity(3, 3) * (c.floor_mass_kg * kKgToProject);
@@ -58,14 +73,7 @@ BenchmarkStructures Silva3Structures(const BenchmarkSpecimen& e, const Benchmark
   x.K(0, 0) = e.k_e_N_per_m * kNPerMToProject;
   x.C(0, 0) = e.c_e_N_s_per_m() * kNsPerMToProject;
 
-  StructureMatrices& n = b.numerical;
-  n.M = r.M - x.M;
-  n.K = r.K - x.K;
-  n.C = r.C - x.C;
-  if (!PositiveDefinite(n.M) || !PositiveDefinite(n.K))
-    throw Error("Silva3Structures", "the experimental substructure leaves M_n or K_n not positive definite");
-  // M_n iota = M_ref 1 (M diagonal): the specimen mass's ground inertia stays on the numerical side.
-  n.iota = (r.M * Eigen::VectorXd::Ones(3)).cwiseQuotient(n.M.diagonal());
+  b.numerical = SubtractSpecimen(r, e, 1);
   b.actuator_dof = 1;
   return b;
 }

@@ -64,6 +64,14 @@ struct BenchmarkStructures {
 /// range (m_e, k_e > 0, zeta_e >= 0, all finite) or leave M_n or K_n not positive definite.
 BenchmarkStructures Silva3Structures(const BenchmarkSpecimen& e = {}, const BenchmarkCase& c = kBenchmarkCases[0]);
 
+/// The numerical substructure of a partitioned test: `reference` minus the specimen `e` at DOF
+/// `dof` (1-based), in project units, as the benchmark's reference code builds it for the plant it
+/// runs (a perturbed k_e included): M_n = M_ref - m_e e_d e_d^T, C_n = C_ref - c_e e_d e_d^T,
+/// K_n = K_ref - k_e e_d e_d^T, and iota with M_n iota = M_ref iota_ref (the specimen mass's ground
+/// inertia stays on the numerical side; element-wise for a diagonal M_n). Throws rths::Error if
+/// e's values are out of range, dof is not a DOF of `reference`, or M_n or K_n is not positive definite.
+StructureMatrices SubtractSpecimen(const StructureMatrices& reference, const BenchmarkSpecimen& e, int dof);
+
 /// Writes the numerical substructure of case `c` for specimen `e` to `path`, with comments saying
 /// where every number comes from (`note`: one more line, e.g. which perturbed plant it is for).
 /// Throws rths::Error if the file cannot be written.

@@ -69,6 +69,11 @@ struct StructureConfig {
   /// (participants/benchmark_run.h). "" for none. Relative to the scenario file's folder.
   std::string reference_file;
   int actuator_dof = 1;       ///< kind = "file": DOF the specimen acts on, 1-based (1 = first story)
+  /// kind = "file" with a reference_file and plant.kind = "benchmark": the numerical substructure is
+  /// the reference minus the plant's experimental substructure (plant.benchmark m_e_kg, k_e_N_per_m,
+  /// zeta_e) at actuator_dof (models::SubtractSpecimen), as the benchmark's reference code builds it
+  /// for the plant it runs, a perturbed one included; `file` is then not read.
+  bool subtract_specimen = false;
   // kind = "sdof":
   double mass_kg = 20000.0;          ///< (0, 1e9]
   double frequency_hz = 5.0;         ///< natural frequency (0, 1/(pi dt)) -- central-difference limit omega dt < 2

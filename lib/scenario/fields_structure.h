@@ -44,6 +44,7 @@ void StructureFields(V& v, models::StructureConfig& st, const Context& cx) {
   v.String("file", st.file);
   v.String("reference_file", st.reference_file);  // ValidateStructure: only with kind = "file"
   v.Integer("actuator_dof", st.actuator_dof);  // ValidateStructure: when kind = "file"
+  v.Bool("subtract_specimen", st.subtract_specimen);  // ValidateStructure: with a reference_file, a benchmark plant
   v.Table("ground", [&](V& t) { SignalFields(t, st.ground, "rms_mm_s2", cx); });
   v.Table("desired", [&](V& t) { SignalFields(t, st.desired, "rms_mm", cx); });
 }

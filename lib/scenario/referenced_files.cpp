@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include "core/names.h"
+#include "models/benchmark_structures.h"
 #include "scenario/walk.h"
 
 namespace rths::scenario {
@@ -14,7 +15,8 @@ namespace {
 
 /// structure.file and structure.reference_file (mode "rths", kind "file"): the matrices, the
 /// reference's DOFs against the structure's, and structure.actuator_dof against them.
-void ReadStructureFiles(const std::string& path, const detail::Check& check, models::StructureConfig* st) {
+void ReadStructureFiles(const std::string& path, const detail::Check& check, const models::PlantConfig& plant,
+                        models::StructureConfig* st) {
   st->matrices = {};
   st->reference = {};
   const bool has_file = st->mode == models::StructureMode::kRths && st->kind == models::StructureKind::kFile;
@@ -26,7 +28,16 @@ void ReadStructureFiles(const std::string& path, const detail::Check& check, mod
     }
   }
   if (!has_file) return;
-  const std::string file = detail::ResolveFile(path, st->file).string();
+  const std::string file = detail::ResolveFile(path, st->subtract_specimen ? st->reference_file : st->file).string();
+  if (st->subtract_specimen) {
+    const models::BenchmarkPlantParams& p = plant.benchmark.params;
+    try {
+      st->matrices = models::SubtractSpecimen(st->reference, {p.m_e_kg, p.k_e_N_per_m, p.zeta_e}, st->actuator_dof);
+    } catch (const Error& e) {
+      check.Fail("structure.subtract_specimen", fmt::format("{}: {}", e.where(), e.problem()));
+    }
+    return;
+  }
   st->matrices = models::LoadStructureFile(file);  // its own errors name the file and line
   const auto dofs = st->matrices.M.rows();
   if (!st->reference_file.empty() && st->reference.M.rows() != dofs) {
@@ -43,7 +54,7 @@ void ReadStructureFiles(const std::string& path, const detail::Check& check, mod
 
 void ReadReferencedFiles(Scenario* s) {
   const detail::Check check(detail::DisplayName(s->path));
-  ReadStructureFiles(s->path, check, &s->structure);
+  ReadStructureFiles(s->path, check, s->plant, &s->structure);
   for (signal::SignalSpec* signal : {&s->structure.ground, &s->structure.desired}) {
     signal->record = {};
     if (signal->kind != signal::SignalKind::kFile) continue;

@@ -88,8 +88,12 @@ void ValidateReferenceFile(const models::StructureConfig& st, const std::string&
 
 void ValidateStructure(const models::StructureConfig& st, const std::string& scenario_path, const Check& check) {
   if (st.mode == models::StructureMode::kRths && st.kind == models::StructureKind::kFile) {
-    if (st.file.empty()) check.Fail("structure.file", "missing: kind = \"file\" needs a structure file");
-    CheckFileExists(check, "structure.file", scenario_path, st.file);
+    if (!st.subtract_specimen) {
+      if (st.file.empty()) check.Fail("structure.file", "missing: kind = \"file\" needs a structure file");
+      CheckFileExists(check, "structure.file", scenario_path, st.file);
+    } else if (st.reference_file.empty()) {
+      check.Fail("structure.subtract_specimen", "needs structure.reference_file, the structure to subtract from");
+    }
     check.InRange("structure.actuator_dof", st.actuator_dof,
                   {1, 10000, false, false, "1-based; at most the structure's number of DOFs"});
   } else if (st.mode == models::StructureMode::kRths && st.actuator_dof != 1) {
@@ -162,6 +166,11 @@ void ValidateScenario(const Scenario& s) {
   }
   ValidateController(s.controller, s.run.dt_s, check);
   ValidatePlant(s.plant, check);
+  if (s.structure.subtract_specimen &&
+      (s.plant.kind != models::PlantKind::kBenchmark || s.structure.kind != models::StructureKind::kFile)) {
+    check.Fail("structure.subtract_specimen", "true needs structure.kind = \"file\" and plant.kind = \"benchmark\" "
+                                              "(the specimen is [plant.benchmark]'s)");
+  }
   ValidateFaults(s.faults, check);
 }
 

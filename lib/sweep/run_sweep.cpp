@@ -21,7 +21,7 @@ namespace {
 
 fs::path RowPath(const fs::path& out, std::int64_t i) { return out / "rows" / fmt::format("{}.json", i); }
 
-/// The value of a dotted field of summary.json ("benchmark_criteria.J1"); null if absent.
+/// The value of a dotted field of summary.json ("benchmark_criteria.J1_ms"); null if absent.
 nlohmann::json Field(const nlohmann::json& summary, const std::string& dotted) {
   const nlohmann::json* j = &summary;
   std::stringstream ss(dotted);
@@ -101,37 +101,58 @@ SweepOutcome RunSweep(const Spec& spec, const SweepOptions& o) {
     }
     todo.push_back(i);
   }
-  std::vector<studies::RunSpec> specs;
-  std::vector<RunPoint> points;
-  for (const std::int64_t i : todo) {
-    const RunPoint p = PointOf(spec, i);
-    const fs::path dir = o.out / "runs" / std::to_string(i);
-    fs::remove_all(dir);  // what an interrupted attempt left
-    try {
-      specs.push_back({fmt::format("run {}", i), scenario::LoadScenario(p.scenario, p.sets), dir});
-      points.push_back(p);
-    } catch (const std::exception& e) {  // e.g. a drawn value out of the key's range: a row, not a crash
-      io::OverwriteFile(RowPath(o.out, i).string(),
-                        Row(spec, p, fmt::format("invalid: {}", e.what()), nullptr).dump(2) + "\n");
-      ++outcome.ran;
-      ++outcome.failed;
+  // Blocks of runs, so that a sweep of 16 000 runs does not hold 16 000 scenarios at once; each
+  // run's row is written as the run ends (an interrupted sweep keeps every finished run's row).
+  const std::size_t block = std::max<std::size_t>(64, 16 * static_cast<std::size_t>(std::max(1, o.jobs)));
+  for (std::size_t from = 0; from < todo.size(); from += block) {
+    std::vector<studies::RunSpec> specs;
+    std::vector<RunPoint> points;
+    for (std::size_t k = from; k < std::min(todo.size(), from + block); ++k) {
+      const RunPoint p = PointOf(spec, todo[k]);
+      const fs::path dir = o.out / "runs" / std::to_string(p.index);
+      fs::remove_all(dir);  // what an interrupted attempt left
+      try {
+        specs.push_back({fmt::format("run {}", p.index), scenario::LoadScenario(p.scenario, p.sets), dir});
+        points.push_back(p);
+      } catch (const std::exception& e) {  // e.g. a drawn value out of the key's range: a row, not a crash
+        io::OverwriteFile(RowPath(o.out, p.index).string(),
+                          Row(spec, p, fmt::format("invalid: {}", e.what()), nullptr).dump(2) + "\n");
+        ++outcome.ran;
+        ++outcome.failed;
+      }
     }
+    std::size_t next = 0;  // RunBatch reports runs in the order they end: find each by its folder
+    studies::RunBatch(specs, std::max(1, o.jobs), nullptr,
+                      [&](std::size_t, std::size_t, const studies::RunResult& result) {
+                        std::size_t r = next;
+                        while (specs[r].dir != result.dir) r = (r + 1) % specs.size();
+                        next = (r + 1) % specs.size();
+                        const nlohmann::json summary = ReadJsonFile(result.dir / "summary.json");
+                        const std::string status =
+                            result.ok ? "completed"
+                                      : fmt::format("failed: {}", result.error.empty() ? "no summary" : result.error);
+                        if (!o.keep_logs) {
+                          std::error_code ec;
+                          fs::remove(result.dir / "log.lcm", ec);
+                          fs::remove(result.dir / "signals.csv", ec);
+                        }
+                        io::OverwriteFile(RowPath(o.out, points[r].index).string(),
+                                          Row(spec, points[r], status, summary).dump(2) + "\n");
+                        ++outcome.ran;
+                        if (!result.ok) ++outcome.failed;
+                        if (o.progress) {
+                          o.progress->Update(static_cast<double>(outcome.ran), static_cast<double>(todo.size()),
+                                             fmt::format("{} of {} runs", outcome.ran, todo.size()));
+                        }
+                      });
   }
-  const auto results = studies::RunBatch(specs, std::max(1, o.jobs), o.progress);
-  for (std::size_t r = 0; r < results.size(); ++r) {
-    const nlohmann::json summary = ReadJsonFile(results[r].dir / "summary.json");
-    const std::string status =
-        results[r].ok ? "completed" : fmt::format("failed: {}", results[r].error.empty() ? "no summary" : results[r].error);
-    if (!o.keep_logs) {
-      std::error_code ec;
-      fs::remove(results[r].dir / "log.lcm", ec);
-      fs::remove(results[r].dir / "signals.csv", ec);
-    }
-    io::OverwriteFile(RowPath(o.out, points[r].index).string(), Row(spec, points[r], status, summary).dump(2) + "\n");
-    ++outcome.ran;
-    if (!results[r].ok) ++outcome.failed;
+  if (o.write_table) {
+    outcome.table = WriteTable(spec, o.out);
+    const Table t = ReadTable(spec, o.out);
+    outcome.rows = static_cast<std::int64_t>(t.rows.size());
+    for (const auto& row : t.rows) outcome.not_completed += row[1] != "completed";
+    outcome.absent_fields = AbsentFields(spec, t);
   }
-  if (o.write_table) outcome.table = WriteTable(spec, o.out);
   return outcome;
 }
 

@@ -1,8 +1,8 @@
 #pragma once
 /// @file The local executor of a sweep (`rths sweep SPEC`, issue 28): the SPEC's runs (or one of
 /// them, or those a previous attempt left undone), `jobs` at a time on this machine
-/// (studies::RunBatch: each run a memq group in this process), one row per run written as it
-/// ends, and the table of every row.
+/// (studies::RunBatch: each run a memq group in this process), one row per run written as soon as
+/// the run ends (an interrupted sweep keeps every finished run's row), and the table of every row.
 ///
 /// Folder layout (DIR): DIR/runs/<i>/ (scenario.toml, summary.json; log.lcm and signals.csv only
 /// with keep_logs), DIR/rows/<i>.json (the run's row, written once the run has ended, whatever its
@@ -31,7 +31,10 @@ struct SweepOptions {
 };
 
 struct SweepOutcome {
-  std::int64_t ran = 0, skipped = 0, failed = 0;  ///< this call's runs; rows already there; rows not "completed"
+  std::int64_t ran = 0, skipped = 0, failed = 0;  ///< this call's runs; rows already there; this call's rows not "completed"
+  /// With the table written: its rows, and those not "completed" (earlier attempts' included).
+  std::int64_t rows = 0, not_completed = 0;
+  std::vector<std::string> absent_fields;         ///< recorded fields no completed row has (AbsentFields)
   std::filesystem::path table;                    ///< DIR/table.csv
 };
 

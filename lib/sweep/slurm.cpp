@@ -235,6 +235,7 @@ SlurmOutcome Finish(const Spec& spec, State s, const SlurmRunOptions& o, SlurmOu
   const Table table = ReadTable(spec, o.out);
   outcome.rows = static_cast<std::int64_t>(table.rows.size());
   for (const auto& row : table.rows) outcome.not_completed += row[1] != "completed";
+  outcome.absent_fields = AbsentFields(spec, table);
   return outcome;
 }
 

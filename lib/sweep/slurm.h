@@ -56,6 +56,7 @@ struct SlurmOutcome {
   std::int64_t chunks = 0;             ///< T
   std::vector<std::int64_t> failed_tasks;  ///< array tasks whose runs still lack rows
   std::vector<std::string> job_ids;    ///< every submission of this call, in order
+  std::vector<std::string> absent_fields;  ///< recorded fields no completed row has (AbsentFields)
   bool detached = false;
   std::filesystem::path table;         ///< DIR/table.csv (not written when detached)
 };

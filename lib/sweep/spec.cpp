@@ -12,6 +12,7 @@
 #include <toml++/toml.h>
 
 #include "core/error.h"
+#include "models/benchmark_plant.h"
 
 namespace rths::sweep {
 
@@ -100,8 +101,12 @@ Draw ParseDraw(const std::string& key, const toml::node& node, const std::string
     d.a = Number(*t, where, "lo");
     d.b = Number(*t, where, "hi");
     if (!(d.a < d.b)) throw Error(where, fmt::format("needs lo < hi (lo = {}, hi = {})", d.a, d.b));
+  } else if (d.dist == "benchmark_plant") {
+    if (key != "plant.benchmark") throw Error(where, "dist = \"benchmark_plant\" is drawn for the key \"plant.benchmark\"");
   } else if (d.dist != "seed") {
-    throw Error(where + ".dist", fmt::format("\"{}\": allowed \"normal\", \"uniform\", \"lognormal\", \"seed\"", d.dist));
+    throw Error(where + ".dist", fmt::format("\"{}\": allowed \"normal\", \"uniform\", \"lognormal\", \"seed\", "
+                                             "\"benchmark_plant\"",
+                                             d.dist));
   }
   return d;
 }
@@ -259,6 +264,13 @@ Spec LoadSpec(const std::string& path) {
   return ParseSpec(text.str(), fs::absolute(path).lexically_normal().string());
 }
 
+std::vector<std::string> DrawColumns(const Draw& d) {
+  if (d.dist == "benchmark_plant") {
+    return {d.key + ".b1", d.key + ".b2", d.key + ".a3", d.key + ".k_e_N_per_m"};
+  }
+  return {d.key};
+}
+
 RunPoint PointOf(const Spec& spec, std::int64_t index) {
   if (index < 0 || index >= spec.runs()) {
     throw Error(spec.path, fmt::format("run {} is out of range [0, {})", index, spec.runs()));
@@ -286,7 +298,19 @@ RunPoint PointOf(const Spec& spec, std::int64_t index) {
     std::uint64_t state = spec.seed;
     state = SplitMix64(&state) ^ static_cast<std::uint64_t>(index);
     state = SplitMix64(&state) ^ KeyHash(d.key);
-    p.sets.push_back(d.key + "=" + Value(d, &state));
+    if (d.dist != "benchmark_plant") {
+      p.sets.push_back(d.key + "=" + Value(d, &state));
+      continue;
+    }
+    // The benchmark's Gaussian uncertainty of b1, b2, a3 and k_e about its nominal plant
+    // (models::PerturbedBenchmarkParams), seeded from this run's stream; the numerical
+    // substructure follows the perturbed specimen (structure.subtract_specimen).
+    const std::uint64_t seed = 1 + SplitMix64(&state) % 2147483646ULL;
+    const models::BenchmarkPlantParams b = models::PerturbedBenchmarkParams(models::BenchmarkPlantParams{}, seed);
+    const std::vector<std::string> keys = DrawColumns(d);
+    const double values[] = {b.b1, b.b2, b.a3, b.k_e_N_per_m};
+    for (std::size_t k = 0; k < keys.size(); ++k) p.sets.push_back(keys[k] + "=" + FloatLiteral(values[k]));
+    p.sets.push_back("structure.subtract_specimen=true");
   }
   return p;
 }

@@ -5,12 +5,13 @@
 ///
 ///     [sweep]
 ///     name = "lqg_noise"              # label of the sweep's output folder
-///     base = "../default.toml"        # the scenario every run starts from (relative to the SPEC)
+///     base = "../default.toml"        # the scenario every run starts from (relative to the SPEC),
+///                                     # or, instead of base, [cases] files (one or the other)
 ///     seed = 1                        # the sweep's seed: every draw derives from it and the run index
 ///     draws = 100                     # runs per grid point with fresh [draw] values (0: no [draw])
-///     record = ["tracking_nrmse_pct", "peak_force_kN", "status"]   # summary.json fields per run
-///     [cases]
-///     files = ["case1.toml", "case2.toml"]   # optional: whole scenarios, each in place of `base`
+///     record = ["tracking_nrmse_pct", "peak_force_kN", "benchmark_criteria.J2_pct"]  # summary.json fields
+///     # [cases]
+///     # files = ["case1.toml", "case2.toml"]  # whole scenarios, each a case, in place of `base`
 ///     [grid]                                   # every combination of these --set values
 ///     "controller.kind" = ["ff", "ff_lqg"]
 ///     "controller.lqg.q" = [1e2, 1e3, 1e4]
@@ -37,7 +38,12 @@ namespace rths::sweep {
 /// A distribution of a [draw] key.
 struct Draw {
   std::string key;      ///< dotted scenario key, e.g. "structure.damping_ratio"
-  std::string dist;     ///< "normal" (mean, std), "uniform" (lo, hi), "lognormal" (mu, sigma of log), "seed"
+  /// "normal" (mean, std), "uniform" (lo, hi), "lognormal" (mu, sigma of log), "seed" (an integer in
+  /// [1, 2^31 - 2]), or the named draw "benchmark_plant" (key "plant.benchmark": the RTHS benchmark's
+  /// perturbed plant, models::PerturbedBenchmarkParams about the nominal constants, b1, b2, a3 and
+  /// k_e_N_per_m set, with structure.subtract_specimen = true so that the numerical substructure is
+  /// the reference minus the perturbed specimen, as the benchmark's reference code runs it)
+  std::string dist;
   double a = 0, b = 0;  ///< the parameters, in that order
 };
 
@@ -93,6 +99,10 @@ inline constexpr std::int64_t kMaxRuns = 10'000'000;
 Spec ParseSpec(const std::string& text, const std::string& path);
 /// Reads and parses a SPEC file; throws rths::Error (unreadable file, as ParseSpec).
 Spec LoadSpec(const std::string& path);
+/// The scenario keys a draw sets, the table's columns for it: its key, or for "benchmark_plant"
+/// plant.benchmark.b1, .b2, .a3 and .k_e_N_per_m.
+std::vector<std::string> DrawColumns(const Draw& d);
+
 /// Run `index` (0 <= index < spec.runs(); throws rths::Error otherwise).
 RunPoint PointOf(const Spec& spec, std::int64_t index);
 

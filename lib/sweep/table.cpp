@@ -117,16 +117,37 @@ std::vector<std::size_t> NumericFields(const Spec& spec, const Table& t) {
 
 bool Completed(const std::vector<nlohmann::json>& row) { return row[1] == "completed"; }
 
+/// The first grid or drawn column: after index, status, scenario_sha256 and, with cases, case.
+std::size_t FirstSetColumn(const Spec& spec) { return spec.cases.size() > 1 ? 4 : 3; }
+
 }  // namespace
 
 std::vector<std::string> TableColumns(const Spec& spec) {
   std::vector<std::string> c = {"index", "status", "scenario_sha256"};
+  if (spec.cases.size() > 1) c.push_back("case");
   for (const Axis& a : spec.grid) c.push_back(a.key);
-  for (const Draw& d : spec.draw) c.push_back(d.key);
+  for (const Draw& d : spec.draw) {
+    for (const std::string& k : DrawColumns(d)) c.push_back(k);
+  }
   for (const std::string& f : spec.record) {  // "status" is the sweep's: summary.json's becomes "summary.status"
     c.push_back(std::find(c.begin(), c.end(), f) == c.end() ? f : "summary." + f);
   }
   return c;
+}
+
+std::vector<std::string> AbsentFields(const Spec& spec, const Table& t) {
+  std::vector<std::string> absent;
+  const std::size_t first = t.columns.size() - spec.record.size();
+  for (std::size_t f = 0; f < spec.record.size(); ++f) {
+    bool any_completed = false, any_value = false;
+    for (const auto& row : t.rows) {
+      if (!Completed(row)) continue;
+      any_completed = true;
+      any_value = any_value || !row[first + f].is_null();
+    }
+    if (any_completed && !any_value) absent.push_back(spec.record[f]);
+  }
+  return absent;
 }
 
 nlohmann::json ReadJsonFile(const fs::path& file) {
@@ -148,10 +169,13 @@ Table ReadTable(const Spec& spec, const fs::path& out) {
     if (!row.is_object()) continue;
     std::vector<nlohmann::json> cells = {row.value("index", i), row.value("status", std::string()),
                                          row.value("scenario_sha256", std::string())};
+    if (spec.cases.size() > 1) cells.push_back(fs::path(PointOf(spec, i).scenario).filename().string());
     const nlohmann::json set = row.value("set", nlohmann::json::object());
     const nlohmann::json record = row.value("record", nlohmann::json::object());
     for (const Axis& a : spec.grid) cells.push_back(set.value(a.key, nlohmann::json()));
-    for (const Draw& d : spec.draw) cells.push_back(set.value(d.key, nlohmann::json()));
+    for (const Draw& d : spec.draw) {
+      for (const std::string& k : DrawColumns(d)) cells.push_back(set.value(k, nlohmann::json()));
+    }
     for (const std::string& f : spec.record) cells.push_back(record.value(f, nlohmann::json()));
     t.rows.push_back(std::move(cells));
     t.group.push_back(i / per_draw);
@@ -215,7 +239,7 @@ void WriteGroupSummary(const Spec& spec, const Table& t, const fs::path& file) {
     const auto& first = t.rows[rows.front()];
     const RunPoint p = PointOf(spec, first[0].get<std::int64_t>());
     std::string key = Cell(fs::path(p.scenario).filename().string());
-    for (std::size_t a = 0; a < spec.grid.size(); ++a) key += "," + Cell(first[3 + a]);
+    for (std::size_t a = 0; a < spec.grid.size(); ++a) key += "," + Cell(first[FirstSetColumn(spec) + a]);
     std::int64_t failures = 0;
     for (const std::size_t r : rows) failures += !Completed(t.rows[r]);
     for (const std::size_t c : fields) {
@@ -252,14 +276,25 @@ std::vector<fs::path> WritePlots(const Spec& spec, const Table& t, const fs::pat
   std::vector<AxisColumn> axes;
   if (spec.cases.size() > 1) {
     AxisColumn a{"case", {}};
-    for (const auto& row : t.rows) a.labels.push_back(fs::path(PointOf(spec, row[0].get<std::int64_t>()).scenario).stem());
+    for (const auto& row : t.rows) a.labels.push_back(fs::path(row[3].get<std::string>()).stem());
     axes.push_back(std::move(a));
   }
-  for (std::size_t k = 0; k < spec.grid.size() + spec.draw.size(); ++k) {
-    if (k >= spec.grid.size() && spec.draw[k - spec.grid.size()].dist == "seed") continue;  // a seed is no axis
-    AxisColumn a{t.columns[3 + k], {}};
-    for (const auto& row : t.rows) a.labels.push_back(Cell(row[3 + k]));
+  std::size_t column = FirstSetColumn(spec);  // the grid's and the draws' columns
+  for (const Axis& g : spec.grid) {
+    AxisColumn a{g.key, {}};
+    for (const auto& row : t.rows) a.labels.push_back(Cell(row[column]));
     axes.push_back(std::move(a));
+    ++column;
+  }
+  for (const Draw& d : spec.draw) {
+    for (const std::string& key : DrawColumns(d)) {
+      if (d.dist != "seed") {  // a seed is no axis
+        AxisColumn a{key, {}};
+        for (const auto& row : t.rows) a.labels.push_back(Cell(row[column]));
+        axes.push_back(std::move(a));
+      }
+      ++column;
+    }
   }
   for (const std::size_t c : NumericFields(spec, t)) {
     io::Figure fig;

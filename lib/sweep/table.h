@@ -2,8 +2,8 @@
 /// @file A sweep's results (issue 28), made from its rows (DIR/rows/<i>.json) once its runs have
 /// ended, by either executor:
 ///
-///   DIR/table.csv     one line per row, by index: index, status, scenario_sha256, each grid key,
-///                     each drawn key, each recorded field; doubles as the shortest text that reads back bit for bit
+///   DIR/table.csv     one line per row, by index: the columns of TableColumns; doubles as the
+///                     shortest text that reads back bit for bit
 ///   DIR/table.h5      the same table in HDF5 (Debian's libhdf5): group /runs, one 1-D dataset per
 ///                     column, named as the column, in the order of /runs's attribute `columns`:
 ///                     float64 for numbers (NaN where a row has none), int64 for integers present in
@@ -34,8 +34,8 @@ struct Table {
   std::vector<std::int64_t> group;                ///< per row: case x combination index (the draws' group)
 };
 
-/// The table's columns: index, status, scenario_sha256, each grid key, each drawn key, each recorded
-/// field (named "summary.<field>" where its name is already a column's, e.g. summary.json's "status").
+/// The table's columns: index, status, scenario_sha256, case (the case's file name, with [cases]
+/// files only), each grid key, each drawn key (DrawColumns), each recorded field (named "summary.<field>" where its name is already a column's, e.g. summary.json's "status").
 std::vector<std::string> TableColumns(const Spec& spec);
 
 /// A JSON file (a row, a summary.json); null if absent or malformed.
@@ -43,6 +43,9 @@ nlohmann::json ReadJsonFile(const std::filesystem::path& file);
 
 /// Reads DIR/rows/<i>.json for every index of the sweep (absent rows are left out).
 Table ReadTable(const Spec& spec, const std::filesystem::path& out);
+
+/// The recorded fields no completed row has a value for: not in summary.json (a misspelt name?).
+std::vector<std::string> AbsentFields(const Spec& spec, const Table& t);
 
 /// DIR/table.csv. Throws rths::Error if it cannot be written.
 void WriteCsv(const Table& t, const std::filesystem::path& file);
