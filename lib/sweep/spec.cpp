@@ -202,8 +202,8 @@ Spec ParseSpec(const std::string& text, const std::string& path) {
   }
   for (const auto& [k, v] : root) {
     const std::string key(k.str());
-    if (key != "sweep" && key != "cases" && key != "grid" && key != "draw" && key != "slurm") {
-      throw Error(path + ": " + key, "unknown table; allowed: [sweep], [cases], [grid], [draw], [slurm]");
+    if (key != "sweep" && key != "cases" && key != "set" && key != "grid" && key != "draw" && key != "slurm") {
+      throw Error(path + ": " + key, "unknown table; allowed: [sweep], [cases], [set], [grid], [draw], [slurm]");
     }
   }
   Spec spec;
@@ -234,6 +234,15 @@ Spec ParseSpec(const std::string& text, const std::string& path) {
       spec.grid.push_back(std::move(axis));
     }
   }
+  if (const auto* set = root["set"].as_table()) {
+    for (const auto& [k, v] : *set) {
+      const std::string literal = Literal(v);
+      if (literal.empty()) {
+        throw Error(fmt::format("{}: set.\"{}\"", path, k.str()), "must be a string, an integer, a finite float or a boolean");
+      }
+      spec.fixed.emplace_back(std::string(k.str()), literal);
+    }
+  }
   if (const auto* draw = root["draw"].as_table()) {
     for (const auto& [k, v] : *draw) {
       spec.draw.push_back(ParseDraw(std::string(k.str()), v, fmt::format("{}: draw.\"{}\"", path, k.str())));
@@ -247,6 +256,18 @@ Spec ParseSpec(const std::string& text, const std::string& path) {
   auto key_order = [](const auto& x, const auto& y) { return x.key < y.key; };
   std::sort(spec.grid.begin(), spec.grid.end(), key_order);
   std::sort(spec.draw.begin(), spec.draw.end(), key_order);
+  std::sort(spec.fixed.begin(), spec.fixed.end());
+  // A key varied in one place only.
+  std::vector<std::string> keys;
+  for (const auto& [k, v] : spec.fixed) keys.push_back(k);
+  for (const Axis& a : spec.grid) keys.push_back(a.key);
+  for (const Draw& d : spec.draw) {
+    for (const std::string& k : DrawColumns(d)) keys.push_back(k);
+  }
+  std::sort(keys.begin(), keys.end());
+  if (const auto dup = std::adjacent_find(keys.begin(), keys.end()); dup != keys.end()) {
+    throw Error(path + ": " + *dup, "is given in more than one of [set], [grid] and [draw]");
+  }
   // The run count, without overflow.
   double runs = static_cast<double>(spec.cases.size()) * static_cast<double>(std::max<std::int64_t>(spec.draws, 1));
   for (const Axis& a : spec.grid) runs *= static_cast<double>(a.values.size());
@@ -291,6 +312,7 @@ RunPoint PointOf(const Spec& spec, std::int64_t index) {
     pick[a] = static_cast<std::size_t>(rest % n);
     rest /= n;
   }
+  for (const auto& [key, value] : spec.fixed) p.sets.push_back(key + "=" + value);
   for (std::size_t a = 0; a < spec.grid.size(); ++a) {
     p.sets.push_back(spec.grid[a].key + "=" + spec.grid[a].values[pick[a]]);
   }

@@ -12,6 +12,8 @@
 ///     record = ["tracking_nrmse_pct", "peak_force_kN", "benchmark_criteria.J2_pct"]  # summary.json fields
 ///     # [cases]
 ///     # files = ["case1.toml", "case2.toml"]  # whole scenarios, each a case, in place of `base`
+///     [set]                                    # optional: these --set values in every run
+///     "run.duration_s" = 10.0
 ///     [grid]                                   # every combination of these --set values
 ///     "controller.kind" = ["ff", "ff_lqg"]
 ///     "controller.lqg.q" = [1e2, 1e3, 1e4]
@@ -73,6 +75,9 @@ struct Spec {
   std::uint64_t seed = 1;
   std::int64_t draws = 0;           ///< runs per grid point (0: one, without draws)
   std::vector<std::string> record;  ///< summary.json fields recorded per run
+  /// [set]: KEY = VALUE for every run (TOML literals, sorted by key), applied before the grid's
+  /// and the draws' values; not a column of the table (the same in every row).
+  std::vector<std::pair<std::string, std::string>> fixed;
   std::vector<Axis> grid;           ///< sorted by key
   std::vector<Draw> draw;           ///< sorted by key
   SlurmSettings slurm;              ///< [slurm]
@@ -88,7 +93,7 @@ struct RunPoint {
   std::int64_t index = 0;
   std::int64_t case_index = 0, combination = 0, draw = 0;
   std::string scenario;             ///< the case's file
-  std::vector<std::string> sets;    ///< "KEY=VALUE": grid values, then drawn values (key order)
+  std::vector<std::string> sets;    ///< "KEY=VALUE": [set] values, grid values, then drawn values (key order)
 };
 
 /// The largest sweep accepted (runs()).
