@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <thread>
 
 #include <nlohmann/json.hpp>
 
@@ -127,4 +128,46 @@ TEST_CASE("a sweep on a one-node Slurm: the local table, a cancelled task seen, 
   CHECK(r.status == 0);
   CHECK(r.output.find("array tasks 3 of 8") != std::string::npos);
   CHECK(rths_test::Slurp(s2 / "table.csv") == local_table);
+
+  // 5. A task killed while it runs: the rows of the runs it finished stay, the collector names it
+  // with Slurm's verdict, and its retry makes only the runs left.
+  const fs::path base2 = dir / "long.toml";
+  std::ofstream(base2) << "[run]\nname = \"sweep_long\"\nduration_s = 8.0\ncsv_every = 0\n";
+  const fs::path spec2_path = dir / "spec2.toml";
+  std::ofstream(spec2_path) << "[sweep]\nname = \"slurm_kill\"\nbase = \"" << base2.string() << "\"\nseed = 5\ndraws = 8\n"
+                            << "record = [\"tracking_nrmse_pct\", \"peak_force_kN\"]\n"
+                            << "[draw]\n\"plant.noise_seed\" = { dist = \"seed\" }\n"
+                            << "[slurm]\nruns_per_task = 4\nretries = 0\n";
+  const auto spec2 = rths::sweep::LoadSpec(spec2_path.string());
+  rths::sweep::SweepOptions local2;
+  local2.out = dir / "local2";
+  local2.jobs = 2;
+  REQUIRE(rths::sweep::RunSweep(spec2, local2).failed == 0);
+  const fs::path s3 = dir / "s3";
+  r = Sweep({spec2_path.string(), "--executor", "slurm", "--out", s3.string(), "--detach"});
+  REQUIRE(r.status == 0);
+  const std::string job3 =
+      nlohmann::json::parse(rths_test::Slurp(s3 / "slurm" / "sweep.json"))["jobs"].back().get<std::string>();
+  // Task 1 runs 1, 3, 5, 7: cancel it once its first row is there.
+  bool killed = false;
+  for (int i = 0; i < 600 && !killed; ++i) {
+    if (fs::exists(s3 / "rows" / "1.json")) {
+      killed = rths::io::RunCommand({rths::io::FindProgram("scancel"), job3 + "_1"}).status == 0;
+    } else {
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    }
+  }
+  REQUIRE(killed);
+  r = Sweep({"--collect", s3.string(), "--retries", "0", "--poll-s", "0.2"});
+  INFO(r.output);
+  CHECK(r.status == 1);
+  CHECK(r.output.find("array task 1 of job " + job3 + ": ") != std::string::npos);
+  CHECK(r.output.find("state CANCELLED") != std::string::npos);
+  CHECK(fs::exists(s3 / "rows" / "1.json"));  // kept: written when run 1 ended
+  int left = 0;
+  for (const int i : {3, 5, 7}) left += !fs::exists(s3 / "rows" / (std::to_string(i) + ".json"));
+  CHECK(left >= 1);
+  r = Sweep({"--collect", s3.string(), "--retries", "1", "--poll-s", "0.2"});
+  CHECK(r.status == 0);
+  CHECK(rths_test::Slurp(s3 / "table.csv") == rths_test::Slurp(local2.out / "table.csv"));
 }

@@ -42,8 +42,8 @@ std::string Slug(const std::string& label) {
 namespace {
 
 /// The first line of a study's scenario.toml.
-std::string ScenarioHeader(const RunSpec& spec) {
-  return spec.label + " (written by rths reproduce; every key is written out)";
+std::string ScenarioHeader(const RunSpec& spec, const std::string& origin = "rths reproduce") {
+  return spec.label + " (written by " + origin + "; every key is written out)";
 }
 
 }  // namespace
@@ -105,7 +105,7 @@ namespace {
 
 /// One run of the batch through the supervisor (memq, in this thread); its summary.json says how
 /// it went, also when it could not run.
-RunResult RunOne(const RunSpec& spec) {
+RunResult RunOne(const RunSpec& spec, const std::string& origin) {
   RunResult res;
   res.label = spec.label;
   res.dir = spec.dir;
@@ -115,7 +115,7 @@ RunResult RunOne(const RunSpec& spec) {
   }
   supervisor::RunRequest request;
   request.scenario = spec.scenario;
-  request.scenario_header = ScenarioHeader(spec);
+  request.scenario_header = ScenarioHeader(spec, origin);
   request.transport = "memq";
   request.out = spec.dir;
   request.checks = false;  // Preflight did
@@ -150,7 +150,7 @@ RunResult RunOne(const RunSpec& spec) {
 }  // namespace
 
 std::vector<RunResult> RunBatch(const std::vector<RunSpec>& specs, int jobs, ProgressLine* line,
-                                const Progress& progress) {
+                                const Progress& progress, const std::string& origin) {
   if (jobs < 1) throw Error("reproduce", "--jobs must be >= 1");
   std::vector<RunResult> results(specs.size());
   std::atomic<std::size_t> next{0};
@@ -163,7 +163,7 @@ std::vector<RunResult> RunBatch(const std::vector<RunSpec>& specs, int jobs, Pro
     for (;;) {
       const std::size_t i = next.fetch_add(1);
       if (i >= specs.size()) return;
-      RunResult r = RunOne(specs[i]);
+      RunResult r = RunOne(specs[i], origin);
       std::lock_guard<std::mutex> lock(m);
       results[i] = r;
       ++done;

@@ -60,8 +60,9 @@ using Progress = std::function<void(std::size_t done, std::size_t total, const R
 /// Runs every spec, `jobs` at a time (>= 1), and returns the results in spec order. A failed
 /// run is reported in its RunResult (and its summary.json), not thrown.
 /// `line`: if not null, shows the batch's progress with an ETA (by simulated steps done).
+/// `origin`: the command scenario.toml's header names ("written by rths reproduce; ...").
 std::vector<RunResult> RunBatch(const std::vector<RunSpec>& specs, int jobs, ProgressLine* line = nullptr,
-                                const Progress& progress = {});
+                                const Progress& progress = {}, const std::string& origin = "rths reproduce");
 
 /// A folder-name-safe form of a label: lower case, runs of other characters -> '-'
 /// ("G_FF,0.0A + LP" -> "g_ff-0.0a-lp").

@@ -112,7 +112,8 @@ SweepOutcome RunSweep(const Spec& spec, const SweepOptions& o) {
       const fs::path dir = o.out / "runs" / std::to_string(p.index);
       fs::remove_all(dir);  // what an interrupted attempt left
       try {
-        specs.push_back({fmt::format("run {}", p.index), scenario::LoadScenario(p.scenario, p.sets), dir});
+        specs.push_back({fmt::format("run {} of sweep {}", p.index, spec.name), scenario::LoadScenario(p.scenario, p.sets),
+                         dir});
         points.push_back(p);
       } catch (const std::exception& e) {  // e.g. a drawn value out of the key's range: a row, not a crash
         io::OverwriteFile(RowPath(o.out, p.index).string(),
@@ -144,7 +145,8 @@ SweepOutcome RunSweep(const Spec& spec, const SweepOptions& o) {
                           o.progress->Update(static_cast<double>(outcome.ran), static_cast<double>(todo.size()),
                                              fmt::format("{} of {} runs", outcome.ran, todo.size()));
                         }
-                      });
+                      },
+                      "rths sweep");
   }
   if (o.write_table) {
     outcome.table = WriteTable(spec, o.out);
