@@ -110,7 +110,7 @@ TEST_CASE("a sweep on a one-node Slurm: the local table, a cancelled task seen, 
   INFO(r.output);
   CHECK(r.status == 1);
   CHECK(r.output.find("array task 7 of job " + job + ": 5 of its 5 runs have no row") != std::string::npos);
-  CHECK(r.output.find("rows 35/40") != std::string::npos);
+  CHECK(r.output.find("runs done 35/40") != std::string::npos);
   // 3. A retry submits task 7 alone and completes the table.
   r = Sweep({"--collect", s2.string(), "--retries", "1", "--poll-s", "0.2"});
   INFO(r.output);
@@ -170,4 +170,34 @@ TEST_CASE("a sweep on a one-node Slurm: the local table, a cancelled task seen, 
   r = Sweep({"--collect", s3.string(), "--retries", "1", "--poll-s", "0.2"});
   CHECK(r.status == 0);
   CHECK(rths_test::Slurp(s3 / "table.csv") == rths_test::Slurp(local2.out / "table.csv"));
+}
+
+TEST_CASE("a reproduction on Slurm: fig9's runs as a job array give its table byte for byte and every run's log" *
+          doctest::skip(!rths_test::IsRoot())) {
+  REQUIRE_MESSAGE(!rths::io::FindProgram("slurmctld").empty(),
+                  "slurmctld is not installed: apt-get install slurmctld slurmd slurm-client munge");
+  rths_test::RequireBuilt("rths-reproduce");
+  rths_test::RequireBuilt("rths-sweep");
+  const fs::path dir = rths_test::TempDir("reproduce_slurm");
+  const std::string reproduce = std::string(RTHS_BIN_DIR) + "/rths-reproduce";
+  auto local = rths::io::RunCommand({reproduce, "fig9", "--quick", "--out", (dir / "local").string()});
+  REQUIRE_MESSAGE(local.status == 0, local.output);
+  OneNodeSlurm slurm(dir / "cluster");
+  REQUIRE_MESSAGE(slurm.up, "the one-node Slurm did not start: " << slurm.log);
+  auto r = rths::io::RunCommand({reproduce, "fig9", "--quick", "--out", (dir / "slurm").string(), "--executor", "slurm",
+                                 "--runs-per-task", "6", "--poll-s", "0.2"});
+  INFO(r.output);
+  REQUIRE(r.status == 0);
+  CHECK(r.output.find("36 runs in 6 array tasks") != std::string::npos);
+  CHECK(rths_test::Slurp(dir / "slurm" / "fig9.csv") == rths_test::Slurp(dir / "local" / "fig9.csv"));
+  int runs = 0;
+  for (const auto& e : fs::directory_iterator(dir / "local" / "runs")) {
+    const fs::path other = dir / "slurm" / "runs" / e.path().filename();
+    CHECK(rths_test::Slurp(other / "scenario.toml") == rths_test::Slurp(e.path() / "scenario.toml"));
+    const auto cmp = rths::io::RunCommand({std::string(RTHS_BIN_DIR) + "/rths-log", "compare",
+                                           (e.path() / "log.lcm").string(), (other / "log.lcm").string()});
+    CHECK_MESSAGE(cmp.status == 0, e.path().filename().string() << ": " << cmp.output);
+    ++runs;
+  }
+  CHECK(runs == 36);
 }

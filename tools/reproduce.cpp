@@ -24,6 +24,7 @@
 #include "studies/fig78.h"
 #include "studies/fig9.h"
 #include "studies/table2.h"
+#include "sweep/study_on_slurm.h"
 
 namespace fs = std::filesystem;
 
@@ -57,6 +58,9 @@ struct Options {
   bool quick = false, extended = false, keep_logs = false, compact = false;
   int jobs = 2;
   std::vector<std::string> sets;
+  std::string executor = "local";         // local | slurm (lib/sweep/study_on_slurm.h)
+  rths::sweep::SlurmSettings slurm;       // --partition, --time, --account, --runs-per-task, --cpus-per-task, --retries
+  double poll_s = 2.0;
 };
 
 void AddOptions(CLI::App& app, Options* o) {
@@ -78,6 +82,38 @@ void AddOptions(CLI::App& app, Options* o) {
       "KEY=VALUE: override a scenario key of every lockstep run of the study (dotted, e.g. plant.noise_y_mm_rms=0.01), "
       "after the study set its own keys; repeatable; checked like a file (docs/scenarios.md)");
   app.add_flag("--compact", o->compact, "runs without signals.csv (as --set run.csv_every=0): log.lcm only, about 70 % of the size");
+  app.add_option("--executor", o->executor, "where the lockstep runs run: local (--jobs at a time) or slurm (a job "
+                                            "array; --out on a filesystem the nodes share; docs/cluster.md)")
+      ->check(CLI::IsMember({"local", "slurm"}));
+  app.add_option("--partition", o->slurm.partition, "slurm: sbatch --partition");
+  app.add_option("--time", o->slurm.time, "slurm: time limit per array task, e.g. 00:30:00");
+  app.add_option("--account", o->slurm.account, "slurm: sbatch --account");
+  app.add_option("--runs-per-task", o->slurm.runs_per_task, "slurm: runs per array task (default 25)")
+      ->check(CLI::Range(std::int64_t{1}, rths::sweep::kMaxRuns));
+  app.add_option("--cpus-per-task", o->slurm.cpus_per_task, "slurm: cores per array task")->check(CLI::Range(1, 4096));
+  app.add_option("--retries", o->slurm.retries, "slurm: times a task that left runs undone is submitted again")
+      ->check(CLI::Range(0, 100));
+  app.add_option("--poll-s", o->poll_s, "slurm: seconds between squeue calls while waiting")->check(CLI::Range(0.05, 600.0));
+}
+
+/// --executor slurm: the study's batches as job arrays (lib/sweep/study_on_slurm.h), run by the
+/// rths-sweep beside this program.
+void UseSlurm(const Options& o, rths::studies::ReproduceOptions* opts) {
+  rths::sweep::StudySlurmOptions s;
+  s.dir = opts->out_dir;
+  s.settings = o.slurm;
+  s.programs = {rths::tools::ProgramOnPath("sbatch"), rths::tools::ProgramOnPath("squeue"),
+                rths::tools::ProgramOnPath("scontrol")};
+  std::error_code ec;
+  s.sweep_program = (fs::read_symlink("/proc/self/exe", ec).parent_path() / "rths-sweep").string();
+  s.poll_s = o.poll_s;
+  const auto log = opts->log;
+  s.say = [log](const std::string& line) {
+    if (log) log(line);
+  };
+  opts->run_batch = [s](const std::vector<rths::studies::RunSpec>& specs, const rths::studies::Progress& progress) {
+    return rths::sweep::RunSpecsOnSlurm(specs, s, progress);
+  };
 }
 
 void Fig5(const Options& o, const rths::studies::ReproduceOptions& opts) {
@@ -238,6 +274,7 @@ int main(int argc, char** argv) {
     std::printf("%.*s\n", static_cast<int>(line.size()), line.data());
     std::fflush(stdout);
   };
+  if (o.executor == "slurm") UseSlurm(o, &opts);
   const auto t0 = std::chrono::steady_clock::now();
   try {
     std::printf("rths reproduce %s%s%s -> %s\n", o.name.c_str(), o.quick ? " (quick)" : "",

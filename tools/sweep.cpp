@@ -21,6 +21,7 @@
 #include "lockstep/exit_code.h"
 #include "sweep/run_sweep.h"
 #include "sweep/slurm.h"
+#include "sweep/study_on_slurm.h"
 
 namespace {
 
@@ -32,7 +33,7 @@ void WarnAbsent(const std::vector<std::string>& fields) {
 }
 
 struct Args {
-  std::string spec_path, out, executor = "local", collect;
+  std::string spec_path, out, executor = "local", collect, batch;
   int jobs = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   std::int64_t only = -1, chunk = 0, chunks = 1;
   bool resume = false, keep_logs = false, task = false, detach = false;
@@ -148,10 +149,19 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0, 100));
   app.add_flag("--detach", a.detach, "slurm: submit and return; then `rths sweep --collect OUT`");
   app.add_option("--collect", a.collect, "slurm: wait for a detached sweep in DIR, retry, write its table");
+  app.add_option("--batch", a.batch, "run chunk --chunk of a study's batch file (what `rths reproduce --executor slurm` "
+                                    "submits; with --task)");
   app.add_option("--poll-s", a.poll_s, "slurm: seconds between squeue calls while waiting")->check(CLI::Range(0.05, 600.0));
   app.footer("Exit codes: 0 every run completed; 1 some runs did not (their rows, or the missing tasks, say why); 2 bad input.");
   if (const int code = rths::tools::ParseCommandLine(app, argc, argv); code >= 0) return code;
   try {
+    if (!a.batch.empty()) {
+      if (!a.task) throw rths::Error("--batch", "is what an array task runs: give --task with it");
+      const auto made = rths::sweep::RunBatchTask(a.batch, a.chunk, a.chunks, a.jobs);
+      std::printf("made %lld runs of %s (chunk %lld of %lld)\n", static_cast<long long>(made), a.batch.c_str(),
+                  static_cast<long long>(a.chunk), static_cast<long long>(a.chunks));
+      return 0;
+    }
     if (!a.collect.empty()) {
       if (!a.spec_path.empty()) throw rths::Error("--collect", "takes the sweep's folder only, not a SPEC");
       return Report(rths::sweep::CollectSweep(SlurmOptions(a, nullptr), a.retries), a.collect);

@@ -64,6 +64,11 @@ using Progress = std::function<void(std::size_t done, std::size_t total, const R
 std::vector<RunResult> RunBatch(const std::vector<RunSpec>& specs, int jobs, ProgressLine* line = nullptr,
                                 const Progress& progress = {}, const std::string& origin = "rths reproduce");
 
+/// The RunResult of a run made elsewhere (an array task on a cluster: sweep/study_on_slurm.h),
+/// read from its folder's summary.json as RunOne takes it from the supervisor's summary (NaN where
+/// the JSON holds null). A folder without a readable summary.json is a failed run saying so.
+RunResult ResultOfRunFolder(const std::filesystem::path& dir, const std::string& label);
+
 /// A folder-name-safe form of a label: lower case, runs of other characters -> '-'
 /// ("G_FF,0.0A + LP" -> "g_ff-0.0a-lp").
 std::string Slug(const std::string& label);

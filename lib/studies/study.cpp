@@ -93,6 +93,7 @@ std::vector<RunResult> RunStudyBatch(std::vector<RunSpec>* specs, const Reproduc
                                      const std::string& intro, const Progress& on_run) {
   Preflight(specs, opts.overrides, opts.log);
   if (opts.log) opts.log(intro);
+  if (opts.run_batch) return opts.run_batch(*specs, on_run);
   return RunBatch(*specs, opts.jobs, opts.progress, on_run);
 }
 

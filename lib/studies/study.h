@@ -45,6 +45,10 @@ struct ReproduceOptions {
   /// compensators and a PI + phase lead beside the paper's proposed controllers. The paper's 36
   /// rows and their files are the same with or without it.
   bool extended = false;
+  /// Where the lockstep runs are made: empty, here, `jobs` at a time (RunBatch); else this
+  /// function makes them (e.g. as a Slurm job array, sweep/study_on_slurm.h) and returns their
+  /// results in spec order, calling `progress` after each as RunBatch does.
+  std::function<std::vector<RunResult>(const std::vector<RunSpec>&, const Progress&)> run_batch;
 };
 
 /// One of the paper's claims (docs/experiments.md) checked on our numbers.

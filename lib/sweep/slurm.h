@@ -3,7 +3,8 @@
 /// runs as one job array, Slurm doing all the scheduling; no daemon of ours.
 ///
 /// The runs are split into T chunks (runs_per_task each, T <= kMaxArrayTasks); array task c runs
-/// the indices i with i % T == c by calling this same program on the compute node:
+/// the indices i with i % T == c by calling this same program on the compute node
+/// (sweep/slurm_array.h, which the studies' runs on Slurm share):
 ///
 ///     rths-sweep SPEC --out DIR --task --chunk c --chunks T --jobs $SLURM_CPUS_PER_TASK
 ///
@@ -23,19 +24,10 @@
 #include <string>
 #include <vector>
 
+#include "sweep/slurm_array.h"
 #include "sweep/spec.h"
 
 namespace rths::sweep {
-
-/// The most array tasks one sweep submits (Slurm's default MaxArraySize is 1001).
-inline constexpr std::int64_t kMaxArrayTasks = 1000;
-/// Runs per array task when neither the SPEC nor a flag says.
-inline constexpr std::int64_t kDefaultRunsPerTask = 25;
-
-/// The Slurm commands, as paths (the main program finds them on PATH: `module load slurm`).
-struct SlurmPrograms {
-  std::string sbatch = "sbatch", squeue = "squeue", scontrol = "scontrol";
-};
 
 struct SlurmRunOptions {
   std::filesystem::path out;           ///< DIR, shared with the compute nodes (created)
@@ -60,10 +52,6 @@ struct SlurmOutcome {
   bool detached = false;
   std::filesystem::path table;         ///< DIR/table.csv (not written when detached)
 };
-
-/// The chunk count T for `runs` runs: ceil(runs / runs_per_task) (kDefaultRunsPerTask when 0),
-/// at most kMaxArrayTasks.
-std::int64_t ChunkCount(std::int64_t runs, std::int64_t runs_per_task);
 
 /// Submits the array tasks whose runs have no row in DIR/rows yet (every task of a new DIR; only
 /// the unfinished ones of a resumed one), then, unless detached, waits, submits failed tasks
