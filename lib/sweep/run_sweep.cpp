@@ -75,18 +75,10 @@ fs::path WriteTable(const Spec& spec, const fs::path& out) {
   return out / "table.csv";
 }
 
-std::vector<std::int64_t> MissingRows(const Spec& spec, const fs::path& out, std::int64_t chunk, std::int64_t chunks) {
-  std::vector<std::int64_t> missing;
-  for (std::int64_t i = chunk; i < spec.runs(); i += chunks) {
-    if (ReadJsonFile(RowPath(out, i)).is_null()) missing.push_back(i);
-  }
-  return missing;
-}
+namespace {
 
-SweepOutcome RunSweep(const Spec& spec, const SweepOptions& o) {
-  fs::create_directories(o.out / "rows");
-  fs::create_directories(o.out / "runs");
-  SweepOutcome outcome;
+/// The indices this call makes: `only`, or the chunk's, less the rows already there with resume.
+std::vector<std::int64_t> Todo(const Spec& spec, const SweepOptions& o, SweepOutcome* outcome) {
   std::vector<std::int64_t> todo;
   const std::int64_t first = o.only.value_or(0), last = o.only ? *o.only + 1 : spec.runs();
   if (o.chunks < 1 || o.chunk < 0 || o.chunk >= o.chunks) {
@@ -95,58 +87,72 @@ SweepOutcome RunSweep(const Spec& spec, const SweepOptions& o) {
   for (std::int64_t i = first; i < last; ++i) {
     PointOf(spec, i);  // throws for an index out of range
     if (i % o.chunks != o.chunk) continue;
-    if (o.resume && !ReadJsonFile(RowPath(o.out, i)).is_null()) {
-      ++outcome.skipped;
+    if (o.resume && fs::exists(RowPath(o.out, i))) {
+      ++outcome->skipped;
       continue;
     }
     todo.push_back(i);
   }
-  // Blocks of runs, so that a sweep of 16 000 runs does not hold 16 000 scenarios at once; each
-  // run's row is written as the run ends (an interrupted sweep keeps every finished run's row).
+  return todo;
+}
+
+/// Makes runs `ids` (`total` in this call, for the progress line), each row written as its run ends.
+void RunBlock(const Spec& spec, const SweepOptions& o, const std::vector<std::int64_t>& ids, std::size_t total,
+              SweepOutcome* outcome) {
+  std::vector<studies::RunSpec> specs;
+  std::vector<RunPoint> points;
+  for (const std::int64_t i : ids) {
+    const RunPoint p = PointOf(spec, i);
+    const fs::path dir = o.out / "runs" / std::to_string(p.index);
+    fs::remove_all(dir);  // what an interrupted attempt left
+    try {
+      specs.push_back({fmt::format("run {} of sweep {}", p.index, spec.name), scenario::LoadScenario(p.scenario, p.sets),
+                       dir});
+      points.push_back(p);
+    } catch (const std::exception& e) {  // e.g. a drawn value out of the key's range: a row, not a crash
+      io::OverwriteFile(RowPath(o.out, p.index).string(),
+                        Row(spec, p, fmt::format("invalid: {}", e.what()), nullptr).dump(2) + "\n");
+      ++outcome->ran;
+      ++outcome->failed;
+    }
+  }
+  std::size_t next = 0;  // RunBatch reports runs in the order they end: find each by its folder
+  auto on_run = [&](std::size_t, std::size_t, const studies::RunResult& result) {
+    std::size_t r = next;
+    while (specs[r].dir != result.dir) r = (r + 1) % specs.size();
+    next = (r + 1) % specs.size();
+    const nlohmann::json summary = ReadJsonFile(result.dir / "summary.json");
+    const std::string status =
+        result.ok ? "completed" : fmt::format("failed: {}", result.error.empty() ? "no summary" : result.error);
+    if (!o.keep_logs) {
+      std::error_code ec;
+      fs::remove(result.dir / "log.lcm", ec);
+      fs::remove(result.dir / "signals.csv", ec);
+    }
+    io::OverwriteFile(RowPath(o.out, points[r].index).string(), Row(spec, points[r], status, summary).dump(2) + "\n");
+    ++outcome->ran;
+    if (!result.ok) ++outcome->failed;
+    if (o.progress) {
+      o.progress->Update(static_cast<double>(outcome->ran), static_cast<double>(total),
+                         fmt::format("{} of {} runs", outcome->ran, total));
+    }
+  };
+  studies::RunBatch(specs, std::max(1, o.jobs), nullptr, on_run, "rths sweep");
+}
+
+}  // namespace
+
+SweepOutcome RunSweep(const Spec& spec, const SweepOptions& o) {
+  fs::create_directories(o.out / "rows");
+  fs::create_directories(o.out / "runs");
+  SweepOutcome outcome;
+  const std::vector<std::int64_t> todo = Todo(spec, o, &outcome);
+  // Blocks of runs, so that a sweep of 16 000 runs does not hold 16 000 scenarios at once.
   const std::size_t block = std::max<std::size_t>(64, 16 * static_cast<std::size_t>(std::max(1, o.jobs)));
   for (std::size_t from = 0; from < todo.size(); from += block) {
-    std::vector<studies::RunSpec> specs;
-    std::vector<RunPoint> points;
-    for (std::size_t k = from; k < std::min(todo.size(), from + block); ++k) {
-      const RunPoint p = PointOf(spec, todo[k]);
-      const fs::path dir = o.out / "runs" / std::to_string(p.index);
-      fs::remove_all(dir);  // what an interrupted attempt left
-      try {
-        specs.push_back({fmt::format("run {} of sweep {}", p.index, spec.name), scenario::LoadScenario(p.scenario, p.sets),
-                         dir});
-        points.push_back(p);
-      } catch (const std::exception& e) {  // e.g. a drawn value out of the key's range: a row, not a crash
-        io::OverwriteFile(RowPath(o.out, p.index).string(),
-                          Row(spec, p, fmt::format("invalid: {}", e.what()), nullptr).dump(2) + "\n");
-        ++outcome.ran;
-        ++outcome.failed;
-      }
-    }
-    std::size_t next = 0;  // RunBatch reports runs in the order they end: find each by its folder
-    studies::RunBatch(specs, std::max(1, o.jobs), nullptr,
-                      [&](std::size_t, std::size_t, const studies::RunResult& result) {
-                        std::size_t r = next;
-                        while (specs[r].dir != result.dir) r = (r + 1) % specs.size();
-                        next = (r + 1) % specs.size();
-                        const nlohmann::json summary = ReadJsonFile(result.dir / "summary.json");
-                        const std::string status =
-                            result.ok ? "completed"
-                                      : fmt::format("failed: {}", result.error.empty() ? "no summary" : result.error);
-                        if (!o.keep_logs) {
-                          std::error_code ec;
-                          fs::remove(result.dir / "log.lcm", ec);
-                          fs::remove(result.dir / "signals.csv", ec);
-                        }
-                        io::OverwriteFile(RowPath(o.out, points[r].index).string(),
-                                          Row(spec, points[r], status, summary).dump(2) + "\n");
-                        ++outcome.ran;
-                        if (!result.ok) ++outcome.failed;
-                        if (o.progress) {
-                          o.progress->Update(static_cast<double>(outcome.ran), static_cast<double>(todo.size()),
-                                             fmt::format("{} of {} runs", outcome.ran, todo.size()));
-                        }
-                      },
-                      "rths sweep");
+    const std::vector<std::int64_t> ids(todo.begin() + static_cast<std::ptrdiff_t>(from),
+                                        todo.begin() + static_cast<std::ptrdiff_t>(std::min(todo.size(), from + block)));
+    RunBlock(spec, o, ids, todo.size(), &outcome);
   }
   if (o.write_table) {
     outcome.table = WriteTable(spec, o.out);

@@ -6,7 +6,7 @@
 ///
 /// Folder layout (DIR): DIR/runs/<i>/ (scenario.toml, summary.json; log.lcm and signals.csv only
 /// with keep_logs), DIR/rows/<i>.json (the run's row, written once the run has ended, whatever its
-/// status), DIR/table.csv (every row present, by index).
+/// status), DIR/table.csv and the other results of sweep/table.h (every row present, by index).
 #include <cstdint>
 #include <filesystem>
 #include <optional>
@@ -43,12 +43,9 @@ struct SweepOutcome {
 /// unwritable DIR throws rths::Error.
 SweepOutcome RunSweep(const Spec& spec, const SweepOptions& o);
 
-/// Writes DIR/table.csv from every row present in DIR/rows, by index; returns its path. Throws
-/// rths::Error if it cannot be written.
+/// Writes DIR/table.csv, table.h5, summary.csv and plots/ (sweep/table.h) from every row present
+/// in DIR/rows; returns table.csv's path. Throws rths::Error if the tables cannot be written (a
+/// plot that fails leaves its message in plots/FAILED.txt instead).
 std::filesystem::path WriteTable(const Spec& spec, const std::filesystem::path& out);
-
-/// The indices i of chunk `chunk` of `chunks` (i % chunks == chunk) with no row in DIR/rows.
-std::vector<std::int64_t> MissingRows(const Spec& spec, const std::filesystem::path& out, std::int64_t chunk,
-                                      std::int64_t chunks);
 
 }  // namespace rths::sweep

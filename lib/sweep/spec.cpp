@@ -193,22 +193,11 @@ std::int64_t Spec::runs() const {
   return static_cast<std::int64_t>(cases.size()) * combinations() * std::max<std::int64_t>(draws, 1);
 }
 
-Spec ParseSpec(const std::string& text, const std::string& path) {
-  toml::table root;
-  try {
-    root = toml::parse(text, path);
-  } catch (const toml::parse_error& e) {
-    throw Error(path, fmt::format("line {}: {}", e.source().begin.line, e.description()));
-  }
-  for (const auto& [k, v] : root) {
-    const std::string key(k.str());
-    if (key != "sweep" && key != "cases" && key != "set" && key != "grid" && key != "draw" && key != "slurm") {
-      throw Error(path + ": " + key, "unknown table; allowed: [sweep], [cases], [set], [grid], [draw], [slurm]");
-    }
-  }
-  Spec spec;
-  spec.path = path;
-  ParseSweepTable(root, path, &spec);
+namespace {
+
+/// [cases], [grid], [set] and [draw] into `spec`.
+void ParseAxes(const toml::table& root, const std::string& path, Spec* spec_ptr) {
+  Spec& spec = *spec_ptr;
   if (const auto* cases = root["cases"].as_table()) {
     if (!spec.cases.empty()) throw Error(path + ": cases", "give either sweep.base or [cases] files, not both");
     const auto* files = (*cases)["files"].as_array();
@@ -248,11 +237,11 @@ Spec ParseSpec(const std::string& text, const std::string& path) {
       spec.draw.push_back(ParseDraw(std::string(k.str()), v, fmt::format("{}: draw.\"{}\"", path, k.str())));
     }
   }
-  if (const auto* slurm = root["slurm"].as_table()) ParseSlurmTable(*slurm, path, &spec.slurm);
-  if (!spec.draw.empty() && spec.draws == 0) {
-    throw Error(path + ": sweep.draws", "[draw] needs sweep.draws >= 1 (the runs per grid point)");
-  }
-  if (spec.draw.empty() && spec.draws > 0) throw Error(path + ": sweep.draws", "needs a [draw] table to draw from");
+}
+
+/// Sorts the axes by key; refuses a key given twice and a sweep of more than kMaxRuns runs.
+void SortAndCheck(const std::string& path, Spec* spec_ptr) {
+  Spec& spec = *spec_ptr;
   auto key_order = [](const auto& x, const auto& y) { return x.key < y.key; };
   std::sort(spec.grid.begin(), spec.grid.end(), key_order);
   std::sort(spec.draw.begin(), spec.draw.end(), key_order);
@@ -274,6 +263,33 @@ Spec ParseSpec(const std::string& text, const std::string& path) {
   if (runs > static_cast<double>(kMaxRuns)) {
     throw Error(path, fmt::format("{:.0f} runs: more than the {} a sweep may hold; split it", runs, kMaxRuns));
   }
+}
+
+}  // namespace
+
+Spec ParseSpec(const std::string& text, const std::string& path) {
+  toml::table root;
+  try {
+    root = toml::parse(text, path);
+  } catch (const toml::parse_error& e) {
+    throw Error(path, fmt::format("line {}: {}", e.source().begin.line, e.description()));
+  }
+  for (const auto& [k, v] : root) {
+    const std::string key(k.str());
+    if (key != "sweep" && key != "cases" && key != "set" && key != "grid" && key != "draw" && key != "slurm") {
+      throw Error(path + ": " + key, "unknown table; allowed: [sweep], [cases], [set], [grid], [draw], [slurm]");
+    }
+  }
+  Spec spec;
+  spec.path = path;
+  ParseSweepTable(root, path, &spec);
+  ParseAxes(root, path, &spec);
+  if (const auto* slurm = root["slurm"].as_table()) ParseSlurmTable(*slurm, path, &spec.slurm);
+  if (!spec.draw.empty() && spec.draws == 0) {
+    throw Error(path + ": sweep.draws", "[draw] needs sweep.draws >= 1 (the runs per grid point)");
+  }
+  if (spec.draw.empty() && spec.draws > 0) throw Error(path + ": sweep.draws", "needs a [draw] table to draw from");
+  SortAndCheck(path, &spec);
   return spec;
 }
 

@@ -265,14 +265,16 @@ void WriteGroupSummary(const Spec& spec, const Table& t, const fs::path& file) {
   if (!io::OverwriteFile(file.string(), csv.str())) throw Error(file.string(), "cannot write the sweep's summary");
 }
 
-std::vector<fs::path> WritePlots(const Spec& spec, const Table& t, const fs::path& dir) {
-  std::vector<fs::path> pngs;
-  if (!io::GnuplotAvailable("gnuplot")) return pngs;
-  // The axes: the case (when there are several), each grid key, each drawn key.
-  struct AxisColumn {
-    std::string name;
-    std::vector<std::string> labels;  // per row
-  };
+namespace {
+
+/// A plot axis: its name and each row's value as text.
+struct AxisColumn {
+  std::string name;
+  std::vector<std::string> labels;  ///< per row
+};
+
+/// The axes: the case (when there are several), each grid key, each drawn key (not seeds).
+std::vector<AxisColumn> PlotAxes(const Spec& spec, const Table& t) {
   std::vector<AxisColumn> axes;
   if (spec.cases.size() > 1) {
     AxisColumn a{"case", {}};
@@ -296,6 +298,47 @@ std::vector<fs::path> WritePlots(const Spec& spec, const Table& t, const fs::pat
       ++column;
     }
   }
+  return axes;
+}
+
+/// Column c of the completed rows against axis `a`: numeric axis values at their value; text
+/// values (a case, a controller) at 0, 1, 2, ... in order of first appearance, labelled.
+io::Panel PlotPanel(const Table& t, std::size_t c, const AxisColumn& a) {
+  io::Panel p = io::MakePanel("", a.name, t.columns[c]);
+  p.key = "off";
+  io::Series s = io::MakeSeries("");
+  s.with = "points";
+  std::map<std::string, double> category;
+  bool numeric = true;
+  for (const std::string& l : a.labels) {
+    char* end = nullptr;
+    std::strtod(l.c_str(), &end);
+    numeric = numeric && !l.empty() && end && *end == '\0';
+  }
+  for (std::size_t r = 0; r < t.rows.size(); ++r) {
+    if (!Completed(t.rows[r])) continue;
+    double x = 0;
+    if (numeric) {
+      x = std::strtod(a.labels[r].c_str(), nullptr);
+    } else {
+      auto [it, fresh] = category.emplace(a.labels[r], static_cast<double>(category.size()));
+      if (fresh) p.x_tics.emplace_back(it->second, a.labels[r]);
+      x = it->second;
+    }
+    s.x.push_back(x);
+    s.y.push_back(AsDouble(t.rows[r][c]));
+  }
+  if (!numeric) p.x_range = std::pair(-0.5, static_cast<double>(category.size()) - 0.5);
+  p.series.push_back(std::move(s));
+  return p;
+}
+
+}  // namespace
+
+std::vector<fs::path> WritePlots(const Spec& spec, const Table& t, const fs::path& dir) {
+  std::vector<fs::path> pngs;
+  if (!io::GnuplotAvailable("gnuplot")) return pngs;
+  const std::vector<AxisColumn> axes = PlotAxes(spec, t);
   for (const std::size_t c : NumericFields(spec, t)) {
     io::Figure fig;
     fig.name = t.columns[c];
@@ -304,37 +347,7 @@ std::vector<fs::path> WritePlots(const Spec& spec, const Table& t, const fs::pat
     }
     fig.title = fmt::format("{}: {} against each axis (completed runs)", spec.name, t.columns[c]);
     fig.columns = axes.size() > 1 ? 2 : 1;
-    for (const AxisColumn& a : axes) {
-      io::Panel p = io::MakePanel("", a.name, t.columns[c]);
-      p.key = "off";
-      io::Series s = io::MakeSeries("");
-      s.with = "points";
-      // Numeric axis values are plotted at their value; text values (a case, a controller) at
-      // 0, 1, 2, ... in order of first appearance, labelled.
-      std::map<std::string, double> category;
-      bool numeric = true;
-      for (const std::string& l : a.labels) {
-        char* end = nullptr;
-        std::strtod(l.c_str(), &end);
-        numeric = numeric && !l.empty() && end && *end == '\0';
-      }
-      for (std::size_t r = 0; r < t.rows.size(); ++r) {
-        if (!Completed(t.rows[r])) continue;
-        double x = 0;
-        if (numeric) {
-          x = std::strtod(a.labels[r].c_str(), nullptr);
-        } else {
-          auto [it, fresh] = category.emplace(a.labels[r], static_cast<double>(category.size()));
-          if (fresh) p.x_tics.emplace_back(it->second, a.labels[r]);
-          x = it->second;
-        }
-        s.x.push_back(x);
-        s.y.push_back(AsDouble(t.rows[r][c]));
-      }
-      if (!numeric) p.x_range = std::pair(-0.5, static_cast<double>(category.size()) - 0.5);
-      p.series.push_back(std::move(s));
-      fig.panels.push_back(std::move(p));
-    }
+    for (const AxisColumn& a : axes) fig.panels.push_back(PlotPanel(t, c, a));
     const bool drawable = std::all_of(fig.panels.begin(), fig.panels.end(), [](const io::Panel& p) {
       return std::any_of(p.series[0].y.begin(), p.series[0].y.end(), [](double y) { return std::isfinite(y); });
     });
