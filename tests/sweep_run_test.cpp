@@ -176,3 +176,26 @@ TEST_CASE("the results: table.h5 holds table.csv's columns (read by Python's h5p
   CHECK(failures == r.failed);
   CHECK(fs::file_size(o.out / "plots" / "tracking_nrmse_pct.png") > 1000);
 }
+
+TEST_CASE("cases: a case column, by file name, or by path where two cases share a name") {
+  const auto dir = rths_test::TempDir("sweep_cases");
+  for (const char* sub : {"a", "b"}) {
+    fs::create_directories(dir / sub);
+    std::ofstream(dir / sub / "base.toml") << "[run]\nname = \"case_" << sub << "\"\nduration_s = 0.05\n";
+  }
+  std::ofstream(dir / "spec.toml") << "[sweep]\nrecord = [\"steps\"]\n[cases]\nfiles = [\"a/base.toml\", \"b/base.toml\"]\n"
+                                   << "[grid]\n\"controller.kind\" = [\"none\", \"ff\"]\n";
+  const auto spec = rths::sweep::LoadSpec((dir / "spec.toml").string());
+  rths::sweep::SweepOptions o;
+  o.out = dir / "out";
+  o.jobs = 2;
+  const auto r = rths::sweep::RunSweep(spec, o);
+  REQUIRE(r.not_completed == 0);
+  const std::string table = Read(r.table);
+  CHECK(table.rfind("index,status,scenario_sha256,case,controller.kind,steps\n", 0) == 0);
+  CHECK(table.find(",a/base.toml,none,100\n") != std::string::npos);
+  CHECK(table.find(",b/base.toml,ff,100\n") != std::string::npos);
+  const std::string summary = Read(o.out / "summary.csv");
+  CHECK(summary.find("b/base.toml,ff,steps,1,0,1,100,0,100,100\n") != std::string::npos);
+  CHECK(fs::exists(o.out / "plots" / "steps.png"));
+}

@@ -120,6 +120,21 @@ bool Completed(const std::vector<nlohmann::json>& row) { return row[1] == "compl
 /// The first grid or drawn column: after index, status, scenario_sha256 and, with cases, case.
 std::size_t FirstSetColumn(const Spec& spec) { return spec.cases.size() > 1 ? 4 : 3; }
 
+/// Each case's name in the table: its file name, or, where two cases share a file name, its path
+/// relative to the SPEC's folder.
+std::vector<std::string> CaseNames(const Spec& spec) {
+  std::vector<std::string> names;
+  for (const std::string& c : spec.cases) names.push_back(fs::path(c).filename().string());
+  std::vector<std::string> sorted = names;
+  std::sort(sorted.begin(), sorted.end());
+  if (std::adjacent_find(sorted.begin(), sorted.end()) == sorted.end()) return names;
+  names.clear();
+  for (const std::string& c : spec.cases) {
+    names.push_back(fs::path(c).lexically_relative(fs::path(spec.path).parent_path()).string());
+  }
+  return names;
+}
+
 }  // namespace
 
 std::vector<std::string> TableColumns(const Spec& spec) {
@@ -161,6 +176,7 @@ nlohmann::json ReadJsonFile(const fs::path& file) {
 }
 
 Table ReadTable(const Spec& spec, const fs::path& out) {
+  const std::vector<std::string> cases = CaseNames(spec);
   Table t;
   t.columns = TableColumns(spec);
   const std::int64_t per_draw = std::max<std::int64_t>(spec.draws, 1);
@@ -169,7 +185,7 @@ Table ReadTable(const Spec& spec, const fs::path& out) {
     if (!row.is_object()) continue;
     std::vector<nlohmann::json> cells = {row.value("index", i), row.value("status", std::string()),
                                          row.value("scenario_sha256", std::string())};
-    if (spec.cases.size() > 1) cells.push_back(fs::path(PointOf(spec, i).scenario).filename().string());
+    if (spec.cases.size() > 1) cells.push_back(cases[static_cast<std::size_t>(PointOf(spec, i).case_index)]);
     const nlohmann::json set = row.value("set", nlohmann::json::object());
     const nlohmann::json record = row.value("record", nlohmann::json::object());
     for (const Axis& a : spec.grid) cells.push_back(set.value(a.key, nlohmann::json()));
@@ -228,6 +244,7 @@ void WriteHdf5(const Spec& spec, const Table& t, const fs::path& file) {
 }
 
 void WriteGroupSummary(const Spec& spec, const Table& t, const fs::path& file) {
+  const std::vector<std::string> cases = CaseNames(spec);
   std::ostringstream csv;
   csv << "case";
   for (const Axis& a : spec.grid) csv << "," << a.key;
@@ -238,7 +255,7 @@ void WriteGroupSummary(const Spec& spec, const Table& t, const fs::path& file) {
   for (const auto& [group, rows] : groups) {
     const auto& first = t.rows[rows.front()];
     const RunPoint p = PointOf(spec, first[0].get<std::int64_t>());
-    std::string key = Cell(fs::path(p.scenario).filename().string());
+    std::string key = Cell(cases[static_cast<std::size_t>(p.case_index)]);
     for (std::size_t a = 0; a < spec.grid.size(); ++a) key += "," + Cell(first[FirstSetColumn(spec) + a]);
     std::int64_t failures = 0;
     for (const std::size_t r : rows) failures += !Completed(t.rows[r]);
@@ -277,8 +294,21 @@ struct AxisColumn {
 std::vector<AxisColumn> PlotAxes(const Spec& spec, const Table& t) {
   std::vector<AxisColumn> axes;
   if (spec.cases.size() > 1) {
+    // The cases' file names without what they all end with ("case1_example.toml" ... -> "case1"),
+    // so that the labels fit under their ticks.
+    const std::vector<std::string> names = CaseNames(spec);
+    auto back = [](const std::string& n, std::size_t k) { return k < n.size() ? n[n.size() - 1 - k] : '\0'; };
+    std::size_t common = 0;  // the length of the names' common ending, leaving each one character
+    while (std::all_of(names.begin(), names.end(), [&](const std::string& n) {
+      return common + 1 < n.size() && back(n, common) == back(names[0], common);
+    })) {
+      ++common;
+    }
     AxisColumn a{"case", {}};
-    for (const auto& row : t.rows) a.labels.push_back(fs::path(row[3].get<std::string>()).stem());
+    for (const auto& row : t.rows) {
+      const std::string name = row[3].get<std::string>();
+      a.labels.push_back(name.substr(0, name.size() - common));
+    }
     axes.push_back(std::move(a));
   }
   std::size_t column = FirstSetColumn(spec);  // the grid's and the draws' columns

@@ -34,8 +34,8 @@ struct Table {
   std::vector<std::int64_t> group;                ///< per row: case x combination index (the draws' group)
 };
 
-/// The table's columns: index, status, scenario_sha256, case (the case's file name, with [cases]
-/// files only), each grid key, each drawn key (DrawColumns), each recorded field (named "summary.<field>" where its name is already a column's, e.g. summary.json's "status").
+/// The table's columns: index, status, scenario_sha256, case (with [cases] files only: the case's
+/// file name, or its path relative to the SPEC's folder where two cases share a file name), each grid key, each drawn key (DrawColumns), each recorded field (named "summary.<field>" where its name is already a column's, e.g. summary.json's "status").
 std::vector<std::string> TableColumns(const Spec& spec);
 
 /// A JSON file (a row, a summary.json); null if absent or malformed.
