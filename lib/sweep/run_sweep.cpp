@@ -19,8 +19,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-fs::path RowPath(const fs::path& out, std::int64_t i) { return out / "rows" / fmt::format("{}.json", i); }
-
 /// The value of a dotted field of summary.json ("benchmark_criteria.J1_ms"); null if absent.
 nlohmann::json Field(const nlohmann::json& summary, const std::string& dotted) {
   const nlohmann::json* j = &summary;
@@ -61,7 +59,7 @@ nlohmann::json Row(const Spec& spec, const RunPoint& p, const std::string& statu
 
 }  // namespace
 
-fs::path WriteTable(const Spec& spec, const fs::path& out) {
+WrittenTable WriteTable(const Spec& spec, const fs::path& out) {
   const Table t = ReadTable(spec, out);
   WriteCsv(t, out / "table.csv");
   WriteHdf5(spec, t, out / "table.h5");
@@ -72,7 +70,9 @@ fs::path WriteTable(const Spec& spec, const fs::path& out) {
     fs::create_directories(out / "plots");
     io::OverwriteFile((out / "plots" / "FAILED.txt").string(), std::string(e.what()) + "\n");
   }
-  return out / "table.csv";
+  WrittenTable w{out / "table.csv", static_cast<std::int64_t>(t.rows.size()), 0, AbsentFields(spec, t)};
+  for (const auto& row : t.rows) w.not_completed += row[1] != "completed";
+  return w;
 }
 
 namespace {
@@ -84,10 +84,10 @@ std::vector<std::int64_t> Todo(const Spec& spec, const SweepOptions& o, SweepOut
   if (o.chunks < 1 || o.chunk < 0 || o.chunk >= o.chunks) {
     throw Error("--chunk", fmt::format("{} of {}: needs 0 <= chunk < chunks", o.chunk, o.chunks));
   }
+  if (o.only) PointOf(spec, *o.only);  // throws for an index out of range
   for (std::int64_t i = first; i < last; ++i) {
-    PointOf(spec, i);  // throws for an index out of range
     if (i % o.chunks != o.chunk) continue;
-    if (o.resume && fs::exists(RowPath(o.out, i))) {
+    if (o.resume && fs::exists(RowFile(o.out, i))) {
       ++outcome->skipped;
       continue;
     }
@@ -110,7 +110,7 @@ void RunBlock(const Spec& spec, const SweepOptions& o, const std::vector<std::in
                        dir});
       points.push_back(p);
     } catch (const std::exception& e) {  // e.g. a drawn value out of the key's range: a row, not a crash
-      io::OverwriteFile(RowPath(o.out, p.index).string(),
+      io::OverwriteFile(RowFile(o.out, p.index).string(),
                         Row(spec, p, fmt::format("invalid: {}", e.what()), nullptr).dump(2) + "\n");
       ++outcome->ran;
       ++outcome->failed;
@@ -129,7 +129,7 @@ void RunBlock(const Spec& spec, const SweepOptions& o, const std::vector<std::in
       fs::remove(result.dir / "log.lcm", ec);
       fs::remove(result.dir / "signals.csv", ec);
     }
-    io::OverwriteFile(RowPath(o.out, points[r].index).string(), Row(spec, points[r], status, summary).dump(2) + "\n");
+    io::OverwriteFile(RowFile(o.out, points[r].index).string(), Row(spec, points[r], status, summary).dump(2) + "\n");
     ++outcome->ran;
     if (!result.ok) ++outcome->failed;
     if (o.progress) {
@@ -155,11 +155,11 @@ SweepOutcome RunSweep(const Spec& spec, const SweepOptions& o) {
     RunBlock(spec, o, ids, todo.size(), &outcome);
   }
   if (o.write_table) {
-    outcome.table = WriteTable(spec, o.out);
-    const Table t = ReadTable(spec, o.out);
-    outcome.rows = static_cast<std::int64_t>(t.rows.size());
-    for (const auto& row : t.rows) outcome.not_completed += row[1] != "completed";
-    outcome.absent_fields = AbsentFields(spec, t);
+    WrittenTable w = WriteTable(spec, o.out);
+    outcome.table = w.csv;
+    outcome.rows = w.rows;
+    outcome.not_completed = w.not_completed;
+    outcome.absent_fields = std::move(w.absent_fields);
   }
   return outcome;
 }

@@ -43,9 +43,17 @@ struct SweepOutcome {
 /// unwritable DIR throws rths::Error.
 SweepOutcome RunSweep(const Spec& spec, const SweepOptions& o);
 
+/// What WriteTable wrote: table.csv's path, its rows, those not "completed", and the recorded
+/// fields no completed row has (AbsentFields).
+struct WrittenTable {
+  std::filesystem::path csv;
+  std::int64_t rows = 0, not_completed = 0;
+  std::vector<std::string> absent_fields;
+};
+
 /// Writes DIR/table.csv, table.h5, summary.csv and plots/ (sweep/table.h) from every row present
-/// in DIR/rows; returns table.csv's path. Throws rths::Error if the tables cannot be written (a
-/// plot that fails leaves its message in plots/FAILED.txt instead).
-std::filesystem::path WriteTable(const Spec& spec, const std::filesystem::path& out);
+/// in DIR/rows, read once. Throws rths::Error if the tables cannot be written (a plot that fails
+/// leaves its message in plots/FAILED.txt instead).
+WrittenTable WriteTable(const Spec& spec, const std::filesystem::path& out);
 
 }  // namespace rths::sweep

@@ -82,8 +82,7 @@ ArrayWork Work(const Spec& spec, const SlurmRunOptions& o, const State& s) {
   w.chunks = s.chunks;
   w.command = {s.sweep_program, spec.path, "--out", o.out.string(), "--task"};
   if (s.keep_logs) w.command.push_back("--keep-logs");
-  const fs::path rows = o.out / "rows";
-  w.done = [rows](std::int64_t i) { return fs::exists(rows / fmt::format("{}.json", i)); };
+  w.done = [out = o.out](std::int64_t i) { return fs::exists(RowFile(out, i)); };
   return w;
 }
 
@@ -98,11 +97,11 @@ SlurmOutcome Finish(const Spec& spec, State s, const SlurmRunOptions& o, SlurmOu
   outcome.failed_tasks = WaitAndRetry(w, Runner(o, s), &s.jobs, &s.retries_left, [&] { Save(o.out, s); });
   for (std::size_t j = submitted; j < s.jobs.size(); ++j) outcome.job_ids.push_back(s.jobs[j]);
   Save(o.out, s);
-  outcome.table = WriteTable(spec, o.out);
-  const Table table = ReadTable(spec, o.out);
-  outcome.rows = static_cast<std::int64_t>(table.rows.size());
-  for (const auto& row : table.rows) outcome.not_completed += row[1] != "completed";
-  outcome.absent_fields = AbsentFields(spec, table);
+  WrittenTable t = WriteTable(spec, o.out);
+  outcome.table = t.csv;
+  outcome.rows = t.rows;
+  outcome.not_completed = t.not_completed;
+  outcome.absent_fields = std::move(t.absent_fields);
   return outcome;
 }
 

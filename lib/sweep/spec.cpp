@@ -20,6 +20,14 @@ namespace fs = std::filesystem;
 
 namespace {
 
+/// A double as a TOML float literal: the shortest text that reads back as the same double, bit
+/// for bit ("1.0", not "1").
+std::string FloatLiteral(double x) {
+  std::string out = fmt::format("{}", x);
+  if (out.find_first_of(".eEn") == std::string::npos) out += ".0";
+  return out;
+}
+
 /// A TOML literal of a grid value, as `--set KEY=VALUE` takes it; "" for an unsupported type.
 std::string Literal(const toml::node& v) {
   if (const auto* s = v.as_string()) {
@@ -32,21 +40,8 @@ std::string Literal(const toml::node& v) {
   }
   if (const auto* i = v.as_integer()) return std::to_string(i->get());
   if (const auto* b = v.as_boolean()) return b->get() ? "true" : "false";
-  if (const auto* d = v.as_floating_point()) {
-    if (!std::isfinite(d->get())) return "";
-    // The shortest text that reads back as the same double, always a TOML float.
-    std::string out = fmt::format("{}", d->get());
-    if (out.find_first_of(".eE") == std::string::npos) out += ".0";
-    return out;
-  }
+  if (const auto* d = v.as_floating_point()) return std::isfinite(d->get()) ? FloatLiteral(d->get()) : "";
   return "";
-}
-
-/// A drawn double as a TOML float literal that reads back bit for bit.
-std::string FloatLiteral(double x) {
-  std::string out = fmt::format("{}", x);
-  if (out.find_first_of(".eEn") == std::string::npos) out += ".0";
-  return out;
 }
 
 /// FNV-1a of a key: its stream differs from every other key's.

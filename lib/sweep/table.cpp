@@ -165,6 +165,8 @@ std::vector<std::string> AbsentFields(const Spec& spec, const Table& t) {
   return absent;
 }
 
+fs::path RowFile(const fs::path& out, std::int64_t i) { return out / "rows" / fmt::format("{}.json", i); }
+
 nlohmann::json ReadJsonFile(const fs::path& file) {
   std::ifstream in(file);
   if (!in) return nullptr;
@@ -181,7 +183,7 @@ Table ReadTable(const Spec& spec, const fs::path& out) {
   t.columns = TableColumns(spec);
   const std::int64_t per_draw = std::max<std::int64_t>(spec.draws, 1);
   for (std::int64_t i = 0; i < spec.runs(); ++i) {
-    const nlohmann::json row = ReadJsonFile(out / "rows" / fmt::format("{}.json", i));
+    const nlohmann::json row = ReadJsonFile(RowFile(out, i));
     if (!row.is_object()) continue;
     std::vector<nlohmann::json> cells = {row.value("index", i), row.value("status", std::string()),
                                          row.value("scenario_sha256", std::string())};

@@ -38,6 +38,9 @@ struct Table {
 /// file name, or its path relative to the SPEC's folder where two cases share a file name), each grid key, each drawn key (DrawColumns), each recorded field (named "summary.<field>" where its name is already a column's, e.g. summary.json's "status").
 std::vector<std::string> TableColumns(const Spec& spec);
 
+/// DIR/rows/<i>.json: run i's row.
+std::filesystem::path RowFile(const std::filesystem::path& out, std::int64_t i);
+
 /// A JSON file (a row, a summary.json); null if absent or malformed.
 nlohmann::json ReadJsonFile(const std::filesystem::path& file);
 
