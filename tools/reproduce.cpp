@@ -15,6 +15,7 @@
 #include <fmt/core.h>
 
 #include "cli.h"
+#include "slurm_flags.h"
 #include "core/error.h"
 #include "io/output_folder.h"
 #include "studies/benchmark.h"
@@ -59,8 +60,7 @@ struct Options {
   int jobs = 2;
   std::vector<std::string> sets;
   std::string executor = "local";         // local | slurm (lib/sweep/study_on_slurm.h)
-  rths::sweep::SlurmSettings slurm;       // --partition, --time, --account, --runs-per-task, --cpus-per-task, --retries
-  double poll_s = 2.0;
+  rths::tools::SlurmFlags slurm;          // --partition, --time, --account, --runs-per-task, ... --poll-s
 };
 
 void AddOptions(CLI::App& app, Options* o) {
@@ -85,15 +85,7 @@ void AddOptions(CLI::App& app, Options* o) {
   app.add_option("--executor", o->executor, "where the lockstep runs run: local (--jobs at a time) or slurm (a job "
                                             "array; --out on a filesystem the nodes share; docs/cluster.md)")
       ->check(CLI::IsMember({"local", "slurm"}));
-  app.add_option("--partition", o->slurm.partition, "slurm: sbatch --partition");
-  app.add_option("--time", o->slurm.time, "slurm: time limit per array task, e.g. 00:30:00");
-  app.add_option("--account", o->slurm.account, "slurm: sbatch --account");
-  app.add_option("--runs-per-task", o->slurm.runs_per_task, "slurm: runs per array task (default 25)")
-      ->check(CLI::Range(std::int64_t{1}, rths::sweep::kMaxRuns));
-  app.add_option("--cpus-per-task", o->slurm.cpus_per_task, "slurm: cores per array task")->check(CLI::Range(1, 4096));
-  app.add_option("--retries", o->slurm.retries, "slurm: times a task that left runs undone is submitted again")
-      ->check(CLI::Range(0, 100));
-  app.add_option("--poll-s", o->poll_s, "slurm: seconds between squeue calls while waiting")->check(CLI::Range(0.05, 600.0));
+  o->slurm.Add(app);
 }
 
 /// --executor slurm: the study's batches as job arrays (lib/sweep/study_on_slurm.h), run by the
@@ -101,12 +93,10 @@ void AddOptions(CLI::App& app, Options* o) {
 void UseSlurm(const Options& o, rths::studies::ReproduceOptions* opts) {
   rths::sweep::StudySlurmOptions s;
   s.dir = opts->out_dir;
-  s.settings = o.slurm;
-  s.programs = {rths::tools::ProgramOnPath("sbatch"), rths::tools::ProgramOnPath("squeue"),
-                rths::tools::ProgramOnPath("scontrol")};
-  std::error_code ec;
-  s.sweep_program = (fs::read_symlink("/proc/self/exe", ec).parent_path() / "rths-sweep").string();
-  s.poll_s = o.poll_s;
+  s.settings = o.slurm.Applied({});
+  s.programs = rths::tools::SlurmProgramsOnPath();
+  s.sweep_program = rths::tools::SweepProgram();
+  s.poll_s = o.slurm.poll_s;
   const auto log = opts->log;
   s.say = [log](const std::string& line) {
     if (log) log(line);
@@ -274,9 +264,9 @@ int main(int argc, char** argv) {
     std::printf("%.*s\n", static_cast<int>(line.size()), line.data());
     std::fflush(stdout);
   };
-  if (o.executor == "slurm") UseSlurm(o, &opts);
   const auto t0 = std::chrono::steady_clock::now();
   try {
+    if (o.executor == "slurm") UseSlurm(o, &opts);
     std::printf("rths reproduce %s%s%s -> %s\n", o.name.c_str(), o.quick ? " (quick)" : "",
                 o.extended ? " (extended)" : "", opts.out_dir.string().c_str());
     std::fflush(stdout);

@@ -16,6 +16,7 @@
 #include <CLI/CLI.hpp>
 
 #include "cli.h"
+#include "slurm_flags.h"
 #include "core/error.h"
 #include "io/output_folder.h"
 #include "lockstep/exit_code.h"
@@ -37,38 +38,19 @@ struct Args {
   int jobs = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   std::int64_t only = -1, chunk = 0, chunks = 1;
   bool resume = false, keep_logs = false, task = false, detach = false;
-  // Slurm: flags override the SPEC's [slurm]; unset (empty, -1) keeps it.
-  std::string partition, time, account;
-  std::int64_t runs_per_task = -1;
-  int cpus_per_task = -1, retries = -1;
-  double poll_s = 2.0;
+  rths::tools::SlurmFlags slurm;  // override the SPEC's [slurm]
 };
-
-std::string SelfPath() {
-  std::error_code ec;
-  const auto p = std::filesystem::read_symlink("/proc/self/exe", ec);
-  if (ec) throw rths::Error("--executor slurm", "cannot find this program's path (/proc/self/exe)");
-  return p.string();
-}
 
 rths::sweep::SlurmRunOptions SlurmOptions(const Args& a, const rths::sweep::Spec* spec) {
   rths::sweep::SlurmRunOptions o;
   o.out = std::filesystem::absolute(a.out.empty() ? a.collect : a.out);
-  if (spec) o.settings = spec->slurm;
-  if (!a.partition.empty()) o.settings.partition = a.partition;
-  if (!a.time.empty()) o.settings.time = a.time;
-  if (!a.account.empty()) o.settings.account = a.account;
-  if (a.runs_per_task > 0) o.settings.runs_per_task = a.runs_per_task;
-  if (a.cpus_per_task > 0) o.settings.cpus_per_task = a.cpus_per_task;
-  if (a.retries >= 0) o.settings.retries = a.retries;
-  o.sweep_program = SelfPath();
-  o.programs.sbatch = rths::tools::ProgramOnPath("sbatch");
-  o.programs.squeue = rths::tools::ProgramOnPath("squeue");
-  o.programs.scontrol = rths::tools::ProgramOnPath("scontrol");
+  o.settings = a.slurm.Applied(spec ? spec->slurm : rths::sweep::SlurmSettings{});
+  o.sweep_program = rths::tools::SweepProgram();
+  o.programs = rths::tools::SlurmProgramsOnPath();
   o.keep_logs = a.keep_logs;
   o.detach = a.detach;
   o.resume = a.resume;
-  o.poll_s = a.poll_s;
+  o.poll_s = a.slurm.poll_s;
   o.say = [](const std::string& line) {
     std::printf("%s\n", line.c_str());
     std::fflush(stdout);
@@ -138,20 +120,11 @@ int main(int argc, char** argv) {
   app.add_option("--chunks", a.chunks, "the number of chunks the sweep is split into")
       ->check(CLI::Range(std::int64_t{1}, std::int64_t{1} << 40));
   app.add_flag("--task", a.task, "run as one array task: --resume, no table, no progress line");
-  app.add_option("--partition", a.partition, "slurm: sbatch --partition (overrides the SPEC's [slurm])");
-  app.add_option("--time", a.time, "slurm: time limit per array task, e.g. 00:30:00");
-  app.add_option("--account", a.account, "slurm: sbatch --account");
-  app.add_option("--runs-per-task", a.runs_per_task, "slurm: runs per array task (default 25, at most 1000 tasks)")
-      ->check(CLI::Range(std::int64_t{1}, rths::sweep::kMaxRuns));
-  app.add_option("--cpus-per-task", a.cpus_per_task, "slurm: cores per array task (its runs at a time)")
-      ->check(CLI::Range(1, 4096));
-  app.add_option("--retries", a.retries, "slurm: times a task that left runs without rows is submitted again (default 1)")
-      ->check(CLI::Range(0, 100));
+  a.slurm.Add(app);
   app.add_flag("--detach", a.detach, "slurm: submit and return; then `rths sweep --collect OUT`");
   app.add_option("--collect", a.collect, "slurm: wait for a detached sweep in DIR, retry, write its table");
   app.add_option("--batch", a.batch, "run chunk --chunk of a study's batch file (what `rths reproduce --executor slurm` "
                                     "submits; with --task)");
-  app.add_option("--poll-s", a.poll_s, "slurm: seconds between squeue calls while waiting")->check(CLI::Range(0.05, 600.0));
   app.footer("Exit codes: 0 every run completed; 1 some runs did not (their rows, or the missing tasks, say why); 2 bad input.");
   if (const int code = rths::tools::ParseCommandLine(app, argc, argv); code >= 0) return code;
   try {
@@ -164,7 +137,7 @@ int main(int argc, char** argv) {
     }
     if (!a.collect.empty()) {
       if (!a.spec_path.empty()) throw rths::Error("--collect", "takes the sweep's folder only, not a SPEC");
-      return Report(rths::sweep::CollectSweep(SlurmOptions(a, nullptr), a.retries), a.collect);
+      return Report(rths::sweep::CollectSweep(SlurmOptions(a, nullptr), a.slurm.retries), a.collect);
     }
     if (a.spec_path.empty()) throw rths::Error("rths sweep", "needs a SPEC (or --collect DIR)");
     const rths::sweep::Spec spec = rths::sweep::LoadSpec(a.spec_path);
