@@ -3,7 +3,10 @@
 // velocity cut-off from the record's band, and the model file read back by the scenario parser
 // and by the diagnosis. The recovery test fits a record made by the plant's rig mode (models::
 // MakeRig with the sensor_noise effect) with a pulsed current of random levels.
+#include <algorithm>
 #include <cmath>
+#include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <numbers>
 #include <random>
@@ -18,6 +21,7 @@
 #include "ident/damper_fit.h"
 #include "ident/spencer_fit.h"
 #include "io/rig_record.h"
+#include "io/utfsm.h"
 #include "models/current_driver.h"
 #include "models/rig.h"
 #include "control/current_schedule.h"
@@ -34,8 +38,9 @@ using rths::ident::ControlFilter;
 /// filter with eta, sensor noise as a rig-mode effect, u = BLWN, i = random pulses.
 rths::io::RigRecord RigModeRecord(double eta_1_s, double dt, double duration_s, double band_hz, double rms_mm,
                                   std::uint64_t seed, const std::string& name, double noise_y_mm = 0.001,
-                                  double noise_f_kN = 0.02) {
+                                  double noise_f_kN = 0.02, double k0_kN_mm = -1.0) {
   m::PlantConfig plant;
+  if (k0_kN_mm >= 0.0) plant.damper.k0 = k0_kN_mm;
   plant.kind = m::PlantKind::kLinear;
   plant.current_driver.kind = m::CurrentFilter::kFirstOrder;
   plant.current_driver.eta_1_s = eta_1_s;
@@ -261,7 +266,7 @@ TEST_CASE("FitSpencer: bad input is refused with the reason") {
 
 TEST_CASE("rths identify --damper without --current: the fit from a CSV record, a model file that loads") {
   const auto dir = rths_test::TempDir("spencer_cli");
-  const auto rec = RigModeRecord(150.0, 0.0005, 8.0, 12.0, 5.0, 11, "cli");
+  const auto rec = RigModeRecord(150.0, 0.0005, 20.0, 20.0, 8.0, 11, "cli");
   const auto csv = (dir / "rec.csv").string(), model = (dir / "model.toml").string(),
              log = (dir / "out.txt").string();
   rths::io::WriteRigRecord(rec, csv);
@@ -274,8 +279,120 @@ TEST_CASE("rths identify --damper without --current: the fit from a CSV record, 
   CHECK(sc.plant.current_driver.kind == m::CurrentFilter::kFirstOrder);
   CHECK(sc.plant.current_driver.eta_1_s == doctest::Approx(150.0).epsilon(0.03));
   CHECK(sc.plant.damper.alpha_b == doctest::Approx(0.55).epsilon(0.03));
+  // The file says how the fit ended (ident/fit_status.h).
+  const std::string text = rths_test::Slurp(model);
+  CHECK(text.find("[fit]\nstatus = \"ok\"") != std::string::npos);
+  CHECK(text.find("FIT FAILED") == std::string::npos);
   // --current on a record whose current varies is refused (exit 2), naming the record.
   const int bad = std::system(
       fmt::format("{}/rths-identify --damper {} --current 1.0 > {} 2>&1", RTHS_BIN_DIR, csv, log).c_str());
   CHECK(WEXITSTATUS(bad) == 2);
+}
+
+TEST_CASE("fit status: a fit stopped early, and a parameter on a bound of its range, say so everywhere") {
+  const double dt = 0.0005;
+  const auto rec = RigModeRecord(150.0, dt, 10.0, 12.0, 6.0, 21, "status");
+  SUBCASE("stopped early: not converged, FIT FAILED in the file, [fit] status failed, the file still loads") {
+    rths::ident::DamperFitOptions o;
+    o.max_iterations = 2;
+    const auto fit = rths::ident::FitSpencer({rec}, o);
+    CHECK_FALSE(fit.status.converged);
+    CHECK_FALSE(fit.status.Ok());
+    CHECK(fit.status.iterations <= 2 + 10 * 8);
+    CHECK(fit.status.Summary().find("not converged") != std::string::npos);
+    const std::string toml = rths::ident::SpencerModelToml(fit, "test");
+    CHECK(toml.find("# FIT FAILED") != std::string::npos);
+    CHECK(toml.find("status = \"failed\"\nconverged = false") != std::string::npos);
+    const auto dir = rths_test::TempDir("fit_status_early");
+    const auto path = (dir / "model.toml").string();
+    { std::ofstream(path) << toml; }
+    CHECK(rths::scenario::LoadScenario(path).plant.current_driver.kind == m::CurrentFilter::kFirstOrder);
+  }
+  SUBCASE("a damper stiffer than the range allows: k0 on its upper bound, the fit failed") {
+    // k0 = 1000 kN/mm, ten times the top of its range (1e2): the fit stops there.
+    const auto stiff = RigModeRecord(150.0, dt, 10.0, 12.0, 6.0, 21, "stiff", 0.001, 0.02, 1000.0);
+    const auto fit = rths::ident::FitSpencer({stiff}, {});
+    CAPTURE(fit.Report());
+    CHECK(fit.params.k0 == doctest::Approx(1e2).epsilon(1e-5));
+    CHECK_FALSE(fit.status.Ok());
+    const auto at_bound = fit.status.Names(rths::ident::ParameterState::kAtBound);
+    CHECK(std::find(at_bound.begin(), at_bound.end(), "k0") != at_bound.end());
+    CHECK(rths::ident::SpencerModelToml(fit, "t").find("at_bound = [") != std::string::npos);
+  }
+  SUBCASE("the CLI: exit 3 for a failed fit, 0 with --accept-unconverged; the model is written both times") {
+    const auto fast = RigModeRecord(150.0, dt, 10.0, 12.0, 6.0, 21, "stiff", 0.001, 0.02, 1000.0);
+    const auto dir = rths_test::TempDir("fit_status_cli");
+    const auto csv = (dir / "fast.csv").string(), model = (dir / "model.toml").string(),
+               log = (dir / "out.txt").string();
+    rths::io::WriteRigRecord(fast, csv);
+    const auto cmd = fmt::format("{}/rths-identify --damper {} --out {} > {} 2>&1", RTHS_BIN_DIR, csv, model, log);
+    const int status = std::system(cmd.c_str());
+    REQUIRE(WIFEXITED(status));
+    CHECK(WEXITSTATUS(status) == rths::ident::kExitFitFailed);
+    CHECK(rths_test::Slurp(log).find("fit status: FAILED") != std::string::npos);
+    CHECK(rths_test::Slurp(model).find("# FIT FAILED") != std::string::npos);
+    std::filesystem::remove(model);
+    const int accepted = std::system(
+        fmt::format("{}/rths-identify --damper {} --out {} --accept-unconverged > {} 2>&1", RTHS_BIN_DIR, csv, model, log)
+            .c_str());
+    CHECK(WEXITSTATUS(accepted) == 0);
+    CHECK(rths_test::Slurp(model).find("status = \"failed\"") != std::string::npos);
+  }
+}
+
+TEST_CASE("fit status: what the records cannot determine is held, a flat law's rate is irrelevant") {
+  // Two records at constant currents 0 and 1 A (UTFSM's design): eta never shows, and two levels
+  // fix each law at those levels only.
+  const double dt = 0.005;
+  std::vector<rths::io::RigRecord> recs;
+  for (double current : {0.0, 1.0}) {
+    auto r = rths::io::ReadUtfsmDamper(fmt::format("{}/data/utfsm/mr_damper/25mm0x5Hz{}A.txt", RTHS_SOURCE_DIR,
+                                                   current == 0.0 ? "0" : "1"));
+    CHECK(r.dt_s == doctest::Approx(dt));
+    recs.push_back(std::move(r));
+  }
+  const auto fit = rths::ident::FitSpencer(recs, {});
+  CAPTURE(fit.Report());
+  CHECK(fit.status.converged);
+  CHECK(fit.status.Ok());
+  const auto held = fit.status.Names(rths::ident::ParameterState::kHeld);
+  CHECK(held == std::vector<std::string>{"alpha_c", "c0_c", "c1_c", "beta_c", "gamma_c", "eta_1_s"});
+  CHECK(fit.params.alpha_c == doctest::Approx(3.0));  // 3 / (1 A - 0 A)
+  CHECK(fit.driver.eta_1_s == doctest::Approx(100.0));
+  // Nothing ran to a bound of its range (before: alpha_c = 1000 in a two-current fit).
+  CHECK(fit.status.Names(rths::ident::ParameterState::kAtBound).empty());
+  CHECK(fit.Report().find("held, not fitted") != std::string::npos);
+}
+
+TEST_CASE("negative commands: a DAQ's small negative samples are taken as 0 with a warning; a bipolar one is refused") {
+  const double dt = 0.0005;
+  auto rec = RigModeRecord(150.0, dt, 10.0, 12.0, 6.0, 31, "negative");
+  rec.v_V = rec.i_A;  // drive the voltage input with the same command
+  rec.i_A.clear();
+  // As the prototype damper's white-noise test: 0.15 % of the samples negative, down to -0.43 V
+  // of a command that reaches about 2.4 V (its anti-alias filter rings at the steps).
+  std::size_t set = 0;
+  for (std::size_t k = 100; k < rec.size() && set < rec.size() * 15 / 10000; k += 600, ++set)
+    rec.v_V[k] = -0.43 * static_cast<double>(set % 3 + 1) / 3.0;
+  const auto c = rths::ident::CommandForModel(rec, true);
+  CHECK(c.negatives == set);
+  CHECK(c.worst == doctest::Approx(-0.43));
+  CHECK(*std::min_element(c.v.begin(), c.v.end()) == 0.0);
+  CHECK(c.warning.find(fmt::format("{} of {} samples of v_V", set, rec.size())) != std::string::npos);
+  CHECK(c.warning.find("-0.43 V") != std::string::npos);
+  CHECK(c.warning.find("taken as 0 V") != std::string::npos);
+  const auto fit = rths::ident::FitSpencer({rec}, {.max_iterations = 3});
+  REQUIRE(fit.warnings.size() == 1);
+  CHECK(fit.warnings[0] == c.warning);
+  CHECK(std::isfinite(rths::ident::ScoreSpencer(fit.params, fit.driver, fit.filter, rec, true).nrmse_f_pct));
+  // A bipolar command (5 % of the samples negative) is refused, naming the rule.
+  for (std::size_t k = 0; k < rec.size(); k += 20) rec.v_V[k] = -0.2;
+  try {
+    (void)rths::ident::CommandForModel(rec, true);
+    FAIL("a bipolar command was accepted");
+  } catch (const rths::Error& e) {
+    const std::string what = e.what();
+    CHECK(what.find("negative") != std::string::npos);
+    CHECK(what.find("at most 1 %") != std::string::npos);
+  }
 }

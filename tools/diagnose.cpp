@@ -1,6 +1,6 @@
 // rths diagnose --train A [B ...] --test C [D ...] [--model MODEL.toml] [--out DIR] [--detrend] [--brief]
 // The sim-to-real gap diagnosis (docs/rig_record.md, docs/diagnosis.md): reads rig
-// records (CSV or our LCM logs), predicts them with the nominal model, localises the residual,
+// records (CSV rig records, our LCM logs, UTFSM files; any CSV or .mat file through --columns), predicts them with the nominal model, localises the residual,
 // fits every effect of the library on the training records, selects greedily, scores the shrink
 // on the test records. Writes DIR/diagnosis.json and DIR/report.html (+ PNG plots), prints a
 // summary (--brief: the verdict and each channel's shrink only). Exit 0 ok, 2 bad input (a bad
@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -21,6 +22,7 @@
 #include "diagnosis/model_file.h"
 #include "report/diagnosis_page.h"
 #include "io/output_folder.h"
+#include "io/column_record.h"
 #include "io/rig_record.h"
 
 namespace fs = std::filesystem;
@@ -49,7 +51,10 @@ int main(int argc, char** argv) {
   std::string model_file, out;
   rths::diagnosis::Options o;
   bool brief = false;
-  app.add_option("--train", train, "training records (CSV rig records or LCM logs)")->required()->expected(1, -1);
+  app.add_option("--train", train, "training records (CSV rig records, LCM logs, UTFSM files, or with --columns any CSV "
+                                   "with named columns or .mat file)")
+      ->required()
+      ->expected(1, -1);
   app.add_option("--test", test, "held-out test records")->required()->expected(1, -1);
   app.add_option("--model", model_file, "nominal model: a scenario TOML or a file written by rths identify "
                                         "(default: the paper's Eq. 30, Table 3, Eq. 40 + 75 Hz)");
@@ -59,6 +64,11 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--smooth-hz", o.smooth_hz, "zero-phase smoothing of the y residual for the force channel's motion [Hz]")
       ->capture_default_str();
+  std::string columns;
+  app.add_option("--columns", columns,
+                 "read every record (a CSV with named columns or a .mat file) through this map: "
+                 "ROLE=SOURCE[*SCALE][:UNIT],... with roles t u y f i v r (or dt=STEP_S), e.g. t=t,y=D:cm,f=F:N,v=Y:V "
+                 "(docs/rig_record.md \"Other formats\")");
   bool time_from_header = false;
   app.add_flag("--time-from-header", time_from_header,
                "take the step from the record's '# dt_s' line; the time column need only lie within half a step "
@@ -71,8 +81,11 @@ int main(int argc, char** argv) {
   const auto axis = time_from_header ? rths::io::TimeAxis::kHeader : rths::io::TimeAxis::kColumn;
   try {
     if (!out.empty()) rths::io::RequireNewOrEmptyFolder(out, "an earlier diagnosis or a run");
-    for (const auto& p : train) tr.push_back(rths::io::ReadRecordAny(p, axis));
-    for (const auto& p : test) te.push_back(rths::io::ReadRecordAny(p, axis));
+    std::optional<rths::io::ColumnMap> map;
+    if (!columns.empty()) map = rths::io::ParseColumnMap(columns);
+    const rths::io::ColumnMap* m = map ? &*map : nullptr;
+    for (const auto& p : train) tr.push_back(rths::io::ReadAnyRecord(p, m, axis));
+    for (const auto& p : test) te.push_back(rths::io::ReadAnyRecord(p, m, axis));
     model = model_file.empty() ? rths::diagnosis::PaperModel() : rths::diagnosis::LoadModel(model_file);
     if (!(o.none_ratio >= 1.0)) throw rths::Error("--none-ratio", fmt::format("{}: must be >= 1", o.none_ratio));
   } catch (const std::exception& e) {

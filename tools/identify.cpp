@@ -10,7 +10,8 @@
 // logs, or UTFSM damper files: x = y_mm, F = f_kN) by least squares on the force, or without
 // --current its current- or voltage-dependent form (ident/damper_model.h); prints the parameters,
 // the force error per record (and per held-out --check record) and the model as a TOML fragment.
-// docs/identification.md. Exit 0 ok, 2 bad input.
+// docs/identification.md. Exit 0 ok, 2 bad input, 3 a damper fit that failed (did not converge, or
+// a parameter on a bound of its range; ident/fit_status.h) unless --accept-unconverged.
 #include <unistd.h>
 
 #include <algorithm>
@@ -22,6 +23,7 @@
 #include <fstream>
 #include <functional>
 #include <numbers>
+#include <optional>
 #include <string>
 
 #include <CLI/CLI.hpp>
@@ -34,6 +36,7 @@
 #include "ident/identify.h"
 #include "io/output_folder.h"
 #include "io/plot.h"
+#include "io/column_record.h"
 #include "io/rig_record.h"
 #include "io/utfsm.h"
 #include "signal/spectral.h"
@@ -229,12 +232,15 @@ struct DamperCli {
   std::vector<std::string> records, checks;
   std::string out, plot;
   rths::io::TimeAxis time = rths::io::TimeAxis::kColumn;
+  bool accept_unconverged = false;  ///< exit 0 for a failed fit (ident/fit_status.h)
+  const rths::io::ColumnMap* map = nullptr;  ///< --columns, or null
 };
 
-std::vector<rths::io::RigRecord> ReadDamperRecords(const std::vector<std::string>& paths, rths::io::TimeAxis time) {
+std::vector<rths::io::RigRecord> ReadDamperRecords(const std::vector<std::string>& paths, rths::io::TimeAxis time,
+                                                   const rths::io::ColumnMap* map) {
   std::vector<rths::io::RigRecord> recs;
   for (const auto& path : paths) {
-    recs.push_back(rths::io::ReadRecordOrUtfsm(path, time));
+    recs.push_back(rths::io::ReadAnyRecord(path, map, time));
     for (const auto& w : recs.back().warnings) std::fprintf(stderr, "rths identify: warning: %s\n", w.c_str());
   }
   return recs;
@@ -257,8 +263,8 @@ std::string Names(const std::vector<std::string>& paths) {
 
 /// The --damper mode (file comment): at one current (--current) or with any input history.
 int RunDamper(const DamperCli& c, rths::ident::DamperFitOptions o) {
-  const auto recs = ReadDamperRecords(c.records, c.time);
-  const auto held = ReadDamperRecords(c.checks, c.time);
+  const auto recs = ReadDamperRecords(c.records, c.time, c.map);
+  const auto held = ReadDamperRecords(c.checks, c.time, c.map);
   rths::ProgressLine progress("rths identify --damper");
   if (progress.enabled()) {
     o.progress = [&progress](double done, double total, std::string_view what) { progress.Update(done, total, what); };
@@ -266,6 +272,12 @@ int RunDamper(const DamperCli& c, rths::ident::DamperFitOptions o) {
   const auto fit = rths::ident::FitDamperModel(recs, o);
   progress.Finish();
   const bool voltage = fit.voltage();
+  if (fit.any_input) {
+    for (const auto& w : fit.any_input->warnings) std::fprintf(stderr, "rths identify: warning: %s\n", w.c_str());
+    for (const auto& h : held)
+      if (const auto c = rths::ident::CommandForModel(h, voltage); !c.warning.empty())
+        std::fprintf(stderr, "rths identify: warning: %s\n", c.warning.c_str());
+  }
   const char* input = voltage ? "voltage" : "current";
   if (fit.at_current) {
     std::printf("rths identify --damper: %zu record(s) at %g A\n%s", recs.size(), *o.current_A, fit.Report().c_str());
@@ -286,7 +298,22 @@ int RunDamper(const DamperCli& c, rths::ident::DamperFitOptions o) {
                                ? fmt::format("rths identify --damper {} --current {}", Names(c.records), *o.current_A)
                                : fmt::format("rths identify --damper {} ({} input)", Names(c.records), input)),
              c.out);
-  if (c.plot.empty()) return 0;
+  // A failed fit (ident/fit_status.h) is written, marked, and exits kExitFitFailed unless accepted.
+  const auto& status = fit.status();
+  int code = 0;
+  if (!status.Ok()) {
+    std::fprintf(stderr, "rths identify: fit status: %s\n", status.Summary().c_str());
+    if (c.accept_unconverged) {
+      std::fprintf(stderr, "rths identify: --accept-unconverged: exit 0 all the same\n");
+    } else {
+      std::fprintf(stderr,
+                   "rths identify: exit %d (the model file says FIT FAILED; --accept-unconverged exits 0; "
+                   "docs/identification.md \"When a fit fails\")\n",
+                   rths::ident::kExitFitFailed);
+      code = rths::ident::kExitFitFailed;
+    }
+  }
+  if (c.plot.empty()) return code;
   std::vector<DamperPlotRecord> all;
   auto add = [&](const rths::io::RigRecord& r, bool fitted) {
     const double cutoff = fit.CutoffHz(r);
@@ -299,7 +326,7 @@ int RunDamper(const DamperCli& c, rths::ident::DamperFitOptions o) {
   PlotDamper(c.plot, all,
              fit.at_current ? fmt::format("at {} A", *o.current_A) : (voltage ? "(voltage input)" : "(current input)"));
   std::printf("wrote %s\n", c.plot.c_str());
-  return 0;
+  return code;
 }
 
 /// The actuator fit's command line (file comment).
@@ -308,6 +335,7 @@ struct ActuatorCli {
   int poles = 3;
   double segment_s = 0.0;
   rths::io::TimeAxis time = rths::io::TimeAxis::kColumn;
+  const rths::io::ColumnMap* map = nullptr;  ///< --columns, or null
 };
 
 /// The actuator options of the command line, checked.
@@ -334,7 +362,7 @@ rths::ident::IdentifyOptions ActuatorOptions(const ActuatorCli& a) {
 /// The actuator fit (file comment): the two fits, their report, the model file and the Bode plot.
 int RunActuator(const ActuatorCli& a) {
   const rths::ident::IdentifyOptions o = ActuatorOptions(a);
-  const auto rec = rths::io::ReadRecordAny(a.record, a.time);
+  const auto rec = rths::io::ReadAnyRecord(a.record, a.map, a.time);
   for (const auto& w : rec.warnings) std::fprintf(stderr, "rths identify: warning: %s\n", w.c_str());
 
   // The model as the paper fits it (continuous, Eq. 15) and the one whose ZOH simulation at the
@@ -398,7 +426,7 @@ void AddDamperOptions(CLI::App* app, rths::ident::DamperFitOptions* o, double* c
 int main(int argc, char** argv) {
   CLI::App app{"rths identify: fit the servohydraulic model of Eq. 15 to a record of command u and measured y"};
   std::vector<std::string> records, checks;
-  bool damper = false, time_from_header = false, no_offset = false;
+  bool damper = false, time_from_header = false, no_offset = false, accept_unconverged = false;
   ActuatorCli ac;
   rths::ident::DamperFitOptions fo;
   std::string input, filter = "first_order";
@@ -407,6 +435,11 @@ int main(int argc, char** argv) {
                  "CSV rig record or LCM run log (log.lcm) of ours; with --damper one or more damper tests (also UTFSM "
                  "damper files)")
       ->required();
+  std::string columns;
+  app.add_option("--columns", columns,
+                 "read the records (a CSV with named columns or a .mat file) through this map: "
+                 "ROLE=SOURCE[*SCALE][:UNIT],... with roles t u y f i v r (or dt=STEP_S), e.g. t=t,y=D:cm,f=F:N,v=Y:V "
+                 "(docs/rig_record.md \"Other formats\")");
   app.add_flag("--time-from-header", time_from_header,
                "take the step from the record's '# dt_s' line; the time column need only lie within half a step "
                "of t_0 + k dt_s (for a rounded time column)");
@@ -415,6 +448,9 @@ int main(int argc, char** argv) {
                "voltage-dependent form (Eqs. 32-39) with a control filter, from records with any input history");
   app.add_option("--check", checks, "--damper: held-out records to score the fitted model on");
   AddDamperOptions(&app, &fo, &current_A, &input, &filter, &no_offset);
+  app.add_flag("--accept-unconverged", accept_unconverged,
+               "--damper: exit 0 for a fit that did not converge or has a parameter on a bound of its range (it is "
+               "written, marked FIT FAILED, either way; without this flag the exit code is 3)");
   app.add_option("--band", ac.band, "frequency band fitted, LO-HI [Hz] (the paper's range)")->capture_default_str();
   app.add_option("--poles", ac.poles, "number of poles N of Eq. 15")->capture_default_str();
   app.add_option("--segment-s", ac.segment_s, "Welch segment length [s] (0: min(4 s, 2/9 of the record))")
@@ -437,6 +473,9 @@ int main(int argc, char** argv) {
       if (!ac.plot.empty()) rths::io::RefuseToReplaceRecord(ac.plot, inputs, "--plot");
     }
     ac.time = time_from_header ? rths::io::TimeAxis::kHeader : rths::io::TimeAxis::kColumn;
+    std::optional<rths::io::ColumnMap> map;
+    if (!columns.empty()) map = rths::io::ParseColumnMap(columns);
+    ac.map = map ? &*map : nullptr;
     if (app.count("--current") > 0) fo.current_A = current_A;
     if (damper) {
       if (fo.current_A) {
@@ -449,9 +488,10 @@ int main(int argc, char** argv) {
                                       : rths::ident::DamperInput::kAuto;
       fo.filter = *rths::ValueOf(rths::ident::kControlFilterNames, filter);
       fo.accumulator = !no_offset;
-      return RunDamper({records, checks, ac.out, ac.plot, ac.time}, fo);
+      return RunDamper({records, checks, ac.out, ac.plot, ac.time, accept_unconverged, ac.map}, fo);
     }
-    if (fo.current_A || !checks.empty()) throw Error("--current/--check", "only with --damper");
+    if (fo.current_A || !checks.empty() || accept_unconverged)
+      throw Error("--current/--check/--accept-unconverged", "only with --damper");
     if (records.size() != 1)
       throw Error("record", fmt::format("{} records given: the actuator fit takes one (or use --damper)", records.size()));
     ac.record = records[0];

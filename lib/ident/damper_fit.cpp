@@ -52,10 +52,15 @@ models::MrDamperCoefficients FromTheta(const Theta& th, double A, double k1, dou
   return k;
 }
 
-Theta Clamp(Theta th) {
-  for (int i = 0; i < kNonlinear; ++i) th[i] = std::clamp(th[i], std::log(kLo[i]), std::log(kHi[i]));
-  return th;
+// The box in theta (ln of the bounds).
+Theta LogBound(const std::array<double, kNonlinear>& b) {
+  Theta t;
+  for (int i = 0; i < kNonlinear; ++i) t[i] = std::log(b[i]);
+  return t;
 }
+const Theta kLogLo = LogBound(kLo), kLogHi = LogBound(kHi);
+
+Theta Clamp(const Theta& th) { return ClampToBox(th, kLogLo, kLogHi); }
 
 // The model at theta on every record: residuals r = sqrt(w_r) (f - F) stacked, with k1 and
 // b = -k1 x0 solved by weighted linear least squares (file comment of damper_fit.h).
@@ -158,8 +163,8 @@ void Iterate(LmState* s, const std::vector<Prepared>& data, double A, int iterat
     const Eigen::MatrixXd H = J.transpose() * J;
     const Eigen::VectorXd g = J.transpose() * base.r;
     ++s->iterations;
-    DampedStep(H, g, &s->theta, &s->ev, &s->mu, [&](const Theta& t) { return Evaluate(t, data, A, 0); }, Clamp,
-               1e-7, 1e-6, &s->converged);
+    DampedStep(H, g, &s->theta, &s->ev, &s->mu, [&](const Theta& t) { return Evaluate(t, data, A, 0); }, kLogLo,
+               kLogHi, 1e-7, 1e-6, &s->converged);
   }
 }
 
@@ -436,6 +441,13 @@ DamperFitResult FitDamper(const std::vector<io::RigRecord>& records, const Dampe
   res.cost = s.ev.cost;
   res.coef = FromTheta(s.theta, o.A, s.ev.k1, s.ev.x0);
   for (const auto& rec : records) res.records.push_back(ScoreDamper(res.coef, rec, o.velocity_cutoff_hz));
+  res.status.converged = s.converged;
+  res.status.iterations = s.iterations;
+  res.status.max_iterations = o.max_iterations.value_or(kMaxIterations);
+  // Every lower bound is a floor standing for 0 (the coefficients are >= 0: fit_status.h).
+  constexpr const char* kNames[kNonlinear] = {"alpha", "c0", "c1", "k0", "beta", "gamma"};
+  for (int i = 0; i < kNonlinear; ++i)
+    res.status.parameters.push_back(StatusOf(kNames[i], std::exp(s.theta[i]), kLo[i], kHi[i], true));
   return res;
 }
 
@@ -453,6 +465,7 @@ std::string DamperFitResult::Report() const {
       zmax, k.alpha * zmax, 1.0 / std::sqrt(k.A * bg), k.c0 * k.c1 / (k.c0 + k.c1));
   o += fmt::format("  Levenberg-Marquardt: start {} of {} won, {} iterations, {}; cost J = {:.6g}\n", best_start + 1,
                    start_costs.size(), iterations, converged ? "converged" : "not converged (iteration limit)", cost);
+  o += status.Details("  ");
   o += "  force error per record (Eq. 31 on f):\n";
   for (const auto& r : records)
     o += fmt::format("    {:<40} {:6d} samples at {:g} s, peak {:.4g} kN: {:.3f} %\n", r.source, r.samples, r.dt_s,
@@ -490,7 +503,9 @@ std::string DamperTomlFragment(const DamperFitResult& fit, const std::string& ti
       "# so it holds at {} A only. Force error (Eq. 31 on f) per training record:\n",
       fit.current_A, fit.current_A);
   for (const auto& r : fit.records) o += fmt::format("#   {}: {:.3f} %\n", r.source, r.nrmse_f_pct);
+  o += fit.status.Comment();
   o += "\n" + DamperTable(p);
+  o += "\n" + fit.status.TomlTable();
   return o;
 }
 

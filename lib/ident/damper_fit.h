@@ -36,6 +36,7 @@
 #include <vector>
 
 #include "ident/damper_options.h"
+#include "ident/fit_status.h"
 #include "io/rig_record.h"
 #include "models/mr_damper.h"
 
@@ -107,6 +108,7 @@ struct DamperFitResult {
   int iterations = 0;                      ///< LM iterations of the winning start, all phases
   bool converged = false;                  ///< relative cost change or step below tolerance
   std::vector<double> start_costs;         ///< J of every start after its first iterations
+  FitStatus status;                        ///< how the fit ended (ident/fit_status.h)
   /// Multi-line text: the coefficients, the derived yield force and pre-yield travel, the errors.
   std::string Report() const;
 };
@@ -138,8 +140,9 @@ models::MrDamperParams ParamsAtOneCurrent(const models::MrDamperCoefficients& k)
 ///     [plant.damper]
 ///     alpha_a = ..  alpha_b = ..  alpha_c = 0  ...  A = ..  n = 2  k0 = ..  k1 = ..  x0 = ..
 /// every MrDamperParams field (one per line), with '#' comments: `title`, the current, each
-/// record's error. Only the [plant.damper] table, so it can follow an actuator fragment of
-/// `rths identify` (which has [plant] and [controller]) in one file.
+/// record's error, the fit's status (FitStatus::Comment); then the [fit] table. No [plant] table,
+/// so it can follow an actuator fragment of `rths identify` (which has [plant] and [controller])
+/// in one file.
 std::string DamperTomlFragment(const DamperFitResult& fit, const std::string& title);
 
 }  // namespace rths::ident

@@ -12,6 +12,8 @@ DamperModelFit FitDamperModel(const std::vector<io::RigRecord>& records, const D
 
 std::string DamperModelFit::Report() const { return at_current ? at_current->Report() : any_input->Report(); }
 
+const FitStatus& DamperModelFit::status() const { return at_current ? at_current->status : any_input->status; }
+
 double DamperModelFit::CutoffHz(const io::RigRecord& record) const {
   return velocity_cutoff_hz > 0.0 ? velocity_cutoff_hz : VelocityCutoffHz(record);
 }

@@ -23,7 +23,9 @@ struct DamperModelFit {
 
   /// The input is a voltage (any input history with v_V).
   bool voltage() const { return any_input && any_input->voltage; }
-  /// The result's Report() (coefficients, derived quantities, per-record errors).
+  /// How the fit ended (ident/fit_status.h).
+  const FitStatus& status() const;
+  /// The result's Report() (coefficients, derived quantities, the status, per-record errors).
   std::string Report() const;
   /// The velocity cut-off [Hz] used on a record: the options' or VelocityCutoffHz(record).
   double CutoffHz(const io::RigRecord& record) const;

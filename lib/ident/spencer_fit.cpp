@@ -45,12 +45,31 @@ double HiBound(int i) {
   if (i < kK0) return i % 3 == 2 ? kRateHi : kEndHi[i / 3];
   return i == kK0 ? kK0Hi : kEtaHi;
 }
+// The lower bound of theta_i stands for 0 (fit_status.h): the laws' ends and k0, not the rates or eta.
+bool ZeroFloor(int i) { return i < kK0 ? i % 3 != 2 : i == kK0; }
 
-Eigen::VectorXd Clamp(Eigen::VectorXd th) {
-  for (Eigen::Index i = 0; i < th.size(); ++i)
-    th[i] = std::clamp(th[i], std::log(LoBound(static_cast<int>(i))), std::log(HiBound(static_cast<int>(i))));
-  return th;
-}
+constexpr const char* kParamNames[kEta + 1] = {"alpha_a", "alpha_b", "alpha_c", "c0_a",    "c0_b",    "c0_c",
+                                               "c1_a",    "c1_b",    "c1_c",    "beta_a",  "beta_b",  "beta_c",
+                                               "gamma_a", "gamma_b", "gamma_c", "k0",      "eta_1_s"};
+
+// The box the fit searches theta in: ln of the bounds, or a point for a held parameter.
+struct Box {
+  Eigen::VectorXd lo, hi;
+  std::vector<std::string> held_why;  // per coordinate: why it is held ("" = fitted)
+
+  explicit Box(int dim) : lo(dim), hi(dim), held_why(static_cast<std::size_t>(dim)) {
+    for (int i = 0; i < dim; ++i) {
+      lo[i] = std::log(LoBound(i));
+      hi[i] = std::log(HiBound(i));
+    }
+  }
+  void Hold(int i, double value, std::string why) {
+    lo[i] = hi[i] = std::log(value);
+    held_why[static_cast<std::size_t>(i)] = std::move(why);
+  }
+  bool Held(int i) const { return !held_why[static_cast<std::size_t>(i)].empty(); }
+  Eigen::VectorXd Clamp(const Eigen::VectorXd& th) const { return ClampToBox(th, lo, hi); }
+};
 
 models::MrDamperParams ParamsOf(const Eigen::VectorXd& th, double A) {
   models::MrDamperParams p;
@@ -99,7 +118,7 @@ void FilteredInput(std::span<const double> v, double dt, ControlFilter f, const 
 // One record prepared for the fit.
 struct Prepared {
   const io::RigRecord* rec = nullptr;
-  std::span<const double> v;  // the command
+  std::vector<double> v;      // the command the model is driven with (CommandForModel)
   std::vector<double> xdot;   // smoothed velocity [mm/s]
   double cutoff_hz = 0.0;
   double weight = 0.0;        // 1 / sum f^2
@@ -133,7 +152,7 @@ bool SimulateNonlinear(const models::MrDamperParams& p, const models::CurrentDri
   const auto& rec = *d.rec;
   const std::size_t n = d.n;
   const double dt = rec.dt_s;
-  FilteredInput(d.v.subspan(0, n), dt, filter, drv, &w->u);
+  FilteredInput(std::span<const double>(d.v).subspan(0, n), dt, filter, drv, &w->u);
   w->c.resize(n);
   for (std::size_t k = 0; k < n; ++k) w->c[k] = models::CoefficientsAt(p, w->u[k]);
   if (choose) msteps->assign(n, 1);
@@ -189,10 +208,11 @@ struct Evaluation {
 
 class Problem {
  public:
-  Problem(const std::vector<Prepared>& data, const DamperFitOptions& o) : data_(data), o_(o) {
+  Problem(const std::vector<Prepared>& data, const DamperFitOptions& o, const Box& box) : data_(data), o_(o), box_(box) {
     for (const auto& d : data_) total_ += d.n;
   }
   int dim() const { return Dim(o_.filter); }
+  const Box& box() const { return box_; }
 
   // fixed: substeps of a base evaluation to keep (nullptr: choose them here).
   Evaluation Evaluate(const Eigen::VectorXd& th, const Evaluation* fixed, Workspace* w,
@@ -250,6 +270,7 @@ class Problem {
  private:
   const std::vector<Prepared>& data_;
   const DamperFitOptions& o_;
+  const Box& box_;
   std::size_t total_ = 0;
 };
 
@@ -275,9 +296,13 @@ void Iterate(LmState* s, const Problem& pb, int iterations, int threads,
     }
     Eigen::MatrixXd J(base.r.size(), P);
     auto column = [&](int i, int t) {
+      if (pb.box().Held(i)) {  // not fitted: no column (DampedStep keeps it)
+        J.col(i).setZero();
+        return;
+      }
       Eigen::VectorXd th = s->theta;
       double h = 1e-5;
-      if (th[i] + h > std::log(HiBound(i))) h = -h;
+      if (th[i] + h > pb.box().hi[i]) h = -h;
       th[i] += h;
       const Evaluation e = pb.Evaluate(th, &base, &ws[static_cast<std::size_t>(t)], &fnl[static_cast<std::size_t>(t)]);
       if (std::isfinite(e.cost))
@@ -300,7 +325,7 @@ void Iterate(LmState* s, const Problem& pb, int iterations, int threads,
     ++s->iterations;
     DampedStep(
         H, g, &s->theta, &s->ev, &s->mu, [&](const Eigen::VectorXd& t) { return pb.Evaluate(t, nullptr, &ws[0], &fnl[0]); },
-        Clamp, 1e-9, 1e-7, &s->converged);
+        pb.box().lo, pb.box().hi, 1e-9, 1e-7, &s->converged);
     if (on_iteration) on_iteration();
   }
 }
@@ -346,13 +371,43 @@ std::span<const double> ControlInput(const io::RigRecord& rec, bool voltage) {
   return rec.i_A;
 }
 
+ModelCommand CommandForModel(const io::RigRecord& rec, bool voltage) {
+  const auto raw = ControlInput(rec, voltage);
+  ModelCommand c;
+  c.v.assign(raw.begin(), raw.end());
+  double top = 0.0;
+  for (double x : c.v) {
+    top = std::max(top, x);
+    if (x < 0.0) {
+      ++c.negatives;
+      c.worst = std::min(c.worst, x);
+    }
+  }
+  if (c.negatives == 0) return c;
+  const char* unit = voltage ? "V" : "A";
+  const char* column = voltage ? "v_V" : "i_A";
+  const double share = static_cast<double>(c.negatives) / static_cast<double>(c.v.size());
+  const std::string what = fmt::format("{} of {} samples of {} ({:.3g} %) are negative, down to {:.4g} {}", c.negatives,
+                                       c.v.size(), column, 100.0 * share, c.worst, unit);
+  if (share > kMaxNegativeShare || -c.worst > top)
+    throw Error(RecordName(rec),
+                fmt::format("{}: not noise around 0 (the rule: at most {:g} % of the samples, none below minus the "
+                            "largest command {:.4g} {}); the damper's laws (Eqs. 35-39) take a command >= 0: a bipolar "
+                            "command needs its magnitude in the column (docs/identification.md \"Negative commands\")",
+                            what, 100.0 * kMaxNegativeShare, top, unit));
+  for (double& x : c.v) x = std::max(x, 0.0);
+  c.warning = fmt::format("{}: {}: taken as 0 {} (a DAQ's noise, or its anti-alias filter ringing at the command's steps)",
+                          RecordName(rec), what, unit);
+  return c;
+}
+
 std::vector<double> PredictSpencerForce(const models::MrDamperParams& params, const models::CurrentDriverParams& driver,
                                         ControlFilter filter, const io::RigRecord& rec, bool voltage,
                                         double cutoff_hz) {
   params.Validate();
   Prepared d;
   d.rec = &rec;
-  d.v = ControlInput(rec, voltage);
+  d.v = CommandForModel(rec, voltage).v;
   d.cutoff_hz = cutoff_hz > 0.0 ? cutoff_hz : VelocityCutoffHz(rec);
   d.xdot = SmoothVelocity(rec.y_mm, rec.dt_s, d.cutoff_hz);
   std::vector<double> f(rec.size(), kNaN);
@@ -389,13 +444,15 @@ struct Extent {
 /// The records prepared for the fit (command, smoothed velocity, weight); checks them and the
 /// input's range (variable and >= 0). Throws rths::Error naming the record or the reason.
 std::vector<Prepared> PrepareRecords(const std::vector<io::RigRecord>& records, bool voltage, const DamperFitOptions& o,
-                                     Extent* e) {
+                                     Extent* e, std::vector<std::string>* warnings) {
   std::vector<Prepared> data;
   for (const auto& rec : records) {
     CheckDamperColumns(rec);
     Prepared p;
     p.rec = &rec;
-    p.v = ControlInput(rec, voltage);
+    auto command = CommandForModel(rec, voltage);
+    if (!command.warning.empty()) warnings->push_back(command.warning);
+    p.v = std::move(command.v);
     p.cutoff_hz = o.velocity_cutoff_hz > 0.0 ? o.velocity_cutoff_hz : VelocityCutoffHz(rec);
     p.xdot = SmoothVelocity(rec.y_mm, rec.dt_s, p.cutoff_hz);
     for (std::size_t k = 0; k < rec.size(); ++k) {
@@ -413,9 +470,6 @@ std::vector<Prepared> PrepareRecords(const std::vector<io::RigRecord>& records, 
   if (!(e->in_hi - e->in_lo > 1e-6))
     throw Error("FitSpencer", fmt::format("the control input is constant ({} {}): its laws (Eqs. 35-39) cannot be "
                                           "fitted; fit at one current instead (--current)",
-                                          e->in_lo, unit));
-  if (e->in_lo < 0.0)
-    throw Error("FitSpencer", fmt::format("the control input goes negative ({} {}): Eqs. 35-39 take an input >= 0",
                                           e->in_lo, unit));
   return data;
 }
@@ -474,7 +528,7 @@ std::vector<LmState> Starts(const Rough& ra, const Rough& rb, const Extent& e, c
       for (int l = 0; l < kLaws; ++l) s.theta[3 * l + 2] = std::log(rate);
       s.theta[kK0] = std::log(0.01 * rb.Fy / std::max(e.xmax, 1e-3));
       if (o.filter == ControlFilter::kFirstOrder) s.theta[kEta] = std::log(o.eta_start_1_s);
-      s.theta = Clamp(s.theta);
+      s.theta = pb.box().Clamp(s.theta);
       Workspace w;
       std::vector<double> f;
       s.ev = pb.Evaluate(s.theta, nullptr, &w, &f);
@@ -502,6 +556,79 @@ int BestOnAllData(std::vector<LmState>* starts, const Problem& pb) {
   return -1;
 }
 
+/// The commands' design (fit_status.h "held"): the distinct levels if every record holds its
+/// command constant (within 1e-6 of the input's range), else empty.
+std::vector<double> ConstantLevels(const std::vector<Prepared>& data, const Extent& e) {
+  const double tol = 1e-6 * std::max(e.in_hi - e.in_lo, 1e-12);
+  std::vector<double> levels;
+  for (const auto& d : data) {
+    const auto [lo, hi] = std::minmax_element(d.v.begin(), d.v.end());
+    if (*hi - *lo > tol) return {};
+    const double level = 0.5 * (*lo + *hi);
+    // One level per cluster within 1 % of the range.
+    if (std::none_of(levels.begin(), levels.end(),
+                     [&](double l) { return std::abs(l - level) <= 0.01 * (e.in_hi - e.in_lo); }))
+      levels.push_back(level);
+  }
+  std::sort(levels.begin(), levels.end());
+  return levels;
+}
+
+/// The box of the fit, with what the records cannot determine held (fit_status.h): eta when
+/// every record holds its command constant (the filter never acts), the rates p_c when the
+/// records hold two levels only (two points fix each law at those levels alone; p_c is then
+/// held at 3 / (level_2 - level_1): 95 % of the change between them is made by the upper one).
+Box DesignBox(const std::vector<Prepared>& data, const Extent& e, const DamperFitOptions& o, bool voltage) {
+  Box box(Dim(o.filter));
+  const auto levels = ConstantLevels(data, e);
+  if (levels.empty()) return box;
+  const char* unit = voltage ? "V" : "A";
+  if (o.filter == ControlFilter::kFirstOrder)
+    box.Hold(kEta, o.eta_start_1_s,
+             "every record holds its command constant, so the filter's time constant never shows: the value of "
+             "the starts");
+  if (levels.size() == 2) {
+    const double rate = 3.0 / (levels[1] - levels[0]);
+    for (int l = 0; l < kLaws; ++l)
+      box.Hold(3 * l + 2, std::clamp(rate, kRateLo, kRateHi),
+               fmt::format("the records hold two input levels, {:.4g} and {:.4g} {}, which fix each law there only: "
+                           "between them the law is this assumption",
+                           levels[0], levels[1], unit));
+  }
+  return box;
+}
+
+/// How the fit ended (fit_status.h) at theta.
+FitStatus StatusAt(const LmState& s, const Box& box, int max_iterations) {
+  FitStatus st;
+  st.converged = s.converged;
+  st.iterations = s.iterations;
+  st.max_iterations = max_iterations;
+  for (int i = 0; i < static_cast<int>(s.theta.size()); ++i) {
+    ParameterStatus p = StatusOf(kParamNames[i], std::exp(s.theta[i]), LoBound(i), HiBound(i), ZeroFloor(i));
+    if (box.Held(i)) {
+      p.state = ParameterState::kHeld;
+      p.why = box.held_why[static_cast<std::size_t>(i)];
+    }
+    st.parameters.push_back(std::move(p));
+  }
+  // A rate on a bound is irrelevant if its law's ends are equal, or both within 10 x the floor
+  // (nil: the floors are far below any value that acts).
+  for (int l = 0; l < kLaws; ++l) {
+    auto& a = st.parameters[static_cast<std::size_t>(3 * l)];
+    auto& b = st.parameters[static_cast<std::size_t>(3 * l + 1)];
+    auto& c = st.parameters[static_cast<std::size_t>(3 * l + 2)];
+    const bool flat = std::abs(s.theta[3 * l] - s.theta[3 * l + 1]) < 1e-3 ||
+                      (a.value <= 10.0 * a.lo && b.value <= 10.0 * b.lo);
+    if (c.state == ParameterState::kAtBound && flat) {
+      c.state = ParameterState::kIrrelevant;
+      c.why = fmt::format("{} = {:.3g} and {} = {:.3g}: the law is flat, so its rate changes nothing", a.name, a.value,
+                          b.name, b.value);
+    }
+  }
+  return st;
+}
+
 }  // namespace
 
 bool UsesVoltage(const std::vector<io::RigRecord>& records, DamperInput input) {
@@ -516,7 +643,9 @@ SpencerFitResult FitSpencer(const std::vector<io::RigRecord>& records, const Dam
   if (records.empty()) throw Error("FitSpencer", "no records");
   const bool voltage = UsesVoltage(records, o.input);
   Extent e;
-  const std::vector<Prepared> data = PrepareRecords(records, voltage, o, &e);
+  SpencerFitResult res;
+  const std::vector<Prepared> data = PrepareRecords(records, voltage, o, &e, &res.warnings);
+  const Box box = DesignBox(data, e, o, voltage);
   const int threads = o.threads > 0 ? o.threads : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
   const auto [ra, rb] = RoughEnds(data, e, PeakForce(records), o);
   // The starts run on the first part of every record (kStartShare of it, at least kStartMinS).
@@ -524,11 +653,10 @@ SpencerFitResult FitSpencer(const std::vector<io::RigRecord>& records, const Dam
   for (auto& d : part)
     d.n = std::min(d.rec->size(), std::max(static_cast<std::size_t>(kStartShare * static_cast<double>(d.rec->size())),
                                            static_cast<std::size_t>(kStartMinS / d.rec->dt_s)));
-  const Problem pb_part(part, o), pb(data, o);
+  const Problem pb_part(part, o, box), pb(data, o, box);
   std::vector<LmState> starts = Starts(ra, rb, e, pb_part, o);
   const int start_iterations = o.start_iterations.value_or(kStartIterations);
   const int max_iterations = o.max_iterations.value_or(kMaxIterations);
-  SpencerFitResult res;
   res.filter = o.filter;
   res.voltage = voltage;
   res.input_min = e.in_lo;
@@ -563,6 +691,7 @@ SpencerFitResult FitSpencer(const std::vector<io::RigRecord>& records, const Dam
   res.params.k1 = s.ev.k1;
   res.params.x0 = s.ev.x0;
   res.driver = DriverOf(s.theta, o.filter);
+  res.status = StatusAt(s, box, max_iterations);
   for (const auto& d : data)
     res.records.push_back(ScoreSpencer(res.params, res.driver, o.filter, *d.rec, voltage, d.cutoff_hz));
   res.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -595,6 +724,7 @@ std::string SpencerFitResult::Report() const {
   o += fmt::format("  Levenberg-Marquardt: start {} of {} won, {} iterations, {}; cost J = {:.6g}; {:.1f} s\n",
                    best_start + 1, start_costs.size(), iterations, converged ? "converged" : "not converged (iteration limit)",
                    cost, seconds);
+  o += status.Details("  ");
   o += "  force error per record (Eq. 31 on f):\n";
   for (const auto& r : records)
     o += fmt::format("    {:<40} {:7d} samples at {:g} s, velocity cut-off {:.0f} Hz, peak {:.4g} kN: {:.3f} %\n",
@@ -610,6 +740,8 @@ std::string SpencerModelToml(const SpencerFitResult& fit, const std::string& tit
                    fit.voltage ? " (a VOLTAGE: the rates p_c are per V, and the damper command of a run is in V)" : "");
   o += "# Force error (Eq. 31 on f) per training record:\n";
   for (const auto& r : fit.records) o += fmt::format("#   {}: {:.3f} %\n", r.source, r.nrmse_f_pct);
+  for (const auto& w : fit.warnings) o += "# warning: " + w + "\n";
+  o += fit.status.Comment();
   o += fmt::format("\n[plant]\ncurrent_dynamics = {}\n", fit.filter == ControlFilter::kNone ? "false" : "true");
   o += "\n" + DamperTable(p);
   if (fit.filter != ControlFilter::kNone) {
@@ -619,6 +751,7 @@ std::string SpencerModelToml(const SpencerFitResult& fit, const std::string& tit
     else
       o += "kind = \"eq40\"\n";
   }
+  o += "\n" + fit.status.TomlTable();
   return o;
 }
 

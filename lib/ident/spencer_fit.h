@@ -41,6 +41,7 @@
 
 #include "ident/damper_fit.h"
 #include "ident/damper_options.h"
+#include "ident/fit_status.h"
 #include "io/rig_record.h"
 #include "models/current_driver.h"
 #include "models/mr_damper.h"
@@ -64,6 +65,8 @@ struct SpencerFitResult {
   bool converged = false;
   std::vector<double> start_costs;
   double seconds = 0.0;                     ///< wall time of the fit [s]
+  FitStatus status;                         ///< how the fit ended (ident/fit_status.h)
+  std::vector<std::string> warnings;        ///< about the records (negative commands taken as 0)
   /// Multi-line text: the parameters at the ends of the input range, eta, the errors.
   std::string Report() const;
 };
@@ -72,14 +75,33 @@ struct SpencerFitResult {
 /// else its i_A (throws if it has none).
 std::span<const double> ControlInput(const io::RigRecord& record, bool voltage);
 
+/// Largest share of a record's samples whose negative command is taken as noise (CommandForModel).
+inline constexpr double kMaxNegativeShare = 0.01;
+
+/// The command a damper model is driven with, and what was done to it.
+struct ModelCommand {
+  std::vector<double> v;       ///< the command [A or V], every sample >= 0
+  std::size_t negatives = 0;   ///< samples that were negative (set to 0)
+  double worst = 0.0;          ///< the most negative one [A or V]
+  std::string warning;         ///< "" if none was negative
+};
+
+/// ControlInput with its negative samples set to 0 (docs/identification.md "Negative commands"):
+/// a real DAQ's command around 0 V has noise and the anti-alias filter's ringing at steps. Allowed
+/// if at most kMaxNegativeShare of the samples are negative and none is below minus the largest
+/// command; else throws rths::Error naming the record, the count, the worst value and the rule
+/// (a bipolar command: Eqs. 35-39 take an input >= 0).
+ModelCommand CommandForModel(const io::RigRecord& record, bool voltage);
+
 /// true if the fit drives the model with the records' v_V (DamperInput::kVoltage, or kAuto and the
 /// first record has no i_A), false for i_A.
 bool UsesVoltage(const std::vector<io::RigRecord>& records, DamperInput input);
 
 /// Fits the model to the records (file comment), driven by the input UsesVoltage(records,
-/// options.input) picks (options.current_A and current_tolerance_A are not read). Throws
-/// rths::Error (where = the record's source) for a record without that column, too short, or
-/// with zero force; (where = "DamperFitOptions") for bad options; if no start gives a finite cost.
+/// options.input) picks, through CommandForModel (options.current_A and current_tolerance_A are
+/// not read); what the records cannot determine is held (fit_status.h), and the result's status
+/// says how the fit ended. Throws rths::Error (where = the record's source) for a record without
+/// that column, too short, with zero force or a command CommandForModel refuses; (where = "DamperFitOptions") for bad options; if no start gives a finite cost.
 SpencerFitResult FitSpencer(const std::vector<io::RigRecord>& records, const DamperFitOptions& options = {});
 
 /// Force prediction F_k [kN] of the model on a record's motion and command (NaN from the first

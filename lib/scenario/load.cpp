@@ -89,6 +89,9 @@ Scenario ScenarioFromToml(const toml::table& root, const std::string& path) {
   s.path = path;
   Section top(file, &root, "");
   ReadFields(&top, &s);
+  // A model file of `rths identify --damper` carries how its fit ended in [fit]
+  // (ident/fit_status.h): a record for the reader, not part of the scenario.
+  (void)top.Sub("fit");
   top.Finish();
   ValidateScenario(s);
   ReadReferencedFiles(&s);
