@@ -282,3 +282,23 @@ TEST_CASE("FitDamper: bad input is refused, naming the record") {
   // A UTFSM file name without a current is refused by the reader.
   CHECK_THROWS_AS(rths::io::UtfsmCurrentFromName("25mm0x5Hz.txt"), rths::Error);
 }
+
+TEST_CASE("LinearTerms: k1 (x - x0) when k1 > 0, else the load cell's zero as a constant") {
+  rths::ident::LinearTerms acc, flat;
+  for (int k = 0; k < 1000; ++k) {
+    const double x = 3.0 * std::sin(2.0 * std::numbers::pi * k / 1000.0);
+    acc.Add(1.0, x, 0.002 * (x + 5.0));  // k1 = 0.002 kN/mm, x0 = -5 mm
+    flat.Add(1.0, x, 0.05 - 0.001 * x);  // k1 < 0 would be needed: refused, the mean stays
+  }
+  const auto a = acc.Solve();
+  CHECK(a.k1 == doctest::Approx(0.002));
+  CHECK(a.x0 == doctest::Approx(-5.0));
+  CHECK(a.offset_kN == 0.0);
+  CHECK(a.At(1.0) == doctest::Approx(0.012));
+  const auto f = flat.Solve();
+  CHECK(f.k1 == 0.0);
+  CHECK(f.x0 == 0.0);
+  CHECK(f.offset_kN == doctest::Approx(0.05));
+  CHECK(rths::ident::ForceOffsetKey(f.offset_kN) == "force_offset_kN = 0.05\n");
+  CHECK(rths::ident::ForceOffsetKey(0.0).empty());
+}

@@ -416,7 +416,8 @@ void AddDamperOptions(CLI::App* app, rths::ident::DamperFitOptions* o, double* c
                   "--damper without --current: control filter between command and parameters: first_order "
                   "(u' = -eta (u - v), eta fitted; default), eq40 (the paper's Eq. 40 + 75 Hz low-pass, fixed), none")
       ->check(CLI::IsMember({"first_order", "eq40", "none"}));
-  app->add_flag("--no-offset", *no_offset, "--damper without --current: hold k1 = x0 = 0 (no accumulator force)");
+  app->add_flag("--no-offset", *no_offset,
+                "--damper without --current: hold k1 = x0 = 0 and no force offset (no accumulator, no load-cell zero)");
   app->add_option("--threads", o->threads, "--damper without --current: threads for the Jacobian (0: one per core)")
       ->capture_default_str();
 }

@@ -67,7 +67,7 @@ Theta Clamp(const Theta& th) { return ClampToBox(th, kLogLo, kLogHi); }
 struct Evaluation {
   Eigen::VectorXd r;
   double cost = kInf;
-  double k1 = 0.0, x0 = 0.0;
+  double k1 = 0.0, x0 = 0.0, offset = 0.0;
 };
 
 Evaluation Evaluate(const Theta& th, const std::vector<Prepared>& data, double A, int substeps_fixed) {
@@ -86,35 +86,23 @@ Evaluation Evaluate(const Theta& th, const std::vector<Prepared>& data, double A
     for (double f : fnl[i])
       if (!std::isfinite(f)) return ev;  // cost = inf
   }
-  // Weighted normal equations for e = f - F_nl - k1 x - b.
-  double sxx = 0, sx = 0, s1 = 0, sxe = 0, se = 0;
+  // k1, x0 and the offset by weighted least squares (LinearTerms).
+  LinearTerms sums;
   for (std::size_t i = 0; i < data.size(); ++i) {
     const auto& d = data[i];
-    for (std::size_t j = 0; j < d.rec->size(); ++j) {
-      const double x = d.rec->y_mm[j], e = d.rec->f_kN[j] - fnl[i][j];
-      sxx += d.weight * x * x;
-      sx += d.weight * x;
-      s1 += d.weight;
-      sxe += d.weight * x * e;
-      se += d.weight * e;
-    }
+    for (std::size_t j = 0; j < d.rec->size(); ++j) sums.Add(d.weight, d.rec->y_mm[j], d.rec->f_kN[j] - fnl[i][j]);
   }
-  const double det = sxx * s1 - sx * sx;
-  double k1 = 0.0, b = 0.0;
-  if (det > 1e-12 * sxx * s1) {
-    k1 = (sxe * s1 - sx * se) / det;
-    b = (sxx * se - sx * sxe) / det;
-  }
-  if (!(k1 > 0.0)) k1 = b = 0.0;
-  ev.k1 = k1;
-  ev.x0 = k1 > 0.0 ? -b / k1 : 0.0;
+  const auto lin = sums.Solve();
+  ev.k1 = lin.k1;
+  ev.x0 = lin.x0;
+  ev.offset = lin.offset_kN;
   ev.r.resize(static_cast<Eigen::Index>(total));
   Eigen::Index row = 0;
   for (std::size_t i = 0; i < data.size(); ++i) {
     const auto& d = data[i];
     const double sw = std::sqrt(d.weight);
     for (std::size_t j = 0; j < d.rec->size(); ++j)
-      ev.r[row++] = sw * (d.rec->f_kN[j] - fnl[i][j] - k1 * d.rec->y_mm[j] - b);
+      ev.r[row++] = sw * (d.rec->f_kN[j] - fnl[i][j] - lin.At(d.rec->y_mm[j]));
   }
   ev.cost = ev.r.squaredNorm();
   if (!std::isfinite(ev.cost)) ev.cost = kInf;
@@ -326,10 +314,40 @@ DamperRecordScore ScoreForce(const io::RigRecord& rec, std::span<const double> F
 }
 
 DamperRecordScore ScoreDamper(const models::MrDamperCoefficients& coef, const io::RigRecord& rec,
-                              double velocity_cutoff_hz) {
+                              double velocity_cutoff_hz, double force_offset_kN) {
   const double cutoff = velocity_cutoff_hz > 0.0 ? velocity_cutoff_hz : VelocityCutoffHz(rec);
   const auto v = SmoothVelocity(rec.y_mm, rec.dt_s, cutoff);
-  return ScoreForce(rec, SimulateDamperForce(coef, rec.y_mm, v, rec.dt_s), cutoff);
+  auto F = SimulateDamperForce(coef, rec.y_mm, v, rec.dt_s);
+  for (double& f : F) f += force_offset_kN;
+  return ScoreForce(rec, F, cutoff);
+}
+
+LinearTerms::Solution LinearTerms::Solve() const {
+  Solution out;
+  const double det = sxx * s1 - sx * sx;
+  if (det > 1e-12 * sxx * s1) {
+    const double k1 = (sxe * s1 - sx * se) / det, b = (sxx * se - sx * sxe) / det;
+    if (k1 > 0.0) {  // an accumulator: k1 (x - x0) carries the constant too
+      out.k1 = k1;
+      out.x0 = -b / k1;
+      return out;
+    }
+  }
+  out.offset_kN = s1 > 0.0 ? se / s1 : 0.0;  // k1 = 0: the constant alone
+  return out;
+}
+
+std::string ForceOffsetComment(double offset_kN) {
+  if (offset_kN == 0.0) return "";
+  return fmt::format(
+      "# Force offset {:.6g} kN: the load cell's zero on the training records, fitted as a constant because\n"
+      "# k1 came out 0 (k1 (x - x0) cannot carry it then). Not part of the damper model: a run does not add\n"
+      "# it; the errors above include it ([fit] force_offset_kN).\n",
+      offset_kN);
+}
+
+std::string ForceOffsetKey(double offset_kN) {
+  return offset_kN == 0.0 ? "" : fmt::format("force_offset_kN = {}\n", TomlFloat(offset_kN));
 }
 
 namespace {
@@ -440,7 +458,9 @@ DamperFitResult FitDamper(const std::vector<io::RigRecord>& records, const Dampe
   res.converged = s.converged;
   res.cost = s.ev.cost;
   res.coef = FromTheta(s.theta, o.A, s.ev.k1, s.ev.x0);
-  for (const auto& rec : records) res.records.push_back(ScoreDamper(res.coef, rec, o.velocity_cutoff_hz));
+  res.force_offset_kN = s.ev.offset;
+  for (const auto& rec : records)
+    res.records.push_back(ScoreDamper(res.coef, rec, o.velocity_cutoff_hz, res.force_offset_kN));
   res.status.converged = s.converged;
   res.status.iterations = s.iterations;
   res.status.max_iterations = o.max_iterations.value_or(kMaxIterations);
@@ -458,6 +478,8 @@ std::string DamperFitResult::Report() const {
   std::string o = fmt::format("Spencer MR damper model at {} A (Eqs. 32-34, n = 2, A held at {}):\n", current_A, k.A);
   o += fmt::format("  alpha = {:.6g} kN/mm   c0 = {:.6g} kN s/mm   c1 = {:.6g} kN s/mm\n", k.alpha, k.c0, k.c1);
   o += fmt::format("  k0 = {:.6g} kN/mm   k1 = {:.6g} kN/mm   x0 = {:.6g} mm\n", k.k0, k.k1, k.x0);
+  if (force_offset_kN != 0.0)
+    o += fmt::format("  force offset (the load cell's zero; k1 = 0) = {:.6g} kN\n", force_offset_kN);
   o += fmt::format("  beta = {:.6g} 1/mm^2   gamma = {:.6g} 1/mm^2   A = {:.6g}   n = 2\n", k.beta, k.gamma, k.A);
   o += fmt::format(
       "  derived: z_max = sqrt(A/(beta+gamma)) = {:.4g} mm, Bouc-Wen force alpha z_max = {:.4g} kN,\n"
@@ -503,9 +525,10 @@ std::string DamperTomlFragment(const DamperFitResult& fit, const std::string& ti
       "# so it holds at {} A only. Force error (Eq. 31 on f) per training record:\n",
       fit.current_A, fit.current_A);
   for (const auto& r : fit.records) o += fmt::format("#   {}: {:.3f} %\n", r.source, r.nrmse_f_pct);
+  o += ForceOffsetComment(fit.force_offset_kN);
   o += fit.status.Comment();
   o += "\n" + DamperTable(p);
-  o += "\n" + fit.status.TomlTable();
+  o += "\n" + fit.status.TomlTable() + ForceOffsetKey(fit.force_offset_kN);
   return o;
 }
 

@@ -23,7 +23,8 @@
 ///   - theta = ln [alpha, c0, c1, k0, beta, gamma], bounded box (DamperFitBounds), by
 ///     Levenberg-Marquardt with a forward-difference Jacobian, the step projected on the box;
 ///   - k1 and the offset b = -k1 x0 enter F linearly and are solved by weighted linear least
-///     squares at every theta (variable projection); if k1 <= 0 comes out, k1 = x0 = 0;
+///     squares at every theta (variable projection, LinearTerms); if k1 <= 0 comes out,
+///     k1 = x0 = 0 and a constant force offset (the load cell's zero) is fitted instead;
 ///   - several starts from a rough yield-force / viscous fit of the data (f ~ F_y sgn(v) + c v)
 ///     with pre-yield travels delta in {0.1, 0.5, 2} mm and c1 / c0 in {1, 10}; each start runs a
 ///     few iterations, the best continues to convergence.
@@ -84,6 +85,32 @@ double ForceWeight(const io::RigRecord& record);
 /// The largest |f| [kN] over the records.
 double PeakForce(const std::vector<io::RigRecord>& records);
 
+/// The force terms that enter linearly, F = F_nl + k1 x + b (Eq. 34's k1 (x - x0) with
+/// b = -k1 x0, plus a load cell's zero): weighted least squares over e = f - F_nl, by sums.
+/// k1 must be > 0 (an accumulator); if the fit gives k1 <= 0, k1 = x0 = 0 and the offset is the
+/// weighted mean of e alone: the load cell's zero, which k1 (x - x0) cannot carry then
+/// (docs/identification.md "Force offset").
+struct LinearTerms {
+  double sxx = 0, sx = 0, s1 = 0, sxe = 0, se = 0;  ///< the weighted sums
+
+  /// Adds sample x [mm] with residual e = f - F_nl [kN] at weight w.
+  void Add(double w, double x, double e) {
+    sxx += w * x * x;
+    sx += w * x;
+    s1 += w;
+    sxe += w * x * e;
+    se += w * e;
+  }
+  struct Solution {
+    double k1 = 0.0;         ///< [kN/mm], >= 0
+    double x0 = 0.0;         ///< [mm]; 0 if k1 = 0
+    double offset_kN = 0.0;  ///< the constant force when k1 = 0 [kN]; 0 if k1 > 0
+    /// k1 x + b at displacement x [mm]: the linear part of F [kN].
+    double At(double x_mm) const { return k1 * (x_mm - x0) + offset_kN; }
+  };
+  Solution Solve() const;
+};
+
 /// One record's score: Eq. 31 on force, sqrt(sum (f - F)^2 / sum f^2) x 100 %.
 struct DamperRecordScore {
   std::string source;     ///< the record's path
@@ -109,6 +136,9 @@ struct DamperFitResult {
   bool converged = false;                  ///< relative cost change or step below tolerance
   std::vector<double> start_costs;         ///< J of every start after its first iterations
   FitStatus status;                        ///< how the fit ended (ident/fit_status.h)
+  /// The load cell's zero on the training records [kN] when k1 = 0 (LinearTerms); not part of
+  /// the damper model (a run does not add it), added to the model's force when it is scored.
+  double force_offset_kN = 0.0;
   /// Multi-line text: the coefficients, the derived yield force and pre-yield travel, the errors.
   std::string Report() const;
 };
@@ -120,10 +150,15 @@ struct DamperFitResult {
 /// gives a finite cost.
 DamperFitResult FitDamper(const std::vector<io::RigRecord>& records, const DamperFitOptions& options);
 
-/// Eq. 31 on force of `coef` on a record (held-out check), with the velocity of
-/// SmoothVelocity(y_mm, dt_s, velocity_cutoff_hz); 0 = VelocityCutoffHz(record).
+/// Eq. 31 on force of `coef` plus force_offset_kN on a record (held-out check), with the velocity
+/// of SmoothVelocity(y_mm, dt_s, velocity_cutoff_hz); 0 = VelocityCutoffHz(record).
 DamperRecordScore ScoreDamper(const models::MrDamperCoefficients& coef, const io::RigRecord& record,
-                              double velocity_cutoff_hz = 0.0);
+                              double velocity_cutoff_hz = 0.0, double force_offset_kN = 0.0);
+
+/// The model file's lines for a fitted force offset (LinearTerms): a comment, and the key
+/// `force_offset_kN` of the [fit] table (which must come last); "" if offset_kN is 0.
+std::string ForceOffsetComment(double offset_kN);
+std::string ForceOffsetKey(double offset_kN);
 
 /// v as a TOML float (10 significant digits, always with a '.' or an exponent).
 std::string TomlFloat(double v);

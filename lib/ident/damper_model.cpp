@@ -21,15 +21,18 @@ double DamperModelFit::CutoffHz(const io::RigRecord& record) const {
 std::vector<double> DamperModelFit::PredictForce(const io::RigRecord& r) const {
   const double cutoff = CutoffHz(r);
   if (any_input)
-    return PredictSpencerForce(any_input->params, any_input->driver, any_input->filter, r, any_input->voltage, cutoff);
-  return SimulateDamperForce(at_current->coef, r.y_mm, SmoothVelocity(r.y_mm, r.dt_s, cutoff), r.dt_s);
+    return PredictSpencerForce(any_input->params, any_input->driver, any_input->filter, r, any_input->voltage, cutoff,
+                               any_input->force_offset_kN);
+  auto F = SimulateDamperForce(at_current->coef, r.y_mm, SmoothVelocity(r.y_mm, r.dt_s, cutoff), r.dt_s);
+  for (double& f : F) f += at_current->force_offset_kN;
+  return F;
 }
 
 DamperRecordScore DamperModelFit::Score(const io::RigRecord& r) const {
   if (any_input)
     return ScoreSpencer(any_input->params, any_input->driver, any_input->filter, r, any_input->voltage,
-                        velocity_cutoff_hz);
-  return ScoreDamper(at_current->coef, r, velocity_cutoff_hz);
+                        velocity_cutoff_hz, any_input->force_offset_kN);
+  return ScoreDamper(at_current->coef, r, velocity_cutoff_hz, at_current->force_offset_kN);
 }
 
 std::string DamperModelFit::ModelToml(const std::string& title) const {

@@ -45,7 +45,7 @@ struct DamperFitOptions {
   DamperInput input = DamperInput::kAuto;
   ControlFilter filter = ControlFilter::kFirstOrder;
   double eta_start_1_s = 100.0;     ///< first-order filter: eta of the starts [1/s], > 0
-  bool accumulator = true;          ///< fit k1 and x0 (the force offset); false: k1 = x0 = 0
+  bool accumulator = true;          ///< fit k1 and x0, or a force offset (LinearTerms); false: none
   int threads = 0;                  ///< Jacobian threads, >= 0; 0 = the machine's cores
   /// Progress in LM iterations on the whole record (a start's iteration on a quarter counts a
   /// quarter; the final fit counts max_iterations until it converges): empty = none.

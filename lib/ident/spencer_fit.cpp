@@ -202,7 +202,7 @@ bool SimulateNonlinear(const models::MrDamperParams& p, const models::CurrentDri
 struct Evaluation {
   Eigen::VectorXd r;
   double cost = kInf;
-  double k1 = 0.0, x0 = 0.0;
+  double k1 = 0.0, x0 = 0.0, offset = 0.0;
   std::vector<std::vector<std::uint8_t>> substeps;  // per record, per sample step
 };
 
@@ -230,36 +230,25 @@ class Problem {
         return ev;  // cost inf
       off += d.n;
     }
-    double k1 = 0.0, b = 0.0;
+    LinearTerms::Solution lin;  // k1, x0 and the offset (LinearTerms), or none without the accumulator
     if (o_.accumulator) {
-      double sxx = 0, sx = 0, s1 = 0, sxe = 0, se = 0;
+      LinearTerms sums;
       off = 0;
       for (const auto& d : data_) {
-        for (std::size_t j = 0; j < d.n; ++j) {
-          const double x = d.rec->y_mm[j], e = d.rec->f_kN[j] - (*fnl)[off + j];
-          sxx += d.weight * x * x;
-          sx += d.weight * x;
-          s1 += d.weight;
-          sxe += d.weight * x * e;
-          se += d.weight * e;
-        }
+        for (std::size_t j = 0; j < d.n; ++j) sums.Add(d.weight, d.rec->y_mm[j], d.rec->f_kN[j] - (*fnl)[off + j]);
         off += d.n;
       }
-      const double det = sxx * s1 - sx * sx;
-      if (det > 1e-12 * sxx * s1) {
-        k1 = (sxe * s1 - sx * se) / det;
-        b = (sxx * se - sx * sxe) / det;
-      }
-      if (!(k1 > 0.0)) k1 = b = 0.0;  // k1 (x - x0) needs k1 > 0 to carry an offset
+      lin = sums.Solve();
     }
-    ev.k1 = k1;
-    ev.x0 = k1 > 0.0 ? -b / k1 : 0.0;
+    ev.k1 = lin.k1;
+    ev.x0 = lin.x0;
+    ev.offset = lin.offset_kN;
     ev.r.resize(static_cast<Eigen::Index>(total_));
     off = 0;
     for (const auto& d : data_) {
       const double sw = std::sqrt(d.weight);
       for (std::size_t j = 0; j < d.n; ++j)
-        ev.r[static_cast<Eigen::Index>(off + j)] = sw * (d.rec->f_kN[j] - (*fnl)[off + j] - k1 * d.rec->y_mm[j] - b);
+        ev.r[static_cast<Eigen::Index>(off + j)] = sw * (d.rec->f_kN[j] - (*fnl)[off + j] - lin.At(d.rec->y_mm[j]));
       off += d.n;
     }
     ev.cost = ev.r.squaredNorm();
@@ -402,8 +391,8 @@ ModelCommand CommandForModel(const io::RigRecord& rec, bool voltage) {
 }
 
 std::vector<double> PredictSpencerForce(const models::MrDamperParams& params, const models::CurrentDriverParams& driver,
-                                        ControlFilter filter, const io::RigRecord& rec, bool voltage,
-                                        double cutoff_hz) {
+                                        ControlFilter filter, const io::RigRecord& rec, bool voltage, double cutoff_hz,
+                                        double force_offset_kN) {
   params.Validate();
   Prepared d;
   d.rec = &rec;
@@ -421,14 +410,15 @@ std::vector<double> PredictSpencerForce(const models::MrDamperParams& params, co
         break;
       }
   }
-  for (std::size_t k = 0; k < f.size(); ++k) f[k] += params.k1 * (rec.y_mm[k] - params.x0);
+  for (std::size_t k = 0; k < f.size(); ++k) f[k] += params.k1 * (rec.y_mm[k] - params.x0) + force_offset_kN;
   return f;
 }
 
 DamperRecordScore ScoreSpencer(const models::MrDamperParams& params, const models::CurrentDriverParams& driver,
-                               ControlFilter filter, const io::RigRecord& rec, bool voltage, double cutoff_hz) {
+                               ControlFilter filter, const io::RigRecord& rec, bool voltage, double cutoff_hz,
+                               double force_offset_kN) {
   const double cutoff = cutoff_hz > 0.0 ? cutoff_hz : VelocityCutoffHz(rec);
-  return ScoreForce(rec, PredictSpencerForce(params, driver, filter, rec, voltage, cutoff), cutoff);
+  return ScoreForce(rec, PredictSpencerForce(params, driver, filter, rec, voltage, cutoff, force_offset_kN), cutoff);
 }
 
 namespace {
@@ -690,10 +680,12 @@ SpencerFitResult FitSpencer(const std::vector<io::RigRecord>& records, const Dam
   res.params = ParamsOf(s.theta, o.A);
   res.params.k1 = s.ev.k1;
   res.params.x0 = s.ev.x0;
+  res.force_offset_kN = s.ev.offset;
   res.driver = DriverOf(s.theta, o.filter);
   res.status = StatusAt(s, box, max_iterations);
   for (const auto& d : data)
-    res.records.push_back(ScoreSpencer(res.params, res.driver, o.filter, *d.rec, voltage, d.cutoff_hz));
+    res.records.push_back(
+        ScoreSpencer(res.params, res.driver, o.filter, *d.rec, voltage, d.cutoff_hz, res.force_offset_kN));
   res.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return res;
 }
@@ -716,6 +708,8 @@ std::string SpencerFitResult::Report() const {
   for (const auto& [name, v] : laws)
     o += fmt::format("    {:<40} {:<14.6g} {:<14.6g} {:.6g}\n", name, v[0], v[1], v[2]);
   o += fmt::format("  k0 = {:.6g} kN/mm   k1 = {:.6g} kN/mm   x0 = {:.6g} mm\n", p.k0, p.k1, p.x0);
+  if (force_offset_kN != 0.0)
+    o += fmt::format("  force offset (the load cell's zero; k1 = 0) = {:.6g} kN\n", force_offset_kN);
   for (double in : {input_min, input_max}) {
     const auto c = models::CoefficientsAt(p, in);
     o += fmt::format("  at {:.4g} {}: alpha {:.4g}, c0 {:.4g}, c1 {:.4g}, beta {:.4g}, gamma {:.4g}\n", in, unit, c.alpha,
@@ -741,6 +735,7 @@ std::string SpencerModelToml(const SpencerFitResult& fit, const std::string& tit
   o += "# Force error (Eq. 31 on f) per training record:\n";
   for (const auto& r : fit.records) o += fmt::format("#   {}: {:.3f} %\n", r.source, r.nrmse_f_pct);
   for (const auto& w : fit.warnings) o += "# warning: " + w + "\n";
+  o += ForceOffsetComment(fit.force_offset_kN);
   o += fit.status.Comment();
   o += fmt::format("\n[plant]\ncurrent_dynamics = {}\n", fit.filter == ControlFilter::kNone ? "false" : "true");
   o += "\n" + DamperTable(p);
@@ -751,7 +746,7 @@ std::string SpencerModelToml(const SpencerFitResult& fit, const std::string& tit
     else
       o += "kind = \"eq40\"\n";
   }
-  o += "\n" + fit.status.TomlTable();
+  o += "\n" + fit.status.TomlTable() + ForceOffsetKey(fit.force_offset_kN);
   return o;
 }
 

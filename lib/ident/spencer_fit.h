@@ -22,8 +22,8 @@
 /// beta_b, beta_c, gamma_a, gamma_b, gamma_c, k0, eta] (eta only for the first-order filter),
 /// in a box, by Levenberg-Marquardt with a forward-difference Jacobian (its columns computed in
 /// parallel; the result does not depend on the number of threads); k1 and b = -k1 x0 enter
-/// linearly and are solved at every theta (variable projection), or held at 0 without the
-/// accumulator. A is held (scale redundancy, damper_fit.h). Starts: rough yield-force /
+/// linearly and are solved at every theta (variable projection, LinearTerms of damper_fit.h: a
+/// constant force offset instead when k1 comes out <= 0), or held at 0 without the accumulator. A is held (scale redundancy, damper_fit.h). Starts: rough yield-force /
 /// viscous fits of the samples at the lowest and at the highest filtered input give p_a and
 /// p_b; pre-yield travels (at the low, high end) in {(0.1, 0.1), (0.1, 0.5), (0.5, 0.5),
 /// (0.5, 2), (2, 2)} mm x c1/c0 in {1, 10}; every start runs a few iterations on the first
@@ -67,6 +67,9 @@ struct SpencerFitResult {
   double seconds = 0.0;                     ///< wall time of the fit [s]
   FitStatus status;                         ///< how the fit ended (ident/fit_status.h)
   std::vector<std::string> warnings;        ///< about the records (negative commands taken as 0)
+  /// The load cell's zero on the training records [kN] when k1 = 0 (LinearTerms, damper_fit.h):
+  /// not part of the damper model, added to its force when it is scored.
+  double force_offset_kN = 0.0;
   /// Multi-line text: the parameters at the ends of the input range, eta, the errors.
   std::string Report() const;
 };
@@ -108,12 +111,12 @@ SpencerFitResult FitSpencer(const std::vector<io::RigRecord>& records, const Dam
 /// non-finite sample). velocity_cutoff_hz 0 = VelocityCutoffHz(record).
 std::vector<double> PredictSpencerForce(const models::MrDamperParams& params, const models::CurrentDriverParams& driver,
                                         ControlFilter filter, const io::RigRecord& record, bool voltage,
-                                        double velocity_cutoff_hz = 0.0);
+                                        double velocity_cutoff_hz = 0.0, double force_offset_kN = 0.0);
 
 /// Eq. 31 on force of the model on a record (held-out check).
 DamperRecordScore ScoreSpencer(const models::MrDamperParams& params, const models::CurrentDriverParams& driver,
                                ControlFilter filter, const io::RigRecord& record, bool voltage,
-                               double velocity_cutoff_hz = 0.0);
+                               double velocity_cutoff_hz = 0.0, double force_offset_kN = 0.0);
 
 /// The model as a model file `rths run`, `design` and `diagnose --model` read: '#' comments
 /// (title, input unit, errors), then [plant] current_dynamics, [plant.damper] (every
