@@ -11,6 +11,7 @@
 #include <fstream>
 #include <functional>
 #include <numbers>
+#include <random>
 #include <set>
 #include <string>
 
@@ -587,7 +588,8 @@ TEST_CASE("options: the ones used are written into the JSON, every field") {
   CHECK(j["refit_rounds"] == 5);
   CHECK(j["min_test_shrink_pct"] == 30.0);
   CHECK(j["detrend"] == false);
-  CHECK(j.size() == 41);  // one per field of Options and per constant of diagnosis/tuning.h
+  CHECK(j["drift_hz"] == 0.5);
+  CHECK(j.size() == 42);  // one per field of Options and per constant of diagnosis/tuning.h
 }
 
 TEST_CASE("Summary: the brief report is the verdict and each channel's shrink; the full one is unchanged") {
@@ -744,5 +746,57 @@ TEST_CASE("report figures: axis units are docs/units.md's, and every legend sits
         if (!s.color.empty() && s.color[0] == '#') CHECK(rths::io::RelativeLuminance(s.color) <= rths::io::kMaxReadableLuminance);
       }
     }
+  }
+}
+
+TEST_CASE("--detrend: a slow sensor drift is removed from y and f only; a nominal record and an effect are untouched") {
+  // A random walk of the noise's rms on both sensors (a thermal drift, as the issue describes), 20 s records.
+  auto drifted = [](rths::io::RigRecord r, std::uint64_t seed) {
+    std::mt19937_64 gen(seed);
+    std::normal_distribution<double> step(0.0, 1.0);
+    for (auto [v, rms] : {std::pair{&r.y_mm, 0.01}, std::pair{&r.f_kN, 0.2}}) {
+      std::vector<double> w(v->size());
+      double s = 0.0, mean = 0.0, sq = 0.0;
+      for (double& x : w) mean += (x = s += step(gen));
+      mean /= static_cast<double>(w.size());
+      for (double x : w) sq += (x - mean) * (x - mean);
+      const double scale = rms / std::sqrt(sq / static_cast<double>(w.size()));
+      for (std::size_t k = 0; k < w.size(); ++k) (*v)[k] += scale * (w[k] - mean);
+    }
+    return r;
+  };
+  Options detrend;
+  detrend.detrend = true;
+  const auto [tr, te] = Records(Noisy(), 20.0);
+  SUBCASE("nominal: the same floor ratios with and without it") {
+    const auto a = Diagnose({tr}, {te}, PaperModel(), Options{});
+    const auto b = Diagnose({tr}, {te}, PaperModel(), detrend);
+    INFO(Summary(b));
+    CHECK(b.verdict == std::vector<std::string>{"none"});
+    for (const char* ch : {"y", "f"})
+      CHECK(b.Channel(ch)->floor_ratio == doctest::Approx(a.Channel(ch)->floor_ratio).epsilon(0.02));
+  }
+  SUBCASE("drifted: unknown without it, none with it, the drift's size in the warnings") {
+    const auto dtr = drifted(tr, 1), dte = drifted(te, 2);
+    const auto a = Diagnose({dtr}, {dte}, PaperModel(), Options{});
+    CHECK(a.verdict == std::vector<std::string>{"unknown"});
+    const auto b = Diagnose({dtr}, {dte}, PaperModel(), detrend);
+    INFO(Summary(b));
+    CHECK(b.verdict == std::vector<std::string>{"none"});
+    int notes = 0;
+    for (const auto& w : b.warnings) notes += w.find("sensor_drift removed from") != std::string::npos;
+    CHECK(notes == 4);  // y and f of both records
+  }
+  SUBCASE("an effect (pure_delay 3 ms) is found with the same parameter") {
+    Truth t = Noisy();
+    t.effects.pure_delay = m::PureDelay{3.0};
+    const auto [etr, ete] = Records(t, 20.0);
+    const auto a = Diagnose({etr}, {ete}, PaperModel(), Options{});
+    const auto b = Diagnose({etr}, {ete}, PaperModel(), detrend);
+    INFO(Summary(b));
+    CHECK(b.verdict == a.verdict);
+    REQUIRE(Find(b, "pure_delay") != nullptr);
+    CHECK(Find(b, "pure_delay")->params.at("tau_ms") == doctest::Approx(Find(a, "pure_delay")->params.at("tau_ms")).epsilon(0.01));
+    CHECK(b.Channel("y")->after_test_pct == doctest::Approx(a.Channel("y")->after_test_pct).epsilon(0.05));
   }
 }

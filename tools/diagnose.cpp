@@ -59,7 +59,9 @@ int main(int argc, char** argv) {
   app.add_option("--model", model_file, "nominal model: a scenario TOML or a file written by rths identify "
                                         "(default: the paper's Eq. 30, Table 3, Eq. 40 + 75 Hz)");
   app.add_option("--out", out, "output folder (default: a new folder under runs/)");
-  app.add_flag("--detrend", o.detrend, "remove each record's mean of u, y and f first");
+  app.add_flag("--detrend", o.detrend,
+               "remove a slow sensor drift (below 0.1 Hz) from the measured y and f, found in their nominal residuals; "
+               "the command u is left as it drove the rig");
   app.add_option("--none-ratio", o.none_ratio, "residual/noise-floor power ratio [-] at or below which a channel is noise (>= 1)")
       ->capture_default_str();
   app.add_option("--smooth-hz", o.smooth_hz, "zero-phase smoothing of the y residual for the force channel's motion [Hz]")

@@ -44,12 +44,6 @@ Data Prepare(const io::RigRecord& r, const Options& o) {
   d.y = r.y_mm;
   d.f = r.f_kN;
   d.i = r.Command();  // the current, or the voltage of a record without one
-  if (o.detrend) {
-    for (auto* v : {&d.u, &d.y, &d.f}) {
-      const double m = std::accumulate(v->begin(), v->end(), 0.0) / static_cast<double>(v->size());
-      for (double& x : *v) x -= m;
-    }
-  }
   d.first = std::min<std::size_t>(d.size() / 2, static_cast<std::size_t>(std::lround(o.warmup_s / r.dt_s)));
   // The force channel's motion is made once y is diagnosed (ModelAidedMotion).
   return d;

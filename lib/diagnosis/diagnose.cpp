@@ -211,6 +211,31 @@ void RunStages(ChannelState* s, const std::vector<stages::CandidateSpec>& specs,
   stages::ScoreCandidates(s, specs, o, er);
 }
 
+/// --detrend for one channel (stages::RemoveSensorDrift): the drift of the nominal residual out, a
+/// scratch selection of effects on that, then, from the original measurement, the drift of the
+/// residual under the selected effects out (notes into *warnings).
+void RemoveDrift(char chan, std::vector<Data>* train, std::vector<Data>* test, const models::LinearServo& servo,
+                 const ForcePredictor* fp, const std::vector<stages::CandidateSpec>& specs, const Options& o,
+                 std::vector<std::string>* warnings) {
+  auto meas = [chan](Data& d) -> std::vector<double>& { return chan == 'y' ? d.y : d.f; };
+  std::vector<std::vector<double>> original;
+  for (auto* recs : {train, test})
+    for (auto& d : *recs) original.push_back(meas(d));
+  for (auto* recs : {train, test}) stages::RemoveSensorDrift(chan, recs, servo, fp, {}, nullptr);
+  ChannelState scratch(chan, Channel(chan, train, &servo, fp), Channel(chan, test, &servo, fp));
+  Options quiet = o;
+  quiet.progress = nullptr;
+  stages::ScoreNominal(&scratch, quiet);
+  Result res;
+  EffectResults er;
+  std::vector<std::string> verdict;
+  RunStages(&scratch, specs, quiet, 0.0, 10.0, &res, &er, &verdict);
+  std::size_t j = 0;
+  for (auto* recs : {train, test})
+    for (auto& d : *recs) meas(d) = original[j++];
+  for (auto* recs : {train, test}) stages::RemoveSensorDrift(chan, recs, servo, fp, scratch.fin_set, warnings);
+}
+
 }  // namespace
 
 Result Diagnose(const std::vector<io::RigRecord>& train_in, const std::vector<io::RigRecord>& test_in,
@@ -243,6 +268,9 @@ Result Diagnose(const std::vector<io::RigRecord>& train_in, const std::vector<io
   std::vector<std::string> verdict;
   for (char chan : chans) {
     if (chan == 'f') SetForceMotion(&train, &test, st[0], y_ok, servo, o, dt);
+    // --detrend: the sensor's drift out of this channel's measurement only (u = y: y has none to
+    // lean on, its drift is in the command too).
+    if (o.detrend && (chan == 'f' || y_ok)) RemoveDrift(chan, &train, &test, servo, fpp, specs, o, &res.warnings);
     st.emplace_back(chan, Channel(chan, &train, &servo, fpp), Channel(chan, &test, &servo, fpp));
     auto& s = st.back();
     stages::ScoreNominal(&s, o);

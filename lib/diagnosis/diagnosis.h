@@ -55,7 +55,7 @@ namespace rths::diagnosis {
 struct Options {
   // --- data and channels
   double warmup_s = 0.1;               ///< start of every record left out of all sums [s], >= 0
-  bool detrend = false;                ///< remove each record's mean of u, y, f first (--detrend)
+  bool detrend = false;                ///< remove the sensors' slow drift from y and f (--detrend; stages::RemoveSensorDrift)
   double smooth_hz = 20.0;             ///< zero-phase smoothing of the y residual for the force channel [Hz], > 0
   /// Upper bound of every smoothing cutoff, in cycles per sample: cutoff <= this / dt_s [Hz]; in (0, 0.5).
   double max_smooth_cycles_per_sample = 0.45;

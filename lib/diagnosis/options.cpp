@@ -48,6 +48,7 @@ bool Options::IsValid(std::string* error) const {
 nlohmann::json ToJson(const Options& o) {
   return {{"warmup_s", o.warmup_s},
           {"detrend", o.detrend},
+          {"drift_hz", tuning::kDriftHz},
           {"smooth_hz", o.smooth_hz},
           {"max_smooth_cycles_per_sample", o.max_smooth_cycles_per_sample},
           {"displacement_only_smooth_factor", tuning::kDisplacementOnlySmoothFactor},

@@ -60,14 +60,26 @@ models::EffectSet ToSet(const std::vector<CandidateSpec>& specs, const Params& p
 struct Data {
   std::string source;
   double dt = 0;                    ///< [s]
-  std::vector<double> u, y, f, i;   ///< [mm], [mm], [kN], [A] (detrended if Options::detrend)
+  std::vector<double> u, y, f, i;   ///< [mm], [mm], [kN], [A] (y, f drift-free if Options::detrend)
   SmoothedMotion motion;            ///< the damper's motion (set once y is diagnosed)
   std::size_t first = 0;            ///< first sample of every sum (warmup_s / dt, at most half the record)
   std::size_t size() const { return u.size(); }
 };
 
-/// The record's signals (detrended if o.detrend) and its first sample; no motion yet.
+/// The record's signals and its first sample; no motion yet.
 Data Prepare(const io::RigRecord& r, const Options& o);
+
+/// --detrend (docs/diagnosis.md "Sensor drift"): a slow drift of a sensor is removed from the
+/// measurement it is in, and only there, so that the model's inputs stay what drove the rig: for
+/// ch = 'y' the measured y loses the slow part of its residual y - yhat(u) under `effects` (u, the
+/// command, has no sensor); for 'f' the measured f loses that of f - fhat(motion) (the motion from
+/// the drift-free y). The slow part: a zero-phase low-pass at tuning::kDriftHz. One note per record
+/// with the drift's rms and range (notes may be null). 'f' needs fp and every record's motion set.
+/// Diagnose calls it twice per channel: with the nominal model to select the effects, then, from
+/// the original measurement, with the selected ones (whose own slow residual is then not taken
+/// for drift), and selects again.
+void RemoveSensorDrift(char ch, std::vector<Data>* recs, const models::LinearServo& servo, const ForcePredictor* fp,
+                       const models::EffectSet& effects, std::vector<std::string>* notes);
 
 /// Samples in the sums (k >= first) of every record.
 std::size_t Count(const std::vector<Data>& ds);

@@ -14,6 +14,10 @@ inline constexpr double kDisplacementOnlySmoothFactor = 4.0;
 /// fastest motion seen, where a flow limit would start to bite.
 inline constexpr double kVmaxSearchFactor = 2.0;
 
+/// --detrend: a sensor's drift is the nominal residual's content below this [Hz] (RemoveSensorDrift):
+/// slower than any excitation a test uses, and 1e-4 of a 2 kHz record's white-noise band.
+inline constexpr double kDriftHz = 0.5;
+
 // --- noise floor and residual statistics
 /// Welch segment length of the noise floor [samples]: 256 gives a PSD resolution of f_s / 256,
 /// fine enough to find the plateau above the excitation and averaged over many segments.
