@@ -589,7 +589,8 @@ TEST_CASE("options: the ones used are written into the JSON, every field") {
   CHECK(j["min_test_shrink_pct"] == 30.0);
   CHECK(j["detrend"] == false);
   CHECK(j["drift_hz"] == 0.5);
-  CHECK(j.size() == 42);  // one per field of Options and per constant of diagnosis/tuning.h
+  CHECK(j["unconfirmed_test_footprint"] == 1.0);
+  CHECK(j.size() == 44);  // one per field of Options and per constant of diagnosis/tuning.h
 }
 
 TEST_CASE("Summary: the brief report is the verdict and each channel's shrink; the full one is unchanged") {
@@ -799,4 +800,36 @@ TEST_CASE("--detrend: a slow sensor drift is removed from y and f only; a nomina
     CHECK(Find(b, "pure_delay")->params.at("tau_ms") == doctest::Approx(Find(a, "pure_delay")->params.at("tau_ms")).epsilon(0.01));
     CHECK(b.Channel("y")->after_test_pct == doctest::Approx(a.Channel("y")->after_test_pct).epsilon(0.05));
   }
+}
+
+TEST_CASE("an effect the test records do not exercise is named unconfirmed, with its training evidence") {
+  // Training: a fast 0-25 Hz command that runs into a 250 mm/s flow limit. Test: a slow 0-2 Hz
+  // command that stays below it, with a 7 Hz ripple outside the library, so the test residual is
+  // structured but the limit cannot show there.
+  Truth t = Noisy();
+  t.effects.servovalve_saturation = m::ServovalveSaturation{250.0};
+  Excitation tr;
+  tr.duration_s = 8.0;
+  tr.band_hz = 25.0;
+  tr.rms_mm = 4.0;
+  tr.seed = 5;
+  Excitation te = tr;
+  te.band_hz = 2.0;
+  te.rms_mm = 2.0;
+  te.seed = 1005;
+  Truth t2 = t;
+  t2.noise_seed += 17;
+  t2.ripple_mm = 0.05;
+  const auto r = Diagnose({MakeRecordBlocks(tr, t, "train")}, {MakeRecordBlocks(te, t2, "test")}, PaperModel(), Options{});
+  const std::string summary = Summary(r);
+  INFO(summary);
+  CHECK(r.verdict == std::vector<std::string>{"servovalve_saturation"});
+  const auto* e = Find(r, "servovalve_saturation");
+  REQUIRE(e != nullptr);
+  CHECK_FALSE(e->selected);  // not in the final model
+  CHECK(e->unconfirmed.find("the test does not exercise it") != std::string::npos);
+  CHECK(summary.find("verdict: servovalve_saturation (unconfirmed: on the training records it removes") !=
+        std::string::npos);
+  CHECK(r.Channel("y")->status == "unconfirmed");
+  CHECK(ToJson(r)["effects"][0]["unconfirmed"] == e->unconfirmed);
 }

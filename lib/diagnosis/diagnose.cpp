@@ -208,6 +208,7 @@ void RunStages(ChannelState* s, const std::vector<stages::CandidateSpec>& specs,
   if (o.progress) o.progress(base + 9, total, "channel " + ch + ": scoring the other candidates");
   if (s->retained)
     for (const auto& n : s->order) verdict->push_back(n);
+  for (const auto& n : s->unconfirmed) verdict->push_back(n);
   stages::ScoreCandidates(s, specs, o, er);
 }
 

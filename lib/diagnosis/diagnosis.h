@@ -148,6 +148,11 @@ struct EffectResult {
   /// terminal summary (diagnosis.json keeps it).
   bool at_bound = false;
   int order = -1;                         ///< position in the verdict (selected only)
+  /// Selected on the training records, but the test records do not exercise it (its fitted form
+  /// barely changes their prediction), so the test can neither confirm nor refute it: why, with
+  /// the training evidence (docs/diagnosis.md "Unconfirmed"). Such an effect is in the verdict
+  /// (Summary prints "name (unconfirmed: why)"), not in the final model. "" otherwise.
+  std::string unconfirmed;
 };
 
 /// Per-channel numbers.
@@ -161,7 +166,7 @@ struct ChannelSummary {
   double floor_ratio = 0;                 ///< rho_c, train and test pooled
   double floor_ratio_test = 0;            ///< rho_c on the test records
   double whiteness = 0;                   ///< Ljung-Box-like: n sum_{l=1..20} r_l^2 (test); ~20 if white
-  std::string status;                     ///< "noise" | "explained" | "unexplained" | "not diagnosed"
+  std::string status;                     ///< "noise" | "explained" | "unconfirmed" | "unexplained" | "not diagnosed"
 };
 
 /// A stretch where a sensor channel holds one value while the rig moves: a stuck or clipped

@@ -48,6 +48,7 @@ json EffectJson(const EffectResult& e) {
   o["shrink_pct"] = Num(e.shrink_pct);
   o["selected"] = e.selected;
   o["at_bound"] = e.at_bound;
+  o["unconfirmed"] = e.unconfirmed;
   o["train_nrmse_" + e.channel + "_pct_after"] = Num(e.train_nrmse_after);
   if (e.name != "sensor_noise") {
     o["excess_reduction_pct"] = Num(100.0 * e.excess_reduction);

@@ -49,6 +49,8 @@ nlohmann::json ToJson(const Options& o) {
   return {{"warmup_s", o.warmup_s},
           {"detrend", o.detrend},
           {"drift_hz", tuning::kDriftHz},
+          {"unconfirmed_test_footprint", tuning::kUnconfirmedTestFootprint},
+          {"unconfirmed_train_footprint", tuning::kUnconfirmedTrainFootprint},
           {"smooth_hz", o.smooth_hz},
           {"max_smooth_cycles_per_sample", o.max_smooth_cycles_per_sample},
           {"displacement_only_smooth_factor", tuning::kDisplacementOnlySmoothFactor},

@@ -9,6 +9,7 @@
 #include "diagnosis/fit.h"
 #include "diagnosis/residual_stats.h"
 #include "diagnosis/stages.h"
+#include "diagnosis/tuning.h"
 
 namespace rths::diagnosis::stages {
 
@@ -80,6 +81,21 @@ void ScoreSelected(const ChannelState& s, const std::vector<CandidateSpec>& spec
   }
 }
 
+/// How much the selected effects change the predictions, training and test, in units of the
+/// noise floor's power: sum_k (pred - nominal)^2 / (n sigma^2) over the samples of the sums.
+std::pair<double, double> Footprints(const ChannelState& s, const std::vector<std::vector<double>>& fin_test) {
+  const double s2 = s.summary.noise_rms * s.summary.noise_rms;
+  auto footprint = [s2](const Channel& c, const std::vector<std::vector<double>>& a,
+                        const std::vector<std::vector<double>>& b) {
+    double sum = 0.0;
+    std::size_t n = 0;
+    for (std::size_t r = 0; r < c.recs().size(); ++r)
+      for (std::size_t k = c.recs()[r].first; k < a[r].size(); ++k, ++n) sum += (a[r][k] - b[r][k]) * (a[r][k] - b[r][k]);
+    return n > 0 && s2 > 0.0 ? sum / (static_cast<double>(n) * s2) : 0.0;
+  };
+  return {footprint(s.train, s.pred_train, s.train.Predict({})), footprint(s.test, fin_test, s.nom_test)};
+}
+
 void ApplyShrinkRule(ChannelState* sp, const std::vector<CandidateSpec>& specs, const Options& o,
                      std::vector<std::string>* warnings, EffectResults* er) {
   ChannelState& s = *sp;
@@ -90,10 +106,27 @@ void ApplyShrinkRule(ChannelState* sp, const std::vector<CandidateSpec>& specs, 
   const bool test_structured = cs.floor_ratio_test > o.none_ratio;
   bool retained = !s.order.empty();
   if (retained && test_structured && ShrinkPct(before, cs.after_test_pct) < o.min_test_shrink_pct) {
-    warnings->push_back(fmt::format(
-        "channel {}: the effects selected on the training records ({}) shrink the test gap by only {:.1f} % "
-        "(< {:.0f} %): not retained",
-        cs.channel, fmt::join(s.order, ", "), ShrinkPct(before, cs.after_test_pct), o.min_test_shrink_pct));
+    const auto [fp_train, fp_test] = Footprints(s, fin);
+    if (fp_test < tuning::kUnconfirmedTestFootprint && fp_train >= tuning::kUnconfirmedTrainFootprint) {
+      // The test records do not exercise the effects: neither confirmed nor refuted.
+      for (const auto& n : s.order) {
+        const auto st = s.sel_stats.find(n);
+        (*er)[n].unconfirmed = fmt::format(
+            "on the training records it removes {:.0f} % of the residual above noise and changes the prediction by "
+            "{:.3g} x the noise floor's power; on the test records by only {:.2g} x: the test does not exercise it",
+            100.0 * (st == s.sel_stats.end() ? 0.0 : st->second.first), fp_train, fp_test);
+      }
+      s.unconfirmed = s.order;
+      warnings->push_back(fmt::format("channel {}: {} found on the training records, unconfirmed: the test records "
+                                      "do not exercise {} (their prediction changes by {:.2g} x the noise floor's power)",
+                                      cs.channel, fmt::join(s.order, ", "), s.order.size() > 1 ? "them" : "it",
+                                      fp_test));
+    } else {
+      warnings->push_back(fmt::format(
+          "channel {}: the effects selected on the training records ({}) shrink the test gap by only {:.1f} % "
+          "(< {:.0f} %): not retained",
+          cs.channel, fmt::join(s.order, ", "), ShrinkPct(before, cs.after_test_pct), o.min_test_shrink_pct));
+    }
     for (const auto& n : s.order) (*er)[n].selected = false;
     cs.after_test_pct = before;
     retained = false;
@@ -112,6 +145,7 @@ void ApplyShrinkRule(ChannelState* sp, const std::vector<CandidateSpec>& specs, 
   }
   if (!s.structured) cs.status = "noise";
   else if (retained) cs.status = "explained";
+  else if (!s.unconfirmed.empty()) cs.status = "unconfirmed";
   else cs.status = "unexplained";
   s.retained = retained;
 }
@@ -119,7 +153,7 @@ void ApplyShrinkRule(ChannelState* sp, const std::vector<CandidateSpec>& specs, 
 void ScoreCandidates(ChannelState* sp, const std::vector<CandidateSpec>& specs, const Options& o, EffectResults* er) {
   ChannelState& s = *sp;
   const double before = s.summary.gap_test_pct;
-  if (!s.retained && !s.order.empty()) {
+  if (!s.retained && !s.order.empty() && s.unconfirmed.empty()) {
     for (auto& [name, t] : s.last_trial) {
       Params q;
       t.sse = FitEffect(s.train, specs, &q, name, o);

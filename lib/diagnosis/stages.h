@@ -140,6 +140,9 @@ struct ChannelState {
   // The selection (SelectEffects .. RetainOnTest).
   Params sel;                        ///< selected effects and their parameters
   std::vector<std::string> order;    ///< selected names in the order they were added
+  /// Set by ApplyShrinkRule: the selected names the test records cannot confirm (they barely act
+  /// there), named in the verdict as unconfirmed; empty otherwise.
+  std::vector<std::string> unconfirmed;
   double sse = 0;                    ///< training SSE with sel
   std::vector<std::vector<double>> pred_train;  ///< predictions with sel, training records
   std::map<std::string, Trial> last_trial;      ///< latest trial of every candidate not selected

@@ -14,9 +14,20 @@ const ChannelSummary* Result::Channel(const std::string& c) const {
 
 namespace {
 
+/// The verdict line: its names, each unconfirmed one with why.
+std::string VerdictLine(const Result& r) {
+  std::string s = "verdict: ";
+  for (std::size_t i = 0; i < r.verdict.size(); ++i) {
+    s += (i ? ", " : "") + r.verdict[i];
+    for (const auto& e : r.effects)
+      if (e.name == r.verdict[i] && !e.unconfirmed.empty()) s += " (unconfirmed: " + e.unconfirmed + ")";
+  }
+  return s + "\n";
+}
+
 /// The brief report: the verdict and, per channel, its status and test NRMSE before -> after.
 std::string BriefSummary(const Result& r) {
-  std::string s = fmt::format("verdict: {}\n", fmt::join(r.verdict, ", "));
+  std::string s = VerdictLine(r);
   for (const auto& c : r.channels) {
     if (!c.diagnosed) {
       s += fmt::format("channel {}: not diagnosed\n", c.channel);
@@ -85,7 +96,7 @@ std::string Summary(const Result& r, SummaryDetail detail) {
                      "diagnosis.json has them)\n",
                      fmt::join(pinned, ", "));
   }
-  s += fmt::format("verdict: {}\n", fmt::join(r.verdict, ", "));
+  s += VerdictLine(r);
   for (const auto& w : r.warnings) s += "warning: " + w + "\n";
   s += fmt::format("runtime: {:.2f} s\n", r.runtime_s);
   return s;

@@ -18,6 +18,15 @@ inline constexpr double kVmaxSearchFactor = 2.0;
 /// slower than any excitation a test uses, and 1e-4 of a 2 kHz record's white-noise band.
 inline constexpr double kDriftHz = 0.5;
 
+// --- unconfirmed effects (ApplyShrinkRule)
+/// Effects selected on the training records whose test shrink fails the rule are "unconfirmed"
+/// rather than dropped if their fitted form changes the test prediction by less than this many
+/// times the noise floor's power (sum (pred - nominal)^2 / (n sigma^2): the test does not
+/// exercise them) ...
+inline constexpr double kUnconfirmedTestFootprint = 1.0;
+/// ... while changing the training prediction by at least this many times it.
+inline constexpr double kUnconfirmedTrainFootprint = 4.0;
+
 // --- noise floor and residual statistics
 /// Welch segment length of the noise floor [samples]: 256 gives a PSD resolution of f_s / 256,
 /// fine enough to find the plateau above the excitation and averaged over many segments.
