@@ -232,6 +232,10 @@ enum class SummaryDetail {
   kFull,   ///< the model, records, channels, where, every effect, verdict, warnings and runtime
 };
 
+/// The verdict as text: its names, comma-separated, each unconfirmed one followed by
+/// "(unconfirmed: why)" (EffectResult::unconfirmed).
+std::string VerdictText(const Result& r);
+
 /// The terminal summary.
 std::string Summary(const Result& r, SummaryDetail detail = SummaryDetail::kFull);
 

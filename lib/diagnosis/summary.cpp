@@ -12,18 +12,20 @@ const ChannelSummary* Result::Channel(const std::string& c) const {
   return nullptr;
 }
 
-namespace {
-
-/// The verdict line: its names, each unconfirmed one with why.
-std::string VerdictLine(const Result& r) {
-  std::string s = "verdict: ";
+std::string VerdictText(const Result& r) {
+  std::string s;
   for (std::size_t i = 0; i < r.verdict.size(); ++i) {
     s += (i ? ", " : "") + r.verdict[i];
     for (const auto& e : r.effects)
       if (e.name == r.verdict[i] && !e.unconfirmed.empty()) s += " (unconfirmed: " + e.unconfirmed + ")";
   }
-  return s + "\n";
+  return s;
 }
+
+namespace {
+
+/// The verdict line of the summaries.
+std::string VerdictLine(const Result& r) { return "verdict: " + VerdictText(r) + "\n"; }
 
 /// The brief report: the verdict and, per channel, its status and test NRMSE before -> after.
 std::string BriefSummary(const Result& r) {

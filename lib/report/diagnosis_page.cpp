@@ -52,7 +52,7 @@ std::string HeadHtml(const Result& r) {
   std::string h;
   h += HtmlHead("rths diagnose");
   h += "<h1>Sim-to-real gap diagnosis</h1>\n";
-  h += fmt::format("<p><b>Verdict: {}</b></p>\n", HtmlEscape(fmt::format("{}", fmt::join(r.verdict, ", "))));
+  h += fmt::format("<p><b>Verdict: {}</b></p>\n", HtmlEscape(diagnosis::VerdictText(r)));
   h += fmt::format("<p>Model: {}<br>Training records: {}<br>Test records: {}<br>dt = {} s, {} samples, runtime {:.2f} s</p>\n",
                    HtmlEscape(r.model_source), HtmlEscape(fmt::format("{}", fmt::join(r.train, ", "))),
                    HtmlEscape(fmt::format("{}", fmt::join(r.test, ", "))), r.dt_s, r.samples, r.runtime_s);
