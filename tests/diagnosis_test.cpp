@@ -590,7 +590,8 @@ TEST_CASE("options: the ones used are written into the JSON, every field") {
   CHECK(j["detrend"] == false);
   CHECK(j["drift_hz"] == 0.5);
   CHECK(j["unconfirmed_test_footprint"] == 1.0);
-  CHECK(j.size() == 44);  // one per field of Options and per constant of diagnosis/tuning.h
+  CHECK(j["start_travel_factor"] == 5.0);
+  CHECK(j.size() == 47);  // one per field of Options and per constant of diagnosis/tuning.h
 }
 
 TEST_CASE("Summary: the brief report is the verdict and each channel's shrink; the full one is unchanged") {

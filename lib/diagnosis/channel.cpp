@@ -2,9 +2,13 @@
 #include <cmath>
 #include <numeric>
 
+#include <fmt/format.h>
+
 #include "core/error.h"
 #include "diagnosis/residual_stats.h"
 #include "diagnosis/stages.h"
+#include "diagnosis/tuning.h"
+#include "models/mr_damper.h"
 
 namespace rths::diagnosis {
 
@@ -47,6 +51,43 @@ Data Prepare(const io::RigRecord& r, const Options& o) {
   d.first = std::min<std::size_t>(d.size() / 2, static_cast<std::size_t>(std::lround(o.warmup_s / r.dt_s)));
   // The force channel's motion is made once y is diagnosed (ModelAidedMotion).
   return d;
+}
+
+void ExtendWarmupIfMoving(Data* d, const NominalModel& model, std::vector<std::string>* notes) {
+  const std::size_t n = d->size();
+  if (n < 20) return;
+  double umax = 0.0, ustart = 0.0;
+  for (std::size_t k = 0; k < n; ++k) umax = std::max(umax, std::abs(d->u[k]));
+  for (std::size_t k = 0; k < 10; ++k) ustart = std::max(ustart, std::abs(d->u[k]));
+  if (!(ustart > tuning::kMovingStartFraction * umax)) return;
+  // The travel the damper needs to forget its start, and the current dynamics' settling time.
+  double travel_mm = 0.0, settle_s = 0.0;
+  if (model.has_damper) {
+    double imax = 0.0;
+    for (double i : d->i) imax = std::max(imax, i);
+    for (double i : {0.0, imax}) {
+      const auto c = models::CoefficientsAt(model.damper, i);
+      if (c.beta + c.gamma > 0.0) travel_mm = std::max(travel_mm, 1.0 / std::sqrt(c.A * (c.beta + c.gamma)));
+    }
+    travel_mm *= tuning::kStartTravelFactor;
+    if (model.current_dynamics && d->i[0] != 0.0) {  // a current on at the start may be mid-transition
+      const auto& cd = model.current_driver;
+      const double tau = cd.kind == models::CurrentFilter::kFirstOrder ? 1.0 / cd.eta_1_s : 1.0 / cd.lag_pole_rad_s;
+      settle_s = tuning::kStartTimeConstants * tau;
+    }
+  }
+  std::size_t k = std::max(d->first, static_cast<std::size_t>(std::ceil(settle_s / d->dt)));
+  double travelled = 0.0;
+  for (std::size_t j = 1; j < k && j < n; ++j) travelled += std::abs(d->u[j] - d->u[j - 1]);
+  for (; k < n / 2 && travelled < travel_mm; ++k) travelled += std::abs(d->u[k] - d->u[k - 1]);
+  k = std::min(k, n / 2);
+  if (k <= d->first) return;
+  notes->push_back(fmt::format("{}: starts in motion (|u| {:.3g} mm in its first 10 samples): the sums start at "
+                               "{:.3f} s instead of {:.3f} s, once u has travelled {:.3g} mm and {:.3g} s have passed "
+                               "(the model starts at rest; its damper and current dynamics forget the difference)",
+                               d->source, ustart, static_cast<double>(k) * d->dt,
+                               static_cast<double>(d->first) * d->dt, travel_mm, settle_s));
+  d->first = k;
 }
 
 std::size_t Count(const std::vector<Data>& ds) {

@@ -248,7 +248,11 @@ Result Diagnose(const std::vector<io::RigRecord>& train_in, const std::vector<io
   std::vector<Data> train, test;
   for (const auto& r : train_in) train.push_back(stages::Prepare(r, o));
   for (const auto& r : test_in) test.push_back(stages::Prepare(r, o));
+  std::vector<std::string> start_notes;
+  for (auto* recs : {&train, &test})
+    for (auto& d : *recs) stages::ExtendWarmupIfMoving(&d, model, &start_notes);
   Result res = StartResult(train_in, test_in, train, test, model, o, dt);
+  res.warnings.insert(res.warnings.end(), start_notes.begin(), start_notes.end());
 
   const auto servo = models::LinearServo::Make(model.actuator, dt);
   std::optional<ForcePredictor> fp;

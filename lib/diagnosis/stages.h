@@ -69,6 +69,17 @@ struct Data {
 /// The record's signals and its first sample; no motion yet.
 Data Prepare(const io::RigRecord& r, const Options& o);
 
+/// A record that starts in motion (cut from a longer acquisition: max |u| over its first 10
+/// samples above tuning::kMovingStartFraction of its max |u|) starts where the rig's states are not
+/// at rest, but the model starts at rest: its damper's z and internal displacement need a travel of
+/// a few pre-yield travels to forget the difference, its current dynamics a few time constants.
+/// Then the record's first sample of the sums moves to where the command u has travelled
+/// tuning::kStartTravelFactor x the model's largest pre-yield travel 1/sqrt(A (beta + gamma)) over
+/// the record's current range, and, if the current command is not 0 at the start (the driver may
+/// be mid-transition), tuning::kStartTimeConstants x the slowest current time constant (Eq. 40's
+/// 1/a, or 1/eta) has passed; at most half the record. A note says how far.
+void ExtendWarmupIfMoving(Data* d, const NominalModel& model, std::vector<std::string>* notes);
+
 /// --detrend (docs/diagnosis.md "Sensor drift"): a slow drift of a sensor is removed from the
 /// measurement it is in, and only there, so that the model's inputs stay what drove the rig: for
 /// ch = 'y' the measured y loses the slow part of its residual y - yhat(u) under `effects` (u, the

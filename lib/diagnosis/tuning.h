@@ -18,6 +18,14 @@ inline constexpr double kVmaxSearchFactor = 2.0;
 /// slower than any excitation a test uses, and 1e-4 of a 2 kHz record's white-noise band.
 inline constexpr double kDriftHz = 0.5;
 
+// --- records that start in motion (stages::ExtendWarmupIfMoving)
+/// A record starts in motion if max |u| over its first 10 samples exceeds this fraction of its max |u|.
+inline constexpr double kMovingStartFraction = 0.01;
+/// Its warm-up lasts until u has travelled this many times the model's largest pre-yield travel ...
+inline constexpr double kStartTravelFactor = 5.0;
+/// ... and this many of the current dynamics' slowest time constants have passed.
+inline constexpr double kStartTimeConstants = 5.0;
+
 // --- unconfirmed effects (ApplyShrinkRule)
 /// Effects selected on the training records whose test shrink fails the rule are "unconfirmed"
 /// rather than dropped if their fitted form changes the test prediction by less than this many
