@@ -290,8 +290,20 @@ int RunDamper(const DamperCli& c, rths::ident::DamperFitOptions o) {
     const int width = fit.at_current ? 6 : 7;
     for (const auto& h : held) {
       const auto sc = fit.Score(h);
-      std::printf("    %-40s %*zu samples at %g s, peak %.4g kN: %.3f %%\n", sc.source.c_str(), width, sc.samples,
-                  sc.dt_s, sc.peak_force_kN, sc.nrmse_f_pct);
+      if (std::isfinite(sc.nrmse_f_pct)) {
+        std::printf("    %-40s %*zu samples at %g s, peak %.4g kN: %.3f %%\n", sc.source.c_str(), width, sc.samples,
+                    sc.dt_s, sc.peak_force_kN, sc.nrmse_f_pct);
+        continue;
+      }
+      // The prediction stopped being finite: say where, not "inf %".
+      const auto F = fit.PredictForce(h);
+      std::size_t k = 0;
+      while (k < F.size() && std::isfinite(F[k])) ++k;
+      std::printf("    %-40s %*zu samples at %g s, peak %.4g kN: no score: the model's force stops being finite at "
+                  "t = %.4g s (sample %zu): the model is too stiff for this record's motion (more than %d substeps a "
+                  "sample) or its state diverges there\n",
+                  sc.source.c_str(), width, sc.samples, sc.dt_s, sc.peak_force_kN, static_cast<double>(k) * h.dt_s, k,
+                  rths::ident::kMaxSpencerSubsteps);
     }
   }
   WriteModel(fit.ModelToml(fit.at_current
