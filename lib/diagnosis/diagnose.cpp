@@ -275,7 +275,20 @@ Result Diagnose(const std::vector<io::RigRecord>& train_in, const std::vector<io
     if (chan == 'f') SetForceMotion(&train, &test, st[0], y_ok, servo, o, dt);
     // --detrend: the sensor's drift out of this channel's measurement only (u = y: y has none to
     // lean on, its drift is in the command too).
-    if (o.detrend && (chan == 'f' || y_ok)) RemoveDrift(chan, &train, &test, servo, fpp, specs, o, &res.warnings);
+    // Without it, a channel whose whole excess lies below the drift band is a drifting sensor too.
+    if (chan == 'f' || y_ok) {
+      bool drift = o.detrend;
+      if (!drift) {
+        ChannelState probe(chan, Channel(chan, &train, &servo, fpp), Channel(chan, &test, &servo, fpp));
+        stages::ScoreNominal(&probe, o);
+        drift = stages::ExcessIsSlow(probe, o.none_ratio);
+        if (drift)
+          res.warnings.push_back(fmt::format("channel {}: its whole excess over the noise floor lies below {:g} Hz: a "
+                                             "drifting sensor, removed as --detrend removes it (sensor_drift below)",
+                                             chan, tuning::kDriftHz));
+      }
+      if (drift) RemoveDrift(chan, &train, &test, servo, fpp, specs, o, &res.warnings);
+    }
     st.emplace_back(chan, Channel(chan, &train, &servo, fpp), Channel(chan, &test, &servo, fpp));
     auto& s = st.back();
     stages::ScoreNominal(&s, o);

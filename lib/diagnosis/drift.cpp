@@ -35,6 +35,24 @@ std::vector<double> SlowPart(std::span<const double> meas, const std::vector<dou
 
 }  // namespace
 
+bool ExcessIsSlow(const ChannelState& s, double none_ratio) {
+  if (!s.structured || !(s.var_floor > 0.0)) return false;
+  double sum = 0.0;
+  std::size_t n = 0;
+  for (const Channel* c : {&s.train, &s.test}) {
+    const auto pred = c->Predict({});
+    for (std::size_t r = 0; r < c->recs().size(); ++r) {
+      const auto meas = c->Meas(r);
+      const auto slow = SlowPart(meas, pred[r], c->recs()[r].dt);
+      for (std::size_t k = c->recs()[r].first; k < meas.size(); ++k, ++n) {
+        const double e = meas[k] - pred[r][k] - slow[k];
+        sum += e * e;
+      }
+    }
+  }
+  return n > 0 && sum / static_cast<double>(n) / s.var_floor <= none_ratio;
+}
+
 void RemoveSensorDrift(char ch, std::vector<Data>* recs, const models::LinearServo& servo, const ForcePredictor* fp,
                        const models::EffectSet& effects, std::vector<std::string>* notes) {
   for (auto& d : *recs) {
@@ -51,7 +69,7 @@ void RemoveSensorDrift(char ch, std::vector<Data>* recs, const models::LinearSer
     }
     const double rms = drift.empty() ? 0.0 : std::sqrt(ss / static_cast<double>(drift.size()));
     if (notes == nullptr) continue;
-    notes->push_back(fmt::format("{}: sensor_drift removed from {} (--detrend: the model's residual below {:g} Hz): "
+    notes->push_back(fmt::format("{}: sensor_drift removed from {} (the model's residual below {:g} Hz): "
                                  "{:.4g} {} rms, {:.4g} {} from its lowest to its highest",
                                  d.source, ch, tuning::kDriftHz, rms, ch == 'y' ? "mm" : "kN", hi - lo,
                                  ch == 'y' ? "mm" : "kN"));
