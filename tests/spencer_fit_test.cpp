@@ -381,7 +381,9 @@ TEST_CASE("negative commands: a DAQ's small negative samples are taken as 0 with
   CHECK(c.warning.find(fmt::format("{} of {} samples of v_V", set, rec.size())) != std::string::npos);
   CHECK(c.warning.find("-0.43 V") != std::string::npos);
   CHECK(c.warning.find("taken as 0 V") != std::string::npos);
-  const auto fit = rths::ident::FitSpencer({rec}, {.max_iterations = 3});
+  rths::ident::DamperFitOptions three;
+  three.max_iterations = 3;
+  const auto fit = rths::ident::FitSpencer({rec}, three);
   REQUIRE(fit.warnings.size() == 1);
   CHECK(fit.warnings[0] == c.warning);
   CHECK(std::isfinite(rths::ident::ScoreSpencer(fit.params, fit.driver, fit.filter, rec, true).nrmse_f_pct));

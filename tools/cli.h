@@ -73,4 +73,15 @@ inline CLI::Option* AddSetOption(CLI::App& app, std::vector<std::string>* sets) 
       ->allow_extra_args(false);
 }
 
+/// Adds `--columns MAP`: how to read a CSV with named columns or a .mat file as a rig record
+/// (io::ParseColumnMap, docs/rig_record.md "Other formats"); the text is parsed by the tool.
+inline CLI::Option* AddColumnsOption(CLI::App& app, std::string* columns) {
+  return app
+      .add_option("--columns", *columns,
+                  "read the records (a CSV with named columns or a .mat file) through this map: "
+                  "ROLE=SOURCE[*SCALE][:UNIT],... with roles t u y f i v r (or dt=STEP_S), e.g. t=t,y=D:cm,f=F:N,v=Y:V "
+                  "(docs/rig_record.md \"Other formats\")")
+      ->type_name("MAP");
+}
+
 }  // namespace rths::tools

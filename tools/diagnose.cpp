@@ -1,8 +1,8 @@
 // rths diagnose --train A [B ...] --test C [D ...] [--model MODEL.toml] [--out DIR] [--detrend] [--brief]
 // The sim-to-real gap diagnosis (docs/rig_record.md, docs/diagnosis.md): reads rig
-// records (CSV rig records, our LCM logs, UTFSM files; any CSV or .mat file through --columns), predicts them with the nominal model, localises the residual,
-// fits every effect of the library on the training records, selects greedily, scores the shrink
-// on the test records. Writes DIR/diagnosis.json and DIR/report.html (+ PNG plots), prints a
+// records (CSV rig records, our LCM logs, UTFSM files; any CSV or .mat file through --columns),
+// predicts them with the nominal model, localises the residual, fits every effect of the library
+// on the training records, selects greedily, scores the shrink on the test records. Writes DIR/diagnosis.json and DIR/report.html (+ PNG plots), prints a
 // summary (--brief: the verdict and each channel's shrink only). Exit 0 ok, 2 bad input (a bad
 // record names its file and line), 1 other failure.
 #include <cstdio>
@@ -20,6 +20,7 @@
 #include "core/progress.h"
 #include "diagnosis/diagnosis.h"
 #include "diagnosis/model_file.h"
+#include "diagnosis/tuning.h"
 #include "report/diagnosis_page.h"
 #include "io/output_folder.h"
 #include "io/column_record.h"
@@ -60,17 +61,16 @@ int main(int argc, char** argv) {
                                         "(default: the paper's Eq. 30, Table 3, Eq. 40 + 75 Hz)");
   app.add_option("--out", out, "output folder (default: a new folder under runs/)");
   app.add_flag("--detrend", o.detrend,
-               "remove a slow sensor drift (below 0.1 Hz) from the measured y and f, found in their nominal residuals; "
-               "the command u is left as it drove the rig");
+               fmt::format("remove a slow sensor drift (below {:g} Hz) from the measured y and f, found in their "
+                           "residuals under the nominal model and then under the effects selected; the command u is "
+                           "left as it drove the rig (a channel whose whole excess is that slow gets it anyway)",
+                           rths::diagnosis::tuning::kDriftHz));
   app.add_option("--none-ratio", o.none_ratio, "residual/noise-floor power ratio [-] at or below which a channel is noise (>= 1)")
       ->capture_default_str();
   app.add_option("--smooth-hz", o.smooth_hz, "zero-phase smoothing of the y residual for the force channel's motion [Hz]")
       ->capture_default_str();
   std::string columns;
-  app.add_option("--columns", columns,
-                 "read every record (a CSV with named columns or a .mat file) through this map: "
-                 "ROLE=SOURCE[*SCALE][:UNIT],... with roles t u y f i v r (or dt=STEP_S), e.g. t=t,y=D:cm,f=F:N,v=Y:V "
-                 "(docs/rig_record.md \"Other formats\")");
+  rths::tools::AddColumnsOption(app, &columns);
   bool time_from_header = false;
   app.add_flag("--time-from-header", time_from_header,
                "take the step from the record's '# dt_s' line; the time column need only lie within half a step "

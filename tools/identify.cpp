@@ -449,10 +449,7 @@ int main(int argc, char** argv) {
                  "damper files)")
       ->required();
   std::string columns;
-  app.add_option("--columns", columns,
-                 "read the records (a CSV with named columns or a .mat file) through this map: "
-                 "ROLE=SOURCE[*SCALE][:UNIT],... with roles t u y f i v r (or dt=STEP_S), e.g. t=t,y=D:cm,f=F:N,v=Y:V "
-                 "(docs/rig_record.md \"Other formats\")");
+  rths::tools::AddColumnsOption(app, &columns);
   app.add_flag("--time-from-header", time_from_header,
                "take the step from the record's '# dt_s' line; the time column need only lie within half a step "
                "of t_0 + k dt_s (for a rounded time column)");

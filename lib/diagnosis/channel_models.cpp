@@ -82,25 +82,34 @@ void Differentiate(const std::vector<double>& x, double dt_s, std::vector<double
   (*v)[n - 1] = (x[n - 1] - x[n - 2]) / dt_s;
 }
 
+std::vector<double> ZeroPhaseLowpass(std::span<const double> x, double dt_s, double fc_hz, std::size_t pad,
+                                     Reflection reflection) {
+  const std::size_t n = x.size();
+  if (n == 0) return {};
+  pad = std::min(pad, n - 1);
+  const auto sos = signal::ButterworthLowpass(2, fc_hz, 1.0 / dt_s);
+  const bool odd = reflection == Reflection::kOdd;
+  std::vector<double> w;
+  w.reserve(n + 2 * pad);
+  for (std::size_t j = pad; j >= 1; --j) w.push_back(odd ? 2.0 * x[0] - x[j] : x[j]);
+  for (double v : x) w.push_back(v);
+  for (std::size_t j = 1; j <= pad; ++j) w.push_back(odd ? 2.0 * x[n - 1] - x[n - 1 - j] : x[n - 1 - j]);
+  FilterInPlace(sos, &w);
+  std::reverse(w.begin(), w.end());
+  FilterInPlace(sos, &w);
+  std::reverse(w.begin(), w.end());
+  return {w.begin() + static_cast<std::ptrdiff_t>(pad), w.begin() + static_cast<std::ptrdiff_t>(pad + n)};
+}
+
 SmoothedMotion SmoothMotion(std::span<const double> y_mm, double dt_s, double smooth_hz) {
   const std::size_t n = y_mm.size();
   if (n < 4) throw Error("SmoothMotion", "need at least 4 samples");
   if (!(dt_s > 0.0) || !(smooth_hz > 0.0) || !(smooth_hz < 0.5 / dt_s))
     throw Error("SmoothMotion", fmt::format("smooth_hz {} must be in (0, {}) Hz", smooth_hz, 0.5 / dt_s));
-  const auto sos = signal::ButterworthLowpass(2, smooth_hz, 1.0 / dt_s);
   // Odd reflection about both ends: 6 time constants of the filter, at most n - 1 samples.
   const std::size_t pad = std::min<std::size_t>(n - 1, static_cast<std::size_t>(std::ceil(6.0 / (smooth_hz * dt_s))) + 8);
-  std::vector<double> w;
-  w.reserve(n + 2 * pad);
-  for (std::size_t j = pad; j >= 1; --j) w.push_back(2.0 * y_mm[0] - y_mm[j]);
-  for (double v : y_mm) w.push_back(v);
-  for (std::size_t j = 1; j <= pad; ++j) w.push_back(2.0 * y_mm[n - 1] - y_mm[n - 1 - j]);
-  FilterInPlace(sos, &w);
-  std::reverse(w.begin(), w.end());
-  FilterInPlace(sos, &w);
-  std::reverse(w.begin(), w.end());
   SmoothedMotion m;
-  m.x_mm.assign(w.begin() + static_cast<std::ptrdiff_t>(pad), w.begin() + static_cast<std::ptrdiff_t>(pad + n));
+  m.x_mm = ZeroPhaseLowpass(y_mm, dt_s, smooth_hz, pad, Reflection::kOdd);
   m.v_mm_s.resize(n);
   Differentiate(m.x_mm, dt_s, &m.v_mm_s);
   return m;

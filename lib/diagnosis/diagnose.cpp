@@ -274,24 +274,22 @@ Result Diagnose(const std::vector<io::RigRecord>& train_in, const std::vector<io
   for (char chan : chans) {
     if (chan == 'f') SetForceMotion(&train, &test, st[0], y_ok, servo, o, dt);
     // --detrend: the sensor's drift out of this channel's measurement only (u = y: y has none to
-    // lean on, its drift is in the command too).
-    // Without it, a channel whose whole excess lies below the drift band is a drifting sensor too.
-    if (chan == 'f' || y_ok) {
-      bool drift = o.detrend;
-      if (!drift) {
-        ChannelState probe(chan, Channel(chan, &train, &servo, fpp), Channel(chan, &test, &servo, fpp));
-        stages::ScoreNominal(&probe, o);
-        drift = stages::ExcessIsSlow(probe, o.none_ratio);
-        if (drift)
-          res.warnings.push_back(fmt::format("channel {}: its whole excess over the noise floor lies below {:g} Hz: a "
-                                             "drifting sensor, removed as --detrend removes it (sensor_drift below)",
-                                             chan, tuning::kDriftHz));
-      }
-      if (drift) RemoveDrift(chan, &train, &test, servo, fpp, specs, o, &res.warnings);
-    }
+    // lean on, its drift is in the command too). Without it, a channel whose whole excess lies
+    // below the drift band is a drifting sensor too: removed the same way, and scored again (a
+    // Channel holds its measurement's sum of squares, so it is made anew).
+    const bool drift_ok = chan == 'f' || y_ok;
+    if (o.detrend && drift_ok) RemoveDrift(chan, &train, &test, servo, fpp, specs, o, &res.warnings);
     st.emplace_back(chan, Channel(chan, &train, &servo, fpp), Channel(chan, &test, &servo, fpp));
     auto& s = st.back();
     stages::ScoreNominal(&s, o);
+    if (!o.detrend && drift_ok && stages::ExcessIsSlow(s, o.none_ratio)) {
+      res.warnings.push_back(fmt::format("channel {}: its whole excess over the noise floor lies below {:g} Hz: a "
+                                         "drifting sensor, removed as --detrend removes it (sensor_drift below)",
+                                         chan, tuning::kDriftHz));
+      RemoveDrift(chan, &train, &test, servo, fpp, specs, o, &res.warnings);
+      s = ChannelState(chan, Channel(chan, &train, &servo, fpp), Channel(chan, &test, &servo, fpp));
+      stages::ScoreNominal(&s, o);
+    }
     if (s.ch == 'y' && !y_ok) {
       stages::MarkNotDiagnosed(&s);
     } else {

@@ -6,31 +6,19 @@
 
 #include "diagnosis/stages.h"
 #include "diagnosis/tuning.h"
-#include "signal/butterworth.h"
 
 namespace rths::diagnosis::stages {
 
 namespace {
 
-/// The slow part of meas - pred: a 2nd-order Butterworth low-pass at tuning::kDriftHz run forward
-/// and backward over the residual extended at both ends by even reflection. (Odd reflection, as
-/// SmoothMotion uses for the motion, mirrors about the end samples: at 0.1 Hz one noisy end sample
-/// becomes a step the filter spreads over seconds, a false drift of a quarter of the noise.)
+/// The slow part of meas - pred: ZeroPhaseLowpass at tuning::kDriftHz over the residual extended
+/// by even reflection, n - 1 samples each side. (Odd reflection, as SmoothMotion uses for the
+/// motion, mirrors about the end samples: at 0.1 Hz one noisy end sample becomes a step the filter
+/// spreads over seconds, a false drift of a quarter of the noise.)
 std::vector<double> SlowPart(std::span<const double> meas, const std::vector<double>& pred, double dt) {
-  const std::size_t n = meas.size();
-  const auto sos = signal::ButterworthLowpass(2, std::min(tuning::kDriftHz, 0.25 / dt), 1.0 / dt);
-  const std::size_t pad = n - 1;
-  std::vector<double> w;
-  w.reserve(n + 2 * pad);
-  for (std::size_t j = pad; j >= 1; --j) w.push_back(meas[j] - pred[j]);
-  for (std::size_t k = 0; k < n; ++k) w.push_back(meas[k] - pred[k]);
-  for (std::size_t j = 1; j <= pad; ++j) w.push_back(meas[n - 1 - j] - pred[n - 1 - j]);
-  for (int pass = 0; pass < 2; ++pass) {
-    auto st = signal::SosAtRest(sos);
-    for (double& v : w) v = signal::SosStep(sos, &st, v);
-    std::reverse(w.begin(), w.end());
-  }
-  return {w.begin() + static_cast<std::ptrdiff_t>(pad), w.begin() + static_cast<std::ptrdiff_t>(pad + n)};
+  std::vector<double> res(meas.size());
+  for (std::size_t k = 0; k < res.size(); ++k) res[k] = meas[k] - pred[k];
+  return ZeroPhaseLowpass(res, dt, std::min(tuning::kDriftHz, 0.25 / dt), res.size(), Reflection::kEven);
 }
 
 }  // namespace
@@ -39,13 +27,12 @@ bool ExcessIsSlow(const ChannelState& s, double none_ratio) {
   if (!s.structured || !(s.var_floor > 0.0)) return false;
   double sum = 0.0;
   std::size_t n = 0;
-  for (const Channel* c : {&s.train, &s.test}) {
-    const auto pred = c->Predict({});
+  for (const auto& [c, pred] : {std::pair{&s.train, &s.pred_train}, std::pair{&s.test, &s.nom_test}}) {
     for (std::size_t r = 0; r < c->recs().size(); ++r) {
       const auto meas = c->Meas(r);
-      const auto slow = SlowPart(meas, pred[r], c->recs()[r].dt);
+      const auto slow = SlowPart(meas, (*pred)[r], c->recs()[r].dt);
       for (std::size_t k = c->recs()[r].first; k < meas.size(); ++k, ++n) {
-        const double e = meas[k] - pred[r][k] - slow[k];
+        const double e = meas[k] - (*pred)[r][k] - slow[k];
         sum += e * e;
       }
     }

@@ -166,8 +166,8 @@ struct ChannelState {
   std::vector<std::vector<double>> pred_train_fin;  ///< final (retained effects), training records
 };
 
-/// Without --detrend: true if the channel is structured (after ScoreNominal) but its nominal
-/// residual less its slow part (RemoveSensorDrift's low-pass) is at the noise floor (floor ratio
+/// Without --detrend: true if the channel is structured (after ScoreNominal, whose nominal
+/// predictions it uses) but its nominal residual less its slow part (RemoveSensorDrift's low-pass) is at the noise floor (floor ratio
 /// <= none_ratio): the whole excess is a drift. Diagnose then removes it as --detrend would.
 bool ExcessIsSlow(const ChannelState& s, double none_ratio);
 

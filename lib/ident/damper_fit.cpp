@@ -313,13 +313,18 @@ DamperRecordScore ScoreForce(const io::RigRecord& rec, std::span<const double> F
   return s;
 }
 
+std::vector<double> PredictDamperForce(const models::MrDamperCoefficients& coef, const io::RigRecord& rec,
+                                       double velocity_cutoff_hz, double force_offset_kN) {
+  const double cutoff = velocity_cutoff_hz > 0.0 ? velocity_cutoff_hz : VelocityCutoffHz(rec);
+  auto F = SimulateDamperForce(coef, rec.y_mm, SmoothVelocity(rec.y_mm, rec.dt_s, cutoff), rec.dt_s);
+  for (double& f : F) f += force_offset_kN;
+  return F;
+}
+
 DamperRecordScore ScoreDamper(const models::MrDamperCoefficients& coef, const io::RigRecord& rec,
                               double velocity_cutoff_hz, double force_offset_kN) {
   const double cutoff = velocity_cutoff_hz > 0.0 ? velocity_cutoff_hz : VelocityCutoffHz(rec);
-  const auto v = SmoothVelocity(rec.y_mm, rec.dt_s, cutoff);
-  auto F = SimulateDamperForce(coef, rec.y_mm, v, rec.dt_s);
-  for (double& f : F) f += force_offset_kN;
-  return ScoreForce(rec, F, cutoff);
+  return ScoreForce(rec, PredictDamperForce(coef, rec, cutoff, force_offset_kN), cutoff);
 }
 
 LinearTerms::Solution LinearTerms::Solve() const {

@@ -150,8 +150,12 @@ struct DamperFitResult {
 /// gives a finite cost.
 DamperFitResult FitDamper(const std::vector<io::RigRecord>& records, const DamperFitOptions& options);
 
-/// Eq. 31 on force of `coef` plus force_offset_kN on a record (held-out check), with the velocity
+/// Force prediction F_k [kN] of `coef` plus force_offset_kN on a record's motion, with the velocity
 /// of SmoothVelocity(y_mm, dt_s, velocity_cutoff_hz); 0 = VelocityCutoffHz(record).
+std::vector<double> PredictDamperForce(const models::MrDamperCoefficients& coef, const io::RigRecord& record,
+                                       double velocity_cutoff_hz = 0.0, double force_offset_kN = 0.0);
+
+/// Eq. 31 on force of PredictDamperForce on a record (held-out check).
 DamperRecordScore ScoreDamper(const models::MrDamperCoefficients& coef, const io::RigRecord& record,
                               double velocity_cutoff_hz = 0.0, double force_offset_kN = 0.0);
 

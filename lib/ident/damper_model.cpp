@@ -23,9 +23,7 @@ std::vector<double> DamperModelFit::PredictForce(const io::RigRecord& r) const {
   if (any_input)
     return PredictSpencerForce(any_input->params, any_input->driver, any_input->filter, r, any_input->voltage, cutoff,
                                any_input->force_offset_kN);
-  auto F = SimulateDamperForce(at_current->coef, r.y_mm, SmoothVelocity(r.y_mm, r.dt_s, cutoff), r.dt_s);
-  for (double& f : F) f += at_current->force_offset_kN;
-  return F;
+  return PredictDamperForce(at_current->coef, r, cutoff, at_current->force_offset_kN);
 }
 
 DamperRecordScore DamperModelFit::Score(const io::RigRecord& r) const {

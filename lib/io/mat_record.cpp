@@ -62,8 +62,10 @@ std::vector<double> Elements(const matvar_t* v, const std::string& what, const s
   return out;
 }
 
-/// The values a SOURCE names (column_record.h): NAME, NAME.FIELD or NAME(:,K), as a vector.
-std::vector<double> ReadSource(mat_t* mat, const std::string& source, const std::string& path) {
+/// The values a SOURCE names (column_record.h): NAME, NAME.FIELD or NAME(:,K), as a vector;
+/// `names`: the file's variables (MatVariableNames).
+std::vector<double> ReadSource(mat_t* mat, const std::vector<std::string>& names, const std::string& source,
+                               const std::string& path) {
   std::string name = source, field;
   long column = 0;  // 1-based, 0 = the variable is a vector
   if (const auto paren = source.find("(:,"); paren != std::string::npos && source.back() == ')') {
@@ -77,7 +79,6 @@ std::vector<double> ReadSource(mat_t* mat, const std::string& source, const std:
     name = source.substr(0, dot);
     field = source.substr(dot + 1);
   }
-  const auto names = MatVariableNames(path);
   if (std::find(names.begin(), names.end(), name) == names.end())
     throw Error(path, fmt::format("no variable \"{}\" (for {}); the file's variables: {}", name, source, JoinNames(names)));
   MatVar var(Mat_VarRead(mat, name.c_str()));
@@ -108,8 +109,7 @@ std::vector<double> ReadSource(mat_t* mat, const std::string& source, const std:
 }
 
 /// The map of a .mat file in the rig record's own names (column_record.h), from the variables it has.
-ColumnMap OwnNamesMap(const std::string& path) {
-  const auto names = MatVariableNames(path);
+ColumnMap OwnNamesMap(mat_t* mat, const std::vector<std::string>& names, const std::string& path) {
   auto has = [&](const char* n) { return std::find(names.begin(), names.end(), n) != names.end(); };
   std::string text;
   for (const auto& [role, name] : {std::pair{'t', "t_s"}, {'u', "u_mm"}, {'y', "y_mm"}, {'f', "f_kN"}, {'i', "i_A"},
@@ -122,8 +122,7 @@ ColumnMap OwnNamesMap(const std::string& path) {
                                   "(docs/rig_record.md \"Other formats\")",
                                   JoinNames(names)));
   if (!has("t_s")) {
-    const MatFile mat = Open(path);
-    const auto dt = ReadSource(mat.get(), "dt_s", path);
+    const auto dt = ReadSource(mat, names, "dt_s", path);
     if (dt.size() != 1) throw Error(path, "dt_s must be a scalar [s]");
     text += fmt::format(",dt={}", dt[0]);
   }
@@ -151,12 +150,13 @@ std::vector<std::string> MatVariableNames(const std::string& path) {
 }
 
 RigRecord ReadMatRecord(const std::string& path, const ColumnMap* map) {
-  const ColumnMap own = map == nullptr ? OwnNamesMap(path) : ColumnMap{};
-  const ColumnMap& m = map == nullptr ? own : *map;
+  const auto names = MatVariableNames(path);
   const MatFile mat = Open(path);
+  const ColumnMap own = map == nullptr ? OwnNamesMap(mat.get(), names, path) : ColumnMap{};
+  const ColumnMap& m = map == nullptr ? own : *map;
   std::vector<std::vector<double>> values;
   for (const auto& c : m.columns) {
-    values.push_back(ReadSource(mat.get(), c.source, path));
+    values.push_back(ReadSource(mat.get(), names, c.source, path));
     for (double x : values.back())
       if (!std::isfinite(x)) throw Error(path, fmt::format("\"{}\" holds a value that is not finite", c.source));
   }
