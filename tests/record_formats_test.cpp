@@ -191,6 +191,17 @@ TEST_CASE("a .mat file: vectors, a struct's fields, a matrix's columns; the rig 
   CheckSameRecord(rths::io::ReadAnyRecord(own, nullptr), utfsm, 1e-12);
 }
 
+TEST_CASE("a map serves a mix of a lab's files and ours: a CSV rig record is read as it is") {
+  const auto utfsm = rths::io::ReadUtfsmDamper(kDamper);
+  const auto dir = rths_test::TempDir("formats_mix");
+  const auto ours = (dir / "ours.csv").string();
+  rths::io::WriteRigRecord(utfsm, ours);
+  const auto map = rths::io::ParseColumnMap("t=time,y=disp:cm,f=force:N,i=I:mA");
+  const auto rec = rths::io::ReadAnyRecord(ours, &map);
+  CHECK(rec.Meta("columns").empty());
+  CheckSameRecord(rec, utfsm, 1e-8);
+}
+
 TEST_CASE("ReadAnyRecord without a map reads the shipped UTFSM files as before") {
   const auto damper = rths::io::ReadAnyRecord(kDamper, nullptr);
   CHECK(damper.size() == rths::io::ReadUtfsmDamper(kDamper).size());

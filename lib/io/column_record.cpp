@@ -326,10 +326,7 @@ RigRecord ReadColumnsCsv(const std::string& path, const ColumnMap& map) {
 
 RigRecord ReadAnyRecord(const std::string& path, const ColumnMap* map, TimeAxis time) {
   if (IsMatFile(path)) return ReadMatRecord(path, map);
-  if (map != nullptr) {
-    if (IsLcmLog(path)) throw Error(path, "an LCM run log of ours: read as it is, without --columns");
-    return ReadColumnsCsv(path, *map);
-  }
+  // Our own formats are read as they are, map or not (a map names the columns of the other files).
   if (IsLcmLog(path)) return ReadRecordAny(path, time);
   std::ifstream in(path);
   if (!in) throw Error(path, "cannot open");
@@ -337,6 +334,7 @@ RigRecord ReadAnyRecord(const std::string& path, const ColumnMap* map, TimeAxis 
   std::getline(in, first);
   const auto t = Trim(first, kLineWhitespace);
   if (t.rfind("# rths rig record", 0) == 0 || t.rfind("Header Size", 0) == 0) return ReadRecordOrUtfsm(path, time);
+  if (map != nullptr) return ReadColumnsCsv(path, *map);
   // A UTFSM damper file starts with a row of numbers; a header of names needs a map.
   const auto fields = Split(first, SeparatorOf(first));
   const bool numeric = !fields.empty() && std::all_of(fields.begin(), fields.end(), [](const std::string& f) {

@@ -86,9 +86,11 @@ std::string JoinNames(const std::vector<std::string>& names);
 /// The variable names of a .mat file (for messages).
 std::vector<std::string> MatVariableNames(const std::string& path);
 
-/// Any record a tool takes: with a map, a .mat file (IsMatFile) or a CSV with named columns; without
-/// one, a .mat file in the rig-record names, or ReadRecordOrUtfsm (utfsm.h). A file that is none of
-/// these is refused with the option that reads it (--columns, naming its columns).
+/// Any record a tool takes. Our own formats as they are, map or not: an LCM log, a CSV rig record,
+/// a UTFSM DAQ export (ReadRecordOrUtfsm, utfsm.h), so that one map serves a mix of a lab's files
+/// and ours. Then a .mat file (through the map, or in the rig-record names without one); with a
+/// map, a CSV with named columns; without one, a UTFSM damper file (rows of numbers). A file that
+/// is none of these is refused with the option that reads it (--columns, naming its columns).
 RigRecord ReadAnyRecord(const std::string& path, const ColumnMap* map, TimeAxis time = TimeAxis::kColumn);
 
 }  // namespace rths::io
