@@ -367,7 +367,8 @@ TEST_CASE("JSON: the contract's fields and keys") {
       {"load_coupling", {"compliance_mm_per_kN"}}, {"oil_column_resonance", {"f_hz", "zeta"}},
       {"coulomb_friction", {"loss_mm"}}, {"backlash", {"gap_mm"}},
       {"servovalve_saturation", {"vmax_mm_per_s"}}, {"sensor_noise", {"rms"}},
-      {"current_lag", {"tau_ms"}},       {"damper_scale", {"scale"}}};
+      {"current_lag", {"tau_ms"}},       {"damper_scale", {"scale"}},
+      {"presliding_friction", {"loss_mm", "travel_mm"}}, {"command_dead_band", {"width_mm"}}};
   std::set<std::string> names;
   for (const auto& e : j["effects"]) {
     const std::string name = e["name"];
@@ -591,7 +592,7 @@ TEST_CASE("options: the ones used are written into the JSON, every field") {
   CHECK(j["drift_hz"] == 0.5);
   CHECK(j["unconfirmed_test_footprint"] == 1.0);
   CHECK(j["start_travel_factor"] == 5.0);
-  CHECK(j.size() == 47);  // one per field of Options and per constant of diagnosis/tuning.h
+  CHECK(j.size() == 49);  // one per field of Options and per constant of diagnosis/tuning.h
 }
 
 TEST_CASE("Summary: the brief report is the verdict and each channel's shrink; the full one is unchanged") {

@@ -114,6 +114,63 @@ TEST_CASE("backlash: lost motion of the gap at a reversal") {
   CHECK(y == doctest::Approx(0.6));
 }
 
+namespace {
+/// presliding_friction's lost motion z = x - y along a path of inputs, by the block.
+double PreslidingLoss(DisplacementEffects* d, double x) { return x - d->Post(x, 0.0); }
+}  // namespace
+
+TEST_CASE("presliding_friction: Dahl's law on the output's travel, solved exactly per sample") {
+  const double loss = 0.2, travel = 0.1;
+  EffectSet e;
+  e.presliding_friction = PreslidingFriction{loss, travel};
+  // Sliding far one way: the lost motion is the loss.
+  DisplacementEffects d(e, kDt);
+  for (int k = 1; k <= 400; ++k) PreslidingLoss(&d, 0.01 * k);
+  CHECK(PreslidingLoss(&d, 4.0) == doctest::Approx(loss).epsilon(1e-9));
+  // After a reversal the output creeps at travel / (travel + 2 loss) of the input's rate ...
+  const double y0 = d.Post(4.0, 0.0);
+  const double y1 = d.Post(4.0 - 1e-6, 0.0);
+  CHECK((y0 - y1) / 1e-6 == doctest::Approx(travel / (travel + 2.0 * loss)).epsilon(1e-4));
+  // ... and the exact per-sample solution does not depend on how the travel is sampled: one big
+  // step against 1000 small ones, from the same state (the closed form, Newton on W + ln W = q).
+  DisplacementEffects coarse = d, fine = d;
+  const double zc = PreslidingLoss(&coarse, 4.0 - 0.3);
+  double zf = 0.0;
+  for (int k = 1; k <= 1000; ++k) zf = PreslidingLoss(&fine, 4.0 - 1e-6 - (0.3 - 1e-6) * k / 1000.0);
+  CHECK(zc == doctest::Approx(zf).epsilon(1e-9));
+  // The implicit law travel ln w + w = const - travel along the reversal's travel (w = loss - s z).
+  const double w_start = loss + loss, w_end = loss + zc;  // s = -1 after the reversal
+  CHECK(travel * std::log(w_end) + w_end == doctest::Approx(travel * std::log(w_start) + w_start - 0.3).epsilon(1e-6));
+  CHECK(zc < 0.0);
+  CHECK(zc > -loss);
+}
+
+TEST_CASE("presliding_friction with a vanishing travel is backlash of gap 2 loss") {
+  EffectSet p, b;
+  p.presliding_friction = PreslidingFriction{0.1, 1e-6};
+  b.backlash = Backlash{0.2};
+  DisplacementEffects dp(p, kDt), db(b, kDt);
+  double worst = 0.0;
+  for (int k = 0; k < 4000; ++k) {
+    const double x = 2.0 * std::sin(2.0 * M_PI * 1.3 * k * kDt) + 0.5 * std::sin(2.0 * M_PI * 7.0 * k * kDt);
+    worst = std::max(worst, std::abs(dp.Post(x, 0.0) - db.Post(x, 0.0)));
+  }
+  // The play operator is centred, so the two differ by a constant shift of the gap's half at most.
+  CHECK(worst < 1e-4);
+}
+
+TEST_CASE("command_dead_band: the actuator gets no command within width/2 of its output") {
+  EffectSet e;
+  e.command_dead_band = CommandDeadBand{0.4};
+  DisplacementEffects d(e, kDt);
+  CHECK_FALSE(d.PreIsIdentity());
+  d.Post(1.0, 0.0);               // the actuator output x_k = 1 mm
+  CHECK(d.Pre(1.15) == 1.0);      // inside the band: hold
+  CHECK(d.Pre(0.85) == 1.0);
+  CHECK(d.Pre(1.5) == doctest::Approx(1.3));   // beyond: the error less the half width
+  CHECK(d.Pre(0.0) == doctest::Approx(0.2));
+}
+
 TEST_CASE("current_lag is a first-order lag; damper_scale scales") {
   EffectSet e;
   e.current_lag = CurrentLag{10.0};
@@ -153,6 +210,8 @@ TEST_CASE("the per-step calls allocate nothing") {
   e.load_coupling = LoadCoupling{0.001};
   e.coulomb_friction = CoulombFriction{0.02, 0.5};
   e.backlash = Backlash{0.05};
+  e.presliding_friction = PreslidingFriction{0.03, 0.05};
+  e.command_dead_band = CommandDeadBand{0.02};
   e.current_lag = CurrentLag{5.0};
   e.damper_scale = DamperScale{1.2};
   DisplacementEffects d(e, kDt);

@@ -71,6 +71,14 @@ bool AtBound(const CandidateSpec& spec, const std::vector<double>& v) {
   return false;
 }
 
+std::string FormOf(const CandidateSpec& spec, const std::vector<double>& v) {
+  if (spec.name == "presliding_friction" && v.size() == 2) {
+    const double loss = v[0], travel = v[1];
+    if (travel < tuning::kPlayCreepSlope * (travel + 2.0 * loss)) return "backlash";
+  }
+  return "";
+}
+
 bool SubSampleDelayBeside(const Params& p, double dt, const Options& o) {
   const auto it = p.find("pure_delay");
   return it != p.end() && p.size() >= 2 && 1e-3 * it->second[0] < o.min_delay_samples * dt;

@@ -21,6 +21,12 @@ const CandidateSpec& SpecOf(const std::vector<CandidateSpec>& c, const std::stri
 /// pushed to the highest frequency, a lag at its floor).
 bool AtBound(const CandidateSpec& spec, const std::vector<double>& v);
 
+/// The library effect whose form a fitted candidate has taken, if it is another one's, else "":
+/// presliding_friction whose output creeps after a reversal at less than tuning::kPlayCreepSlope of
+/// its input's rate (travel / (travel + 2 loss)) is "backlash" (a play, its engagement rounded).
+/// Such a fit is not an explanation of its own (like AtBound).
+std::string FormOf(const CandidateSpec& spec, const std::vector<double>& v);
+
 /// true if the set holds pure_delay beside another effect and its tau is shorter than
 /// o.min_delay_samples dt: a delay below a sample is a timing convention (a ZOH lags by dt/2, a
 /// discrete block and a continuous effect differ by a fraction of a sample), which a sub-sample

@@ -153,6 +153,21 @@ struct EffectResult {
   /// the training evidence (docs/diagnosis.md "Unconfirmed"). Such an effect is in the verdict
   /// (Summary prints "name (unconfirmed: why)"), not in the final model. "" otherwise.
   std::string unconfirmed;
+  /// Not empty: the fit took another library effect's form, named here (presliding_friction whose
+  /// output does not creep after a reversal is a play, "backlash": docs/diagnosis.md "Lost motion");
+  /// never selected, and left out of the terminal summary.
+  std::string form_of;
+  /// Another candidate that explains a selected effect's training residual nearly as well.
+  struct Alternative {
+    std::string name;
+    /// Its BIC minus the selected effect's, at the step the selected one was added (rule (a)'s
+    /// n_eff ln(SSE_alt / SSE_sel) + (p_alt - p_sel) ln n_eff), >= 0.
+    double delta_bic = 0;
+    std::map<std::string, double> params;  ///< its fitted parameters (contract keys)
+  };
+  /// A selected effect's close calls: the candidates of its channel that passed every rule at the
+  /// same step with a BIC within tuning::kCloseCallBic of it, closest first; empty if none.
+  std::vector<Alternative> alternatives;
 };
 
 /// Per-channel numbers.

@@ -49,6 +49,14 @@ json EffectJson(const EffectResult& e) {
   o["selected"] = e.selected;
   o["at_bound"] = e.at_bound;
   o["unconfirmed"] = e.unconfirmed;
+  o["form_of"] = e.form_of;
+  json alts = json::array();
+  for (const auto& a : e.alternatives) {
+    json pa = json::object();
+    for (const auto& [k, v] : a.params) pa[k] = Num(v);
+    alts.push_back({{"name", a.name}, {"delta_bic", Num(a.delta_bic)}, {"params", pa}});
+  }
+  o["alternatives"] = alts;
   o["train_nrmse_" + e.channel + "_pct_after"] = Num(e.train_nrmse_after);
   if (e.name != "sensor_noise") {
     o["excess_reduction_pct"] = Num(100.0 * e.excess_reduction);

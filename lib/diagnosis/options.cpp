@@ -71,6 +71,8 @@ nlohmann::json ToJson(const Options& o) {
           {"max_effects_per_channel", tuning::kMaxEffectsPerChannel},
           {"min_delay_samples", o.min_delay_samples},
           {"at_bound_fraction", tuning::kAtBoundFraction},
+          {"play_creep_slope", tuning::kPlayCreepSlope},
+          {"close_call_bic", tuning::kCloseCallBic},
           {"swap_passes", o.swap_passes},
           {"swap_min_gain", tuning::kSwapMinGain},
           {"min_test_shrink_pct", o.min_test_shrink_pct},

@@ -77,6 +77,7 @@ void ScoreSelected(const ChannelState& s, const std::vector<CandidateSpec>& spec
     e.selected = true;
     e.excess_reduction = stats == s.sel_stats.end() ? 0.0 : stats->second.first;
     e.delta_bic = stats == s.sel_stats.end() ? 0.0 : stats->second.second;
+    if (const auto a = s.alternatives.find(name); a != s.alternatives.end()) e.alternatives = a->second;
     (*er)[name] = e;
   }
 }
@@ -184,7 +185,7 @@ void ScoreCandidates(ChannelState* sp, const std::vector<CandidateSpec>& specs, 
     e.excess_reduction = t.excess_red;
     e.delta_bic = t.dbic;
     for (const auto& spec : specs)
-      if (spec.name == name) e.at_bound = AtBound(spec, t.params.at(name));
+      if (spec.name == name) e.at_bound = AtBound(spec, t.params.at(name)), e.form_of = FormOf(spec, t.params.at(name));
     (*er)[name] = e;
   }
 }

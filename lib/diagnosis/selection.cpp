@@ -43,12 +43,23 @@ void SelectEffects(ChannelState* sp, const std::vector<CandidateSpec>& specs, co
                t.marginal_red >= o.min_excess_reduction &&
                (sse_wo - sse) >= o.min_floor_gain * static_cast<double>(s.n_train) * s.var_floor &&
                static_cast<int>(s.order.size()) < tuning::kMaxEffectsPerChannel &&
-               !AtBound(spec, t.params.at(spec.name)) &&
+               !AtBound(spec, t.params.at(spec.name)) && FormOf(spec, t.params.at(spec.name)).empty() &&
                !(spec.name == "pure_delay" && SubSampleDelayBeside(t.params, dt, o));
       s.last_trial[spec.name] = t;
       if (t.pass && (!best || t.excess_red > best->excess_red)) best = t;
     }
     if (!best) break;
+    // Close calls: the other candidates that passed at this step, with BIC near the winner's.
+    std::vector<EffectResult::Alternative> alts;
+    const int p_best = static_cast<int>(SpecOf(specs, best->name).params.size());
+    for (const auto& [name, t] : s.last_trial) {
+      if (name == best->name || !t.pass) continue;
+      const int p = static_cast<int>(SpecOf(specs, name).params.size());
+      const double d = n_eff * std::log(std::max(t.sse, 1e-300) / std::max(best->sse, 1e-300)) + (p - p_best) * std::log(n_eff);
+      if (d < tuning::kCloseCallBic) alts.push_back({name, std::max(0.0, d), ParamMap(specs, name, t.params.at(name))});
+    }
+    std::sort(alts.begin(), alts.end(), [](const auto& a, const auto& b) { return a.delta_bic < b.delta_bic; });
+    s.alternatives[best->name] = alts;
     s.sel = best->params;
     s.order.push_back(best->name);
     s.sel_stats[best->name] = {best->excess_red, best->dbic};
@@ -74,7 +85,7 @@ void SwapEffects(ChannelState* sp, const std::vector<CandidateSpec>& specs, cons
         q.erase(s.order[j]);
         double sq = FitEffect(s.train, specs, &q, spec.name, o);
         sq = RefitAll(s.train, specs, &q, sq, o.refit_rounds, o);
-        if (AtBound(spec, q.at(spec.name))) continue;  // not an explanation
+        if (AtBound(spec, q.at(spec.name)) || !FormOf(spec, q.at(spec.name)).empty()) continue;  // not an explanation
         if (sq < best_sse) best_sse = sq, swap = std::make_pair(j, q), swap_in = spec.name;
       }
     }
@@ -82,6 +93,7 @@ void SwapEffects(ChannelState* sp, const std::vector<CandidateSpec>& specs, cons
     warnings->push_back(fmt::format("channel {}: {} replaced by {} (training SSE {:.4g} -> {:.4g})", s.summary.channel,
                                     s.order[swap->first], swap_in, s.sse, best_sse));
     s.sel_stats[swap_in] = s.sel_stats[s.order[swap->first]];
+    s.alternatives.erase(s.order[swap->first]);  // those were the replaced effect's
     s.order[swap->first] = swap_in;
     s.sel = swap->second;
     s.sse = best_sse;

@@ -158,6 +158,8 @@ struct ChannelState {
   std::vector<std::vector<double>> pred_train;  ///< predictions with sel, training records
   std::map<std::string, Trial> last_trial;      ///< latest trial of every candidate not selected
   std::map<std::string, std::pair<double, double>> sel_stats;  ///< selected: (excess reduction, dBIC) when added
+  /// selected: its close calls at the step it was added (EffectResult::alternatives)
+  std::map<std::string, std::vector<EffectResult::Alternative>> alternatives;
 
   // Set by ApplyShrinkRule.
   bool retained = false;             ///< the selected effects are kept (the verdict names them)

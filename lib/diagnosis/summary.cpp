@@ -17,7 +17,10 @@ std::string VerdictText(const Result& r) {
   for (std::size_t i = 0; i < r.verdict.size(); ++i) {
     s += (i ? ", " : "") + r.verdict[i];
     for (const auto& e : r.effects)
-      if (e.name == r.verdict[i] && !e.unconfirmed.empty()) s += " (unconfirmed: " + e.unconfirmed + ")";
+      if (e.name == r.verdict[i]) {
+        if (!e.unconfirmed.empty()) s += " (unconfirmed: " + e.unconfirmed + ")";
+        for (const auto& a : e.alternatives) s += fmt::format(" (close call: or {}, BIC +{:.1f})", a.name, a.delta_bic);
+      }
   }
   return s;
 }
@@ -79,10 +82,14 @@ std::string Summary(const Result& r, SummaryDetail detail) {
     if (top) s += "\n";
   }
   s += "effects (test NRMSE after, shrink):\n";
-  std::vector<std::string> pinned;
+  std::vector<std::string> pinned, other_form;
   for (const auto& e : r.effects) {
     if (e.at_bound && !e.selected) {
       pinned.push_back(e.name);
+      continue;
+    }
+    if (!e.form_of.empty() && !e.selected) {
+      other_form.push_back(fmt::format("{} (fitted as {})", e.name, e.form_of));
       continue;
     }
     std::string ps;
@@ -97,6 +104,9 @@ std::string Summary(const Result& r, SummaryDetail detail) {
     s += fmt::format("  (not shown: {} fitted to an end of the search range, so not a description of the residual; "
                      "diagnosis.json has them)\n",
                      fmt::join(pinned, ", "));
+  }
+  if (!other_form.empty()) {
+    s += fmt::format("  (not shown: {}: another effect's form, not an explanation of its own)\n", fmt::join(other_form, ", "));
   }
   s += VerdictLine(r);
   for (const auto& w : r.warnings) s += "warning: " + w + "\n";

@@ -55,6 +55,15 @@ inline constexpr double kAtBoundFraction = 1e-3;
 /// A swap is made if it lowers the channel's training SSE by more than this fraction.
 inline constexpr double kSwapMinGain = 1e-3;
 
+// --- lost motion (docs/diagnosis.md "Lost motion")
+/// presliding_friction whose output moves at less than this fraction of its input's rate just
+/// after a reversal (travel / (travel + 2 loss)) stands still there: a play (backlash) with a
+/// rounded engagement, not friction's presliding creep.
+inline constexpr double kPlayCreepSlope = 0.05;
+/// A selected effect's alternative is a close call if its BIC exceeds the selected one's by less
+/// than this (10: "very strong" evidence on the usual BIC scale).
+inline constexpr double kCloseCallBic = 10.0;
+
 // --- parameter search (one effect) and joint refits (coordinate-wise)
 /// Golden-section iterations after the full-range grid: y effects ...
 inline constexpr int kGoldenItersY = 24;
@@ -89,6 +98,7 @@ static_assert(kDisplacementOnlySmoothFactor > 0 && kVmaxSearchFactor >= 1);
 static_assert(kNoisePsdSegment >= 8 && kWhitenessLags >= 1 && kCorrelationMaxLag >= 1 && kCorrelationLagDivisor >= 1);
 static_assert(kMaxEffectsPerChannel >= 1 && kAtBoundFraction >= 0 && kAtBoundFraction < 0.5);
 static_assert(kSwapMinGain >= 0 && kSwapMinGain < 1);
+static_assert(kPlayCreepSlope >= 0 && kPlayCreepSlope < 1 && kCloseCallBic >= 0);
 static_assert(kGoldenItersY >= 0 && kGoldenItersF >= 0 && kRefitGoldenItersY >= 0 && kRefitGoldenItersF >= 0);
 static_assert(kRefitBracketFactor > 1 && kRefitBracketFraction > 0 && kRefitBracketFraction <= 1);
 static_assert(kSimplexEvals >= 3 && kRefitSimplexEvals >= 3);

@@ -38,7 +38,7 @@ constexpr EffectParam kNoParam{};
 
 }  // namespace
 
-const std::array<EffectInfo, 10> kEffects = {{
+const std::array<EffectInfo, 12> kEffects = {{
     {"pure_delay", 'y', true,
      {{{"tau_ms", 0.0, 100.0, false, false, 0.0, true, true, 0.0, 40.0, false, 81, 0.0, false,
         FieldOf<&EffectSet::pure_delay, &PureDelay::tau_ms>},
@@ -95,6 +95,18 @@ const std::array<EffectInfo, 10> kEffects = {{
         FieldOf<&EffectSet::damper_scale, &DamperScale::scale>},
        kNoParam}},
      1, TurnOn<&EffectSet::damper_scale>, IsOn<&EffectSet::damper_scale>},
+    // travel -> 0 is backlash: a travel at the search's floor is not presliding (AtBound).
+    {"presliding_friction", 'y', true,
+     {{{"loss_mm", 0.0, 10.0, false, false, 0.0, true, true, 1e-3, 10.0, true, 21, 0.0, false,
+        FieldOf<&EffectSet::presliding_friction, &PreslidingFriction::loss_mm>},
+       {"travel_mm", 1e-6, 100.0, false, false, 0.0, false, true, 1e-3, 10.0, true, 13, 0.0, false,
+        FieldOf<&EffectSet::presliding_friction, &PreslidingFriction::travel_mm>}}},
+     2, TurnOn<&EffectSet::presliding_friction>, IsOn<&EffectSet::presliding_friction>},
+    {"command_dead_band", 'y', true,
+     {{{"width_mm", 0.0, 10.0, false, false, 0.0, true, true, 1e-3, 10.0, true, 31, 0.0, false,
+        FieldOf<&EffectSet::command_dead_band, &CommandDeadBand::width_mm>},
+       kNoParam}},
+     1, TurnOn<&EffectSet::command_dead_band>, IsOn<&EffectSet::command_dead_band>},
 }};
 
 const EffectInfo* FindEffect(std::string_view name) {
@@ -173,11 +185,15 @@ void DisplacementEffects::Reset() {
   rate_out_ = 0.0;
   fric_prev_in_ = 0.0;
   play_out_ = 0.0;
+  dahl_prev_in_ = 0.0;
+  dahl_z_ = 0.0;
+  x_last_ = 0.0;
 }
 
 bool DisplacementEffects::PreIsIdentity() const {
   return (!e_.pure_delay || e_.pure_delay->tau_ms == 0.0) &&
-         (!e_.gain_error || e_.gain_error->gain == 1.0);
+         (!e_.gain_error || e_.gain_error->gain == 1.0) &&
+         (!e_.command_dead_band || e_.command_dead_band->width_mm == 0.0);
 }
 
 double DisplacementEffects::Pre(double u_mm) {
@@ -197,10 +213,16 @@ double DisplacementEffects::Pre(double u_mm) {
     u = (1.0 - frac) * past(m) + (frac > 0.0 ? frac * past(m + 1) : 0.0);
   }
   if (e_.gain_error) u *= e_.gain_error->gain;
+  if (e_.command_dead_band) {
+    const double h = 0.5 * e_.command_dead_band->width_mm;
+    const double e = u - x_last_;
+    u = x_last_ + (e > h ? e - h : e < -h ? e + h : 0.0);
+  }
   return u;
 }
 
 double DisplacementEffects::Post(double x_mm, double f_kN) {
+  x_last_ = x_mm;
   double y = x_mm;
   if (e_.oil_column_resonance) {
     // The input x_k is held over the step that ends at t_k (a half-sample advance against a
@@ -222,6 +244,7 @@ double DisplacementEffects::Post(double x_mm, double f_kN) {
     fric_prev_in_ = y;
     y -= e_.coulomb_friction->loss_mm * std::tanh(v / e_.coulomb_friction->v_smooth_mm_s);
   }
+  if (e_.presliding_friction) y -= PreslidingStep(y);
   if (e_.backlash) {
     const double h = 0.5 * e_.backlash->gap_mm;
     if (y - play_out_ > h) play_out_ = y - h;
@@ -229,6 +252,36 @@ double DisplacementEffects::Post(double x_mm, double f_kN) {
     y = play_out_;
   }
   return y;
+}
+
+double DisplacementEffects::PreslidingStep(double x_mm) {
+  // With s = sgn(dx) and w = loss - s z in [0, 2 loss] (0: sliding, 2 loss: just reversed),
+  // dz/dy = s w / travel and dy = dx - dz give dw/d|x| = -w / (travel + w), whose solution over a
+  // travel |dx| is travel ln w + w = travel ln w_prev + w_prev - |dx|: w = travel W(e^q),
+  // q = ln(w_prev / travel) + (w_prev - |dx|) / travel, W + ln W = q solved by Newton in ln W
+  // (convex and increasing: from ln(w_prev / travel), above the root, it converges monotonically).
+  const double loss = e_.presliding_friction->loss_mm, travel = e_.presliding_friction->travel_mm;
+  const double dx = x_mm - dahl_prev_in_;
+  dahl_prev_in_ = x_mm;
+  if (dx == 0.0 || loss == 0.0) return dahl_z_;
+  const double s = dx > 0.0 ? 1.0 : -1.0;
+  const double w_prev = std::clamp(loss - s * dahl_z_, 0.0, 2.0 * loss);
+  if (w_prev <= 1e-12 * loss) {  // already sliding this way: the lost motion stays at s loss
+    dahl_z_ = s * loss;
+    return dahl_z_;
+  }
+  const double l0 = std::log(w_prev) - std::log(travel);
+  const double q = l0 + (w_prev - std::abs(dx)) / travel;
+  double l = l0;
+  for (int it = 0; it < 60; ++it) {
+    const double el = std::exp(l);
+    const double step = (el + l - q) / (el + 1.0);
+    l -= step;
+    if (std::abs(step) < 1e-13 * (1.0 + std::abs(l))) break;
+  }
+  const double w = std::clamp(travel * std::exp(l), 0.0, w_prev);
+  dahl_z_ = s * (loss - w);
+  return dahl_z_;
 }
 
 ForceEffects::ForceEffects(const EffectSet& effects, double dt_s) : e_(effects) {

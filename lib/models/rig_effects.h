@@ -7,9 +7,11 @@
 ///
 /// Where each effect acts (one order, documented in docs/diagnosis.md):
 ///
-///   displacement path   u_k --[pure_delay]--[gain_error]--> actuator model --> x_k
+///   displacement path   u_k --[pure_delay]--[gain_error]--[command_dead_band (on u - x)]
+///                           --> actuator model --> x_k
 ///                       x_k --[oil_column_resonance]--[servovalve_saturation]
-///                           --[load_coupling (- c f)]--[coulomb_friction]--[backlash]--> y_k
+///                           --[load_coupling (- c f)]--[coulomb_friction]--[presliding_friction]
+///                           --[backlash]--> y_k
 ///   force path          i_k --[current_lag]--> model's current dynamics (Eq. 40 + 75 Hz) --> i_c
 ///                       damper model (Eqs. 32-39) at (y, y', i_c) --[damper_scale]--> f_k
 ///   both channels       + sensor_noise (rig mode only: the diagnosis never adds noise)
@@ -57,6 +59,23 @@ struct OilColumnResonance { double f_hz = 60.0; double zeta = 0.05; bool operato
 struct CoulombFriction { double loss_mm = 0.0; double v_smooth_mm_s = 0.5; bool operator==(const CoulombFriction&) const = default; };  ///< loss [0, 10] mm
 /// Dead band (play operator): y holds until its input has moved gap/2 past it, then follows.
 struct Backlash { double gap_mm = 0.0; bool operator==(const Backlash&) const = default; };                           ///< [0, 10] mm
+/// Presliding (Dahl-type) friction: a lost motion z = x - y that builds up over a travel after
+/// each reversal, independent of the velocity. Dahl's law (Dahl 1968, docs/rig_mode.md "Presliding
+/// friction") on the output's travel: dz/dy = (loss - z sgn(y')) / travel, which at a
+/// reversal gives dy/dx = travel / (travel + 2 loss) (the output creeps) rising to 1 as the
+/// lost motion reaches loss. travel -> 0 is backlash with gap 2 loss; a large travel is a small,
+/// smooth lag. Solved exactly per sample (docs/rig_mode.md).
+struct PreslidingFriction {
+  double loss_mm = 0.0;    ///< the lost motion once sliding [mm], [0, 10]
+  double travel_mm = 0.1;  ///< the presliding travel over which it builds up [mm], [1e-6, 100]
+  bool operator==(const PreslidingFriction&) const = default;
+};
+/// Servovalve overlap: a dead band on the servo loop's error. The actuator model is driven by
+/// x_k + dz(v_k - x_k), v_k the command after pure_delay and gain_error, x_k the actuator
+/// model's output at t_k and dz(e) = sgn(e) max(0, |e| - width/2): within width/2 of its command
+/// the actuator gets no flow and stops (a play inside the loop, filtered by the actuator's
+/// dynamics, where backlash is a play on its output).
+struct CommandDeadBand { double width_mm = 0.0; bool operator==(const CommandDeadBand&) const = default; };  ///< [0, 10] mm
 /// Flow limit: the output moves at most vmax * dt per step towards its input (rate limiter).
 struct ServovalveSaturation { double vmax_mm_per_s = 1e9; bool operator==(const ServovalveSaturation&) const = default; };        ///< > 0
 /// Gaussian measurement noise added to a channel (rig mode only); rms in the channel's unit.
@@ -75,6 +94,8 @@ struct EffectSet {
   std::optional<OilColumnResonance> oil_column_resonance;
   std::optional<CoulombFriction> coulomb_friction;
   std::optional<Backlash> backlash;
+  std::optional<PreslidingFriction> presliding_friction;
+  std::optional<CommandDeadBand> command_dead_band;
   std::optional<ServovalveSaturation> servovalve_saturation;
   std::optional<SensorNoise> sensor_noise;
   std::optional<CurrentLag> current_lag;
@@ -135,7 +156,7 @@ struct EffectInfo {
 
 /// The effect library: one entry per effect. Adding an effect is one entry here (plus its
 /// struct above, its member of EffectSet and its block in the classes below).
-extern const std::array<EffectInfo, 10> kEffects;
+extern const std::array<EffectInfo, 12> kEffects;
 /// The entry called `name`, or nullptr.
 const EffectInfo* FindEffect(std::string_view name);
 
@@ -149,16 +170,21 @@ class DisplacementEffects {
   /// Back to rest (all inputs and outputs 0).
   void Reset();
   /// Command u_k [mm] -> the command the actuator model holds over [t_k, t_{k+1}) [mm]
-  /// (pure_delay, then gain_error). Call once per step, in order.
+  /// (pure_delay, gain_error, then command_dead_band against the actuator output x_k given to
+  /// the last Post). Call once per step, in order, after that step's Post.
   double Pre(double u_mm);
   /// Actuator model output x_k [mm] at t_k and the specimen force f_kN [kN] to couple with
   /// (LoadCoupling) -> the specimen / measured displacement y_k [mm] (oil_column_resonance,
-  /// servovalve_saturation, load_coupling, coulomb_friction, backlash). Call once per step.
+  /// servovalve_saturation, load_coupling, coulomb_friction, presliding_friction, backlash).
+  /// Call once per step.
   double Post(double x_mm, double f_kN);
-  /// true if Pre() is the identity (no delay, gain 1).
+  /// true if Pre() is the identity (no delay, gain 1, no dead band).
   bool PreIsIdentity() const;
 
  private:
+  /// presliding_friction: the lost motion z_k [mm] after the block's input moved to x_mm.
+  double PreslidingStep(double x_mm);
+
   EffectSet e_;
   double dt_s_ = 0.0;
   // pure delay: ring buffer of past commands
@@ -171,6 +197,9 @@ class DisplacementEffects {
   double rate_out_ = 0.0;      // servovalve saturation output
   double fric_prev_in_ = 0.0;  // friction block's previous input
   double play_out_ = 0.0;      // backlash output
+  double dahl_prev_in_ = 0.0;  // presliding friction's previous input
+  double dahl_z_ = 0.0;        // presliding friction's lost motion [mm]
+  double x_last_ = 0.0;        // the actuator output given to the last Post (command_dead_band)
 };
 
 /// The force path's effects: current_lag before the model's current dynamics, damper_scale

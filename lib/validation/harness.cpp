@@ -26,7 +26,8 @@ const std::vector<std::string> kSingles = [] {
 }();
 const std::vector<std::string> kPairs = {"pure_delay+damper_scale", "gain_error+current_lag", "pure_delay+gain_error",
                                          "backlash+damper_scale", "load_coupling+current_lag",
-                                         "oil_column_resonance+coulomb_friction"};
+                                         "oil_column_resonance+coulomb_friction", "presliding_friction+damper_scale",
+                                         "command_dead_band+current_lag", "pure_delay+presliding_friction"};
 
 std::vector<std::string> Split(const std::string& s) {
   std::vector<std::string> out;
@@ -44,7 +45,8 @@ std::vector<std::string> Split(const std::string& s) {
 // backlash+oil_column_resonance) and four more across both channels.
 const std::vector<std::string> kIndependentPairs = {
     "load_coupling+gain_error", "backlash+oil_column_resonance",         "pure_delay+damper_scale",
-    "gain_error+current_lag",   "oil_column_resonance+coulomb_friction", "servovalve_saturation+current_lag"};
+    "gain_error+current_lag",   "oil_column_resonance+coulomb_friction", "servovalve_saturation+current_lag",
+    "presliding_friction+damper_scale", "command_dead_band+oil_column_resonance", "pure_delay+presliding_friction"};
 
 }  // namespace
 
@@ -103,6 +105,13 @@ IndependentCase IndependentHarnessCase(const std::string& kind, std::uint64_t se
     } else if (e == "backlash") {
       t.backlash_gap_mm = U(0.1, 0.6);
       txt += fmt::format("gap_mm={:.3g} ", t.backlash_gap_mm);
+    } else if (e == "presliding_friction") {
+      t.presliding_loss_mm = U(0.05, 0.3);
+      t.presliding_rho = U(0.5, 0.9);
+      txt += fmt::format("loss_mm={:.3g} rho={:.3g} ", t.presliding_loss_mm, t.presliding_rho);
+    } else if (e == "command_dead_band") {
+      t.dead_band_mm = U(0.1, 0.6);
+      txt += fmt::format("width_mm={:.3g} ", t.dead_band_mm);
     } else if (e == "servovalve_saturation") {
       t.vmax_mm_per_s = U(150.0, 300.0);
       txt += fmt::format("vmax_mm_per_s={:.4g} ", t.vmax_mm_per_s);
@@ -198,6 +207,13 @@ Truth HarnessTruth(const std::string& kind, std::uint64_t seed, double noise_y_m
     } else if (e == "backlash") {
       t.effects.backlash = models::Backlash{U(0.1, 0.6)};
       txt += fmt::format("gap_mm={:.3g} ", t.effects.backlash->gap_mm);
+    } else if (e == "presliding_friction") {
+      t.effects.presliding_friction = models::PreslidingFriction{U(0.05, 0.3), U(0.1, 0.5)};
+      txt += fmt::format("loss_mm={:.3g} travel_mm={:.3g} ", t.effects.presliding_friction->loss_mm,
+                         t.effects.presliding_friction->travel_mm);
+    } else if (e == "command_dead_band") {
+      t.effects.command_dead_band = models::CommandDeadBand{U(0.1, 0.6)};
+      txt += fmt::format("width_mm={:.3g} ", t.effects.command_dead_band->width_mm);
     } else if (e == "servovalve_saturation") {
       t.effects.servovalve_saturation = models::ServovalveSaturation{U(150.0, 300.0)};
       txt += fmt::format("vmax_mm_per_s={:.4g} ", t.effects.servovalve_saturation->vmax_mm_per_s);

@@ -230,7 +230,7 @@ std::vector<double> Current(const IndependentExcitation& ex, std::size_t n, sign
 // ------------------------------------------------------------------------------------------
 // The continuous rig
 
-enum : int { kW, kX, kXv, kQ, kQv, kR, kYl, kPhi, kYb, kYd, kZ, kM, kIc, kIcv, kL1, kL2, kStates };
+enum : int { kW, kX, kXv, kQ, kQv, kR, kYl, kPhi, kPs, kYb, kYd, kZ, kM, kIc, kIcv, kL1, kL2, kStates };
 using State = std::array<double, kStates>;
 
 struct Outputs {
@@ -246,7 +246,10 @@ class ContinuousRig {
     K_ = m.K, p_ = m.p, b_ = m.b, c_ = m.c;
     oil_ = t.oil_f_hz > 0, sat_ = t.vmax_mm_per_s > 0, lc_ = t.compliance_mm_per_kN > 0;
     fr_ = t.friction_loss_mm > 0, bl_ = t.backlash_gap_mm > 0, lag_ = t.current_lag_ms > 0;
-    if (lc_ && (fr_ || bl_)) throw Error("independent rig", "load_coupling with coulomb_friction or backlash is not modelled");
+    ps_ = t.presliding_loss_mm > 0;
+    if (lc_ && (fr_ || bl_ || ps_))
+      throw Error("independent rig", "load_coupling with coulomb_friction, presliding_friction or backlash is not modelled");
+    if (ps_ && !(t.presliding_rho > 0 && t.presliding_rho <= 1)) throw Error("independent rig", "presliding_rho must be in (0, 1]");
     w_oil_ = 2.0 * kPi * t.oil_f_hz;
     tau1_ = 0.8e-3 * t.current_lag_ms, tau2_ = 0.2e-3 * t.current_lag_ms;
     h_ = 0.5 * t.backlash_gap_mm, wb_ = 0.3 * h_;
@@ -266,7 +269,11 @@ class ContinuousRig {
     ds->fill(0.0);
     State& d = *ds;
     double lam = 0.0;
-    // Servo, cascade form.
+    // Servo, cascade form; a valve overlap acts on the continuous loop error u - x.
+    if (t_.dead_band_mm > 0) {
+      const double h = 0.5 * t_.dead_band_mm, e = us - s[kX];
+      us = s[kX] + e - h * std::tanh(e / h);
+    }
     d[kW] = -p_ * s[kW] + K_ * us;
     d[kX] = s[kXv];
     d[kXv] = s[kW] - b_ * s[kXv] - c_ * s[kX];
@@ -323,6 +330,15 @@ class ContinuousRig {
       // The lag, and the sign law's own time scale at a reversal, |y''| / v_s.
       lam = std::max(lam, std::max(1.0 / tau_f, std::abs(ya) / vs));
     }
+    if (ps_) {
+      const double L = t_.presliding_loss_mm, sigma = t_.presliding_rho / std::pow(2.0, 1.5);
+      const double sg = yv > 0 ? 1.0 : yv < 0 ? -1.0 : 0.0;
+      const double base = std::clamp(1.0 - s[kPs] * sg / L, 0.0, 2.0);
+      const double dps = sigma * yv * std::pow(base, 1.5);
+      d[kPs] = dps;
+      y -= s[kPs], yv -= dps;
+      lam = std::max(lam, 1.5 * sigma * std::abs(yv) * std::sqrt(base) / L);
+    }
     if (bl_) {
       const double e = y - s[kYb];
       const double g = e * yv > 0 ? std::clamp((std::abs(e) - (h_ - wb_)) / wb_, 0.0, 1.0) : 0.0;
@@ -376,7 +392,7 @@ class ContinuousRig {
   models::MrDamperParams d_;
   double K_ = 0, p_ = 0, b_ = 0, c_ = 0;
   const double a_ = kPi, b9_ = 9.0 * kPi, wn_ = 2.0 * kPi * 75.0, zn_ = 1.0 / std::sqrt(2.0);
-  bool oil_ = false, sat_ = false, lc_ = false, fr_ = false, bl_ = false, lag_ = false;
+  bool oil_ = false, sat_ = false, lc_ = false, fr_ = false, bl_ = false, lag_ = false, ps_ = false;
   double w_oil_ = 0, tau1_ = 0, tau2_ = 0, h_ = 0, wb_ = 0;
 };
 

@@ -36,6 +36,13 @@
 ///     backlash       a play with a rounded engagement: y' = x' g(e), e = x - y, g = 0 while moving away
 ///                    from contact, else clamp((|e| - (h - w)) / w, 0, 1), h = gap / 2, w = 0.3 h
 ///                    (the library: the sharp play operator on the samples);
+///     presliding_friction  Dahl's law with exponent 1.5 on the input's travel:
+///                    phi' = sigma y' (1 - phi sgn(y') / loss)^1.5, sigma = rho / 2^1.5, y = x - phi, so the
+///                    output's slope after a reversal is 1 - rho (the library: exponent 1 on the
+///                    output's travel, solved exactly per sample);
+///     command_dead_band  a smooth dead zone on the continuous loop error: the servo is driven by
+///                    x + e - h tanh(e / h), e = u - x, h = width / 2, x the servo's continuous
+///                    output (the library: a sharp dead zone against the sampled x_k);
 ///     current_lag    two first-order lags in series, tau1 = 0.8 tau, tau2 = 0.2 tau (the library:
 ///                    one of tau);
 ///     damper_scale   alpha, c0, c1 scaled by s (exactly a force scale) times a slow drift:
@@ -107,6 +114,9 @@ struct IndependentTruth {
   double oil_f_hz = 0.0, oil_zeta = 0.1;  ///< oil_column_resonance (f 0: off)
   double friction_loss_mm = 0.0;       ///< coulomb_friction [mm]
   double backlash_gap_mm = 0.0;        ///< backlash [mm]
+  double presliding_loss_mm = 0.0;     ///< presliding_friction's lost motion once sliding [mm]
+  double presliding_rho = 0.8;         ///< ... and 1 - the output's slope just after a reversal, (0, 1]
+  double dead_band_mm = 0.0;           ///< command_dead_band's width [mm]
   double vmax_mm_per_s = 0.0;          ///< servovalve_saturation [mm/s]
   double current_lag_ms = 0.0;         ///< current_lag [ms]
   double damper_scale = 1.0;           ///< damper_scale (1: off)
