@@ -190,7 +190,7 @@ TEST_CASE("harness (independent generator): confusion table and held-out shrink 
   const auto sc = rths_test::RunHarnessReported(o);
   REQUIRE(sc.single_n == 11 * o.seeds);
   REQUIRE(sc.pair_n == 9 * o.seeds);
-  REQUIRE(sc.none_n == 2 * o.seeds);
+  REQUIRE(sc.none_n == 3 * o.seeds);
   REQUIRE(sc.unknown_n == 3 * o.seeds);
   rths_test::CheckHarnessTargets(sc);
   CHECK(sc.none_right == sc.none_n);

@@ -108,7 +108,7 @@ TEST_CASE("SelectEffects: picks the known effect and its parameter, and nothing 
   st::ScoreNominal(&noise.s(), o);
   st::SelectEffects(&noise.s(), noise.specs, o);
   CHECK(noise.s().order.empty());
-  CHECK(noise.s().last_trial.size() == 7);  // every displacement candidate tried
+  CHECK(noise.s().last_trial.size() == 9);  // every displacement candidate tried
 }
 
 TEST_CASE("PruneEffects: an effect that explains nothing is removed, two needed ones are kept") {

@@ -60,8 +60,8 @@ struct CoulombFriction { double loss_mm = 0.0; double v_smooth_mm_s = 0.5; bool 
 /// Dead band (play operator): y holds until its input has moved gap/2 past it, then follows.
 struct Backlash { double gap_mm = 0.0; bool operator==(const Backlash&) const = default; };                           ///< [0, 10] mm
 /// Presliding (Dahl-type) friction: a lost motion z = x - y that builds up over a travel after
-/// each reversal, independent of the velocity. Dahl's law (Dahl 1968, docs/rig_mode.md "Presliding
-/// friction") on the output's travel: dz/dy = (loss - z sgn(y')) / travel, which at a
+/// each reversal, independent of the velocity. Dahl's law (Dahl 1968, docs/rig_mode.md "Lost motion
+/// at reversals") on the output's travel: dz/dy = (loss - z sgn(y')) / travel, which at a
 /// reversal gives dy/dx = travel / (travel + 2 loss) (the output creeps) rising to 1 as the
 /// lost motion reaches loss. travel -> 0 is backlash with gap 2 loss; a large travel is a small,
 /// smooth lag. Solved exactly per sample (docs/rig_mode.md).

@@ -62,7 +62,8 @@ std::vector<std::string> HarnessCaseKinds(bool pairs) {
 std::vector<std::string> IndependentCaseKinds(bool pairs) {
   std::vector<std::string> k = kSingles;
   if (pairs) k.insert(k.end(), kIndependentPairs.begin(), kIndependentPairs.end());
-  for (const char* s : {"none", "none_white", "unknown_ripple", "unknown_cubic", "unknown_asymmetric"}) k.emplace_back(s);
+  for (const char* s : {"none", "none_white", "none_drift", "unknown_ripple", "unknown_cubic", "unknown_asymmetric"})
+    k.emplace_back(s);
   return k;
 }
 
@@ -126,6 +127,9 @@ IndependentCase IndependentHarnessCase(const std::string& kind, std::uint64_t se
       t.colour = NoiseColour::kWhite;
       t.drift_fraction = 0.0;
       txt += "white noise ";
+    } else if (e == "none_drift") {
+      t.walk_fraction = U(0.5, 1.5);
+      txt += fmt::format("sensor drift: random walk of {:.3g} x the noise rms ", t.walk_fraction);
     } else if (e == "unknown_ripple") {
       t.ripple_mm = U(0.05, 0.2);
       t.ripple_hz = U(11.0, 17.0);

@@ -61,7 +61,8 @@ std::vector<std::string> HarnessCaseKinds(bool pairs);
 /// The case kinds of the independent generator: the 9 single effects (its own forms), pairs
 /// (load_coupling+gain_error, backlash+oil_column_resonance, pure_delay+damper_scale,
 /// gain_error+current_lag, oil_column_resonance+coulomb_friction, servovalve_saturation+current_lag),
-/// "none" (anti-aliased noise with drift), "none_white" (white noise, no drift), and outside the
+/// "none" (anti-aliased noise with drift), "none_white" (white noise, no drift), "none_drift" (a
+/// random-walk sensor drift of 0.5-1.5 x the noise rms on both channels), and outside the
 /// library "unknown_ripple" (amplitude-modulated, 11-17 Hz), "unknown_cubic" (F += k3 y^3),
 /// "unknown_asymmetric" (valve gain 1 +- a).
 std::vector<std::string> IndependentCaseKinds(bool pairs);

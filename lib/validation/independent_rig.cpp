@@ -496,6 +496,23 @@ std::vector<double> IndependentNoise(std::size_t n, double dt, double rms, Noise
   return v;
 }
 
+namespace {
+
+/// A random walk of n samples from 0, scaled to rms `rms` over the record (0 if rms is 0).
+std::vector<double> RandomWalk(std::size_t n, double rms, std::uint64_t seed) {
+  std::vector<double> w(n, 0.0);
+  if (!(rms > 0) || n < 2) return w;
+  auto g = signal::MakeGaussian(seed);
+  for (std::size_t k = 1; k < n; ++k) w[k] = w[k - 1] + signal::NextGaussian(&g);
+  double ss = 0.0;
+  for (double x : w) ss += x * x;
+  const double scale = rms / std::sqrt(ss / static_cast<double>(n));
+  for (double& x : w) x *= scale;
+  return w;
+}
+
+}  // namespace
+
 io::RigRecord MakeIndependentRecord(const IndependentExcitation& ex, const IndependentTruth& truth,
                                     const std::string& name) {
   io::RigRecord r;
@@ -509,13 +526,15 @@ io::RigRecord MakeIndependentRecord(const IndependentExcitation& ex, const Indep
   const auto ny = IndependentNoise(n, ex.dt_s, truth.noise_y_mm, truth.colour, truth.drift_fraction, truth.noise_seed);
   const auto nf = IndependentNoise(n, ex.dt_s, truth.noise_f_kN, truth.colour, truth.drift_fraction,
                                    truth.noise_seed * 0x2545F4914F6CDD1DULL + 5);
+  const auto wy = RandomWalk(n, truth.walk_fraction * truth.noise_y_mm, truth.noise_seed * 31 + 1);
+  const auto wf = RandomWalk(n, truth.walk_fraction * truth.noise_f_kN, truth.noise_seed * 37 + 2);
   r.y_mm.resize(n);
   r.f_kN.resize(n);
   for (std::size_t k = 0; k < n; ++k) {
     const double t = r.t_s[k];
     const double ripple = truth.ripple_mm * (1.0 + 0.5 * std::sin(2.0 * kPi * 0.3 * t)) * std::sin(2.0 * kPi * truth.ripple_hz * t);
-    r.y_mm[k] = tr.y_mm[k] + ripple + ny[k];
-    r.f_kN[k] = tr.f_kN[k] + nf[k];
+    r.y_mm[k] = tr.y_mm[k] + ripple + ny[k] + wy[k];
+    r.f_kN[k] = tr.f_kN[k] + nf[k] + wf[k];
   }
   r.metadata.push_back({"generator", "validation::MakeIndependentRecord (continuous RK4, independent forms)"});
   r.metadata.push_back({"command", fmt::format("{} {}-{} Hz, {} mm rms", Name(ex.command), ex.lo_hz, ex.hi_hz, ex.rms_mm)});

@@ -53,7 +53,8 @@
 ///     asymmetric valve  u_s = u (1 + a) for u > 0, u (1 - a) for u < 0.
 /// * Noise: white, or anti-alias filtered (white at 8 times the record rate through a 4th-order
 ///   Butterworth low-pass at 0.4 / dt, then sampled), plus a slow drift of a fraction of its rms
-///   (a sine of 0.02-0.1 Hz); scaled so that the sampled noise has the requested rms.
+///   (a sine of 0.02-0.1 Hz); scaled so that the sampled noise has the requested rms; optionally a
+///   random-walk drift (a sensor's thermal drift) of a given multiple of the noise rms.
 /// * Excitations: band noise (white through a 6th-order Butterworth low-pass and a 2nd-order
 ///   high-pass, both biquads written here), logarithmic chirps, random-phase multisines, and an
 ///   RTHS-like command: the displacement of an SDOF (f_n = lo_hz, zeta 3 %) under the El Centro
@@ -129,6 +130,9 @@ struct IndependentTruth {
   double noise_y_mm = 0.01, noise_f_kN = 0.2;  ///< sampled noise rms
   NoiseColour colour = NoiseColour::kAntiAliased;
   double drift_fraction = 0.5;         ///< slow drift amplitude / noise rms (0: none)
+  /// A sensor's thermal drift on both channels: a random walk from 0 (the sensor zeroed at the
+  /// start), scaled so that its rms over the record is this times the channel's noise rms (0: none).
+  double walk_fraction = 0.0;
   std::uint64_t noise_seed = 11;
   /// RK4 substeps per record step, at least (raised where the local stiffness needs it).
   int substeps = 8;
