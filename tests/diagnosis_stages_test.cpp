@@ -2,11 +2,14 @@
 // from the effect blocks: the nominal scoring, the greedy selection, the pruning, the held-out
 // retention and the shrink rule, each run on a channel state set up by hand.
 #include <algorithm>
+#include <cmath>
+#include <map>
 #include <string>
 #include <vector>
 
 #include <doctest/doctest.h>
 
+#include "diagnosis/candidates.h"
 #include "diagnosis/diagnosis.h"
 #include "diagnosis/stages.h"
 #include "validation/synthetic.h"
@@ -109,6 +112,61 @@ TEST_CASE("SelectEffects: picks the known effect and its parameter, and nothing 
   st::SelectEffects(&noise.s(), noise.specs, o);
   CHECK(noise.s().order.empty());
   CHECK(noise.s().last_trial.size() == 9);  // every displacement candidate tried
+}
+
+TEST_CASE("lost motion: presliding is told from backlash by its creep after a reversal") {
+  const Options o;
+  m::EffectSet dahl;
+  dahl.presliding_friction = m::PreslidingFriction{0.2, 0.3};  // creeps at 0.3 / 0.7 = 43 % of the input's rate
+  YChannel p(dahl);
+  st::ScoreNominal(&p.s(), o);
+  st::SelectEffects(&p.s(), p.specs, o);
+  REQUIRE(p.s().order == std::vector<std::string>{"presliding_friction"});
+  CHECK(p.s().sel.at("presliding_friction")[0] == doctest::Approx(0.2).epsilon(0.1));
+  CHECK(p.s().sel.at("presliding_friction")[1] == doctest::Approx(0.3).epsilon(0.2));
+
+  m::EffectSet play;
+  play.backlash = m::Backlash{0.4};
+  YChannel b(play);
+  st::ScoreNominal(&b.s(), o);
+  st::SelectEffects(&b.s(), b.specs, o);
+  REQUIRE(b.s().order == std::vector<std::string>{"backlash"});
+  // Rule 7: a presliding fit that stands still after a reversal is backlash's form.
+  const auto& spec = st::SpecOf(b.specs, "presliding_friction");
+  CHECK(st::FormOf(spec, {0.2, 0.01}) == "backlash");  // creeps at 0.01 / 0.41 = 2.4 %
+  CHECK(st::FormOf(spec, {0.2, 0.1}).empty());         // 20 %
+  CHECK(st::FormOf(st::SpecOf(b.specs, "backlash"), {0.4}).empty());
+}
+
+TEST_CASE("CloseCalls: the passing trials of a step within kCloseCallBic of the winner, closest first") {
+  const auto specs = st::Candidates(0.0005, 1e4);
+  auto trial = [&](const std::string& name, double sse, bool pass) {
+    st::Trial t;
+    t.name = name;
+    t.sse = sse;
+    t.pass = pass;
+    const auto& spec = st::SpecOf(specs, name);
+    std::vector<double> v;
+    for (const auto& q : spec.params) v.push_back(q.lo * 2.0);
+    t.params[name] = v;
+    return t;
+  };
+  const st::Trial best = trial("backlash", 100.0, true);
+  std::map<std::string, st::Trial> trials = {
+      {"backlash", best},
+      {"presliding_friction", trial("presliding_friction", 100.1, true)},  // 1000 ln 1.001 + ln 1000 = 7.9
+      {"coulomb_friction", trial("coulomb_friction", 100.5, true)},        // 1000 ln 1.005 = 5.0
+      {"command_dead_band", trial("command_dead_band", 101.5, true)},      // 14.9: decided
+      {"gain_error", trial("gain_error", 100.0, false)},                   // failed a rule
+  };
+  const double n_eff = 1000.0;
+  const auto alts = st::CloseCalls(trials, best, n_eff, specs);
+  REQUIRE(alts.size() == 2);
+  CHECK(alts[0].name == "coulomb_friction");
+  CHECK(alts[0].delta_bic == doctest::Approx(1000.0 * std::log(1.005)));
+  CHECK(alts[1].name == "presliding_friction");
+  CHECK(alts[1].delta_bic == doctest::Approx(1000.0 * std::log(1.001) + std::log(1000.0)));
+  CHECK(alts[1].params.count("travel_mm") == 1);
 }
 
 TEST_CASE("PruneEffects: an effect that explains nothing is removed, two needed ones are kept") {

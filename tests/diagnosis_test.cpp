@@ -378,6 +378,10 @@ TEST_CASE("JSON: the contract's fields and keys") {
     CHECK(e["nrmse_" + ch + "_pct_after"].is_number());
     CHECK(e["shrink_pct"].is_number());
     CHECK(e["selected"].is_boolean());
+    if (name != "sensor_noise") {
+      CHECK(e["alternatives"].is_array());
+      CHECK(e["form_of"].is_string());
+    }
     REQUIRE(keys.count(name) == 1);
     for (const auto& k : keys.at(name)) CHECK(e["params"].contains(k));
     if (name == "sensor_noise") CHECK_FALSE(e["selected"].get<bool>());

@@ -12,6 +12,20 @@
 
 namespace rths::diagnosis::stages {
 
+std::vector<EffectResult::Alternative> CloseCalls(const std::map<std::string, Trial>& trials, const Trial& best,
+                                                  double n_eff, const std::vector<CandidateSpec>& specs) {
+  std::vector<EffectResult::Alternative> alts;
+  const int p_best = static_cast<int>(SpecOf(specs, best.name).params.size());
+  for (const auto& [name, t] : trials) {
+    if (name == best.name || !t.pass) continue;
+    const int p = static_cast<int>(SpecOf(specs, name).params.size());
+    const double d = n_eff * std::log(std::max(t.sse, 1e-300) / std::max(best.sse, 1e-300)) + (p - p_best) * std::log(n_eff);
+    if (d < tuning::kCloseCallBic) alts.push_back({name, std::max(0.0, d), ParamMap(specs, name, t.params.at(name))});
+  }
+  std::sort(alts.begin(), alts.end(), [](const auto& a, const auto& b) { return a.delta_bic < b.delta_bic; });
+  return alts;
+}
+
 void SelectEffects(ChannelState* sp, const std::vector<CandidateSpec>& specs, const Options& o) {
   ChannelState& s = *sp;
   const double dt = s.train.recs().front().dt;
@@ -49,17 +63,7 @@ void SelectEffects(ChannelState* sp, const std::vector<CandidateSpec>& specs, co
       if (t.pass && (!best || t.excess_red > best->excess_red)) best = t;
     }
     if (!best) break;
-    // Close calls: the other candidates that passed at this step, with BIC near the winner's.
-    std::vector<EffectResult::Alternative> alts;
-    const int p_best = static_cast<int>(SpecOf(specs, best->name).params.size());
-    for (const auto& [name, t] : s.last_trial) {
-      if (name == best->name || !t.pass) continue;
-      const int p = static_cast<int>(SpecOf(specs, name).params.size());
-      const double d = n_eff * std::log(std::max(t.sse, 1e-300) / std::max(best->sse, 1e-300)) + (p - p_best) * std::log(n_eff);
-      if (d < tuning::kCloseCallBic) alts.push_back({name, std::max(0.0, d), ParamMap(specs, name, t.params.at(name))});
-    }
-    std::sort(alts.begin(), alts.end(), [](const auto& a, const auto& b) { return a.delta_bic < b.delta_bic; });
-    s.alternatives[best->name] = alts;
+    s.alternatives[best->name] = CloseCalls(s.last_trial, *best, n_eff, specs);
     s.sel = best->params;
     s.order.push_back(best->name);
     s.sel_stats[best->name] = {best->excess_red, best->dbic};
