@@ -71,20 +71,14 @@ std::vector<std::string> CaseKinds(Generator g, bool pairs) {
   return g == Generator::kIndependent ? IndependentCaseKinds(pairs) : HarnessCaseKinds(pairs);
 }
 
-IndependentCase IndependentHarnessCase(const std::string& kind, std::uint64_t seed, double duration_s,
-                                       double noise_y_mm, double noise_f_kN) {
-  IndependentCase c;
-  IndependentTruth& t = c.truth;
-  // A stream of its own (not HarnessTruth's): another draw for the same seed.
-  auto g = signal::MakeGaussian(seed * 0x94D049BB133111EBULL + std::hash<std::string>{}(kind) % 1000003 + 17);
-  auto U = [&](double a, double b) { return a + (b - a) * signal::NextUniform(&g); };
-  auto side = [&](double a, double b, double c, double d) { return signal::NextUniform(&g) < 0.5 ? U(a, b) : U(c, d); };
-  auto pick = [&](int n) { return std::min(n - 1, static_cast<int>(std::floor(n * signal::NextUniform(&g)))); };
-  t.noise_y_mm = noise_y_mm;
-  t.noise_f_kN = noise_f_kN;
-  t.noise_seed = seed * 7727 + 3;
-  t.colour = NoiseColour::kAntiAliased;
-  t.drift_fraction = 0.5;
+namespace {
+
+/// Draws an independent case's true effects for `kind` from the stream g (in the documented ranges)
+/// into *t; returns them as text. Throws rths::Error for an unknown kind.
+std::string DrawIndependentTruth(const std::string& kind, signal::GaussianState* g, IndependentTruth* tp) {
+  IndependentTruth& t = *tp;
+  auto U = [&](double a, double b) { return a + (b - a) * signal::NextUniform(g); };
+  auto side = [&](double a, double b, double c, double d) { return signal::NextUniform(g) < 0.5 ? U(a, b) : U(c, d); };
   std::string txt;
   for (const auto& e : Split(kind)) {
     if (e == "pure_delay") {
@@ -144,6 +138,25 @@ IndependentCase IndependentHarnessCase(const std::string& kind, std::uint64_t se
       throw Error("harness", "unknown independent case kind " + kind);
     }
   }
+  return txt;
+}
+
+}  // namespace
+
+IndependentCase IndependentHarnessCase(const std::string& kind, std::uint64_t seed, double duration_s,
+                                       double noise_y_mm, double noise_f_kN) {
+  IndependentCase c;
+  IndependentTruth& t = c.truth;
+  // A stream of its own (not HarnessTruth's): another draw for the same seed.
+  auto g = signal::MakeGaussian(seed * 0x94D049BB133111EBULL + std::hash<std::string>{}(kind) % 1000003 + 17);
+  auto U = [&](double a, double b) { return a + (b - a) * signal::NextUniform(&g); };
+  auto pick = [&](int n) { return std::min(n - 1, static_cast<int>(std::floor(n * signal::NextUniform(&g)))); };
+  t.noise_y_mm = noise_y_mm;
+  t.noise_f_kN = noise_f_kN;
+  t.noise_seed = seed * 7727 + 3;
+  t.colour = NoiseColour::kAntiAliased;
+  t.drift_fraction = 0.5;
+  const std::string txt = DrawIndependentTruth(kind, &g, &t);
   // Training: a broad family (band noise to 40 Hz, a chirp 0.5-40 Hz or a multisine 0.5-30 Hz)
   // with a varying current; test: another family, narrower (band noise to 12 Hz, a multisine
   // 0.3-10 Hz, a chirp 0.3-10 Hz or an SDOF under El Centro), another varying current.
