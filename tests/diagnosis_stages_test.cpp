@@ -12,6 +12,7 @@
 #include "diagnosis/candidates.h"
 #include "diagnosis/diagnosis.h"
 #include "diagnosis/stages.h"
+#include "synthetic_records.h"
 #include "validation/synthetic.h"
 #include "models/servo_linear.h"
 
@@ -27,18 +28,7 @@ std::pair<rths::io::RigRecord, rths::io::RigRecord> Records(const m::EffectSet& 
   Truth truth;
   truth.effects = effects;
   truth.effects.sensor_noise = m::SensorNoise{0.01, 0.2};
-  Excitation tr;
-  tr.duration_s = 6.0;
-  tr.band_hz = 25.0;
-  tr.rms_mm = 4.0;
-  tr.seed = 3;
-  Excitation te = tr;
-  te.band_hz = 8.0;
-  te.rms_mm = 5.0;
-  te.seed = 1003;
-  Truth t2 = truth;
-  t2.noise_seed += 17;
-  return {MakeRecordBlocks(tr, truth, "train"), MakeRecordBlocks(te, t2, "test")};
+  return rths_test::Records(truth);
 }
 
 /// The displacement channel of one training and one test record, as Diagnose sets it up.

@@ -22,6 +22,7 @@
 #include "core/error.h"
 #include "diagnosis/diagnosis.h"
 #include "diagnosis/report_figures.h"
+#include "synthetic_records.h"
 #include "validation/synthetic.h"
 #include "io/rig_record.h"
 #include "test_support.h"
@@ -43,26 +44,7 @@ fs::path TempDir(const std::string& name) {
   return p;
 }
 
-/// Short training (BLWN 0-25 Hz) and test (BLWN 0-8 Hz) records from the effect blocks (or from
-/// `make`); `edit` changes the training excitation before the test one is derived from it.
-std::pair<rths::io::RigRecord, rths::io::RigRecord> Records(
-    const Truth& truth, double duration_s = 6.0, std::uint64_t seed = 3,
-    const std::function<void(Excitation*)>& edit = {},
-    rths::io::RigRecord (*make)(const Excitation&, const Truth&, const std::string&) = &MakeRecordBlocks) {
-  Excitation tr;
-  tr.duration_s = duration_s;
-  tr.band_hz = 25.0;
-  tr.rms_mm = 4.0;
-  tr.seed = seed;
-  if (edit) edit(&tr);
-  Excitation te = tr;
-  te.band_hz = 8.0;
-  te.rms_mm = 5.0;
-  te.seed = seed + 1000;
-  Truth t2 = truth;
-  t2.noise_seed += 17;
-  return {make(tr, truth, "train"), make(te, t2, "test")};
-}
+using rths_test::Records;
 
 Truth Noisy() {
   Truth t;
@@ -818,19 +800,12 @@ TEST_CASE("an effect the test records do not exercise is named unconfirmed, with
   // structured but the limit cannot show there.
   Truth t = Noisy();
   t.effects.servovalve_saturation = m::ServovalveSaturation{250.0};
-  Excitation tr;
-  tr.duration_s = 8.0;
-  tr.band_hz = 25.0;
-  tr.rms_mm = 4.0;
-  tr.seed = 5;
-  Excitation te = tr;
-  te.band_hz = 2.0;
-  te.rms_mm = 2.0;
-  te.seed = 1005;
-  Truth t2 = t;
-  t2.noise_seed += 17;
-  t2.ripple_mm = 0.05;
-  const auto r = Diagnose({MakeRecordBlocks(tr, t, "train")}, {MakeRecordBlocks(te, t2, "test")}, PaperModel(), Options{});
+  const auto [tr, te] = Records(t, 8.0, 5, {}, &MakeRecordBlocks, [](Excitation* e, Truth* tt) {
+    e->band_hz = 2.0;
+    e->rms_mm = 2.0;
+    tt->ripple_mm = 0.05;
+  });
+  const auto r = Diagnose({tr}, {te}, PaperModel(), Options{});
   const std::string summary = Summary(r);
   INFO(summary);
   CHECK(r.verdict == std::vector<std::string>{"servovalve_saturation"});

@@ -184,8 +184,9 @@ void ScoreCandidates(ChannelState* sp, const std::vector<CandidateSpec>& specs, 
     e.shrink_pct = ShrinkPct(before, e.test_nrmse_after);
     e.excess_reduction = t.excess_red;
     e.delta_bic = t.dbic;
-    for (const auto& spec : specs)
-      if (spec.name == name) e.at_bound = AtBound(spec, t.params.at(name)), e.form_of = FormOf(spec, t.params.at(name));
+    const CandidateSpec& spec = SpecOf(specs, name);
+    e.at_bound = AtBound(spec, t.params.at(name));
+    e.form_of = FormOf(spec, t.params.at(name));
     (*er)[name] = e;
   }
 }

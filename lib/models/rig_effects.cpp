@@ -95,7 +95,8 @@ const std::array<EffectInfo, 12> kEffects = {{
         FieldOf<&EffectSet::damper_scale, &DamperScale::scale>},
        kNoParam}},
      1, TurnOn<&EffectSet::damper_scale>, IsOn<&EffectSet::damper_scale>},
-    // travel -> 0 is backlash: a travel at the search's floor is not presliding (AtBound).
+    // travel -> 0 is backlash: a fit that does not creep after a reversal is named backlash's
+    // form by the diagnosis (diagnosis/candidates.h FormOf), not selected.
     {"presliding_friction", 'y', true,
      {{{"loss_mm", 0.0, 10.0, false, false, 0.0, true, true, 1e-3, 10.0, true, 21, 0.0, false,
         FieldOf<&EffectSet::presliding_friction, &PreslidingFriction::loss_mm>},

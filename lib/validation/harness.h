@@ -54,13 +54,16 @@ struct HarnessCase {
   double runtime_s = 0;
 };
 
-/// The case kinds of the rig and blocks generators: 9 single effects, pairs, "none",
+/// The case kinds of the rig and blocks generators: the 11 single effects (every diagnosable entry
+/// of models::kEffects), pairs, "none",
 /// "unknown_ripple", "unknown_stiffness".
 std::vector<std::string> HarnessCaseKinds(bool pairs);
 
-/// The case kinds of the independent generator: the 9 single effects (its own forms), pairs
+/// The case kinds of the independent generator: the 11 single effects (its own forms), pairs
 /// (load_coupling+gain_error, backlash+oil_column_resonance, pure_delay+damper_scale,
-/// gain_error+current_lag, oil_column_resonance+coulomb_friction, servovalve_saturation+current_lag),
+/// gain_error+current_lag, oil_column_resonance+coulomb_friction, servovalve_saturation+current_lag,
+/// presliding_friction+damper_scale, command_dead_band+oil_column_resonance,
+/// pure_delay+presliding_friction),
 /// "none" (anti-aliased noise with drift), "none_white" (white noise, no drift), "none_drift" (a
 /// random-walk sensor drift of 0.5-1.5 x the noise rms on both channels), and outside the
 /// library "unknown_ripple" (amplitude-modulated, 11-17 Hz), "unknown_cubic" (F += k3 y^3),

@@ -85,6 +85,16 @@ void ScaleToRms(std::vector<double>* v, double rms) {
     for (double& x : *v) x *= rms / r;
 }
 
+/// A random walk of n samples from 0, scaled to rms `rms` over the record (0 if rms is 0).
+std::vector<double> RandomWalk(std::size_t n, double rms, std::uint64_t seed) {
+  std::vector<double> w(n, 0.0);
+  if (!(rms > 0) || n < 2) return w;
+  auto g = signal::MakeGaussian(seed);
+  for (std::size_t k = 1; k < n; ++k) w[k] = w[k - 1] + signal::NextGaussian(&g);
+  ScaleToRms(&w, rms);
+  return w;
+}
+
 /// Raised-cosine fade-in over the first `s` seconds (the record starts at rest).
 void FadeIn(std::vector<double>* v, double dt, double s) {
   const auto nf = static_cast<std::size_t>(std::lround(s / dt));
@@ -336,8 +346,9 @@ class ContinuousRig {
       const double base = std::clamp(1.0 - s[kPs] * sg / L, 0.0, 2.0);
       const double dps = sigma * yv * std::pow(base, 1.5);
       d[kPs] = dps;
-      y -= s[kPs], yv -= dps;
+      // |d dps / d phi| at the input's velocity, before the output's replaces it.
       lam = std::max(lam, 1.5 * sigma * std::abs(yv) * std::sqrt(base) / L);
+      y -= s[kPs], yv -= dps;
     }
     if (bl_) {
       const double e = y - s[kYb];
@@ -495,23 +506,6 @@ std::vector<double> IndependentNoise(std::size_t n, double dt, double rms, Noise
   }
   return v;
 }
-
-namespace {
-
-/// A random walk of n samples from 0, scaled to rms `rms` over the record (0 if rms is 0).
-std::vector<double> RandomWalk(std::size_t n, double rms, std::uint64_t seed) {
-  std::vector<double> w(n, 0.0);
-  if (!(rms > 0) || n < 2) return w;
-  auto g = signal::MakeGaussian(seed);
-  for (std::size_t k = 1; k < n; ++k) w[k] = w[k - 1] + signal::NextGaussian(&g);
-  double ss = 0.0;
-  for (double x : w) ss += x * x;
-  const double scale = rms / std::sqrt(ss / static_cast<double>(n));
-  for (double& x : w) x *= scale;
-  return w;
-}
-
-}  // namespace
 
 io::RigRecord MakeIndependentRecord(const IndependentExcitation& ex, const IndependentTruth& truth,
                                     const std::string& name) {

@@ -144,7 +144,8 @@ void MakeIndependentInputs(const IndependentExcitation& ex, std::vector<double>*
 
 /// Noise-free samples y_k [mm], f_k [kN] at t_k = k dt of the truth driven by u, i (file comment):
 /// y_0 = 0, f_0 = the force at rest. The ripple and noise are not included. Throws rths::Error if
-/// the truth combines load_coupling with coulomb_friction or backlash (not modelled).
+/// the truth combines load_coupling with coulomb_friction, presliding_friction or backlash (not
+/// modelled).
 struct IndependentTraces {
   std::vector<double> y_mm, f_kN;
   std::size_t substeps_max = 0;   ///< largest number of RK4 substeps a record step took
