@@ -23,7 +23,7 @@ TEST_CASE("harness (rig mode): confusion table and held-out shrink meet the harn
   o.generator = Generator::kRig;
   o.pairs = true;
   const auto sc = rths_test::RunHarnessReported(o);
-  REQUIRE(sc.single_n == 11 * o.seeds);  // the diagnosable effects of models::kEffects
+  REQUIRE(sc.single_n == 12 * o.seeds);  // the diagnosable effects of models::kEffects
   REQUIRE(sc.pair_n > 0);
   REQUIRE(sc.none_n == o.seeds);
   REQUIRE(sc.unknown_n == 2 * o.seeds);
@@ -40,7 +40,7 @@ TEST_CASE("harness (effect blocks, one seed): confusion table and held-out shrin
   o.generator = Generator::kBlocks;
   o.pairs = true;
   const auto sc = rths_test::RunHarnessReported(o);
-  REQUIRE(sc.single_n == 11);
+  REQUIRE(sc.single_n == 12);
   REQUIRE(sc.none_n == 1);
   REQUIRE(sc.unknown_n == 2);
   rths_test::CheckHarnessTargets(sc);

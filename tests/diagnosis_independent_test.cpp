@@ -188,8 +188,8 @@ TEST_CASE("harness (independent generator): confusion table and held-out shrink 
   o.pairs = true;
   o.ground_g = ElCentroG();
   const auto sc = rths_test::RunHarnessReported(o);
-  REQUIRE(sc.single_n == 11 * o.seeds);
-  REQUIRE(sc.pair_n == 9 * o.seeds);
+  REQUIRE(sc.single_n == 12 * o.seeds);
+  REQUIRE(sc.pair_n == 10 * o.seeds);
   REQUIRE(sc.none_n == 3 * o.seeds);
   REQUIRE(sc.unknown_n == 3 * o.seeds);
   rths_test::CheckHarnessTargets(sc);

@@ -2,6 +2,7 @@
 // from the effect blocks: the nominal scoring, the greedy selection, the pruning, the held-out
 // retention and the shrink rule, each run on a channel state set up by hand.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <map>
 #include <string>
@@ -11,10 +12,12 @@
 
 #include "diagnosis/candidates.h"
 #include "diagnosis/diagnosis.h"
+#include "diagnosis/ripple_fit.h"
 #include "diagnosis/stages.h"
 #include "synthetic_records.h"
 #include "validation/synthetic.h"
 #include "models/servo_linear.h"
+#include "signal/random.h"
 
 using namespace rths::diagnosis;
 using namespace rths::validation;
@@ -101,7 +104,7 @@ TEST_CASE("SelectEffects: picks the known effect and its parameter, and nothing 
   st::ScoreNominal(&noise.s(), o);
   st::SelectEffects(&noise.s(), noise.specs, o);
   CHECK(noise.s().order.empty());
-  CHECK(noise.s().last_trial.size() == 9);  // every displacement candidate tried
+  CHECK(noise.s().last_trial.size() == 10);  // every displacement candidate tried
 }
 
 TEST_CASE("lost motion: presliding is told from backlash by its creep after a reversal") {
@@ -150,7 +153,7 @@ TEST_CASE("CloseCalls: the passing trials of a step within kCloseCallBic of the 
       {"gain_error", trial("gain_error", 100.0, false)},                   // failed a rule
   };
   const double n_eff = 1000.0;
-  const auto alts = st::CloseCalls(trials, best, n_eff, specs);
+  const auto alts = st::CloseCalls(trials, best, n_eff, specs, 1);
   REQUIRE(alts.size() == 2);
   CHECK(alts[0].name == "coulomb_friction");
   CHECK(alts[0].delta_bic == doctest::Approx(1000.0 * std::log(1.005)));
@@ -272,4 +275,50 @@ TEST_CASE("ApplyShrinkRule: a selection short of min_test_shrink_pct is not reta
     if (kept) CHECK(y.s().summary.after_test_pct < 0.5 * y.s().summary.gap_test_pct);
     else CHECK(y.s().summary.after_test_pct == y.s().summary.gap_test_pct);
   }
+}
+
+TEST_CASE("supply_ripple's closed form: amplitude and phase per harmonic, an aliased one included") {
+  // A residual with a ripple at 380 Hz sampled at 2 kHz: its third harmonic (1140 Hz) is folded to
+  // 860 Hz. Harmonic sizes and phases not the library's shape.
+  const double dt = 0.0005, f = 380.0;
+  const std::size_t n = 8000, first = 400;
+  const std::array<double, 6> truth{0.02, -0.01, 0.004, 0.007, -0.003, 0.002};  // s1 c1 s2 c2 s3 c3 [mm]
+  auto g = rths::signal::MakeGaussian(5);
+  std::vector<double> e(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    const double w = 2 * M_PI * f * static_cast<double>(k) * dt;
+    for (int h = 0; h < 3; ++h) e[k] += truth[2 * h] * std::sin((h + 1) * w) + truth[2 * h + 1] * std::cos((h + 1) * w);
+    e[k] += 0.01 * rths::signal::NextGaussian(&g);
+  }
+  const RippleFit r = FitRipple(e, dt, f, first);
+  for (int j = 0; j < 6; ++j) CHECK(std::abs(r.coef[j] - truth[j]) < 6e-4);  // 4 x sigma sqrt(2 / n)
+  CHECK(r.FundamentalAmplitude() == doctest::Approx(std::hypot(0.02, 0.01)).epsilon(0.03));
+  // The fit leaves the noise: its SSE is about (n - first - 6) sigma^2.
+  CHECK(RippleSse(e, dt, f, first) / static_cast<double>(n - first) == doctest::Approx(1e-4).epsilon(0.1));
+  // The harmonic spectrum's peak is within one line width (1 / T) of f, not at a harmonic.
+  const double peak = RipplePeakHz({e}, {first}, dt, 20.0, 900.0);
+  CHECK(std::abs(peak - f) < 1.0 / ((n - first) * dt));
+  // Its rate is the sum's exact derivative (against a central difference at a thousandth of dt).
+  const double hs = dt / 1000.0;
+  for (std::size_t k : {1000u, 3333u}) {
+    const double num = (r.Value(1000 * k + 1, hs) - r.Value(1000 * k - 1, hs)) / (2.0 * hs);
+    CHECK(r.Rate(k, dt) == doctest::Approx(num).epsilon(1e-4));
+  }
+}
+
+TEST_CASE("SelectEffects: a pump's ripple is selected as supply_ripple, its frequency to a fraction of its line width") {
+  const Options o;
+  m::EffectSet ripple;
+  ripple.supply_ripple = m::SupplyRipple{173.3, 0.03};
+  YChannel y(ripple);
+  st::ScoreNominal(&y.s(), o);
+  REQUIRE(y.s().structured);
+  st::SelectEffects(&y.s(), y.specs, o);
+  REQUIRE(y.s().order == std::vector<std::string>{"supply_ripple"});
+  CHECK(y.s().sel.at("supply_ripple")[0] == doctest::Approx(173.3).epsilon(1e-4));
+  CHECK(y.s().sel.at("supply_ripple")[1] == doctest::Approx(0.03).epsilon(0.05));
+  // At the floor afterwards: the ripple's 6 coefficients take no more than their share of noise.
+  CHECK(y.s().sse / static_cast<double>(y.s().n_train) <= 1.1 * y.s().var_floor);
+  // Its BIC counts the frequency and 2 x 3 coefficients per record.
+  CHECK(st::FreeParams(st::SpecOf(y.specs, "supply_ripple"), 2) == 13);
 }

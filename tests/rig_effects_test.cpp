@@ -171,6 +171,25 @@ TEST_CASE("command_dead_band: the actuator gets no command within width/2 of its
   CHECK(d.Pre(0.0) == doctest::Approx(0.2));
 }
 
+TEST_CASE("supply_ripple adds the library's harmonic shape at t_k = k dt, from Reset") {
+  EffectSet e;
+  e.supply_ripple = SupplyRipple{150.0, 0.02};
+  DisplacementEffects d(e, kDt);
+  CHECK(d.PreIsIdentity());  // it acts on the output only
+  auto expected = [](int k) {
+    const double t = k * kDt;
+    return 0.02 * (std::sin(2 * M_PI * 150.0 * t) + 0.5 * std::sin(2 * M_PI * 300.0 * t + 1.0) +
+                   0.25 * std::sin(2 * M_PI * 450.0 * t + 2.0));
+  };
+  for (int k = 0; k < 50; ++k) CHECK(d.Post(1.0, 0.0) == doctest::Approx(1.0 + expected(k)).epsilon(1e-12));
+  d.Reset();
+  CHECK(d.Post(0.0, 0.0) == doctest::Approx(expected(0)).epsilon(1e-12));  // sin(0) + 0.5 sin 1 + 0.25 sin 2
+  CHECK(expected(0) != 0.0);
+  EffectSet bad;
+  bad.supply_ripple = SupplyRipple{1000.0, 0.01};  // at the Nyquist frequency 0.5 / dt
+  CHECK_THROWS_AS(DisplacementEffects(bad, kDt), Error);
+}
+
 TEST_CASE("current_lag is a first-order lag; damper_scale scales") {
   EffectSet e;
   e.current_lag = CurrentLag{10.0};
@@ -212,6 +231,7 @@ TEST_CASE("the per-step calls allocate nothing") {
   e.backlash = Backlash{0.05};
   e.presliding_friction = PreslidingFriction{0.03, 0.05};
   e.command_dead_band = CommandDeadBand{0.02};
+  e.supply_ripple = SupplyRipple{120.0, 0.01};
   e.current_lag = CurrentLag{5.0};
   e.damper_scale = DamperScale{1.2};
   DisplacementEffects d(e, kDt);

@@ -60,6 +60,11 @@ const CandidateSpec& SpecOf(const std::vector<CandidateSpec>& c, const std::stri
   throw Error("diagnosis", "unknown effect " + name);
 }
 
+int FreeParams(const CandidateSpec& spec, std::size_t records) {
+  if (spec.name == "supply_ripple") return 1 + 2 * models::kRippleHarmonics * static_cast<int>(records);
+  return static_cast<int>(spec.params.size());
+}
+
 bool AtBound(const CandidateSpec& spec, const std::vector<double>& v) {
   for (std::size_t j = 0; j < spec.params.size() && j < v.size(); ++j) {
     const auto& p = spec.params[j];

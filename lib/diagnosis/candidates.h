@@ -15,6 +15,11 @@ namespace rths::diagnosis::stages {
 /// The candidate named `name`; throws rths::Error for an unknown name.
 const CandidateSpec& SpecOf(const std::vector<CandidateSpec>& c, const std::string& name);
 
+/// The number of parameters a candidate's fit is free in over `records` records (the BIC's p): its
+/// fitted parameters; for supply_ripple its frequency and the amplitude and phase of each of its
+/// models::kRippleHarmonics harmonics per record (its reported amplitude is theirs).
+int FreeParams(const CandidateSpec& spec, std::size_t records);
+
 /// true if a fitted parameter sits on an end of its search range (within tuning::kAtBoundFraction
 /// of the range, in log space for log parameters; a closed-form fit is clipped to its range): the
 /// effect's model does not describe the residual there, so it is not selected (e.g. a "resonance"

@@ -106,7 +106,7 @@ std::vector<std::vector<double>> Channel::Predict(const models::EffectSet& set, 
   std::vector<std::vector<double>> out;
   out.reserve(recs_->size());
   if (ch_ == 'y') {
-    for (const auto& d : *recs_) out.push_back(PredictDisplacement(*servo_, set, d.u, d.f));
+    for (const auto& d : *recs_) out.push_back(PredictDisplacement(*servo_, set, d.u, d.f, nullptr, nullptr, d.y, d.first));
     return out;
   }
   for (const auto& d : *recs_) out.push_back(fp_->PredictUnscaled(d.motion, d.i, set));

@@ -1,4 +1,5 @@
 #include "diagnosis/channel_models.h"
+#include "diagnosis/ripple_fit.h"
 
 #include <algorithm>
 #include <cmath>
@@ -140,7 +141,25 @@ SmoothedMotion ModelAidedMotion(std::span<const double> y_mm, std::span<const do
 
 std::vector<double> PredictDisplacement(const models::LinearServo& servo, const models::EffectSet& effects,
                                         std::span<const double> u_mm, std::span<const double> f_kN,
-                                        std::vector<double>* v_mm_s, std::vector<double>* a_mm_s2) {
+                                        std::vector<double>* v_mm_s, std::vector<double>* a_mm_s2,
+                                        std::span<const double> y_meas_mm, std::size_t first) {
+  const bool fit_ripple = effects.supply_ripple.has_value() && !y_meas_mm.empty();
+  if (fit_ripple && y_meas_mm.size() != u_mm.size())
+    throw Error("PredictDisplacement", fmt::format("y has {} samples, u {}", y_meas_mm.size(), u_mm.size()));
+  if (fit_ripple) {
+    models::EffectSet rest = effects;
+    rest.supply_ripple.reset();
+    std::vector<double> y = PredictDisplacement(servo, rest, u_mm, f_kN, v_mm_s, a_mm_s2);
+    std::vector<double> e(y.size());
+    for (std::size_t k = 0; k < y.size(); ++k) e[k] = y_meas_mm[k] - y[k];
+    const RippleFit r = FitRipple(e, servo.dt_s, effects.supply_ripple->f_hz, first);
+    for (std::size_t k = 0; k < y.size(); ++k) {
+      y[k] += r.Value(k, servo.dt_s);
+      if (v_mm_s != nullptr) (*v_mm_s)[k] += r.Rate(k, servo.dt_s);
+      if (a_mm_s2 != nullptr) (*a_mm_s2)[k] += r.Acceleration(k, servo.dt_s);
+    }
+    return y;
+  }
   const std::size_t n = u_mm.size();
   std::vector<double> y(n);
   std::vector<double> servo_v, servo_a;  // the servo's exact velocity z1 and acceleration z2 at t_k

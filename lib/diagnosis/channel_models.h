@@ -127,11 +127,16 @@ SmoothedMotion ModelAidedMotion(std::span<const double> y_mm, std::span<const do
 /// state y-dot) plus the difference quotient of what the output effects add to its displacement.
 /// a_mm_s2 (optional, with v_mm_s): its acceleration [mm/s^2], the servo's exact y'' plus the
 /// difference quotient of the effects' velocity share.
+/// y_meas_mm (optional): the measured y. With it, supply_ripple (if on) is not the library's shape
+/// but the least-squares ripple at its f_hz in y_meas - (the prediction without it) over k >= first
+/// (FitRipple: amplitude and phase per harmonic, per record), and its exact derivatives are added
+/// to v and a.
 std::vector<double> PredictDisplacement(const models::LinearServo& servo,
                                         const models::EffectSet& effects,
                                         std::span<const double> u_mm, std::span<const double> f_kN,
                                         std::vector<double>* v_mm_s = nullptr,
-                                        std::vector<double>* a_mm_s2 = nullptr);
+                                        std::vector<double>* a_mm_s2 = nullptr,
+                                        std::span<const double> y_meas_mm = {}, std::size_t first = 0);
 
 /// Force channel predictor: an immutable description (damper, current dynamics, dt).
 class ForcePredictor {

@@ -93,7 +93,7 @@ void SetForceMotion(std::vector<Data>* train, std::vector<Data>* test, const Cha
   // residual's.
   auto motion = [&](const Data& d) {
     std::vector<double> vhat, ahat;
-    const std::vector<double> yhat = PredictDisplacement(servo, y.fin_set, d.u, d.f, &vhat, &ahat);
+    const std::vector<double> yhat = PredictDisplacement(servo, y.fin_set, d.u, d.f, &vhat, &ahat, d.y, d.first);
     return ModelAidedMotion(d.y, yhat, vhat, dt, MotionCutoffHz(o, dt), ahat);
   };
   for (auto& d : *train) d.motion = motion(d);

@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "diagnosis/candidates.h"
+#include "diagnosis/ripple_fit.h"
 #include "diagnosis/search.h"
 #include "diagnosis/tuning.h"
 
@@ -78,6 +79,45 @@ double FitTwoParams(const ParamSpec& a, const ParamSpec& b, const std::vector<do
   return best;
 }
 
+/// supply_ripple in closed form (ripple_fit.h): the residual of the set without it; its frequency
+/// the peak of the residual's harmonic spectrum (a refit: the current one), refined by golden
+/// section on the SSE within one spectral line width 1/T of it (T: the shortest record's span);
+/// its amplitude the training records' mean fundamental.
+double FitSupplyRipple(const Channel& ch, const std::vector<CandidateSpec>& specs, Params* p, const std::string& name) {
+  const ParamSpec& fr = SpecOf(specs, name).params[0];
+  Params q = *p;
+  const auto cur = q.find(name);
+  const double f_cur = cur == q.end() ? 0.0 : cur->second[0];
+  q.erase(name);
+  const auto base = ch.Predict(ToSet(specs, q));
+  const double dt = ch.recs().front().dt;
+  std::vector<std::vector<double>> e(base.size());
+  std::vector<std::size_t> first(base.size());
+  double span_s = std::numeric_limits<double>::infinity();
+  for (std::size_t r = 0; r < base.size(); ++r) {
+    const auto meas = ch.Meas(r);
+    e[r].resize(meas.size());
+    for (std::size_t k = 0; k < meas.size(); ++k) e[r][k] = meas[k] - base[r][k];
+    first[r] = ch.recs()[r].first;
+    span_s = std::min(span_s, static_cast<double>(meas.size() - first[r]) * dt);
+  }
+  const double fc = f_cur > 0.0 ? f_cur : RipplePeakHz(e, first, dt, fr.lo, fr.hi);
+  const ParamSpec bracket{fr.key, std::max(fr.lo, fc - 1.0 / span_s), std::min(fr.hi, fc + 1.0 / span_s), false,
+                          tuning::kRippleBracketGrid};
+  auto sse = [&](double f) {
+    double s = 0.0;
+    for (std::size_t r = 0; r < e.size(); ++r) s += RippleSse(e[r], dt, f, first[r]);
+    return s;
+  };
+  double best = 0.0;
+  const double f = Minimise1D(sse, bracket, tuning::kGoldenItersY, &best, {fc});
+  double amp = 0.0;
+  for (std::size_t r = 0; r < e.size(); ++r) amp += FitRipple(e[r], dt, f, first[r]).FundamentalAmplitude();
+  amp /= static_cast<double>(e.size());
+  (*p)[name] = {f, std::clamp(amp, SpecOf(specs, name).params[1].lo, SpecOf(specs, name).params[1].hi)};
+  return best;
+}
+
 }  // namespace
 
 double FitEffect(const Channel& ch, const std::vector<CandidateSpec>& specs, Params* p, const std::string& name,
@@ -90,6 +130,7 @@ double FitEffect(const Channel& ch, const std::vector<CandidateSpec>& specs, Par
     (*p)[name] = {s};
     return ch.Sse(pred);
   }
+  if (name == "supply_ripple") return FitSupplyRipple(ch, specs, p, name);
   const bool refit = p->count(name) > 0;
   const std::vector<double> cur = refit ? (*p)[name] : std::vector<double>{};
   // A non-finite SSE (an overflow on absurd data) ranks last, so the searches below always

@@ -13,12 +13,13 @@
 namespace rths::diagnosis::stages {
 
 std::vector<EffectResult::Alternative> CloseCalls(const std::map<std::string, Trial>& trials, const Trial& best,
-                                                  double n_eff, const std::vector<CandidateSpec>& specs) {
+                                                  double n_eff, const std::vector<CandidateSpec>& specs,
+                                                  std::size_t records) {
   std::vector<EffectResult::Alternative> alts;
-  const int p_best = static_cast<int>(SpecOf(specs, best.name).params.size());
+  const int p_best = FreeParams(SpecOf(specs, best.name), records);
   for (const auto& [name, t] : trials) {
     if (name == best.name || !t.pass) continue;
-    const int p = static_cast<int>(SpecOf(specs, name).params.size());
+    const int p = FreeParams(SpecOf(specs, name), records);
     const double d = n_eff * std::log(std::max(t.sse, 1e-300) / std::max(best.sse, 1e-300)) + (p - p_best) * std::log(n_eff);
     if (d < tuning::kCloseCallBic) alts.push_back({name, std::max(0.0, d), ParamMap(specs, name, t.params.at(name))});
   }
@@ -44,7 +45,7 @@ void SelectEffects(ChannelState* sp, const std::vector<CandidateSpec>& specs, co
       double sse = FitEffect(s.train, specs, &t.params, spec.name, o);
       sse = RefitAll(s.train, specs, &t.params, sse, tuning::kTrialRefitRounds, o);  // joint refit
       t.sse = sse;
-      const int p = static_cast<int>(spec.params.size());
+      const int p = FreeParams(spec, s.train.recs().size());
       t.dbic = n_eff * std::log(std::max(sse, 1e-300) / std::max(s.sse, 1e-300)) + p * std::log(n_eff);
       t.excess_red = excess > 0 ? (s.sse - sse) / excess : 0.0;
       // The candidate's own share: the trial's set without it (the others as refitted).
@@ -63,7 +64,7 @@ void SelectEffects(ChannelState* sp, const std::vector<CandidateSpec>& specs, co
       if (t.pass && (!best || t.excess_red > best->excess_red)) best = t;
     }
     if (!best) break;
-    s.alternatives[best->name] = CloseCalls(s.last_trial, *best, n_eff, specs);
+    s.alternatives[best->name] = CloseCalls(s.last_trial, *best, n_eff, specs, s.train.recs().size());
     s.sel = best->params;
     s.order.push_back(best->name);
     s.sel_stats[best->name] = {best->excess_red, best->dbic};

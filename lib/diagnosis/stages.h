@@ -193,8 +193,10 @@ void SelectEffects(ChannelState* s, const std::vector<CandidateSpec>& specs, con
 /// The close calls of the step that selects `best`: every other trial of the step that passed
 /// every rule and whose BIC, n_eff ln(SSE_t / SSE_best) + (p_t - p_best) ln n_eff, is below
 /// tuning::kCloseCallBic above best's (clipped at 0), closest first (EffectResult::alternatives).
+/// p counts FreeParams over `records` training records.
 std::vector<EffectResult::Alternative> CloseCalls(const std::map<std::string, Trial>& trials, const Trial& best,
-                                                  double n_eff, const std::vector<CandidateSpec>& specs);
+                                                  double n_eff, const std::vector<CandidateSpec>& specs,
+                                                  std::size_t records);
 /// Up to o.swap_passes times: the effect of the set whose replacement by another candidate (fitted,
 /// then the set refitted) lowers the training SSE the most, by more than tuning::kSwapMinGain of it, is
 /// replaced. Each swap is a warning.

@@ -67,6 +67,9 @@ inline constexpr double kCloseCallBic = 10.0;
 // --- parameter search (one effect) and joint refits (coordinate-wise)
 /// Golden-section iterations after the full-range grid: y effects ...
 inline constexpr int kGoldenItersY = 24;
+/// supply_ripple: grid points over the bracket of +- one spectral line width around the harmonic
+/// spectrum's peak, before golden section (diagnosis/fit.cpp FitSupplyRipple).
+inline constexpr int kRippleBracketGrid = 9;
 /// ... force effects (each evaluation re-simulates the damper, so fewer).
 inline constexpr int kGoldenItersF = 12;
 /// Golden-section iterations of a local refit: y effects ...

@@ -38,7 +38,7 @@ constexpr EffectParam kNoParam{};
 
 }  // namespace
 
-const std::array<EffectInfo, 12> kEffects = {{
+const std::array<EffectInfo, 13> kEffects = {{
     {"pure_delay", 'y', true,
      {{{"tau_ms", 0.0, 100.0, false, false, 0.0, true, true, 0.0, 40.0, false, 81, 0.0, false,
         FieldOf<&EffectSet::pure_delay, &PureDelay::tau_ms>},
@@ -108,6 +108,16 @@ const std::array<EffectInfo, 12> kEffects = {{
         FieldOf<&EffectSet::command_dead_band, &CommandDeadBand::width_mm>},
        kNoParam}},
      1, TurnOn<&EffectSet::command_dead_band>, IsOn<&EffectSet::command_dead_band>},
+    // grid 0: closed form (diagnosis/ripple_fit.h): the frequency from the residual's harmonic
+    // spectrum, searched from 20 Hz (below, a periodic disturbance overlaps the tests' excitation
+    // bands and is not a pump's piston frequency) to 0.45 / dt; the amplitude is the fundamental's,
+    // fitted per record with the harmonics' phases and reported as their mean.
+    {"supply_ripple", 'y', true,
+     {{{"f_hz", 0.0, kInf, true, true, 0.5, true, true, 20.0, 0.0, true, 0, 0.45, false,
+        FieldOf<&EffectSet::supply_ripple, &SupplyRipple::f_hz>},
+       {"amplitude_mm", 0.0, 10.0, false, false, 0.0, true, true, 1e-6, 10.0, true, 0, 0.0, false,
+        FieldOf<&EffectSet::supply_ripple, &SupplyRipple::amplitude_mm>}}},
+     2, TurnOn<&EffectSet::supply_ripple>, IsOn<&EffectSet::supply_ripple>},
 }};
 
 const EffectInfo* FindEffect(std::string_view name) {
@@ -189,6 +199,7 @@ void DisplacementEffects::Reset() {
   dahl_prev_in_ = 0.0;
   dahl_z_ = 0.0;
   x_last_ = 0.0;
+  post_k_ = 0;
 }
 
 bool DisplacementEffects::PreIsIdentity() const {
@@ -252,6 +263,14 @@ double DisplacementEffects::Post(double x_mm, double f_kN) {
     else if (y - play_out_ < -h) play_out_ = y + h;
     y = play_out_;
   }
+  if (e_.supply_ripple) {
+    const double t = static_cast<double>(post_k_) * dt_s_;
+    double r = 0.0;
+    for (int h = 0; h < kRippleHarmonics; ++h)
+      r += kRippleWeights[h] * std::sin(2.0 * M_PI * (h + 1) * e_.supply_ripple->f_hz * t + kRipplePhases[h]);
+    y += e_.supply_ripple->amplitude_mm * r;
+  }
+  ++post_k_;
   return y;
 }
 

@@ -11,7 +11,7 @@
 ///                           --> actuator model --> x_k
 ///                       x_k --[oil_column_resonance]--[servovalve_saturation]
 ///                           --[load_coupling (- c f)]--[coulomb_friction]--[presliding_friction]
-///                           --[backlash]--> y_k
+///                           --[backlash]--[supply_ripple (+)]--> y_k
 ///   force path          i_k --[current_lag]--> model's current dynamics (Eq. 40 + 75 Hz) --> i_c
 ///                       damper model (Eqs. 32-39) at (y, y', i_c) --[damper_scale]--> f_k
 ///   both channels       + sensor_noise (rig mode only: the diagnosis never adds noise)
@@ -76,6 +76,25 @@ struct PreslidingFriction {
 /// the actuator gets no flow and stops (a play inside the loop, filtered by the actuator's
 /// dynamics, where backlash is a play on its output).
 struct CommandDeadBand { double width_mm = 0.0; bool operator==(const CommandDeadBand&) const = default; };  ///< [0, 10] mm
+/// Hydraulic supply (pump) ripple: the pump's pressure pulsation at its piston frequency f and its
+/// harmonics moves the actuator at frequencies the servo loop does not follow, an additive
+/// periodic motion of the specimen (the damper sees it too):
+///     y_k += amplitude sum_{h=1..kRippleHarmonics} w_h sin(2 pi h f t_k + phi_h),  t_k = k dt
+/// from the block's Reset, with the library's shape w = (1, 0.5, 0.25), phi = (0, 1, 2) rad. A
+/// harmonic above the Nyquist frequency is sampled as it comes (aliased), as an unfiltered
+/// sensor would see it. The diagnosis does not assume this shape: it fits the amplitude and phase
+/// of every harmonic per record (a pump is not synchronised with the test; docs/diagnosis.md
+/// "Supply ripple"), and reports the fundamental's amplitude.
+struct SupplyRipple {
+  double f_hz = 200.0;        ///< the pump's fundamental [Hz], (0, 0.5/dt)
+  double amplitude_mm = 0.0;  ///< the fundamental's amplitude [mm], [0, 10]
+  bool operator==(const SupplyRipple&) const = default;
+};
+/// Harmonics of SupplyRipple (the fundamental included).
+inline constexpr int kRippleHarmonics = 3;
+/// The library's shape of SupplyRipple: amplitude weight and phase [rad] of harmonic h = 1, 2, 3.
+inline constexpr std::array<double, kRippleHarmonics> kRippleWeights{1.0, 0.5, 0.25};
+inline constexpr std::array<double, kRippleHarmonics> kRipplePhases{0.0, 1.0, 2.0};
 /// Flow limit: the output moves at most vmax * dt per step towards its input (rate limiter).
 struct ServovalveSaturation { double vmax_mm_per_s = 1e9; bool operator==(const ServovalveSaturation&) const = default; };        ///< > 0
 /// Gaussian measurement noise added to a channel (rig mode only); rms in the channel's unit.
@@ -100,6 +119,7 @@ struct EffectSet {
   std::optional<SensorNoise> sensor_noise;
   std::optional<CurrentLag> current_lag;
   std::optional<DamperScale> damper_scale;
+  std::optional<SupplyRipple> supply_ripple;
 
   bool Empty() const;
   /// Throws rths::Error naming the effect and parameter out of its range (ranges above) for a
@@ -156,7 +176,7 @@ struct EffectInfo {
 
 /// The effect library: one entry per effect. Adding an effect is one entry here (plus its
 /// struct above, its member of EffectSet and its block in the classes below).
-extern const std::array<EffectInfo, 12> kEffects;
+extern const std::array<EffectInfo, 13> kEffects;
 /// The entry called `name`, or nullptr.
 const EffectInfo* FindEffect(std::string_view name);
 
@@ -175,8 +195,8 @@ class DisplacementEffects {
   double Pre(double u_mm);
   /// Actuator model output x_k [mm] at t_k and the specimen force f_kN [kN] to couple with
   /// (LoadCoupling) -> the specimen / measured displacement y_k [mm] (oil_column_resonance,
-  /// servovalve_saturation, load_coupling, coulomb_friction, presliding_friction, backlash).
-  /// Call once per step.
+  /// servovalve_saturation, load_coupling, coulomb_friction, presliding_friction, backlash,
+  /// supply_ripple at t_k = k dt, k counting the calls since Reset). Call once per step.
   double Post(double x_mm, double f_kN);
   /// true if Pre() is the identity (no delay, gain 1, no dead band).
   bool PreIsIdentity() const;
@@ -200,6 +220,7 @@ class DisplacementEffects {
   double dahl_prev_in_ = 0.0;  // presliding friction's previous input
   double dahl_z_ = 0.0;        // presliding friction's lost motion [mm]
   double x_last_ = 0.0;        // the actuator output given to the last Post (command_dead_band)
+  std::size_t post_k_ = 0;     // the sample index of the next Post (supply_ripple's t_k)
 };
 
 /// The force path's effects: current_lag before the model's current dynamics, damper_scale

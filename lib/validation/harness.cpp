@@ -27,7 +27,8 @@ const std::vector<std::string> kSingles = [] {
 const std::vector<std::string> kPairs = {"pure_delay+damper_scale", "gain_error+current_lag", "pure_delay+gain_error",
                                          "backlash+damper_scale", "load_coupling+current_lag",
                                          "oil_column_resonance+coulomb_friction", "presliding_friction+damper_scale",
-                                         "command_dead_band+current_lag", "pure_delay+presliding_friction"};
+                                         "command_dead_band+current_lag", "pure_delay+presliding_friction",
+                                         "gain_error+supply_ripple"};
 
 std::vector<std::string> Split(const std::string& s) {
   std::vector<std::string> out;
@@ -46,7 +47,8 @@ std::vector<std::string> Split(const std::string& s) {
 const std::vector<std::string> kIndependentPairs = {
     "load_coupling+gain_error", "backlash+oil_column_resonance",         "pure_delay+damper_scale",
     "gain_error+current_lag",   "oil_column_resonance+coulomb_friction", "servovalve_saturation+current_lag",
-    "presliding_friction+damper_scale", "command_dead_band+oil_column_resonance", "pure_delay+presliding_friction"};
+    "presliding_friction+damper_scale", "command_dead_band+oil_column_resonance", "pure_delay+presliding_friction",
+    "oil_column_resonance+supply_ripple"};
 
 }  // namespace
 
@@ -116,6 +118,12 @@ std::string DrawIndependentTruth(const std::string& kind, signal::GaussianState*
     } else if (e == "damper_scale") {
       t.damper_scale = side(0.75, 0.9, 1.1, 1.3);
       txt += fmt::format("scale={:.3g} ", t.damper_scale);
+    } else if (e == "supply_ripple") {
+      t.pump_hz = U(50.0, 250.0);
+      t.pump_mm = U(0.015, 0.05);
+      t.pump_h2 = U(0.2, 0.8), t.pump_h3 = U(0.05, 0.5);
+      t.pump_phase2 = U(0.0, 6.2832), t.pump_phase3 = U(0.0, 6.2832);
+      txt += fmt::format("pump_hz={:.4g} pump_mm={:.3g} h2={:.2g} h3={:.2g} ", t.pump_hz, t.pump_mm, t.pump_h2, t.pump_h3);
     } else if (e == "none") {
     } else if (e == "none_white") {
       t.colour = NoiseColour::kWhite;
@@ -240,6 +248,10 @@ Truth HarnessTruth(const std::string& kind, std::uint64_t seed, double noise_y_m
     } else if (e == "damper_scale") {
       t.effects.damper_scale = models::DamperScale{side(0.75, 0.9, 1.1, 1.3)};
       txt += fmt::format("scale={:.3g} ", t.effects.damper_scale->scale);
+    } else if (e == "supply_ripple") {
+      t.effects.supply_ripple = models::SupplyRipple{U(60.0, 300.0), U(0.015, 0.05)};
+      txt += fmt::format("f_hz={:.4g} amplitude_mm={:.3g} ", t.effects.supply_ripple->f_hz,
+                         t.effects.supply_ripple->amplitude_mm);
     } else if (e == "none") {
     } else if (e == "unknown_ripple") {
       t.ripple_mm = U(0.05, 0.2);

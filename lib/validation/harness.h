@@ -59,7 +59,7 @@ struct HarnessCase {
 /// "unknown_ripple", "unknown_stiffness".
 std::vector<std::string> HarnessCaseKinds(bool pairs);
 
-/// The case kinds of the independent generator: the 11 single effects (its own forms), pairs
+/// The case kinds of the independent generator: the 12 single effects (its own forms), pairs
 /// (load_coupling+gain_error, backlash+oil_column_resonance, pure_delay+damper_scale,
 /// gain_error+current_lag, oil_column_resonance+coulomb_friction, servovalve_saturation+current_lag,
 /// presliding_friction+damper_scale, command_dead_band+oil_column_resonance,

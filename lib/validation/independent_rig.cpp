@@ -287,6 +287,7 @@ class ContinuousRig {
     d[kW] = -p_ * s[kW] + K_ * us;
     d[kX] = s[kXv];
     d[kXv] = s[kW] - b_ * s[kXv] - c_ * s[kX];
+    if (t_.pump_hz > 0) d[kX] += PumpFlow(time_s);
     double y = s[kX], yv = s[kXv];
     double ya = d[kXv];  // the acceleration of y where the chain knows it (for the friction's step size)
     if (oil_) {
@@ -397,6 +398,16 @@ class ContinuousRig {
     return t_.damper_scale * (1.0 + t_.damper_scale_drift * (time_s / duration_s_ - 0.5));
   }
   double Extra(double y) const { return t_.cubic_kN_per_mm3 * y * y * y; }
+  /// supply_ripple's velocity disturbance [mm/s] at time_s (file comment).
+  double PumpFlow(double time_s) const {
+    const double fw = 0.1, w = t_.pump_wander;
+    const double theta = 2.0 * kPi * t_.pump_hz * (time_s + w * std::sin(2.0 * kPi * fw * time_s) / (2.0 * kPi * fw));
+    const double theta_v = 2.0 * kPi * t_.pump_hz * (1.0 + w * std::cos(2.0 * kPi * fw * time_s));
+    const double a[3] = {1.0, t_.pump_h2, t_.pump_h3}, ph[3] = {0.0, t_.pump_phase2, t_.pump_phase3};
+    double q = 0.0;
+    for (int h = 0; h < 3; ++h) q += t_.pump_mm * a[h] * (h + 1) * theta_v * std::cos((h + 1) * theta + ph[h]);
+    return q;
+  }
 
   IndependentTruth t_;
   double duration_s_;

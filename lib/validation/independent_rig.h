@@ -47,6 +47,11 @@
 ///                    one of tau);
 ///     damper_scale   alpha, c0, c1 scaled by s (exactly a force scale) times a slow drift:
 ///                    s(t) = s (1 + drift (t / T - 1/2)), drift 1 % over the record (warming up).
+///     supply_ripple  a flow ripple inside the servo loop: the piston's velocity gets
+///                    sum_h a_h theta_h' cos(theta_h), theta_h = h theta + phi_h, with the pump's angle
+///                    theta = 2 pi f (t + w sin(2 pi 0.1 t) / (2 pi 0.1)) (its speed wanders by w),
+///                    harmonic sizes a_2/a_1, a_3/a_1 and phases drawn per case, filtered by the loop
+///                    (the library: a fixed-shape sum of sines added to y);
 ///   Outside the library (the diagnosis must answer "unknown"):
 ///     ripple         y_meas += a (1 + 0.5 sin(2 pi 0.3 t)) sin(2 pi f t), an amplitude-modulated ripple;
 ///     cubic spring   F += k3 y^3 (a hardening bumper);
@@ -122,6 +127,11 @@ struct IndependentTruth {
   double current_lag_ms = 0.0;         ///< current_lag [ms]
   double damper_scale = 1.0;           ///< damper_scale (1: off)
   double damper_scale_drift = 0.01;    ///< relative drift of the scale over the record (only if scale != 1)
+  double pump_hz = 0.0;                ///< supply_ripple's fundamental [Hz] (0: off)
+  double pump_mm = 0.0;                ///< ... its fundamental's size a_1 [mm] (before the loop's filtering)
+  double pump_h2 = 0.5, pump_h3 = 0.25;   ///< ... a_2 / a_1, a_3 / a_1
+  double pump_phase2 = 0.0, pump_phase3 = 0.0;  ///< ... phi_2, phi_3 [rad] (phi_1 = 0)
+  double pump_wander = 2e-4;           ///< ... the relative wander of the pump's speed
   // Outside the library.
   double ripple_mm = 0.0, ripple_hz = 13.0;  ///< amplitude-modulated ripple on the measured y
   double cubic_kN_per_mm3 = 0.0;       ///< F += k3 y^3

@@ -1,0 +1,127 @@
+#include "diagnosis/ripple_fit.h"
+
+#include <algorithm>
+#include <cmath>
+#include <complex>
+
+#include <Eigen/Dense>
+
+#include "signal/spectral.h"
+
+namespace rths::diagnosis {
+
+namespace {
+
+constexpr int kH = models::kRippleHarmonics;
+constexpr double kTwoPi = 2.0 * M_PI;
+
+/// The 2 H regressors at sample k: sin and cos of 2 pi h f k dt, h = 1 .. H.
+void Regressors(double f_hz, double dt_s, std::size_t k, double* phi) {
+  const double w = kTwoPi * f_hz * static_cast<double>(k) * dt_s;
+  for (int h = 0; h < kH; ++h) {
+    phi[2 * h] = std::sin((h + 1) * w);
+    phi[2 * h + 1] = std::cos((h + 1) * w);
+  }
+}
+
+}  // namespace
+
+double RippleFit::FundamentalAmplitude() const { return std::hypot(coef[0], coef[1]); }
+
+double RippleFit::Value(std::size_t k, double dt_s) const {
+  double phi[2 * kH];
+  Regressors(f_hz, dt_s, k, phi);
+  double r = 0.0;
+  for (int j = 0; j < 2 * kH; ++j) r += coef[j] * phi[j];
+  return r;
+}
+
+double RippleFit::Rate(std::size_t k, double dt_s) const {
+  // d/dt (s sin(w t) + c cos(w t)) = w (s cos(w t) - c sin(w t)), w = 2 pi h f.
+  double phi[2 * kH];
+  Regressors(f_hz, dt_s, k, phi);
+  double r = 0.0;
+  for (int h = 0; h < kH; ++h) r += kTwoPi * (h + 1) * f_hz * (coef[2 * h] * phi[2 * h + 1] - coef[2 * h + 1] * phi[2 * h]);
+  return r;
+}
+
+double RippleFit::Acceleration(std::size_t k, double dt_s) const {
+  // d^2/dt^2 = -w^2 (the harmonic itself).
+  double phi[2 * kH];
+  Regressors(f_hz, dt_s, k, phi);
+  double r = 0.0;
+  for (int h = 0; h < kH; ++h) {
+    const double w = kTwoPi * (h + 1) * f_hz;
+    r -= w * w * (coef[2 * h] * phi[2 * h] + coef[2 * h + 1] * phi[2 * h + 1]);
+  }
+  return r;
+}
+
+RippleFit FitRipple(std::span<const double> e, double dt_s, double f_hz, std::size_t first) {
+  using Mat = Eigen::Matrix<double, 2 * kH, 2 * kH>;
+  using Vec = Eigen::Matrix<double, 2 * kH, 1>;
+  Mat g = Mat::Zero();
+  Vec b = Vec::Zero();
+  double phi[2 * kH];
+  for (std::size_t k = first; k < e.size(); ++k) {
+    Regressors(f_hz, dt_s, k, phi);
+    const Eigen::Map<const Vec> p(phi);
+    g.selfadjointView<Eigen::Lower>().rankUpdate(p);
+    b += p * e[k];
+  }
+  g = g.selfadjointView<Eigen::Lower>();
+  const double ridge = 1e-9 * std::max(g.trace() / (2 * kH), 1e-300);
+  g.diagonal().array() += ridge;
+  const Vec c = g.ldlt().solve(b);
+  RippleFit r;
+  r.f_hz = f_hz;
+  for (int j = 0; j < 2 * kH; ++j) r.coef[j] = std::isfinite(c(j)) ? c(j) : 0.0;
+  return r;
+}
+
+double RippleSse(std::span<const double> e, double dt_s, double f_hz, std::size_t first) {
+  const RippleFit r = FitRipple(e, dt_s, f_hz, first);
+  double s = 0.0;
+  for (std::size_t k = first; k < e.size(); ++k) {
+    const double d = e[k] - r.Value(k, dt_s);
+    s += d * d;
+  }
+  return s;
+}
+
+double RipplePeakHz(const std::vector<std::vector<double>>& e, const std::vector<std::size_t>& first, double dt_s,
+                    double lo_hz, double hi_hz) {
+  std::size_t longest = 0;
+  for (std::size_t r = 0; r < e.size(); ++r) longest = std::max(longest, e[r].size() - std::min(first[r], e[r].size()));
+  std::size_t npad = 1;
+  while (npad < 2 * longest) npad *= 2;
+  const std::size_t nbins = npad / 2 + 1;
+  std::vector<double> power(nbins, 0.0);
+  std::vector<double> x(npad);
+  for (std::size_t r = 0; r < e.size(); ++r) {
+    const std::size_t k0 = std::min(first[r], e[r].size()), m = e[r].size() - k0;
+    if (m < 4) continue;
+    std::fill(x.begin(), x.end(), 0.0);
+    for (std::size_t j = 0; j < m; ++j)
+      x[j] = e[r][k0 + j] * 0.5 * (1.0 - std::cos(kTwoPi * static_cast<double>(j) / static_cast<double>(m)));
+    const auto spec = signal::RealDft(x);
+    for (std::size_t i = 0; i < nbins; ++i) power[i] += std::norm(spec[i]);
+  }
+  // Bin i is f_i = i / (npad dt); harmonic h of bin i is bin h i, folded about the Nyquist bin as
+  // sampling folds it.
+  const double df = 1.0 / (static_cast<double>(npad) * dt_s);
+  auto folded = [&](std::size_t i) {
+    const std::size_t j = i % npad;
+    return j < nbins ? j : npad - j;
+  };
+  double best_f = lo_hz, best_p = -1.0;
+  const auto i_lo = static_cast<std::size_t>(std::ceil(lo_hz / df));
+  for (std::size_t i = std::max<std::size_t>(i_lo, 1); i < nbins && static_cast<double>(i) * df <= hi_hz; ++i) {
+    double p = 0.0;
+    for (int h = 1; h <= kH; ++h) p += power[folded(static_cast<std::size_t>(h) * i)];
+    if (p > best_p) best_p = p, best_f = static_cast<double>(i) * df;
+  }
+  return best_f;
+}
+
+}  // namespace rths::diagnosis
