@@ -304,6 +304,14 @@ TEST_CASE("supply_ripple's closed form: amplitude and phase per harmonic, an ali
     const double num = (r.Value(1000 * k + 1, hs) - r.Value(1000 * k - 1, hs)) / (2.0 * hs);
     CHECK(r.Rate(k, dt) == doctest::Approx(num).epsilon(1e-4));
   }
+  // AddTo (a rotating phasor, resynchronised every 256 samples) agrees with the direct sines.
+  std::vector<double> y(n, 0.0), v(n, 0.0), a(n, 0.0);
+  r.AddTo(dt, y, v, a);
+  for (std::size_t k : {0u, 255u, 256u, 1000u, 7999u}) {
+    CHECK(y[k] == doctest::Approx(r.Value(k, dt)).epsilon(1e-10).scale(0.02));
+    CHECK(v[k] == doctest::Approx(r.Rate(k, dt)).epsilon(1e-10).scale(50.0));
+    CHECK(a[k] == doctest::Approx(r.Acceleration(k, dt)).epsilon(1e-10).scale(1e5));
+  }
 }
 
 TEST_CASE("SelectEffects: a pump's ripple is selected as supply_ripple, its frequency to a fraction of its line width") {

@@ -152,12 +152,9 @@ std::vector<double> PredictDisplacement(const models::LinearServo& servo, const 
     std::vector<double> y = PredictDisplacement(servo, rest, u_mm, f_kN, v_mm_s, a_mm_s2);
     std::vector<double> e(y.size());
     for (std::size_t k = 0; k < y.size(); ++k) e[k] = y_meas_mm[k] - y[k];
-    const RippleFit r = FitRipple(e, servo.dt_s, effects.supply_ripple->f_hz, first);
-    for (std::size_t k = 0; k < y.size(); ++k) {
-      y[k] += r.Value(k, servo.dt_s);
-      if (v_mm_s != nullptr) (*v_mm_s)[k] += r.Rate(k, servo.dt_s);
-      if (a_mm_s2 != nullptr) (*a_mm_s2)[k] += r.Acceleration(k, servo.dt_s);
-    }
+    FitRipple(e, servo.dt_s, effects.supply_ripple->f_hz, first)
+        .AddTo(servo.dt_s, y, v_mm_s != nullptr ? std::span<double>(*v_mm_s) : std::span<double>{},
+               a_mm_s2 != nullptr ? std::span<double>(*a_mm_s2) : std::span<double>{});
     return y;
   }
   const std::size_t n = u_mm.size();

@@ -24,6 +24,36 @@ void Regressors(double f_hz, double dt_s, std::size_t k, double* phi) {
   }
 }
 
+/// The same regressors for k = first, first + 1, ... in order, by rotating a unit phasor
+/// exp(i 2 pi f k dt) (a complex product per sample instead of 2 H sines and cosines), set exactly
+/// every kResync samples so that rounding cannot accumulate.
+class RegressorStream {
+ public:
+  RegressorStream(double f_hz, double dt_s, std::size_t first)
+      : w_dt_(kTwoPi * f_hz * dt_s), step_(std::polar(1.0, w_dt_)), k_(first) {
+    Resync();
+  }
+  /// The regressors of the current sample, then moves to the next.
+  void Next(double* phi) {
+    std::complex<double> zh = z_;
+    for (int h = 0; h < kH; ++h) {
+      phi[2 * h] = zh.imag();
+      phi[2 * h + 1] = zh.real();
+      zh *= z_;
+    }
+    ++k_;
+    if (k_ % kResync == 0) Resync();
+    else z_ *= step_;
+  }
+
+ private:
+  static constexpr std::size_t kResync = 256;
+  void Resync() { z_ = std::polar(1.0, w_dt_ * static_cast<double>(k_)); }
+  double w_dt_;
+  std::complex<double> step_, z_;
+  std::size_t k_;
+};
+
 }  // namespace
 
 double RippleFit::FundamentalAmplitude() const { return std::hypot(coef[0], coef[1]); }
@@ -63,8 +93,9 @@ RippleFit FitRipple(std::span<const double> e, double dt_s, double f_hz, std::si
   Mat g = Mat::Zero();
   Vec b = Vec::Zero();
   double phi[2 * kH];
+  RegressorStream stream(f_hz, dt_s, first);
   for (std::size_t k = first; k < e.size(); ++k) {
-    Regressors(f_hz, dt_s, k, phi);
+    stream.Next(phi);
     const Eigen::Map<const Vec> p(phi);
     g.selfadjointView<Eigen::Lower>().rankUpdate(p);
     b += p * e[k];
@@ -81,12 +112,30 @@ RippleFit FitRipple(std::span<const double> e, double dt_s, double f_hz, std::si
 
 double RippleSse(std::span<const double> e, double dt_s, double f_hz, std::size_t first) {
   const RippleFit r = FitRipple(e, dt_s, f_hz, first);
-  double s = 0.0;
+  double s = 0.0, phi[2 * kH];
+  RegressorStream stream(f_hz, dt_s, first);
   for (std::size_t k = first; k < e.size(); ++k) {
-    const double d = e[k] - r.Value(k, dt_s);
+    stream.Next(phi);
+    double d = e[k];
+    for (int j = 0; j < 2 * kH; ++j) d -= r.coef[j] * phi[j];
     s += d * d;
   }
   return s;
+}
+
+void RippleFit::AddTo(double dt_s, std::span<double> y, std::span<double> v, std::span<double> a) const {
+  double phi[2 * kH];
+  RegressorStream stream(f_hz, dt_s, 0);
+  for (std::size_t k = 0; k < y.size(); ++k) {
+    stream.Next(phi);
+    for (int h = 0; h < kH; ++h) {
+      const double w = kTwoPi * (h + 1) * f_hz, sn = phi[2 * h], cs = phi[2 * h + 1];
+      const double s = coef[2 * h], c = coef[2 * h + 1];
+      y[k] += s * sn + c * cs;
+      if (!v.empty()) v[k] += w * (s * cs - c * sn);
+      if (!a.empty()) a[k] -= w * w * (s * sn + c * cs);
+    }
+  }
 }
 
 double RipplePeakHz(const std::vector<std::vector<double>>& e, const std::vector<std::size_t>& first, double dt_s,

@@ -24,6 +24,9 @@ struct RippleFit {
   double Value(std::size_t k, double dt_s) const;
   double Rate(std::size_t k, double dt_s) const;
   double Acceleration(std::size_t k, double dt_s) const;
+  /// Adds r_k to y_k for k = 0 .. y.size() - 1, and its rate to v_k and acceleration to a_k where
+  /// v, a are not empty (the same length as y).
+  void AddTo(double dt_s, std::span<double> y, std::span<double> v = {}, std::span<double> a = {}) const;
 };
 
 /// The least-squares ripple at f_hz in the residual e over k >= first (the normal equations of the

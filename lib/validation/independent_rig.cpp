@@ -287,13 +287,15 @@ class ContinuousRig {
     d[kW] = -p_ * s[kW] + K_ * us;
     d[kX] = s[kXv];
     d[kXv] = s[kW] - b_ * s[kXv] - c_ * s[kX];
-    if (t_.pump_hz > 0) d[kX] += PumpFlow(time_s);
-    double y = s[kX], yv = s[kXv];
+    // The pump's flow ripple enters the piston's chamber: the oil column's state when it has one.
+    const double pump = t_.pump_hz > 0 ? PumpFlow(time_s) : 0.0;
+    if (!oil_) d[kX] += pump;
+    double y = s[kX], yv = d[kX];
     double ya = d[kXv];  // the acceleration of y where the chain knows it (for the friction's step size)
     if (oil_) {
-      d[kQ] = s[kQv];
+      d[kQ] = s[kQv] + pump;
       d[kQv] = w_oil_ * w_oil_ * (y - s[kQ]) - 2.0 * t_.oil_zeta * w_oil_ * s[kQv];
-      y = s[kQ], yv = s[kQv], ya = d[kQv];
+      y = s[kQ], yv = d[kQ], ya = d[kQv];
     }
     if (sat_) {
       const double vm = t_.vmax_mm_per_s, tau_r = 1e-3;

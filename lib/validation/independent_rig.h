@@ -50,7 +50,8 @@
 ///     supply_ripple  a flow ripple inside the servo loop: the piston's velocity gets
 ///                    sum_h a_h theta_h' cos(theta_h), theta_h = h theta + phi_h, with the pump's angle
 ///                    theta = 2 pi f (t + w sin(2 pi 0.1 t) / (2 pi 0.1)) (its speed wanders by w),
-///                    harmonic sizes a_2/a_1, a_3/a_1 and phases drawn per case, filtered by the loop
+///                    harmonic sizes a_2/a_1, a_3/a_1 and phases drawn per case, filtered by the loop;
+///                    it enters the piston's chamber, the oil column's displacement when there is one
 ///                    (the library: a fixed-shape sum of sines added to y);
 ///   Outside the library (the diagnosis must answer "unknown"):
 ///     ripple         y_meas += a (1 + 0.5 sin(2 pi 0.3 t)) sin(2 pi f t), an amplitude-modulated ripple;
