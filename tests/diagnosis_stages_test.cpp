@@ -277,10 +277,10 @@ TEST_CASE("ApplyShrinkRule: a selection short of min_test_shrink_pct is not reta
   }
 }
 
-TEST_CASE("supply_ripple's closed form: amplitude and phase per harmonic, an aliased one included") {
-  // A residual with a ripple at 380 Hz sampled at 2 kHz: its third harmonic (1140 Hz) is folded to
-  // 860 Hz. Harmonic sizes and phases not the library's shape.
-  const double dt = 0.0005, f = 380.0;
+TEST_CASE("supply_ripple's closed form: amplitude and phase per harmonic, none above Nyquist") {
+  // A residual with a ripple at 280 Hz sampled at 2 kHz (harmonics at 560 and 840 Hz), harmonic
+  // sizes and phases not the library's shape.
+  const double dt = 0.0005, f = 280.0;
   const std::size_t n = 8000, first = 400;
   const std::array<double, 6> truth{0.02, -0.01, 0.004, 0.007, -0.003, 0.002};  // s1 c1 s2 c2 s3 c3 [mm]
   auto g = rths::signal::MakeGaussian(5);
@@ -304,6 +304,11 @@ TEST_CASE("supply_ripple's closed form: amplitude and phase per harmonic, an ali
     const double num = (r.Value(1000 * k + 1, hs) - r.Value(1000 * k - 1, hs)) / (2.0 * hs);
     CHECK(r.Rate(k, dt) == doctest::Approx(num).epsilon(1e-4));
   }
+  // At 380 Hz the third harmonic (1140 Hz) is above the Nyquist frequency: not fitted (sampled it
+  // would fold to 860 Hz, or, nearer fs / 3, down into a test's band).
+  const RippleFit high = FitRipple(e, dt, 380.0, first);
+  CHECK(high.coef[4] == 0.0);
+  CHECK(high.coef[5] == 0.0);
   // AddTo (a rotating phasor, resynchronised every 256 samples) agrees with the direct sines.
   std::vector<double> y(n, 0.0), v(n, 0.0), a(n, 0.0);
   r.AddTo(dt, y, v, a);

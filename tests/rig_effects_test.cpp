@@ -185,6 +185,15 @@ TEST_CASE("supply_ripple adds the library's harmonic shape at t_k = k dt, from R
   d.Reset();
   CHECK(d.Post(0.0, 0.0) == doctest::Approx(expected(0)).epsilon(1e-12));  // sin(0) + 0.5 sin 1 + 0.25 sin 2
   CHECK(expected(0) != 0.0);
+  // At 400 Hz the third harmonic (1200 Hz) is above the Nyquist frequency (1 kHz): left out.
+  EffectSet high;
+  high.supply_ripple = SupplyRipple{400.0, 0.02};
+  DisplacementEffects dh(high, kDt);
+  for (int k = 0; k < 20; ++k) {
+    const double t = k * kDt;
+    CHECK(dh.Post(0.0, 0.0) ==
+          doctest::Approx(0.02 * (std::sin(2 * M_PI * 400.0 * t) + 0.5 * std::sin(2 * M_PI * 800.0 * t + 1.0))).epsilon(1e-12));
+  }
   EffectSet bad;
   bad.supply_ripple = SupplyRipple{1000.0, 0.01};  // at the Nyquist frequency 0.5 / dt
   CHECK_THROWS_AS(DisplacementEffects(bad, kDt), Error);

@@ -15,12 +15,14 @@ namespace {
 constexpr int kH = models::kRippleHarmonics;
 constexpr double kTwoPi = 2.0 * M_PI;
 
-/// The 2 H regressors at sample k: sin and cos of 2 pi h f k dt, h = 1 .. H.
+/// The 2 H regressors at sample k: sin and cos of 2 pi h f k dt, h = 1 .. H; 0 for a harmonic at
+/// or above the Nyquist frequency (models::RippleHarmonicSampled).
 void Regressors(double f_hz, double dt_s, std::size_t k, double* phi) {
   const double w = kTwoPi * f_hz * static_cast<double>(k) * dt_s;
   for (int h = 0; h < kH; ++h) {
-    phi[2 * h] = std::sin((h + 1) * w);
-    phi[2 * h + 1] = std::cos((h + 1) * w);
+    const bool on = models::RippleHarmonicSampled(h + 1, f_hz, dt_s);
+    phi[2 * h] = on ? std::sin((h + 1) * w) : 0.0;
+    phi[2 * h + 1] = on ? std::cos((h + 1) * w) : 0.0;
   }
 }
 
@@ -31,14 +33,15 @@ class RegressorStream {
  public:
   RegressorStream(double f_hz, double dt_s, std::size_t first)
       : w_dt_(kTwoPi * f_hz * dt_s), step_(std::polar(1.0, w_dt_)), k_(first) {
+    for (int h = 0; h < kH; ++h) on_[h] = models::RippleHarmonicSampled(h + 1, f_hz, dt_s) ? 1.0 : 0.0;
     Resync();
   }
   /// The regressors of the current sample, then moves to the next.
   void Next(double* phi) {
     std::complex<double> zh = z_;
     for (int h = 0; h < kH; ++h) {
-      phi[2 * h] = zh.imag();
-      phi[2 * h + 1] = zh.real();
+      phi[2 * h] = on_[h] * zh.imag();
+      phi[2 * h + 1] = on_[h] * zh.real();
       zh *= z_;
     }
     ++k_;
@@ -52,6 +55,7 @@ class RegressorStream {
   double w_dt_;
   std::complex<double> step_, z_;
   std::size_t k_;
+  double on_[kH];
 };
 
 }  // namespace
@@ -156,18 +160,13 @@ double RipplePeakHz(const std::vector<std::vector<double>>& e, const std::vector
     const auto spec = signal::RealDft(x);
     for (std::size_t i = 0; i < nbins; ++i) power[i] += std::norm(spec[i]);
   }
-  // Bin i is f_i = i / (npad dt); harmonic h of bin i is bin h i, folded about the Nyquist bin as
-  // sampling folds it.
+  // Bin i is f_i = i / (npad dt); harmonic h of bin i is bin h i (below the Nyquist bin only).
   const double df = 1.0 / (static_cast<double>(npad) * dt_s);
-  auto folded = [&](std::size_t i) {
-    const std::size_t j = i % npad;
-    return j < nbins ? j : npad - j;
-  };
   double best_f = lo_hz, best_p = -1.0;
   const auto i_lo = static_cast<std::size_t>(std::ceil(lo_hz / df));
   for (std::size_t i = std::max<std::size_t>(i_lo, 1); i < nbins && static_cast<double>(i) * df <= hi_hz; ++i) {
     double p = 0.0;
-    for (int h = 1; h <= kH; ++h) p += power[folded(static_cast<std::size_t>(h) * i)];
+    for (int h = 1; h <= kH && static_cast<std::size_t>(h) * i < nbins - 1; ++h) p += power[static_cast<std::size_t>(h) * i];
     if (p > best_p) best_p = p, best_f = static_cast<double>(i) * df;
   }
   return best_f;

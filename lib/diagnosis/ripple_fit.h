@@ -30,15 +30,15 @@ struct RippleFit {
 };
 
 /// The least-squares ripple at f_hz in the residual e over k >= first (the normal equations of the
-/// 2 H sines and cosines, with a ridge of 1e-9 of their mean diagonal, so a harmonic sampled at
-/// 0 or at the Nyquist frequency, or aliased onto another, stays solvable).
+/// 2 H sines and cosines, with a ridge of 1e-9 of their mean diagonal). A harmonic at or above the
+/// Nyquist frequency is not fitted (its coefficients 0: models::RippleHarmonicSampled).
 RippleFit FitRipple(std::span<const double> e, double dt_s, double f_hz, std::size_t first);
 
 /// Sum over k >= first of (e_k - r_k)^2 for the least-squares ripple r at f_hz.
 double RippleSse(std::span<const double> e, double dt_s, double f_hz, std::size_t first);
 
 /// The frequency in [lo_hz, hi_hz] that maximises the harmonic sum of the residuals' spectra,
-/// sum_records sum_h |E(h f)|^2, with E the DFT of the Hann-windowed residual over k >= first,
+/// sum_records sum_h |E(h f)|^2 over the harmonics below the Nyquist frequency, with E the DFT of the Hann-windowed residual over k >= first,
 /// zero-padded to at least twice the longest record (so that h f falls on a bin when f does);
 /// lo_hz if no bin lies in the range. All residuals share dt_s.
 double RipplePeakHz(const std::vector<std::vector<double>>& e, const std::vector<std::size_t>& first, double dt_s,

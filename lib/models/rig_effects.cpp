@@ -267,7 +267,8 @@ double DisplacementEffects::Post(double x_mm, double f_kN) {
     const double t = static_cast<double>(post_k_) * dt_s_;
     double r = 0.0;
     for (int h = 0; h < kRippleHarmonics; ++h)
-      r += kRippleWeights[h] * std::sin(2.0 * M_PI * (h + 1) * e_.supply_ripple->f_hz * t + kRipplePhases[h]);
+      if (RippleHarmonicSampled(h + 1, e_.supply_ripple->f_hz, dt_s_))
+        r += kRippleWeights[h] * std::sin(2.0 * M_PI * (h + 1) * e_.supply_ripple->f_hz * t + kRipplePhases[h]);
     y += e_.supply_ripple->amplitude_mm * r;
   }
   ++post_k_;

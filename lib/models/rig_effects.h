@@ -81,8 +81,8 @@ struct CommandDeadBand { double width_mm = 0.0; bool operator==(const CommandDea
 /// periodic motion of the specimen (the damper sees it too):
 ///     y_k += amplitude sum_{h=1..kRippleHarmonics} w_h sin(2 pi h f t_k + phi_h),  t_k = k dt
 /// from the block's Reset, with the library's shape w = (1, 0.5, 0.25), phi = (0, 1, 2) rad. A
-/// harmonic above the Nyquist frequency is sampled as it comes (aliased), as an unfiltered
-/// sensor would see it. The diagnosis does not assume this shape: it fits the amplitude and phase
+/// harmonic at or above the Nyquist frequency is left out (a DAQ's anti-alias filter removes it;
+/// sampled, it would fold onto any frequency, down into the test's band). The diagnosis does not assume this shape: it fits the amplitude and phase
 /// of every harmonic per record (a pump is not synchronised with the test; docs/diagnosis.md
 /// "Supply ripple"), and reports the fundamental's amplitude.
 struct SupplyRipple {
@@ -92,6 +92,9 @@ struct SupplyRipple {
 };
 /// Harmonics of SupplyRipple (the fundamental included).
 inline constexpr int kRippleHarmonics = 3;
+/// true if SupplyRipple's harmonic h (1 = the fundamental) at f_hz is below the Nyquist frequency
+/// 0.5 / dt_s: the harmonics that are sampled (the others are left out).
+inline bool RippleHarmonicSampled(int h, double f_hz, double dt_s) { return h * f_hz * dt_s < 0.5; }
 /// The library's shape of SupplyRipple: amplitude weight and phase [rad] of harmonic h = 1, 2, 3.
 inline constexpr std::array<double, kRippleHarmonics> kRippleWeights{1.0, 0.5, 0.25};
 inline constexpr std::array<double, kRippleHarmonics> kRipplePhases{0.0, 1.0, 2.0};
