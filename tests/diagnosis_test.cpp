@@ -350,7 +350,8 @@ TEST_CASE("JSON: the contract's fields and keys") {
       {"coulomb_friction", {"loss_mm"}}, {"backlash", {"gap_mm"}},
       {"servovalve_saturation", {"vmax_mm_per_s"}}, {"sensor_noise", {"rms"}},
       {"current_lag", {"tau_ms"}},       {"damper_scale", {"scale"}},
-      {"presliding_friction", {"loss_mm", "travel_mm"}}, {"command_dead_band", {"width_mm"}}};
+      {"presliding_friction", {"loss_mm", "travel_mm"}}, {"command_dead_band", {"width_mm"}},
+      {"supply_ripple", {"f_hz", "amplitude_mm"}}};
   std::set<std::string> names;
   for (const auto& e : j["effects"]) {
     const std::string name = e["name"];

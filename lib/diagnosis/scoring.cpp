@@ -44,7 +44,11 @@ void ScoreNominal(ChannelState* s, const Options& o) {
   cs.floor_ratio = s->var_floor > 0 ? ms / s->var_floor : std::numeric_limits<double>::infinity();
   cs.floor_ratio_test = s->var_floor > 0 ? (sse_test / n_te) / s->var_floor : std::numeric_limits<double>::infinity();
   cs.whiteness = Whiteness(s->test, s->nom_test);
-  s->structured = cs.floor_ratio > o.none_ratio;
+  // Structured if the pooled residual is above the floor, or the training records' alone: a long test
+  // that does not exercise an effect (a slow test below a flow limit) must not dilute the training
+  // records' evidence into "noise".
+  const double ratio_train = s->var_floor > 0 ? (s->sse / n_tr) / s->var_floor : std::numeric_limits<double>::infinity();
+  s->structured = cs.floor_ratio > o.none_ratio || ratio_train > o.none_ratio;
   s->sse_nominal = s->sse;
   s->excess_nominal = s->sse_nominal - static_cast<double>(s->n_train) * s->var_floor;
 }
@@ -97,6 +101,15 @@ std::pair<double, double> Footprints(const ChannelState& s, const std::vector<st
   return {footprint(s.train, s.pred_train, s.train.Predict({})), footprint(s.test, fin_test, s.nom_test)};
 }
 
+/// The evidence of an unconfirmed effect `name` (EffectResult::unconfirmed).
+std::string UnconfirmedText(const ChannelState& s, const std::string& name, double fp_train, double fp_test) {
+  const auto st = s.sel_stats.find(name);
+  return fmt::format(
+      "on the training records it removes {:.0f} % of the residual above noise and changes the prediction by "
+      "{:.3g} x the noise floor's power; on the test records by only {:.2g} x: the test does not exercise it",
+      100.0 * (st == s.sel_stats.end() ? 0.0 : st->second.first), fp_train, fp_test);
+}
+
 void ApplyShrinkRule(ChannelState* sp, const std::vector<CandidateSpec>& specs, const Options& o,
                      std::vector<std::string>* warnings, EffectResults* er) {
   ChannelState& s = *sp;
@@ -110,13 +123,7 @@ void ApplyShrinkRule(ChannelState* sp, const std::vector<CandidateSpec>& specs, 
     const auto [fp_train, fp_test] = Footprints(s, fin);
     if (fp_test < tuning::kUnconfirmedTestFootprint && fp_train >= tuning::kUnconfirmedTrainFootprint) {
       // The test records do not exercise the effects: neither confirmed nor refuted.
-      for (const auto& n : s.order) {
-        const auto st = s.sel_stats.find(n);
-        (*er)[n].unconfirmed = fmt::format(
-            "on the training records it removes {:.0f} % of the residual above noise and changes the prediction by "
-            "{:.3g} x the noise floor's power; on the test records by only {:.2g} x: the test does not exercise it",
-            100.0 * (st == s.sel_stats.end() ? 0.0 : st->second.first), fp_train, fp_test);
-      }
+      for (const auto& n : s.order) (*er)[n].unconfirmed = UnconfirmedText(s, n, fp_train, fp_test);
       s.unconfirmed = s.order;
       warnings->push_back(fmt::format("channel {}: {} found on the training records, unconfirmed: the test records "
                                       "do not exercise {} (their prediction changes by {:.2g} x the noise floor's power)",
@@ -132,9 +139,20 @@ void ApplyShrinkRule(ChannelState* sp, const std::vector<CandidateSpec>& specs, 
     cs.after_test_pct = before;
     retained = false;
   } else if (retained && !test_structured) {
-    warnings->push_back(fmt::format("channel {}: the test records' residual is at the noise floor; the effects "
-                                    "were found on the training records only",
-                                    cs.channel));
+    const auto [fp_train, fp_test] = Footprints(s, fin);
+    if (fp_test < tuning::kUnconfirmedTestFootprint && fp_train >= tuning::kUnconfirmedTrainFootprint) {
+      // Kept (they do no harm on the test), but named unconfirmed: the test cannot show them.
+      for (const auto& n : s.order) (*er)[n].unconfirmed = UnconfirmedText(s, n, fp_train, fp_test);
+      s.unconfirmed = s.order;
+      warnings->push_back(fmt::format("channel {}: {} found on the training records, unconfirmed: the test records "
+                                      "are at the noise floor and do not exercise {} (their prediction changes by "
+                                      "{:.2g} x the noise floor's power)",
+                                      cs.channel, fmt::join(s.order, ", "), s.order.size() > 1 ? "them" : "it", fp_test));
+    } else {
+      warnings->push_back(fmt::format("channel {}: the test records' residual is at the noise floor; the effects "
+                                      "were found on the training records only",
+                                      cs.channel));
+    }
   }
   s.fin_set = retained ? ToSet(specs, s.sel) : models::EffectSet{};
   if (retained) {
@@ -145,8 +163,8 @@ void ApplyShrinkRule(ChannelState* sp, const std::vector<CandidateSpec>& specs, 
     s.pred_train_fin = s.train.Predict({});
   }
   if (!s.structured) cs.status = "noise";
-  else if (retained) cs.status = "explained";
   else if (!s.unconfirmed.empty()) cs.status = "unconfirmed";
+  else if (retained) cs.status = "explained";
   else cs.status = "unexplained";
   s.retained = retained;
 }

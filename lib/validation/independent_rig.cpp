@@ -254,7 +254,8 @@ class ContinuousRig {
       : t_(t), duration_s_(duration_s), d_(models::MrDamperParams::Table3()) {
     const models::ServoModel3 m = models::ServoPreset("avg");
     K_ = m.K, p_ = m.p, b_ = m.b, c_ = m.c;
-    oil_ = t.oil_f_hz > 0, sat_ = t.vmax_mm_per_s > 0, lc_ = t.compliance_mm_per_kN > 0;
+    oil_ = t.oil_f_hz > 0, sat_ = t.vmax_mm_per_s > 0 && !t.vmax_in_loop, loop_sat_ = t.vmax_mm_per_s > 0 && t.vmax_in_loop,
+    lc_ = t.compliance_mm_per_kN > 0;
     fr_ = t.friction_loss_mm > 0, bl_ = t.backlash_gap_mm > 0, lag_ = t.current_lag_ms > 0;
     ps_ = t.presliding_loss_mm > 0;
     if (lc_ && (fr_ || bl_ || ps_))
@@ -285,7 +286,8 @@ class ContinuousRig {
       us = s[kX] + e - h * std::tanh(e / h);
     }
     d[kW] = -p_ * s[kW] + K_ * us;
-    d[kX] = s[kXv];
+    // A flow limit inside the loop: the piston's velocity is the loop's velocity state, saturated.
+    d[kX] = loop_sat_ ? SmoothSat(s[kXv], t_.vmax_mm_per_s) : s[kXv];
     d[kXv] = s[kW] - b_ * s[kXv] - c_ * s[kX];
     // The pump's flow ripple enters the piston's chamber: the oil column's state when it has one.
     const double pump = t_.pump_hz > 0 ? PumpFlow(time_s) : 0.0;
@@ -299,8 +301,7 @@ class ContinuousRig {
     }
     if (sat_) {
       const double vm = t_.vmax_mm_per_s, tau_r = 1e-3;
-      const double q = (yv + (y - s[kR]) / tau_r) / vm;
-      const double v = vm * q / std::pow(1.0 + std::pow(std::abs(q), 8.0), 0.125);
+      const double v = SmoothSat(yv + (y - s[kR]) / tau_r, vm);
       d[kR] = v;
       ya = (v - yv) / tau_r;  // where the limit does not act, the error's rate
       y = s[kR], yv = v;
@@ -399,6 +400,11 @@ class ContinuousRig {
     if (t_.damper_scale == 1.0) return 1.0;
     return t_.damper_scale * (1.0 + t_.damper_scale_drift * (time_s / duration_s_ - 0.5));
   }
+  /// vmax sat(v / vmax), sat(q) = q / (1 + |q|^8)^(1/8).
+  static double SmoothSat(double v, double vmax) {
+    const double q = v / vmax;
+    return vmax * q / std::pow(1.0 + std::pow(std::abs(q), 8.0), 0.125);
+  }
   double Extra(double y) const { return t_.cubic_kN_per_mm3 * y * y * y; }
   /// supply_ripple's velocity disturbance [mm/s] at time_s (file comment).
   double PumpFlow(double time_s) const {
@@ -416,6 +422,7 @@ class ContinuousRig {
   models::MrDamperParams d_;
   double K_ = 0, p_ = 0, b_ = 0, c_ = 0;
   const double a_ = kPi, b9_ = 9.0 * kPi, wn_ = 2.0 * kPi * 75.0, zn_ = 1.0 / std::sqrt(2.0);
+  bool loop_sat_ = false;
   bool oil_ = false, sat_ = false, lc_ = false, fr_ = false, bl_ = false, lag_ = false, ps_ = false;
   double w_oil_ = 0, tau1_ = 0, tau2_ = 0, h_ = 0, wb_ = 0;
 };

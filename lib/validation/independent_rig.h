@@ -27,7 +27,8 @@
 ///                    (the library: ZOH of the sampled x);
 ///     servovalve_saturation  r' = vmax sat((x' + (x - r) / tau_r) / vmax), sat(v) = v / (1 + |v|^8)^(1/8),
 ///                    tau_r = 1 ms (a smooth flow limit with its own recovery; the library: a
-///                    sample-wise rate limiter);
+///                    sample-wise rate limiter); or (vmax_in_loop) inside the servo loop: the
+///                    piston's velocity x' = vmax sat(x_v / vmax) of the loop's velocity state x_v;
 ///     load_coupling  a continuous series compliance: y = x - c F(t) at every instant, F the
 ///                    damper force, solved as an ODE for y (F is affine in y');
 ///     coulomb_friction  Dahl-like lag of the lost motion: phi' = (loss (2/pi) atan(x'/v_s) - phi) / tau_f,
@@ -125,6 +126,10 @@ struct IndependentTruth {
   double presliding_rho = 0.8;         ///< ... and 1 - the output's slope just after a reversal, (0, 1]
   double dead_band_mm = 0.0;           ///< command_dead_band's width [mm]
   double vmax_mm_per_s = 0.0;          ///< servovalve_saturation [mm/s]
+  /// servovalve_saturation's form: false, a smooth limiter on the servo's output (file comment);
+  /// true, inside the loop: the piston's velocity is vmax sat(x_v / vmax) of the loop's velocity
+  /// state x_v, which keeps growing while the piston is limited (the loop winds up and overshoots).
+  bool vmax_in_loop = false;
   double current_lag_ms = 0.0;         ///< current_lag [ms]
   double damper_scale = 1.0;           ///< damper_scale (1: off)
   double damper_scale_drift = 0.01;    ///< relative drift of the scale over the record (only if scale != 1)
