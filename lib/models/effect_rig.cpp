@@ -1,4 +1,5 @@
 #include "models/effect_rig.h"
+#include "models/supply_ripple.h"
 
 #include <algorithm>
 #include <array>
@@ -79,8 +80,12 @@ int EffectRig::Rhs(double t, const double* w, double* wdot, void* self) {
   const Eigen::Vector3d zdot = servo.A * z + servo.B * me->u_act_;
   wdot[0] = zdot(0), wdot[1] = zdot(1), wdot[2] = zdot(2);
   // Specimen motion: the servo's x(t) plus the effects' offset, linear over the step.
-  const double y = (servo.C * z).value() + (me->d0_ + me->dv_ * t);
-  const double ydot = (servo.C * zdot).value() + me->dv_;
+  double y = (servo.C * z).value() + (me->d0_ + me->dv_ * t);
+  double ydot = (servo.C * zdot).value() + me->dv_;
+  if (me->ripple_in_step_) {  // supply_ripple: its continuous motion, not a line between samples
+    const RippleMotion r = SupplyRippleAt(*me->m_.effects.supply_ripple, servo.dt_s, me->ripple_t0_s_ + t);
+    y += r.mm, ydot += r.mm_s;
+  }
   const MrDamperCoefficients coef =
       me->constant_current_
           ? me->coef_
@@ -96,13 +101,25 @@ double EffectRig::Trial(double x0, double x1, const LinearServoState& next, doub
   const LinearRig& rig = m_.rig;
   d0_ = y_ - x0;
   dv_ = ((y1 - x1) - d0_) / rig.servo.dt_s;
+  // supply_ripple: Post gave sample j its ripple at (j - 1) dt (sample 0, at rest, has none); from
+  // the second step on the damper moves with the ripple itself (Rhs), the rest of the effects'
+  // share stays linear over the step.
+  ripple_in_step_ = m_.effects.supply_ripple.has_value() && k_ >= 1;
+  RippleMotion r1;
+  if (ripple_in_step_) {
+    ripple_t0_s_ = static_cast<double>(k_ - 1) * rig.servo.dt_s;
+    const RippleMotion r0 = SupplyRippleAt(*m_.effects.supply_ripple, rig.servo.dt_s, ripple_t0_s_);
+    r1 = SupplyRippleAt(*m_.effects.supply_ripple, rig.servo.dt_s, ripple_t0_s_ + rig.servo.dt_s);
+    d0_ -= r0.mm;
+    dv_ = ((y1 - x1 - r1.mm) - d0_) / rig.servo.dt_s;
+  }
   *damper = damper_;
   double force = 0.0;
   if (rig.has_damper) {
     double w[5] = {servo_.z(0), servo_.z(1), servo_.z(2), damper_.y_mm, damper_.z_mm};
     ode_.Advance(0.0, rig.servo.dt_s, w);
     *damper = {w[3], w[4]};
-    const double ydot = OutputVelocity(rig.servo, next) + dv_;
+    const double ydot = OutputVelocity(rig.servo, next) + dv_ + r1.mm_s;
     force = DamperForceKn(CoefficientsAt(rig.damper, i_end_A), *damper, y1, ydot);
   }
   return force_.Force(force) + m_.unmodelled.stiffness_kN_per_mm * y1;

@@ -121,7 +121,9 @@ class EffectRig final : public Rig {
   // within the step being integrated
   double u_act_ = 0.0;            // servo input
   double d0_ = 0.0;               // y - x at the step's start [mm]
-  double dv_ = 0.0;               // (d_{k+1} - d_k) / dt [mm/s]
+  double dv_ = 0.0;               // (d_{k+1} - d_k) / dt [mm/s] (without supply_ripple's share)
+  bool ripple_in_step_ = false;   // supply_ripple's continuous motion is added in Rhs
+  double ripple_t0_s_ = 0.0;      // ... its time at the step's start [s]
   MrDamperCoefficients coef_{};   // at a constant current
   bool constant_current_ = true;
   // sample k

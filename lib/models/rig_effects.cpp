@@ -11,6 +11,7 @@
 #include <fmt/format.h>
 
 #include "core/error.h"
+#include "models/supply_ripple.h"
 
 namespace rths::models {
 namespace {
@@ -263,14 +264,7 @@ double DisplacementEffects::Post(double x_mm, double f_kN) {
     else if (y - play_out_ < -h) play_out_ = y + h;
     y = play_out_;
   }
-  if (e_.supply_ripple) {
-    const double t = static_cast<double>(post_k_) * dt_s_;
-    double r = 0.0;
-    for (int h = 0; h < kRippleHarmonics; ++h)
-      if (RippleHarmonicSampled(h + 1, e_.supply_ripple->f_hz, dt_s_))
-        r += kRippleWeights[h] * std::sin(2.0 * M_PI * (h + 1) * e_.supply_ripple->f_hz * t + kRipplePhases[h]);
-    y += e_.supply_ripple->amplitude_mm * r;
-  }
+  if (e_.supply_ripple) y += SupplyRippleAt(*e_.supply_ripple, dt_s_, static_cast<double>(post_k_) * dt_s_).mm;
   ++post_k_;
   return y;
 }
@@ -303,6 +297,17 @@ double DisplacementEffects::PreslidingStep(double x_mm) {
   const double w = std::clamp(travel * std::exp(l), 0.0, w_prev);
   dahl_z_ = s * (loss - w);
   return dahl_z_;
+}
+
+RippleMotion SupplyRippleAt(const SupplyRipple& r, double dt_s, double t_s) {
+  RippleMotion m;
+  for (int h = 0; h < kRippleHarmonics; ++h) {
+    if (!RippleHarmonicSampled(h + 1, r.f_hz, dt_s)) continue;
+    const double w = 2.0 * M_PI * (h + 1) * r.f_hz, a = r.amplitude_mm * kRippleWeights[h];
+    m.mm += a * std::sin(w * t_s + kRipplePhases[h]);
+    m.mm_s += a * w * std::cos(w * t_s + kRipplePhases[h]);
+  }
+  return m;
 }
 
 ForceEffects::ForceEffects(const EffectSet& effects, double dt_s) : e_(effects) {

@@ -57,7 +57,7 @@ struct HarnessCase {
   double runtime_s = 0;
 };
 
-/// The case kinds of the rig and blocks generators: the 11 single effects (every diagnosable entry
+/// The case kinds of the rig and blocks generators: the 12 single effects (every diagnosable entry
 /// of models::kEffects), pairs, "none",
 /// "unknown_ripple", "unknown_stiffness".
 std::vector<std::string> HarnessCaseKinds(bool pairs);
@@ -68,7 +68,7 @@ std::vector<std::string> HarnessCaseKinds(bool pairs);
 /// (load_coupling+gain_error, backlash+oil_column_resonance, pure_delay+damper_scale,
 /// gain_error+current_lag, oil_column_resonance+coulomb_friction, servovalve_saturation+current_lag,
 /// presliding_friction+damper_scale, command_dead_band+oil_column_resonance,
-/// pure_delay+presliding_friction),
+/// pure_delay+presliding_friction, oil_column_resonance+supply_ripple),
 /// "none" (anti-aliased noise with drift), "none_white" (white noise, no drift), "none_drift" (a
 /// random-walk sensor drift of 0.5-1.5 x the noise rms on both channels), and outside the
 /// library "unknown_ripple" (amplitude-modulated, 11-17 Hz), "unknown_cubic" (F += k3 y^3),

@@ -11,6 +11,7 @@
 #include "models/mr_damper.h"
 #include "models/rig.h"
 #include "models/servo_linear.h"
+#include "models/supply_ripple.h"
 #include "signal/blwn.h"
 #include "signal/random.h"
 
@@ -93,19 +94,27 @@ io::RigRecord MakeRecordBlocks(const Excitation& ex, const Truth& truth, const s
       dfx_try = dfx;
       ds_try = ds;
       y = dfx_try.Post(x, f_in);
-      const double d = y - x;
-      const double dd = k > 0 ? (d - d_prev) / dt : 0.0;
-      const double v = xd + dd;
+      // supply_ripple moves the damper continuously (models/supply_ripple.h): its share of d is taken
+      // out of the linear interpolation and added as it is (Post gives sample k its ripple at k dt).
+      const auto* rip = truth.effects.supply_ripple ? &*truth.effects.supply_ripple : nullptr;
+      auto ripple = [&](double t) { return rip ? models::SupplyRippleAt(*rip, dt, t) : models::RippleMotion{}; };
+      const double t_prev = (static_cast<double>(k) - 1.0) * dt;
+      const models::RippleMotion r_end = ripple(static_cast<double>(k) * dt);
+      const double d = y - x - r_end.mm, dprev = d_prev - (k > 0 ? ripple(t_prev).mm : 0.0);
+      const double dd = k > 0 ? (d - dprev) / dt : 0.0;
+      const double v = xd + dd + r_end.mm_s;
       if (k > 0) {
         const int m = 8;
         const double h = dt / m;
         auto at = [&](double tau, double* pos, double* vel) {
           const double t = tau / dt, t2 = t * t, t3 = t2 * t;
           *pos = (2 * t3 - 3 * t2 + 1) * x_prev + (t3 - 2 * t2 + t) * dt * xd_prev + (-2 * t3 + 3 * t2) * x +
-                 (t3 - t2) * dt * xd + d_prev + dd * tau;
+                 (t3 - t2) * dt * xd + dprev + dd * tau;
           *vel = ((6 * t2 - 6 * t) * x_prev + (3 * t2 - 4 * t + 1) * dt * xd_prev + (-6 * t2 + 6 * t) * x +
                   (3 * t2 - 2 * t) * dt * xd) / dt +
                  dd;
+          const models::RippleMotion r = ripple(t_prev + tau);
+          *pos += r.mm, *vel += r.mm_s;
         };
         for (int j = 0; j < m; ++j) {
           const double ta = j * h;
