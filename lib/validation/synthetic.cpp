@@ -55,6 +55,37 @@ io::RigRecord Empty(const Excitation& ex, const std::string& name, std::size_t n
   return r;
 }
 
+/// What the output effects add to the specimen's motion over the step from sample k - 1 (d_prev =
+/// y - x there) to k (d_end), as the rig mode moves its damper: linear between the samples, except
+/// supply_ripple's share, its continuous motion (models/supply_ripple.h; Post gives sample k its
+/// ripple at k dt).
+class EffectShare {
+ public:
+  EffectShare(const models::EffectSet& e, double dt, std::size_t k, double d_prev, double d_end)
+      : ripple_(e.supply_ripple ? &*e.supply_ripple : nullptr), dt_(dt),
+        t_prev_((static_cast<double>(k) - 1.0) * dt) {
+    end_ = Ripple(static_cast<double>(k) * dt);
+    d0_ = d_prev - (k > 0 ? Ripple(t_prev_).mm : 0.0);
+    dd_ = k > 0 ? (d_end - end_.mm - d0_) / dt : 0.0;
+  }
+  /// Adds the share at tau [s] into the step to *pos [mm] and *vel [mm/s].
+  void Add(double tau, double* pos, double* vel) const {
+    const models::RippleMotion r = Ripple(t_prev_ + tau);
+    *pos += d0_ + dd_ * tau + r.mm;
+    *vel += dd_ + r.mm_s;
+  }
+  /// Its rate at sample k [mm/s].
+  double EndRate() const { return dd_ + end_.mm_s; }
+
+ private:
+  models::RippleMotion Ripple(double t) const {
+    return ripple_ ? models::SupplyRippleAt(*ripple_, dt_, t) : models::RippleMotion{};
+  }
+  const models::SupplyRipple* ripple_;
+  double dt_, t_prev_, d0_ = 0.0, dd_ = 0.0;
+  models::RippleMotion end_;
+};
+
 }  // namespace
 
 io::RigRecord MakeRecordBlocks(const Excitation& ex, const Truth& truth, const std::string& name) {
@@ -94,27 +125,18 @@ io::RigRecord MakeRecordBlocks(const Excitation& ex, const Truth& truth, const s
       dfx_try = dfx;
       ds_try = ds;
       y = dfx_try.Post(x, f_in);
-      // supply_ripple moves the damper continuously (models/supply_ripple.h): its share of d is taken
-      // out of the linear interpolation and added as it is (Post gives sample k its ripple at k dt).
-      const auto* rip = truth.effects.supply_ripple ? &*truth.effects.supply_ripple : nullptr;
-      auto ripple = [&](double t) { return rip ? models::SupplyRippleAt(*rip, dt, t) : models::RippleMotion{}; };
-      const double t_prev = (static_cast<double>(k) - 1.0) * dt;
-      const models::RippleMotion r_end = ripple(static_cast<double>(k) * dt);
-      const double d = y - x - r_end.mm, dprev = d_prev - (k > 0 ? ripple(t_prev).mm : 0.0);
-      const double dd = k > 0 ? (d - dprev) / dt : 0.0;
-      const double v = xd + dd + r_end.mm_s;
+      const EffectShare share(truth.effects, dt, k, d_prev, y - x);
+      const double v = xd + share.EndRate();
       if (k > 0) {
         const int m = 8;
         const double h = dt / m;
         auto at = [&](double tau, double* pos, double* vel) {
           const double t = tau / dt, t2 = t * t, t3 = t2 * t;
           *pos = (2 * t3 - 3 * t2 + 1) * x_prev + (t3 - 2 * t2 + t) * dt * xd_prev + (-2 * t3 + 3 * t2) * x +
-                 (t3 - t2) * dt * xd + dprev + dd * tau;
+                 (t3 - t2) * dt * xd;
           *vel = ((6 * t2 - 6 * t) * x_prev + (3 * t2 - 4 * t + 1) * dt * xd_prev + (-6 * t2 + 6 * t) * x +
-                  (3 * t2 - 2 * t) * dt * xd) / dt +
-                 dd;
-          const models::RippleMotion r = ripple(t_prev + tau);
-          *pos += r.mm, *vel += r.mm_s;
+                  (3 * t2 - 2 * t) * dt * xd) / dt;
+          share.Add(tau, pos, vel);
         };
         for (int j = 0; j < m; ++j) {
           const double ta = j * h;
