@@ -143,10 +143,9 @@ std::vector<double> PredictDisplacement(const models::LinearServo& servo, const 
                                         std::span<const double> u_mm, std::span<const double> f_kN,
                                         std::vector<double>* v_mm_s, std::vector<double>* a_mm_s2,
                                         std::span<const double> y_meas_mm, std::size_t first) {
-  const bool fit_ripple = effects.supply_ripple.has_value() && !y_meas_mm.empty();
-  if (fit_ripple && y_meas_mm.size() != u_mm.size())
-    throw Error("PredictDisplacement", fmt::format("y has {} samples, u {}", y_meas_mm.size(), u_mm.size()));
-  if (fit_ripple) {
+  if (effects.supply_ripple && !y_meas_mm.empty()) {
+    if (y_meas_mm.size() != u_mm.size())
+      throw Error("PredictDisplacement", fmt::format("y has {} samples, u {}", y_meas_mm.size(), u_mm.size()));
     models::EffectSet rest = effects;
     rest.supply_ripple.reset();
     std::vector<double> y = PredictDisplacement(servo, rest, u_mm, f_kN, v_mm_s, a_mm_s2);

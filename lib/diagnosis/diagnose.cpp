@@ -206,11 +206,8 @@ void RunStages(ChannelState* s, const std::vector<stages::CandidateSpec>& specs,
   stages::ScoreSelected(*s, specs, er);
   stages::ApplyShrinkRule(s, specs, o, &res->warnings, er);
   if (o.progress) o.progress(base + 9, total, "channel " + ch + ": scoring the other candidates");
-  // Retained effects, and unconfirmed ones (retained or not: named once).
-  if (s->retained)
-    for (const auto& n : s->order) verdict->push_back(n);
-  for (const auto& n : s->unconfirmed)
-    if (!s->retained) verdict->push_back(n);
+  // The retained effects (unconfirmed or not), else the unconfirmed ones (not retained).
+  for (const auto& n : s->retained ? s->order : s->unconfirmed) verdict->push_back(n);
   stages::ScoreCandidates(s, specs, o, er);
 }
 

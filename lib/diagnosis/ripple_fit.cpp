@@ -1,6 +1,7 @@
 #include "diagnosis/ripple_fit.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <complex>
 
@@ -58,37 +59,43 @@ class RegressorStream {
   double on_[kH];
 };
 
+/// Adds the ripple with coefficients c at frequency f_hz, given its regressors phi at a sample, to
+/// *y, and its rate and acceleration to *v, *a where not null: for s sin(w t) + c cos(w t),
+/// w = 2 pi h f, the rate is w (s cos - c sin) and the acceleration -w^2 (s sin + c cos).
+void AddHarmonics(const std::array<double, 2 * kH>& c, double f_hz, const double* phi, double* y, double* v,
+                  double* a) {
+  for (int h = 0; h < kH; ++h) {
+    const double w = kTwoPi * (h + 1) * f_hz, sn = phi[2 * h], cs = phi[2 * h + 1];
+    const double value = c[2 * h] * sn + c[2 * h + 1] * cs;
+    *y += value;
+    if (v != nullptr) *v += w * (c[2 * h] * cs - c[2 * h + 1] * sn);
+    if (a != nullptr) *a -= w * w * value;
+  }
+}
+
 }  // namespace
 
 double RippleFit::FundamentalAmplitude() const { return std::hypot(coef[0], coef[1]); }
 
 double RippleFit::Value(std::size_t k, double dt_s) const {
-  double phi[2 * kH];
+  double phi[2 * kH], y = 0.0;
   Regressors(f_hz, dt_s, k, phi);
-  double r = 0.0;
-  for (int j = 0; j < 2 * kH; ++j) r += coef[j] * phi[j];
-  return r;
+  AddHarmonics(coef, f_hz, phi, &y, nullptr, nullptr);
+  return y;
 }
 
 double RippleFit::Rate(std::size_t k, double dt_s) const {
-  // d/dt (s sin(w t) + c cos(w t)) = w (s cos(w t) - c sin(w t)), w = 2 pi h f.
-  double phi[2 * kH];
+  double phi[2 * kH], y = 0.0, v = 0.0;
   Regressors(f_hz, dt_s, k, phi);
-  double r = 0.0;
-  for (int h = 0; h < kH; ++h) r += kTwoPi * (h + 1) * f_hz * (coef[2 * h] * phi[2 * h + 1] - coef[2 * h + 1] * phi[2 * h]);
-  return r;
+  AddHarmonics(coef, f_hz, phi, &y, &v, nullptr);
+  return v;
 }
 
 double RippleFit::Acceleration(std::size_t k, double dt_s) const {
-  // d^2/dt^2 = -w^2 (the harmonic itself).
-  double phi[2 * kH];
+  double phi[2 * kH], y = 0.0, a = 0.0;
   Regressors(f_hz, dt_s, k, phi);
-  double r = 0.0;
-  for (int h = 0; h < kH; ++h) {
-    const double w = kTwoPi * (h + 1) * f_hz;
-    r -= w * w * (coef[2 * h] * phi[2 * h] + coef[2 * h + 1] * phi[2 * h + 1]);
-  }
-  return r;
+  AddHarmonics(coef, f_hz, phi, &y, nullptr, &a);
+  return a;
 }
 
 RippleFit FitRipple(std::span<const double> e, double dt_s, double f_hz, std::size_t first) {
@@ -132,13 +139,7 @@ void RippleFit::AddTo(double dt_s, std::span<double> y, std::span<double> v, std
   RegressorStream stream(f_hz, dt_s, 0);
   for (std::size_t k = 0; k < y.size(); ++k) {
     stream.Next(phi);
-    for (int h = 0; h < kH; ++h) {
-      const double w = kTwoPi * (h + 1) * f_hz, sn = phi[2 * h], cs = phi[2 * h + 1];
-      const double s = coef[2 * h], c = coef[2 * h + 1];
-      y[k] += s * sn + c * cs;
-      if (!v.empty()) v[k] += w * (s * cs - c * sn);
-      if (!a.empty()) a[k] -= w * w * (s * sn + c * cs);
-    }
+    AddHarmonics(coef, f_hz, phi, &y[k], v.empty() ? nullptr : &v[k], a.empty() ? nullptr : &a[k]);
   }
 }
 

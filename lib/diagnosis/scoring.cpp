@@ -110,6 +110,24 @@ std::string UnconfirmedText(const ChannelState& s, const std::string& name, doub
       100.0 * (st == s.sel_stats.end() ? 0.0 : st->second.first), fp_train, fp_test);
 }
 
+/// If the selected effects change the test prediction by less than kUnconfirmedTestFootprint x the
+/// noise floor's power while changing the training prediction by at least kUnconfirmedTrainFootprint x,
+/// names them unconfirmed (their evidence in er, s.unconfirmed, a warning saying `why_test`) and
+/// returns true.
+bool NameUnconfirmed(ChannelState* sp, const std::vector<std::vector<double>>& fin, const char* why_test,
+                     std::vector<std::string>* warnings, EffectResults* er) {
+  ChannelState& s = *sp;
+  const auto [fp_train, fp_test] = Footprints(s, fin);
+  if (!(fp_test < tuning::kUnconfirmedTestFootprint && fp_train >= tuning::kUnconfirmedTrainFootprint)) return false;
+  for (const auto& n : s.order) (*er)[n].unconfirmed = UnconfirmedText(s, n, fp_train, fp_test);
+  s.unconfirmed = s.order;
+  warnings->push_back(fmt::format("channel {}: {} found on the training records, unconfirmed: the test records {}do "
+                                  "not exercise {} (their prediction changes by {:.2g} x the noise floor's power)",
+                                  s.summary.channel, fmt::join(s.order, ", "), why_test,
+                                  s.order.size() > 1 ? "them" : "it", fp_test));
+  return true;
+}
+
 void ApplyShrinkRule(ChannelState* sp, const std::vector<CandidateSpec>& specs, const Options& o,
                      std::vector<std::string>* warnings, EffectResults* er) {
   ChannelState& s = *sp;
@@ -120,16 +138,8 @@ void ApplyShrinkRule(ChannelState* sp, const std::vector<CandidateSpec>& specs, 
   const bool test_structured = cs.floor_ratio_test > o.none_ratio;
   bool retained = !s.order.empty();
   if (retained && test_structured && ShrinkPct(before, cs.after_test_pct) < o.min_test_shrink_pct) {
-    const auto [fp_train, fp_test] = Footprints(s, fin);
-    if (fp_test < tuning::kUnconfirmedTestFootprint && fp_train >= tuning::kUnconfirmedTrainFootprint) {
-      // The test records do not exercise the effects: neither confirmed nor refuted.
-      for (const auto& n : s.order) (*er)[n].unconfirmed = UnconfirmedText(s, n, fp_train, fp_test);
-      s.unconfirmed = s.order;
-      warnings->push_back(fmt::format("channel {}: {} found on the training records, unconfirmed: the test records "
-                                      "do not exercise {} (their prediction changes by {:.2g} x the noise floor's power)",
-                                      cs.channel, fmt::join(s.order, ", "), s.order.size() > 1 ? "them" : "it",
-                                      fp_test));
-    } else {
+    // The test records may not exercise the effects: then neither confirmed nor refuted.
+    if (!NameUnconfirmed(&s, fin, "", warnings, er)) {
       warnings->push_back(fmt::format(
           "channel {}: the effects selected on the training records ({}) shrink the test gap by only {:.1f} % "
           "(< {:.0f} %): not retained",
@@ -139,16 +149,8 @@ void ApplyShrinkRule(ChannelState* sp, const std::vector<CandidateSpec>& specs, 
     cs.after_test_pct = before;
     retained = false;
   } else if (retained && !test_structured) {
-    const auto [fp_train, fp_test] = Footprints(s, fin);
-    if (fp_test < tuning::kUnconfirmedTestFootprint && fp_train >= tuning::kUnconfirmedTrainFootprint) {
-      // Kept (they do no harm on the test), but named unconfirmed: the test cannot show them.
-      for (const auto& n : s.order) (*er)[n].unconfirmed = UnconfirmedText(s, n, fp_train, fp_test);
-      s.unconfirmed = s.order;
-      warnings->push_back(fmt::format("channel {}: {} found on the training records, unconfirmed: the test records "
-                                      "are at the noise floor and do not exercise {} (their prediction changes by "
-                                      "{:.2g} x the noise floor's power)",
-                                      cs.channel, fmt::join(s.order, ", "), s.order.size() > 1 ? "them" : "it", fp_test));
-    } else {
+    // Kept (they do no harm on the test); named unconfirmed if the test cannot show them.
+    if (!NameUnconfirmed(&s, fin, "are at the noise floor and ", warnings, er)) {
       warnings->push_back(fmt::format("channel {}: the test records' residual is at the noise floor; the effects "
                                       "were found on the training records only",
                                       cs.channel));

@@ -99,20 +99,18 @@ int EffectRig::Rhs(double t, const double* w, double* wdot, void* self) {
 double EffectRig::Trial(double x0, double x1, const LinearServoState& next, double y1, double i_end_A,
                        MrDamperState* damper) {
   const LinearRig& rig = m_.rig;
-  d0_ = y_ - x0;
-  dv_ = ((y1 - x1) - d0_) / rig.servo.dt_s;
   // supply_ripple: Post gave sample j its ripple at (j - 1) dt (sample 0, at rest, has none); from
   // the second step on the damper moves with the ripple itself (Rhs), the rest of the effects'
   // share stays linear over the step.
   ripple_in_step_ = m_.effects.supply_ripple.has_value() && k_ >= 1;
-  RippleMotion r1;
+  RippleMotion r0, r1;
   if (ripple_in_step_) {
     ripple_t0_s_ = static_cast<double>(k_ - 1) * rig.servo.dt_s;
-    const RippleMotion r0 = SupplyRippleAt(*m_.effects.supply_ripple, rig.servo.dt_s, ripple_t0_s_);
+    r0 = SupplyRippleAt(*m_.effects.supply_ripple, rig.servo.dt_s, ripple_t0_s_);
     r1 = SupplyRippleAt(*m_.effects.supply_ripple, rig.servo.dt_s, ripple_t0_s_ + rig.servo.dt_s);
-    d0_ -= r0.mm;
-    dv_ = ((y1 - x1 - r1.mm) - d0_) / rig.servo.dt_s;
   }
+  d0_ = y_ - x0 - r0.mm;
+  dv_ = ((y1 - x1 - r1.mm) - d0_) / rig.servo.dt_s;
   *damper = damper_;
   double force = 0.0;
   if (rig.has_damper) {
