@@ -16,6 +16,7 @@ packages=(
   gnuplot-nox                      # figures (PNG via pngcairo)
   default-jdk-headless liblcm-java # the Java types jar (lcm-spy, MATLAB) and examples/java_plant
   clang-14 libclang-rt-14-dev      # libFuzzer + ASan/UBSan for the fuzz targets (fuzz/, build-fuzz/)
+  libcpp-httplib-dev libjs-dygraphs  # the live monitor's web server and its plotting library (rths watch)
   libmatio-dev                     # .mat export (rths export): MATLAB v5, and v7.3 through HDF5
   libhdf5-dev python3-h5py         # a sweep's table.h5 (lib/sweep/table.h) and the test that reads it in Python
   octave                           # the test that loads an exported .mat in GNU Octave

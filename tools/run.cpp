@@ -5,7 +5,10 @@
 #include <cstdio>
 #include <filesystem>
 #include <sstream>
+#include <chrono>
+#include <memory>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <CLI/CLI.hpp>
@@ -19,6 +22,7 @@
 #include "supervisor/run.h"
 #include "cli.h"
 #include "external_block.h"
+#include "watch_flags.h"
 
 namespace fs = std::filesystem;
 namespace sup = rths::supervisor;
@@ -33,7 +37,8 @@ struct Options {
   std::string scenario_path, default_scenario = "scenarios/default.toml";
   std::string out, transport, bin_dir, url, external;  ///< transport "": TransportOf
   bool quiet = false, skip_space_check = false, port_per_channel = false, realtime = false;
-  bool compact = false, report = false;
+  bool compact = false, report = false, watch = false;
+  rths::tools::WatchFlags watch_flags;
   std::int64_t run_id = 0;
   double join_timeout_s = 120.0;
   std::vector<std::string> sets;
@@ -83,6 +88,10 @@ void AddOptions(CLI::App& app, Options* o) {
                "no signals.csv (as --set run.csv_every=0): log.lcm alone holds every step; `rths export` makes "
                "a CSV or .mat of it when needed");
   app.add_flag("--report", o->report, "at the end, write RUN_DIR/report.html with figures (as `rths report RUN_DIR`)");
+  app.add_flag("--watch", o->watch,
+               "watch the run live in a browser, with an ABORT button: prints the monitor's address "
+               "(http://127.0.0.1:8765/?token=...; udpm transport; docs/monitor.md)");
+  o->watch_flags.Add(app, "--watch-");
 }
 
 /// The transport asked for, or the default: mixed with --external, else udpm.
@@ -112,6 +121,10 @@ std::string UrlOf(const Options& o) {
   if (!o.url.empty() && o.url.rfind("udpm://", 0) != 0) {
     throw std::runtime_error(
         fmt::format("--lcm-url {}: must be a udpm:// URL (e.g. udpm://239.255.76.67:7667?ttl=0)", o.url));
+  }
+  if (o.watch && TransportOf(o) != "udpm") {
+    throw std::runtime_error("--watch needs the udpm transport (the monitor listens to the run's UDP port; " +
+                             TransportOf(o) + " keeps the built-in participants' messages inside one process)");
   }
   if (o.port_per_channel && TransportOf(o) != "udpm") {
     throw std::runtime_error(o.external.empty() ? "--port-per-channel needs the udpm transport"
@@ -173,6 +186,7 @@ void PrintHeader(const Options& o, const sup::RunPlan& plan) {
                 sup::Megabytes(z.csv_bytes).c_str(),
                 s.run.csv_every == 1 ? " (--compact: none)" : fmt::format(" (every {} steps)", s.run.csv_every).c_str());
   }
+  if (plan.url.rfind("udpm://", 0) == 0) std::printf("  lcm url          %s\n", plan.url.c_str());
 }
 
 /// The report of what was logged (also of a run that stopped: its complete steps). A report that
@@ -205,6 +219,8 @@ int PrintEnd(const Options& o, const sup::RunResult& result) {
     std::fprintf(stderr, "rths run: interrupted; the group was stopped\n");
   } else if (sum.exit_code == rths::lockstep::kExitSafety) {
     std::fprintf(stderr, "rths run: STOPPED by the safety monitor: %s\n", what.c_str());
+  } else if (sum.exit_code == rths::lockstep::kExitPeerAbort) {
+    std::fprintf(stderr, "rths run: ABORTED: %s\n", what.c_str());
   } else if (sum.exit_code == rths::lockstep::kExitRealtime) {
     std::fprintf(stderr, "rths run: STOPPED by the real-time miss policy: %s\n", what.c_str());
   } else {
@@ -239,15 +255,29 @@ int main(int argc, char** argv) {
   }
   std::signal(SIGINT, OnSignal);
   std::signal(SIGTERM, OnSignal);
+  std::unique_ptr<rths::monitor::Monitor> monitor;
+  bool monitor_failed = false;
   request.on_start = [&](const sup::RunPlan& plan) {
     if (!o.quiet) PrintHeader(o, plan);
     if (!request.external.roles.empty()) rths::tools::PrintExternal(request, plan, plan.scenario.steps());
+    // A monitor that cannot start stops the run before its participants do (RunError, exit 2).
+    if (o.watch) {
+      monitor_failed = true;
+      monitor = o.watch_flags.Start(plan.url, plan.scenario.realtime.enabled, "rths monitor: " + plan.scenario.run.name,
+                                    "run", stdout);
+      monitor_failed = false;
+    }
     std::fflush(stdout);
   };
   try {
-    return PrintEnd(o, sup::Run(request));
+    const sup::RunResult result = sup::Run(request);
+    if (monitor) {
+      std::this_thread::sleep_for(std::chrono::seconds(1));  // the page gets the run's end
+      monitor->Stop();
+    }
+    return PrintEnd(o, result);
   } catch (const sup::RunError& e) {
-    std::fprintf(stderr, "rths run: %s\n", e.what());
-    return e.exit_code();
+    std::fprintf(stderr, "rths run: %s%s\n", monitor_failed ? "--watch: " : "", e.what());
+    return monitor_failed ? rths::lockstep::kExitUsage : e.exit_code();
   }
 }

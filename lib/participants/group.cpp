@@ -338,7 +338,10 @@ Verdict Judge(const std::vector<Outcome>& outcomes) {
     return v;
   }
   v.exit_code = worst->exit_code;
-  v.what = worst->external && !worst->message.empty()
+  // Everyone was told to stop (an ABORT from outside the group: the monitor's Abort button, a
+  // user's tool): the abort's own words, "<sender> aborted the run: <reason>".
+  const bool told = worst->exit_code == lockstep::kExitPeerAbort && !worst->message.empty();
+  v.what = (worst->external || told) && !worst->message.empty()
                ? worst->message
                : fmt::format("{} exited with code {}{}{}", worst->role, worst->exit_code,
                              worst->message.empty() ? "" : ": ", worst->message);

@@ -7,6 +7,7 @@
 #include "core/names.h"
 #include "io/output_folder.h"
 #include "io/reserved_file.h"
+#include "lockstep/abort.h"
 #include "lockstep/exit_code.h"
 #include "lockstep/faults.h"
 #include "lockstep/protocol.h"
@@ -114,7 +115,9 @@ GroupEnd RunGroup(const RunRequest& r, const RunPlan& plan) {
       end.outcomes = RunInProcessGroup(plan.scenario, r.replay ? &*r.replay : nullptr, &r.external, plan.url,
                                        plan.run_id, plan.out.string(), interrupted, &end.memq_setup);
       // The built-in participants stopped at the interrupt; the external ones hear it here.
-      if (r.transport == "mixed" && *interrupted) BroadcastAbort(plan.url, plan.run_id, "interrupted by the user");
+      if (r.transport == "mixed" && *interrupted) {
+        lockstep::BroadcastAbort(plan.url, plan.run_id, "supervisor", "interrupted by the user");
+      }
     } else {
       const ProcessGroupSpec spec{plan.scenario_path, plan.run_id, plan.out,   r.bin_dir,
                                   plan.url,           r.external,  r.role_args};

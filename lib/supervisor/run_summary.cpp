@@ -190,7 +190,8 @@ void SetVerdict(Verdict verdict, bool interrupted, RunSummary* s) {
     s->exit_code = verdict.exit_code != 0 ? verdict.exit_code : lockstep::kExitLockstep;
     s->status = s->exit_code == lockstep::kExitSafety     ? "stopped by the safety monitor"
                 : s->exit_code == lockstep::kExitRealtime ? "stopped by the miss policy"
-                                                          : "failed";
+                : s->exit_code == lockstep::kExitPeerAbort ? "aborted"
+                                                           : "failed";
   }
   s->stopped = interrupted ? std::string("interrupted by the user") : verdict.failed ? verdict.what : "no";
   s->failure.reset();

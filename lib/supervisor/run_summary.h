@@ -45,7 +45,8 @@ struct RunSummary {
   // From the outcomes (SetOutcomes, SetVerdict).
   double stepping_s = 0.0;        ///< [s] the clock's GO to its last committed step
   std::string status = "completed";  ///< completed | interrupted | stopped by the safety monitor |
-                                     ///< stopped by the miss policy | failed
+                                     ///< stopped by the miss policy | aborted (an ABORT from outside
+                                     ///< the group, e.g. the monitor's button) | failed
   int exit_code = 0;              ///< the run's exit code (lockstep::ExitCode, 130 interrupted, 128 + signal)
   std::string stopped = "no";     ///< "no", or why the run stopped
   struct Failure {

@@ -6,30 +6,10 @@
 #include <iterator>
 
 #include <fmt/format.h>
-#include <lcm/lcm-cpp.hpp>
 
-#include "lockstep/protocol.h"
-#include "lockstep/transport.h"
-#include "rths/handshake_t.hpp"
+#include "lockstep/abort.h"
 
 namespace rths::supervisor {
-
-void BroadcastAbort(const std::string& url, std::int64_t run_id, const std::string& reason) {
-  // A run with a port per channel hears handshakes on the handshake channel's port.
-  const auto parsed = lockstep::UdpmUrl::Parse(url);
-  lcm::LCM lcm(parsed ? parsed->ChannelUrl(lockstep::kChHandshake) : url);
-  if (!lcm.good()) return;
-  rths::handshake_t h{};
-  h.run_id = run_id;
-  h.phase = lockstep::kAbort;
-  h.participant = "supervisor";
-  h.k = -1;
-  h.n_roster = 0;
-  h.reason = reason;
-  lockstep::Bytes bytes;
-  lockstep::Encode(h, &bytes);
-  for (int i = 0; i < 3; ++i) lcm.publish(lockstep::kChHandshake, bytes.data(), bytes.size());
-}
 
 char ProcessState(pid_t pid) {
   std::ifstream in(fmt::format("/proc/{}/stat", pid));
@@ -42,7 +22,7 @@ void Teardown::Start(const std::string& reason) {
   if (started_) return;
   started_ = true;
   noticed_ = Clock::now();
-  BroadcastAbort(url_, run_id_, reason);
+  lockstep::BroadcastAbort(url_, run_id_, "supervisor", reason);
   term_at_ = noticed_ + kGraceAbort;
 }
 

@@ -16,9 +16,6 @@ using Clock = std::chrono::steady_clock;
 inline constexpr auto kGraceAbort = std::chrono::milliseconds(1000);
 inline constexpr auto kGraceTerm = std::chrono::milliseconds(1000);
 
-/// Tells every participant of the run to stop: ABORT on the run's URL, from "supervisor".
-void BroadcastAbort(const std::string& url, std::int64_t run_id, const std::string& reason);
-
 /// The state letter of /proc/PID/stat ('T': stopped), or 0.
 char ProcessState(pid_t pid);
 

@@ -1,0 +1,11 @@
+#pragma once
+/// @file The live monitor's page (docs/monitor.md): HTML, CSS and the script that draws the pushed
+/// points with dygraphs (served by the monitor from Debian's libjs-dygraphs, nothing from a CDN).
+#include <string>
+
+namespace rths::monitor {
+
+/// The page, titled `title` (HTML-escaped). Its script reads the token from the page's own URL.
+std::string PageHtml(const std::string& title);
+
+}  // namespace rths::monitor

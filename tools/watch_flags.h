@@ -1,0 +1,74 @@
+#pragma once
+// The live monitor's flags, shared by `rths watch` and `rths run --watch`, and the plotting
+// library read here at the edge (docs/monitor.md).
+#include <cstdio>
+#include <fstream>
+#include <memory>
+#include <sstream>
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+#include "core/error.h"
+#include "monitor/monitor.h"
+
+namespace rths::tools {
+
+/// Where Debian's libjs-dygraphs puts the library the page plots with.
+inline constexpr const char* kDygraphsJs = "/usr/share/javascript/dygraphs/dygraph.min.js";
+
+struct WatchFlags {
+  int port = 8765;
+  bool lan = false;
+  std::string dygraphs = kDygraphsJs;
+
+  /// Adds the flags with `prefix` ("--" for watch, "--watch-" for run).
+  void Add(CLI::App& app, const std::string& prefix) {
+    app.add_option(prefix + "port", port, "the monitor's TCP port (0: any free port)")
+        ->check(CLI::Range(0, 65535))
+        ->capture_default_str();
+    app.add_flag(prefix + "lan", lan,
+                 "serve on every interface (0.0.0.0), not only this host (127.0.0.1): anyone on the LAN who has the "
+                 "printed URL, token included, can see the run and ABORT it");
+    app.add_option(prefix + "dygraphs", dygraphs, "the dygraphs library the page plots with (libjs-dygraphs)")
+        ->group("");
+  }
+
+  /// The monitor's options for a run on `lcm_url`; reads the plotting library (throws Error naming
+  /// the file and the package if it cannot).
+  monitor::MonitorOptions Options(const std::string& lcm_url, bool paced, const std::string& title) const {
+    monitor::MonitorOptions o;
+    o.lcm_url = lcm_url;
+    o.view.paced = paced;
+    o.server.host = lan ? "0.0.0.0" : "127.0.0.1";
+    o.server.port = port;
+    o.server.title = title;
+    std::ifstream in(dygraphs, std::ios::binary);
+    std::stringstream bytes;
+    bytes << in.rdbuf();
+    if (!in || bytes.str().empty()) {
+      throw Error(dygraphs, "cannot read the monitor's plotting library (install Debian's libjs-dygraphs: apt-get "
+                            "install libjs-dygraphs)");
+    }
+    o.server.dygraphs_js = bytes.str();
+    return o;
+  }
+
+  /// Starts a monitor on `lcm_url` and prints its address (and the LAN warning) on `out`.
+  std::unique_ptr<monitor::Monitor> Start(const std::string& lcm_url, bool paced, const std::string& title,
+                                          const std::string& command, std::FILE* out) const {
+    auto m = std::make_unique<monitor::Monitor>(Options(lcm_url, paced, title));
+    m->Start();
+    if (lan) {
+      std::fprintf(stderr,
+                   "rths %s: warning: the monitor serves the whole network (--%slan): anyone with its URL can see "
+                   "this run and ABORT it; share the URL only with the test's operators\n",
+                   command.c_str(), command == "run" ? "watch-" : "");
+    }
+    std::fprintf(out, "  monitor          %s\n", m->Url().c_str());
+    std::fflush(out);
+    return m;
+  }
+};
+
+}  // namespace rths::tools
