@@ -22,7 +22,7 @@ struct LiveViewOptions {
   /// Plotted points per second of simulated time [1/s]: a bucket is round(1 / (dt * this)) steps
   /// (at least 1); each signal keeps its value of largest magnitude in the bucket, so a peak is
   /// never decimated away.
-  double points_per_sim_s = 200.0;
+  double points_per_sim_s = 100.0;
   std::size_t capacity = 1 << 16;  ///< points kept for a browser that connects late (the newest)
   /// The run is paced to the wall clock (`run --realtime`): report each step's lateness and count
   /// the steps seen completing after their deadline. Unpaced: the lateness is not shown.

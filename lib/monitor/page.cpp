@@ -138,7 +138,16 @@ function onEvent(e) {
   st.points += j.points.length;
   if (st.rows.length) st.lastT = st.rows[st.rows.length - 1][0];
   showStatus(j.status);
-  if (j.points.length) redraw();
+  if (j.points.length) scheduleRedraw();
+}
+// At most 4 redraws a second: a scope that is read by eye, and a browser on the rig's own machine
+// takes less of its CPU.
+let redrawPending = false, lastRedraw = 0;
+function scheduleRedraw() {
+  if (redrawPending) return;
+  redrawPending = true;
+  setTimeout(() => { redrawPending = false; lastRedraw = performance.now(); redraw(); },
+             Math.max(0, 250 - (performance.now() - lastRedraw)));
 }
 const source = new EventSource("events?token=" + encodeURIComponent(token));
 source.onmessage = onEvent;

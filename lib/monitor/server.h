@@ -25,7 +25,7 @@ struct ServerOptions {
   std::string token;               ///< required on every request but /dygraph.min.js (non-empty)
   std::string dygraphs_js;         ///< the plotting library's bytes (Debian's libjs-dygraphs), served as is
   std::string title = "rths monitor";  ///< the page's title (e.g. the scenario's name)
-  double push_period_s = 0.1;      ///< [s] between two pushes to a browser
+  double push_period_s = 0.2;      ///< [s] between two pushes to a browser
 };
 
 /// Stops the watched run: returns "" if ABORT was sent, else why not.

@@ -61,6 +61,14 @@ std::string HtmlHead(const std::string& title) {
          "</title>\n<style>" + kStyle + "</style></head><body>\n";
 }
 
+std::string FigureHtml(const std::string& id, const std::string& heading, const std::string& png_file, int width_px,
+                       const std::string& caption_html) {
+  return fmt::format("<h3 id=\"{}\">{}</h3>\n<figure><img src=\"figures/{}\" alt=\"{}\" width=\"{}\">\n"
+                     "<figcaption>{} (<a href=\"figures/{}\">{}</a>; data and gnuplot script beside it)</figcaption>"
+                     "</figure>\n",
+                     id, HtmlEscape(heading), png_file, HtmlEscape(heading), width_px, caption_html, png_file, png_file);
+}
+
 void WriteFileAtomically(const fs::path& path, const std::string& text) {
   const fs::path tmp = path.string() + ".tmp";
   {

@@ -18,6 +18,11 @@ std::string HtmlRow(const std::string& name, const std::string& value_html, cons
 /// the shared style sheet (headings, tables, banners `.banner.failed|.note|.ok`, a selected row `tr.sel`, figures, `.where`).
 std::string HtmlHead(const std::string& title);
 
+/// One figure of a page: a heading `<h3 id="id">` and the PNG figures/`png_file` at `width_px`
+/// with its caption (HTML already) and a link to it ("data and gnuplot script beside it").
+std::string FigureHtml(const std::string& id, const std::string& heading, const std::string& png_file, int width_px,
+                       const std::string& caption_html);
+
 /// Writes `text` to `path` through `path.tmp` and a rename, so that a reader never sees half a
 /// page. Throws rths::Error naming the file if it cannot be written.
 void WriteFileAtomically(const std::filesystem::path& path, const std::string& text);

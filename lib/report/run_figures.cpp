@@ -45,7 +45,23 @@ bool AnyNonZero(const std::vector<double>& x) {
   return std::any_of(x.begin(), x.end(), [](double v) { return v != 0.0; });
 }
 
-/// A curve of y against x over the samples `idx`.
+/// A time history of y against t, min/max-decimated to max_points.
+Series History(const std::string& title, const std::string& color, const std::vector<double>& t,
+               const std::vector<double>& y, std::size_t max_points) {
+  return Curve(title, color, t, y, MinMaxDecimate(y, max_points));
+}
+
+Figure NewFigure(const std::string& name, const RunReportOptions& o) {
+  Figure f;
+  f.name = name;
+  f.gnuplot = o.gnuplot;
+  f.width_px = 1100;
+  f.panel_height_px = 300;
+  return f;
+}
+
+}  // namespace
+
 Series Curve(const std::string& title, const std::string& color, const std::vector<double>& x,
              const std::vector<double>& y, const std::vector<std::size_t>& idx) {
   Series s = MakeSeries(title, color);
@@ -59,13 +75,6 @@ Series Curve(const std::string& title, const std::string& color, const std::vect
   return s;
 }
 
-/// A time history of y against t, min/max-decimated to max_points.
-Series History(const std::string& title, const std::string& color, const std::vector<double>& t,
-               const std::vector<double>& y, std::size_t max_points) {
-  return Curve(title, color, t, y, MinMaxDecimate(y, max_points));
-}
-
-/// Indices begin, begin + stride, ... < end with at most max_points of them.
 std::vector<std::size_t> Strided(std::size_t begin, std::size_t end, std::size_t max_points) {
   std::vector<std::size_t> idx;
   if (end <= begin) return idx;
@@ -74,28 +83,12 @@ std::vector<std::size_t> Strided(std::size_t begin, std::size_t end, std::size_t
   return idx;
 }
 
-
-
-Figure NewFigure(const std::string& name, const RunReportOptions& o) {
-  Figure f;
-  f.name = name;
-  f.gnuplot = o.gnuplot;
-  f.width_px = 1100;
-  f.panel_height_px = 300;
-  return f;
-}
-
-
-/// Welch segment length: a power of two of steps near welch_segment_s, at most n/4, at least 32.
 std::size_t SegmentLength(std::size_t n, double dt_s, double segment_s) {
   const double want = std::max(32.0, segment_s / dt_s);
   std::size_t l = 32;
   while (l * 2 <= n / 4 && static_cast<double>(l * 2) <= want * std::sqrt(2.0)) l *= 2;
   return l;
 }
-
-}  // namespace
-
 
 PageFigure TimeHistories(const io::RunSignals& s, const RunReportOptions& o) {
   const auto& t = s.At("t_s").values;
@@ -197,8 +190,6 @@ PageFigure Loops(const io::RunSignals& s, const RunReportOptions& o) {
     pf.caption_html += fmt::format(" Every {}th step drawn.", y.size() / std::max<std::size_t>(1, idx.size()));
   return pf;
 }
-
-
 
 namespace {
 

@@ -19,6 +19,14 @@ struct PageFigure {
   std::string caption_html;
 };
 
+/// A curve of y against x over the samples `idx` (line width 1.2).
+io::Series Curve(const std::string& title, const std::string& color, const std::vector<double>& x,
+                 const std::vector<double>& y, const std::vector<std::size_t>& idx);
+/// Indices begin, begin + stride, ... < end, at most max_points of them (max_points >= 1).
+std::vector<std::size_t> Strided(std::size_t begin, std::size_t end, std::size_t max_points);
+/// Welch segment length [steps]: a power of two near segment_s / dt_s, at most n / 4, at least 32.
+std::size_t SegmentLength(std::size_t n, double dt_s, double segment_s);
+
 /// r, u, y [mm]; f (and the clipped-optimal desired force) [kN]; i_cmd, i_eff [A] against t [s].
 PageFigure TimeHistories(const io::RunSignals& s, const RunReportOptions& o);
 /// e = r - y [mm] over the run, and r, u, y over the 0.5 s around the largest |e|.

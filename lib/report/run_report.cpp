@@ -122,11 +122,7 @@ std::string FiguresSection(const DrawnFigures& f, const std::vector<fs::path>& p
   }
   for (std::size_t i = 0; i < f.drawn.size(); ++i) {
     const std::string png = pngs[i].filename().string();
-    h += fmt::format("<h3 id=\"{}\">{}</h3>\n<figure><img src=\"figures/{}\" alt=\"{}\" width=\"{}\">\n"
-                     "<figcaption>{} (<a href=\"figures/{}\">{}</a>; data and gnuplot script beside it)</figcaption>"
-                     "</figure>\n",
-                     f.drawn[i].figure.name, HtmlEscape(f.drawn[i].heading), png, HtmlEscape(f.drawn[i].heading),
-                     f.drawn[i].figure.width_px, f.drawn[i].caption_html, png, png);
+    h += FigureHtml(f.drawn[i].figure.name, f.drawn[i].heading, png, f.drawn[i].figure.width_px, f.drawn[i].caption_html);
   }
   return h;
 }

@@ -1,0 +1,111 @@
+// lib/report/compare_page + rths-compare (docs/compare.md): the scenario keys that differ, a page
+// comparing three memq runs (one a shorter run of another controller), its figures and table, and
+// the tool's refusals.
+#include <doctest/doctest.h>
+
+#include <sys/wait.h>
+
+#include <cstdlib>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "core/error.h"
+#include "report/compare_page.h"
+#include "test_support.h"
+
+namespace fs = std::filesystem;
+using rths_test::RunCli;
+using rths_test::Slurp;
+using rths_test::TempDir;
+
+namespace {
+
+/// A compact memq run of the default scenario with `sets`; its folder.
+fs::path MakeRun(const fs::path& dir, const std::string& name, const std::string& sets) {
+  const fs::path out = dir / name;
+  std::string output;
+  const int code = RunCli(std::string(RTHS_SOURCE_DIR) + "/scenarios/default.toml --transport memq --compact --quiet "
+                          "--skip-space-check --set run.duration_s=1 " + sets + " --out " + out.string(), &output);
+  REQUIRE_MESSAGE(code == 0, output);
+  return out;
+}
+
+int Compare(const std::string& args, std::string* output) {
+  const fs::path txt = fs::temp_directory_path() / fmt::format("rths_compare_{}.txt", ::getpid());
+  const int status = std::system((std::string(RTHS_BIN_DIR) + "/rths-compare " + args + " > " + txt.string() + " 2>&1").c_str());
+  *output = Slurp(txt);
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+}  // namespace
+
+TEST_CASE("scenario keys: flattened, and those that differ between texts (or some lack)") {
+  const std::string a = "[run]\nname = \"a\"\ndt_s = 0.0005\n[plant.damper]\nc0_a = 21.0\nlist = [1, 2]\n";
+  const std::string b = "[run]\nname = \"a\"\ndt_s = 0.001\n[plant.damper]\nc0_a = 21.0\nlist = [1, 3]\nextra = true\n";
+  const auto flat = rths::report::FlattenScenario(a);
+  REQUIRE(flat.size() == 4);
+  CHECK(flat[0].key == "plant.damper.c0_a");
+  CHECK(flat[0].value == "21.0");
+  CHECK(rths::report::DifferingKeys({a, a}).empty());
+  CHECK(rths::report::DifferingKeys({a, b}) ==
+        std::vector<std::string>{"plant.damper.list", "run.dt_s", "plant.damper.extra"});
+  CHECK(rths::report::FlattenScenario("not toml [").empty());
+}
+
+TEST_CASE("rths compare: three runs in one page, aligned by step over the steps they all have") {
+  const fs::path dir = TempDir("compare");
+  const fs::path ff = MakeRun(dir, "ff", "");
+  const fs::path none = MakeRun(dir, "none", "--set controller.kind=none");
+  const fs::path shorter = MakeRun(dir, "lqg_short", "--set controller.kind=ff_lqg --set run.duration_s=0.5");
+
+  std::string output;
+  const fs::path out = dir / "cmp";
+  REQUIRE_MESSAGE(Compare(fmt::format("{} {} {} --out {}", ff.string(), none.string(), shorter.string(), out.string()),
+                          &output) == 0,
+                  output);
+  CHECK(output.find("3 runs over 1000 common steps") != std::string::npos);
+  CHECK(output.find("scenario keys that differ: controller.kind, run.duration_s") != std::string::npos);
+  const std::string html = Slurp(out / "compare.html");
+  for (const char* fig : {"compare_histories", "compare_error", "compare_loops", "compare_spectra"}) {
+    CAPTURE(fig);
+    CHECK(fs::file_size(out / "figures" / (std::string(fig) + ".png")) > 10000);
+    CHECK(html.find(std::string("figures/") + fig + ".png") != std::string::npos);
+  }
+  // The table quotes each run's own Eq. 31 value, and the differing keys with their values.
+  for (const fs::path& run : {ff, none, shorter}) {
+    const auto summary = nlohmann::json::parse(Slurp(run / "summary.json"));
+    CHECK(html.find(fmt::format("{:.4g} %", summary["tracking_nrmse_pct"].get<double>())) != std::string::npos);
+  }
+  CHECK(html.find("<code>controller.kind</code></th><td><code>&#39;ff&#39;</code></td><td><code>&#39;none&#39;</code>"
+                  "</td><td><code>&#39;ff_lqg&#39;</code></td>") != std::string::npos);
+  CHECK(html.find("1000 of 1000 (0.5 s)") != std::string::npos);
+
+  // The same run twice: no differences; the default folder is beside the first run.
+  REQUIRE(Compare(fmt::format("{} {}", ff.string(), ff.string()), &output) == 0);
+  CHECK(output.find("the scenarios are the same, key by key") != std::string::npos);
+  CHECK(fs::exists(dir / "compare-ff-ff" / "compare.html"));
+  CHECK(Slurp(dir / "compare-ff-ff" / "compare.html").find("ff (2)") != std::string::npos);
+
+  // Refusals (exit 2): one run, an output folder that is not empty, a folder that is not a run,
+  // labels that are not one per run.
+  CHECK(Compare(ff.string(), &output) == 2);
+  CHECK(Compare(fmt::format("{} {} --out {}", ff.string(), none.string(), out.string()), &output) == 2);
+  CHECK(output.find("not empty") != std::string::npos);
+  CHECK(Compare(fmt::format("{} {} --out {}", ff.string(), dir.string(), (dir / "x").string()), &output) == 2);
+  CHECK(output.find("log.lcm") != std::string::npos);
+  CHECK(Compare(fmt::format("{} {} --labels a --out {}", ff.string(), none.string(), (dir / "y").string()), &output) == 2);
+  CHECK(output.find("1 labels for 2 runs") != std::string::npos);
+}
+
+TEST_CASE("rths compare: runs with different steps are refused, naming both") {
+  const fs::path dir = TempDir("compare_dt");
+  const fs::path a = MakeRun(dir, "a", "");
+  const fs::path b = MakeRun(dir, "b", "--set run.dt_s=0.001");
+  std::string output;
+  CHECK(Compare(fmt::format("{} {} --out {}", a.string(), b.string(), (dir / "c").string()), &output) == 2);
+  CHECK(output.find("must share dt") != std::string::npos);
+  CHECK_FALSE(fs::exists(dir / "c" / "compare.html"));
+}
