@@ -1,6 +1,7 @@
 // bench-monitor: does watching a run slow it down? The same run, side by side and repeated:
-// without a monitor, with `rths run --watch` (the monitor listening, no browser), and with a
-// headless Chromium showing the monitor's page for the whole run. Prints each run's steps/s (from
+// without a monitor, with `rths run --watch` (the monitor listening, no browser), with a headless
+// Chromium showing the monitor's page for the whole run, and with the same Chromium on a blank page
+// (what a browser on the run's own machine costs by itself, page or not). Prints each run's steps/s (from
 // its summary.json), the medians and their ratios to the unwatched run (machines are shared and
 // noisy: only ratios from one invocation mean anything).
 //
@@ -44,10 +45,12 @@ double Median(std::vector<double> v) {
   return n == 0 ? 0 : n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
-/// One run of `rths-run ARGS --out DIR`; with `browser`, a headless Chromium shows the monitor's
-/// page (the run must have --watch) from the moment its address is printed to the run's end.
-/// Returns the run's steps/s, or a negative number if it failed.
-double Run(const std::string& run_cmd, const fs::path& dir, bool browser) {
+enum class Browser { kNone, kMonitorPage, kBlankPage };
+
+/// One run of `rths-run ARGS --out DIR`; with a browser, a headless Chromium shows the monitor's
+/// page (the run must have --watch) or a blank page from the moment the monitor's address is
+/// printed to the run's end. Returns the run's steps/s, or a negative number if it failed.
+double Run(const std::string& run_cmd, const fs::path& dir, Browser browser) {
   const fs::path out_txt = dir.string() + ".txt";
   const std::string cmd = "exec " + run_cmd + " --out " + dir.string() + " > " + out_txt.string() + " 2>&1";
   const pid_t pid = ::fork();
@@ -56,7 +59,7 @@ double Run(const std::string& run_cmd, const fs::path& dir, bool browser) {
     ::_exit(127);
   }
   std::unique_ptr<rths_test::ChromiumPipe> chromium;
-  if (browser) {
+  if (browser != Browser::kNone) {
     const std::regex line("monitor +(http://\\S+)");
     std::string url;
     for (int i = 0; i < 600 && url.empty(); ++i) {
@@ -67,7 +70,7 @@ double Run(const std::string& run_cmd, const fs::path& dir, bool browser) {
     }
     if (!url.empty()) {
       chromium = std::make_unique<rths_test::ChromiumPipe>(dir.string() + "-chromium");
-      chromium->Open(url);
+      chromium->Open(browser == Browser::kMonitorPage ? url : "about:blank");
     }
   }
   int status = 0;
@@ -104,12 +107,13 @@ int main(int argc, char** argv) {
   struct Kind {
     const char* name;
     std::string args;
-    bool browser;
+    Browser browser;
     std::vector<double> rates;
   };
-  std::vector<Kind> kinds = {{"no monitor", "", false, {}},
-                             {"--watch, no browser", " --watch --watch-port 0", false, {}},
-                             {"--watch, Chromium on the page", " --watch --watch-port 0", true, {}}};
+  std::vector<Kind> kinds = {{"no monitor", "", Browser::kNone, {}},
+                             {"--watch, no browser", " --watch --watch-port 0", Browser::kNone, {}},
+                             {"--watch, Chromium on the page", " --watch --watch-port 0", Browser::kMonitorPage, {}},
+                             {"--watch, Chromium on about:blank", " --watch --watch-port 0", Browser::kBlankPage, {}}};
   std::printf("bench-monitor: %s, %g s runs, %d of each kind, interleaved\n", scenario.c_str(), duration_s, repeat);
   for (int r = 0; r < repeat; ++r) {
     for (std::size_t n = 0; n < kinds.size(); ++n) {

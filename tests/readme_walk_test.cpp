@@ -59,9 +59,9 @@ int RunLine(std::string line, const fs::path& cwd, std::string* out) {
 
 }  // namespace
 
-TEST_CASE("README first steps: run + report, export, Octave, a --set variant") {
+TEST_CASE("README first steps: run + report, export, Octave, a --set variant, the two compared") {
   const std::vector<std::string> lines = WalkLines();
-  REQUIRE(lines.size() == 5);
+  REQUIRE(lines.size() == 6);
   CHECK(lines[0] == "bash scripts/bootstrap.sh");  // the install, which CI has run already
   if (!rths_test::UdpmAvailable()) FAIL("udpm cannot run on this host: " << rths::lockstep::CheckMulticastRoute());
   const fs::path cwd = rths_test::TempDir("readme_walk");
@@ -106,4 +106,18 @@ TEST_CASE("README first steps: run + report, export, Octave, a --set variant") {
         rths::control::ControllerKind::kNone);
   const auto summary_none = nlohmann::json::parse(Slurp(none / "summary.json"));
   CHECK(summary_none["tracking_nrmse_pct"].get<double>() > 5 * nrmse);
+
+  // 6. The two side by side: the keys that differ (the controller, and what --compact set), both
+  // Eq. 31 values, four figures.
+  INFO(lines[5]);
+  REQUIRE_MESSAGE(RunLine(lines[5], cwd, &out) == 0, out);
+  CHECK(out.find("scenario keys that differ: controller.kind, run.csv_every") != std::string::npos);
+  const std::string cmp = Slurp(cwd / "runs" / "first_vs_none" / "compare.html");
+  CHECK(cmp.find(fmt::format("{:.4g} %", nrmse)) != std::string::npos);
+  CHECK(cmp.find(fmt::format("{:.4g} %", summary_none["tracking_nrmse_pct"].get<double>())) != std::string::npos);
+  int compare_figures = 0;
+  for (const auto& e : fs::directory_iterator(cwd / "runs" / "first_vs_none" / "figures")) {
+    compare_figures += e.path().extension() == ".png" ? 1 : 0;
+  }
+  CHECK(compare_figures == 4);
 }

@@ -118,7 +118,7 @@ std::map<std::string, ImageStats> OctaveImageStats(const std::vector<fs::path>& 
   return stats;
 }
 
-const std::vector<std::string> kFigures = {"time_histories", "tracking_error", "loops", "spectra", "gyr"};
+const std::vector<std::string> kFigures = {"tracking_error", "time_histories", "loops", "spectra", "gyr"};
 
 }  // namespace
 
@@ -191,7 +191,7 @@ TEST_CASE("the report of a run: five real figures, the Eq. 31 value of summary.j
     CHECK(s.ink_fraction > 0.01);
   }
   CHECK(stats.at("time_histories.png").blue_pixels > 500);  // u is drawn
-  CHECK(stats.at("gyr.png").blue_pixels > 100);              // the coherence is drawn
+  CHECK(stats.at("gyr.png").blue_pixels < 20);               // no sensor noise: the coherence is 1, not drawn
 
   // The page in a headless browser: not blank, and the figures load (their blue is on screen).
   rths_test::RequireTool("chromium", "chromium");
@@ -317,4 +317,70 @@ TEST_CASE("rths report: exit codes, help, the output line") {
   CHECK(out.find("8000 of 8000 steps -> " + (dir / "rep" / "report.html").string() + " (5 figures)") !=
         std::string::npos);
   CHECK(fs::exists(dir / "rep" / "figures" / "gyr.png"));
+}
+
+TEST_CASE("a reviewer's figures: a constant current is a line of text, the spectra show the band of r, a flat "
+          "coherence is left out, a paced run that missed deadlines is not green") {
+  // kScenario with the current held at 0 A and no sensor noise: a deterministic run.
+  const auto dir = TempDir("report_reviewer");
+  REQUIRE(MakeRun(dir, "") == 0);  // kScenario's pulse current, for the spectra
+  const fs::path run = dir / "run";
+  const fs::path dir0 = TempDir("report_reviewer_const");
+  std::string text0 = kScenario;
+  const std::string pulse = "mode = \"pulse\"";
+  text0.replace(text0.find(pulse), pulse.size(), "mode = \"passive_off\"");
+  const fs::path scenario0 = WriteScenario(dir0, text0);
+  std::string out;
+  REQUIRE_MESSAGE(RunCli(scenario0.string() + " --transport memq --out " + (dir0 / "run").string(), &out) == 0, out);
+
+  const auto files0 = rths::report::WriteRunReport(dir0 / "run");
+  const std::string html0 = Slurp(files0.html);
+  CHECK(html0.find("The damper current is constant over the run: commanded 0 A, effective 0 A (not drawn).") !=
+        std::string::npos);
+  const std::string gp0 = Slurp(dir0 / "run" / "figures" / "time_histories.gp");
+  CHECK(gp0.find("current [A]") == std::string::npos);
+  CHECK(gp0.find("force [kN]") != std::string::npos);
+  // The pulsed run keeps its current panel.
+  const auto files = rths::report::WriteRunReport(run);
+  CHECK(Slurp(run / "figures" / "time_histories.gp").find("current [A]") != std::string::npos);
+
+  // Spectra: x from 0 to 1.5 x the top of r's 40 dB band (a 0-30 Hz excitation of a 5 Hz structure:
+  // tens of Hz, not the 1 kHz Nyquist), y over at most 8 decades (+ the factor-2 margins).
+  const std::string sp = Slurp(run / "figures" / "spectra.gp");
+  const auto xr = sp.find("set xrange [");
+  REQUIRE(xr != std::string::npos);
+  const double x_hi = std::stod(sp.substr(sp.find(':', xr) + 1));
+  CHECK(x_hi > 10.0);
+  CHECK(x_hi < 300.0);
+  const auto yr = sp.find("set yrange [");
+  REQUIRE(yr != std::string::npos);
+  const double y_lo = std::stod(sp.substr(yr + 12)), y_hi = std::stod(sp.substr(sp.find(':', yr) + 1));
+  CHECK(std::log10(y_hi / y_lo) <= 8.0 + std::log10(4.0) + 1e-9);
+  CHECK(sp.find("set logscale x") == std::string::npos);
+
+  // Without sensor noise the coherence is 1 over the band: not drawn, and the caption says why;
+  // with noise on y it falls, and is drawn.
+  const std::string gyr0 = Slurp(dir0 / "run" / "figures" / "gyr.gp");
+  CHECK(gyr0.find("coherence [-]") == std::string::npos);
+  CHECK(html0.find("The coherence is not drawn: it is 1 to within 0.001 over the whole band") != std::string::npos);
+  const fs::path dirn = TempDir("report_reviewer_noise");
+  std::string text_n = kScenario;
+  text_n.replace(text_n.find("actuator = \"avg\""), 16, "actuator = \"avg\"\nnoise_y_mm_rms = 0.05");
+  const fs::path scenario_n = WriteScenario(dirn, text_n);
+  REQUIRE_MESSAGE(RunCli(scenario_n.string() + " --transport memq --out " + (dirn / "run").string(), &out) == 0, out);
+  rths::report::WriteRunReport(dirn / "run");
+  CHECK(Slurp(dirn / "run" / "figures" / "gyr.gp").find("coherence [-]") != std::string::npos);
+
+  // A paced run that missed deadlines (summary.json's figures): a note in the banner, not green.
+  rths::report::RunData d = rths::report::LoadRunData(dir0 / "run");
+  d.summary["realtime"] = {{"paced", true}, {"steps", 8000}, {"deadline_misses", 94}, {"miss_fraction", 94.0 / 8000},
+                           {"max_consecutive_misses", 44}, {"first_miss_step", 1200}, {"latency_max_us", 15600.0}};
+  rths::report::RunReportOptions o;
+  o.out_dir = dir0 / "paced";
+  const auto paced = rths::report::WriteRunReport(d, o);
+  const std::string html_paced = Slurp(paced.html);
+  CHECK(html_paced.find("class=\"banner ok\"") == std::string::npos);
+  CHECK(html_paced.find("NOT real time: this paced run missed 94 of 8000 deadlines (1.18 %); the longest stretch was "
+                        "44 steps in a row (22 ms), the largest step latency 15.6 ms, the first miss at step 1200.") !=
+        std::string::npos);
 }

@@ -1,4 +1,4 @@
-// Structure files and the 9-story benchmark building (spec/models.md section 8).
+// Structure files and the 9-story benchmark building (docs/models.md section 8).
 #include <doctest/doctest.h>
 
 #include <filesystem>

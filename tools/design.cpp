@@ -16,6 +16,7 @@
 #include "models/benchmark_plant.h"
 #include "scenario/scenario.h"
 #include "cli.h"
+#include "set_hint.h"
 
 int main(int argc, char** argv) {
   CLI::App app{"rths design: design the controller a scenario names, from its models, and analyse it"};
@@ -25,7 +26,10 @@ int main(int argc, char** argv) {
   std::vector<std::string> sets;
   rths::tools::AddSetOption(app, &sets);
   rths::tools::NameCommand(app, "design");
-  if (const int code = rths::tools::ParseCommandLine(app, argc, argv); code >= 0) return code;
+  if (const int code = rths::tools::ParseCommandLine(app, argc, argv); code >= 0) {
+    if (code == rths::lockstep::kExitUsage) rths::tools::PrintSetHints(app, argc, argv, "design");
+    return code;
+  }
   try {
     const rths::scenario::Scenario s = rths::scenario::LoadScenario(scenario_path, sets);
     std::vector<rths::control::DesignPlant> plants;

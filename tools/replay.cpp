@@ -95,8 +95,7 @@ std::vector<std::string> LiveRoles(const std::string& arg) {
 }
 
 rths::io::RunLog ReadRecord(const std::string& run_dir) {
-  const fs::path log_path = fs::path(run_dir) / "log.lcm";
-  if (!fs::exists(log_path)) throw rths::Error(log_path.string(), "no such file: is this a run folder of rths run?");
+  const fs::path log_path = rths::io::RunFolderLog(run_dir);  // names the folder to give
   rths::io::RunLog record = rths::io::ReadRunLog(log_path.string());
   const std::int64_t complete = record.CompleteSteps();
   if (complete == 0) throw rths::Error(log_path.string(), "holds no complete step: nothing to replay");

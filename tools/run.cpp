@@ -23,6 +23,7 @@
 #include "cli.h"
 #include "external_block.h"
 #include "watch_flags.h"
+#include "set_hint.h"
 
 namespace fs = std::filesystem;
 namespace sup = rths::supervisor;
@@ -242,7 +243,10 @@ int main(int argc, char** argv) {
   Options o;
   AddOptions(app, &o);
   rths::tools::NameCommand(app, "run");
-  if (const int code = rths::tools::ParseCommandLine(app, argc, argv); code >= 0) return code;
+  if (const int code = rths::tools::ParseCommandLine(app, argc, argv); code >= 0) {
+    if (code == rths::lockstep::kExitUsage) rths::tools::PrintSetHints(app, argc, argv, "run");
+    return code;
+  }
   if (o.scenario_path.empty()) o.scenario_path = o.default_scenario;
   if (o.compact) o.sets.push_back("run.csv_every=0");
 

@@ -1,5 +1,5 @@
 #pragma once
-/// @file One error type for the whole project (docs/units.md, ../design.md "Errors").
+/// @file One error type for the whole project (docs/units.md; README "What happens when things go wrong").
 /// It carries where the problem is (file, key or line) and what was expected, so that a
 /// tool can print it and exit with a documented code. Library code throws; only main() exits.
 #include <stdexcept>

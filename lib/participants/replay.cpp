@@ -1,12 +1,15 @@
 #include "participants/replay.h"
 
+#include "core/closest_name.h"
+
 #include "lockstep/bridge.h"
 
 #include <algorithm>
 #include <memory>
 
-#include <fmt/core.h>
+#include <fmt/format.h>
 
+#include "core/closest_name.h"
 #include "core/error.h"
 #include "lockstep/clock.h"
 #include "lockstep/transport.h"
@@ -61,13 +64,16 @@ bool IsLive(const std::vector<std::string>& live, std::string_view role) {
 }  // namespace
 
 const char* AnswerChannelOf(std::string_view role) {
-  std::string roles;  // the roles a replay can take live: all but the logger
+  std::vector<std::string_view> roles;  // the roles a replay can take live: all but the logger
   for (const lockstep::RoleRow& r : lockstep::kStepTable) {
     if (!r.variant.empty() || r.acks_barrier) continue;
     if (role == r.role) return lockstep::ChannelName(r.answer);
-    roles += (roles.empty() ? "" : ", ") + std::string(r.role);
+    roles.push_back(r.role);
   }
-  throw Error("replay", fmt::format("unknown role '{}' (live roles: {})", role, roles));
+  const std::string_view close = ClosestName(role, roles);
+  throw Error("--live", fmt::format("unknown role '{}'{} (live roles: {})", role,
+                                    close.empty() ? "" : fmt::format("; did you mean {}?", close),
+                                    fmt::join(roles, ", ")));
 }
 
 std::vector<Outcome> RunReplay(const scenario::Scenario& s, const io::RunLog& record, std::int64_t steps,

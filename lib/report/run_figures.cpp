@@ -12,6 +12,7 @@
 
 #include "participants/benchmark_run.h"
 #include "report/html.h"
+#include "report/spectrum_axes.h"
 #include "signal/benchmark_criteria.h"
 #include "signal/metrics.h"
 #include "signal/spectral.h"
@@ -29,6 +30,11 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kPi = 3.14159265358979323846;
+/// Half the window of the tracking error's zoom [s].
+constexpr double kZoomHalfS = 0.125;
+/// A coherence within this of 1 over the whole band is a flat line at 1 on the page (a run without
+/// sensor noise: our simulations reach 0.9997 at worst): not drawn.
+constexpr double kFlatCoherence = 1e-3;
 // Colours of the signals, the same in every figure.
 constexpr const char* kColorR = "black";
 constexpr const char* kColorU = "#1f77b4";
@@ -39,6 +45,11 @@ constexpr const char* kColorI = "#ff7f0e";
 
 bool AllFinite(const std::vector<double>& x) {
   return std::all_of(x.begin(), x.end(), [](double v) { return std::isfinite(v); });
+}
+
+/// True if every value equals the first (an empty series too).
+bool Constant(const std::vector<double>& x) {
+  return std::all_of(x.begin(), x.end(), [&](double v) { return v == x.front(); });
 }
 
 bool AnyNonZero(const std::vector<double>& x) {
@@ -105,14 +116,23 @@ PageFigure TimeHistories(const io::RunSignals& s, const RunReportOptions& o) {
     fd.width = 1.0;
     force.series.push_back(fd);
   }
-  Panel cur = MakePanel("Damper current", "t [s]", "current [A]");
-  cur.series = {History("i_cmd (commanded)", kColorI, t, s.At("i_cmd_A").values, m),
-                History("i_eff (effective)", kColorE, t, s.At("i_eff_A").values, m)};
   PageFigure pf{NewFigure("time_histories", o), "Time histories", ""};
-  pf.figure.panels = {disp, force, cur};
-  pf.caption_html =
-      "Desired displacement r, actuator command u and measured displacement y [mm]; measured force f [kN]; "
-      "commanded and effective damper current [A].";
+  pf.figure.panels = {disp, force};
+  pf.caption_html = "Desired displacement r, actuator command u and measured displacement y [mm]; measured force f [kN]";
+  // A current that never changes is a line of text, not a third of the figure.
+  const auto& i_cmd = s.At("i_cmd_A").values;
+  const auto& i_eff = s.At("i_eff_A").values;
+  if (Constant(i_cmd) && Constant(i_eff)) {
+    pf.caption_html += fmt::format(". The damper current is constant over the run: commanded {:.4g} A, effective "
+                                   "{:.4g} A (not drawn).",
+                                   i_cmd.empty() ? 0.0 : i_cmd[0], i_eff.empty() ? 0.0 : i_eff[0]);
+  } else {
+    Panel cur = MakePanel("Damper current", "t [s]", "current [A]");
+    cur.series = {History("i_cmd (commanded)", kColorI, t, i_cmd, m), History("i_eff (effective)", kColorE, t, i_eff, m)};
+    pf.figure.panels.push_back(cur);
+    pf.caption_html += "; commanded and effective damper current [A].";
+  }
+  pf.caption_html += " The command u lies under y at this scale: the tracking error's figure shows them apart.";
   if (t.size() > m)
     pf.caption_html += fmt::format(" Each curve shows the minimum and maximum of {} windows of {:.3g} s "
                                    "(every peak kept); the spectra below use every step.",
@@ -127,10 +147,11 @@ PageFigure TrackingError(const io::RunSignals& s, const RunReportOptions& o) {
   err.key = "off";
   err.series = {History("e", kColorE, t, e, o.max_plot_points)};
 
-  // r, u, y around the largest |e|: +-0.25 s (or the whole run if it is shorter).
+  // r, u, y around the largest |e|: +-kZoomHalfS (or the whole run if it is shorter), where the
+  // command's lead over the response is a visible fraction of the window.
   std::size_t at = 0;
   signal::PeakAbs(e, &at);
-  const std::size_t half = static_cast<std::size_t>(std::lround(0.25 / s.dt_s));
+  const std::size_t half = static_cast<std::size_t>(std::lround(kZoomHalfS / s.dt_s));
   const std::size_t lo = at > half ? at - half : 0;
   const std::size_t hi = std::min(t.size(), at + half + 1);
   const auto idx = Strided(lo, hi, o.max_plot_points);
@@ -139,10 +160,14 @@ PageFigure TrackingError(const io::RunSignals& s, const RunReportOptions& o) {
   zoom.series = {Curve("r (desired)", kColorR, t, s.At("r_mm").values, idx),
                  Curve("u (command)", kColorU, t, s.At("u_mm").values, idx),
                  Curve("y (measured)", kColorY, t, s.At("y_mm").values, idx)};
+  zoom.x_range = std::make_pair(t[lo], t[hi - 1]);
   PageFigure pf{NewFigure("tracking_error", o), "Tracking error", ""};
   pf.figure.panels = {err, zoom};
-  pf.caption_html = "Top: e = r - y [mm] over the run. Bottom: r, u and y [mm] over the 0.5 s around the "
-                    "largest |e|, every step.";
+  pf.figure.panel_height_px = 360;
+  pf.caption_html = fmt::format("Top: e = r - y [mm] over the run, on its own axis. Bottom: r, u and y [mm] over the "
+                                "{:.3g} s around the largest |e|, every step: the command u leads the response y by "
+                                "about the actuator's lag.",
+                                2 * kZoomHalfS);
   return pf;
 }
 
@@ -198,9 +223,14 @@ PageFigure SpectraFigure(const signal::CrossSpectra& cs, const std::vector<doubl
                          const RunReportOptions& o) {
   const auto positive = [](double v) { return v > 0.0 ? v : kNaN; };
   Panel psd = MakePanel("", "frequency [Hz]", "PSD [mm^2/Hz]");
-  psd.log_x = psd.log_y = true;
+  psd.log_y = true;
+  // The band that carries r and eight decades under the highest density: not every bin to
+  // Nyquist and down to round-off (a simulation's e reaches 1e-20).
+  const SpectrumAxes ax = SpectrumAxesOf(cs.f_hz, cs.s_uu, {&cs.s_uu, &cs.s_yy, &s_ee}, 40.0, 1.5, 8.0);
+  psd.x_range = std::make_pair(0.0, ax.f_hi_hz);
+  if (ax.psd_hi > 0) psd.y_range = std::make_pair(ax.psd_lo, ax.psd_hi);
   Series sr = MakeSeries("r", kColorR), sy = MakeSeries("y", kColorY), se = MakeSeries("e = r - y", kColorE);
-  for (std::size_t i = 1; i < cs.f_hz.size(); ++i) {
+  for (std::size_t i = 1; i < cs.f_hz.size() && cs.f_hz[i] <= ax.f_hi_hz; ++i) {
     sr.x.push_back(cs.f_hz[i]);
     sr.y.push_back(positive(cs.s_uu[i]));
     sy.x.push_back(cs.f_hz[i]);
@@ -215,8 +245,10 @@ PageFigure SpectraFigure(const signal::CrossSpectra& cs, const std::vector<doubl
   sp.figure.panel_height_px = 450;
   sp.caption_html = fmt::format("Welch power spectral densities of r, y and e [mm<sup>2</sup>/Hz]: every step, "
                                 "segments of {} steps ({:.3g} s, df = {:.3g} Hz), {} segments, Hann window, 50 % "
-                                "overlap.",
-                                l, static_cast<double>(l) * dt_s, cs.df_hz, cs.segments);
+                                "overlap. Drawn over the band that carries r, 0-{:.3g} Hz (1.5 times the highest "
+                                "frequency at which its PSD is within 40 dB of its peak), down to eight decades "
+                                "below the highest density.",
+                                l, static_cast<double>(l) * dt_s, cs.df_hz, cs.segments, ax.f_hi_hz);
   return sp;
 }
 
@@ -291,14 +323,24 @@ void GyrFigure(const signal::CrossSpectra& cs, const signal::FrequencyResponseEs
     return;
   }
   PageFigure g{NewFigure("gyr", o), "G_yr = Y / R", ""};
-  g.figure.panels = {mag, ph, coh};
+  // A simulation without sensor noise is a deterministic map from r to y: its coherence is 1 but
+  // for the damper's slight nonlinearity, and a panel of it would be a flat line. It is drawn when
+  // it says something.
+  double min_coherence = 1.0;
+  for (std::size_t i = i_lo; i <= i_hi; ++i) min_coherence = std::min(min_coherence, h1.coherence[i]);
+  const bool coherence_flat = min_coherence > 1.0 - kFlatCoherence;
+  g.figure.panels = coherence_flat ? std::vector<Panel>{mag, ph} : std::vector<Panel>{mag, ph, coh};
   g.figure.panel_height_px = 260;
   g.caption_html = fmt::format(
       "H1 estimate of the tracking transfer function G<sub>yr</sub> = S<sub>ry</sub> / S<sub>rr</sub> (same "
       "segments as the spectra): magnitude [-], unwrapped phase [deg] and coherence &gamma;<sup>2</sup> [-] over the "
       "excited band of r ({:.3g}-{:.3g} Hz: its PSD within {:g} dB of its peak). Points with &gamma;<sup>2</sup> &lt; "
-      "{:g} are masked ({} of {} kept). A perfect tracker has |G<sub>yr</sub>| = 1 and phase 0.",
-      f_lo, f_hi, o.band_db, o.min_coherence, kept, i_hi - i_lo + 1);
+      "{:g} are masked ({} of {} kept). A perfect tracker has |G<sub>yr</sub>| = 1 and phase 0.{}",
+      f_lo, f_hi, o.band_db, o.min_coherence, kept, i_hi - i_lo + 1,
+      coherence_flat ? fmt::format(" The coherence is not drawn: it is 1 to within {:g} over the whole band (its "
+                                   "least is {:.5f}), as in a run without sensor noise.",
+                                   kFlatCoherence, min_coherence)
+                     : std::string());
   out->gyr = g;
   std::vector<double> sorted = lag_ms;
   std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2), sorted.end());

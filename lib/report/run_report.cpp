@@ -56,8 +56,8 @@ DrawnFigures ChooseFigures(const RunData& d, const RunReportOptions& o) {
   DrawnFigures out;
   std::vector<PageFigure> figures;
   if (d.signals.steps() >= 2) {
+    figures.push_back(run_figures::TrackingError(d.signals, o));  // first: what a tracking test is judged by
     figures.push_back(run_figures::TimeHistories(d.signals, o));
-    figures.push_back(run_figures::TrackingError(d.signals, o));
     figures.push_back(run_figures::Loops(d.signals, o));
     if (auto ad = run_figures::Adaptation(d.signals, o)) figures.push_back(*ad);
     run_figures::FrequencyFigures ff = run_figures::Frequency(d.signals, o);
@@ -125,6 +125,19 @@ std::string FiguresSection(const DrawnFigures& f, const std::vector<fs::path>& p
     h += FigureHtml(f.drawn[i].figure.name, f.drawn[i].heading, png, f.drawn[i].figure.width_px, f.drawn[i].caption_html);
   }
   return h;
+}
+
+/// The page's title: the scenario's name, and the overrides a `--set` run was made with (its
+/// scenario.toml's first line, "# FILE with --set K=V ..."), so a variant is not named as its base.
+std::string RunTitle(const RunData& d) {
+  std::string name = d.scenario ? d.scenario->run.name : d.run_dir.filename().string();
+  const std::string first = d.scenario_toml.substr(0, d.scenario_toml.find('\n'));
+  if (const auto with = first.find(" with --set "); first.rfind("# ", 0) == 0 && with != std::string::npos) {
+    std::string sets = first.substr(with + 6);  // "--set a=1 --set b=2"
+    for (std::size_t at; (at = sets.find("--set ")) != std::string::npos;) sets.erase(at, 6);
+    name += " (" + sets + ")";
+  }
+  return name;
 }
 
 }  // namespace
@@ -217,7 +230,7 @@ ReportFiles WriteRunReport(const RunData& d, const RunReportOptions& o) {
   const DrawnFigures figures = ChooseFigures(d, o);
   files.figures = DrawFigures(figures.drawn, fig_dir);
 
-  const std::string name = d.scenario ? d.scenario->run.name : d.run_dir.filename().string();
+  const std::string name = RunTitle(d);
   std::string h = HtmlHead("rths run report: " + name);
   h += "<h1>Run report: " + HtmlEscape(name) + "</h1>\n";
   h += "<p class=\"where\">" + HtmlEscape(fs::absolute(d.run_dir).lexically_normal().string()) +

@@ -10,12 +10,15 @@
 /// says so at the top.
 ///
 /// Figures (gnuplot, io/plot.h), in OUT/figures/:
-///   time_histories.png  r, u, y [mm]; f [kN]; damper current i_cmd, i_eff [A] against t [s]
-///   tracking_error.png  e = r - y [mm] against t [s], and r, u, y around the largest |e|
+///   tracking_error.png  e = r - y [mm] against t [s], and r, u, y over 0.25 s around the largest |e|
+///   time_histories.png  r, u, y [mm]; f [kN]; damper current i_cmd, i_eff [A] against t [s] (a
+///                       constant current is a line of the caption instead)
 ///   loops.png           force-displacement f(y) and force-velocity f(y') (y' by central difference)
-///   spectra.png         Welch PSDs of r, y, e [mm^2/Hz] (signal/spectral.h)
-///   gyr.png             G_yr = Y/R by H1: magnitude [-], phase [deg] and coherence [-], limited to
-///                       the excited band of r, points of low coherence masked
+///   spectra.png         Welch PSDs of r, y, e [mm^2/Hz] (signal/spectral.h) over the band that
+///                       carries r, at most 8 decades (report/spectrum_axes.h)
+///   gyr.png             G_yr = Y/R by H1: magnitude [-], phase [deg] and coherence [-] (left out
+///                       when it is 1 to within 1e-4: a noise-free run), limited to the excited
+///                       band of r, points of low coherence masked
 ///   benchmark.png       scenarios with structure.reference_file (the RTHS benchmark, docs/benchmark.md):
 ///                       x_t = r, x_m = y and the reference's actuator floor x_r,a; x_m - x_t and
 ///                       x_m - x_r,a; each other floor x_n,i against x_r,i [mm] against t [s]. The page

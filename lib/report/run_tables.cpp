@@ -211,6 +211,21 @@ std::vector<std::string> Warnings(const RunData& d, bool* failed) {
                             static_cast<double>(d.steps_planned) * d.signals.dt_s));
     if (!why.empty() && !d.log_complete) w.push_back("log.lcm: " + d.truncation_reason);
   }
+  // A paced run that missed deadlines did not run in real time, even if it completed: the
+  // banner says so (a note, not green), with how long the worst stretch lasted.
+  if (has_summary && d.summary.contains("realtime") && d.summary["realtime"].is_object()) {
+    const auto& rt = d.summary["realtime"];
+    const auto misses = rt.value("deadline_misses", std::int64_t{0});
+    if (rt.value("paced", false) && misses > 0) {
+      const auto longest = rt.value("max_consecutive_misses", std::int64_t{0});
+      w.push_back(fmt::format("NOT real time: this paced run missed {} of {} deadlines ({:.3g} %); the longest "
+                              "stretch was {} steps in a row ({:.3g} ms), the largest step latency {:.3g} ms, the "
+                              "first miss at step {}.",
+                              misses, rt.value("steps", std::int64_t{0}), 100.0 * rt.value("miss_fraction", 0.0),
+                              longest, static_cast<double>(longest) * d.signals.dt_s * 1e3,
+                              rt.value("latency_max_us", 0.0) / 1e3, rt.value("first_miss_step", std::int64_t{-1})));
+    }
+  }
   if (!has_summary) {
     w.push_back(d.summary_error + ": how the run ended (status, exit code), link and real-time figures are unknown; "
                 "the numbers below come from the log");

@@ -14,6 +14,7 @@
 #include <toml++/toml.h>
 
 #include "control/lti_controller.h"
+#include "core/closest_name.h"
 #include "core/error.h"
 #include "models/servo_linear.h"
 
@@ -23,8 +24,6 @@ namespace rths::scenario::detail {
 inline std::string DisplayName(const std::string& path) { return path.empty() ? "<scenario text>" : path; }
 /// Comma-separated list, each item wrapped in `quote`.
 std::string JoinList(const std::vector<std::string_view>& items, std::string_view quote = "");
-/// The allowed name closest to `name`, or "" if none is close (a typo or a missing/extra suffix).
-std::string_view ClosestName(std::string_view name, const std::vector<std::string_view>& allowed);
 /// "string \"abc\"", "float 2.5", "table", ... for type errors.
 std::string DescribeNode(const toml::node& node);
 
@@ -202,7 +201,7 @@ class Section {
         list = "allowed: " + JoinList(allowed);
       }
       std::string problem = fmt::format("unknown {} ({})", is_table ? "table" : "key", list);
-      if (std::string_view close = ClosestName(name, allowed); !close.empty()) {
+      if (std::string_view close = rths::ClosestName(name, allowed); !close.empty()) {
         problem += fmt::format("; did you mean \"{}{}\"?", prefix_, close);
       }
       Fail(name, problem);

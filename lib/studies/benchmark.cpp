@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <fstream>
 #include <future>
 #include <mutex>
@@ -325,9 +326,52 @@ BenchmarkResult ReproduceBenchmark(const ReproduceOptions& opts, bool keep_logs)
   Spreads(&res);
   if (opts.log) opts.log("benchmark: the example controller's nominal loop closed as the reference code closes it");
   res.loops = Loops(specs);
+  res.claims = CheckBenchmarkClaims(res);
   res.wall_s = SecondsSince(t0);
   WriteBenchmarkOutputs(res, opts);
   return res;
+}
+
+std::vector<Claim> CheckBenchmarkClaims(const BenchmarkResult& res) {
+  const auto& published = PublishedExampleCriteria();
+  auto loop = [&](int c, const std::string& variant) -> const BenchmarkLoopRow* {
+    for (const auto& l : res.loops) {
+      if (l.case_number == c && l.variant == variant) return &l;
+    }
+    return nullptr;
+  };
+  Claim match{"(1) closed as the reference code closes it, the example controller's J1-J9 on the nominal plant are "
+              "the published ones: J1 within 0.15 ms, J2-J9 within 0.6 points, in every case",
+              true, ""};
+  Claim tracking{"(2) tracking (J1-J3) does not depend on how the loop is closed: the lockstep loop and the "
+                 "reference code's within 0.1 ms and 0.1 points in every case",
+                 true, ""};
+  for (int c = 1; c <= 4; ++c) {
+    const BenchmarkLoopRow* ref = loop(c, "reference code");
+    const BenchmarkLoopRow* ls = loop(c, "lockstep");
+    double worst = 0;
+    int worst_j = 0;
+    for (int j = 0; ref != nullptr && j < 9; ++j) {
+      const double d = std::abs(ref->j.At(j) - published[c - 1][j]);
+      if (std::isfinite(worst) && !(d <= worst)) {  // the largest, or the first that is not finite
+        worst = d;
+        worst_j = j + 1;
+      }
+      match.holds = match.holds && std::isfinite(d) && d <= (j == 0 ? 0.15 : 0.6);
+    }
+    match.holds = match.holds && ref != nullptr;
+    match.detail += fmt::format("{}case {}: {}", c == 1 ? "" : "; ", c,
+                                ref ? fmt::format("largest difference J{} {:.2f}", worst_j, worst) : "not run");
+    double worst_t = 0;
+    for (int j = 0; ref != nullptr && ls != nullptr && j < 3; ++j) {
+      const double d = std::abs(ref->j.At(j) - ls->j.At(j));
+      worst_t = std::isfinite(d) ? std::max(worst_t, d) : std::numeric_limits<double>::infinity();
+    }
+    tracking.holds = tracking.holds && ref != nullptr && ls != nullptr && worst_t <= 0.1;
+    tracking.detail += fmt::format("{}case {}: {}", c == 1 ? "" : "; ", c,
+                                   ref && ls ? fmt::format("J1-J3 differ by at most {:.2f}", worst_t) : "not run");
+  }
+  return {match, tracking};
 }
 
 }  // namespace rths::studies

@@ -163,7 +163,7 @@ void WriteMarkdown(const Fig78Result& res, const ReproduceOptions& opts, const s
              : "E2 states these for a plant equal to the design model (`--plant linear`); on the physical plant "
                "they are reported, not required.\n\n");
   for (const auto& c : res.checks) {
-    md << fmt::format("- **{}** {}.  \n  {}\n", c.holds ? "Holds:" : "Does not hold:", c.text, c.detail);
+    md << ClaimMarkdown(c);
   }
 }
 

@@ -19,6 +19,10 @@ namespace rths::studies {
 
 namespace fs = std::filesystem;
 
+std::string ClaimMarkdown(const Claim& c) {
+  return fmt::format("- **{}** {}.  \n  {}\n", c.holds ? "Holds:" : "Does not hold:", c.text, c.detail);
+}
+
 std::string UtcStamp() {
   const std::time_t now = std::time(nullptr);
   char stamp[32];

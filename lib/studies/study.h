@@ -58,6 +58,10 @@ struct Claim {
   std::string detail;              ///< the numbers behind it
 };
 
+/// A claim as a line of a reproduction's Markdown: "- **Holds:** TEXT.  \n  DETAIL\n" (or "Does not
+/// hold:"), as `rths reproduce` prints it "[holds]" / "[does not hold]".
+std::string ClaimMarkdown(const Claim& c);
+
 /// Now, as "YYYY-MM-DD HH:MM UTC": the stamp of a reproduction's Markdown.
 std::string UtcStamp();
 

@@ -263,7 +263,7 @@ void WriteMarkdown(const fs::path& file, const ReproduceOptions& opts, const std
   }
   md << "\n## The paper's claims (docs/experiments.md E3), checked on this table\n\n";
   for (const auto& c : claims) {
-    md << fmt::format("- **{}** {}.  \n  {}\n", c.holds ? "Holds:" : "Does not hold:", c.text, c.detail);
+    md << ClaimMarkdown(c);
   }
   WriteOrder(md, rows);
 }

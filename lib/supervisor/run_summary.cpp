@@ -74,7 +74,9 @@ nlohmann::json RunSummary::ToJson() const {
 
 std::string RunSummary::Report(double dt_s) const {
   std::string o = fmt::format("  steps              {} of {}\n", steps, steps_expected);
-  if (metrics) {
+  if (metrics && steps == 0) {
+    o += "  tracking error     - (no step completed)\n";
+  } else if (metrics) {
     o += fmt::format("  tracking error     {:.3f} % (RMS, Eq. 31)\n", metrics->tracking_nrmse_pct);
     o += fmt::format("  peak specimen force {:.2f} kN\n", metrics->peak_force_kN);
     o += fmt::format("  rate               {:.0f} steps/s ({:.2f}x real time)\n", steps_per_s(),
