@@ -16,6 +16,7 @@
 #include "core/progress.h"
 #include "io/run_log.h"
 #include "scenario/scenario.h"
+#include "supervisor/run_summary.h"
 #include "test_support.h"
 
 namespace {
@@ -46,7 +47,8 @@ long Lines(const fs::path& file) {
 }
 
 const char* const kTools[] = {"run",    "design",    "identify", "reproduce",     "diagnose", "record",
-                              "replay", "structure", "log",      "utfsm-convert", "export",   "report"};
+                              "replay", "structure", "log",      "utfsm-convert", "export",   "report",
+                              "compare", "watch"};
 
 }  // namespace
 
@@ -252,4 +254,35 @@ TEST_CASE("no output replaces what a run recorded or the file being read") {
   CHECK(digest() == before);  // every recorded byte is still there
   CHECK_FALSE(fs::exists(dir / "x.csv"));
   CHECK_FALSE(fs::exists(dir / "x.mat"));
+}
+
+TEST_CASE("small frictions: the folder to give, the role meant, the --set meant, no Eq. 31 of no step") {
+  const fs::path dir = TempDir("cli_frictions");
+  std::string out;
+  REQUIRE(RunTool("run", Scenario("default.toml") + " --transport memq --skip-space-check --compact --quiet --set "
+                                                    "run.duration_s=0.05 --out " + (dir / "run").string(),
+                  &out) == 0);
+  // rths replay RUN/log.lcm: the folder is what it takes, and it says which.
+  CHECK(RunTool("replay", (dir / "run" / "log.lcm").string() + " --live plant", &out) == 2);
+  CHECK(out.find("is a file, not a run folder: give the folder that holds log.lcm (here " + (dir / "run").string() +
+                 ")") != std::string::npos);
+  CHECK(out.find("log.lcm/log.lcm") == std::string::npos);
+  // A mistyped role: named once, with the one meant.
+  CHECK(RunTool("replay", (dir / "run").string() + " --live plnt", &out) == 2);
+  CHECK(out.find("rths replay: --live: unknown role 'plnt'; did you mean plant? (live roles: integrator, controller, "
+                 "plant, semiactive)") != std::string::npos);
+  // An option that is a scenario key: the --set line it means.
+  CHECK(RunTool("run", "--duration 5", &out) == 2);
+  CHECK(out.find("rths run: --duration is not an option; to change the scenario's run.duration_s: --set "
+                 "run.duration_s=5") != std::string::npos);
+  CHECK(RunTool("design", Scenario("default.toml") + " --dt_s=0.001", &out) == 2);
+  CHECK(out.find("--set run.dt_s=0.001") != std::string::npos);
+  // A run in which no step completed prints no tracking error of 0 %.
+  rths::supervisor::RunSummary never;
+  never.steps = 0;
+  never.steps_expected = 100;
+  never.metrics = rths::io::RunMetrics{};
+  const std::string report = never.Report(0.0005);
+  CHECK(report.find("0.000 %") == std::string::npos);
+  CHECK(report.find("tracking error     - (no step completed)") != std::string::npos);
 }
