@@ -66,7 +66,10 @@ void KeysBeside(Figure* f) {
     Panel& p = f->panels[i];
     const bool last_in_row = f->columns == 1 || (i + 1) % static_cast<std::size_t>(f->columns) == 0;
     p.key = last_in_row ? "outside right top" : "off";
-    if (f->columns == 1) p.right_margin_chars = margin;
+    if (f->columns == 1) {
+      p.right_margin_chars = margin;
+      p.left_margin_chars = 11;  // stacked axes line up whatever their tick labels' widths
+    }
   }
 }
 
@@ -362,7 +365,7 @@ CompareFiles WriteComparison(const std::vector<RunData>& runs, const CompareOpti
 
   std::vector<CompareFigure> figures;
   if (ov.n >= 2) {
-    figures = {Histories(ov, o), ErrorFigure(ov, o), Loops(ov, o)};
+    figures = {ErrorFigure(ov, o), Histories(ov, o), Loops(ov, o)};  // the tracking error first, as in the report
     if (auto s = Spectra(ov, o)) figures.push_back(*s);
   }
   const fs::path fig_dir = o.out_dir / "figures";

@@ -2,9 +2,9 @@
 /// @file Runs side by side (`rths compare RUN_A RUN_B [RUN_C ...]`, docs/compare.md): one
 /// self-contained HTML page with the runs' summary figures in one table, the scenario keys that
 /// differ between them, and figures that overlay them, aligned by step (t = k dt):
-///   compare_histories.png  y of every run with r of the first [mm]; f of every run [kN]
 ///   compare_error.png      e = r - y of every run [mm] over the run, and r with every y over the
 ///                          0.5 s around the largest |e| of any run
+///   compare_histories.png  y of every run with r of the first [mm]; f of every run [kN]
 ///   compare_loops.png      f against y [kN, mm] and against y' [mm/s], every run
 ///   compare_spectra.png    Welch PSDs of e [mm^2/Hz] over the band that carries r
 #include <filesystem>
