@@ -670,7 +670,7 @@ TEST_CASE("report figures: the FRF leaves out the points whose coherence is belo
   REQUIRE(fig.panels.size() == 3);
   const auto& mag = fig.panels[0].series;
   const auto& coh = fig.panels[2].series[0];
-  REQUIRE(mag.size() == 3);
+  REQUIRE(mag.size() == 2);  // measured, nominal: no effect selected, so no third curve over the nominal
   std::size_t kept = 0, left_out = 0;
   for (const auto& s : mag) {
     REQUIRE(s.x.size() == coh.x.size());
@@ -688,6 +688,39 @@ TEST_CASE("report figures: the FRF leaves out the points whose coherence is belo
   CHECK(kept > 0);
   CHECK(left_out > 0);
   CHECK(fig.title.find("coherence < 0.5 left out") != std::string::npos);
+}
+
+TEST_CASE("report figures: a verdict without effects is drawn once, labelled; with effects, beside the nominal") {
+  const double dt = 0.0005;
+  const std::size_t n = 40000;
+  const auto u = rths::signal::Blwn(15.0, 2.0, dt, n, 5, 2.0);
+  Traces::Record t = BandRecord(u, std::vector<double>(n, 0.0), dt);
+  t.f_meas = t.f_nom = t.f_fin = t.y_meas;
+  for (const auto& fig : {FrfFigure(t, 0), TraceFigure(t, "y"), SpectrumFigure(t, "y", 0)}) {
+    CAPTURE(fig.name);
+    std::size_t finals = 0, labelled = 0;
+    for (const auto& p : fig.panels) {
+      for (const auto& s : p.series) {
+        finals += s.title.find("with the verdict's effects") != std::string::npos ? 1 : 0;
+        labelled += s.title.find("(= the verdict's: no effect selected)") != std::string::npos ? 1 : 0;
+      }
+      if (p.key != "off") CHECK(p.key == "outside top center horizontal");  // above the axes, not beside
+    }
+    CHECK(finals == 0);
+    CHECK(labelled >= 1);
+  }
+  t.y_fin[100] += 1e-3;  // an effect that changes the prediction: its curve is drawn
+  std::size_t finals = 0;
+  for (const auto& p : TraceFigure(t, "y").panels) {
+    for (const auto& s : p.series) finals += s.title.find("with the verdict's effects") != std::string::npos ? 1 : 0;
+  }
+  CHECK(finals == 2);
+  // The spectrum's axis starts at 0 Hz (as the band table) and is linear; it ends at the signal's band.
+  const auto sp = SpectrumFigure(t, "y", 0).panels[0];
+  REQUIRE(sp.x_range.has_value());
+  CHECK(sp.x_range->first == 0.0);
+  CHECK_FALSE(sp.log_x);
+  CHECK(sp.x_range->second < 100.0);  // a 0-15 Hz input, not up to the 1 kHz Nyquist
 }
 
 TEST_CASE("report figures: the state conditions are bars over the named conditions") {
@@ -712,7 +745,7 @@ TEST_CASE("report figures: the state conditions are bars over the named conditio
   CHECK(ConditionFigure(Result{}).panels.empty());
 }
 
-TEST_CASE("report figures: axis units are docs/units.md's, and every legend sits beside the axes") {
+TEST_CASE("report figures: axis units are docs/units.md's, and every legend sits outside the axes") {
   const auto [tr, te] = Records(Noisy());
   Traces traces;
   const auto r = Diagnose({tr}, {te}, PaperModel(), Options{}, &traces);

@@ -170,7 +170,8 @@ TEST_CASE("rths replay: bad input is refused before anything runs") {
     CHECK(!fs::exists(dir / "e"));
   }
   CHECK(Replay((dir / "nothing").string() + " --live plant --out " + (dir / "c").string(), &out) == 2);
-  CHECK(out.find("log.lcm") != std::string::npos);
+  CHECK(out.find((dir / "nothing").string() + ": no such run folder (give the folder `rths run` printed") !=
+        std::string::npos);
   CHECK(Replay(rec.string() + " --live plant --steps 5000 --out " + (dir / "d").string(), &out) == 2);
   CHECK(out.find("--steps") != std::string::npos);
   // Never overwrites: an existing, non-empty output folder is refused.

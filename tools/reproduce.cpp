@@ -4,6 +4,7 @@
 // Markdown, PNG figures and, for the lockstep studies, every run's folder. The work is done by
 // lib/studies (one header per study); this file parses options and prints.
 #include <chrono>
+#include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -59,9 +60,12 @@ void PrintCheck(bool holds, const std::string& text, const std::string& detail, 
               standing.c_str());
 }
 
+volatile std::sig_atomic_t g_interrupted = 0;
+void OnSignal(int) { g_interrupted = 1; }
+
 struct Options {
   std::string name, out, plant = "physical";
-  bool quick = false, extended = false, keep_logs = false, compact = false;
+  bool quick = false, extended = false, keep_logs = false, compact = false, resume = false;
   int jobs = 2;
   std::vector<std::string> sets;
   std::string executor = "local";         // local | slurm (lib/sweep/study_on_slurm.h)
@@ -73,6 +77,9 @@ void AddOptions(CLI::App& app, Options* o) {
       ->required()
       ->check(CLI::IsMember({"fig5", "fig6", "fig7", "fig8", "fig9", "fig11", "table2", "benchmark"}));
   app.add_option("--out", o->out, "output folder (default: a new folder under runs/); never overwritten");
+  app.add_flag("--resume", o->resume,
+               "finish the study an interrupted `rths reproduce NAME --out DIR` left in DIR: the runs that ended "
+               "are taken as they are, the others made again (the same tables as an uninterrupted study)");
   app.add_flag("--quick", o->quick, "shorter records (for tests; numbers are noisier)");
   app.add_flag("--extended", o->extended,
                "table2: also the extended table (table2_extended.csv/.md/.png): ats, ambc and a PI + phase lead "
@@ -235,6 +242,16 @@ int CheckOptions(Options* o) {
     std::fprintf(stderr, "rths reproduce fig5: --set/--compact: fig5 runs the damper model alone, no scenario\n");
     return rths::lockstep::kExitUsage;
   }
+  if (o->resume && o->out.empty()) {
+    std::fprintf(stderr, "rths reproduce %s: --resume needs --out DIR: the folder of the interrupted study\n",
+                 o->name.c_str());
+    return rths::lockstep::kExitUsage;
+  }
+  if (o->resume && o->executor == "slurm") {
+    std::fprintf(stderr, "rths reproduce %s: --resume is for local runs; a Slurm study resumes with rths sweep --collect "
+                         "(docs/cluster.md)\n", o->name.c_str());
+    return rths::lockstep::kExitUsage;
+  }
   if (o->extended && o->name != "table2") {
     std::fprintf(stderr, "rths reproduce %s: --extended is for table2 only\n", o->name.c_str());
     return rths::lockstep::kExitUsage;
@@ -265,6 +282,8 @@ int main(int argc, char** argv) {
   opts.jobs = o.jobs;
   opts.overrides = o.sets;
   opts.extended = o.extended;
+  opts.batch.interrupted = &g_interrupted;
+  opts.batch.resume = o.resume;
   opts.gnuplot = rths::tools::ProgramOnPath("gnuplot");
   if (const char* dir = std::getenv("RTHS_SOURCE_DIR"); dir != nullptr && *dir != '\0') opts.source_dir = dir;
   rths::ProgressLine progress("rths reproduce " + o.name);
@@ -280,7 +299,16 @@ int main(int argc, char** argv) {
     std::printf("rths reproduce %s%s%s -> %s\n", o.name.c_str(), o.quick ? " (quick)" : "",
                 o.extended ? " (extended)" : "", opts.out_dir.string().c_str());
     std::fflush(stdout);
+    std::signal(SIGINT, OnSignal);
+    std::signal(SIGTERM, OnSignal);
     Reproduce(o, opts);
+  } catch (const rths::studies::BatchInterrupted& e) {
+    progress.Finish();
+    std::fprintf(stderr, "rths reproduce %s: %s.\nFinish it (the runs that ended are kept): rths reproduce %s --out %s%s "
+                         "--resume\n",
+                 o.name.c_str(), e.what(), o.name.c_str(), opts.out_dir.string().c_str(),
+                 o.quick ? " --quick" : "");
+    return 130;
   } catch (const rths::Error& e) {
     progress.Finish();
     std::fprintf(stderr, "rths reproduce %s: %s\n", o.name.c_str(), e.what());

@@ -10,6 +10,7 @@
 #include "diagnosis/localise.h"
 #include "io/plot.h"
 #include "signal/spectral.h"
+#include "signal/spectrum_axes.h"
 
 namespace rths::diagnosis {
 
@@ -23,19 +24,28 @@ std::vector<double> Residual(const std::vector<double>& m, const std::vector<dou
   return e;
 }
 
-// Legend beside the axes (never over the data), the same margins in every panel so stacked
-// axes line up.
+// Legend above the axes in one row (never over the data, and the plot keeps the figure's whole
+// width), the same margins in every panel so stacked axes line up.
 constexpr int kLeftMarginChars = 12;
-void KeyOutside(io::Figure* fig) {
-  std::vector<const io::Panel*> panels;
-  for (const auto& p : fig->panels) panels.push_back(&p);
-  const int right = io::KeyMarginChars(panels);
-  fig->width_px = 1200;  // the plot keeps about 1000 px beside the legend
+constexpr int kRightMarginChars = 4;
+void KeyAbove(io::Figure* fig) {
+  fig->width_px = 1200;
   for (auto& p : fig->panels) {
     p.left_margin_chars = kLeftMarginChars;
-    p.right_margin_chars = right;
-    if (p.key != "off") p.key = "outside right top";
+    p.right_margin_chars = kRightMarginChars;
+    if (p.key != "off") p.key = "outside top center horizontal";
   }
+}
+
+/// True if the verdict's prediction is the nominal one (no effect selected: `unknown`, `none`):
+/// its curve would be drawn exactly over the nominal one and hide it, so it is left out.
+bool SameAsNominal(const std::vector<double>& nominal, const std::vector<double>& final_prediction) {
+  return nominal == final_prediction;
+}
+
+/// The nominal curve's legend: says it is also the verdict's when no effect was selected.
+std::string NominalTitle(const std::string& base, bool same) {
+  return same ? base + " (= the verdict's: no effect selected)" : base;
 }
 
 const std::string kMeasuredColor = "#0072B2", kNominalColor = "#D55E00", kFinalColor = "#009E73";
@@ -75,10 +85,15 @@ io::Figure SpectrumFigure(const Traces::Record& t, const std::string& ch, std::s
   const auto& pn = ch == "y" ? t.y_nom : t.f_nom;
   const auto& pf = ch == "y" ? t.y_fin : t.f_fin;
   std::vector<double> meas(m.begin() + static_cast<std::ptrdiff_t>(first), m.end());
-  const std::size_t L = std::max<std::size_t>(64, std::min<std::size_t>(static_cast<std::size_t>(std::lround(1.0 / t.dt_s)), meas.size() / 8));
+  // 4 s segments (df = 0.25 Hz) where the record allows 8 of them: the axis starts at 0 Hz, as the
+  // band table does, and the lowest band has points in it.
+  const std::size_t L = std::max<std::size_t>(64, std::min<std::size_t>(static_cast<std::size_t>(std::lround(4.0 / t.dt_s)), meas.size() / 8));
   const auto sm = signal::WelchPsd(meas, t.dt_s, L);
   const auto sn = signal::WelchPsd(Residual(m, pn, first), t.dt_s, L);
   const auto sf = signal::WelchPsd(Residual(m, pf, first), t.dt_s, L);
+  const bool same = SameAsNominal(pn, pf);
+  std::vector<double> f_hz(sm.size());
+  for (std::size_t j = 0; j < f_hz.size(); ++j) f_hz[j] = static_cast<double>(j) / (t.dt_s * static_cast<double>(L));
   const std::string unit = ch == "y" ? "mm^2/Hz" : "kN^2/Hz";
   io::Figure fig;
   fig.name = "spectrum_" + ch;
@@ -88,20 +103,25 @@ io::Figure SpectrumFigure(const Traces::Record& t, const std::string& ch, std::s
                                 : src.filename().string();
   auto p = io::MakePanel(fmt::format("channel {}: spectra (test record {})", ch, shown), "Frequency [Hz]",
                          fmt::format("PSD of {} [{}]", ch, unit));
-  p.log_x = p.log_y = true;
-  p.x_range = std::make_pair(1.0 / (t.dt_s * static_cast<double>(L)), 0.5 / t.dt_s);  // first bin to Nyquist
+  p.log_y = true;
+  // 0 Hz to the band that carries the measured signal (1.5 x where it is within 60 dB of its peak),
+  // eight decades under the highest density.
+  const signal::SpectrumAxes ax = signal::SpectrumAxesOf(f_hz, sm, {&sm, &sn, &sf}, 60.0, 1.5, 8.0);
+  p.x_range = std::make_pair(0.0, ax.f_hi_hz);
+  if (ax.psd_hi > 0) p.y_range = std::make_pair(ax.psd_lo, ax.psd_hi);
   auto s1 = io::MakeSeries("measured", kMeasuredColor);
-  auto s2 = io::MakeSeries("residual, nominal model", kNominalColor);
+  auto s2 = io::MakeSeries(NominalTitle("residual, nominal model", same), kNominalColor);
   auto s3 = io::MakeSeries("residual, with the verdict's effects", kFinalColor);
-  for (std::size_t j = 1; j < sm.size(); ++j) {
-    const double f = static_cast<double>(j) / (t.dt_s * static_cast<double>(L));
+  for (std::size_t j = 1; j < sm.size() && f_hz[j] <= ax.f_hi_hz; ++j) {
+    const double f = f_hz[j];
     s1.x.push_back(f), s1.y.push_back(sm[j] > 0 ? sm[j] : NAN);
     s2.x.push_back(f), s2.y.push_back(sn[j] > 0 ? sn[j] : NAN);
     s3.x.push_back(f), s3.y.push_back(sf[j] > 0 ? sf[j] : NAN);
   }
-  p.series = {s1, s2, s3};
+  p.series = {s1, s2};
+  if (!same) p.series.push_back(s3);
   fig.panels.push_back(p);
-  KeyOutside(&fig);
+  KeyAbove(&fig);
   return fig;
 }
 
@@ -157,7 +177,9 @@ io::Figure FrfFigure(const Traces::Record& t, std::size_t first) {
   auto pp = io::MakePanel("", "Frequency [Hz]", "Phase [deg]");
   auto pc = io::MakePanel("", "Frequency [Hz]", "Coherence u -> y_meas [-]");
   for (auto* p : {&pm, &pp, &pc}) p->x_range = std::make_pair(lo, hi);
-  auto a1 = io::MakeSeries("measured", kMeasuredColor), a2 = io::MakeSeries("nominal model", kNominalColor, 2),
+  const bool same = SameAsNominal(t.y_nom, t.y_fin);
+  auto a1 = io::MakeSeries("measured", kMeasuredColor),
+       a2 = io::MakeSeries(NominalTitle("nominal model", same), kNominalColor, 2),
        a3 = io::MakeSeries("with the verdict's effects", kFinalColor, 3);
   a1.width = 2.0;
   a3.width = 2.5;  // on top of the measured curve it follows
@@ -182,14 +204,14 @@ io::Figure FrfFigure(const Traces::Record& t, std::size_t first) {
   }
   c2.x = {lo, hi};
   c2.y = {kFrfMinCoherence, kFrfMinCoherence};
-  pm.series = {a1, a2, a3};
-  pp.series = {b1, b2, b3};
+  pm.series = same ? std::vector<io::Series>{a1, a2} : std::vector<io::Series>{a1, a2, a3};
+  pp.series = same ? std::vector<io::Series>{b1, b2} : std::vector<io::Series>{b1, b2, b3};
   pp.key = "off";
   pc.series = {c1, c2};
   pc.y_range = std::make_pair(0.0, 1.05);
   fig.panels = {pm, pp, pc};
   fig.panel_height_px = 260;
-  KeyOutside(&fig);
+  KeyAbove(&fig);
   return fig;
 }
 
@@ -222,7 +244,7 @@ io::Figure ConditionFigure(const Result& r) {
     p.y_range = std::make_pair(0.0, std::max(10.0, 1.1 * top));
     fig.panels.push_back(p);
   }
-  KeyOutside(&fig);
+  KeyAbove(&fig);
   return fig;
 }
 
@@ -245,9 +267,11 @@ io::Figure TraceFigure(const Traces::Record& t, const std::string& ch) {
   const std::string unit = ch == "y" ? "mm" : "kN";
   auto p1 = io::MakePanel(fmt::format("channel {}: measured and predicted", ch), "Time [s]", ChannelQuantity(ch));
   auto p2 = io::MakePanel("residual: measured - predicted", "Time [s]", fmt::format("Residual {} [{}]", ch, unit));
-  auto s1 = io::MakeSeries("measured", kMeasuredColor), s2 = io::MakeSeries("nominal", kNominalColor, 2),
+  const bool same = SameAsNominal(pn, pf);
+  auto s1 = io::MakeSeries("measured", kMeasuredColor), s2 = io::MakeSeries(NominalTitle("nominal", same), kNominalColor, 2),
        s3 = io::MakeSeries("with the verdict's effects", kFinalColor, 3);
-  auto r1 = io::MakeSeries("nominal", kNominalColor), r2 = io::MakeSeries("with the verdict's effects", kFinalColor);
+  auto r1 = io::MakeSeries(NominalTitle("nominal", same), kNominalColor),
+       r2 = io::MakeSeries("with the verdict's effects", kFinalColor);
   for (std::size_t k = best; k < b; ++k) {
     const double tt = static_cast<double>(k) * t.dt_s;
     s1.x.push_back(tt), s1.y.push_back(m[k]);
@@ -256,11 +280,11 @@ io::Figure TraceFigure(const Traces::Record& t, const std::string& ch) {
     r1.x.push_back(tt), r1.y.push_back(m[k] - pn[k]);
     r2.x.push_back(tt), r2.y.push_back(m[k] - pf[k]);
   }
-  p1.series = {s1, s2, s3};
-  p2.series = {r1, r2};
+  p1.series = same ? std::vector<io::Series>{s1, s2} : std::vector<io::Series>{s1, s2, s3};
+  p2.series = same ? std::vector<io::Series>{r1} : std::vector<io::Series>{r1, r2};
   fig.panels = {p1, p2};
   fig.panel_height_px = 280;
-  KeyOutside(&fig);
+  KeyAbove(&fig);
   return fig;
 }
 

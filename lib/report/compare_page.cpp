@@ -17,7 +17,7 @@
 #include "report/html.h"
 #include "report/run_figures.h"
 #include "report/run_tables.h"
-#include "report/spectrum_axes.h"
+#include "signal/spectrum_axes.h"
 #include "signal/metrics.h"
 #include "signal/spectral.h"
 
@@ -55,21 +55,12 @@ std::vector<double> Head(const std::vector<double>& x, std::size_t n) {
   return {x.begin(), x.begin() + static_cast<std::ptrdiff_t>(std::min(n, x.size()))};
 }
 
-/// The legends go beside the axes (with several runs overlaid no corner of the data is free), as
-/// narrow as the labels allow; stacked panels get the same margin so their axes line up. Side by
-/// side panels show the legend once, beside the last.
-void KeysBeside(Figure* f) {
-  std::vector<const Panel*> panels;
-  for (const auto& p : f->panels) panels.push_back(&p);
-  const int margin = io::KeyMarginChars(panels);
-  for (std::size_t i = 0; i < f->panels.size(); ++i) {
-    Panel& p = f->panels[i];
-    const bool last_in_row = f->columns == 1 || (i + 1) % static_cast<std::size_t>(f->columns) == 0;
-    p.key = last_in_row ? "outside right top" : "off";
-    if (f->columns == 1) {
-      p.right_margin_chars = margin;
-      p.left_margin_chars = 11;  // stacked axes line up whatever their tick labels' widths
-    }
+/// The legends go above the axes, in a row: with several runs overlaid no corner of the data is
+/// free, and beside the axes they would take a third of the width. Stacked axes line up.
+void KeysAbove(Figure* f) {
+  for (auto& p : f->panels) {
+    p.key = "outside top center horizontal";
+    if (f->columns == 1) p.left_margin_chars = 11;
   }
 }
 
@@ -181,7 +172,7 @@ std::optional<CompareFigure> Spectra(const Overlay& ov, const CompareOptions& o)
     std::vector<const std::vector<double>*> curves;
     for (const auto& c : psds) curves.push_back(&c);
     if (with_r) curves.push_back(&r_psd);
-    const SpectrumAxes ax = SpectrumAxesOf(f, r_psd, curves, 40.0, 1.5, 8.0);
+    const signal::SpectrumAxes ax = signal::SpectrumAxesOf(f, r_psd, curves, 40.0, 1.5, 8.0);
     std::vector<std::size_t> idx;
     for (std::size_t i = 1; i < f.size() && f[i] <= ax.f_hi_hz; ++i) idx.push_back(i);
     if (with_r) p.series.push_back(Reference(Curve("r (" + ov.labels[0] + ")", "black", f, r_psd, idx)));
@@ -371,7 +362,7 @@ CompareFiles WriteComparison(const std::vector<RunData>& runs, const CompareOpti
   const fs::path fig_dir = o.out_dir / "figures";
   fs::create_directories(fig_dir);
   std::vector<std::future<io::PlotFiles>> jobs;
-  for (auto& cf : figures) KeysBeside(&cf.figure);
+  for (auto& cf : figures) KeysAbove(&cf.figure);
   for (const auto& cf : figures) {
     jobs.push_back(std::async(std::launch::async, [&cf, &fig_dir] { return io::Plot(cf.figure, fig_dir); }));
   }

@@ -12,7 +12,7 @@
 
 #include "participants/benchmark_run.h"
 #include "report/html.h"
-#include "report/spectrum_axes.h"
+#include "signal/spectrum_axes.h"
 #include "signal/benchmark_criteria.h"
 #include "signal/metrics.h"
 #include "signal/spectral.h"
@@ -226,7 +226,7 @@ PageFigure SpectraFigure(const signal::CrossSpectra& cs, const std::vector<doubl
   psd.log_y = true;
   // The band that carries r and eight decades under the highest density: not every bin to
   // Nyquist and down to round-off (a simulation's e reaches 1e-20).
-  const SpectrumAxes ax = SpectrumAxesOf(cs.f_hz, cs.s_uu, {&cs.s_uu, &cs.s_yy, &s_ee}, 40.0, 1.5, 8.0);
+  const signal::SpectrumAxes ax = signal::SpectrumAxesOf(cs.f_hz, cs.s_uu, {&cs.s_uu, &cs.s_yy, &s_ee}, 40.0, 1.5, 8.0);
   psd.x_range = std::make_pair(0.0, ax.f_hi_hz);
   if (ax.psd_hi > 0) psd.y_range = std::make_pair(ax.psd_lo, ax.psd_hi);
   Series sr = MakeSeries("r", kColorR), sy = MakeSeries("y", kColorY), se = MakeSeries("e = r - y", kColorE);

@@ -15,7 +15,7 @@
 ///                       constant current is a line of the caption instead)
 ///   loops.png           force-displacement f(y) and force-velocity f(y') (y' by central difference)
 ///   spectra.png         Welch PSDs of r, y, e [mm^2/Hz] (signal/spectral.h) over the band that
-///                       carries r, at most 8 decades (report/spectrum_axes.h)
+///                       carries r, at most 8 decades (signal/spectrum_axes.h)
 ///   gyr.png             G_yr = Y/R by H1: magnitude [-], phase [deg] and coherence [-] (left out
 ///                       when it is 1 to within 1e-4: a noise-free run), limited to the excited
 ///                       band of r, points of low coherence masked

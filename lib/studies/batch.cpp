@@ -4,6 +4,7 @@
 #include <atomic>
 #include <cmath>
 #include <fstream>
+#include <iterator>
 #include <limits>
 #include <mutex>
 #include <thread>
@@ -106,10 +107,25 @@ namespace {
 
 /// One run of the batch through the supervisor (memq, in this thread); its summary.json says how
 /// it went, also when it could not run.
-RunResult RunOne(const RunSpec& spec, const std::string& origin) {
+RunResult RunOne(const RunSpec& spec, const std::string& origin, const BatchControl& control, bool* reused) {
   RunResult res;
   res.label = spec.label;
   res.dir = spec.dir;
+  if (control.resume && fs::exists(spec.dir)) {
+    // A run that ended stands; one that was interrupted, or never wrote its summary, is made again.
+    nlohmann::json j;
+    try {
+      std::ifstream in(spec.dir / "summary.json");
+      j = nlohmann::json::parse(in);
+    } catch (const std::exception&) {
+    }
+    const std::string status = j.is_object() ? j.value("status", std::string()) : std::string();
+    if (!status.empty() && status != "interrupted") {
+      *reused = true;
+      return ResultOfRunFolder(spec.dir, spec.label);
+    }
+    fs::remove_all(spec.dir);
+  }
   if (fs::exists(spec.dir / "log.lcm")) {  // the folder's run and its summary stay as they are
     res.error = Error(spec.dir.string(), "holds a run already; refusing to overwrite it").what();
     return res;
@@ -122,6 +138,7 @@ RunResult RunOne(const RunSpec& spec, const std::string& origin) {
   request.checks = false;  // Preflight did
   request.study = true;
   request.label = spec.label;
+  request.interrupted = control.interrupted;
   supervisor::RunSummary sum;
   try {
     sum = supervisor::Run(request).summary;
@@ -146,6 +163,26 @@ RunResult RunOne(const RunSpec& spec, const std::string& origin) {
   res.benchmark = sum.benchmark_criteria;
   res.benchmark_error = sum.benchmark_error;
   return res;
+}
+
+/// Resuming: every run folder already there must hold the very scenario this batch would write
+/// (the same study, options and overrides), else the tables would mix two studies. Throws
+/// rths::Error naming the folders that differ.
+void CheckResumable(const std::vector<RunSpec>& specs, const std::string& origin) {
+  std::vector<std::string> differ;
+  for (const auto& spec : specs) {
+    const fs::path file = spec.dir / "scenario.toml";
+    if (!fs::exists(file)) continue;
+    std::ifstream in(file, std::ios::binary);
+    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    if (text != "# " + ScenarioHeader(spec, origin) + "\n" + scenario::ToToml(spec.scenario)) {
+      differ.push_back(spec.dir.string());
+    }
+  }
+  if (differ.empty()) return;
+  throw Error("--resume", fmt::format("{} run folder(s) hold another scenario than this study makes (e.g. {}): resume "
+                                      "with the options the interrupted study had (--quick, --plant, --set, ...)",
+                                      differ.size(), differ.front()));
 }
 
 /// A number of summary.json: NaN for null (nlohmann writes NaN as null), `fallback` if absent.
@@ -190,10 +227,19 @@ RunResult ResultOfRunFolder(const fs::path& dir, const std::string& label) {
   return res;
 }
 
+std::string BatchInterrupted::Describe(std::size_t ended, std::size_t cut, std::size_t not_started) {
+  return fmt::format("interrupted: {} run(s) ended and stand, {} stopped mid-run (their summary.json says "
+                     "\"interrupted\", their log ends on their last complete step), {} not started",
+                     ended, cut, not_started);
+}
+
 std::vector<RunResult> RunBatch(const std::vector<RunSpec>& specs, int jobs, ProgressLine* line,
-                                const Progress& progress, const std::string& origin) {
+                                const Progress& progress, const std::string& origin, const BatchControl& control) {
   if (jobs < 1) throw Error("reproduce", "--jobs must be >= 1");
+  if (control.resume) CheckResumable(specs, origin);
   std::vector<RunResult> results(specs.size());
+  std::vector<char> started(specs.size(), 0), cut(specs.size(), 0);
+  auto stopping = [&] { return control.interrupted != nullptr && *control.interrupted != 0; };
   std::atomic<std::size_t> next{0};
   std::size_t done = 0;
   // Progress by simulated steps of the finished runs (runs differ in length).
@@ -202,10 +248,15 @@ std::vector<RunResult> RunBatch(const std::vector<RunSpec>& specs, int jobs, Pro
   std::mutex m;
   auto worker = [&] {
     for (;;) {
+      if (stopping()) return;
       const std::size_t i = next.fetch_add(1);
       if (i >= specs.size()) return;
-      RunResult r = RunOne(specs[i], origin);
+      started[i] = 1;
+      bool reused = false;
+      RunResult r = RunOne(specs[i], origin, control, &reused);
       std::lock_guard<std::mutex> lock(m);
+      // A run the interrupt cut short is no result: it is made again on --resume.
+      if (!reused && stopping() && !r.ok) cut[i] = 1;
       results[i] = r;
       ++done;
       done_steps += static_cast<double>(specs[i].scenario.steps());
@@ -217,6 +268,14 @@ std::vector<RunResult> RunBatch(const std::vector<RunSpec>& specs, int jobs, Pro
   std::vector<std::thread> threads;
   for (int t = 0; t < n; ++t) threads.emplace_back(worker);
   for (auto& t : threads) t.join();
+  if (stopping()) {
+    std::size_t n_started = 0, n_cut = 0;
+    for (std::size_t i = 0; i < specs.size(); ++i) {
+      n_started += started[i];
+      n_cut += cut[i];
+    }
+    throw BatchInterrupted(n_started - n_cut, n_cut, specs.size() - n_started);
+  }
   return results;
 }
 

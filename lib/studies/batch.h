@@ -5,6 +5,7 @@
 /// gets a folder of its own with the exact scenario file that ran (scenario.toml, written by
 /// scenario::ToToml and loaded back, so its hash is that of the file), log.lcm, signals.csv and
 /// summary.json.
+#include <csignal>
 #include <cstdint>
 #include <filesystem>
 #include <functional>
@@ -12,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "core/error.h"
 #include "core/progress.h"
 #include "scenario/scenario.h"
 #include "signal/benchmark_criteria.h"
@@ -54,6 +56,30 @@ void Preflight(const std::vector<RunSpec>& specs);
 void Preflight(std::vector<RunSpec>* specs, const std::vector<std::string>& overrides,
                const std::function<void(std::string_view)>& log = {});
 
+/// How a batch can be stopped and finished later (`rths reproduce`: Ctrl-C, then --resume).
+struct BatchControl {
+  /// Set (by a signal handler) to stop: the runs in progress stop at their next step, their
+  /// summary.json says "interrupted", no new run starts, and RunBatch throws BatchInterrupted.
+  volatile std::sig_atomic_t* interrupted = nullptr;
+  /// A run folder whose summary.json says the run ended (any status but "interrupted") is taken as
+  /// it is (ResultOfRunFolder); a folder without one, or with an interrupted run, is made again.
+  bool resume = false;
+};
+
+/// A batch stopped by BatchControl::interrupted: what was done and what was not.
+class BatchInterrupted : public Error {
+ public:
+  BatchInterrupted(std::size_t ended, std::size_t cut, std::size_t not_started)
+      : Error("", Describe(ended, cut, not_started)), ended_(ended), cut_(cut), not_started_(not_started) {}
+  std::size_t ended() const { return ended_; }              ///< runs that ended (their results stand)
+  std::size_t cut() const { return cut_; }                  ///< runs stopped mid-way (summary.json "interrupted")
+  std::size_t not_started() const { return not_started_; }  ///< runs never started
+
+ private:
+  static std::string Describe(std::size_t ended, std::size_t cut, std::size_t not_started);
+  std::size_t ended_, cut_, not_started_;
+};
+
 /// Called after each run (from the worker threads, serialised): done so far, total, the result.
 using Progress = std::function<void(std::size_t done, std::size_t total, const RunResult&)>;
 
@@ -61,8 +87,10 @@ using Progress = std::function<void(std::size_t done, std::size_t total, const R
 /// run is reported in its RunResult (and its summary.json), not thrown.
 /// `line`: if not null, shows the batch's progress with an ETA (by simulated steps done).
 /// `origin`: the command scenario.toml's header names ("written by rths reproduce; ...").
+/// `control`: how it can be interrupted and resumed (BatchControl; throws BatchInterrupted).
 std::vector<RunResult> RunBatch(const std::vector<RunSpec>& specs, int jobs, ProgressLine* line = nullptr,
-                                const Progress& progress = {}, const std::string& origin = "rths reproduce");
+                                const Progress& progress = {}, const std::string& origin = "rths reproduce",
+                                const BatchControl& control = {});
 
 /// The RunResult of a run made elsewhere (an array task on a cluster: sweep/study_on_slurm.h),
 /// read from its folder's summary.json as RunOne takes it from the supervisor's summary (NaN where

@@ -297,7 +297,7 @@ std::vector<BenchmarkLoopRow> Loops(const std::vector<RunSpec>& specs) {
 
 BenchmarkResult ReproduceBenchmark(const ReproduceOptions& opts, bool keep_logs) {
   const auto t0 = std::chrono::steady_clock::now();
-  PrepareOutDir(opts.out_dir);
+  PrepareOutDir(opts.out_dir, opts.batch.resume);
   const std::vector<scenario::Scenario> bases = LoadBases(opts);
   BenchmarkResult res;
   res.duration_s = bases[0].run.duration_s;

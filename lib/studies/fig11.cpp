@@ -376,7 +376,7 @@ std::vector<Claim> CheckFig11Claims(const Fig11Result& res) {
 
 Fig11Result ReproduceFig11(const ReproduceOptions& opts) {
   const auto t0 = std::chrono::steady_clock::now();
-  PrepareOutDir(opts.out_dir);
+  PrepareOutDir(opts.out_dir, opts.batch.resume);
   if (opts.plant != "ideal") RequirePlant(opts.plant, opts.out_dir);
   const fs::path base_file = io::FindSourceFile("scenarios/fig11_base.toml", opts.source_dir);
   const scenario::Scenario base = scenario::LoadScenario(base_file.string());

@@ -153,7 +153,7 @@ Figure Fig5Figure(const Fig5Result& res, const std::vector<Loop>& loops) {
 }  // namespace
 
 Fig5Result ReproduceFig5(const ReproduceOptions& opts) {
-  PrepareOutDir(opts.out_dir);
+  PrepareOutDir(opts.out_dir, opts.batch.resume);
   const double dt_s = 0.0005;  // 2 kHz, the paper's rate
   std::vector<Loop> loops;
   const Fig5Result res = SimulateLoops(opts, dt_s, &loops);

@@ -196,7 +196,7 @@ void WriteMarkdown(const Fig6Result& res, const ReproduceOptions& opts, double d
 }  // namespace
 
 Fig6Result ReproduceFig6(const ReproduceOptions& opts) {
-  PrepareOutDir(opts.out_dir);
+  PrepareOutDir(opts.out_dir, opts.batch.resume);
   RequirePlant(opts.plant, opts.out_dir);
   const double duration = opts.quick ? kFreqQuickS : kFreqFullS;
   const auto results = RunFrequencyBatch(Fig6Specs(opts, duration), opts, "fig6");

@@ -171,7 +171,7 @@ void WriteMarkdown(const Fig78Result& res, const ReproduceOptions& opts, const s
 
 Fig78Result ReproduceFig78(const ReproduceOptions& opts, const std::string& figure) {
   if (figure != "fig7" && figure != "fig8") throw Error("ReproduceFig78", "figure must be fig7 or fig8");
-  PrepareOutDir(opts.out_dir);
+  PrepareOutDir(opts.out_dir, opts.batch.resume);
   RequirePlant(opts.plant, opts.out_dir);
   Fig78Result res;
   res.condition = figure == "fig7" ? "0.0A" : "2.5A";

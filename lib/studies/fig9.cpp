@@ -210,7 +210,7 @@ void WriteMarkdown(const Fig9Result& res, const ReproduceOptions& opts, const sa
 
 Fig9Result ReproduceFig9(const ReproduceOptions& opts) {
   const auto t0 = std::chrono::steady_clock::now();
-  PrepareOutDir(opts.out_dir);
+  PrepareOutDir(opts.out_dir, opts.batch.resume);
   if (opts.plant != "ideal") RequirePlant(opts.plant, opts.out_dir);
   const fs::path base_file = io::FindSourceFile("scenarios/fig9_base.toml", opts.source_dir);
   const scenario::Scenario base = scenario::LoadScenario(base_file.string());

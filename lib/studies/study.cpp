@@ -36,8 +36,8 @@ double SecondsSince(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-void PrepareOutDir(const fs::path& dir) {
-  io::RequireNewOrEmptyFolder(dir, "an earlier reproduction");
+void PrepareOutDir(const fs::path& dir, bool resume) {
+  if (!resume) io::RequireNewOrEmptyFolder(dir, "an earlier reproduction (or finish it: --resume)");
   fs::create_directories(dir);
 }
 
@@ -98,7 +98,7 @@ std::vector<RunResult> RunStudyBatch(std::vector<RunSpec>* specs, const Reproduc
   Preflight(specs, opts.overrides, opts.log);
   if (opts.log) opts.log(intro);
   if (opts.run_batch) return opts.run_batch(*specs, on_run);
-  return RunBatch(*specs, opts.jobs, opts.progress, on_run);
+  return RunBatch(*specs, opts.jobs, opts.progress, on_run, "rths reproduce", opts.batch);
 }
 
 std::string StoppedText(const RunResult& r) {

@@ -49,6 +49,9 @@ struct ReproduceOptions {
   /// function makes them (e.g. as a Slurm job array, sweep/study_on_slurm.h) and returns their
   /// results in spec order, calling `progress` after each as RunBatch does.
   std::function<std::vector<RunResult>(const std::vector<RunSpec>&, const Progress&)> run_batch;
+  /// Ctrl-C and --resume of the runs made here (BatchControl; with resume, out_dir may hold the
+  /// interrupted study).
+  BatchControl batch;
 };
 
 /// One of the paper's claims (docs/experiments.md) checked on our numbers.
@@ -69,8 +72,9 @@ std::string UtcStamp();
 double SecondsSince(std::chrono::steady_clock::time_point t0);
 
 /// Creates `dir`, or accepts it if it exists and is empty; throws rths::Error if it holds
-/// anything (a reproduction never overwrites an earlier one).
-void PrepareOutDir(const std::filesystem::path& dir);
+/// anything (a reproduction never overwrites an earlier one), unless `resume` (it holds the
+/// interrupted study being finished).
+void PrepareOutDir(const std::filesystem::path& dir, bool resume = false);
 
 /// Throws rths::Error with a clear message unless `plant` is "linear" or "physical", and, for
 /// "physical", unless this build's plant really runs the physics-based actuator (it runs a

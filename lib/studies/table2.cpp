@@ -411,7 +411,7 @@ PiLeadDesign LoggedPiLead(const ReproduceOptions& opts) {
 
 Table2Result ReproduceTable2(const ReproduceOptions& opts) {
   const auto t0 = std::chrono::steady_clock::now();
-  PrepareOutDir(opts.out_dir);
+  PrepareOutDir(opts.out_dir, opts.batch.resume);
   RequirePlant(opts.plant, opts.out_dir);
   Table2Result res;
   std::vector<RunSpec> specs = Table2Specs(opts, &res.rows);

@@ -1,10 +1,10 @@
 #pragma once
-/// @file The axes of a spectrum figure (the run report's, the comparison's): the band that
+/// @file The axes of a spectrum figure (the run report, the comparison, the diagnosis): the band that
 /// carries the signal and a range of density a reader can see into, instead of every bin from the
 /// first to Nyquist and every decade down to round-off.
 #include <vector>
 
-namespace rths::report {
+namespace rths::signal {
 
 struct SpectrumAxes {
   double f_lo_hz = 0, f_hi_hz = 0;  ///< [Hz]
@@ -23,4 +23,4 @@ SpectrumAxes SpectrumAxesOf(const std::vector<double>& f, const std::vector<doub
                             const std::vector<const std::vector<double>*>& curves, double band_db = 40.0,
                             double widen = 1.5, double decades = 6.0);
 
-}  // namespace rths::report
+}  // namespace rths::signal

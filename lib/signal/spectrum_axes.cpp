@@ -1,10 +1,10 @@
-#include "report/spectrum_axes.h"
+#include "signal/spectrum_axes.h"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
-namespace rths::report {
+namespace rths::signal {
 
 SpectrumAxes SpectrumAxesOf(const std::vector<double>& f, const std::vector<double>& reference,
                             const std::vector<const std::vector<double>*>& curves, double band_db, double widen,
@@ -40,4 +40,4 @@ SpectrumAxes SpectrumAxesOf(const std::vector<double>& f, const std::vector<doub
   return a;
 }
 
-}  // namespace rths::report
+}  // namespace rths::signal
