@@ -286,3 +286,23 @@ TEST_CASE("small frictions: the folder to give, the role meant, the --set meant,
   CHECK(report.find("0.000 %") == std::string::npos);
   CHECK(report.find("tracking error     - (no step completed)") != std::string::npos);
 }
+
+TEST_CASE("design of an identified model file: at the record's step, on the file's own actuator") {
+  // A 1 kHz record, identified, then designed: the file carries dt, and G_yr is evaluated on its
+  // [plant] actuator, not on the paper's three models.
+  const fs::path dir = TempDir("cli_design_model");
+  std::string out;
+  REQUIRE(RunTool("run", Scenario("default.toml") + " --transport memq --skip-space-check --compact --set run.dt_s=0.001 "
+                                                    "--set run.duration_s=4 --out " + (dir / "run").string(),
+                  &out) == 0);
+  REQUIRE(RunTool("record", (dir / "run").string(), &out) == 0);
+  REQUIRE_MESSAGE(RunTool("identify", (dir / "run" / "record.csv").string() + " --band 0.5-20 --out " +
+                                          (dir / "model.toml").string(),
+                          &out) == 0,
+                  out);
+  CHECK(rths::scenario::LoadScenario((dir / "model.toml").string()).run.dt_s == 0.001);
+  REQUIRE_MESSAGE(RunTool("design", (dir / "model.toml").string(), &out) == 0, out);
+  CHECK(out.find("dt = 0.001 s") != std::string::npos);
+  CHECK(out.find("the scenario's [plant] actuator (custom, ZOH)") != std::string::npos);
+  CHECK(out.find("2.5A") == std::string::npos);  // not the paper's models
+}

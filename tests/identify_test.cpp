@@ -204,12 +204,16 @@ TEST_CASE("E1 on the linear plants: BLWN 0-50 Hz, 0.254 mm RMS, 60 s through the
       CHECK(rc.fit.model.DcGain() == doctest::Approx(m.K / (m.p * m.c)).epsilon(0.015));
       CHECK((rc.fit.model.DcLagS() - m.b / m.c - 1.0 / m.p) == doctest::Approx(dt / 2).epsilon(0.25));
 
-      // The printed fragment is a valid scenario part: plant.actuator = the ZOH-consistent fit,
-      // controller.model = the continuous fit.
+      // The printed fragment is a valid scenario part: run.dt_s = the record's step (its [run]
+      // table takes more keys), plant.actuator = the ZOH-consistent fit, controller.model = the
+      // continuous fit.
       const auto dir = rths_test::TempDir("identify_fragment");
-      const auto sc = rths::scenario::LoadScenario(
-          rths_test::WriteScenario(dir, "[run]\nduration_s = 0.5\n" + rths::ident::ScenarioFragment(rc, rz, "E1"))
-              .string());
+      std::string fragment = rths::ident::ScenarioFragment(rc, rz, "E1");
+      const auto run_table = fragment.find("[run]\n");
+      REQUIRE(run_table != std::string::npos);
+      fragment.insert(run_table + 6, "duration_s = 0.5\n");
+      const auto sc = rths::scenario::LoadScenario(rths_test::WriteScenario(dir, fragment).string());
+      CHECK(sc.run.dt_s == rz.dt_s);
       CHECK(sc.plant.actuator.K == doctest::Approx(z.K).epsilon(1e-9));
       CHECK(sc.plant.actuator.c == doctest::Approx(z.c).epsilon(1e-9));
       CHECK(sc.controller.model.p == doctest::Approx(c.p).epsilon(1e-9));

@@ -13,6 +13,7 @@
 #include <CLI/CLI.hpp>
 
 #include "control/design.h"
+#include "control/lti.h"
 #include "models/benchmark_plant.h"
 #include "scenario/scenario.h"
 #include "cli.h"
@@ -37,7 +38,14 @@ int main(int argc, char** argv) {
       // Gp is m/m, i.e. mm/mm: its ZOH model is the plant u -> y as the controller sees it.
       const auto g = rths::models::BenchmarkPlant::Make(s.plant.benchmark.params, s.run.dt_s);
       plants.push_back({"benchmark plant Gp ([plant.benchmark])", {g.Phi, g.Gamma, g.C, 0.0, s.run.dt_s}});
+    } else if (s.plant.kind == rths::models::PlantKind::kLinear && s.plant.actuator.name == "custom") {
+      // A plant of the user's own (an identified model file): the design is judged on it, at the
+      // scenario's step, not on the paper's three.
+      plants.push_back({"the scenario's [plant] actuator (custom, ZOH)",
+                        rths::control::ServoZoh(s.plant.actuator, s.run.dt_s)});
     }
+    std::printf("rths design: %s, dt = %g s%s\n", scenario_path.c_str(), s.run.dt_s,
+                s.run.dt_s == rths::scenario::RunConfig{}.dt_s ? " (the default: the file sets no [run] dt_s)" : "");
     const rths::control::DesignSummary d = rths::control::DesignController(s.controller, s.run.dt_s, plants);
     std::fputs(d.Report().c_str(), stdout);
     if (!out.empty()) {

@@ -136,6 +136,7 @@ std::string ScenarioFragment(const IdentifyResult& continuous, const IdentifyRes
     s += zoh_note + "# " + Factors(mz) + "\n" + cont_note + "# " + Factors(mc) + "\n";
     return s;
   }
+  s += fmt::format("\n[run]\n# the record's step: `rths run` and `rths design` of this file use it\ndt_s = {}\n", zoh.dt_s);
   s += "\n[plant]\n" + zoh_note + "actuator = " + Table(mz) + "\n";
   s += "\n[controller]\n" + cont_note + "model = " + Table(mc) + "\n";
   return s;

@@ -65,6 +65,8 @@ IdentifyResult Identify(std::span<const double> u_mm, std::span<const double> y_
                         const IdentifyOptions& options);
 
 /// The scenario fragment `rths identify` prints and writes, from the two fits of one record:
+///     [run]
+///     dt_s = ..                                       <- the record's step
 ///     [plant]
 ///     actuator = { K = .., p = .., b = .., c = .. }   <- `zoh`: its ZOH simulation at the record's
 ///                                                       dt reproduces the record (a plant to simulate)
