@@ -22,6 +22,7 @@
 #include "lockstep/exit_code.h"
 #include "monitor/live_view.h"
 #include "monitor/server.h"
+#include "supervisor/ports.h"
 #include "chromium_pipe.h"
 #include "test_support.h"
 // Last: it includes <resolv.h>, whose `_res` macro breaks Eigen's headers included before it.
@@ -243,4 +244,52 @@ TEST_CASE("rths run --watch: the page in headless Chromium follows the run, and 
   CHECK(log.CompleteSteps() == summary["steps"].get<std::int64_t>());
   CHECK(log.CompleteSteps() > 1000);
   CHECK(log.CompleteSteps() < 600000);
+}
+
+TEST_CASE("rths watch --lcm-url: a run started elsewhere is watched and stopped; --exit-at-end ends with it") {
+  if (!rths_test::UdpmAvailable()) {
+    FAIL("no multicast route for udpm (as root: ip route add 224.0.0.0/4 dev lo; scripts/bootstrap.sh adds it)");
+  }
+  rths_test::RequireFile("/usr/share/javascript/dygraphs/dygraph.min.js", "libjs-dygraphs");
+  const fs::path dir = rths_test::TempDir("monitor_watch_cli");
+  const std::string url = "udpm://239.255.76.67:" + std::to_string(rths::supervisor::FreeUdpPort()) + "?ttl=0";
+  // The monitor first, as an operator would open it before the test.
+  BackgroundRun watch("exec " + std::string(RTHS_BIN_DIR) + "/rths-watch --lcm-url '" + url +
+                      "' --port 0 --exit-at-end > " + (dir / "watch.txt").string() + " 2>&1");
+  std::string address;
+  const std::regex line("monitor +http://127\\.0\\.0\\.1:([0-9]+)/\\?token=([0-9a-f]+)");
+  std::smatch m;
+  for (int i = 0; i < 200; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    const std::string text = rths_test::Slurp(dir / "watch.txt");
+    if (std::regex_search(text, m, line)) break;
+  }
+  REQUIRE_MESSAGE(!m.empty(), rths_test::Slurp(dir / "watch.txt"));
+  const int port = std::stoi(m[1]);
+  const std::string token = m[2];
+  BackgroundRun run("exec " + std::string(RTHS_BIN_DIR) + "/rths-run " + RTHS_SOURCE_DIR +
+                    "/scenarios/default.toml --compact --set run.duration_s=300 --lcm-url '" + url + "' --out " +
+                    (dir / "run").string() + " > " + (dir / "run.txt").string() + " 2>&1");
+  httplib::Client c("127.0.0.1", port);
+  nlohmann::json state;
+  for (int i = 0; i < 600; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    const auto res = c.Get("/state?token=" + token);
+    if (!res || res->status != 200) continue;
+    state = nlohmann::json::parse(res->body);
+    if (state["status"]["phase"] == "running" && state["status"]["last_k"].get<std::int64_t>() > 2000) break;
+  }
+  REQUIRE_MESSAGE(state["status"]["phase"] == "running", state.dump());
+  CHECK(state["status"]["n_steps"] == 600000);
+  const auto abort = c.Post("/abort?token=" + token, "", "text/plain");
+  REQUIRE(abort);
+  CHECK(abort->status == 200);
+  CHECK(run.Wait() == rths::lockstep::kExitPeerAbort);
+  CHECK(watch.Wait() == 0);  // --exit-at-end: it ends with the run
+  const std::string said = rths_test::Slurp(dir / "watch.txt");
+  CAPTURE(said);
+  CHECK(said.find("running") != std::string::npos);
+  CHECK(said.find("aborted by monitor: operator abort from the monitor") != std::string::npos);
+  const auto summary = nlohmann::json::parse(rths_test::Slurp(dir / "run" / "summary.json"));
+  CHECK(summary["status"] == "aborted");
 }
