@@ -45,14 +45,14 @@ int Compare(const std::string& args, std::string* output) {
 TEST_CASE("scenario keys: flattened, and those that differ between texts (or some lack)") {
   const std::string a = "[run]\nname = \"a\"\ndt_s = 0.0005\n[plant.damper]\nc0_a = 21.0\nlist = [1, 2]\n";
   const std::string b = "[run]\nname = \"a\"\ndt_s = 0.001\n[plant.damper]\nc0_a = 21.0\nlist = [1, 3]\nextra = true\n";
-  const auto flat = rths::report::FlattenScenario(a);
+  const auto flat = rths::scenario::FlattenScenario(a);
   REQUIRE(flat.size() == 4);
   CHECK(flat[0].key == "plant.damper.c0_a");
   CHECK(flat[0].value == "21.0");
   CHECK(rths::report::DifferingKeys({a, a}).empty());
   CHECK(rths::report::DifferingKeys({a, b}) ==
         std::vector<std::string>{"plant.damper.list", "run.dt_s", "plant.damper.extra"});
-  CHECK(rths::report::FlattenScenario("not toml [").empty());
+  CHECK(rths::scenario::FlattenScenario("not toml [").empty());
 }
 
 TEST_CASE("rths compare: three runs in one page, aligned by step over the steps they all have") {

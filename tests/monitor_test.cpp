@@ -293,3 +293,26 @@ TEST_CASE("rths watch --lcm-url: a run started elsewhere is watched and stopped;
   const auto summary = nlohmann::json::parse(rths_test::Slurp(dir / "run" / "summary.json"));
   CHECK(summary["status"] == "aborted");
 }
+
+TEST_CASE("rths run --watch on a port in use: nothing runs, exit 2, the option and the port named") {
+  if (!rths_test::UdpmAvailable()) {
+    FAIL("no multicast route for udpm (as root: ip route add 224.0.0.0/4 dev lo; scripts/bootstrap.sh adds it)");
+  }
+  rths_test::RequireFile("/usr/share/javascript/dygraphs/dygraph.min.js", "libjs-dygraphs");
+  LiveView view;
+  rths::monitor::ServerOptions o;
+  o.port = 0;
+  rths::monitor::MonitorServer taken(o, &view, {});
+  taken.Start();
+  const fs::path dir = rths_test::TempDir("monitor_port_taken");
+  std::string out;
+  const int code = rths_test::RunCli(std::string(RTHS_SOURCE_DIR) + "/scenarios/default.toml --compact --set "
+                                     "run.duration_s=1 --watch --watch-port " + std::to_string(taken.port()) +
+                                     " --out " + (dir / "run").string(),
+                                     &out);
+  CAPTURE(out);
+  CHECK(code == rths::lockstep::kExitUsage);
+  CHECK(out.find("rths run: --watch: cannot serve on 127.0.0.1:" + std::to_string(taken.port())) != std::string::npos);
+  CHECK_FALSE(fs::exists(dir / "run" / "log.lcm"));
+  taken.Stop();
+}

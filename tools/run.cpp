@@ -14,6 +14,7 @@
 #include <CLI/CLI.hpp>
 #include <fmt/core.h>
 
+#include "core/error.h"
 #include "core/progress.h"
 #include "lockstep/exit_code.h"
 #include "lockstep/transport.h"
@@ -260,16 +261,17 @@ int main(int argc, char** argv) {
   std::signal(SIGINT, OnSignal);
   std::signal(SIGTERM, OnSignal);
   std::unique_ptr<rths::monitor::Monitor> monitor;
-  bool monitor_failed = false;
   request.on_start = [&](const sup::RunPlan& plan) {
     if (!o.quiet) PrintHeader(o, plan);
     if (!request.external.roles.empty()) rths::tools::PrintExternal(request, plan, plan.scenario.steps());
     // A monitor that cannot start stops the run before its participants do (RunError, exit 2).
     if (o.watch) {
-      monitor_failed = true;
-      monitor = o.watch_flags.Start(plan.url, plan.scenario.realtime.enabled, "rths monitor: " + plan.scenario.run.name,
-                                    "run", stdout);
-      monitor_failed = false;
+      try {
+        monitor = o.watch_flags.Start(plan.url, plan.scenario.realtime.enabled,
+                                      "rths monitor: " + plan.scenario.run.name, "run", stdout);
+      } catch (const std::exception& e) {
+        throw rths::Error("--watch", e.what());  // nothing runs: RunError, exit 2
+      }
     }
     std::fflush(stdout);
   };
@@ -281,7 +283,7 @@ int main(int argc, char** argv) {
     }
     return PrintEnd(o, result);
   } catch (const sup::RunError& e) {
-    std::fprintf(stderr, "rths run: %s%s\n", monitor_failed ? "--watch: " : "", e.what());
-    return monitor_failed ? rths::lockstep::kExitUsage : e.exit_code();
+    std::fprintf(stderr, "rths run: %s\n", e.what());
+    return e.exit_code();
   }
 }

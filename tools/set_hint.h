@@ -10,7 +10,7 @@
 #include <CLI/CLI.hpp>
 
 #include "core/closest_name.h"
-#include "report/compare_page.h"
+#include "scenario/flat_keys.h"
 #include "scenario/scenario.h"
 
 namespace rths::tools {
@@ -18,9 +18,9 @@ namespace rths::tools {
 /// Prints `rths <command>: --NAME is not an option; a scenario key? --set KEY=VALUE` for each such
 /// argument of argv.
 inline void PrintSetHints(CLI::App& app, int argc, char** argv, const std::string& command) {
-  std::vector<report::ScenarioKey> keys;
+  std::vector<scenario::ScenarioKey> keys;
   try {
-    keys = report::FlattenScenario(scenario::ToToml(scenario::Scenario{}));
+    keys = scenario::FlattenScenario(scenario::ToToml(scenario::Scenario{}));
   } catch (const std::exception&) {
     return;
   }

@@ -1,21 +1,9 @@
 #include "monitor/page.h"
 
+#include "core/html_escape.h"
+
 namespace rths::monitor {
 namespace {
-
-std::string Escape(const std::string& s) {
-  std::string o;
-  for (char c : s) {
-    switch (c) {
-      case '&': o += "&amp;"; break;
-      case '<': o += "&lt;"; break;
-      case '>': o += "&gt;"; break;
-      case '"': o += "&quot;"; break;
-      default: o += c;
-    }
-  }
-  return o;
-}
 
 // The page's script keeps every point it was sent (up to kKeep), draws the chosen window, and
 // exposes its state as window.rths for tests (points, lastT, status, abortMessage).
@@ -157,7 +145,10 @@ source.onopen = () => { if ($("message").textContent.startsWith("lost")) $("mess
 $("abort").addEventListener("click", () => {
   $("abort").disabled = true;
   fetch("abort?token=" + encodeURIComponent(token), { method: "POST" })
-    .then((r) => r.json()).then((j) => { st.abortMessage = j.message; $("message").textContent = j.ok ? "ABORT sent" : j.message; })
+    .then((r) => r.json()).then((j) => {
+      st.abortMessage = j.message;
+      // The run's own word wins: its "Aborted by ..." may have come over the events first.
+      if (!st.status || st.status.phase !== "aborted") $("message").textContent = j.ok ? "ABORT sent" : j.message; })
     .catch((err) => { st.abortMessage = String(err); $("message").textContent = "ABORT could not be sent: " + err; });
 });
 for (const b of document.querySelectorAll("#controls button")) {
@@ -174,7 +165,7 @@ for (const b of document.querySelectorAll("#controls button")) {
 
 std::string PageHtml(const std::string& title) {
   std::string page = kHead;
-  const std::string escaped = Escape(title);
+  const std::string escaped = HtmlEscape(title);
   for (std::size_t at; (at = page.find("@TITLE@")) != std::string::npos;) page.replace(at, 7, escaped);
   return page + kScript;
 }

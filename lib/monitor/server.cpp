@@ -1,5 +1,6 @@
 #include "monitor/server.h"
 
+#include <sys/socket.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -89,6 +90,13 @@ void MonitorServer::Routes() {
 void MonitorServer::Start() {
   if (thread_.joinable()) return;
   auto& s = *server_;
+  // cpp-httplib's default sets SO_REUSEPORT, with which a second server (ours or anyone's of this
+  // user) binds the same port and takes some of its connections. SO_REUSEADDR alone still allows a
+  // restart over connections in TIME_WAIT, and a port in use fails.
+  s.set_socket_options([](socket_t sock) {
+    int yes = 1;
+    ::setsockopt(sock, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof(yes));
+  });
   if (options_.port == 0) {
     port_ = s.bind_to_any_port(options_.host);
   } else {

@@ -6,10 +6,8 @@
 #include <future>
 #include <map>
 #include <set>
-#include <sstream>
 
 #include <fmt/format.h>
-#include <toml++/toml.h>
 
 #include "core/error.h"
 #include "core/names.h"
@@ -64,21 +62,13 @@ void KeysAbove(Figure* f) {
   }
 }
 
-Figure NewFigure(const std::string& name, const CompareOptions& o) {
-  Figure f;
-  f.name = name;
-  f.gnuplot = o.gnuplot;
-  f.width_px = 1100;
-  f.panel_height_px = 300;
-  return f;
-}
+Figure NewFigure(const std::string& name, const CompareOptions& o) { return run_figures::PageFrame(name, o.gnuplot); }
 
 /// A time history of run `run`'s column over the common steps, min/max decimated.
 Series History(const Overlay& ov, std::size_t run, const char* column, const std::string& title,
                const CompareOptions& o) {
   const std::vector<double> t = Head(ov.Col(run, "t_s"), ov.n);
-  const std::vector<double> y = Head(ov.Col(run, column), ov.n);
-  return Curve(title, ov.colors[run], t, y, MinMaxDecimate(y, o.max_plot_points));
+  return run_figures::History(title, ov.colors[run], t, Head(ov.Col(run, column), ov.n), o.max_plot_points);
 }
 
 /// r of the first run, dashed black: the reference every y is drawn against.
@@ -254,13 +244,13 @@ std::string SummaryTable(const std::vector<RunData>& runs, const std::vector<std
 /// in what they leave to defaults compare equal; the folder's text if it does not load.
 std::string FullScenario(const RunData& r) { return r.scenario ? scenario::ToToml(*r.scenario) : r.scenario_toml; }
 
-std::string DifferencesTable(const std::vector<RunData>& runs, const std::vector<std::string>& labels,
+std::string DifferencesTable(const std::vector<std::string>& texts, const std::vector<std::string>& labels,
                              const std::vector<std::string>& keys) {
   if (keys.empty()) return "<p id=\"no-differences\">The runs' scenarios are the same, key by key.</p>\n";
   std::vector<std::map<std::string, std::string>> values;
-  for (const auto& r : runs) {
+  for (const auto& text : texts) {
     std::map<std::string, std::string> m;
-    for (auto& kv : FlattenScenario(FullScenario(r))) m[kv.key] = kv.value;
+    for (auto& kv : scenario::FlattenScenario(text)) m[kv.key] = kv.value;
     values.push_back(std::move(m));
   }
   std::string h = "<table class=\"compare\" id=\"differences\">\n<tr><th>key</th>";
@@ -277,30 +267,7 @@ std::string DifferencesTable(const std::vector<RunData>& runs, const std::vector
   return h + "</table>\n";
 }
 
-void Flatten(const toml::table& t, const std::string& prefix, std::vector<ScenarioKey>* out) {
-  for (auto&& [k, v] : t) {
-    const std::string key = prefix.empty() ? std::string(k.str()) : prefix + "." + std::string(k.str());
-    if (const auto* sub = v.as_table()) {
-      Flatten(*sub, key, out);
-      continue;
-    }
-    std::ostringstream text;
-    v.visit([&](const auto& node) { text << node; });
-    out->push_back({key, text.str()});
-  }
-}
-
 }  // namespace
-
-std::vector<ScenarioKey> FlattenScenario(const std::string& toml_text) {
-  std::vector<ScenarioKey> out;
-  try {
-    Flatten(toml::parse(toml_text), "", &out);
-  } catch (const toml::parse_error&) {
-    out.clear();
-  }
-  return out;
-}
 
 std::vector<std::string> DifferingKeys(const std::vector<std::string>& toml_texts) {
   std::vector<std::map<std::string, std::string>> maps;
@@ -308,7 +275,7 @@ std::vector<std::string> DifferingKeys(const std::vector<std::string>& toml_text
   std::set<std::string> seen;
   for (const auto& text : toml_texts) {
     std::map<std::string, std::string> m;
-    for (auto& kv : FlattenScenario(text)) {
+    for (auto& kv : scenario::FlattenScenario(text)) {
       if (seen.insert(kv.key).second) order.push_back(kv.key);
       m[kv.key] = kv.value;
     }
@@ -373,7 +340,7 @@ CompareFiles WriteComparison(const std::vector<RunData>& runs, const CompareOpti
   h += fmt::format("<p>{} runs, aligned by step (t = k dt, dt = {:g} s) over the {} steps they all have ({:.4g} s).</p>\n",
                    runs.size(), ov.dt_s, ov.n, static_cast<double>(ov.n) * ov.dt_s);
   h += "<h2 id=\"summary\">Summary</h2>\n" + SummaryTable(runs, ov.labels);
-  h += "<h2 id=\"scenario\">Scenario differences</h2>\n" + DifferencesTable(runs, ov.labels, files.differing_keys);
+  h += "<h2 id=\"scenario\">Scenario differences</h2>\n" + DifferencesTable(texts, ov.labels, files.differing_keys);
   h += "<h2 id=\"figures\">Figures</h2>\n";
   if (figures.empty()) h += "<p>No figures: a run has fewer than 2 complete steps.</p>\n";
   for (std::size_t i = 0; i < figures.size(); ++i) {

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "report/run_report.h"
+#include "scenario/flat_keys.h"
 
 namespace rths::report {
 
@@ -31,13 +32,6 @@ struct CompareFiles {
   std::int64_t aligned_steps = 0;              ///< steps every run has (the overlays' common span)
 };
 
-/// One key of a scenario.toml, flattened: "controller.kind" -> "\"ff_lqg\"" (the TOML value's
-/// text; arrays and inline tables whole).
-struct ScenarioKey {
-  std::string key, value;
-};
-/// Every key of a scenario's TOML text, flattened, in document order (empty if it does not parse).
-std::vector<ScenarioKey> FlattenScenario(const std::string& toml_text);
 /// The keys whose values differ between the texts (or that some lack), in the first text's order
 /// then the others'.
 std::vector<std::string> DifferingKeys(const std::vector<std::string>& toml_texts);

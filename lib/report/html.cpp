@@ -36,22 +36,6 @@ pre { background: #f6f6f6; padding: 0.8em; overflow-x: auto; font-size: 0.9em; }
 
 }  // namespace
 
-std::string HtmlEscape(const std::string& text) {
-  std::string out;
-  out.reserve(text.size());
-  for (char c : text) {
-    switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      case '\'': out += "&#39;"; break;
-      default: out += c;
-    }
-  }
-  return out;
-}
-
 std::string HtmlRow(const std::string& name, const std::string& value_html, const std::string& id) {
   return fmt::format("<tr><th>{}</th><td{}>{}</td></tr>\n", name, id.empty() ? "" : " id=\"" + id + "\"", value_html);
 }

@@ -5,10 +5,12 @@
 #include <filesystem>
 #include <string>
 
+#include "core/html_escape.h"
+
 namespace rths::report {
 
-/// Text with &, <, >, " and ' escaped for HTML.
-std::string HtmlEscape(const std::string& text);
+/// Text with &, <, >, " and ' escaped for HTML (core/html_escape.h).
+using rths::HtmlEscape;
 
 /// One row of a two-column table: `<tr><th>name</th><td id="id">value_html</td></tr>` (no id
 /// attribute if `id` is empty); `name` and `value_html` are HTML already.

@@ -56,20 +56,7 @@ bool AnyNonZero(const std::vector<double>& x) {
   return std::any_of(x.begin(), x.end(), [](double v) { return v != 0.0; });
 }
 
-/// A time history of y against t, min/max-decimated to max_points.
-Series History(const std::string& title, const std::string& color, const std::vector<double>& t,
-               const std::vector<double>& y, std::size_t max_points) {
-  return Curve(title, color, t, y, MinMaxDecimate(y, max_points));
-}
-
-Figure NewFigure(const std::string& name, const RunReportOptions& o) {
-  Figure f;
-  f.name = name;
-  f.gnuplot = o.gnuplot;
-  f.width_px = 1100;
-  f.panel_height_px = 300;
-  return f;
-}
+Figure NewFigure(const std::string& name, const RunReportOptions& o) { return PageFrame(name, o.gnuplot); }
 
 }  // namespace
 
@@ -84,6 +71,20 @@ Series Curve(const std::string& title, const std::string& color, const std::vect
     s.y.push_back(y[i]);
   }
   return s;
+}
+
+Series History(const std::string& title, const std::string& color, const std::vector<double>& t,
+               const std::vector<double>& y, std::size_t max_points) {
+  return Curve(title, color, t, y, MinMaxDecimate(y, max_points));
+}
+
+Figure PageFrame(const std::string& name, const std::string& gnuplot) {
+  Figure f;
+  f.name = name;
+  f.gnuplot = gnuplot;
+  f.width_px = 1100;
+  f.panel_height_px = 300;
+  return f;
 }
 
 std::vector<std::size_t> Strided(std::size_t begin, std::size_t end, std::size_t max_points) {

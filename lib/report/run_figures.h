@@ -22,6 +22,11 @@ struct PageFigure {
 /// A curve of y against x over the samples `idx` (line width 1.2).
 io::Series Curve(const std::string& title, const std::string& color, const std::vector<double>& x,
                  const std::vector<double>& y, const std::vector<std::size_t>& idx);
+/// A time history of y against t, min/max-decimated to max_points (every peak kept).
+io::Series History(const std::string& title, const std::string& color, const std::vector<double>& t,
+                   const std::vector<double>& y, std::size_t max_points);
+/// An empty figure of a page: `name`, 1100 px wide, 300 px per row of panels, drawn by `gnuplot`.
+io::Figure PageFrame(const std::string& name, const std::string& gnuplot);
 /// Indices begin, begin + stride, ... < end, at most max_points of them (max_points >= 1).
 std::vector<std::size_t> Strided(std::size_t begin, std::size_t end, std::size_t max_points);
 /// Welch segment length [steps]: a power of two near segment_s / dt_s, at most n / 4, at least 32.

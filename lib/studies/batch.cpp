@@ -105,6 +105,53 @@ void Preflight(std::vector<RunSpec>* specs, const std::vector<std::string>& over
 
 namespace {
 
+/// A number of summary.json: NaN for null (nlohmann writes NaN as null), `fallback` if absent.
+double NumberOf(const nlohmann::json& j, const char* key, double fallback = 0.0) {
+  if (!j.contains(key)) return fallback;
+  return j[key].is_number() ? j[key].get<double>() : std::numeric_limits<double>::quiet_NaN();
+}
+
+/// summary.json of a run folder (null if it is missing or unreadable).
+nlohmann::json ReadSummary(const fs::path& dir) {
+  try {
+    std::ifstream in(dir / "summary.json");
+    return nlohmann::json::parse(in);
+  } catch (const std::exception&) {
+    return nullptr;
+  }
+}
+
+/// A run's result as its summary.json gives it (ResultOfRunFolder).
+RunResult ResultOfSummary(const nlohmann::json& j, const fs::path& dir, const std::string& label) {
+  RunResult res;
+  res.label = label;
+  res.dir = dir;
+  if (!j.is_object()) {
+    res.error = Error((dir / "summary.json").string(), "missing or unreadable: the run did not end").what();
+    return res;
+  }
+  res.error = j.value("status", std::string()) == "completed" ? "" : j.value("stopped", std::string("no status"));
+  res.ok = res.error.empty();
+  res.wall_s = NumberOf(j, "wall_s");
+  res.steps = j.value("steps", std::int64_t{0});
+  res.tracking_pct = NumberOf(j, "tracking_nrmse_pct");
+  res.peak_force_kN = NumberOf(j, "peak_force_kN");
+  if (j.contains("benchmark_criteria")) {
+    const nlohmann::json& b = j["benchmark_criteria"];
+    signal::BenchmarkCriteria c;
+    double* const js[] = {&c.J1_ms, &c.J2_pct, &c.J3_pct, &c.J4_pct, &c.J5_pct, &c.J6_pct, &c.J7_pct, &c.J8_pct, &c.J9_pct};
+    const char* const names[] = {"J1_ms", "J2_pct", "J3_pct", "J4_pct", "J5_pct", "J6_pct", "J7_pct", "J8_pct", "J9_pct"};
+    for (int i = 0; i < 9; ++i) *js[i] = NumberOf(b, names[i]);
+    c.lag_samples = b.value("lag_samples", 0);
+    for (const auto& f : b.value("floors", nlohmann::json::array())) {
+      c.floors.push_back({f.value("floor", 0), NumberOf(f, "std_pct"), NumberOf(f, "max_pct")});
+    }
+    res.benchmark = c;
+  }
+  res.benchmark_error = j.value("benchmark_criteria_error", std::string());
+  return res;
+}
+
 /// One run of the batch through the supervisor (memq, in this thread); its summary.json says how
 /// it went, also when it could not run.
 RunResult RunOne(const RunSpec& spec, const std::string& origin, const BatchControl& control, bool* reused) {
@@ -113,16 +160,11 @@ RunResult RunOne(const RunSpec& spec, const std::string& origin, const BatchCont
   res.dir = spec.dir;
   if (control.resume && fs::exists(spec.dir)) {
     // A run that ended stands; one that was interrupted, or never wrote its summary, is made again.
-    nlohmann::json j;
-    try {
-      std::ifstream in(spec.dir / "summary.json");
-      j = nlohmann::json::parse(in);
-    } catch (const std::exception&) {
-    }
+    const nlohmann::json j = ReadSummary(spec.dir);
     const std::string status = j.is_object() ? j.value("status", std::string()) : std::string();
     if (!status.empty() && status != "interrupted") {
       *reused = true;
-      return ResultOfRunFolder(spec.dir, spec.label);
+      return ResultOfSummary(j, spec.dir, spec.label);
     }
     fs::remove_all(spec.dir);
   }
@@ -185,46 +227,10 @@ void CheckResumable(const std::vector<RunSpec>& specs, const std::string& origin
                                       differ.size(), differ.front()));
 }
 
-/// A number of summary.json: NaN for null (nlohmann writes NaN as null), `fallback` if absent.
-double NumberOf(const nlohmann::json& j, const char* key, double fallback = 0.0) {
-  if (!j.contains(key)) return fallback;
-  return j[key].is_number() ? j[key].get<double>() : std::numeric_limits<double>::quiet_NaN();
-}
-
 }  // namespace
 
 RunResult ResultOfRunFolder(const fs::path& dir, const std::string& label) {
-  RunResult res;
-  res.label = label;
-  res.dir = dir;
-  nlohmann::json j;
-  try {
-    std::ifstream in(dir / "summary.json");
-    j = nlohmann::json::parse(in);
-  } catch (const std::exception&) {
-    res.error = Error((dir / "summary.json").string(), "missing or unreadable: the run did not end").what();
-    return res;
-  }
-  res.error = j.value("status", std::string()) == "completed" ? "" : j.value("stopped", std::string("no status"));
-  res.ok = res.error.empty();
-  res.wall_s = NumberOf(j, "wall_s");
-  res.steps = j.value("steps", std::int64_t{0});
-  res.tracking_pct = NumberOf(j, "tracking_nrmse_pct");
-  res.peak_force_kN = NumberOf(j, "peak_force_kN");
-  if (j.contains("benchmark_criteria")) {
-    const nlohmann::json& b = j["benchmark_criteria"];
-    signal::BenchmarkCriteria c;
-    double* const js[] = {&c.J1_ms, &c.J2_pct, &c.J3_pct, &c.J4_pct, &c.J5_pct, &c.J6_pct, &c.J7_pct, &c.J8_pct, &c.J9_pct};
-    const char* const names[] = {"J1_ms", "J2_pct", "J3_pct", "J4_pct", "J5_pct", "J6_pct", "J7_pct", "J8_pct", "J9_pct"};
-    for (int i = 0; i < 9; ++i) *js[i] = NumberOf(b, names[i]);
-    c.lag_samples = b.value("lag_samples", 0);
-    for (const auto& f : b.value("floors", nlohmann::json::array())) {
-      c.floors.push_back({f.value("floor", 0), NumberOf(f, "std_pct"), NumberOf(f, "max_pct")});
-    }
-    res.benchmark = c;
-  }
-  res.benchmark_error = j.value("benchmark_criteria_error", std::string());
-  return res;
+  return ResultOfSummary(ReadSummary(dir), dir, label);
 }
 
 std::string BatchInterrupted::Describe(std::size_t ended, std::size_t cut, std::size_t not_started) {

@@ -84,7 +84,9 @@ struct RunRequest {
   /// Null: the run cannot be interrupted.
   volatile std::sig_atomic_t* interrupted = nullptr;
   std::function<void(const std::string&)> on_warning;  ///< e.g. "this run will write about 3 GB"
-  std::function<void(const RunPlan&)> on_start;        ///< called once, just before the participants start
+  /// Called once, just before the participants start; if it throws, nothing runs (RunError,
+  /// kExitUsage, the folder made for the run removed).
+  std::function<void(const RunPlan&)> on_start;
 };
 
 /// A finished run (also one that failed: its summary says how).

@@ -108,8 +108,10 @@ GroupEnd RunGroup(const RunRequest& r, const RunPlan& plan) {
   volatile std::sig_atomic_t not_interruptible = 0;
   volatile std::sig_atomic_t* interrupted = r.interrupted ? r.interrupted : &not_interruptible;
   const auto t0 = Clock::now();
+  bool group_started = false;  // an on_start that throws (a monitor that cannot bind): nothing ran
   try {
     if (r.on_start) r.on_start(plan);
+    group_started = true;
     const RunProgress progress(plan.out / "log.lcm", plan.scenario, r.progress);
     if (r.transport == "memq" || r.transport == "mixed") {
       end.outcomes = RunInProcessGroup(plan.scenario, r.replay ? &*r.replay : nullptr, &r.external, plan.url,
@@ -130,7 +132,7 @@ GroupEnd RunGroup(const RunRequest& r, const RunPlan& plan) {
     if (plan.created_out && !r.study && !fs::exists(plan.out / "log.lcm")) fs::remove_all(plan.out, ec);
     RunSummary head = SummaryHead(r, plan);
     head.wall_s = std::chrono::duration<double>(Clock::now() - t0).count();
-    throw RunError(lockstep::kExitLockstep, e.what(), head);
+    throw RunError(group_started ? lockstep::kExitLockstep : lockstep::kExitUsage, e.what(), head);
   }
   end.wall_s = std::chrono::duration<double>(Clock::now() - t0).count();
   end.interrupted = *interrupted != 0;
