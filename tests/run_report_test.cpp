@@ -383,4 +383,31 @@ TEST_CASE("a reviewer's figures: a constant current is a line of text, the spect
   CHECK(html_paced.find("NOT real time: this paced run missed 94 of 8000 deadlines (1.18 %); the longest stretch was "
                         "44 steps in a row (22 ms), the largest step latency 15.6 ms, the first miss at step 1200.") !=
         std::string::npos);
+  CHECK_FALSE(fs::exists(dir0 / "paced" / "figures" / "realtime.png"));  // no windows in that summary
+
+  // A real paced run: the clock keeps the largest latency and the misses of every 0.1 s window,
+  // and the report draws them over the run with the windows that missed marked.
+  const fs::path dirp = TempDir("report_reviewer_paced");
+  REQUIRE_MESSAGE(RunCli(scenario0.string() + " --transport memq --realtime --set run.duration_s=1 --out " +
+                             (dirp / "run").string(),
+                         &out) == 0,
+                  out);
+  auto sp_json = ReadJson(dirp / "run" / "summary.json");
+  const auto& windows = sp_json["realtime"]["latency_windows"];
+  CHECK(windows["window_steps"] == 200);
+  REQUIRE(windows["max_us"].size() == 10);
+  CHECK(windows["misses"].size() == 10);
+  for (const auto& v : windows["max_us"]) CHECK(v.get<double>() > 0.0);
+  rths::report::RunData dp = rths::report::LoadRunData(dirp / "run");
+  dp.summary["realtime"]["latency_windows"]["misses"][4] = 3;  // as if window 4 had missed 3 deadlines
+  rths::report::RunReportOptions op;
+  op.out_dir = dirp / "report";
+  const auto paced_files = rths::report::WriteRunReport(dp, op);
+  CHECK(fs::file_size(dirp / "report" / "figures" / "realtime.png") > 10000);
+  const std::string gp = Slurp(dirp / "report" / "figures" / "realtime.gp");
+  CHECK(gp.find("windows with deadline misses") != std::string::npos);
+  int missed_windows = 0;  // window 4, and any the real run missed in
+  for (const auto& m : dp.summary["realtime"]["latency_windows"]["misses"]) missed_windows += m.get<int>() > 0 ? 1 : 0;
+  CHECK(Slurp(paced_files.html).find(fmt::format("{} window(s) held deadline misses (marked)", missed_windows)) !=
+        std::string::npos);
 }

@@ -46,6 +46,7 @@ ClockParticipant::ClockParticipant(std::string name, RunIdentity id, LockstepCon
   last_send_ = start_ - std::chrono::seconds(1);
   rt_.paced = timing_.pacing.enabled;
   rt_.period_s = timing_.pacing.period_s;
+  if (rt_.paced) rt_.SizeWindows(id_.n_steps, rt_.period_s);
   SetAnswerChannel(kDesired, &desired_cache_);
   // The barrier of step k is the clock's inputs of step k+1 (wiring.h); only the last of them to
   // be sent (ack_t: the logger acknowledges step k once it holds the rest) wakes the clock.
@@ -166,9 +167,11 @@ SteadyClock::time_point ClockParticipant::ReleaseOf(std::int64_t k) const {
 }
 
 bool ClockParticipant::AccountStep(SteadyClock::time_point now) {
-  rt_.latency.Add(Seconds(step_since_, now));
+  const double latency_s = Seconds(step_since_, now);
+  rt_.latency.Add(latency_s);
   ++rt_.steps;
   if (!rt_.paced) return true;
+  rt_.AddToWindow(k_, latency_s, now > ReleaseOf(k_ + 1));
   if (now > ReleaseOf(k_ + 1)) {
     ++rt_.misses;
     if (rt_.first_miss_step < 0) rt_.first_miss_step = k_;

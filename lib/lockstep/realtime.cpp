@@ -12,6 +12,14 @@
 
 namespace rths::lockstep {
 
+void RealtimeStats::SizeWindows(std::int64_t n_steps, double period_s) {
+  if (!(period_s > 0) || n_steps <= 0) return;
+  window_steps = std::max<std::int64_t>(1, std::llround(kLatencyWindowS / period_s));
+  const auto n = static_cast<std::size_t>((n_steps + window_steps - 1) / window_steps);
+  window_max_s.assign(n, 0.0F);
+  window_misses.assign(n, 0);
+}
+
 void LatencyHistogram::Add(double seconds) {
   int i = 0;
   if (seconds >= kLowestS) {

@@ -12,6 +12,7 @@
 #include <array>
 #include <cstdint>
 #include <string>
+#include <vector>
 
 namespace rths::lockstep {
 
@@ -82,6 +83,25 @@ struct RealtimeStats {
   LatencyHistogram latency;                 ///< request -> barrier complete, every step
   /// How late step releases were (wake-up jitter; catching up after a miss) [s]: max.
   double max_release_late_s = 0.0;
+  /// The latency over the run (paced runs): per window of `window_steps` steps (about
+  /// kLatencyWindowS), the largest step latency [s] and the misses in it. Sized before step 0 by
+  /// SizeWindows; AccountStep only writes into them.
+  std::int64_t window_steps = 0;
+  std::vector<float> window_max_s;
+  std::vector<std::int32_t> window_misses;
+
+  /// The windows' length aimed at [s].
+  static constexpr double kLatencyWindowS = 0.1;
+  /// Sizes the windows for `n_steps` steps of `period_s` (allocates; before step 0).
+  void SizeWindows(std::int64_t n_steps, double period_s);
+  /// Step k's latency [s] and whether it missed, into its window (allocates nothing).
+  void AddToWindow(std::int64_t k, double latency_s, bool missed) {
+    if (window_steps <= 0) return;
+    const auto w = static_cast<std::size_t>(k / window_steps);
+    if (w >= window_max_s.size()) return;
+    if (latency_s > window_max_s[w]) window_max_s[w] = static_cast<float>(latency_s);
+    if (missed) ++window_misses[w];
+  }
 };
 
 /// What a process achieved when it tried to run in real time.

@@ -31,6 +31,20 @@ nlohmann::json StatsToJson(const lockstep::LinkStats& s) {
             {"reordered", s.injected.reordered}}}};
 }
 
+namespace {
+/// The latency over the run: per window (steps k = i window_steps ..), the largest latency [us]
+/// and the misses; the windows the run reached.
+nlohmann::json LatencyWindowsJson(const lockstep::RealtimeStats& r) {
+  nlohmann::json max_us = nlohmann::json::array(), misses = nlohmann::json::array();
+  const std::int64_t reached = r.window_steps > 0 ? (r.steps + r.window_steps - 1) / r.window_steps : 0;
+  for (std::int64_t w = 0; w < reached && w < static_cast<std::int64_t>(r.window_max_s.size()); ++w) {
+    max_us.push_back(std::round(1e7 * r.window_max_s[static_cast<std::size_t>(w)]) / 10.0);  // 0.1 us
+    misses.push_back(r.window_misses[static_cast<std::size_t>(w)]);
+  }
+  return {{"window_steps", r.window_steps}, {"max_us", max_us}, {"misses", misses}};
+}
+}  // namespace
+
 nlohmann::json RealtimeToJson(const lockstep::RealtimeStats& r) {
   const auto& h = r.latency;
   nlohmann::json bins = nlohmann::json::array();
@@ -51,7 +65,8 @@ nlohmann::json RealtimeToJson(const lockstep::RealtimeStats& r) {
           {"latency_p999_us", 1e6 * h.Quantile(0.999)},
           {"latency_max_us", 1e6 * h.max_s()},
           {"max_release_late_us", 1e6 * r.max_release_late_s},
-          {"latency_histogram_us", bins}};
+          {"latency_histogram_us", bins},
+          {"latency_windows", LatencyWindowsJson(r)}};
 }
 
 namespace {

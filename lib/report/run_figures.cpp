@@ -195,6 +195,46 @@ std::optional<PageFigure> Adaptation(const io::RunSignals& s, const RunReportOpt
   return pf;
 }
 
+std::optional<PageFigure> RealtimeLatency(const RunData& d, const RunReportOptions& o) {
+  if (!d.summary.is_object() || !d.summary.contains("realtime")) return std::nullopt;
+  const nlohmann::json& rt = d.summary["realtime"];
+  if (!rt.is_object() || !rt.value("paced", false) || !rt.contains("latency_windows")) return std::nullopt;
+  const nlohmann::json& w = rt["latency_windows"];
+  const auto steps = w.value("window_steps", std::int64_t{0});
+  if (steps <= 0 || !w.contains("max_us") || w["max_us"].empty()) return std::nullopt;
+  const double window_s = static_cast<double>(steps) * d.signals.dt_s;
+  Series lat = MakeSeries("largest step latency per window", kColorU);
+  Series missed = MakeSeries("windows with deadline misses", kColorY);
+  missed.with = "points pt 7 ps 1.2";
+  std::int64_t windows_missed = 0;
+  for (std::size_t i = 0; i < w["max_us"].size(); ++i) {
+    const double t = (static_cast<double>(i) + 0.5) * window_s;
+    const double ms = w["max_us"][i].get<double>() / 1e3;
+    lat.x.push_back(t);
+    lat.y.push_back(ms);
+    if (i < w["misses"].size() && w["misses"][i].get<std::int64_t>() > 0) {
+      missed.x.push_back(t);
+      missed.y.push_back(ms);
+      ++windows_missed;
+    }
+  }
+  Series deadline = MakeSeries("deadline dt", "black", 2);
+  deadline.x = {0.0, static_cast<double>(lat.x.size()) * window_s};
+  deadline.y = {1e3 * d.signals.dt_s, 1e3 * d.signals.dt_s};
+  deadline.width = 1.0;
+  Panel p = MakePanel("", "t [s]", "latency [ms]");
+  p.log_y = true;
+  p.series = {lat, deadline};
+  if (!missed.x.empty()) p.series.push_back(missed);
+  PageFigure pf{NewFigure("realtime", o), "Real time: step latency over the run", ""};
+  pf.figure.panels = {p};
+  pf.caption_html = fmt::format(
+      "The largest step latency (release to the barrier complete, as the clock measured it) in each window of {} "
+      "steps ({:.3g} s) [ms], log scale, against the deadline dt; {} window(s) held deadline misses{}.",
+      steps, window_s, windows_missed, windows_missed > 0 ? " (marked)" : "");
+  return pf;
+}
+
 PageFigure Loops(const io::RunSignals& s, const RunReportOptions& o) {
   const auto& y = s.At("y_mm").values;
   const auto& f = s.At("f_kN").values;

@@ -39,6 +39,10 @@ PageFigure TrackingError(const io::RunSignals& s, const RunReportOptions& o);
 /// An adaptive controller's coefficients (columns a0, a1_s, ...), one panel each; nullopt for a
 /// fixed controller.
 std::optional<PageFigure> Adaptation(const io::RunSignals& s, const RunReportOptions& o);
+/// A paced run's step latency over the run (summary.json realtime.latency_windows): the largest
+/// latency of each 0.1 s window [ms], the deadline dt, and the windows with misses marked;
+/// nullopt for an unpaced run or a summary without them.
+std::optional<PageFigure> RealtimeLatency(const RunData& d, const RunReportOptions& o);
 /// f [kN] against y [mm] and against y' [mm/s] (central difference).
 PageFigure Loops(const io::RunSignals& s, const RunReportOptions& o);
 

@@ -58,6 +58,7 @@ DrawnFigures ChooseFigures(const RunData& d, const RunReportOptions& o) {
   if (d.signals.steps() >= 2) {
     figures.push_back(run_figures::TrackingError(d.signals, o));  // first: what a tracking test is judged by
     figures.push_back(run_figures::TimeHistories(d.signals, o));
+    if (auto rt = run_figures::RealtimeLatency(d, o)) figures.push_back(*rt);
     figures.push_back(run_figures::Loops(d.signals, o));
     if (auto ad = run_figures::Adaptation(d.signals, o)) figures.push_back(*ad);
     run_figures::FrequencyFigures ff = run_figures::Frequency(d.signals, o);
@@ -86,7 +87,8 @@ DrawnFigures ChooseFigures(const RunData& d, const RunReportOptions& o) {
 /// earlier report's figures that this one does not draw; the PNGs in page order.
 std::vector<fs::path> DrawFigures(const std::vector<PageFigure>& drawn, const fs::path& fig_dir) {
   std::error_code ec;
-  for (const char* stale : {"time_histories", "tracking_error", "loops", "adaptation", "spectra", "gyr", "benchmark"}) {
+  for (const char* stale :
+       {"time_histories", "tracking_error", "realtime", "loops", "adaptation", "spectra", "gyr", "benchmark"}) {
     if (std::any_of(drawn.begin(), drawn.end(), [&](const PageFigure& pf) { return pf.figure.name == stale; }))
       continue;
     for (const char* ext : {".png", ".dat", ".gp"}) fs::remove(fig_dir / (std::string(stale) + ext), ec);
