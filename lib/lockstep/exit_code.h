@@ -18,6 +18,9 @@ enum ExitCode : int {
   /// an external participant was lost: its heartbeats stopped, or its process ended with a status
   /// rths could not read or with code 0 before the run's end (docs/participant.md, "Liveness")
   kExitExternalLost = 10,
+  /// a participant in follow mode (`--follow`, docs/replay.md) answered the whole feed, but not
+  /// every step exactly: some were answered from a held input, after one, or never seen
+  kExitFollowInexact = 11,
 };
 
 /// Of the tools that read a run's log: `rths log` (stats, digest, dump, compare) and `rths export`.

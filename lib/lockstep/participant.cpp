@@ -39,6 +39,7 @@ struct Participant::Route {
   };
   Evidence step_evidence = kNothing;
   Wake wake = Wake::kOnArrival;
+  lcm::Subscription* subscription = nullptr;  ///< on an LCM instance (its queue capacity: follow mode)
   void OnMessage(const lcm::ReceiveBuffer* rbuf, const std::string&) { self->Deliver(this, rbuf); }
   static void OnChannelMessage(void* route, const lcm::ReceiveBuffer* rbuf) {
     auto* r = static_cast<Route*>(route);
@@ -74,7 +75,7 @@ void Participant::Subscribe(const char* channel, Handler handler, Wake wake) {
       throw std::runtime_error(fmt::format("{}: {}", name_, channels_->error()));
     }
   } else if (lcm_) {
-    lcm_->subscribe(channel, &Route::OnMessage, routes_.back().get());
+    routes_.back()->subscription = lcm_->subscribe(channel, &Route::OnMessage, routes_.back().get());
   }
 }
 
@@ -85,6 +86,14 @@ void Participant::SubscribeInputs(const ResolvedRole& role, StepMailboxes* boxes
     Subscribe(ChannelName(channel), [this, channel, boxes, on_new](const lcm::ReceiveBuffer* rbuf) {
       if (finished()) return;
       std::int64_t k = -1;
+      if (follow_) {
+        std::int64_t run_id = 0;
+        if (PeekRunAndStep(static_cast<const std::uint8_t*>(rbuf->data), rbuf->data_size, &run_id, &k) &&
+            run_id == id_.run_id && k >= 0) {
+          BeforeFollowInput(channel, k);
+          if (finished()) return;
+        }
+      }
       const Put put = boxes->Add(channel, rbuf, id_.run_id, &k);
       Count(channel, put, k);
       if (put == Put::kNew) on_new(channel, k, rbuf);
@@ -148,7 +157,10 @@ void Participant::Deliver(Route* route, const lcm::ReceiveBuffer* rbuf) {
 
 void Participant::DeliverNow(Route* route, const lcm::ReceiveBuffer* rbuf) {
   if (finished_) return;
-  if (follow_) last_clock_ = SteadyClock::now();  // any message counts as the feed being alive
+  if (follow_) {  // any message counts as the feed being alive
+    last_clock_ = SteadyClock::now();
+    follow_heard_ = true;
+  }
   if (!is_clock_ && route->step_evidence != Route::kNothing) {
     // Only the clock publishes desired_t: it is alive, and it has sent GO (a lost GO is
     // repaired here: the first message of a step of our run starts us). A participant that
@@ -261,9 +273,14 @@ void Participant::SendHandshake(Phase phase, std::int64_t k, const std::string& 
   }
 }
 
-void Participant::Follow(double idle_exit_s) {
+void Participant::Follow(const FollowOptions& o) {
   follow_ = true;
-  follow_idle_s_ = idle_exit_s;
+  follow_idle_s_ = o.idle_exit_s;
+  follow_start_s_ = o.start_wait_s;
+  for (auto& r : routes_) {
+    if (r->subscription) r->subscription->setQueueCapacity(o.queue_capacity);
+  }
+  OnFollowStart();
   last_clock_ = SteadyClock::now();
   StartRunning();
 }
@@ -372,7 +389,10 @@ void Participant::Poll(SteadyClock::time_point now, bool idle) {
   }
   if (!idle) return;  // judge silence only once every waiting message has been handled
   if (follow_) {
-    if (running_ && SecondsBetween(last_clock_, now) > follow_idle_s_) Finish();
+    if (running_ && SecondsBetween(last_clock_, now) > (follow_heard_ ? follow_idle_s_ : follow_start_s_)) {
+      OnFollowEnd();
+      Finish();
+    }
     return;
   }
   if (!running_) {

@@ -23,6 +23,7 @@
 #include "lockstep/config.h"
 #include "lockstep/exit_code.h"
 #include "lockstep/faults.h"
+#include "lockstep/follow_ledger.h"
 #include "lockstep/link_stats.h"
 #include "lockstep/mailbox.h"
 #include "lockstep/peer_watch.h"
@@ -37,6 +38,16 @@
 namespace rths::lockstep {
 
 class Channels;
+
+/// Follow mode's knobs (Participant::Follow; `--follow-idle-s`, `--follow-queue`).
+struct FollowOptions {
+  double idle_exit_s = 2.0;  ///< finish after this long without a message, once one came [s]
+  double start_wait_s = 60.0;  ///< ... and before the first one (time to start lcm-logplayer) [s]
+  /// Messages LCM may hold per subscription before it drops one (LCM's default: 30). Deep, so that
+  /// a participant held off the CPU for a while catches up instead of losing its inputs: 50 000 is
+  /// 25 s of one channel at 2 kHz.
+  int queue_capacity = 50000;
+};
 
 /// A subclass subscribes to its step channels, declares its answer channel, lists what it lacks
 /// for a step, and implements the step (StepParticipant and ClockParticipant, from the step table).
@@ -77,10 +88,13 @@ class Participant {
   /// Stops now, as if the supervisor had said ABORT (an interrupt): flushes, exit kExitPeerAbort.
   void Interrupt(const std::string& reason);
   /// Follow mode (a participant fed by `lcm-logplayer`, docs/replay.md): no handshake and no
-  /// clock; it starts at once, answers each step as soon as its inputs arrive, and finishes
-  /// (exit 0) after `idle_exit_s` without a message of its run. Nothing re-requests a lost
-  /// message: a lost input stops its answers there.
-  void Follow(double idle_exit_s);
+  /// clock; it starts at once, answers each step as soon as its inputs arrive, and finishes after
+  /// `o.idle_exit_s` without a message (`o.start_wait_s` before the first). Nothing re-requests a lost message: a step
+  /// participant answers a step whose input was lost from the input before it (StepParticipant,
+  /// zero-order hold) and keeps a FollowLedger of what it did.
+  void Follow(const FollowOptions& o);
+  /// Follow mode only: what it did with every step (nullptr otherwise, and for the clock).
+  virtual const FollowLedger* follow_ledger() const { return nullptr; }
 
   /// Moves every subscription, and every publication from now on, to `channels` (a per-channel
   /// udpm run, or the in-process queue of a memq run). For a participant built with
@@ -142,6 +156,15 @@ class Participant {
   void SubscribeInputs(const ResolvedRole& role, StepMailboxes* boxes, OnNewInput on_new);
   /// Sends a repair_t for step k listing `wants` (remembered, to count what gets repaired).
   void SendRepair(std::int64_t k, const WantList& wants);
+
+  /// Follow mode: a message of step k of this run arrives on `channel`, before it is stored (a step
+  /// participant answers, from held inputs, the steps it now knows will never be complete).
+  virtual void BeforeFollowInput(Channel /*channel*/, std::int64_t /*k*/) {}
+  /// Follow mode: the feed has gone quiet; called once, before the participant finishes.
+  virtual void OnFollowEnd() {}
+  /// Follow mode: set up before the feed starts (sizes its ledger).
+  virtual void OnFollowStart() {}
+  bool following() const { return follow_; }
 
   /// Marks the clock as alive (call on every message from the clock).
   void HeardClock(SteadyClock::time_point now) { last_clock_ = now; }
@@ -214,6 +237,8 @@ class Participant {
   bool lingering_ = false;  ///< after DONE and BYE: answering repeated DONEs until CLOSE
   bool follow_ = false;     ///< follow mode (Follow())
   double follow_idle_s_ = 0;
+  double follow_start_s_ = 0;
+  bool follow_heard_ = false;  ///< follow mode: a message has arrived
   SteadyClock::time_point linger_since_;
   int exit_code_ = kExitOk;
   std::string error_;

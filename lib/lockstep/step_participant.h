@@ -30,6 +30,10 @@ class StepParticipant : public Participant {
 
   void OnGo() override { TryStep(); }
   void Lacks(std::int64_t k, WantList* out) const override;
+  const FollowLedger* follow_ledger() const override { return following() ? &ledger_ : nullptr; }
+  void OnFollowStart() override;
+  void BeforeFollowInput(Channel channel, std::int64_t k) override;
+  void OnFollowEnd() override;
 
   const StepMailboxes& inputs() const { return boxes_; }
   const ResolvedRole& wiring() const { return wiring_; }
@@ -41,6 +45,11 @@ class StepParticipant : public Participant {
   void TryStep();
   /// Fills `in` with the row's inputs of step k; false if one is missing.
   bool Gather(std::int64_t k, StepInputs* in) const;
+  /// Follow mode: computes (if not yet) and publishes step k now, a lost input replaced by the
+  /// last one used on its channel (zero-order hold; before any, the message of zeros: at rest).
+  void AnswerWithHolds(std::int64_t k);
+  /// Follow mode: the inputs of step k just used become the ones a later lost input is held at.
+  void KeepAsHeld(const StepInputs& in);
   /// Whether every message step k waits for is in.
   bool Complete(std::int64_t k) const;
   /// The input (channel, k + offset) exists in this run (0 <= k + offset < n_steps).
@@ -51,6 +60,22 @@ class StepParticipant : public Participant {
   AnswerCache cache_;
   std::int64_t next_ = 0;      ///< next step to answer
   std::int64_t computed_ = 0;  ///< next step to compute (next_, or next_ + 1 while waiting to publish)
+
+  // Follow mode only.
+  /// A message of step j proves every input of steps up to j - kFollowLag lost if it is missing:
+  /// the recorded log holds every message of step k before any of step k + 1, and lcm-logplayer
+  /// plays them in order. 2 (not 1) leaves room for a datagram overtaken by one step. Below the
+  /// mailboxes' depth, so a message never evicts an input still waited for.
+  static constexpr std::int64_t kFollowLag = 2;
+  FollowLedger ledger_;
+  std::int64_t latest_seen_ = -1;  ///< the latest step of any message of the run
+  bool computed_held_ = false;     ///< the answer computed for next_ used a held input
+  struct Held {
+    rths::desired_t desired{};
+    rths::command_t command{};
+    rths::measured_t measured{};
+    rths::current_t current{};
+  } held_;
 };
 
 /// A StepParticipant answering with messages of type Msg.

@@ -111,13 +111,19 @@ std::string OutcomePath(const std::string& out_dir, const std::string& role) {
 /// Its space is reserved at start-up, so that a disk that fills up during the run cannot take it.
 constexpr std::size_t kOutcomeReserve = 8192;
 
+/// Follow mode's default socket receive buffer [bytes]: the kernel doubles it for its bookkeeping,
+/// ~8000 small datagrams, over 1 s of a 2 kHz feed. Capped by net.core.rmem_max.
+constexpr int kFollowRecvBufBytes = 4 << 20;
+
 /// The command line of a participant process.
 struct RoleArgs {
   std::string scenario_path, url, out_dir = ".";
   std::int64_t run_id = 0;
   double handshake_timeout_s = 0;
   bool follow = false;
-  double follow_idle_s = 2.0;
+  lockstep::FollowOptions follow_options;
+  /// Follow mode: the socket receive buffer to ask for [bytes] (LCM's recv_buf_size), 0: the OS's.
+  int follow_recv_buf_bytes = kFollowRecvBufBytes;
   bool realtime = false;
   double heartbeat_s = 0;
 };
@@ -140,10 +146,25 @@ int ParseRoleArgs(const std::string& name, int argc, char** argv, RoleArgs* a) {
       ->check(CLI::Range(0.01, 60.0));
   app.add_flag("--follow", a->follow,
                "follow mode: no handshake, no clock; answer each step as soon as its inputs arrive (fed by "
-               "lcm-logplayer from a recorded log, with that log's --run-id; docs/replay.md). Delivery is not "
-               "guaranteed: a lost input stops the answers there");
-  app.add_option("--follow-idle-s", a->follow_idle_s, "follow mode: finish after this long without a message [s]")
+               "lcm-logplayer from a recorded log, with that log's --run-id; docs/replay.md). A lost input is "
+               "held at the one before it; at the end it prints how many steps it answered exactly, and exits 11 "
+               "if not all");
+  app.add_option("--follow-idle-s", a->follow_options.idle_exit_s,
+                 "follow mode: finish after this long without a message [s]")
       ->check(CLI::Range(0.1, 3600.0))
+      ->capture_default_str();
+  app.add_option("--follow-start-s", a->follow_options.start_wait_s,
+                 "follow mode: wait this long for the first message (time to start lcm-logplayer) [s]")
+      ->check(CLI::Range(0.1, 86400.0))
+      ->capture_default_str();
+  app.add_option("--follow-queue", a->follow_options.queue_capacity,
+                 "follow mode: messages LCM may queue per channel before it drops one (LCM's own default: 30)")
+      ->check(CLI::Range(1, 10000000))
+      ->capture_default_str();
+  app.add_option("--follow-recv-buf", a->follow_recv_buf_bytes,
+                 "follow mode: socket receive buffer to ask for [bytes], capped by net.core.rmem_max; 0: the "
+                 "system's default; ignored if the URL gives recv_buf_size")
+      ->check(CLI::Range(0, 1 << 30))
       ->capture_default_str();
   app.add_flag("--realtime", a->realtime, "real-time paced mode, as if the scenario said [realtime] enabled = true");
   try {
@@ -154,16 +175,63 @@ int ParseRoleArgs(const std::string& name, int argc, char** argv, RoleArgs* a) {
   return -1;
 }
 
+/// Follow mode: says what the participant did with the feed (stdout) and exits kExitFollowInexact
+/// if a step was not answered exactly.
+void JudgeFollow(const RoleArgs& a, Outcome* o) {
+  if (o->follow.is_null()) return;
+  const nlohmann::json& f = o->follow;
+  const auto n = f.at("n_steps").get<std::int64_t>();
+  const auto exact = f.at("exact").get<std::int64_t>();
+  std::printf("rths-%s: follow: run %lld, %lld steps: %lld exact, %lld held, %lld resumed after a hold, %lld unseen "
+              "(%s)\n",
+              o->role.c_str(), static_cast<long long>(a.run_id), static_cast<long long>(n),
+              static_cast<long long>(exact), static_cast<long long>(f.at("held").get<std::int64_t>()),
+              static_cast<long long>(f.at("resumed").get<std::int64_t>()),
+              static_cast<long long>(f.at("unseen").get<std::int64_t>()), OutcomePath(a.out_dir, o->role).c_str());
+  std::fflush(stdout);
+  if (o->exit_code != 0 || exact == n) return;
+  o->exit_code = lockstep::kExitFollowInexact;
+  if (f.at("messages").get<std::int64_t>() == 0) {
+    o->message = fmt::format("follow: heard nothing of run {} on {} (is lcm-logplayer playing that run's log on "
+                             "this URL, with this --run-id?)",
+                             a.run_id, a.url);
+  } else {
+    o->message = fmt::format("follow: {} of {} steps answered exactly (the others are listed in {}; docs/replay.md)",
+                             exact, n, OutcomePath(a.out_dir, o->role));
+  }
+}
+
+/// Follow mode: the URL with a socket receive buffer (LCM's recv_buf_size) unless it names one,
+/// no larger than the kernel allows (`rmem_max_bytes`, net.core.rmem_max; 0 if unknown), so that
+/// LCM does not warn; a note on stderr if the kernel allows less than asked.
+std::string FollowUrl(const std::string& url, int want_bytes, long long rmem_max_bytes, const std::string& role) {
+  if (want_bytes <= 0 || url.find("recv_buf_size=") != std::string::npos) return url;
+  long long bytes = want_bytes;
+  if (rmem_max_bytes > 0 && rmem_max_bytes < bytes) {
+    std::fprintf(stderr,
+                 "rths-%s: follow: the kernel allows a socket receive buffer of %lld bytes (net.core.rmem_max), "
+                 "%d asked; a burst of the feed may be lost (as root: sysctl -w net.core.rmem_max=%d)\n",
+                 role.c_str(), rmem_max_bytes, want_bytes, want_bytes);
+    bytes = rmem_max_bytes;
+  }
+  return url + (url.find('?') == std::string::npos ? "?" : "&") + "recv_buf_size=" + std::to_string(bytes);
+}
+
+/// net.core.rmem_max [bytes], 0 if it cannot be read.
+long long ReadRmemMax() {
+  std::ifstream in("/proc/sys/net/core/rmem_max");
+  long long v = 0;
+  return (in >> v) ? v : 0;
+}
+
 /// Follow mode if asked, then the event loop on the participant's transport; its outcome in `*o`.
 template <class Transport>
 void RunParticipant(const RoleArgs& a, lockstep::Participant* p, Transport* transport, Outcome* o) {
-  if (a.follow) {
-    if (p->name() == lockstep::kClockRole) throw Error("--follow", "the integrator is the clock: it cannot follow");
-    p->Follow(a.follow_idle_s);
-  }
+  if (a.follow) p->Follow(a.follow_options);
   const int rc = lockstep::RunLoop(transport, {p}, &g_stop);
   *o = OutcomeOf(*p, *o);
   if (o->exit_code == 0) o->exit_code = rc;  // e.g. the receive failed
+  if (a.follow) JudgeFollow(a, o);
 }
 
 /// Builds the participant on the transport of `a.url` (one LCM instance, or a port per channel:
@@ -173,6 +241,8 @@ void RunOnTransport(std::string_view role, const scenario::Scenario& s, const Ro
     const std::string hint = lockstep::CheckMulticastRoute();
     return hint.empty() ? hint : "\n" + hint;
   };
+  const std::string url =
+      a.follow ? FollowUrl(a.url, a.follow_recv_buf_bytes, ReadRmemMax(), std::string(role)) : a.url;
   if (lockstep::IsPortPerChannel(a.url)) {
     lockstep::UdpmChannels channels(*lockstep::UdpmUrl::Parse(a.url));
     auto p = MakeParticipant(role, s, IdentityOf(s, a.run_id), nullptr, a.out_dir);
@@ -187,9 +257,9 @@ void RunOnTransport(std::string_view role, const scenario::Scenario& s, const Ro
     if (why.empty()) return RunParticipant(a, p.get(), static_cast<lockstep::Channels*>(&channels), o);
     o->exit_code = lockstep::kExitLockstep;
     o->message = fmt::format("cannot open the channels of {}: {}{}", a.url, why, more());
-  } else if (lcm::LCM lcm(a.url); !lcm.good()) {
+  } else if (lcm::LCM lcm(url); !lcm.good()) {
     o->exit_code = lockstep::kExitLockstep;
-    o->message = fmt::format("cannot open LCM at {}{}", a.url, more());
+    o->message = fmt::format("cannot open LCM at {}{}", url, more());
   } else {
     RunParticipant(a, MakeParticipant(role, s, IdentityOf(s, a.run_id), &lcm, a.out_dir).get(), &lcm, o);
   }
@@ -200,6 +270,12 @@ int RoleMain(std::string_view role, int argc, char** argv) {
   const std::string name(role);
   RoleArgs a;
   if (const int code = ParseRoleArgs(name, argc, argv, &a); code >= 0) return code;
+  if (a.follow && (role == lockstep::kClockRole || role == "logger")) {
+    std::fprintf(stderr, "rths-%s: --follow: %s\n", name.c_str(),
+                 role == "logger" ? "the logger records a lockstep run; record a replay with lcm-logger"
+                                  : "the integrator is the clock: it cannot follow");
+    return lockstep::kExitUsage;
+  }
   // A file grown past RLIMIT_FSIZE must fail the write (EFBIG), not kill the process.
   std::signal(SIGXFSZ, SIG_IGN);
   // SIGTERM (the supervisor's teardown) or SIGINT (Ctrl-C reaches the whole process group): stop
@@ -208,6 +284,11 @@ int RoleMain(std::string_view role, int argc, char** argv) {
   std::signal(SIGINT, OnStopSignal);
   Outcome o;
   o.role = name;
+  // A follow-mode process is started by hand: its outcome folder may not exist yet.
+  if (a.follow) {
+    std::error_code ec;
+    fs::create_directories(fs::path(OutcomePath(a.out_dir, name)).parent_path(), ec);
+  }
   io::ReserveFile(OutcomePath(a.out_dir, name), kOutcomeReserve, "{}\n");
   try {
     scenario::Scenario s = scenario::LoadScenario(a.scenario_path);

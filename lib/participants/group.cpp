@@ -116,6 +116,26 @@ lockstep::PeerObservation PeerFromJson(const nlohmann::json& j) {
 }
 }  // namespace
 
+nlohmann::json FollowToJson(const lockstep::FollowLedger& ledger) {
+  const lockstep::FollowCounts c = ledger.Counts();
+  nlohmann::json j = {{"n_steps", ledger.n_steps()}, {"messages", ledger.messages()}, {"exact", c.exact},
+                      {"resumed", c.resumed},         {"held", c.held},                {"unseen", c.unseen},
+                      {"ranges_truncated", false}};
+  const std::pair<const char*, lockstep::FollowStep> classes[] = {{"held_steps", lockstep::FollowStep::kHeld},
+                                                                  {"resumed_steps", lockstep::FollowStep::kResumed},
+                                                                  {"unseen_steps", lockstep::FollowStep::kUnseen}};
+  for (const auto& [key, cls] : classes) {
+    const auto ranges = ledger.Ranges(cls);
+    nlohmann::json list = nlohmann::json::array();
+    for (std::size_t i = 0; i < ranges.size() && i < kFollowRangesKept; ++i) {
+      list.push_back({ranges[i].first, ranges[i].second});
+    }
+    if (ranges.size() > kFollowRangesKept) j["ranges_truncated"] = true;
+    j[key] = list;
+  }
+  return j;
+}
+
 Outcome OutcomeOf(const lockstep::Participant& p, Outcome o) {
   o.role = p.name();
   o.exit_code = p.exit_code();
@@ -126,6 +146,7 @@ Outcome OutcomeOf(const lockstep::Participant& p, Outcome o) {
   o.stats_known = true;
   o.stepping_s = p.stepping_s();
   if (const auto* rt = p.realtime()) o.realtime = *rt;
+  if (const auto* ledger = p.follow_ledger()) o.follow = FollowToJson(*ledger);
   if (const auto* peers = p.peers()) {
     for (int i = 0; i < lockstep::kRosterSize; ++i) {
       if (lockstep::kRoster[i] != p.name()) o.peers[std::string(lockstep::kRoster[i])] = (*peers)[i];
@@ -158,6 +179,7 @@ nlohmann::json OutcomeToJson(const Outcome& o) {
                            {"note", o.realtime_setup.note}};
   }
   if (const nlohmann::json rt = o.RealtimeJson(); !rt.is_null()) j["realtime"] = rt;
+  if (!o.follow.is_null()) j["follow"] = o.follow;
   if (o.stats_known) j["link"] = StatsToJson(o.stats);
   if (!o.peers.empty()) {
     nlohmann::json peers = nlohmann::json::object();
@@ -193,6 +215,7 @@ Outcome OutcomeFromJson(const nlohmann::json& j) {
     o.realtime_setup.note = r.value("note", std::string());
   }
   if (j.contains("realtime")) o.realtime_json = j.at("realtime");
+  if (j.contains("follow")) o.follow = j.at("follow");
   if (j.contains("link")) {
     const auto& l = j.at("link");
     lockstep::LinkStats& s = o.stats;

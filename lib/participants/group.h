@@ -53,12 +53,21 @@ struct Outcome {
   lockstep::RealtimeStats realtime;
   /// ... as read back from a participant process's outcome file (RealtimeToJson), if any.
   nlohmann::json realtime_json;
+  /// Follow mode (`--follow`): what the participant did with every step (null otherwise):
+  /// FollowToJson.
+  nlohmann::json follow;
   /// The realtime JSON of either source (null if none).
   nlohmann::json RealtimeJson() const;
 };
 /// The clock's latency figures as JSON (summary.json "realtime"): percentiles and max [us],
 /// misses, the non-empty histogram bins as [lower_us, upper_us, count].
 nlohmann::json RealtimeToJson(const lockstep::RealtimeStats& r);
+/// A follow-mode participant's ledger as JSON (its outcome file's "follow"): the counts `exact`,
+/// `resumed`, `held`, `unseen` and `n_steps`, the `messages` of the run it heard, and the step ranges [first, last] of each class but
+/// exact (`held_steps`, `resumed_steps`, `unseen_steps`; at most kFollowRangesKept each, with
+/// `ranges_truncated` if more).
+nlohmann::json FollowToJson(const lockstep::FollowLedger& ledger);
+inline constexpr std::size_t kFollowRangesKept = 1000;
 /// How a finished participant ended: its exit code, message, culprit, step, link statistics and
 /// (the clock) its stepping time and latency figures. Keeps `base`'s other fields.
 Outcome OutcomeOf(const lockstep::Participant& p, Outcome base = {});
