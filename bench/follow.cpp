@@ -1,12 +1,13 @@
 // bench-follow: how much of a recorded run survives `lcm-logplayer` into `rths-plant --follow`
 // (docs/replay.md)? One recorded run (the default scenario), played at each speed, on a quiet
-// machine and with every core busy (one busy loop per core), with LCM's own defaults (a queue of 30
+// machine, with every core busy (one busy loop per core) and heavily loaded (six per core: a load
+// average near 12 on 2 cores), with LCM's own defaults (a queue of 30
 // messages per channel, the system's socket receive buffer: what follow mode had before) and with
 // follow mode's (a deep queue, a 4 MiB receive buffer). Prints the plant's steps exact / held /
 // resumed after a hold / unseen for each. Under the old behaviour the plant stopped at the first
 // lost input, so its "exact" count is what it used to answer.
 //
-//   build/bin/bench-follow [--duration-s S] [--speeds 0.5,1,2] [--scenario FILE] [--loads quiet,busy]
+//   build/bin/bench-follow [--duration-s S] [--speeds 0.5,1,2] [--scenario FILE] [--loads quiet,busy,heavy]
 #include <unistd.h>
 
 #include <cstdio>
@@ -40,14 +41,14 @@ struct Config {
 int main(int argc, char** argv) {
   double duration_s = 20.0;
   std::vector<double> speeds = {0.5, 1.0, 2.0};
-  std::vector<std::string> loads = {"quiet", "busy"};
+  std::vector<std::string> loads = {"quiet", "busy", "heavy"};
   const fs::path bin_dir = fs::read_symlink("/proc/self/exe").parent_path();
   std::string scenario = (bin_dir.parent_path().parent_path() / "scenarios" / "default.toml").string();
   CLI::App app{"bench-follow: lcm-logplayer into rths-plant --follow, quiet and loaded, before and after"};
   app.add_option("--duration-s", duration_s, "the recorded run's duration [s]")->check(CLI::Range(0.5, 600.0));
   app.add_option("--speeds", speeds, "lcm-logplayer speeds")->delimiter(',');
-  app.add_option("--loads", loads, "quiet, busy (one busy loop per core)")->delimiter(',')
-      ->check(CLI::IsMember({"quiet", "busy"}));
+  app.add_option("--loads", loads, "quiet, busy (one busy loop per core), heavy (six per core)")->delimiter(',')
+      ->check(CLI::IsMember({"quiet", "busy", "heavy"}));
   app.add_option("--scenario", scenario, "the scenario recorded")->check(CLI::ExistingFile);
   CLI11_PARSE(app, argc, argv);
 
@@ -75,7 +76,7 @@ int main(int argc, char** argv) {
     for (const double speed : speeds) {
       for (const Config& c : configs) {
         std::unique_ptr<rths_test::BusyLoops> busy;
-        if (load == "busy") busy = std::make_unique<rths_test::BusyLoops>(cores);
+        if (load != "quiet") busy = std::make_unique<rths_test::BusyLoops>(load == "busy" ? cores : 6 * cores);
         const std::string url = fmt::format("udpm://239.255.76.67:{}?ttl=0", port++);
         const auto r = rths_test::PlayFollow(
             {bin_dir, rec, work / fmt::format("play{}", i++), run_id, url, speed, std::string(c.plant_args)});
