@@ -23,10 +23,10 @@ TEST_CASE("harness (rig mode): confusion table and held-out shrink meet the harn
   o.generator = Generator::kRig;
   o.pairs = true;
   const auto sc = rths_test::RunHarnessReported(o);
-  REQUIRE(sc.single_n == 12 * o.seeds);  // the diagnosable effects of models::kEffects
+  REQUIRE(sc.single_n == 15 * o.seeds);  // the 14 diagnosable effects of models::kEffects, short-travel presliding
   REQUIRE(sc.pair_n > 0);
-  REQUIRE(sc.none_n == o.seeds);
-  REQUIRE(sc.unknown_n == 2 * o.seeds);
+  REQUIRE(sc.none_n == 2 * o.seeds);     // none, none_current_on
+  REQUIRE(sc.unknown_n == 3 * o.seeds);  // ripple, stiffness, heating
   rths_test::CheckHarnessTargets(sc);
   CHECK(sc.none_as_effect == 0);
   CHECK(sc.unknown_as_effect == 0);
@@ -40,9 +40,9 @@ TEST_CASE("harness (effect blocks, one seed): confusion table and held-out shrin
   o.generator = Generator::kBlocks;
   o.pairs = true;
   const auto sc = rths_test::RunHarnessReported(o);
-  REQUIRE(sc.single_n == 12);
-  REQUIRE(sc.none_n == 1);
-  REQUIRE(sc.unknown_n == 2);
+  REQUIRE(sc.single_n == 15);
+  REQUIRE(sc.none_n == 2);
+  REQUIRE(sc.unknown_n == 3);
   rths_test::CheckHarnessTargets(sc);
   CHECK(sc.none_right == sc.none_n);
   CHECK(sc.unknown_right == sc.unknown_n);

@@ -150,6 +150,8 @@ TEST_CASE("each effect of the library is named and its parameter recovered (synt
        "vmax_mm_per_s", 200.0, 0.05},
       {"current_lag", [](m::EffectSet* e) { e->current_lag = m::CurrentLag{80.0}; }, "tau_ms", 80.0, 0.15},
       {"damper_scale", [](m::EffectSet* e) { e->damper_scale = m::DamperScale{1.2}; }, "scale", 1.2, 0.02},
+      {"channel_skew", [](m::EffectSet* e) { e->channel_skew = m::ChannelSkew{1.0}; }, "skew_ms", 1.0, 0.05},
+      {"load_cell_inertia", [](m::EffectSet* e) { e->load_cell_inertia = m::LoadCellInertia{80.0}; }, "mass_kg", 80.0, 0.1},
   };
   for (const auto& c : cases) {
     SUBCASE(c.name.c_str()) {
@@ -351,7 +353,8 @@ TEST_CASE("JSON: the contract's fields and keys") {
       {"servovalve_saturation", {"vmax_mm_per_s"}}, {"sensor_noise", {"rms"}},
       {"current_lag", {"tau_ms"}},       {"damper_scale", {"scale"}},
       {"presliding_friction", {"loss_mm", "travel_mm"}}, {"command_dead_band", {"width_mm"}},
-      {"supply_ripple", {"f_hz", "amplitude_mm"}}};
+      {"supply_ripple", {"f_hz", "amplitude_mm"}}, {"channel_skew", {"skew_ms"}},
+      {"load_cell_inertia", {"mass_kg"}}};
   std::set<std::string> names;
   for (const auto& e : j["effects"]) {
     const std::string name = e["name"];

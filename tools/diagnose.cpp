@@ -71,6 +71,10 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   std::string columns;
   rths::tools::AddColumnsOption(app, &columns);
+  std::optional<double> current_A;
+  app.add_option("--current", current_A,
+                 "with --columns: the constant damper current [A] of records mapped without a current or voltage "
+                 "column (the map's i=VALUE does the same)");
   bool time_from_header = false;
   app.add_flag("--time-from-header", time_from_header,
                "take the step from the record's '# dt_s' line; the time column need only lie within half a step "
@@ -85,6 +89,14 @@ int main(int argc, char** argv) {
     if (!out.empty()) rths::io::RequireNewOrEmptyFolder(out, "an earlier diagnosis or a run");
     std::optional<rths::io::ColumnMap> map;
     if (!columns.empty()) map = rths::io::ParseColumnMap(columns);
+    if (current_A) {
+      if (!map) throw rths::Error("--current", "only with --columns (our own formats carry their current)");
+      if (map->Find('i') || map->Find('v') || map->current_A || map->voltage_V)
+        throw rths::Error("--current", "the map already gives the damper command (i or v)");
+      if (!(*current_A >= 0.0 && *current_A <= rths::io::kMaxAbsCurrentA))
+        throw rths::Error("--current", fmt::format("{} A: must be in [0, {:g}] A", *current_A, rths::io::kMaxAbsCurrentA));
+      map->current_A = *current_A;
+    }
     const rths::io::ColumnMap* m = map ? &*map : nullptr;
     for (const auto& p : train) tr.push_back(rths::io::ReadAnyRecord(p, m, axis));
     for (const auto& p : test) te.push_back(rths::io::ReadAnyRecord(p, m, axis));

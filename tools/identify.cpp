@@ -487,6 +487,9 @@ int main(int argc, char** argv) {
     if (!columns.empty()) map = rths::io::ParseColumnMap(columns);
     ac.map = map ? &*map : nullptr;
     if (app.count("--current") > 0) fo.current_A = current_A;
+    // A file mapped without a current or voltage column was run at the one current of --current.
+    if (map && fo.current_A && !map->Find('i') && !map->Find('v') && !map->current_A && !map->voltage_V)
+      map->current_A = *fo.current_A;
     if (damper) {
       if (fo.current_A) {
         if (!(*fo.current_A >= 0.0)) throw Error("--current", fmt::format("{} A: must be >= 0", *fo.current_A));

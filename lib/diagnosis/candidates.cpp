@@ -84,14 +84,14 @@ std::string FormOf(const CandidateSpec& spec, const std::vector<double>& v) {
   return "";
 }
 
+bool SkewTooShort(const ChannelState& s, const Params& p) {
+  const auto it = p.find("channel_skew");
+  return it != p.end() && 1e-3 * std::abs(it->second[0]) < s.min_skew_s;
+}
+
 bool SubSampleDelayBeside(const Params& p, double dt, const Options& o) {
   const auto it = p.find("pure_delay");
   return it != p.end() && p.size() >= 2 && 1e-3 * it->second[0] < o.min_delay_samples * dt;
-}
-
-std::optional<double> FittedScale(const Params& p) {
-  const auto it = p.find("damper_scale");
-  return it == p.end() ? std::nullopt : std::optional<double>(it->second[0]);
 }
 
 std::map<std::string, double> ParamMap(const std::vector<CandidateSpec>& specs, const std::string& name,

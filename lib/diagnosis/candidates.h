@@ -38,10 +38,6 @@ std::string FormOf(const CandidateSpec& spec, const std::vector<double>& v);
 /// delay added to the other effect only compensates; it is not a transport delay of its own.
 bool SubSampleDelayBeside(const Params& p, double dt, const Options& o);
 
-/// The damper scale fitted on the training records, if the set has one: on the test records it is
-/// held at that value (not refitted in closed form).
-std::optional<double> FittedScale(const Params& p);
-
 /// An effect's parameters by their contract keys: the fitted values v (in the order of its
 /// CandidateSpec) and the defaults of the parameters the diagnosis does not fit.
 std::map<std::string, double> ParamMap(const std::vector<CandidateSpec>& specs, const std::string& name,

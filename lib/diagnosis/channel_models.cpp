@@ -359,15 +359,15 @@ void IntegrateStep(const StepMotion& mo, int m, bool constant, const models::MrD
 }  // namespace
 
 std::vector<double> ForcePredictor::Predict(const SmoothedMotion& motion, std::span<const double> i_A,
-                                            const models::EffectSet& effects) const {
-  auto f = PredictUnscaled(motion, i_A, effects);
+                                            const models::EffectSet& effects, double i_start_A) const {
+  auto f = PredictUnscaled(motion, i_A, effects, i_start_A);
   if (effects.damper_scale)
     for (double& v : f) v *= effects.damper_scale->scale;
   return f;
 }
 
 std::vector<double> ForcePredictor::PredictUnscaled(const SmoothedMotion& motion, std::span<const double> i_A,
-                                                    const models::EffectSet& effects) const {
+                                                    const models::EffectSet& effects, double i_start_A) const {
   const std::size_t n = motion.x_mm.size();
   if (i_A.size() != n || motion.v_mm_s.size() != n) throw Error("ForcePredictor", "lengths differ");
   std::vector<double> f(n, 0.0);
@@ -375,8 +375,9 @@ std::vector<double> ForcePredictor::PredictUnscaled(const SmoothedMotion& motion
   models::EffectSet fe_set;  // force effects only (current_lag); damper_scale is applied outside
   fe_set.current_lag = effects.current_lag;
   models::ForceEffects fe(fe_set, dt_s_);
-  fe.Reset(i_A[0]);
-  models::CurrentDriverState cs = models::SteadyState(i_A[0]);
+  const double i_before = std::isnan(i_start_A) ? i_A[0] : i_start_A;
+  fe.Reset(i_before);
+  models::CurrentDriverState cs = models::SteadyState(i_before);
   models::MrDamperState s{};
   const CoefficientTable coef(damper_, i_A);
   HalfStepCurrents ic(driver_);

@@ -41,6 +41,7 @@
 ///      i_c at the substep times from the driver's closed form advanced by multiplication.
 ///      Deterministic, about a microsecond per sample.
 ///   4. fhat_k = Force(Eq. 34 at (ys_k, v_k), i_c(t_k)) (damper_scale).
+#include <limits>
 #include <span>
 #include <string>
 #include <vector>
@@ -102,6 +103,10 @@ enum class Reflection {
 std::vector<double> ZeroPhaseLowpass(std::span<const double> x, double dt_s, double fc_hz, std::size_t pad,
                                      Reflection reflection);
 
+/// v = dx/dt of samples x [unit/s]: the fourth-order central difference inside, second order next to
+/// the ends, one-sided at the ends (n >= 2).
+void Differentiate(const std::vector<double>& x, double dt_s, std::vector<double>* v);
+
 /// Throws rths::Error unless smooth_hz is in (0, 0.5/dt_s) and y has at least 4 samples.
 SmoothedMotion SmoothMotion(std::span<const double> y_mm, double dt_s, double smooth_hz);
 
@@ -144,12 +149,17 @@ class ForcePredictor {
   ForcePredictor(const models::MrDamperParams& damper, bool current_dynamics, double dt_s,
                  const models::CurrentDriverParams& driver = {});
   /// fhat_k for one record (file comment, steps 2-4): the smoothed motion and the current
-  /// commands i_A (same length). Only the force effects of `effects` act.
+  /// commands i_A (same length). Only current_lag and damper_scale of `effects` act (the
+  /// measurement's effects, load_cell_inertia and channel_skew, are the caller's: stages::Channel).
+  /// i_start_A: the command the current dynamics (and current_lag) held before the record, whose
+  /// steady state they start from [A]; NaN: i_A[0] (the current set before the record started).
   std::vector<double> Predict(const SmoothedMotion& motion, std::span<const double> i_A,
-                              const models::EffectSet& effects) const;
+                              const models::EffectSet& effects, double i_start_A = kFirstCommand) const;
   /// The same without damper_scale applied (Predict = scale x this).
   std::vector<double> PredictUnscaled(const SmoothedMotion& motion, std::span<const double> i_A,
-                                      const models::EffectSet& effects) const;
+                                      const models::EffectSet& effects, double i_start_A = kFirstCommand) const;
+  /// i_start_A's default: the driver at the steady state of the record's first command.
+  static constexpr double kFirstCommand = std::numeric_limits<double>::quiet_NaN();
 
  private:
   models::MrDamperParams damper_;

@@ -83,10 +83,15 @@ double MotionCutoffHz(const Options& o, double dt) { return std::min(o.smooth_hz
 /// smoothed at a cutoff above the excitation.
 void SetForceMotion(std::vector<Data>* train, std::vector<Data>* test, const ChannelState& y, bool y_ok,
                     const models::LinearServo& servo, const Options& o, double dt) {
+  // The damper's acceleration (load_cell_inertia): the motion's own, else its velocity's derivative.
+  auto set_acc = [dt](Data& d) {
+    if (d.motion.a_mm_s2.size() == d.size()) d.acc_mm_s2 = d.motion.a_mm_s2;
+    else Differentiate(d.motion.v_mm_s, dt, &d.acc_mm_s2);
+  };
   if (!y_ok) {
     const double fc = std::min(tuning::kDisplacementOnlySmoothFactor * o.smooth_hz, o.max_smooth_cycles_per_sample / dt);
-    for (auto& d : *train) d.motion = SmoothMotion(d.y, dt, fc);
-    for (auto& d : *test) d.motion = SmoothMotion(d.y, dt, fc);
+    for (auto* recs : {train, test})
+      for (auto& d : *recs) d.motion = SmoothMotion(d.y, dt, fc), set_acc(d);
     return;
   }
   // The final model's own velocity and acceleration (exact for the servo) under the smoothed
@@ -96,8 +101,8 @@ void SetForceMotion(std::vector<Data>* train, std::vector<Data>* test, const Cha
     const std::vector<double> yhat = PredictDisplacement(servo, y.fin_set, d.u, d.f, &vhat, &ahat, d.y, d.first);
     return ModelAidedMotion(d.y, yhat, vhat, dt, MotionCutoffHz(o, dt), ahat);
   };
-  for (auto& d : *train) d.motion = motion(d);
-  for (auto& d : *test) d.motion = motion(d);
+  for (auto* recs : {train, test})
+    for (auto& d : *recs) d.motion = motion(d), set_acc(d);
 }
 
 /// The damper's motion in every test record for the localisation's conditions: the force
@@ -205,6 +210,7 @@ void RunStages(ChannelState* s, const std::vector<stages::CandidateSpec>& specs,
   stages::RetainOnTest(s, specs, o, &res->warnings);
   stages::ScoreSelected(*s, specs, er);
   stages::ApplyShrinkRule(s, specs, o, &res->warnings, er);
+  stages::AssessParameters(*s, specs, er, &res->warnings);
   if (o.progress) o.progress(base + 9, total, "channel " + ch + ": scoring the other candidates");
   // The retained effects (unconfirmed or not), else the unconfirmed ones (not retained).
   for (const auto& n : s->retained ? s->order : s->unconfirmed) verdict->push_back(n);
@@ -271,7 +277,11 @@ Result Diagnose(const std::vector<io::RigRecord>& train_in, const std::vector<io
   EffectResults er;
   std::vector<std::string> verdict;
   for (char chan : chans) {
-    if (chan == 'f') SetForceMotion(&train, &test, st[0], y_ok, servo, o, dt);
+    if (chan == 'f') {
+      SetForceMotion(&train, &test, st[0], y_ok, servo, o, dt);
+      for (auto* recs : {&train, &test})
+        for (auto& d : *recs) stages::EstimateCurrentStart(&d, *fp, model, &res.warnings);
+    }
     // --detrend: the sensor's drift out of this channel's measurement only (u = y: y has none to
     // lean on, its drift is in the command too). Without it, a channel whose whole excess lies
     // below the drift band is a drifting sensor too: removed the same way, and scored again (a
@@ -280,13 +290,16 @@ Result Diagnose(const std::vector<io::RigRecord>& train_in, const std::vector<io
     if (o.detrend && drift_ok) RemoveDrift(chan, &train, &test, servo, fpp, specs, o, &res.warnings);
     st.emplace_back(chan, Channel(chan, &train, &servo, fpp), Channel(chan, &test, &servo, fpp));
     auto& s = st.back();
+    if (chan == 'f' && !st[0].fin_set.Empty()) s.min_skew_s = dt;  // rule 8
     stages::ScoreNominal(&s, o);
     if (!o.detrend && drift_ok && stages::ExcessIsSlow(s, o.none_ratio)) {
       res.warnings.push_back(fmt::format("channel {}: its whole excess over the noise floor lies below {:g} Hz: a "
                                          "drifting sensor, removed as --detrend removes it (sensor_drift below)",
                                          chan, tuning::kDriftHz));
       RemoveDrift(chan, &train, &test, servo, fpp, specs, o, &res.warnings);
+      const double min_skew_s = s.min_skew_s;
       s = ChannelState(chan, Channel(chan, &train, &servo, fpp), Channel(chan, &test, &servo, fpp));
+      s.min_skew_s = min_skew_s;
       stages::ScoreNominal(&s, o);
     }
     if (s.ch == 'y' && !y_ok) {

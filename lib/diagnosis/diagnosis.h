@@ -168,6 +168,25 @@ struct EffectResult {
   /// A selected effect's close calls: the candidates of its channel that passed every rule at the
   /// same step with a BIC within tuning::kCloseCallBic of it, closest first; empty if none.
   std::vector<Alternative> alternatives;
+  /// A selected effect's parameters' standard errors (contract keys; stages::AssessParameters):
+  /// from the curvature of the training SSE at the fit, sigma^2 = SSE / n with n counted once per
+  /// correlation time of the residual. Empty for the others.
+  std::map<std::string, double> params_se;
+  /// A parameter of a selected effect fitted per segment of the training records (each record's
+  /// summed span cut into tuning::kDriftSegments in time, segment j of every record pooled).
+  struct Drift {
+    std::string key;              ///< the parameter
+    std::vector<double> values;   ///< its fit on each segment, in time order
+    std::vector<double> se;       ///< their standard errors
+    double chi2 = 0;              ///< sum ((v_j - mean_w) / se_j)^2, mean_w the se-weighted mean
+  };
+  /// Every fitted parameter's segment fits (selected effects; empty for the others).
+  std::vector<Drift> segments;
+  /// Not empty: a parameter is not constant over the training records (drifting beyond its
+  /// uncertainty: tuning::kDriftChi2 and tuning::kDriftMinRelative), e.g. "drifting over the
+  /// record: scale 0.97 -> 0.86": an effect that changes during the test is not that library
+  /// effect, whose parameters are constants; the verdict names it with this.
+  std::string drift;
 };
 
 /// Per-channel numbers.

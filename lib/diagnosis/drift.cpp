@@ -44,7 +44,7 @@ void RemoveSensorDrift(char ch, std::vector<Data>* recs, const models::LinearSer
                        const models::EffectSet& effects, std::vector<std::string>* notes) {
   for (auto& d : *recs) {
     const std::vector<double> pred =
-        ch == 'y' ? PredictDisplacement(servo, effects, d.u, d.f, nullptr, nullptr, d.y, d.first) : fp->Predict(d.motion, d.i, effects);
+        ch == 'y' ? PredictDisplacement(servo, effects, d.u, d.f, nullptr, nullptr, d.y, d.first) : PredictForce(d, *fp, effects);
     std::vector<double>& meas = ch == 'y' ? d.y : d.f;
     const auto drift = SlowPart(meas, pred, d.dt);
     double ss = 0.0, lo = drift.empty() ? 0.0 : drift[0], hi = lo;

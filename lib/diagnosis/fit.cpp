@@ -123,11 +123,12 @@ double FitSupplyRipple(const Channel& ch, const std::vector<CandidateSpec>& spec
 double FitEffect(const Channel& ch, const std::vector<CandidateSpec>& specs, Params* p, const std::string& name,
                  const Options& o) {
   const auto& spec = SpecOf(specs, name);
-  if (name == "damper_scale") {
-    (*p)[name] = {1.0};
-    double s = 1.0;
-    const auto pred = ch.Predict(ToSet(specs, *p), &s);
-    (*p)[name] = {s};
+  if (name == "damper_scale" || name == "load_cell_inertia") {  // closed form, both together (Channel::Predict)
+    if (!p->count(name)) (*p)[name] = {name == "damper_scale" ? 1.0 : 1.0};
+    LinearForce lin;
+    const auto pred = ch.Predict(ToSet(specs, *p), &lin);
+    if (p->count("damper_scale")) (*p)["damper_scale"] = {lin.scale};
+    if (p->count("load_cell_inertia")) (*p)["load_cell_inertia"] = {lin.mass_kg};
     return ch.Sse(pred);
   }
   if (name == "supply_ripple") return FitSupplyRipple(ch, specs, p, name);

@@ -57,6 +57,17 @@ json EffectJson(const EffectResult& e) {
     alts.push_back({{"name", a.name}, {"delta_bic", Num(a.delta_bic)}, {"params", pa}});
   }
   o["alternatives"] = alts;
+  json se = json::object();
+  for (const auto& [k, v] : e.params_se) se[k] = Num(v);
+  o["params_se"] = se;
+  json segs = json::array();
+  for (const auto& d : e.segments) {
+    json vals = json::array(), ses = json::array();
+    for (std::size_t j = 0; j < d.values.size(); ++j) vals.push_back(Num(d.values[j])), ses.push_back(Num(d.se[j]));
+    segs.push_back({{"key", d.key}, {"values", vals}, {"se", ses}, {"chi2", Num(d.chi2)}});
+  }
+  o["segments"] = segs;
+  o["drift"] = e.drift;
   o["train_nrmse_" + e.channel + "_pct_after"] = Num(e.train_nrmse_after);
   if (e.name != "sensor_noise") {
     o["excess_reduction_pct"] = Num(100.0 * e.excess_reduction);

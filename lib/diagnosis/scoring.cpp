@@ -67,9 +67,8 @@ void ScoreSelected(const ChannelState& s, const std::vector<CandidateSpec>& spec
   for (const auto& name : s.order) {
     cum[name] = s.sel.at(name);
     const auto sset = ToSet(specs, cum);
-    const std::optional<double> fixed = FittedScale(cum);
-    const auto pt = s.test.Predict(sset, nullptr, fixed);
-    const auto ptr = s.train.Predict(sset, nullptr, fixed);
+    const auto pt = s.test.Predict(sset, nullptr, true);
+    const auto ptr = s.train.Predict(sset, nullptr, true);
     const auto stats = s.sel_stats.find(name);
     EffectResult e;
     e.name = name;
@@ -133,7 +132,7 @@ void ApplyShrinkRule(ChannelState* sp, const std::vector<CandidateSpec>& specs, 
   ChannelState& s = *sp;
   ChannelSummary& cs = s.summary;
   const double before = cs.gap_test_pct;
-  auto fin = s.test.Predict(ToSet(specs, s.sel), nullptr, FittedScale(s.sel));
+  auto fin = s.test.Predict(ToSet(specs, s.sel), nullptr, true);
   cs.after_test_pct = s.test.NrmsePct(s.test.Sse(fin));
   const bool test_structured = cs.floor_ratio_test > o.none_ratio;
   bool retained = !s.order.empty();
@@ -194,7 +193,7 @@ void ScoreCandidates(ChannelState* sp, const std::vector<CandidateSpec>& specs, 
   }
   for (const auto& [name, t] : s.last_trial) {
     if (er->count(name)) continue;
-    const auto pt = s.test.Predict(ToSet(specs, t.params), nullptr, FittedScale(t.params));
+    const auto pt = s.test.Predict(ToSet(specs, t.params), nullptr, true);
     EffectResult e;
     e.name = name;
     e.channel = s.summary.channel;

@@ -59,7 +59,7 @@ void SelectEffects(ChannelState* sp, const std::vector<CandidateSpec>& specs, co
                (sse_wo - sse) >= o.min_floor_gain * static_cast<double>(s.n_train) * s.var_floor &&
                static_cast<int>(s.order.size()) < tuning::kMaxEffectsPerChannel &&
                !AtBound(spec, t.params.at(spec.name)) && FormOf(spec, t.params.at(spec.name)).empty() &&
-               !(spec.name == "pure_delay" && SubSampleDelayBeside(t.params, dt, o));
+               !(spec.name == "pure_delay" && SubSampleDelayBeside(t.params, dt, o)) && !SkewTooShort(s, t.params);
       s.last_trial[spec.name] = t;
       if (t.pass && (!best || t.excess_red > best->excess_red)) best = t;
     }
@@ -90,7 +90,8 @@ void SwapEffects(ChannelState* sp, const std::vector<CandidateSpec>& specs, cons
         q.erase(s.order[j]);
         double sq = FitEffect(s.train, specs, &q, spec.name, o);
         sq = RefitAll(s.train, specs, &q, sq, o.refit_rounds, o);
-        if (AtBound(spec, q.at(spec.name)) || !FormOf(spec, q.at(spec.name)).empty()) continue;  // not an explanation
+        if (AtBound(spec, q.at(spec.name)) || !FormOf(spec, q.at(spec.name)).empty() || SkewTooShort(s, q))
+          continue;  // not an explanation
         if (sq < best_sse) best_sse = sq, swap = std::make_pair(j, q), swap_in = spec.name;
       }
     }
@@ -156,7 +157,7 @@ void RetainOnTest(ChannelState* sp, const std::vector<CandidateSpec>& specs, con
   std::vector<std::string> kept;
   for (const auto& name : s.order) {
     cum[name] = s.sel.at(name);
-    const double after = s.test.NrmsePct(s.test.Sse(s.test.Predict(ToSet(specs, cum), nullptr, FittedScale(cum))));
+    const double after = s.test.NrmsePct(s.test.Sse(s.test.Predict(ToSet(specs, cum), nullptr, true)));
     if (after > prev * (1.0 + o.max_test_worsening)) {
       warnings->push_back(fmt::format("channel {}: {} (selected on the training records) raises the test NRMSE "
                                       "from {:.4g} % to {:.4g} %: not retained",

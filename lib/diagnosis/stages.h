@@ -62,9 +62,28 @@ struct Data {
   double dt = 0;                    ///< [s]
   std::vector<double> u, y, f, i;   ///< [mm], [mm], [kN], [A] (y, f drift-free if Options::detrend)
   SmoothedMotion motion;            ///< the damper's motion (set once y is diagnosed)
+  /// The damper's smoothed acceleration [mm/s^2] (load_cell_inertia), set with the motion: the
+  /// motion's own where it carries one, else the derivative of its velocity.
+  std::vector<double> acc_mm_s2;
+  /// The command the current dynamics held before the record [A] (EstimateCurrentStart); NaN: its
+  /// first command (ForcePredictor::kFirstCommand).
+  double i_start_A = ForcePredictor::kFirstCommand;
   std::size_t first = 0;            ///< first sample of every sum (warmup_s / dt, at most half the record)
   std::size_t size() const { return u.size(); }
 };
+
+/// The force channel's terms that enter linearly (Channel::Predict): damper_scale's scale and
+/// load_cell_inertia's mass [kg], f = shift(scale fhat + 1e-6 mass a) (channel_skew's shift).
+struct LinearForce {
+  double scale = 1.0;
+  double mass_kg = 0.0;
+};
+
+/// The measured force of record d that the force predictor and the measurement effects of `set`
+/// predict, with the set's own scale and mass (damper_scale, load_cell_inertia), current_lag,
+/// channel_skew, and the record's i_start_A. d's motion (and acc_mm_s2 for load_cell_inertia)
+/// must be set.
+std::vector<double> PredictForce(const Data& d, const ForcePredictor& fp, const models::EffectSet& set);
 
 /// The record's signals and its first sample; no motion yet.
 Data Prepare(const io::RigRecord& r, const Options& o);
@@ -79,6 +98,19 @@ Data Prepare(const io::RigRecord& r, const Options& o);
 /// be mid-transition), tuning::kStartTimeConstants x the slowest current time constant (Eq. 40's
 /// 1/a, or 1/eta) has passed; at most half the record. A note says how far.
 void ExtendWarmupIfMoving(Data* d, const NominalModel& model, std::vector<std::string>* notes);
+
+/// A record whose current command is not 0 at its first sample may start with the current dynamics
+/// anywhere from rest (an amplifier switched on with the test) to the steady state of that command
+/// (the current set before the test): the model's start would otherwise err for the first few time
+/// constants, by up to the whole damper force at that current. The command the dynamics held before
+/// the record, d->i_start_A, is fitted in [0, max i] (grid, then golden section) on the nominal
+/// force residual over the samples [first, first + tuning::kStartTimeConstants x the slowest time
+/// constant (Eq. 40's 1/a, or 1/eta)), the nominal force scaled by its least-squares factor over
+/// those samples (a damper_scale not yet found must not pass for a start); a note says so when it
+/// differs from the first command by more
+/// than tuning::kStartCurrentNote of max i. Nothing to do without a damper, without current
+/// dynamics or with the current off at the start. Needs d's motion (SetForceMotion).
+void EstimateCurrentStart(Data* d, const ForcePredictor& fp, const NominalModel& model, std::vector<std::string>* notes);
 
 /// --detrend (docs/diagnosis.md "Sensor drift"): a slow drift of a sensor is removed from the
 /// measurement it is in, and only there, so that the model's inputs stay what drove the rig: for
@@ -101,11 +133,12 @@ class Channel {
  public:
   /// ch: 'y' or 'f'; fp may be null for 'y'.
   Channel(char ch, const std::vector<Data>* recs, const models::LinearServo* servo, const ForcePredictor* fp);
-  /// Predictions per record. For 'f' with damper_scale in the set, the scale is replaced by the
-  /// least-squares one over these records (closed form, clipped to [0.1, 10]) and written back to
-  /// *scale_out; with fixed_scale, that scale is used instead.
-  std::vector<std::vector<double>> Predict(const models::EffectSet& set, double* scale_out = nullptr,
-                                           std::optional<double> fixed_scale = std::nullopt) const;
+  /// Predictions per record. For 'f' with damper_scale or load_cell_inertia in the set, their
+  /// scale and mass are replaced by the least-squares ones over these records (closed form, jointly,
+  /// clipped to their search ranges: [0.1, 10] and [0.01, 1e4] kg) and written to *fitted; with
+  /// hold_linear (a held-out prediction), the set's own values are used instead.
+  std::vector<std::vector<double>> Predict(const models::EffectSet& set, LinearForce* fitted = nullptr,
+                                           bool hold_linear = false) const;
   /// Sum of squared residuals over the records (k >= first).
   double Sse(const std::vector<std::vector<double>>& pred) const;
   /// NRMSE [%] of a sum of squared residuals over these records.
@@ -115,11 +148,19 @@ class Channel {
   std::span<const double> Meas(std::size_t r) const;
 
  private:
+  /// 'f': the damper's force per record before the measurement's effects and the linear terms
+  /// (ForcePredictor::PredictUnscaled), which depends on current_lag alone: the last few are kept
+  /// (keyed by its tau, -1 without it), so that fitting a skew, a scale or a mass re-simulates
+  /// nothing.
+  const std::vector<std::vector<double>>& DamperForces(const models::EffectSet& set) const;
+
   char ch_;
   const std::vector<Data>* recs_;
   const models::LinearServo* servo_;
   const ForcePredictor* fp_;
   double meas2_ = 0;
+  static constexpr std::size_t kDamperCache = 4;
+  mutable std::vector<std::pair<double, std::vector<std::vector<double>>>> damper_cache_;  // oldest first
 };
 
 /// A candidate's latest trial: the channel's whole set with it, fitted on the training records.
@@ -139,6 +180,11 @@ struct ChannelState {
   char ch;                           ///< 'y' or 'f'
   Channel train, test;               ///< the training and test records of the channel
   ChannelSummary summary;            ///< the channel's numbers (filled by the stages)
+  /// The shortest channel_skew the channel may select [s] (selection rule 8, docs/diagnosis.md):
+  /// one sample when the damper's motion carries displacement effects (y's final model has some:
+  /// a shift below a sample then compensates their form's timing convention, as a sub-sample
+  /// pure_delay beside another effect does), else 0. Set by Diagnose for the force channel.
+  double min_skew_s = 0.0;
 
   // Set by ScoreNominal.
   std::size_t n_train = 0;           ///< samples in the training sums
@@ -167,6 +213,9 @@ struct ChannelState {
   std::vector<std::vector<double>> fin_test;        ///< final (retained effects), test records
   std::vector<std::vector<double>> pred_train_fin;  ///< final (retained effects), training records
 };
+
+/// true if p holds a channel_skew shorter than s.min_skew_s (rule 8): not a skew of the DAQ.
+bool SkewTooShort(const ChannelState& s, const Params& p);
 
 /// Without --detrend: true if the channel is structured (after ScoreNominal, whose nominal
 /// predictions it uses) but its nominal residual less its slow part (RemoveSensorDrift's low-pass) is at the noise floor (floor ratio
@@ -223,6 +272,19 @@ void ScoreSelected(const ChannelState& s, const std::vector<CandidateSpec>& spec
 /// after_test_pct and status, fin_test and pred_train_fin.
 void ApplyShrinkRule(ChannelState* s, const std::vector<CandidateSpec>& specs, const Options& o,
                      std::vector<std::string>* warnings, EffectResults* er);
+
+/// The uncertainty and the constancy of the selected effects' parameters (after ApplyShrinkRule,
+/// retained or unconfirmed; docs/diagnosis.md "Drift"): per fitted parameter (supply_ripple's
+/// are fitted per record and left out), its standard error on the whole training set and its fit on
+/// each of tuning::kDriftSegments time segments of the training records (each record's summed span
+/// cut alike, segment j of every record pooled: the prediction runs over the whole record with the
+/// parameter changed, the SSE is summed over the segment only; the other parameters held), with
+/// their standard errors from the SSE's curvature, se^2 = 2 (SSE / n) tau_int / SSE''. A parameter
+/// drifts if the segment fits' chi^2 exceeds tuning::kDriftChi2 and the last differs from the first
+/// by more than tuning::kDriftMinRelative of its size and tuning::kDriftMinSigmas of that difference's
+/// standard error; the effect's `drift` then says so and a warning too.
+void AssessParameters(const ChannelState& s, const std::vector<CandidateSpec>& specs, EffectResults* er,
+                      std::vector<std::string>* warnings);
 
 /// The candidates not selected, from their latest trial; if a selection was not retained, every
 /// candidate is refitted alone on the nominal model first (its numbers then stand on their own).

@@ -18,6 +18,7 @@ std::string VerdictText(const Result& r) {
     s += (i ? ", " : "") + r.verdict[i];
     for (const auto& e : r.effects)
       if (e.name == r.verdict[i]) {
+        if (!e.drift.empty()) s += ", " + e.drift;
         if (!e.unconfirmed.empty()) s += " (unconfirmed: " + e.unconfirmed + ")";
         for (const auto& a : e.alternatives) s += fmt::format(" (close call: or {}, BIC +{:.1f})", a.name, a.delta_bic);
       }
@@ -99,6 +100,16 @@ std::string Summary(const Result& r, SummaryDetail detail) {
     s += fmt::format("  {} {:<22} [{}]{}: {:.3f} %, shrink {:.1f} % (training: {} {:.0f} % of the residual above noise)\n",
                      e.selected ? "*" : " ", e.name, e.channel, ps, e.test_nrmse_after, e.shrink_pct,
                      red_pct >= 0.0 ? "removes" : "adds", std::abs(red_pct));
+    // A selected effect's parameters with their uncertainty, and per segment of the training records.
+    for (const auto& seg : e.segments) {
+      const auto se = e.params_se.find(seg.key);
+      std::string parts;
+      for (std::size_t j = 0; j < seg.values.size(); ++j)
+        parts += fmt::format("{}{:.4g} +- {:.2g}", j ? ", " : "", seg.values[j], seg.se[j]);
+      s += fmt::format("      {} = {:.4g} +- {:.2g}; per {} of the training records: {} (chi2 {:.3g})\n", seg.key,
+                       e.params.count(seg.key) ? e.params.at(seg.key) : 0.0, se == e.params_se.end() ? 0.0 : se->second,
+                       seg.values.size() == 4 ? "quarter" : "segment", parts, seg.chi2);
+    }
   }
   if (!pinned.empty()) {
     s += fmt::format("  (not shown: {} fitted to an end of the search range, so not a description of the residual; "

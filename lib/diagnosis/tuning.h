@@ -25,6 +25,12 @@ inline constexpr double kMovingStartFraction = 0.01;
 inline constexpr double kStartTravelFactor = 5.0;
 /// ... and this many of the current dynamics' slowest time constants have passed.
 inline constexpr double kStartTimeConstants = 5.0;
+/// EstimateCurrentStart: the fitted start is named in a note when it differs from the first command by
+/// more than this fraction of the record's largest command.
+inline constexpr double kStartCurrentNote = 0.05;
+/// ... its grid over [0, max i] before golden section, and the golden-section iterations.
+inline constexpr int kStartCurrentGrid = 11;
+inline constexpr int kStartCurrentIters = 20;
 
 // --- unconfirmed effects (ApplyShrinkRule)
 /// Effects selected on the training records whose test shrink fails the rule are "unconfirmed"
@@ -63,6 +69,27 @@ inline constexpr double kPlayCreepSlope = 0.05;
 /// A selected effect's alternative is a close call if its BIC exceeds the selected one's by less
 /// than this (10: "very strong" evidence on the usual BIC scale).
 inline constexpr double kCloseCallBic = 10.0;
+
+// --- parameter uncertainty and drift (stages::AssessParameters)
+/// The training records' summed span is cut into this many segments in time, each fitted alone.
+inline constexpr int kDriftSegments = 4;
+/// A parameter drifts if its segment fits' chi^2 about their weighted mean exceeds this (p = 0.001
+/// at kDriftSegments - 1 = 3 degrees of freedom) ...
+inline constexpr double kDriftChi2 = 16.27;
+/// ... and its last segment differs from its first by more than this fraction of max(|value|, 1 %
+/// of its search range) (a drift a lab would care about, not a per mille the statistics can see) ...
+inline constexpr double kDriftMinRelative = 0.05;
+/// ... and by more than this many standard errors of that difference.
+inline constexpr double kDriftMinSigmas = 4.0;
+/// A segment's fit searches the parameter within [v / this, v x this] (log parameters) ...
+inline constexpr double kSegmentBracketFactor = 1.5;
+/// ... or v +- this x its search range (linear ones).
+inline constexpr double kSegmentBracketFraction = 0.1;
+/// Golden-section iterations of a segment's fit.
+inline constexpr int kSegmentGoldenIters = 12;
+/// The curvature of the SSE is taken over +- this relative step (log parameters: of the value; linear
+/// ones: of the search range).
+inline constexpr double kCurvatureStep = 0.01;
 
 // --- parameter search (one effect) and joint refits (coordinate-wise)
 /// Golden-section iterations after the full-range grid: y effects ...

@@ -136,6 +136,8 @@ std::string ColumnMap::Describe() const {
     if (c.scale != 1.0) o += fmt::format("*{}", c.scale);
     if (!c.unit.empty()) o += ":" + c.unit;
   }
+  if (current_A) o += fmt::format("{}i={}", o.empty() ? "" : ",", *current_A);
+  if (voltage_V) o += fmt::format("{}v={}", o.empty() ? "" : ",", *voltage_V);
   return o;
 }
 
@@ -176,7 +178,9 @@ ColumnMap ParseColumnMap(std::string_view text, const std::string& where) {
     }
     const Role* role = RoleOf(role_name);
     if (role == nullptr) throw Error(where, fmt::format("\"{}\": unknown role \"{}\" (roles: {})", entry, role_name, RoleList()));
-    if (map.Find(role->letter) != nullptr) throw Error(where, fmt::format("\"{}\": role {} given twice", entry, role_name));
+    const bool constant_given = (role->letter == 'i' && map.current_A) || (role->letter == 'v' && map.voltage_V);
+    if (map.Find(role->letter) != nullptr || constant_given)
+      throw Error(where, fmt::format("\"{}\": role {} given twice", entry, role_name));
     ColumnSource c;
     c.role = role->letter;
     const auto close = rest.rfind(')');  // a ':' or '*' inside NAME(:,K) is not a unit or scale
@@ -201,6 +205,16 @@ ColumnMap ParseColumnMap(std::string_view text, const std::string& where) {
       factor = u->second;
     }
     c.to_record = c.scale * factor;
+    // i=VALUE, v=VALUE: a constant damper command (a number where a name would be).
+    if (double value = 0.0; (c.role == 'i' || c.role == 'v') && ParseNumber(c.source, &value)) {
+      value *= c.to_record;
+      const double max = c.role == 'i' ? kMaxAbsCurrentA : kMaxAbsVoltageV;
+      if (!(value >= 0.0 && value <= max))
+        throw Error(where, fmt::format("\"{}\": a constant damper command must be in [0, {:g}] {}", entry, max,
+                                       c.role == 'i' ? "A" : "V"));
+      (c.role == 'i' ? map.current_A : map.voltage_V) = value;
+      continue;
+    }
     map.columns.push_back(std::move(c));
   }
   for (char need : {'y', 'f'})
@@ -265,9 +279,12 @@ RigRecord RecordFromColumns(const ColumnMap& map, const std::string& path, std::
     rec.u_mm = rec.y_mm;
     rec.warnings.push_back(fmt::format("{}: no command column (u): u = y, as for a damper test", path));
   }
+  if (map.current_A) rec.i_A.assign(n, *map.current_A);
+  if (map.voltage_V) rec.v_V.assign(n, *map.voltage_V);
   if (rec.i_A.empty() && rec.v_V.empty()) {
     rec.i_A.assign(n, 0.0);
-    rec.warnings.push_back(fmt::format("{}: no damper command (i or v): i = 0 A", path));
+    rec.warnings.push_back(fmt::format("{}: no damper command (i or v): i = 0 A (a constant one: i=VALUE in the map, "
+                                       "or --current)", path));
   }
   rec.metadata.emplace_back("source", path);
   rec.metadata.emplace_back("columns", map.Describe());

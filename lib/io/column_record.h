@@ -6,7 +6,8 @@
 /// Column map: comma-separated entries ROLE=SOURCE[*SCALE][:UNIT]
 ///     ROLE    t (time), u (command), y (measured displacement), f (force), i (damper current),
 ///             v (damper voltage), r (desired displacement); or dt=STEP_S for a file without a
-///             time column
+///             time column; or i=VALUE[:UNIT] (v=VALUE[:UNIT]) for a file without a current (voltage)
+///             column, run at that constant command (a lab's damper tests at fixed currents)
 ///     SOURCE  a CSV column's name (as in its header line, quotes removed), or a .mat variable:
 ///             NAME (a vector), NAME.FIELD (a struct's field), NAME(:,K) (column K of a matrix, 1-based)
 ///     SCALE   a factor the source is multiplied by first (e.g. a DAQ's volts to engineering units)
@@ -43,6 +44,8 @@ struct ColumnSource {
 struct ColumnMap {
   std::vector<ColumnSource> columns;
   std::optional<double> dt_s;  ///< dt=STEP_S [s], for a file without a time column
+  /// i=VALUE [A] (v=VALUE [V]): a constant damper command for a file without its column.
+  std::optional<double> current_A, voltage_V;
 
   /// The entry for `role`, or nullptr.
   const ColumnSource* Find(char role) const;

@@ -74,6 +74,10 @@ bool AtSteadyState(const CurrentDriverState& s) {
   return s.e1_A_s == 0.0 && s.eq_A_s.real() == 0.0 && s.eq_A_s.imag() == 0.0;
 }
 
+CurrentDriverState StartState(const CurrentDriverParams& p, double i_first_A) {
+  return SteadyState(p.start == CurrentStart::kRest ? 0.0 : i_first_A);
+}
+
 void Hold(const CurrentDriver& d, CurrentDriverState* s, double i_cmd_A) {
   if (i_cmd_A == s->held_A) return;  // same hold: nothing to re-express (keeps e = 0 exact)
   const double delta = i_cmd_A - s->held_A;

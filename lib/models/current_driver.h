@@ -46,6 +46,15 @@ enum class CurrentFilter { kEq40, kFirstOrder };
 inline constexpr std::array<Named<CurrentFilter>, 2> kCurrentFilterNames = {
     {{CurrentFilter::kEq40, "eq40"}, {CurrentFilter::kFirstOrder, "first_order"}}};
 
+/// The driver's state when a test starts (CurrentDriverParams::start, `[plant.current_driver] start`):
+///  - kSteady: at the steady state of the first command, as if it had been held before the test
+///    (the current is set before the test starts; the default);
+///  - kRest: at rest at 0 A, as an amplifier switched on with the test: a first command that is not
+///    0 starts a transient (Eq. 40: 1 / a = 0.32 s).
+enum class CurrentStart { kSteady, kRest };
+inline constexpr std::array<Named<CurrentStart>, 2> kCurrentStartNames = {
+    {{CurrentStart::kSteady, "steady"}, {CurrentStart::kRest, "rest"}}};
+
 /// Parameters of H(s). Defaults: the paper's Eq. 40 and a 75 Hz Butterworth.
 struct CurrentDriverParams {
   CurrentFilter kind = CurrentFilter::kEq40;  ///< `[plant.current_driver] kind`
@@ -54,6 +63,7 @@ struct CurrentDriverParams {
   double lag_zero_rad_s = 28.274333882308138;  ///< Eq. 40's zero b = 9 pi [rad/s], > 0
   double lowpass_hz = 75.0;                   ///< low-pass natural frequency w_n / 2 pi [Hz], > 0
   double lowpass_zeta = 0.7071067811865476;   ///< low-pass damping, (0, 1) (1/sqrt(2): Butterworth)
+  CurrentStart start = CurrentStart::kSteady;  ///< the state at the test's start (CurrentStart)
   bool operator==(const CurrentDriverParams&) const = default;
 };
 
@@ -86,6 +96,9 @@ struct CurrentDriverState {
 
 /// The steady state for a constant current i_A [A] (held for ever): i_c = i_A exactly.
 CurrentDriverState SteadyState(double i_A);
+/// The state before a test's first step whose first command is i_first_A [A]: SteadyState(i_first_A)
+/// for CurrentStart::kSteady, SteadyState(0) for kRest.
+CurrentDriverState StartState(const CurrentDriverParams& p, double i_first_A);
 /// true when the state is exactly at the steady state of its held command (e = 0): i_c(t) = i_h
 /// for as long as the command stays i_h.
 bool AtSteadyState(const CurrentDriverState& s);

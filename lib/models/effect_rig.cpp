@@ -49,6 +49,10 @@ EffectRigModel EffectRigModel::Make(const models::PlantConfig& plant, double dt_
   if (!(std::isfinite(u.stiffness_kN_per_mm) && std::abs(u.stiffness_kN_per_mm) <= 100.0))
     throw Error("plant.unmodelled.stiffness_kN_per_mm",
                 fmt::format("{} is out of range [-100, 100]", u.stiffness_kN_per_mm));
+  if (!(std::isfinite(u.fade_start) && u.fade_start >= 0.1 && u.fade_start <= 10.0))
+    throw Error("plant.unmodelled.fade_start", fmt::format("{} is out of range [0.1, 10]", u.fade_start));
+  if (!(std::isfinite(u.fade_per_s) && std::abs(u.fade_per_s) <= 1.0))
+    throw Error("plant.unmodelled.fade_per_s", fmt::format("{} is out of range [-1, 1]", u.fade_per_s));
   EffectRigModel m;
   m.rig = LinearRig::Make(plant.actuator, dt_s, damper, plant.damper, plant.cvode_rtol, plant.current_dynamics,
                           plant.current_driver);
@@ -63,6 +67,7 @@ EffectRig::EffectRig(const EffectRigModel& model)
     : m_(model),
       disp_(model.effects, model.rig.servo.dt_s),
       force_(model.effects, model.rig.servo.dt_s),
+      meas_(model.effects, model.rig.servo.dt_s),
       scratch_(disp_),
       noise_(signal::MakeGaussian(EffectNoiseSeed(model.noise_seed))),
       ode_(5, model.rig.rtol, AbsTol(model.rig), &EffectRig::Rhs, this) {
@@ -120,14 +125,17 @@ double EffectRig::Trial(double x0, double x1, const LinearServoState& next, doub
     const double ydot = OutputVelocity(rig.servo, next) + dv_ + r1.mm_s;
     force = DamperForceKn(CoefficientsAt(rig.damper, i_end_A), *damper, y1, ydot);
   }
-  return force_.Force(force) + m_.unmodelled.stiffness_kN_per_mm * y1;
+  // The fading damper (outside the library) at t_{k+1}, bounded so that a long run cannot reverse it.
+  const double fade = std::clamp(m_.unmodelled.FadeAt(static_cast<double>(k_ + 1) * rig.servo.dt_s), 0.05, 10.0);
+  return fade * force_.Force(force) + m_.unmodelled.stiffness_kN_per_mm * y1;
 }
 
 void EffectRig::Step(double u_mm, double i_cmd_A) {
   const LinearRig& rig = m_.rig;
-  if (k_ == 0) {  // the current is set before the test starts: every lag at its steady state
-    force_.Reset(i_cmd_A);
-    current_ = SteadyState(i_cmd_A);
+  if (k_ == 0) {  // [plant.current_driver] start: every lag at the first command's steady state, or at rest
+    const bool rest = rig.driver.params.start == CurrentStart::kRest;
+    force_.Reset(rest ? 0.0 : i_cmd_A);
+    current_ = StartState(rig.driver.params, i_cmd_A);
   }
   // Force path, current: the extra lag, then the model's own current dynamics.
   const double i_lag = force_.Current(i_cmd_A);
@@ -183,8 +191,15 @@ void EffectRig::Step(double u_mm, double i_cmd_A) {
 }
 
 void EffectRig::Measure() {
-  double y = y_;
-  double f = f_;
+  // The specimen's acceleration at t_k: the servo's own y'' (exact) plus the second backward
+  // difference of what the displacement effects add to it (load_cell_inertia only).
+  const double dt = m_.rig.servo.dt_s;
+  const double d = y_ - Output(m_.rig.servo, servo_);
+  const double a = servo_.z(2) + (k_ >= 2 ? (d - 2.0 * d_prev_ + d_prev2_) / (dt * dt) : 0.0);
+  d_prev2_ = d_prev_;
+  d_prev_ = d;
+  double y = 0.0, f = 0.0;
+  meas_.Measure(y_, a, f_, &y, &f);
   if (m_.unmodelled.ripple_mm > 0.0) {
     const double t = static_cast<double>(k_) * m_.rig.servo.dt_s;
     y += m_.unmodelled.ripple_mm * std::sin(kTwoPi * m_.unmodelled.ripple_hz * t);

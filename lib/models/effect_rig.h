@@ -19,7 +19,9 @@
 ///             with x(t), x'(t) the servo's continuous motion (its states in the same ODE)
 ///     f_{k+1} = ForceEffects::Force(F_{k+1}) + k_u y_{k+1}     damper_scale; unmodelled spring
 ///             F_{k+1} = Eq. 34 at y_{k+1}, y'(t_{k+1}^-), i_c(t_{k+1})
-///     measured: y_m = y_{k+1} + a sin(2 pi f_r t_{k+1}) + n_y,  f_m = f_{k+1} + n_f
+///     (y_s, f_s) = MeasurementEffects::Measure(y_{k+1}, a_{k+1}, f_{k+1})  load_cell_inertia
+///             (+ m a, a the servo's y'' plus the effects' second difference), channel_skew
+///     measured: y_m = y_s + a sin(2 pi f_r t_{k+1}) + n_y,  f_m = f_s + n_f
 ///
 /// (*) The choice of the specimen motion inside a step: the servo's own continuous motion plus
 /// a linear interpolation of what the effects add at the samples. Without displacement effects
@@ -113,6 +115,7 @@ class EffectRig final : public Rig {
   const EffectRigModel m_;
   DisplacementEffects disp_;
   ForceEffects force_;
+  MeasurementEffects meas_;
   DisplacementEffects scratch_;   // load_coupling: trial copy of disp_ (same sizes)
   signal::GaussianState noise_;
   LinearServoState servo_{};
@@ -130,6 +133,7 @@ class EffectRig final : public Rig {
   double y_ = 0.0, f_ = 0.0;      // true specimen displacement and force
   double y_meas_ = 0.0, f_meas_ = 0.0;
   double f_prev_ = 0.0;           // load_coupling: f_{k-1}, for the first trial
+  double d_prev_ = 0.0, d_prev2_ = 0.0;  // y - x at the last two samples (the effects' acceleration)
   std::int64_t k_ = 0;
   std::int64_t unconverged_steps_ = 0;
   OdeStepper ode_;

@@ -19,7 +19,7 @@ class RigAdapter final : public Rig {
  public:
   explicit RigAdapter(const Model& rig) : rig_(rig), stepper_(rig_) {}
   void Step(double u_mm, double i_cmd_A) override {
-    if (k_ == 0) state_.current = SteadyState(i_cmd_A);  // current set before the test
+    if (k_ == 0) state_.current = StartState(rig_.driver.params, i_cmd_A);  // [plant.current_driver] start
     stepper_.Step(&state_, u_mm, i_cmd_A);
     ++k_;
   }
@@ -56,7 +56,7 @@ class IdealRig final : public Rig {
     v_ = 0.0;
   }
   void Step(double r_mm, double i_cmd_A) override {
-    if (k_ == 0) state_ = SteadyState(i_cmd_A);  // current set before the test
+    if (k_ == 0) state_ = StartState(driver_.params, i_cmd_A);  // [plant.current_driver] start
     if (current_dynamics_) {
       Hold(driver_, &state_, i_cmd_A);
     } else {

@@ -39,7 +39,7 @@ constexpr EffectParam kNoParam{};
 
 }  // namespace
 
-const std::array<EffectInfo, 13> kEffects = {{
+const std::array<EffectInfo, 15> kEffects = {{
     {"pure_delay", 'y', true,
      {{{"tau_ms", 0.0, 100.0, false, false, 0.0, true, true, 0.0, 40.0, false, 81, 0.0, false,
         FieldOf<&EffectSet::pure_delay, &PureDelay::tau_ms>},
@@ -119,6 +119,21 @@ const std::array<EffectInfo, 13> kEffects = {{
        {"amplitude_mm", 0.0, 10.0, false, false, 0.0, true, true, 1e-6, 10.0, true, 0, 0.0, false,
         FieldOf<&EffectSet::supply_ripple, &SupplyRipple::amplitude_mm>}}},
      2, TurnOn<&EffectSet::supply_ripple>, IsOn<&EffectSet::supply_ripple>},
+    // A DAQ's channel skew: from a fraction of a sample to a few ms; searched over +-10 ms (81
+    // points, then golden section): beyond, the records' own pairing is wrong, not the DAQ's.
+    {"channel_skew", 'f', true,
+     {{{"skew_ms", -20.0, 20.0, false, false, 0.0, true, true, -10.0, 10.0, false, 81, 0.0, false,
+        FieldOf<&EffectSet::channel_skew, &ChannelSkew::skew_ms>},
+       kNoParam}},
+     1, TurnOn<&EffectSet::channel_skew>, IsOn<&EffectSet::channel_skew>},
+    // grid 0: closed form (least squares of the measured force on the modelled one and the
+    // damper's smoothed acceleration, with damper_scale when both are in the set); searched in
+    // [0.01, 1e4] kg on a log axis (a negative least-squares mass ends at 0.01: at a bound).
+    {"load_cell_inertia", 'f', true,
+     {{{"mass_kg", 0.0, 1e4, false, false, 0.0, true, true, 0.01, 1e4, true, 0, 0.0, false,
+        FieldOf<&EffectSet::load_cell_inertia, &LoadCellInertia::mass_kg>},
+       kNoParam}},
+     1, TurnOn<&EffectSet::load_cell_inertia>, IsOn<&EffectSet::load_cell_inertia>},
 }};
 
 const EffectInfo* FindEffect(std::string_view name) {
@@ -308,6 +323,86 @@ RippleMotion SupplyRippleAt(const SupplyRipple& r, double dt_s, double t_s) {
     m.mm_s += a * w * std::cos(w * t_s + kRipplePhases[h]);
   }
   return m;
+}
+
+double ShiftedSample(std::span<const double> x, double pos) {
+  const auto n = static_cast<std::ptrdiff_t>(x.size());
+  if (n == 0) return 0.0;
+  const double fl = std::floor(pos);
+  const auto j = static_cast<std::ptrdiff_t>(fl);
+  const double t = pos - fl;  // in [0, 1)
+  auto at = [&](std::ptrdiff_t i) { return x[static_cast<std::size_t>(std::clamp<std::ptrdiff_t>(i, 0, n - 1))]; };
+  if (t == 0.0) return at(j);
+  // Lagrange weights on the nodes -1, 0, 1, 2 at t.
+  const double wm = -t * (t - 1.0) * (t - 2.0) / 6.0;
+  const double w0 = (t + 1.0) * (t - 1.0) * (t - 2.0) / 2.0;
+  const double w1 = -(t + 1.0) * t * (t - 2.0) / 2.0;
+  const double w2 = (t + 1.0) * t * (t - 1.0) / 6.0;
+  return wm * at(j - 1) + w0 * at(j) + w1 * at(j + 1) + w2 * at(j + 2);
+}
+
+std::vector<double> ShiftSamples(std::span<const double> x, double skew_s, double dt_s) {
+  std::vector<double> y(x.begin(), x.end());
+  if (skew_s == 0.0) return y;
+  const double d = skew_s / dt_s;
+  for (std::size_t k = 0; k < y.size(); ++k) y[k] = ShiftedSample(x, static_cast<double>(k) - d);
+  return y;
+}
+
+MeasurementEffects::MeasurementEffects(const EffectSet& effects, double dt_s) {
+  if (!(dt_s > 0) || !std::isfinite(dt_s)) throw Error("MeasurementEffects", "dt_s must be > 0");
+  effects.Validate(dt_s, "");
+  if (effects.load_cell_inertia) mass_kg_ = effects.load_cell_inertia->mass_kg;
+  if (effects.channel_skew && effects.channel_skew->skew_ms != 0.0) {
+    const double skew_s = 1e-3 * effects.channel_skew->skew_ms;
+    delay_force_ = skew_s > 0.0;
+    delay_samples_ = std::abs(skew_s) / dt_s;
+    line_.assign(static_cast<std::size_t>(std::floor(delay_samples_)) + 4, 0.0);
+  }
+  Reset();
+}
+
+void MeasurementEffects::Reset() {
+  std::fill(line_.begin(), line_.end(), 0.0);
+  head_ = 0;
+  count_ = 0;
+}
+
+double MeasurementEffects::Delay(double v) {
+  const std::size_t n = line_.size();
+  head_ = (head_ + 1) % n;
+  line_[head_] = v;
+  count_ = std::min(count_ + 1, n);
+  // back(b): the value b samples ago (b = 0: v); before the line filled, the oldest one.
+  auto back = [&](std::size_t b) { return line_[(head_ + n - std::min(b, count_ - 1)) % n]; };
+  // The newest four samples that bracket t_k - d: nodes b0 + 2 .. b0 - 1 samples ago with
+  // b0 = max(floor(d), 1) - 1 ... i.e. the interval [floor(d), floor(d) + 1] ago, centred when
+  // the line allows, else shifted towards the present (d < 1).
+  const double fl = std::floor(delay_samples_);
+  const double t = delay_samples_ - fl;  // fraction of a sample beyond floor(d) ago
+  const auto m = static_cast<std::size_t>(fl);
+  if (t == 0.0) return back(m);
+  // Nodes at m - 1, m, m + 1, m + 2 samples ago (position -(m + t) between m and m + 1 ago); for
+  // m = 0 the node 'm - 1 ago' is in the future: use m .. m + 3 ago instead.
+  const std::size_t b0 = m == 0 ? 0 : m - 1;
+  const double pos = static_cast<double>(m) + t - static_cast<double>(b0);  // in samples ago from b0
+  // Lagrange on nodes 0, 1, 2, 3 (samples ago from b0) at pos.
+  const double l0 = -(pos - 1.0) * (pos - 2.0) * (pos - 3.0) / 6.0;
+  const double l1 = pos * (pos - 2.0) * (pos - 3.0) / 2.0;
+  const double l2 = -pos * (pos - 1.0) * (pos - 3.0) / 2.0;
+  const double l3 = pos * (pos - 1.0) * (pos - 2.0) / 6.0;
+  return l0 * back(b0) + l1 * back(b0 + 1) + l2 * back(b0 + 2) + l3 * back(b0 + 3);
+}
+
+void MeasurementEffects::Measure(double y_mm, double a_mm_s2, double f_kN, double* y_meas_mm, double* f_meas_kN) {
+  double f = f_kN + 1e-6 * mass_kg_ * a_mm_s2;
+  double y = y_mm;
+  if (!line_.empty()) {
+    if (delay_force_) f = Delay(f);
+    else y = Delay(y);
+  }
+  *y_meas_mm = y;
+  *f_meas_kN = f;
 }
 
 ForceEffects::ForceEffects(const EffectSet& effects, double dt_s) : e_(effects) {

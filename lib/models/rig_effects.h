@@ -13,7 +13,8 @@
 ///                           --[load_coupling (- c f)]--[coulomb_friction]--[presliding_friction]
 ///                           --[backlash]--[supply_ripple (+)]--> y_k
 ///   force path          i_k --[current_lag]--> model's current dynamics (Eq. 40 + 75 Hz) --> i_c
-///                       damper model (Eqs. 32-39) at (y, y', i_c) --[damper_scale]--> f_k
+///                       damper model (Eqs. 32-39) at (y, y', i_c) --[damper_scale]
+///                           --[load_cell_inertia (+ m y'')]--[channel_skew]--> f_k
 ///   both channels       + sensor_noise (rig mode only: the diagnosis never adds noise)
 ///
 /// Every block is an immutable description (the parameters and dt) plus a per-step state; the
@@ -38,8 +39,15 @@ struct UnmodelledConfig {
   /// Extra spring force on the measured force (e.g. an accumulator): f += k y, y the specimen
   /// displacement before noise [kN/mm], [-100, 100].
   double stiffness_kN_per_mm = 0.0;
+  /// A damper force that fades over the test (the fluid heats): the damper's force is multiplied by
+  /// fade_start + fade_per_s t_k, t_k = k dt from the rig's start. fade_start [0.1, 10] (1: off) ...
+  double fade_start = 1.0;
+  /// ... and its change per second [1/s], [-1, 1] (0: off); the product must stay in [0.05, 10].
+  double fade_per_s = 0.0;
+  /// The damper force's factor at t_s [s].
+  double FadeAt(double t_s) const { return fade_start + fade_per_s * t_s; }
   /// true if every disturbance is off.
-  bool Empty() const { return ripple_mm == 0.0 && stiffness_kN_per_mm == 0.0; }
+  bool Empty() const { return ripple_mm == 0.0 && stiffness_kN_per_mm == 0.0 && fade_start == 1.0 && fade_per_s == 0.0; }
   bool operator==(const UnmodelledConfig&) const = default;
 };
 
@@ -107,6 +115,17 @@ struct SensorNoise { double rms_y_mm = 0.0; double rms_f_kN = 0.0; bool operator
 struct CurrentLag { double tau_ms = 0.0; bool operator==(const CurrentLag&) const = default; };                         ///< [0, 1000] ms
 /// Damper force level drift: f = scale * f_model.
 struct DamperScale { double scale = 1.0; bool operator==(const DamperScale&) const = default; };                         ///< [0.1, 10]
+/// A time offset between the force channel and the displacement channel of the DAQ (channels
+/// sampled in turn, anti-alias filters of different delays): the force recorded at t_k is the force
+/// at t_k - skew, f_meas(t_k) = f(t_k - skew) (skew > 0: the force channel lags the displacement
+/// channel). Offline (the diagnosis, the blocks generator) the shift is the 4-point Lagrange
+/// interpolant of the samples (ShiftedSample); the rig mode, causal, delays the force channel for
+/// skew > 0 and the displacement channel (which the controller then sees late) for skew < 0.
+struct ChannelSkew { double skew_ms = 0.0; bool operator==(const ChannelSkew&) const = default; };  ///< [-20, 20] ms
+/// The mass between the load cell and the damper (piston rod, clevis, fixture): the load cell
+/// carries the damper's force plus the force that accelerates it,
+///     f_measured = f_damper + m y'' 1e-6   [kN] (m [kg], y'' [mm/s^2]).
+struct LoadCellInertia { double mass_kg = 0.0; bool operator==(const LoadCellInertia&) const = default; };  ///< [0, 1e4] kg
 
 /// Which effects are on, with their parameters. Default: none (the nominal model).
 struct EffectSet {
@@ -123,6 +142,8 @@ struct EffectSet {
   std::optional<CurrentLag> current_lag;
   std::optional<DamperScale> damper_scale;
   std::optional<SupplyRipple> supply_ripple;
+  std::optional<ChannelSkew> channel_skew;
+  std::optional<LoadCellInertia> load_cell_inertia;
 
   bool Empty() const;
   /// Throws rths::Error naming the effect and parameter out of its range (ranges above) for a
@@ -179,7 +200,7 @@ struct EffectInfo {
 
 /// The effect library: one entry per effect. Adding an effect is one entry here (plus its
 /// struct above, its member of EffectSet and its block in the classes below).
-extern const std::array<EffectInfo, 13> kEffects;
+extern const std::array<EffectInfo, 15> kEffects;
 /// The entry called `name`, or nullptr.
 const EffectInfo* FindEffect(std::string_view name);
 
@@ -224,6 +245,39 @@ class DisplacementEffects {
   double dahl_z_ = 0.0;        // presliding friction's lost motion [mm]
   double x_last_ = 0.0;        // the actuator output given to the last Post (command_dead_band)
   std::size_t post_k_ = 0;     // the sample index of the next Post (supply_ripple's t_k)
+};
+
+/// x_k at the fractional sample position pos (in samples, any real): the 4-point Lagrange
+/// interpolant through the samples j - 1 .. j + 2, j = floor(pos), indices clamped to [0, n - 1]
+/// (the record held at its ends). Exact for cubics; at 0.1 of the sample rate its error is
+/// about 2e-4 of the amplitude.
+double ShiftedSample(std::span<const double> x, double pos);
+/// x shifted by skew_s [s] at step dt_s [s]: y_k = x(t_k - skew_s) by ShiftedSample (skew > 0: a
+/// delay). skew_s = 0 returns x.
+std::vector<double> ShiftSamples(std::span<const double> x, double skew_s, double dt_s);
+
+/// The force channel's measurement in the rig mode: load_cell_inertia adds m a to the damper's
+/// force (the load cell also accelerates the mass between it and the damper), channel_skew delays
+/// the force channel (skew > 0) or the displacement channel (skew < 0) by |skew|, through a
+/// delay line of the last samples and a 4-point Lagrange interpolant over the newest four that
+/// bracket t_k - |skew| (causal). Allocates only at construction.
+class MeasurementEffects {
+ public:
+  MeasurementEffects(const EffectSet& effects, double dt_s);
+  void Reset();
+  /// Sample k: the specimen's displacement y_k [mm], its acceleration a_k [mm/s^2] and the damper's
+  /// force f_k [kN] (after damper_scale) -> the measured displacement and force (before noise).
+  void Measure(double y_mm, double a_mm_s2, double f_kN, double* y_meas_mm, double* f_meas_kN);
+
+ private:
+  /// Pushes v into the delay line and returns its value |skew| ago (before the line holds enough
+  /// samples, the oldest one stands in: the rig was at rest before its first sample).
+  double Delay(double v);
+  double mass_kg_ = 0.0;
+  double delay_samples_ = 0.0;  // |skew| / dt
+  bool delay_force_ = true;     // skew >= 0: the force channel lags, else the displacement channel
+  std::vector<double> line_;    // the delayed channel's last samples, newest at head_
+  std::size_t head_ = 0, count_ = 0;
 };
 
 /// The force path's effects: current_lag before the model's current dynamics, damper_scale

@@ -71,6 +71,7 @@ void PlantFields(V& v, models::PlantConfig& p, const Context& cx) {
     t.Number("lag_zero_rad_s", d.lag_zero_rad_s, OpenClosed(0.0, 1e6));
     t.Number("lowpass_hz", d.lowpass_hz, OpenClosed(0.0, 1e6));
     t.Number("lowpass_zeta", d.lowpass_zeta, {0.0, 1.0, true, true});
+    t.Choice("start", d.start, models::kCurrentStartNames);
   });
   v.Table("unmodelled", [&](V& t) {
     models::UnmodelledConfig& u = p.unmodelled;
@@ -80,6 +81,8 @@ void PlantFields(V& v, models::PlantConfig& p, const Context& cx) {
               u.ripple_mm > 0.0 ? "a ripple needs a frequency below the Nyquist frequency 0.5/run.dt_s"
                                 : "below the Nyquist frequency 0.5/run.dt_s"});
     t.Number("stiffness_kN_per_mm", u.stiffness_kN_per_mm, Closed(-100.0, 100.0));
+    t.Number("fade_start", u.fade_start, Closed(0.1, 10.0));
+    t.Number("fade_per_s", u.fade_per_s, Closed(-1.0, 1.0));
   });
   v.Effects("effects", p.effects, p.load_coupling_same_sample);
 }

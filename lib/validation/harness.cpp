@@ -28,7 +28,8 @@ const std::vector<std::string> kPairs = {"pure_delay+damper_scale", "gain_error+
                                          "backlash+damper_scale", "load_coupling+current_lag",
                                          "oil_column_resonance+coulomb_friction", "presliding_friction+damper_scale",
                                          "command_dead_band+current_lag", "pure_delay+presliding_friction",
-                                         "gain_error+supply_ripple"};
+                                         "gain_error+supply_ripple", "channel_skew+current_lag",
+                                         "load_cell_inertia+damper_scale", "presliding_friction@short+oil_column_resonance"};
 
 std::vector<std::string> Split(const std::string& s) {
   std::vector<std::string> out;
@@ -48,16 +49,21 @@ const std::vector<std::string> kIndependentPairs = {
     "load_coupling+gain_error", "backlash+oil_column_resonance",         "pure_delay+damper_scale",
     "gain_error+current_lag",   "oil_column_resonance+coulomb_friction", "servovalve_saturation+current_lag",
     "presliding_friction+damper_scale", "command_dead_band+oil_column_resonance", "pure_delay+presliding_friction",
-    "oil_column_resonance+supply_ripple"};
+    "oil_column_resonance+supply_ripple",
+    // Short-travel presliding (issue 42) beside each kind of effect it was missed with.
+    "presliding_friction@short+oil_column_resonance", "presliding_friction@short+load_coupling",
+    "presliding_friction@short+damper_scale", "presliding_friction@short+command_dead_band",
+    "presliding_friction@short+supply_ripple", "presliding_friction@short+servovalve_saturation",
+    // The flow limit inside the loop beside a force effect; the DAQ's effects beside the damper's.
+    "servovalve_saturation@loop+damper_scale", "channel_skew+damper_scale", "load_cell_inertia+current_lag"};
 
 }  // namespace
 
 std::vector<std::string> HarnessCaseKinds(bool pairs) {
   std::vector<std::string> k = kSingles;
+  k.push_back("presliding_friction@short");
   if (pairs) k.insert(k.end(), kPairs.begin(), kPairs.end());
-  k.push_back("none");
-  k.push_back("unknown_ripple");
-  k.push_back("unknown_stiffness");
+  for (const char* c : {"none", "none_current_on", "unknown_ripple", "unknown_stiffness", "unknown_heating"}) k.emplace_back(c);
   return k;
 }
 
@@ -66,8 +72,10 @@ std::vector<std::string> IndependentCaseKinds(bool pairs) {
   if (pairs) k.insert(k.end(), kIndependentPairs.begin(), kIndependentPairs.end());
   // Variants of a single effect (kind@variant: the truth is the effect): the flow limit inside the
   // servo loop, and a test record too slow to reach the limit (the verdict may only be unconfirmed).
-  for (const char* s : {"servovalve_saturation@loop", "servovalve_saturation@unreached"}) k.emplace_back(s);
-  for (const char* s : {"none", "none_white", "none_drift", "unknown_ripple", "unknown_cubic", "unknown_asymmetric"})
+  for (const char* s : {"servovalve_saturation@loop", "servovalve_saturation@unreached", "presliding_friction@short"})
+    k.emplace_back(s);
+  for (const char* s : {"none", "none_white", "none_drift", "none_current_on", "unknown_ripple", "unknown_cubic",
+                        "unknown_asymmetric", "unknown_heating"})
     k.emplace_back(s);
   return k;
 }
@@ -109,6 +117,17 @@ std::string DrawIndependentTruth(const std::string& kind, signal::GaussianState*
       t.presliding_loss_mm = U(0.05, 0.3);
       t.presliding_rho = U(0.5, 0.9);
       txt += fmt::format("loss_mm={:.3g} rho={:.3g} ", t.presliding_loss_mm, t.presliding_rho);
+    } else if (e == "presliding_friction@short") {
+      // A short presliding travel: the output creeps at 0.1-0.25 of the input's rate after a reversal.
+      t.presliding_loss_mm = U(0.04, 0.09);
+      t.presliding_rho = U(0.75, 0.9);
+      txt += fmt::format("loss_mm={:.3g} rho={:.3g} (short travel) ", t.presliding_loss_mm, t.presliding_rho);
+    } else if (e == "channel_skew") {
+      t.skew_ms = U(0.2, 3.0);
+      txt += fmt::format("skew_ms={:.3g} ", t.skew_ms);
+    } else if (e == "load_cell_inertia") {
+      t.cell_mass_kg = U(30.0, 150.0);
+      txt += fmt::format("mass_kg={:.3g} ", t.cell_mass_kg);
     } else if (e == "command_dead_band") {
       t.dead_band_mm = U(0.1, 0.6);
       txt += fmt::format("width_mm={:.3g} ", t.dead_band_mm);
@@ -133,6 +152,16 @@ std::string DrawIndependentTruth(const std::string& kind, signal::GaussianState*
       t.colour = NoiseColour::kWhite;
       t.drift_fraction = 0.0;
       txt += "white noise ";
+    } else if (e == "none_current_on") {
+      t.driver_at_rest = true;  // the excitation's current is on at its first sample (IndependentHarnessCase)
+      txt += "current on at the first sample, driver at rest ";
+    } else if (e == "unknown_heating") {
+      // The damper's force scale falls from 1 to 0.82-0.88 over the training record (lower again in
+      // the test: IndependentHarnessCase): not a constant damper_scale.
+      const double end = U(0.82, 0.88);
+      t.damper_scale = 0.5 * (1.0 + end);
+      t.damper_scale_drift = (end - 1.0) / t.damper_scale;
+      txt += fmt::format("damper heating: scale 1 -> {:.3g} over the training record ", end);
     } else if (e == "none_drift") {
       t.walk_fraction = U(0.5, 1.5);
       txt += fmt::format("sensor drift: random walk of {:.3g} x the noise rms ", t.walk_fraction);
@@ -204,12 +233,28 @@ IndependentCase IndependentHarnessCase(const std::string& kind, std::uint64_t se
   }
   te.current = varying[pick(3)];
   te.current_period_s = te.current == CurrentPattern::kStaircase ? U(0.3, 0.8) : U(0.6, 2.0);
+  c.truth_test = t;
+  if (kind == "none_current_on") {
+    // Training starts at rest with the current already on (the driver at rest: DrawIndependentTruth);
+    // the test does too, or starts at 0 A.
+    tr.current_start_A = U(0.6, 2.2);
+    if (signal::NextUniform(&g) < 0.5) te.current_start_A = U(0.6, 2.2);
+  }
+  if (kind == "unknown_heating") {
+    // The test continues below where the training record ended.
+    const double end = t.damper_scale * (1.0 + 0.5 * t.damper_scale_drift);
+    const double te0 = end * U(0.97, 1.0), te1 = end * U(0.88, 0.94);
+    c.truth_test.damper_scale = 0.5 * (te0 + te1);
+    c.truth_test.damper_scale_drift = (te1 - te0) / c.truth_test.damper_scale;
+  }
   auto ex_text = [](const IndependentExcitation& x) {
     return x.command == CommandFamily::kEarthquake
                ? fmt::format("{} fn={:.2g}Hz/{}", Name(x.command), x.lo_hz, Name(x.current))
                : fmt::format("{} {:.3g}-{:.3g}Hz/{}", Name(x.command), x.lo_hz, x.hi_hz, Name(x.current));
   };
-  c.text = txt + fmt::format("| train {} | test {}", ex_text(tr), ex_text(te));
+  c.text = txt + fmt::format("| train {}{} | test {}{}", ex_text(tr),
+                             tr.current_start_A > 0 ? fmt::format(" on at {:.2g} A", tr.current_start_A) : "", ex_text(te),
+                             te.current_start_A > 0 ? fmt::format(" on at {:.2g} A", te.current_start_A) : "");
   return c;
 }
 
@@ -243,6 +288,25 @@ Truth HarnessTruth(const std::string& kind, std::uint64_t seed, double noise_y_m
     } else if (e == "backlash") {
       t.effects.backlash = models::Backlash{U(0.1, 0.6)};
       txt += fmt::format("gap_mm={:.3g} ", t.effects.backlash->gap_mm);
+    } else if (e == "presliding_friction@short") {
+      // A short travel (Dahl stiffness 1 / travel = 30-50 per mm): the output creeps at 0.1-0.25 of the input's rate.
+      t.effects.presliding_friction = models::PreslidingFriction{U(0.04, 0.09), 1.0 / U(30.0, 50.0)};
+      txt += fmt::format("loss_mm={:.3g} travel_mm={:.3g} (short travel) ", t.effects.presliding_friction->loss_mm,
+                         t.effects.presliding_friction->travel_mm);
+    } else if (e == "channel_skew") {
+      t.effects.channel_skew = models::ChannelSkew{U(0.2, 3.0)};
+      txt += fmt::format("skew_ms={:.3g} ", t.effects.channel_skew->skew_ms);
+    } else if (e == "load_cell_inertia") {
+      t.effects.load_cell_inertia = models::LoadCellInertia{U(30.0, 150.0)};
+      txt += fmt::format("mass_kg={:.3g} ", t.effects.load_cell_inertia->mass_kg);
+    } else if (e == "none_current_on") {
+      t.driver_at_rest = true;  // and a current on at the first sample (RunHarnessCase)
+      txt += "current on at the first sample, driver at rest ";
+    } else if (e == "unknown_heating") {
+      // The damper's force falls from 1 to 0.82-0.88 of the model's over a 20 s training record
+      // (RunHarnessCase continues it lower in the test).
+      t.fade_per_s = (U(0.82, 0.88) - 1.0) / 20.0;  // per 20 s; RunHarnessCase scales it to the record
+      txt += fmt::format("damper heating: force x 1 -> {:.3g} over the training record ", 1.0 + 20.0 * t.fade_per_s);
     } else if (e == "presliding_friction") {
       t.effects.presliding_friction = models::PreslidingFriction{U(0.05, 0.3), U(0.1, 0.5)};
       txt += fmt::format("loss_mm={:.3g} travel_mm={:.3g} ", t.effects.presliding_friction->loss_mm,
@@ -293,7 +357,7 @@ HarnessCase RunHarnessCase(const std::string& kind, std::uint64_t seed, const Ha
     IndependentCase ic = IndependentHarnessCase(kind, seed, o.duration_s, o.noise_y_mm, o.noise_f_kN);
     for (IndependentExcitation* ex : {&ic.train, &ic.test}) ex->ground_g = o.ground_g;
     c.params = ic.text;
-    IndependentTruth ttr = ic.truth, tte = ic.truth;
+    IndependentTruth ttr = ic.truth, tte = ic.truth_test;
     tte.noise_seed = ic.truth.noise_seed + 99991;
     rtr = MakeIndependentRecord(ic.train, ttr, fmt::format("{}-s{}-train", kind, seed));
     rte = MakeIndependentRecord(ic.test, tte, fmt::format("{}-s{}-test", kind, seed));
@@ -312,6 +376,18 @@ HarnessCase RunHarnessCase(const std::string& kind, std::uint64_t seed, const Ha
     te.hold_max_s = 1.5;
     Truth ttr = truth, tte = truth;
     tte.noise_seed = truth.noise_seed + 99991;
+    if (kind == "none_current_on") {
+      // Training starts with the current on (the driver at rest); the test on at another level.
+      tr.current_start_A = 0.6 + 0.4 * static_cast<double>(seed % 5);
+      te.current_start_A = 2.2 - 0.4 * static_cast<double>(seed % 4);
+    }
+    if (kind == "unknown_heating") {
+      // The drawn fall over the training record whatever its length; the test continues where the
+      // training record ended, and falls on at half the rate.
+      ttr.fade_per_s = truth.fade_per_s * 20.0 / o.duration_s;
+      tte.fade_start = ttr.fade_start + ttr.fade_per_s * o.duration_s;
+      tte.fade_per_s = 0.5 * ttr.fade_per_s;
+    }
     const auto make = o.generator == Generator::kRig ? &MakeRecordRig : &MakeRecordBlocks;
     rtr = make(tr, ttr, fmt::format("{}-s{}-train", kind, seed));
     rte = make(te, tte, fmt::format("{}-s{}-test", kind, seed));
@@ -323,8 +399,14 @@ HarnessCase RunHarnessCase(const std::string& kind, std::uint64_t seed, const Ha
   if (o.verbose) std::printf("--- %s seed %llu [%s]\n%s", kind.c_str(), static_cast<unsigned long long>(seed), c.params.c_str(), diagnosis::Summary(r).c_str());
   auto v = r.verdict;
   std::sort(v.begin(), v.end());
-  c.right = v == c.truth;
-  for (const auto& e : r.effects) c.unconfirmed = c.unconfirmed || !e.unconfirmed.empty();
+  for (const auto& e : r.effects) {
+    c.unconfirmed = c.unconfirmed || !e.unconfirmed.empty();
+    c.drift = c.drift || (e.selected && !e.drift.empty());
+  }
+  // A damper that heats over the test is outside the library: right if unknown, or named
+  // damper_scale with its drift (never damper_scale as a constant).
+  c.right = kind == "unknown_heating" ? v == c.truth || (v == std::vector<std::string>{"damper_scale"} && c.drift)
+                                      : v == c.truth;
   if (c.right && !c.unconfirmed && c.truth[0] != "none" && c.truth[0] != "unknown") {
     std::set<std::string> chans;
     for (const auto& e : r.effects)
@@ -370,7 +452,7 @@ HarnessScore ScoreHarness(const std::vector<HarnessCase>& cases) {
     } else if (is_unk) {
       ++sc.unknown_n;
       sc.unknown_right += c.right;
-      sc.unknown_as_effect += named_effect;
+      sc.unknown_as_effect += named_effect && !c.right;  // a heating damper named with its drift is right
     } else if (c.truth.size() == 1) {
       ++sc.single_n;
       sc.single_right += c.right;
@@ -408,7 +490,8 @@ HarnessScore ScoreHarness(const std::vector<HarnessCase>& cases) {
 std::string FormatCase(const HarnessCase& c) {
   return fmt::format("{:<38} seed {:2} {:<5} verdict {:<44} shrink {:6.1f} %  {:5.2f} s  [{}]\n", c.kind, c.seed,
                      c.right ? "RIGHT" : "wrong",
-                     fmt::format("{}{}", fmt::join(c.verdict, ","), c.unconfirmed ? " (unconfirmed)" : ""), c.shrink_pct,
+                     fmt::format("{}{}{}", fmt::join(c.verdict, ","), c.unconfirmed ? " (unconfirmed)" : "",
+                                 c.drift ? " (drifting)" : ""), c.shrink_pct,
                      c.runtime_s, c.params);
 }
 

@@ -54,6 +54,8 @@ struct HarnessCase {
   /// The verdict names an effect as unconfirmed (the test records do not exercise it): no held-out
   /// shrink to show, so the case is left out of the shrink means.
   bool unconfirmed = false;
+  /// The verdict names an effect as drifting over the records (EffectResult::drift).
+  bool drift = false;
   double runtime_s = 0;
 };
 
@@ -82,7 +84,8 @@ std::vector<std::string> CaseKinds(Generator g, bool pairs);
 /// and its training and test excitations (families drawn from the seed, the test's always another
 /// family than the training's). Throws rths::Error for an unknown kind.
 struct IndependentCase {
-  IndependentTruth truth;
+  IndependentTruth truth;       ///< the training record's
+  IndependentTruth truth_test;  ///< the test record's (the same but for a damper that goes on heating)
   IndependentExcitation train, test;
   std::string text;  ///< parameters and excitations, as text
 };
@@ -107,6 +110,7 @@ struct HarnessScore {
   int single_n = 0, single_right = 0;
   int pair_n = 0, pair_right = 0;
   int none_n = 0, none_right = 0, none_as_effect = 0;
+  /// unknown_as_effect: named a library effect as if constant (not a drifting one, which is right).
   int unknown_n = 0, unknown_right = 0, unknown_as_effect = 0;
   double single_shrink_mean = 0;   ///< over correctly identified single-effect cases
   std::string table;               ///< confusion table and shrink per effect, as text

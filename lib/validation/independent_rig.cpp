@@ -197,7 +197,21 @@ std::vector<double> Earthquake(const IndependentExcitation& ex, std::size_t n) {
   return u;
 }
 
+std::vector<double> Pattern(const IndependentExcitation& ex, std::size_t n, signal::GaussianState* g);
+
+/// The current command: the pattern, on at current_start_A from the first sample until the pattern
+/// first changes (IndependentExcitation::current_start_A).
 std::vector<double> Current(const IndependentExcitation& ex, std::size_t n, signal::GaussianState* g) {
+  std::vector<double> i = Pattern(ex, n, g);
+  if (ex.current_start_A > 0.0 && !i.empty()) {
+    std::size_t k1 = 1;
+    while (k1 < n && i[k1] == i[0]) ++k1;
+    std::fill(i.begin(), i.begin() + static_cast<std::ptrdiff_t>(k1), ex.current_start_A);
+  }
+  return i;
+}
+
+std::vector<double> Pattern(const IndependentExcitation& ex, std::size_t n, signal::GaussianState* g) {
   std::vector<double> i(n, 0.0);
   const double P = std::max(ex.current_period_s, 10.0 * ex.dt_s), I = ex.current_max_A;
   switch (ex.current) {
@@ -245,6 +259,7 @@ using State = std::array<double, kStates>;
 
 struct Outputs {
   double y_mm, yv_mm_s, f_kN;
+  double ya_mm_s2;  ///< the specimen's acceleration as the effect chain knows it (load_cell_inertia)
   double lambda;  ///< a bound of the local Jacobian's size [1/s]
 };
 
@@ -258,8 +273,8 @@ class ContinuousRig {
     lc_ = t.compliance_mm_per_kN > 0;
     fr_ = t.friction_loss_mm > 0, bl_ = t.backlash_gap_mm > 0, lag_ = t.current_lag_ms > 0;
     ps_ = t.presliding_loss_mm > 0;
-    if (lc_ && (fr_ || bl_ || ps_))
-      throw Error("independent rig", "load_coupling with coulomb_friction, presliding_friction or backlash is not modelled");
+    if (lc_ && (fr_ || bl_))
+      throw Error("independent rig", "load_coupling with coulomb_friction or backlash is not modelled");
     if (ps_ && !(t.presliding_rho > 0 && t.presliding_rho <= 1)) throw Error("independent rig", "presliding_rho must be in (0, 1]");
     w_oil_ = 2.0 * kPi * t.oil_f_hz;
     tau1_ = 0.8e-3 * t.current_lag_ms, tau2_ = 0.2e-3 * t.current_lag_ms;
@@ -327,14 +342,24 @@ class ContinuousRig {
     const double beta = at(d_.beta_a, d_.beta_b, d_.beta_c), gamma = at(d_.gamma_a, d_.gamma_b, d_.gamma_c);
     const double z = s[kZ], yd = s[kYd];
     if (lc_) {
-      // y = x - c F with F = c1/(c0+c1) (alpha z + k0 (y - yd)) + B y' + k1 (y - x0) + extra(y).
+      // yl = x - c F, the specimen at yf = yl - phi (presliding after the compliance, phi = 0
+      // without it) with F = c1/(c0+c1) (alpha z + k0 (yf - yd)) + B yf' + k1 (yf - x0) + extra(yf)
+      // = P + B yf', yf' = g yl' (g = 1 - sigma base^1.5, the presliding law's slope, > 0).
       const double yl = s[kYl], cc = t_.compliance_mm_per_kN;
-      const double P = c1 / (c0 + c1) * (alpha * z + k0 * (yl - yd)) + d_.k1 * (yl - d_.x0) + Extra(yl);
+      const double phi = ps_ ? s[kPs] : 0.0, yf = yl - phi;
+      const double P = c1 / (c0 + c1) * (alpha * z + k0 * (yf - yd)) + d_.k1 * (yf - d_.x0) + Extra(yf);
       const double B = c0 * c1 / (c0 + c1);
-      const double v = ((y - yl) / cc - P) / B;
+      const double num = (y - yl) / cc - P;  // B yf', whose sign is yl''s
+      double g = 1.0;
+      if (ps_) {
+        const double L = t_.presliding_loss_mm, sigma = t_.presliding_rho / std::pow(2.0, 1.5);
+        const double sg = num > 0 ? 1.0 : num < 0 ? -1.0 : 0.0;
+        g = 1.0 - sigma * std::pow(std::clamp(1.0 - phi * sg / L, 0.0, 2.0), 1.5);
+      }
+      const double v = num / (B * g);
       d[kYl] = v;
       y = yl, yv = v, ya = 0.0;
-      lam = std::max(lam, 1.0 / (cc * B));
+      lam = std::max(lam, 1.0 / (cc * B * g));
     }
     if (fr_) {
       const double vs = 1.5, tau_f = 0.3e-3;
@@ -370,7 +395,7 @@ class ContinuousRig {
     d[kZ] = -gamma * std::abs(rel) * z * zn1 - beta * rel * std::abs(z) * zn1 + d_.A * rel;
     const double f = alpha * z + c0 * rel + k0 * (y - yd) + d_.k1 * (y - d_.x0) + Extra(y);
     lam = std::max(lam, (beta + gamma) * n * zn1 * std::abs(rel) + d_.A * alpha / (c0 + c1));
-    return {y, yv, f, lam};
+    return {y, yv, f, ya, lam};
   }
 
   /// m RK4 steps of h from time t0, inputs held.
@@ -462,41 +487,78 @@ IndependentTraces SimulateIndependent(const std::vector<double>& u, const std::v
                                       const IndependentTruth& truth) {
   if (u.size() != i.size() || u.empty()) throw Error("independent rig", "u and i must have the same, non-zero length");
   if (truth.substeps < 1) throw Error("independent rig", "substeps must be >= 1");
+  if (!std::isfinite(truth.skew_ms) || std::abs(truth.skew_ms) > 100.0)
+    throw Error("independent rig", "skew_ms must be in [-100, 100]");
   const std::size_t n = u.size();
   const ContinuousRig rig(truth, static_cast<double>(n) * dt);
   IndependentTraces out;
   out.y_mm.resize(n);
   out.f_kN.resize(n);
-  State s = rig.Rest(i[0]), ds;
+  State s = rig.Rest(truth.driver_at_rest ? 0.0 : i[0]), ds;
   // The delay: tau = (m + phi) dt; over step k the servo sees u_{k-m-1} until t_k + phi dt, then u_{k-m}.
   const double tau_s = std::max(0.0, truth.delay_ms) * 1e-3;
   auto m = static_cast<long>(std::floor(tau_s / dt));
   double phi = tau_s / dt - static_cast<double>(m);
   if (phi > 1.0 - 1e-9) ++m, phi = 0.0;
   if (phi < 1e-9) phi = 0.0;
+  // The skew: the force recorded at t_k is the load cell's at t_k - (D + e) dt, e in [0, 1): for
+  // e > 0, inside step j at tau = (1 - e) dt, recorded as sample j + D + 1; for e = 0, sample j + D.
+  const double skew = 1e-3 * truth.skew_ms / dt;
+  auto D = static_cast<long>(std::floor(skew));
+  double e = skew - static_cast<double>(D);
+  if (e > 1.0 - 1e-9) ++D, e = 0.0;
+  if (e < 1e-9) e = 0.0;
+  std::vector<double> cell(n), skewed(n, std::nan(""));  // the load cell's force at t_k; at t_k - skew
+  auto cell_force = [&](const Outputs& o) { return o.f_kN + 1e-6 * truth.cell_mass_kg * o.ya_mm_s2; };
   auto cmd = [&](long j) { return j < 0 ? 0.0 : rig.ServoCommand(u[static_cast<std::size_t>(j)]); };
   const double sub = static_cast<double>(truth.substeps);
   for (std::size_t k = 0; k < n; ++k) {
     const double t = static_cast<double>(k) * dt;
     const Outputs o = rig.Deriv(s, cmd(static_cast<long>(k) - m), i[k], t, &ds);
     out.y_mm[k] = o.y_mm;
-    out.f_kN[k] = o.f_kN;
+    cell[k] = cell_force(o);
     if (k + 1 == n) break;
     // Substeps for this record step: at least `substeps`, and h lambda <= 8 / substeps.
     const double need = std::ceil(sub * dt * o.lambda / 8.0);
     const int M = static_cast<int>(std::clamp(std::max(sub, need), 1.0, 65536.0));
     out.substeps_max = std::max<std::size_t>(out.substeps_max, static_cast<std::size_t>(M));
     const long j = static_cast<long>(k) - m;
-    if (phi == 0.0) {
-      rig.Rk4(&s, cmd(j), i[k], t, dt / M, M);
-    } else {
-      const int m1 = std::max(1, static_cast<int>(std::ceil(M * phi))), m2 = std::max(1, static_cast<int>(std::ceil(M * (1.0 - phi))));
-      rig.Rk4(&s, cmd(j - 1), i[k], t, phi * dt / m1, m1);
-      rig.Rk4(&s, cmd(j), i[k], t + phi * dt, (1.0 - phi) * dt / m2, m2);
+    // The step's pieces: split where the delayed command switches (phi dt) and where the skewed
+    // force is taken ((1 - e) dt); each piece gets its share of the M substeps.
+    double cuts[4] = {0.0, 0.0, 0.0, 1.0};
+    int nc = 1;
+    if (phi > 0.0) cuts[nc++] = phi;
+    if (e > 0.0) cuts[nc++] = 1.0 - e;
+    std::sort(cuts + 1, cuts + nc);
+    cuts[nc] = 1.0;
+    for (int q = 0; q < nc; ++q) {
+      const double a = cuts[q], b = cuts[q + 1];
+      if (b - a > 1e-12) {
+        const int mq = std::max(1, static_cast<int>(std::ceil(M * (b - a))));
+        rig.Rk4(&s, cmd(a < phi ? j - 1 : j), i[k], t + a * dt, (b - a) * dt / mq, mq);
+      }
+      if (e > 0.0 && b == 1.0 - e) {  // the skewed force of sample k + D + 1
+        const long target = static_cast<long>(k) + D + 1;
+        if (target >= 0 && target < static_cast<long>(n)) {
+          State dd;
+          const double tb = t + b * dt;
+          skewed[static_cast<std::size_t>(target)] = cell_force(rig.Deriv(s, cmd(b < phi ? j - 1 : j), i[k], tb, &dd));
+        }
+      }
     }
     for (double v : s)
       if (!std::isfinite(v))
         throw Error("independent rig", fmt::format("the simulation diverged at t = {} s", t + dt));
+  }
+  // Recorded force: the skewed samples; e = 0 (or no skew) the load cell's own samples D back; before
+  // the record (skew > 0) the force at rest, after it (skew < 0) the last one.
+  for (std::size_t k = 0; k < n; ++k) {
+    if (e > 0.0 && !std::isnan(skewed[k])) {
+      out.f_kN[k] = skewed[k];
+      continue;
+    }
+    const long src = static_cast<long>(k) - D - (e > 0.0 ? 1 : 0);
+    out.f_kN[k] = cell[static_cast<std::size_t>(std::clamp<long>(src, 0, static_cast<long>(n) - 1))];
   }
   return out;
 }

@@ -48,6 +48,11 @@
 ///                    one of tau);
 ///     damper_scale   alpha, c0, c1 scaled by s (exactly a force scale) times a slow drift:
 ///                    s(t) = s (1 + drift (t / T - 1/2)), drift 1 % over the record (warming up).
+///     channel_skew   the force sampled at t_k - skew from the continuous solution (the record step
+///                    split at that instant; the library: a 4-point interpolant of the samples);
+///     load_cell_inertia  m y'' with y'' the continuous acceleration of the specimen as the effect
+///                    chain knows it (exact without displacement effects; the library: a smoothed
+///                    acceleration of the model-aided motion);
 ///     supply_ripple  a flow ripple inside the servo loop: the piston's velocity gets
 ///                    sum_h a_h theta_h' cos(theta_h), theta_h = h theta + phi_h, with the pump's angle
 ///                    theta = 2 pi f (t + w sin(2 pi 0.1 t) / (2 pi 0.1)) (its speed wanders by w),
@@ -104,6 +109,9 @@ struct IndependentExcitation {
   CurrentPattern current = CurrentPattern::kPulsed;
   double current_max_A = 2.5;     ///< on level, top of the staircase [A]; kConstant: the current
   double current_period_s = 1.0;  ///< pulse period, staircase step, telegraph mean hold [s]
+  /// > 0: the current command is on at this level [A] from the first sample until the pattern
+  /// first changes (a test that starts with the damper energised); 0: the pattern from its start.
+  double current_start_A = 0.0;
   /// kEarthquake: the ground acceleration [g] at 0.02 s steps (ReadGroundMotion of
   /// data/ground_motion/elcentro_1940_ns_g.txt, read by the caller); unused otherwise.
   std::vector<double> ground_g;
@@ -133,6 +141,14 @@ struct IndependentTruth {
   double current_lag_ms = 0.0;         ///< current_lag [ms]
   double damper_scale = 1.0;           ///< damper_scale (1: off)
   double damper_scale_drift = 0.01;    ///< relative drift of the scale over the record (only if scale != 1)
+  /// channel_skew: the force channel records the load cell's force at t_k - skew [ms], taken from the
+  /// continuous simulation at that instant (the step split there); any real value.
+  double skew_ms = 0.0;
+  /// load_cell_inertia: f += m y'' 1e-6, y'' the specimen's continuous acceleration [kg].
+  double cell_mass_kg = 0.0;
+  /// The current driver (Eq. 40, the low-pass, the current lags) at rest at 0 A when the record
+  /// starts, whatever the first command; false: at the first command's steady state.
+  bool driver_at_rest = false;
   double pump_hz = 0.0;                ///< supply_ripple's fundamental [Hz] (0: off)
   double pump_mm = 0.0;                ///< ... its fundamental's size a_1 [mm] (before the loop's filtering)
   double pump_h2 = 0.5, pump_h3 = 0.25;   ///< ... a_2 / a_1, a_3 / a_1
@@ -160,8 +176,8 @@ void MakeIndependentInputs(const IndependentExcitation& ex, std::vector<double>*
 
 /// Noise-free samples y_k [mm], f_k [kN] at t_k = k dt of the truth driven by u, i (file comment):
 /// y_0 = 0, f_0 = the force at rest. The ripple and noise are not included. Throws rths::Error if
-/// the truth combines load_coupling with coulomb_friction, presliding_friction or backlash (not
-/// modelled).
+/// the truth combines load_coupling with coulomb_friction or backlash (not modelled; with
+/// presliding_friction the compliance's ODE carries the presliding law's slope).
 struct IndependentTraces {
   std::vector<double> y_mm, f_kN;
   std::size_t substeps_max = 0;   ///< largest number of RK4 substeps a record step took

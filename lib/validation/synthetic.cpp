@@ -1,5 +1,7 @@
 #include "validation/synthetic.h"
 
+#include <algorithm>
+
 #include <cmath>
 #include <utility>
 
@@ -31,7 +33,8 @@ void MakeInputs(const Excitation& ex, std::vector<double>* u_mm, std::vector<dou
     const int level = static_cast<int>(std::floor(6.0 * signal::NextUniform(&g)));
     const double hold = ex.hold_min_s + (ex.hold_max_s - ex.hold_min_s) * signal::NextUniform(&g);
     const std::size_t m = std::max<std::size_t>(1, static_cast<std::size_t>(std::lround(hold / ex.dt_s)));
-    for (std::size_t j = k; j < std::min(n, k + m); ++j) (*i_A)[j] = ex.current_max_A * std::min(level, 5) / 5.0;
+    const double i_level = k == 0 && ex.current_start_A >= 0.0 ? ex.current_start_A : ex.current_max_A * std::min(level, 5) / 5.0;
+    for (std::size_t j = k; j < std::min(n, k + m); ++j) (*i_A)[j] = i_level;
     k += m;
   }
 }
@@ -100,9 +103,10 @@ io::RigRecord MakeRecordBlocks(const Excitation& ex, const Truth& truth, const s
   models::LinearServoState xs;
   models::DisplacementEffects dfx(truth.effects, dt);
   models::ForceEffects ffx(truth.effects, dt);
-  ffx.Reset(i[0]);
+  const double i_before = truth.driver_at_rest ? 0.0 : i[0];  // what the driver held before the record
+  ffx.Reset(i_before);
   const auto driver = models::CurrentDriver::Make({}, dt);
-  models::CurrentDriverState cs = models::SteadyState(i[0]);
+  models::CurrentDriverState cs = models::SteadyState(i_before);
   const auto damper = models::MrDamperParams::Table3();
   models::MrDamperState ds{};
   auto g = signal::MakeGaussian(truth.noise_seed);
@@ -114,7 +118,9 @@ io::RigRecord MakeRecordBlocks(const Excitation& ex, const Truth& truth, const s
   // d_k = y_k - x_k.
   // load_coupling sees the force of the same sample, as in the rig mode: a fixed point solved
   // by models::SolveCoupledForce, each trial re-integrating the step from the saved state.
-  double x_prev = 0.0, xd_prev = 0.0, d_prev = 0.0, f_prev = 0.0, f_prev2 = 0.0;
+  double x_prev = 0.0, xd_prev = 0.0, d_prev = 0.0, d_prev2 = 0.0, f_prev = 0.0, f_prev2 = 0.0;
+  // The load cell's force before noise (load_cell_inertia added), shifted by channel_skew after the loop.
+  std::vector<double> f_cell(n, 0.0);
   models::DisplacementEffects dfx_try = dfx;  // a trial's copy: same sizes, assigned without allocating
   for (std::size_t k = 0; k < n; ++k) {
     const double x = models::Output(servo, xs), xd = models::OutputVelocity(servo, xs);
@@ -159,6 +165,7 @@ io::RigRecord MakeRecordBlocks(const Excitation& ex, const Truth& truth, const s
       }
       const double ic = models::EffectiveCurrentA(driver, k > 0 ? Advanced(driver, cs) : cs);
       f = ffx.Force(models::DamperForceKn(models::CoefficientsAt(damper, ic), ds_try, y, v));
+      f *= std::clamp(truth.fade_start + truth.fade_per_s * static_cast<double>(k) * dt, 0.05, 10.0);
       f += truth.stiffness_kN_per_mm * y;
       return f - f_in;
     };
@@ -176,12 +183,21 @@ io::RigRecord MakeRecordBlocks(const Excitation& ex, const Truth& truth, const s
     const double d = y - x;
     const double t = static_cast<double>(k) * dt;
     r.y_mm[k] = y + truth.ripple_mm * std::sin(2.0 * M_PI * truth.ripple_hz * t) + sy * signal::NextGaussian(&g);
-    r.f_kN[k] = f + sf * signal::NextGaussian(&g);
+    r.f_kN[k] = sf * signal::NextGaussian(&g);  // the force is added below
+    // load_cell_inertia: the specimen's acceleration, the servo's exact y'' plus the second
+    // difference of the effects' share (as the rig mode takes it).
+    const double acc = xs.z(2) + (k >= 2 ? (d - 2.0 * d_prev + d_prev2) / (dt * dt) : 0.0);
+    f_cell[k] = f + (truth.effects.load_cell_inertia ? 1e-6 * truth.effects.load_cell_inertia->mass_kg * acc : 0.0);
+    d_prev2 = d_prev;
     // Step k -> k+1.
     models::Hold(driver, &cs, ffx.Current(i[k]));
     models::Step(servo, &xs, dfx.Pre(u[k]));
     x_prev = x, xd_prev = xd, d_prev = d, f_prev2 = f_prev, f_prev = f;
   }
+  // channel_skew: the force channel records the load cell's force at t_k - skew (offline: either sign).
+  const double skew_s = truth.effects.channel_skew ? 1e-3 * truth.effects.channel_skew->skew_ms : 0.0;
+  const std::vector<double> f_rec = models::ShiftSamples(f_cell, skew_s, dt);
+  for (std::size_t k = 0; k < n; ++k) r.f_kN[k] += f_rec[k];
   r.metadata.push_back({"generator", "validation::MakeRecordBlocks"});
   io::ValidateRigRecord(r, name);
   return r;
@@ -196,11 +212,14 @@ io::RigRecord MakeRecordRig(const Excitation& ex, const Truth& truth, const std:
   plant.actuator = models::ServoPreset("avg");
   plant.specimen = models::Specimen::kMrDamper;
   plant.current_dynamics = true;
+  if (truth.driver_at_rest) plant.current_driver.start = models::CurrentStart::kRest;
   plant.effects = truth.effects;
   plant.noise_seed = truth.noise_seed;
   plant.unmodelled.ripple_mm = truth.ripple_mm;
   plant.unmodelled.ripple_hz = truth.ripple_mm > 0 ? truth.ripple_hz : 0.0;
   plant.unmodelled.stiffness_kN_per_mm = truth.stiffness_kN_per_mm;
+  plant.unmodelled.fade_start = truth.fade_start;
+  plant.unmodelled.fade_per_s = truth.fade_per_s;
   auto rig = models::MakeRig(plant, ex.dt_s);
   io::RigRecord r = Empty(ex, name, n);
   r.u_mm = u;

@@ -28,12 +28,21 @@ struct Excitation {
   double current_max_A = 2.5;    ///< staircase levels 0 .. max in steps of max / 5
   double hold_min_s = 0.2, hold_max_s = 1.0;
   bool current_constant = false; ///< true: i = current_max_A throughout
+  /// >= 0: the staircase's first hold is at this level [A] (a current on at the first sample), the
+  /// rest drawn as usual; < 0: the first level drawn too.
+  double current_start_A = -1.0;
 };
 
 struct Truth {
   models::EffectSet effects;     ///< sensor_noise here is the record's noise
   double ripple_mm = 0.0, ripple_hz = 7.0;  ///< outside the library: y += ripple sin(2 pi f t)
   double stiffness_kN_per_mm = 0.0;         ///< outside the library: f += k y
+  /// The current driver at rest (0 A) when the record starts, whatever its first command
+  /// ([plant.current_driver] start = "rest"); false: at the first command's steady state.
+  bool driver_at_rest = false;
+  /// Outside the library: the damper's force scaled by fade_start + fade_per_s t (a damper that
+  /// heats over the test; models::UnmodelledConfig).
+  double fade_start = 1.0, fade_per_s = 0.0;
   std::uint64_t noise_seed = 11;
 };
 

@@ -1,0 +1,157 @@
+// AssessParameters of stages.h: the selected effects' standard errors and their fits per time
+// segment of the training records (docs/diagnosis.md "Drift").
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include <fmt/format.h>
+
+#include "diagnosis/candidates.h"
+#include "diagnosis/residual_stats.h"
+#include "diagnosis/search.h"
+#include "diagnosis/stages.h"
+#include "diagnosis/tuning.h"
+
+namespace rths::diagnosis::stages {
+
+namespace {
+
+/// The samples of segment [a, b) (fractions of a record's summed span [first, n)).
+std::pair<std::size_t, std::size_t> SegmentOf(const Data& d, double a, double b) {
+  const auto span = static_cast<double>(d.size() - d.first);
+  const auto lo = d.first + static_cast<std::size_t>(std::floor(a * span));
+  const auto hi = b >= 1.0 ? d.size() : d.first + static_cast<std::size_t>(std::floor(b * span));
+  return {lo, hi};
+}
+
+/// SSE of a prediction over segment [a, b) of every record; *count the samples.
+double SegmentSse(const Channel& ch, const std::vector<std::vector<double>>& pred, double a, double b,
+                  std::size_t* count) {
+  double s = 0.0;
+  std::size_t n = 0;
+  for (std::size_t r = 0; r < ch.recs().size(); ++r) {
+    const auto meas = ch.Meas(r);
+    const auto [lo, hi] = SegmentOf(ch.recs()[r], a, b);
+    for (std::size_t k = lo; k < hi; ++k) s += (meas[k] - pred[r][k]) * (meas[k] - pred[r][k]);
+    n += hi - lo;
+  }
+  if (count) *count = n;
+  return std::isfinite(s) ? s : std::numeric_limits<double>::infinity();
+}
+
+/// One parameter's fit and standard error on a segment [a, b) of the training records.
+struct SegmentFit {
+  double value = 0, se = std::numeric_limits<double>::infinity();
+};
+
+class ParamProbe {
+ public:
+  ParamProbe(const ChannelState& s, const std::vector<CandidateSpec>& specs, const std::string& name, std::size_t j,
+             double tau)
+      : s_(s), specs_(specs), name_(name), j_(j), range_(SpecOf(specs, name).params[j]), tau_(tau) {}
+
+  /// The SSE over [a, b) with the parameter at x (the rest of the set held, the linear terms too).
+  double Sse(double x, double a, double b, std::size_t* n = nullptr) const {
+    Params q = s_.sel;
+    q[name_][j_] = x;
+    return SegmentSse(s_.train, s_.train.Predict(ToSet(specs_, q), nullptr, true), a, b, n);
+  }
+
+  /// The standard error at x from the curvature of the SSE over [a, b): se^2 = 2 (SSE / n) tau / SSE''.
+  double Se(double x, double a, double b) const {
+    std::size_t n = 0;
+    const double s0 = Sse(x, a, b, &n);
+    const double h = range_.log ? std::abs(x) * tuning::kCurvatureStep : tuning::kCurvatureStep * (range_.hi - range_.lo);
+    if (!(h > 0.0) || n == 0) return std::numeric_limits<double>::infinity();
+    const double sp = Sse(x + h, a, b), sm = Sse(x - h, a, b);
+    const double curv = (sp - 2.0 * s0 + sm) / (h * h);
+    if (!(curv > 0.0) || !std::isfinite(curv)) return std::numeric_limits<double>::infinity();
+    return std::sqrt(2.0 * (s0 / static_cast<double>(n)) * tau_ / curv);
+  }
+
+  /// The fit over [a, b), searched around v (tuning::kSegmentBracketFactor / Fraction).
+  SegmentFit Fit(double v, double a, double b) const {
+    ParamSpec br = range_;
+    if (range_.log) {
+      br.lo = std::max(range_.lo, v / tuning::kSegmentBracketFactor);
+      br.hi = std::min(range_.hi, v * tuning::kSegmentBracketFactor);
+    } else {
+      const double w = tuning::kSegmentBracketFraction * (range_.hi - range_.lo);
+      br.lo = std::max(range_.lo, v - w), br.hi = std::min(range_.hi, v + w);
+    }
+    br.grid = 5;
+    double best = 0.0;
+    SegmentFit f;
+    f.value = Minimise1D([&](double x) { return Sse(x, a, b); }, br, tuning::kSegmentGoldenIters, &best, {v});
+    f.se = Se(f.value, a, b);
+    return f;
+  }
+
+  const ParamSpec& range() const { return range_; }
+
+ private:
+  const ChannelState& s_;
+  const std::vector<CandidateSpec>& specs_;
+  std::string name_;
+  std::size_t j_;
+  ParamSpec range_;
+  double tau_;
+};
+
+/// The segment fits' chi^2 about their se-weighted mean.
+double Chi2(const std::vector<double>& v, const std::vector<double>& se) {
+  double sw = 0.0, swv = 0.0;
+  for (std::size_t j = 0; j < v.size(); ++j)
+    if (std::isfinite(se[j]) && se[j] > 0.0) sw += 1.0 / (se[j] * se[j]), swv += v[j] / (se[j] * se[j]);
+  if (!(sw > 0.0)) return 0.0;
+  const double mean = swv / sw;
+  double c = 0.0;
+  for (std::size_t j = 0; j < v.size(); ++j)
+    if (std::isfinite(se[j]) && se[j] > 0.0) c += (v[j] - mean) * (v[j] - mean) / (se[j] * se[j]);
+  return c;
+}
+
+}  // namespace
+
+void AssessParameters(const ChannelState& s, const std::vector<CandidateSpec>& specs, EffectResults* er,
+                      std::vector<std::string>* warnings) {
+  if (s.order.empty() || (!s.retained && s.unconfirmed.empty())) return;
+  const double tau = IntegratedCorrelationTime(s.train, s.pred_train);
+  const int K = tuning::kDriftSegments;
+  for (const auto& name : s.order) {
+    if (name == "supply_ripple") continue;  // fitted per record (its phases): no constant to follow
+    const CandidateSpec& spec = SpecOf(specs, name);
+    EffectResult& e = (*er)[name];
+    std::vector<std::string> drifting;
+    for (std::size_t j = 0; j < spec.params.size(); ++j) {
+      const ParamProbe probe(s, specs, name, j, tau);
+      const double v = s.sel.at(name)[j];
+      e.params_se[spec.params[j].key] = probe.Se(v, 0.0, 1.0);
+      EffectResult::Drift dr;
+      dr.key = spec.params[j].key;
+      for (int q = 0; q < K; ++q) {
+        const SegmentFit f = probe.Fit(v, static_cast<double>(q) / K, static_cast<double>(q + 1) / K);
+        dr.values.push_back(f.value);
+        dr.se.push_back(f.se);
+      }
+      dr.chi2 = Chi2(dr.values, dr.se);
+      const double first = dr.values.front(), last = dr.values.back();
+      const double size = std::max(std::abs(v), 0.01 * (probe.range().hi - probe.range().lo));
+      const double se_diff = std::hypot(dr.se.front(), dr.se.back());
+      const bool drifts = dr.chi2 > tuning::kDriftChi2 && std::abs(last - first) > tuning::kDriftMinRelative * size &&
+                          std::abs(last - first) > tuning::kDriftMinSigmas * se_diff;
+      if (drifts) drifting.push_back(fmt::format("{} {:.3g} -> {:.3g}", dr.key, first, last));
+      e.segments.push_back(std::move(dr));
+    }
+    if (!drifting.empty()) {
+      e.drift = fmt::format("drifting over the record: {}", fmt::join(drifting, ", "));
+      warnings->push_back(fmt::format(
+          "channel {}: {} is not constant over the training records ({}, fitted per {} of each record): a parameter "
+          "that changes during the test is not this library effect's constant; the fit is its average",
+          s.summary.channel, name, e.drift.substr(std::string("drifting over the record: ").size()),
+          K == 4 ? "quarter" : fmt::format("1/{}", K)));
+    }
+  }
+}
+
+}  // namespace rths::diagnosis::stages
