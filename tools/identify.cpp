@@ -5,7 +5,7 @@
 // time-domain check. Prints the model as a scenario fragment; writes a Bode plot like the
 // paper's Fig. 6 with gnuplot.
 // rths identify --damper RECORD... --current A [--check RECORD...] [--A A] [--velocity-cutoff-hz F]
-//                        [--out FILE.toml]
+//                        [--skew auto|MS] [--inertia auto|KG] [--out FILE.toml]
 // Fits the Spencer MR damper model (Eqs. 32-34) at one current to damper tests (rig records, LCM
 // logs, or UTFSM damper files: x = y_mm, F = f_kN) by least squares on the force, or without
 // --current its current- or voltage-dependent form (ident/damper_model.h); prints the parameters,
@@ -234,7 +234,27 @@ struct DamperCli {
   rths::io::TimeAxis time = rths::io::TimeAxis::kColumn;
   bool accept_unconverged = false;  ///< exit 0 for a failed fit (ident/fit_status.h)
   const rths::io::ColumnMap* map = nullptr;  ///< --columns, or null
+  rths::ident::MeasurementOptions measurement;  ///< --skew, --inertia
 };
+
+/// --skew / --inertia: "auto" (fitted), a number (held at it), or "" (off).
+void ParseMeasurement(const std::string& skew, const std::string& inertia, rths::ident::MeasurementOptions* m) {
+  auto parse = [](const std::string& text, const char* flag, const char* unit, rths::ident::MeasurementMode* mode,
+                  double* value) {
+    if (text.empty()) return;
+    if (text == "auto") {
+      *mode = rths::ident::MeasurementMode::kAuto;
+      return;
+    }
+    char* end = nullptr;
+    *value = std::strtod(text.c_str(), &end);
+    if (end == text.c_str() || *end != '\0' || !std::isfinite(*value))
+      throw Error(flag, fmt::format("\"{}\": expected auto or a number [{}]", text, unit));
+    *mode = rths::ident::MeasurementMode::kGiven;
+  };
+  parse(skew, "--skew", "ms", &m->skew, &m->skew_ms);
+  parse(inertia, "--inertia", "kg", &m->inertia, &m->mass_kg);
+}
 
 std::vector<rths::io::RigRecord> ReadDamperRecords(const std::vector<std::string>& paths, rths::io::TimeAxis time,
                                                    const rths::io::ColumnMap* map) {
@@ -269,7 +289,7 @@ int RunDamper(const DamperCli& c, rths::ident::DamperFitOptions o) {
   if (progress.enabled()) {
     o.progress = [&progress](double done, double total, std::string_view what) { progress.Update(done, total, what); };
   }
-  const auto fit = rths::ident::FitDamperModel(recs, o);
+  const auto fit = rths::ident::FitDamperModel(recs, o, c.measurement);
   progress.Finish();
   const bool voltage = fit.voltage();
   if (fit.any_input) {
@@ -413,7 +433,7 @@ int RunActuator(const ActuatorCli& a) {
 
 /// The --damper options of the command line (their checks beyond DamperFitOptions::IsValid).
 void AddDamperOptions(CLI::App* app, rths::ident::DamperFitOptions* o, double* current_A, std::string* input,
-                      std::string* filter, bool* no_offset) {
+                      std::string* filter, bool* no_offset, std::string* skew, std::string* inertia) {
   app->add_option("--current", *current_A, "--damper: fit at this one current [A] (the records' constant current)");
   app->add_option("--A", o->A, "--damper: Bouc-Wen A [-], held fixed (Table 3)")->capture_default_str();
   app->add_option("--velocity-cutoff-hz", o->velocity_cutoff_hz,
@@ -432,6 +452,12 @@ void AddDamperOptions(CLI::App* app, rths::ident::DamperFitOptions* o, double* c
                 "--damper without --current: hold k1 = x0 = 0 and no force offset (no accumulator, no load-cell zero)");
   app->add_option("--threads", o->threads, "--damper without --current: threads for the Jacobian (0: one per core)")
       ->capture_default_str();
+  app->add_option("--skew", *skew,
+                  "--damper: the force channel's lag behind the displacement channel (channel_skew): auto (fitted, "
+                  "with its uncertainty) or MS held (default: none)");
+  app->add_option("--inertia", *inertia,
+                  "--damper: the mass between the load cell and the damper (load_cell_inertia, f += m x''): auto "
+                  "(fitted, with its uncertainty) or KG held (default: none)");
 }
 
 }  // namespace
@@ -442,7 +468,7 @@ int main(int argc, char** argv) {
   bool damper = false, time_from_header = false, no_offset = false, accept_unconverged = false;
   ActuatorCli ac;
   rths::ident::DamperFitOptions fo;
-  std::string input, filter = "first_order";
+  std::string input, filter = "first_order", skew, inertia;
   double current_A = 0.0;
   app.add_option("record", records,
                  "CSV rig record or LCM run log (log.lcm) of ours; with --damper one or more damper tests (also UTFSM "
@@ -457,7 +483,7 @@ int main(int argc, char** argv) {
                "fit the Spencer MR damper model instead: at one current (--current) or, without it, its current- or "
                "voltage-dependent form (Eqs. 32-39) with a control filter, from records with any input history");
   app.add_option("--check", checks, "--damper: held-out records to score the fitted model on");
-  AddDamperOptions(&app, &fo, &current_A, &input, &filter, &no_offset);
+  AddDamperOptions(&app, &fo, &current_A, &input, &filter, &no_offset, &skew, &inertia);
   app.add_flag("--accept-unconverged", accept_unconverged,
                "--damper: exit 0 for a fit that did not converge or has a parameter on a bound of its range (it is "
                "written, marked FIT FAILED, either way; without this flag the exit code is 3)");
@@ -501,8 +527,11 @@ int main(int argc, char** argv) {
                                       : rths::ident::DamperInput::kAuto;
       fo.filter = *rths::ValueOf(rths::ident::kControlFilterNames, filter);
       fo.accumulator = !no_offset;
-      return RunDamper({records, checks, ac.out, ac.plot, ac.time, accept_unconverged, ac.map}, fo);
+      DamperCli dc{records, checks, ac.out, ac.plot, ac.time, accept_unconverged, ac.map, {}};
+      ParseMeasurement(skew, inertia, &dc.measurement);
+      return RunDamper(dc, fo);
     }
+    if (!skew.empty() || !inertia.empty()) throw Error("--skew/--inertia", "only with --damper");
     if (fo.current_A || !checks.empty() || accept_unconverged)
       throw Error("--current/--check/--accept-unconverged", "only with --damper");
     if (records.size() != 1)

@@ -81,6 +81,10 @@ inline constexpr double kDriftChi2 = 16.27;
 inline constexpr double kDriftMinRelative = 0.05;
 /// ... and by more than this many standard errors of that difference.
 inline constexpr double kDriftMinSigmas = 4.0;
+/// Segments are alike in excitation if the rms command, its rms rate / rms and the rms current differ
+/// by at most this factor between any two (stages::AssessParameters); only then is a parameter of a
+/// dynamic effect judged for drift (the force's linear terms always are).
+inline constexpr double kSegmentExcitationRatio = 1.25;
 /// A segment's fit searches the parameter within [v / this, v x this] (log parameters) ...
 inline constexpr double kSegmentBracketFactor = 1.5;
 /// ... or v +- this x its search range (linear ones).

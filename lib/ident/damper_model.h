@@ -10,6 +10,7 @@
 
 #include "ident/damper_fit.h"
 #include "ident/damper_options.h"
+#include "ident/measurement_fit.h"
 #include "ident/spencer_fit.h"
 #include "io/rig_record.h"
 
@@ -20,6 +21,10 @@ struct DamperModelFit {
   std::optional<DamperFitResult> at_current;  ///< the fit at one current
   std::optional<SpencerFitResult> any_input;  ///< the fit with any input history
   double velocity_cutoff_hz = 0.0;            ///< the options' cut-off [Hz]; 0 = VelocityCutoffHz per record
+  /// The force channel's skew and the load cell's inertia (measurement_fit.h), if asked for: the
+  /// damper model is then fitted to the damper's own force they imply, and predicts the
+  /// measured force through them.
+  MeasurementFit measurement;
 
   /// The input is a voltage (any input history with v_V).
   bool voltage() const { return any_input && any_input->voltage; }
@@ -29,7 +34,10 @@ struct DamperModelFit {
   std::string Report() const;
   /// The velocity cut-off [Hz] used on a record: the options' or VelocityCutoffHz(record).
   double CutoffHz(const io::RigRecord& record) const;
-  /// The model's force F_k [kN] on a record's motion (and command), with the velocity smoothed at CutoffHz.
+  /// The damper's force F_k [kN] on a record's motion (and command), with the velocity smoothed at
+  /// CutoffHz (and the load cell's zero when fitted), before the measurement's effects.
+  std::vector<double> DamperForce(const io::RigRecord& record) const;
+  /// The measured force the model predicts [kN]: DamperForce through the measurement's effects.
   std::vector<double> PredictForce(const io::RigRecord& record) const;
   /// Eq. 31 on force of the model on a record (held-out check).
   DamperRecordScore Score(const io::RigRecord& record) const;
@@ -38,7 +46,11 @@ struct DamperModelFit {
 };
 
 /// Fits the damper model options ask for (options.current_A set: FitDamper; else FitSpencer) to
-/// the records. Throws rths::Error as those do.
-DamperModelFit FitDamperModel(const std::vector<io::RigRecord>& records, const DamperFitOptions& options);
+/// the records. With measurement effects asked for (measurement.Any()): the model is fitted, the
+/// skew and mass are fitted around it (FitMeasurement), the model is fitted again to the damper's
+/// own force they imply (MeasurementFit::DamperForceRecord), and the skew and mass again around
+/// that model; the training scores are those of the measured force. Throws rths::Error as those do.
+DamperModelFit FitDamperModel(const std::vector<io::RigRecord>& records, const DamperFitOptions& options,
+                              const MeasurementOptions& measurement = {});
 
 }  // namespace rths::ident
