@@ -23,7 +23,7 @@ TEST_CASE("harness (rig mode): confusion table and held-out shrink meet the harn
   o.generator = Generator::kRig;
   o.pairs = true;
   const auto sc = rths_test::RunHarnessReported(o);
-  REQUIRE(sc.single_n == 15 * o.seeds);  // the 14 diagnosable effects of models::kEffects, short-travel presliding
+  REQUIRE(sc.single_n == 16 * o.seeds);  // the 14 diagnosable effects of models::kEffects, short presliding, in-loop flow limit
   REQUIRE(sc.pair_n > 0);
   REQUIRE(sc.none_n == 2 * o.seeds);     // none, none_current_on
   REQUIRE(sc.unknown_n == 3 * o.seeds);  // ripple, stiffness, heating
@@ -40,7 +40,7 @@ TEST_CASE("harness (effect blocks, one seed): confusion table and held-out shrin
   o.generator = Generator::kBlocks;
   o.pairs = true;
   const auto sc = rths_test::RunHarnessReported(o);
-  REQUIRE(sc.single_n == 15);
+  REQUIRE(sc.single_n == 16);
   REQUIRE(sc.none_n == 2);
   REQUIRE(sc.unknown_n == 3);
   rths_test::CheckHarnessTargets(sc);

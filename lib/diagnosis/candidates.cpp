@@ -62,12 +62,15 @@ const CandidateSpec& SpecOf(const std::vector<CandidateSpec>& c, const std::stri
 
 int FreeParams(const CandidateSpec& spec, std::size_t records) {
   if (spec.name == "supply_ripple") return 1 + 2 * models::kRippleHarmonics * static_cast<int>(records);
-  return static_cast<int>(spec.params.size());
+  int p = 0;
+  for (const auto& q : spec.params) p += q.grid >= 0;  // a switch (grid < 0) is no free parameter
+  return p;
 }
 
 bool AtBound(const CandidateSpec& spec, const std::vector<double>& v) {
   for (std::size_t j = 0; j < spec.params.size() && j < v.size(); ++j) {
     const auto& p = spec.params[j];
+    if (p.grid < 0) continue;  // a switch: 0 and 1 are its values, not bounds
     const double lo = p.log ? std::log(p.lo) : p.lo, hi = p.log ? std::log(p.hi) : p.hi;
     const double x = p.log ? std::log(std::max(v[j], 1e-300)) : v[j];
     const double tol = tuning::kAtBoundFraction * (hi - lo);

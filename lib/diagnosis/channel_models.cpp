@@ -2,6 +2,7 @@
 #include "diagnosis/ripple_fit.h"
 
 #include <algorithm>
+#include <optional>
 #include <cmath>
 #include <complex>
 
@@ -10,6 +11,7 @@
 
 #include "core/error.h"
 #include "scenario/from_toml.h"
+#include "models/servo_flow_limit.h"
 #include "signal/butterworth.h"
 
 namespace rths::diagnosis {
@@ -170,6 +172,12 @@ std::vector<double> PredictDisplacement(const models::LinearServo& servo, const 
   const Eigen::Matrix3d& P = servo.Phi;
   const Eigen::Vector3d& G = servo.Gamma;
   double z0 = 0, z1 = 0, z2 = 0;
+  // servovalve_saturation inside the loop: the actuator integrated with its flow limit
+  // (models/servo_flow_limit.h); z0, z1, z2 then carry its x, x' and x''.
+  const bool in_loop = effects.servovalve_saturation && effects.servovalve_saturation->InLoop();
+  std::optional<models::FlowLimitedServo> limited;
+  if (in_loop) limited = models::FlowLimitedServo::Make(servo, effects.servovalve_saturation->vmax_mm_per_s);
+  models::FlowLimitedServoState ls;
   for (std::size_t k = 0; k < n; ++k) {
     // load_coupling acts on the measured force of the same sample (see the header).
     const double fk = k < f_kN.size() ? f_kN[k] : 0.0;
@@ -180,6 +188,11 @@ std::vector<double> PredictDisplacement(const models::LinearServo& servo, const 
     }
     if (a_mm_s2 != nullptr) servo_a[k] = z2;
     const double ua = fx.Pre(u_mm[k]);
+    if (in_loop) {
+      models::Step(*limited, &ls, ua);
+      z0 = ls.x, z1 = models::Velocity(*limited, ls), z2 = models::Acceleration(*limited, ls);
+      continue;
+    }
     const double n0 = P(0, 0) * z0 + P(0, 1) * z1 + P(0, 2) * z2 + G(0) * ua;
     const double n1 = P(1, 0) * z0 + P(1, 1) * z1 + P(1, 2) * z2 + G(1) * ua;
     const double n2 = P(2, 0) * z0 + P(2, 1) * z1 + P(2, 2) * z2 + G(2) * ua;

@@ -143,6 +143,19 @@ double FitEffect(const Channel& ch, const std::vector<CandidateSpec>& specs, Par
     return std::isfinite(sse) ? sse : std::numeric_limits<double>::infinity();
   };
   std::vector<double> x;
+  if (spec.params.size() == 2 && spec.params[1].grid < 0) {
+    // A parameter and a switch (servovalve_saturation's in_loop): the parameter fitted with the
+    // switch at 0 and at 1, the better kept; a refit keeps the switch.
+    double best = std::numeric_limits<double>::infinity();
+    for (const double sw : refit ? std::vector<double>{cur[1]} : std::vector<double>{0.0, 1.0}) {
+      const Objective with = [&](const std::vector<double>& v) { return eval({v[0], sw}); };
+      std::vector<double> xs;
+      const double f = FitOneParam(spec.params[0], spec.channel == 'f', refit ? std::vector<double>{cur[0]} : cur, o, with, &xs);
+      if (f < best) best = f, x = {xs[0], sw};
+    }
+    (*p)[name] = x;
+    return best;
+  }
   const double best = spec.params.size() == 1
                           ? FitOneParam(spec.params[0], spec.channel == 'f', cur, o, eval, &x)
                           : FitTwoParams(spec.params[0], spec.params[1], cur, eval, &x);

@@ -161,6 +161,7 @@ void AssessParameters(const ChannelState& s, const std::vector<CandidateSpec>& s
     EffectResult& e = (*er)[name];
     std::vector<std::string> drifting;
     for (std::size_t j = 0; j < spec.params.size(); ++j) {
+      if (spec.params[j].grid < 0) continue;  // a switch: no uncertainty, no drift
       const ParamProbe probe(s, specs, name, j, tau);
       const double v = s.sel.at(name)[j];
       e.params_se[spec.params[j].key] = probe.Se(v, 0.0, 1.0);

@@ -7,6 +7,7 @@
 ///   SelectEffects     greedy selection on the training records (rules (a)-(c) of diagnosis.h);
 ///   SwapEffects       an effect replaced by another candidate that fits the training records better;
 ///   PruneEffects      an effect whose own share of the excess is below min_excess_reduction removed;
+///   WeighLostMotion   two lost-motion effects weighed against one that explains the same lost motion;
 ///   RetainOnTest      an effect that raises the test NRMSE by more than max_test_worsening dropped;
 ///   ScoreSelected     the selected effects' numbers, cumulative in selection order;
 ///   ApplyShrinkRule   the min_test_shrink_pct rule, the channel's status and final predictions;
@@ -257,6 +258,19 @@ void SwapEffects(ChannelState* s, const std::vector<CandidateSpec>& specs, const
 /// warning. On return pred_train and sse are those of the final set.
 void PruneEffects(ChannelState* s, const std::vector<CandidateSpec>& specs, const Options& o,
                   std::vector<std::string>* warnings);
+
+/// The lost-motion effects (backlash, coulomb_friction, presliding_friction, command_dead_band:
+/// docs/diagnosis.md "Lost motion") lose motion at reversals, and two of them together can mimic a
+/// third (a play and a friction jump standing in for a short presliding travel). When the set holds
+/// two or more, each single lost-motion effect is fitted in their place (from the full range, and
+/// from where the set says the motion is lost: L = the sum of their lost motions, gap/2, loss,
+/// width/2, as its loss, gap 2L or width 2L, with presliding travels of 0.05, 0.2 and 0.5 L), the
+/// rest refitted. If the single's BIC (rule (a)'s form, its parameters against theirs) is below the
+/// set's, it replaces them (a warning says so, with the set named as its close call if within
+/// tuning::kCloseCallBic); if it is within tuning::kCloseCallBic above, the set stays and the single
+/// is named as the first of them's close call (the verdict says "close call: or ...").
+void WeighLostMotion(ChannelState* s, const std::vector<CandidateSpec>& specs, const Options& o,
+                     std::vector<std::string>* warnings);
 
 /// In selection order, an effect whose addition raises the channel's test NRMSE by more than
 /// o.max_test_worsening (relative) is dropped (a warning); if any was, the rest are refitted on the

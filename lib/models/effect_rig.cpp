@@ -72,6 +72,8 @@ EffectRig::EffectRig(const EffectRigModel& model)
       noise_(signal::MakeGaussian(EffectNoiseSeed(model.noise_seed))),
       ode_(5, model.rig.rtol, AbsTol(model.rig), &EffectRig::Rhs, this) {
   m_.rig.damper.Validate();
+  if (m_.effects.servovalve_saturation && m_.effects.servovalve_saturation->InLoop())
+    limited_ = FlowLimitedServo::Make(m_.rig.servo, m_.effects.servovalve_saturation->vmax_mm_per_s);
   // Sample 0: at rest, 0 A (as the linear rig).
   f_ = m_.rig.has_damper ? force_.Force(DamperForceKn(CoefficientsAt(m_.rig.damper, 0.0), damper_, 0.0, 0.0))
                          : 0.0;
@@ -81,12 +83,22 @@ EffectRig::EffectRig(const EffectRigModel& model)
 int EffectRig::Rhs(double t, const double* w, double* wdot, void* self) {
   const auto* me = static_cast<const EffectRig*>(self);
   const LinearServo& servo = me->m_.rig.servo;
-  const Eigen::Map<const Eigen::Vector3d> z(w);
-  const Eigen::Vector3d zdot = servo.A * z + servo.B * me->u_act_;
-  wdot[0] = zdot(0), wdot[1] = zdot(1), wdot[2] = zdot(2);
+  double x = 0.0, xdot = 0.0;
+  if (me->limited_) {  // [x, xv, w] of the flow-limited servo (its derivative in [w, x, xv] order)
+    const double st[3] = {w[2], w[0], w[1]};
+    double d[3];
+    Derivative(*me->limited_, st, me->u_act_, d);
+    wdot[0] = d[1], wdot[1] = d[2], wdot[2] = d[0];
+    x = w[0], xdot = d[1];
+  } else {
+    const Eigen::Map<const Eigen::Vector3d> z(w);
+    const Eigen::Vector3d zdot = servo.A * z + servo.B * me->u_act_;
+    wdot[0] = zdot(0), wdot[1] = zdot(1), wdot[2] = zdot(2);
+    x = (servo.C * z).value(), xdot = (servo.C * zdot).value();
+  }
   // Specimen motion: the servo's x(t) plus the effects' offset, linear over the step.
-  double y = (servo.C * z).value() + (me->d0_ + me->dv_ * t);
-  double ydot = (servo.C * zdot).value() + me->dv_;
+  double y = x + (me->d0_ + me->dv_ * t);
+  double ydot = xdot + me->dv_;
   if (me->ripple_in_step_) {  // supply_ripple: its continuous motion, not a line between samples
     const RippleMotion r = SupplyRippleAt(*me->m_.effects.supply_ripple, servo.dt_s, me->ripple_t0_s_ + t);
     y += r.mm, ydot += r.mm_s;
@@ -101,8 +113,7 @@ int EffectRig::Rhs(double t, const double* w, double* wdot, void* self) {
   return 0;
 }
 
-double EffectRig::Trial(double x0, double x1, const LinearServoState& next, double y1, double i_end_A,
-                       MrDamperState* damper) {
+double EffectRig::Trial(double x0, double x1, double x1_dot, double y1, double i_end_A, MrDamperState* damper) {
   const LinearRig& rig = m_.rig;
   // supply_ripple: Post gave sample j its ripple at (j - 1) dt (sample 0, at rest, has none); from
   // the second step on the damper moves with the ripple itself (Rhs), the rest of the effects'
@@ -120,9 +131,10 @@ double EffectRig::Trial(double x0, double x1, const LinearServoState& next, doub
   double force = 0.0;
   if (rig.has_damper) {
     double w[5] = {servo_.z(0), servo_.z(1), servo_.z(2), damper_.y_mm, damper_.z_mm};
+    if (limited_) w[0] = loop_.x, w[1] = loop_.xv, w[2] = loop_.w;
     ode_.Advance(0.0, rig.servo.dt_s, w);
     *damper = {w[3], w[4]};
-    const double ydot = OutputVelocity(rig.servo, next) + dv_ + r1.mm_s;
+    const double ydot = x1_dot + dv_ + r1.mm_s;
     force = DamperForceKn(CoefficientsAt(rig.damper, i_end_A), *damper, y1, ydot);
   }
   // The fading damper (outside the library) at t_{k+1}, bounded so that a long run cannot reverse it.
@@ -152,23 +164,26 @@ void EffectRig::Step(double u_mm, double i_cmd_A) {
 
   // Displacement path: command effects, the servo (exact ZOH), output effects.
   u_act_ = disp_.Pre(u_mm);
-  const double x0 = Output(rig.servo, servo_);
+  const double x0 = actuator_x_mm();
   LinearServoState next = servo_;
-  models::Step(rig.servo, &next, u_act_);
-  const double x1 = Output(rig.servo, next);
+  FlowLimitedServoState loop_next = loop_;
+  if (limited_) models::Step(*limited_, &loop_next, u_act_);
+  else models::Step(rig.servo, &next, u_act_);
+  const double x1 = limited_ ? loop_next.x : Output(rig.servo, next);
+  const double x1_dot = limited_ ? Velocity(*limited_, loop_next) : OutputVelocity(rig.servo, next);
 
   double y1 = 0.0, f1 = 0.0;
   MrDamperState damper{};
   if (!m_.effects.load_coupling || !m_.coupling_same_sample) {
     y1 = disp_.Post(x1, f_);
-    f1 = Trial(x0, x1, next, y1, i_end, &damper);
+    f1 = Trial(x0, x1, x1_dot, y1, i_end, &damper);
   } else {
     // Load coupling: y_{k+1} = Post(x_{k+1}, f_{k+1}) with the force of the same sample
     // (models/coupling_solver.h).
     auto eval = [&](double f_in) {
       scratch_ = disp_;  // same sizes: no allocation
       y1 = scratch_.Post(x1, f_in);
-      f1 = Trial(x0, x1, next, y1, i_end, &damper);
+      f1 = Trial(x0, x1, x1_dot, y1, i_end, &damper);
       return f1 - f_in;
     };
     const double f_start = k_ >= 1 ? 2.0 * f_ - f_prev_ : f_;  // linear extrapolation of the force
@@ -183,6 +198,7 @@ void EffectRig::Step(double u_mm, double i_cmd_A) {
   }
   damper_ = damper;
   servo_ = next;  // authoritative for x (exact ZOH)
+  loop_ = loop_next;
   current_ = end;
   y_ = y1;
   f_ = f1;
@@ -194,8 +210,9 @@ void EffectRig::Measure() {
   // The specimen's acceleration at t_k: the servo's own y'' (exact) plus the second backward
   // difference of what the displacement effects add to it (load_cell_inertia only).
   const double dt = m_.rig.servo.dt_s;
-  const double d = y_ - Output(m_.rig.servo, servo_);
-  const double a = servo_.z(2) + (k_ >= 2 ? (d - 2.0 * d_prev_ + d_prev2_) / (dt * dt) : 0.0);
+  const double d = y_ - actuator_x_mm();
+  const double a = (limited_ ? Acceleration(*limited_, loop_) : servo_.z(2)) +
+                   (k_ >= 2 ? (d - 2.0 * d_prev_ + d_prev2_) / (dt * dt) : 0.0);
   d_prev2_ = d_prev_;
   d_prev_ = d;
   double y = 0.0, f = 0.0;

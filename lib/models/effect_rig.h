@@ -10,7 +10,8 @@
 ///     i_c(t)  the model's current dynamics (Eq. 40 + 75 Hz, closed form) driven by i_l held,
 ///             or i_l itself without them (plant.current_dynamics)
 ///     v_k   = DisplacementEffects::Pre(u_k)                    pure_delay, gain_error
-///     z_{k+1} = Phi z_k + Gamma v_k,   x_{k+1} = C z_{k+1}     linear servo, exact ZOH
+///     z_{k+1} = Phi z_k + Gamma v_k,   x_{k+1} = C z_{k+1}     linear servo, exact ZOH (with the flow
+///             limit in the loop, servovalve_saturation in_loop = 1: FlowLimitedServo, RK4)
 ///     y_{k+1} = DisplacementEffects::Post(x_{k+1}, f_k)        oil column, saturation, load
 ///                                                              coupling, friction, backlash (**)
 ///     damper  Eqs. 32-33 integrated by CVODE over the step, driven by the specimen motion
@@ -47,6 +48,7 @@
 /// the measured noise has rms sqrt(baseline^2 + effect^2). Same seed, same bits.
 #include <cstdint>
 #include <memory>
+#include <optional>
 
 #include "models/current_driver.h"
 #include "models/linear_rig.h"
@@ -54,6 +56,7 @@
 #include "models/ode.h"
 #include "models/rig.h"
 #include "models/rig_effects.h"
+#include "models/servo_flow_limit.h"
 #include "models/servo_linear.h"
 #include "models/rig.h"
 #include "signal/random.h"
@@ -95,7 +98,7 @@ class EffectRig final : public Rig {
   double true_y_mm() const { return y_; }
   double true_f_kN() const { return f_; }
   /// The actuator model's output x_k [mm] (before the displacement effects).
-  double actuator_x_mm() const { return Output(m_.rig.servo, servo_); }
+  double actuator_x_mm() const { return limited_ ? loop_.x : Output(m_.rig.servo, servo_); }
   const EffectRigModel& model() const { return m_; }
   /// load_coupling: steps whose same-sample force had no root to the tolerance (the closest
   /// trial was taken; happens at reversals with coulomb_friction, whose steep sign makes the
@@ -107,8 +110,7 @@ class EffectRig final : public Rig {
   /// One integration of the step for a candidate specimen displacement y1 at its end: sets the
   /// motion (d0_, dv_), integrates the damper from the saved state into *damper, returns the total
   /// force f_{k+1} [kN] (damper_scale, unmodelled spring) at the effective current i_end_A.
-  double Trial(double x0, double x1, const LinearServoState& next, double y1, double i_end_A,
-               MrDamperState* damper);
+  double Trial(double x0, double x1, double x1_dot, double y1, double i_end_A, MrDamperState* damper);
   void Measure();  // noise and ripple for the current sample
   static constexpr int kMaxCouplingIterations = 20;
 
@@ -119,6 +121,10 @@ class EffectRig final : public Rig {
   DisplacementEffects scratch_;   // load_coupling: trial copy of disp_ (same sizes)
   signal::GaussianState noise_;
   LinearServoState servo_{};
+  /// servovalve_saturation in the loop: the actuator with its flow limit (models/servo_flow_limit.h)
+  /// instead of servo_; the damper's ODE then carries its state as [x, xv, w].
+  std::optional<FlowLimitedServo> limited_;
+  FlowLimitedServoState loop_{};
   MrDamperState damper_{};
   CurrentDriverState current_{};
   // within the step being integrated

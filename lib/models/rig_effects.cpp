@@ -73,11 +73,13 @@ const std::array<EffectInfo, 15> kEffects = {{
         FieldOf<&EffectSet::backlash, &Backlash::gap_mm>},
        kNoParam}},
      1, TurnOn<&EffectSet::backlash>, IsOn<&EffectSet::backlash>},
+    // in_loop: a switch (grid -1), the diagnosis fits vmax both ways and keeps the better.
     {"servovalve_saturation", 'y', true,
      {{{"vmax_mm_per_s", 0.0, 1e9, true, false, 0.0, true, true, 1.0, 0.0, true, 31, 0.0, true,
         FieldOf<&EffectSet::servovalve_saturation, &ServovalveSaturation::vmax_mm_per_s>},
-       kNoParam}},
-     1, TurnOn<&EffectSet::servovalve_saturation>, IsOn<&EffectSet::servovalve_saturation>},
+       {"in_loop", 0.0, 1.0, false, false, 0.0, false, true, 0.0, 1.0, false, -1, 0.0, false,
+        FieldOf<&EffectSet::servovalve_saturation, &ServovalveSaturation::in_loop>}}},
+     2, TurnOn<&EffectSet::servovalve_saturation>, IsOn<&EffectSet::servovalve_saturation>},
     // The noise floor, not an effect the diagnosis selects; a table needs one of its keys.
     {"sensor_noise", 'b', false,
      {{{"rms_y_mm", 0.0, 10.0, false, false, 0.0, false, false, 0.0, 0.0, false, 0, 0.0, false,
@@ -172,7 +174,10 @@ void EffectSet::Validate(double dt_s, std::string_view where) const {
   for (const EffectInfo& e : kEffects) {
     for (const EffectParam& p : e.params()) {
       const double* v = p.field(copy);
-      if (v == nullptr || p.Valid(*v, dt_s)) continue;
+      if (v == nullptr || (p.Valid(*v, dt_s) && (p.grid >= 0 || *v == 0.0 || *v == 1.0))) continue;
+      if (p.grid < 0)
+        throw Error(fmt::format("{}{}effects.{}.{}", where, where.empty() ? "" : ": ", e.name, p.key),
+                    fmt::format("value {} is not allowed; allowed 0 or 1", *v));
       throw Error(fmt::format("{}{}effects.{}.{}", where, where.empty() ? "" : ": ", e.name, p.key),
                   fmt::format("value {} is out of range; allowed {}", *v, p.RangeText(dt_s)));
     }
@@ -261,7 +266,7 @@ double DisplacementEffects::Post(double x_mm, double f_kN) {
     q2_ = q2;
     y = q1;
   }
-  if (e_.servovalve_saturation) {
+  if (e_.servovalve_saturation && !e_.servovalve_saturation->InLoop()) {  // in the loop: the actuator model's
     const double dmax = e_.servovalve_saturation->vmax_mm_per_s * dt_s_;
     rate_out_ += std::clamp(y - rate_out_, -dmax, dmax);
     y = rate_out_;

@@ -106,8 +106,16 @@ inline bool RippleHarmonicSampled(int h, double f_hz, double dt_s) { return h * 
 /// The library's shape of SupplyRipple: amplitude weight and phase [rad] of harmonic h = 1, 2, 3.
 inline constexpr std::array<double, kRippleHarmonics> kRippleWeights{1.0, 0.5, 0.25};
 inline constexpr std::array<double, kRippleHarmonics> kRipplePhases{0.0, 1.0, 2.0};
-/// Flow limit: the output moves at most vmax * dt per step towards its input (rate limiter).
-struct ServovalveSaturation { double vmax_mm_per_s = 1e9; bool operator==(const ServovalveSaturation&) const = default; };        ///< > 0
+/// Flow limit. in_loop = 0: on the actuator's output, which moves at most vmax * dt per step towards
+/// its input (a rate limiter after the loop). in_loop = 1: inside the servo loop, the piston's
+/// velocity limited while the loop's own velocity state winds up (models/servo_flow_limit.h: the
+/// actuator model is then integrated with the limit inside it, and Post does not limit).
+struct ServovalveSaturation {
+  double vmax_mm_per_s = 1e9;  ///< > 0
+  double in_loop = 0.0;        ///< 0 (after the loop) or 1 (inside it)
+  bool InLoop() const { return in_loop >= 0.5; }
+  bool operator==(const ServovalveSaturation&) const = default;
+};
 /// Gaussian measurement noise added to a channel (rig mode only); rms in the channel's unit.
 struct SensorNoise { double rms_y_mm = 0.0; double rms_f_kN = 0.0; bool operator==(const SensorNoise&) const = default; };  ///< >= 0
 /// Extra first-order lag of the damper current, 1 / (tau s + 1), exact ZOH, in series with the
@@ -172,6 +180,8 @@ struct EffectParam {
   int grid;
   double search_hi_per_dt;
   bool search_hi_from_data;
+  /// grid < 0: a switch, 0 or 1 (valid values only those two); the diagnosis tries both and counts
+  /// it as no free parameter; never "at a bound".
   /// The parameter in a set where the effect is on (nullptr if it is off).
   double* (*field)(EffectSet&);
 

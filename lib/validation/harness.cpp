@@ -29,7 +29,8 @@ const std::vector<std::string> kPairs = {"pure_delay+damper_scale", "gain_error+
                                          "oil_column_resonance+coulomb_friction", "presliding_friction+damper_scale",
                                          "command_dead_band+current_lag", "pure_delay+presliding_friction",
                                          "gain_error+supply_ripple", "channel_skew+current_lag",
-                                         "load_cell_inertia+damper_scale", "presliding_friction@short+oil_column_resonance"};
+                                         "load_cell_inertia+damper_scale", "presliding_friction@short+oil_column_resonance",
+                                         "servovalve_saturation@loop+damper_scale"};
 
 std::vector<std::string> Split(const std::string& s) {
   std::vector<std::string> out;
@@ -62,6 +63,7 @@ const std::vector<std::string> kIndependentPairs = {
 std::vector<std::string> HarnessCaseKinds(bool pairs) {
   std::vector<std::string> k = kSingles;
   k.push_back("presliding_friction@short");
+  k.push_back("servovalve_saturation@loop");
   if (pairs) k.insert(k.end(), kPairs.begin(), kPairs.end());
   for (const char* c : {"none", "none_current_on", "unknown_ripple", "unknown_stiffness", "unknown_heating"}) k.emplace_back(c);
   return k;
@@ -314,9 +316,10 @@ Truth HarnessTruth(const std::string& kind, std::uint64_t seed, double noise_y_m
     } else if (e == "command_dead_band") {
       t.effects.command_dead_band = models::CommandDeadBand{U(0.1, 0.6)};
       txt += fmt::format("width_mm={:.3g} ", t.effects.command_dead_band->width_mm);
-    } else if (e == "servovalve_saturation") {
-      t.effects.servovalve_saturation = models::ServovalveSaturation{U(150.0, 300.0)};
-      txt += fmt::format("vmax_mm_per_s={:.4g} ", t.effects.servovalve_saturation->vmax_mm_per_s);
+    } else if (e == "servovalve_saturation" || e == "servovalve_saturation@loop") {
+      t.effects.servovalve_saturation = models::ServovalveSaturation{U(150.0, 300.0), e == "servovalve_saturation" ? 0.0 : 1.0};
+      txt += fmt::format("vmax_mm_per_s={:.4g}{} ", t.effects.servovalve_saturation->vmax_mm_per_s,
+                         e == "servovalve_saturation" ? "" : " (in the loop)");
     } else if (e == "current_lag") {
       t.effects.current_lag = models::CurrentLag{U(20.0, 150.0)};
       txt += fmt::format("tau_ms={:.3g} ", t.effects.current_lag->tau_ms);

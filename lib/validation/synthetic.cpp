@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include <cmath>
+#include <optional>
 #include <utility>
 
 #include <fmt/format.h>
@@ -12,6 +13,7 @@
 #include "models/current_driver.h"
 #include "models/mr_damper.h"
 #include "models/rig.h"
+#include "models/servo_flow_limit.h"
 #include "models/servo_linear.h"
 #include "models/supply_ripple.h"
 #include "signal/blwn.h"
@@ -101,6 +103,11 @@ io::RigRecord MakeRecordBlocks(const Excitation& ex, const Truth& truth, const s
   const double dt = ex.dt_s;
   const auto servo = models::LinearServo::Make(models::ServoPreset("avg"), dt);
   models::LinearServoState xs;
+  // servovalve_saturation in the loop: the flow-limited actuator instead (models/servo_flow_limit.h).
+  std::optional<models::FlowLimitedServo> limited;
+  if (truth.effects.servovalve_saturation && truth.effects.servovalve_saturation->InLoop())
+    limited = models::FlowLimitedServo::Make(servo, truth.effects.servovalve_saturation->vmax_mm_per_s);
+  models::FlowLimitedServoState ls;
   models::DisplacementEffects dfx(truth.effects, dt);
   models::ForceEffects ffx(truth.effects, dt);
   const double i_before = truth.driver_at_rest ? 0.0 : i[0];  // what the driver held before the record
@@ -123,7 +130,8 @@ io::RigRecord MakeRecordBlocks(const Excitation& ex, const Truth& truth, const s
   std::vector<double> f_cell(n, 0.0);
   models::DisplacementEffects dfx_try = dfx;  // a trial's copy: same sizes, assigned without allocating
   for (std::size_t k = 0; k < n; ++k) {
-    const double x = models::Output(servo, xs), xd = models::OutputVelocity(servo, xs);
+    const double x = limited ? ls.x : models::Output(servo, xs);
+    const double xd = limited ? models::Velocity(*limited, ls) : models::OutputVelocity(servo, xs);
     // One trial: the output effects and the damper from the step's start, fed the force f_in.
     models::MrDamperState ds_try = ds;
     double y = 0.0, f = 0.0;
@@ -186,12 +194,14 @@ io::RigRecord MakeRecordBlocks(const Excitation& ex, const Truth& truth, const s
     r.f_kN[k] = sf * signal::NextGaussian(&g);  // the force is added below
     // load_cell_inertia: the specimen's acceleration, the servo's exact y'' plus the second
     // difference of the effects' share (as the rig mode takes it).
-    const double acc = xs.z(2) + (k >= 2 ? (d - 2.0 * d_prev + d_prev2) / (dt * dt) : 0.0);
+    const double acc = (limited ? models::Acceleration(*limited, ls) : xs.z(2)) +
+                       (k >= 2 ? (d - 2.0 * d_prev + d_prev2) / (dt * dt) : 0.0);
     f_cell[k] = f + (truth.effects.load_cell_inertia ? 1e-6 * truth.effects.load_cell_inertia->mass_kg * acc : 0.0);
     d_prev2 = d_prev;
     // Step k -> k+1.
     models::Hold(driver, &cs, ffx.Current(i[k]));
-    models::Step(servo, &xs, dfx.Pre(u[k]));
+    if (limited) models::Step(*limited, &ls, dfx.Pre(u[k]));
+    else models::Step(servo, &xs, dfx.Pre(u[k]));
     x_prev = x, xd_prev = xd, d_prev = d, f_prev2 = f_prev, f_prev = f;
   }
   // channel_skew: the force channel records the load cell's force at t_k - skew (offline: either sign).

@@ -1,0 +1,125 @@
+// WeighLostMotion of stages.h: two lost-motion effects weighed against one (docs/diagnosis.md "Lost motion").
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <optional>
+
+#include <fmt/format.h>
+
+#include "diagnosis/candidates.h"
+#include "diagnosis/fit.h"
+#include "diagnosis/residual_stats.h"
+#include "diagnosis/stages.h"
+#include "diagnosis/tuning.h"
+
+namespace rths::diagnosis::stages {
+
+namespace {
+
+constexpr const char* kLostMotion[] = {"backlash", "coulomb_friction", "presliding_friction", "command_dead_band"};
+
+bool IsLostMotion(const std::string& name) {
+  return std::find(std::begin(kLostMotion), std::end(kLostMotion), name) != std::end(kLostMotion);
+}
+
+/// The motion an effect loses at a reversal, from each side [mm] (its half gap, loss or half width).
+double LostMotionOf(const std::string& name, const std::vector<double>& v) {
+  if (name == "backlash" || name == "command_dead_band") return 0.5 * v[0];
+  return v[0];  // coulomb_friction's and presliding_friction's loss
+}
+
+/// `single`'s starting points from a lost motion L [mm], in its parameters' order.
+std::vector<std::vector<double>> StartsFrom(const std::string& single, double L) {
+  if (single == "presliding_friction") return {{L, 0.05 * L}, {L, 0.2 * L}, {L, 0.5 * L}};
+  if (single == "coulomb_friction") return {{L}};
+  return {{2.0 * L}};  // backlash's gap, command_dead_band's width
+}
+
+struct Candidate {
+  std::string name;
+  Params params;  // the whole set with it in the lost-motion effects' place
+  double sse = std::numeric_limits<double>::infinity();
+};
+
+}  // namespace
+
+void WeighLostMotion(ChannelState* sp, const std::vector<CandidateSpec>& specs, const Options& o,
+                     std::vector<std::string>* warnings) {
+  ChannelState& s = *sp;
+  std::vector<std::string> lost;
+  for (const auto& n : s.order)
+    if (IsLostMotion(n)) lost.push_back(n);
+  if (lost.size() < 2) return;
+  double L = 0.0;
+  int p_lost = 0;
+  Params rest = s.sel;
+  for (const auto& n : lost) {
+    L += LostMotionOf(n, s.sel.at(n));
+    p_lost += FreeParams(SpecOf(specs, n), s.train.recs().size());
+    rest.erase(n);
+  }
+  const double tau = IntegratedCorrelationTime(s.train, s.pred_train);
+  const double n_eff = std::max(1.0, static_cast<double>(s.n_train) / tau);
+  std::optional<Candidate> best;
+  double best_dbic = std::numeric_limits<double>::infinity();
+  for (const char* single : kLostMotion) {
+    const CandidateSpec* spec = nullptr;
+    for (const auto& c : specs)
+      if (c.name == single && c.channel == s.ch) spec = &c;
+    if (spec == nullptr) continue;
+    Candidate c{single, {}, std::numeric_limits<double>::infinity()};
+    // From its whole range, and from the lost motion of the set it would replace (a local refit).
+    std::vector<Params> tries;
+    Params q = rest;
+    FitEffect(s.train, specs, &q, single, o);
+    tries.push_back(q);
+    for (const auto& start : StartsFrom(single, L)) {
+      Params r = rest;
+      std::vector<double> v = start;
+      for (std::size_t j = 0; j < v.size(); ++j) v[j] = std::clamp(v[j], spec->params[j].lo, spec->params[j].hi);
+      r[single] = v;
+      FitEffect(s.train, specs, &r, single, o);
+      tries.push_back(r);
+    }
+    for (auto& t : tries) {
+      const double sse = RefitAll(s.train, specs, &t, s.train.Sse(s.train.Predict(ToSet(specs, t))), o.refit_rounds, o);
+      if (AtBound(*spec, t.at(single)) || !FormOf(*spec, t.at(single)).empty()) continue;
+      if (sse < c.sse) c.sse = sse, c.params = t;
+    }
+    if (!std::isfinite(c.sse)) continue;
+    const int p = FreeParams(*spec, s.train.recs().size());
+    const double dbic = n_eff * std::log(std::max(c.sse, 1e-300) / std::max(s.sse, 1e-300)) + (p - p_lost) * std::log(n_eff);
+    if (dbic < best_dbic) best_dbic = dbic, best = std::move(c);
+  }
+  if (!best) return;
+  const std::string pair = fmt::format("{}", fmt::join(lost, "+"));
+  if (best_dbic < 0.0) {
+    warnings->push_back(fmt::format("channel {}: {} replaced by {}: one lost-motion effect explains the lost motion the "
+                                    "set shared (training BIC {:.1f} lower)",
+                                    s.summary.channel, fmt::join(lost, " + "), best->name, -best_dbic));
+    // In the place of the first of them, with their evidence.
+    const auto first = std::find(s.order.begin(), s.order.end(), lost.front());
+    const std::size_t at = static_cast<std::size_t>(first - s.order.begin());
+    s.sel_stats[best->name] = s.sel_stats[lost.front()];
+    for (const auto& n : lost) {
+      s.order.erase(std::find(s.order.begin(), s.order.end(), n));
+      s.alternatives.erase(n);
+      s.sel_stats.erase(n);
+    }
+    s.order.insert(s.order.begin() + static_cast<std::ptrdiff_t>(std::min(at, s.order.size())), best->name);
+    // The set as the single's close call, its parameters keyed "effect.key".
+    std::map<std::string, double> merged;
+    for (const auto& n : lost)
+      for (const auto& [k, v] : ParamMap(specs, n, s.sel.at(n))) merged[n + "." + k] = v;
+    s.sel = best->params;
+    s.alternatives[best->name].clear();
+    if (-best_dbic < tuning::kCloseCallBic) s.alternatives[best->name].push_back({pair, -best_dbic, merged});
+    s.pred_train = s.train.Predict(ToSet(specs, s.sel));
+    s.sse = s.train.Sse(s.pred_train);
+  } else if (best_dbic < tuning::kCloseCallBic) {
+    auto& alts = s.alternatives[lost.front()];
+    alts.insert(alts.begin(), {best->name, best_dbic, ParamMap(specs, best->name, best->params.at(best->name))});
+  }
+}
+
+}  // namespace rths::diagnosis::stages
