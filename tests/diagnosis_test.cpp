@@ -855,3 +855,70 @@ TEST_CASE("an effect the test records do not exercise is named unconfirmed, with
   CHECK(r.Channel("y")->status == "unconfirmed");
   CHECK(ToJson(r)["effects"][0]["unconfirmed"] == e->unconfirmed);
 }
+
+TEST_CASE("a current on at the first sample with the driver at rest: the driver's start is estimated, none") {
+  // The issue's false alarm: training records that start at rest with 0.6-2.2 A already commanded,
+  // the rig's driver starting from 0 A (the model assumed the steady state of the first command).
+  for (const double i0 : {0.6, 1.5, 2.0}) {
+    CAPTURE(i0);
+    Truth t = Noisy();
+    t.driver_at_rest = true;
+    const auto [tr, te] = Records(t, 6.0, 5, [i0](Excitation* ex) { ex->current_start_A = i0; });
+    REQUIRE(tr.i_A.front() == i0);
+    const auto r = Diagnose({tr}, {te}, PaperModel(), Options{});
+    INFO(Summary(r));
+    CHECK(r.verdict == std::vector<std::string>{"none"});
+    bool noted = false;
+    for (const auto& w : r.warnings) noted = noted || w.find("train: the current command is") != std::string::npos;
+    CHECK(noted);
+  }
+  // The driver at the first command's steady state (as before): no note, still none.
+  Truth t = Noisy();
+  const auto [tr, te] = Records(t, 6.0, 5, [](Excitation* ex) { ex->current_start_A = 1.5; });
+  const auto r = Diagnose({tr}, {te}, PaperModel(), Options{});
+  CHECK(r.verdict == std::vector<std::string>{"none"});
+  for (const auto& w : r.warnings) CHECK(w.find("the current command is") == std::string::npos);
+}
+
+TEST_CASE("a damper that heats over the test: damper_scale named with its drift; a constant one without") {
+  Truth heat = Noisy();
+  heat.fade_per_s = -0.15 / 6.0;  // 1 -> 0.85 over the 6 s training record
+  const auto [tr, te] = Records(heat, 6.0, 3, {}, &MakeRecordBlocks, [](Excitation*, Truth* t) {
+    t->fade_start = 0.85, t->fade_per_s = -0.05 / 6.0;  // lower again in the test
+  });
+  const auto r = Diagnose({tr}, {te}, PaperModel(), Options{});
+  INFO(Summary(r));
+  const bool unknown = r.verdict == std::vector<std::string>{"unknown"};
+  if (!unknown) {
+    REQUIRE(r.verdict == std::vector<std::string>{"damper_scale"});
+    const auto* e = Find(r, "damper_scale");
+    REQUIRE(e != nullptr);
+    CHECK(e->drift.find("drifting over the record: scale") != std::string::npos);
+    CHECK(VerdictText(r).find("damper_scale, drifting over the record") != std::string::npos);
+    REQUIRE(e->segments.size() == 1);
+    CHECK(e->segments[0].values.front() > e->segments[0].values.back() + 0.05);
+    CHECK(ToJson(r)["effects"][0]["drift"].get<std::string>() == e->drift);
+  }
+  // A constant scale: no drift, and its uncertainty small.
+  Truth still = Noisy();
+  still.effects.damper_scale = m::DamperScale{1.2};
+  const auto [tr2, te2] = Records(still);
+  const auto r2 = Diagnose({tr2}, {te2}, PaperModel(), Options{});
+  REQUIRE(r2.verdict == std::vector<std::string>{"damper_scale"});
+  const auto* e2 = Find(r2, "damper_scale");
+  CHECK(e2->drift.empty());
+  CHECK(e2->params_se.at("scale") < 0.01);
+  CHECK(std::abs(e2->params.at("scale") - 1.2) < 4.0 * e2->params_se.at("scale") + 0.005);
+}
+
+TEST_CASE("a flow limit inside the servo loop is found in its own form") {
+  Truth t = Noisy();
+  t.effects.servovalve_saturation = m::ServovalveSaturation{200.0, 1.0};
+  const auto [tr, te] = Records(t, 6.0, 3, [](Excitation* ex) { ex->rms_mm = 6.0; });
+  const auto r = Diagnose({tr}, {te}, PaperModel(), Options{});
+  INFO(Summary(r));
+  REQUIRE(r.verdict == std::vector<std::string>{"servovalve_saturation"});
+  const auto* e = Find(r, "servovalve_saturation");
+  CHECK(e->params.at("in_loop") == 1.0);
+  CHECK(e->params.at("vmax_mm_per_s") == doctest::Approx(200.0).epsilon(0.03));
+}

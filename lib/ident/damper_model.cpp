@@ -2,6 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <optional>
+
+#include <Eigen/Dense>
 
 namespace rths::ident {
 
@@ -9,6 +13,9 @@ namespace {
 
 /// At most this many refits of the damper model around the measurement's effects.
 constexpr int kMeasurementRounds = 6;
+/// The profiles' smallest steps (ProfileMeasurement): the skew's [ms] (or a sample) and the mass's [kg].
+constexpr double kProfileSkewStepMs = 0.1;
+constexpr double kProfileMassStepKg = 0.05;
 
 /// The fit the options ask for, without measurement effects.
 DamperModelFit FitBase(const std::vector<io::RigRecord>& records, const DamperFitOptions& o) {
@@ -26,6 +33,89 @@ MeasurementFit MeasureAround(const DamperModelFit& fit, const std::vector<io::Ri
   std::vector<double> cut;
   for (const auto& r : records) F.push_back(fit.DamperForce(r)), cut.push_back(fit.CutoffHz(r));
   return FitMeasurement(records, F, cut, m);
+}
+
+/// The model refitted with the measurement held at (skew_ms, mass_kg) where given ("fixed"), the
+/// other fitted around it as the options say.
+DamperModelFit RefitAt(const std::vector<io::RigRecord>& records, const DamperFitOptions& o,
+                       const MeasurementOptions& m, const DamperModelFit& at, std::optional<double> skew_ms,
+                       std::optional<double> mass_kg) {
+  MeasurementFit held = at.measurement;
+  if (skew_ms) held.skew_ms = *skew_ms;
+  if (mass_kg) held.mass_kg = *mass_kg;
+  std::vector<io::RigRecord> own;
+  for (const auto& r : records) own.push_back(held.DamperForceRecord(r, at.CutoffHz(r)));
+  DamperModelFit f = FitBase(own, o);
+  MeasurementOptions mo = m;
+  if (skew_ms) mo.skew = MeasurementMode::kGiven, mo.skew_ms = *skew_ms;
+  if (mass_kg) mo.inertia = MeasurementMode::kGiven, mo.mass_kg = *mass_kg;
+  f.measurement = MeasureAround(f, records, mo);
+  f.measurement.options = m;  // what was asked, for the report
+  return f;
+}
+
+/// The least-squares parabola J(x) = a + b (x - x0) + c (x - x0)^2 through the points; returns
+/// {b, c} (c <= 0 or too few points: no minimum).
+std::pair<double, double> Parabola(const std::vector<std::pair<double, double>>& pts, double x0) {
+  Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d y = Eigen::Vector3d::Zero();
+  for (const auto& [x, J] : pts) {
+    const Eigen::Vector3d row(1.0, x - x0, (x - x0) * (x - x0));
+    A += row * row.transpose();
+    y += row * J;
+  }
+  if (pts.size() < 3) return {0.0, 0.0};
+  const Eigen::Vector3d c = A.ldlt().solve(y);
+  return {c(1), c(2)};
+}
+
+/// Profiles of the cost J (the damper model refitted at each point, the other measurement parameter
+/// fitted around it): five points about each fitted parameter, a least-squares parabola through
+/// them (a refit's own convergence scatters J by more than a three-point curvature could stand),
+/// its curvature c giving the standard error sqrt(2 sigma^2 tau / (2 c)); for the skew the
+/// parabola's vertex, refitted, replaces the alternation's end if its cost is lower.
+void ProfileMeasurement(const std::vector<io::RigRecord>& records, const DamperFitOptions& o,
+                        const MeasurementOptions& m, DamperModelFit* fit) {
+  const double dt_ms = 1e3 * records.front().dt_s;
+  if (m.skew == MeasurementMode::kAuto) {
+    const double s0 = fit->measurement.skew_ms;
+    const double h = std::max({dt_ms, kProfileSkewStepMs, 3.0 * fit->measurement.skew_se_ms});
+    std::vector<std::pair<double, double>> pts;
+    std::optional<DamperModelFit> best;
+    for (int j = -2; j <= 2; ++j) {
+      DamperModelFit f = RefitAt(records, o, m, *fit, s0 + j * h, std::nullopt);
+      pts.emplace_back(s0 + j * h, f.measurement.cost);
+      if (f.measurement.cost < (best ? best->measurement.cost : fit->measurement.cost)) best = std::move(f);
+    }
+    const auto [b, c] = Parabola(pts, s0);
+    if (c > 0.0) {
+      const double v = std::clamp(s0 - b / (2.0 * c), s0 - 2.0 * h, s0 + 2.0 * h);
+      DamperModelFit at_v = RefitAt(records, o, m, *fit, v, std::nullopt);
+      if (at_v.measurement.cost < (best ? best->measurement.cost : fit->measurement.cost)) best = std::move(at_v);
+    }
+    const double se = c > 0.0 ? std::sqrt(fit->measurement.sigma2 * fit->measurement.tau / c)
+                              : std::numeric_limits<double>::infinity();
+    if (best) *fit = std::move(*best);
+    fit->measurement.skew_se_ms = se;
+    fit->measurement.profiled = true;
+  }
+  if (m.inertia == MeasurementMode::kAuto) {
+    const double m0 = fit->measurement.mass_kg;
+    const double h = std::max({0.25 * m0, 3.0 * fit->measurement.mass_se_kg, kProfileMassStepKg});
+    const auto sk = std::optional<double>(fit->measurement.skew_ms);
+    std::vector<std::pair<double, double>> pts{{m0, fit->measurement.cost}};
+    for (int j : {-2, -1, 1, 2}) {
+      const double mj = m0 + j * h;
+      if (mj < 0.0) continue;
+      pts.emplace_back(mj, RefitAt(records, o, m, *fit, sk, mj).measurement.cost);
+    }
+    const auto [b, c] = Parabola(pts, m0);
+    (void)b;
+    fit->measurement.mass_se_kg = c > 0.0 ? std::sqrt(fit->measurement.sigma2 * fit->measurement.tau / c)
+                                          : std::numeric_limits<double>::infinity();
+    fit->measurement.mass_unresolved = !(fit->measurement.mass_kg > 2.0 * fit->measurement.mass_se_kg);
+    fit->measurement.profiled = true;
+  }
 }
 
 }  // namespace
@@ -47,6 +137,7 @@ DamperModelFit FitDamperModel(const std::vector<io::RigRecord>& records, const D
         std::abs(fit.measurement.mass_kg - before.mass_kg) <= std::max(fit.measurement.mass_se_kg, 1e-9))
       break;
   }
+  ProfileMeasurement(records, o, m, &fit);
   // The training scores on the measured force.
   auto& scores = fit.at_current ? fit.at_current->records : fit.any_input->records;
   for (std::size_t j = 0; j < records.size() && j < scores.size(); ++j) scores[j] = fit.Score(records[j]);

@@ -122,6 +122,8 @@ std::string MeasurementFit::Report() const {
   if (options.skew != MeasurementMode::kOff)
     s += fmt::format("  channel skew (the force channel's lag behind the displacement's): {:.4g} ms{} ({})\n", skew_ms,
                      skew_se_ms > 0 ? fmt::format(" +- {:.2g} ms", skew_se_ms) : "", how(options.skew));
+  if (profiled && (skew_se_ms > 0 || mass_se_kg > 0))
+    s += "    (+- one standard error, from the cost's profile with the damper model refitted at either side)\n";
   if (options.inertia != MeasurementMode::kOff) {
     s += fmt::format("  load-cell inertia (the mass between load cell and damper): {:.4g} kg{} ({})\n", mass_kg,
                      mass_se_kg > 0 ? fmt::format(" +- {:.2g} kg", mass_se_kg) : "", how(options.inertia));
@@ -192,6 +194,7 @@ MeasurementFit FitMeasurement(const std::vector<io::RigRecord>& records, const s
   fit.mass_kg = e.m;
   const double tau = CorrelationTime(recs, s, e.m);
   const double sigma2 = e.J / static_cast<double>(std::max<std::size_t>(n, 1));
+  fit.cost = e.J, fit.sigma2 = sigma2, fit.tau = tau;
   if (o.skew == MeasurementMode::kAuto) {
     const double h = 0.05 * records.front().dt_s;
     const double Jp = Evaluate(recs, s + h, o).J, Jm = Evaluate(recs, s - h, o).J;

@@ -18,7 +18,9 @@
 /// (clipped at 0: a mass is not negative), s over [-kMaxSkewMs, kMaxSkewMs] by a grid of
 /// kSkewGrid points, then golden section. Standard errors from J's curvature, se^2 = 2 (J / n)
 /// tau / J'' (n the samples, tau the residual's integrated correlation time: correlated samples
-/// count once per correlation time), each with the other held.
+/// count once per correlation time), each with the other held, and the damper model held:
+/// FitDamperModel replaces them by profiles, the model refitted (the skew trades with the damper's
+/// own lag, the mass with its stiffness: held, the curvature overstates what the records tell).
 #include <span>
 #include <string>
 #include <vector>
@@ -56,6 +58,12 @@ struct MeasurementFit {
   /// A fitted mass smaller than twice its standard error: the records' acceleration is too small
   /// to tell m from noise (said in the report).
   bool mass_unresolved = false;
+  double cost = 0.0;    ///< J at (skew, mass) (file comment)
+  double sigma2 = 0.0;  ///< J / n: the weighted residual's mean square
+  double tau = 1.0;     ///< the residual's integrated correlation time [samples]
+  /// The standard errors are profiles (the damper model refitted at either side), not only J's
+  /// curvature with the model held (DamperModelFit: the skew trades with the damper's own lag).
+  bool profiled = false;
 
   bool Any() const { return options.Any(); }
   /// The force channel f_k predicted from the damper's force F_k [kN] on record r (file comment).
