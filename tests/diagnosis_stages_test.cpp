@@ -12,6 +12,7 @@
 
 #include "diagnosis/candidates.h"
 #include "diagnosis/diagnosis.h"
+#include "diagnosis/fit.h"
 #include "diagnosis/ripple_fit.h"
 #include "diagnosis/stages.h"
 #include "synthetic_records.h"
@@ -334,4 +335,34 @@ TEST_CASE("SelectEffects: a pump's ripple is selected as supply_ripple, its freq
   CHECK(y.s().sse / static_cast<double>(y.s().n_train) <= 1.1 * y.s().var_floor);
   // Its BIC counts the frequency and 2 x 3 coefficients per record.
   CHECK(st::FreeParams(st::SpecOf(y.specs, "supply_ripple"), 2) == 13);
+}
+
+TEST_CASE("WeighLostMotion: a play and a friction jump standing in for a short presliding travel are replaced by it") {
+  // The issue's miss: a short presliding travel (Dahl stiffness 40 per mm: 0.025 mm) read as
+  // backlash + coulomb_friction. Held as the selection, the stage weighs the pair against the one.
+  m::EffectSet e;
+  e.presliding_friction = m::PreslidingFriction{0.07, 0.025};
+  YChannel y(e);
+  st::ScoreNominal(&y.s(), Options{});
+  REQUIRE(y.s().structured);
+  // The pair as a greedy selection would leave it (fitted jointly on the training record).
+  st::Params pair = {{"backlash", {0.08}}, {"coulomb_friction", {0.03}}};
+  st::RefitAll(y.s().train, y.specs, &pair, y.s().train.Sse(y.s().train.Predict(st::ToSet(y.specs, pair))), 6, Options{});
+  y.Select(pair, {"backlash", "coulomb_friction"});
+  std::vector<std::string> warnings;
+  st::WeighLostMotion(&y.s(), y.specs, Options{}, &warnings);
+  REQUIRE(y.s().order == std::vector<std::string>{"presliding_friction"});
+  CHECK(Mentions(warnings, "backlash + coulomb_friction replaced by", "presliding_friction"));
+  CHECK(y.s().sel.at("presliding_friction")[0] == doctest::Approx(0.07).epsilon(0.15));
+  // A true pair of lost-motion effects stays (the single explains it worse by far).
+  m::EffectSet two;
+  two.backlash = m::Backlash{0.3};
+  two.coulomb_friction = m::CoulombFriction{0.15, 0.5};
+  YChannel y2(two);
+  st::ScoreNominal(&y2.s(), Options{});
+  st::Params both = {{"backlash", {0.3}}, {"coulomb_friction", {0.15}}};
+  y2.Select(both, {"backlash", "coulomb_friction"});
+  std::vector<std::string> w2;
+  st::WeighLostMotion(&y2.s(), y2.specs, Options{}, &w2);
+  CHECK(y2.s().order == std::vector<std::string>{"backlash", "coulomb_friction"});
 }

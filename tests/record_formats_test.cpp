@@ -1,5 +1,6 @@
 // Rig records in the formats labs have (io/column_record.h): a CSV with named columns and a
 // MATLAB .mat file through a column map, checked against the shipped UTFSM data read directly.
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
@@ -231,4 +232,34 @@ TEST_CASE("rths identify and rths diagnose take --columns") {
                                   .c_str());
   CHECK(WEXITSTATUS(bad) == 2);
   CHECK(rths_test::Slurp(log).find("unit \"parsec\"") != std::string::npos);
+}
+
+TEST_CASE("a file without a current column: i=VALUE in the map, or --current, gives its constant current") {
+  const auto utfsm = rths::io::ReadUtfsmDamper(kDamper);  // a test at 1 A
+  const auto dir = rths_test::TempDir("formats_const_current");
+  const auto csv = (dir / "lab.csv").string(), log = (dir / "out.txt").string();
+  WriteLabCsv(utfsm, csv);
+  const auto map = rths::io::ParseColumnMap("t=time,y=disp:cm,f=force:N,i=1000:mA");
+  REQUIRE(map.current_A.has_value());
+  CHECK(*map.current_A == doctest::Approx(1.0));
+  const auto rec = rths::io::ReadAnyRecord(csv, &map);
+  CHECK(rec.i_A.size() == rec.size());
+  CHECK(std::all_of(rec.i_A.begin(), rec.i_A.end(), [](double i) { return i == 1.0; }));
+  for (const auto& w : rec.warnings) CHECK(w.find("no damper command") == std::string::npos);
+  CHECK(rec.Meta("columns").find("i=1") != std::string::npos);
+  CHECK(ErrorOf([] { rths::io::ParseColumnMap("t=t,y=D,f=F,i=I,i=2"); }).find("twice") != std::string::npos);
+  CHECK(ErrorOf([] { rths::io::ParseColumnMap("t=t,y=D,f=F,i=-1"); }).find("[0, 100] A") != std::string::npos);
+  // rths identify --damper --current 1 on a map without i: the file's current is 1 A (it refused it at 0 A).
+  const int fit = std::system(fmt::format("{}/rths-identify --damper {} --current 1 --columns t=time,y=disp:cm,f=force:N "
+                                          "> {} 2>&1",
+                                          RTHS_BIN_DIR, csv, log)
+                                  .c_str());
+  CHECK(WEXITSTATUS(fit) == 0);
+  CHECK(rths_test::Slurp(log).find("Spencer MR damper model at 1 A") != std::string::npos);
+  // rths diagnose --current: only with --columns and a map without the command.
+  const int no_map = std::system(fmt::format("{}/rths-diagnose --train {} --test {} --current 1 > {} 2>&1",
+                                             RTHS_BIN_DIR, kDamper, kDamper, log)
+                                     .c_str());
+  CHECK(WEXITSTATUS(no_map) == 2);
+  CHECK(rths_test::Slurp(log).find("only with --columns") != std::string::npos);
 }

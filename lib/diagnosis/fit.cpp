@@ -145,13 +145,23 @@ double FitEffect(const Channel& ch, const std::vector<CandidateSpec>& specs, Par
   std::vector<double> x;
   if (spec.params.size() == 2 && spec.params[1].grid < 0) {
     // A parameter and a switch (servovalve_saturation's in_loop): the parameter fitted with the
-    // switch at 0 and at 1, the better kept; a refit keeps the switch.
+    // switch at 0 over its range, then at 1 within a factor tuning::kSwitchBracketFactor of that fit
+    // (the in-loop form is the slower to simulate, and its vmax is near the other's), the better
+    // kept; a refit keeps the switch.
     double best = std::numeric_limits<double>::infinity();
     for (const double sw : refit ? std::vector<double>{cur[1]} : std::vector<double>{0.0, 1.0}) {
       const Objective with = [&](const std::vector<double>& v) { return eval({v[0], sw}); };
+      ParamSpec range = spec.params[0];
+      std::vector<double> start = refit ? std::vector<double>{cur[0]} : std::vector<double>{};
+      if (!refit && sw == 1.0 && !x.empty()) {
+        range.lo = std::max(range.lo, x[0] / tuning::kSwitchBracketFactor);
+        range.hi = std::min(range.hi, x[0] * tuning::kSwitchBracketFactor);
+        range.grid = o.refit_grid;
+      }
       std::vector<double> xs;
-      const double f = FitOneParam(spec.params[0], spec.channel == 'f', refit ? std::vector<double>{cur[0]} : cur, o, with, &xs);
+      const double f = FitOneParam(range, spec.channel == 'f', start, o, with, &xs);
       if (f < best) best = f, x = {xs[0], sw};
+      else if (x.empty()) x = {xs[0], sw};
     }
     (*p)[name] = x;
     return best;

@@ -111,6 +111,9 @@ inline constexpr int kRefitGoldenItersF = 8;
 inline constexpr double kRefitBracketFactor = 1.3;
 /// Local refit of a linear parameter: the bracket v +- this x its search range.
 inline constexpr double kRefitBracketFraction = 0.05;
+/// A switch's second form (servovalve_saturation in the loop) is fitted within this factor of the first
+/// form's fit (FitEffect).
+inline constexpr double kSwitchBracketFactor = 2.0;
 /// Nelder-Mead evaluations of a two-parameter fit (after its grid).
 inline constexpr int kSimplexEvals = 48;
 /// ... of a two-parameter local refit.
