@@ -25,15 +25,7 @@ double FitOneParam(const ParamSpec& range, bool is_f, const std::vector<double>&
   int giters = is_f ? tuning::kGoldenItersF : tuning::kGoldenItersY;
   const bool refit = !cur.empty();
   if (refit) {
-    const double v = cur[0];
-    if (ps.log) {
-      ps.lo = std::max(range.lo, v / tuning::kRefitBracketFactor);
-      ps.hi = std::min(range.hi, v * tuning::kRefitBracketFactor);
-    } else {
-      const double w = tuning::kRefitBracketFraction * (range.hi - range.lo);
-      ps.lo = std::max(range.lo, v - w), ps.hi = std::min(range.hi, v + w);
-    }
-    ps.grid = o.refit_grid;
+    ps = BracketAround(range, cur[0], tuning::kRefitBracketFactor, tuning::kRefitBracketFraction, o.refit_grid);
     giters = is_f ? tuning::kRefitGoldenItersF : tuning::kRefitGoldenItersY;
   }
   double best = 0;

@@ -39,6 +39,9 @@ double SegmentSse(const Channel& ch, const std::vector<std::vector<double>>& pre
   return std::isfinite(s) ? s : std::numeric_limits<double>::infinity();
 }
 
+/// Grid points of a segment's bracket before golden section.
+constexpr int kSegmentGrid = 5;
+
 /// One parameter's fit and standard error on a segment [a, b) of the training records.
 struct SegmentFit {
   double value = 0, se = std::numeric_limits<double>::infinity();
@@ -71,15 +74,8 @@ class ParamProbe {
 
   /// The fit over [a, b), searched around v (tuning::kSegmentBracketFactor / Fraction).
   SegmentFit Fit(double v, double a, double b) const {
-    ParamSpec br = range_;
-    if (range_.log) {
-      br.lo = std::max(range_.lo, v / tuning::kSegmentBracketFactor);
-      br.hi = std::min(range_.hi, v * tuning::kSegmentBracketFactor);
-    } else {
-      const double w = tuning::kSegmentBracketFraction * (range_.hi - range_.lo);
-      br.lo = std::max(range_.lo, v - w), br.hi = std::min(range_.hi, v + w);
-    }
-    br.grid = 5;
+    const ParamSpec br =
+        BracketAround(range_, v, tuning::kSegmentBracketFactor, tuning::kSegmentBracketFraction, kSegmentGrid);
     double best = 0.0;
     SegmentFit f;
     f.value = Minimise1D([&](double x) { return Sse(x, a, b); }, br, tuning::kSegmentGoldenIters, &best, {v});

@@ -110,4 +110,17 @@ std::vector<double> NelderMead2(const std::function<double(const std::vector<dou
   return p[best];
 }
 
+ParamSpec BracketAround(const ParamSpec& range, double v, double factor, double fraction, int grid) {
+  ParamSpec br = range;
+  if (range.log) {
+    br.lo = std::max(range.lo, v / factor);
+    br.hi = std::min(range.hi, v * factor);
+  } else {
+    const double w = fraction * (range.hi - range.lo);
+    br.lo = std::max(range.lo, v - w), br.hi = std::min(range.hi, v + w);
+  }
+  br.grid = grid;
+  return br;
+}
+
 }  // namespace rths::diagnosis::stages

@@ -14,6 +14,10 @@ namespace rths::diagnosis::stages {
 double Minimise1D(const std::function<double(double)>& f, const ParamSpec& s, int golden_iters, double* fbest,
                   std::vector<double> extra = {});
 
+/// The search range `range` narrowed to a bracket around v: [v / factor, v x factor] on a log axis,
+/// v +- fraction x (hi - lo) on a linear one, within the range, with `grid` points.
+ParamSpec BracketAround(const ParamSpec& range, double v, double factor, double fraction, int grid);
+
 /// Nelder-Mead on two variables (the simplex from x0 with steps dx), `evals` function evaluations
 /// at most. Returns the best point; *fbest its value.
 std::vector<double> NelderMead2(const std::function<double(const std::vector<double>&)>& f, std::vector<double> x0,
