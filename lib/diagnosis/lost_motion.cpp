@@ -100,12 +100,13 @@ void WeighLostMotion(ChannelState* sp, const std::vector<CandidateSpec>& specs, 
     // In the place of the first of them, with their evidence.
     const auto first = std::find(s.order.begin(), s.order.end(), lost.front());
     const std::size_t at = static_cast<std::size_t>(first - s.order.begin());
-    s.sel_stats[best->name] = s.sel_stats[lost.front()];
+    const auto stats = s.sel_stats[lost.front()];
     for (const auto& n : lost) {
       s.order.erase(std::find(s.order.begin(), s.order.end(), n));
       s.alternatives.erase(n);
       s.sel_stats.erase(n);
     }
+    s.sel_stats[best->name] = stats;
     s.order.insert(s.order.begin() + static_cast<std::ptrdiff_t>(std::min(at, s.order.size())), best->name);
     // The set as the single's close call, its parameters keyed "effect.key".
     std::map<std::string, double> merged;

@@ -160,7 +160,12 @@ void AssessParameters(const ChannelState& s, const std::vector<CandidateSpec>& s
       if (spec.params[j].grid < 0) continue;  // a switch: no uncertainty, no drift
       const ParamProbe probe(s, specs, name, j, tau);
       const double v = s.sel.at(name)[j];
-      e.params_se[spec.params[j].key] = probe.Se(v, 0.0, 1.0);
+      const double se = probe.Se(v, 0.0, 1.0);
+      e.params_se[spec.params[j].key] = se;
+      if (name == "load_cell_inertia" && !(v > 2.0 * se))
+        warnings->push_back(fmt::format("channel {}: load_cell_inertia's mass {:.3g} kg is within two standard errors "
+                                        "({:.2g} kg) of 0: the records' acceleration is too small to tell it from noise",
+                                        s.summary.channel, v, se));
       EffectResult::Drift dr;
       dr.key = spec.params[j].key;
       for (int q = 0; q < K; ++q) {
