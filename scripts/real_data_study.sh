@@ -14,7 +14,8 @@
 #      --skew auto --inertia auto), scored on the earthquake tests at 0.2 ... 1 A
 #      (data/utfsm/mr_damper_earthquake/validacion.mat); the authors' moving average applied to
 #      sinusoid tests; rths diagnose train 1 kHz sinusoids at one current, test the earthquake test
-#      at the nearest current. The longest part: about 30 min on 2 cores.
+#      at the nearest current. The longest part: about 23 min on 2 cores (20 fits of 15 s to 3.4 min;
+#      with --skew auto the all-30 fit stops at commit f91e132, and runs about 9 min a current).
 # Usage: scripts/real_data_study.sh [OUT]     (binaries: build/bin, or set RTHS_BIN_DIR)
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"

@@ -122,6 +122,9 @@ void EstimateCurrentStart(Data* d, const ForcePredictor& fp, const NominalModel&
   double best = 0.0;
   const ParamSpec range{"i_start_A", 0.0, imax, false, tuning::kStartCurrentGrid};
   const double i0 = Minimise1D(sse, range, tuning::kStartCurrentIters, &best, {d->i[0], 0.0});
+  // The start must tell: a window where the damper hardly moves (its force does not depend on the
+  // current) or whose start fits about as well at the first command keeps that (no claim).
+  if (!(best < tuning::kStartCurrentGain * sse(d->i[0]))) return;
   d->i_start_A = i0;
   if (notes != nullptr && std::abs(i0 - d->i[0]) > tuning::kStartCurrentNote * imax)
     notes->push_back(fmt::format("{}: the current command is {:.3g} at its first sample, but the current dynamics start as "

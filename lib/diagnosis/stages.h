@@ -107,8 +107,10 @@ void ExtendWarmupIfMoving(Data* d, const NominalModel& model, std::vector<std::s
 /// the record, d->i_start_A, is fitted in [0, max i] (grid, then golden section) on the nominal
 /// force residual over the samples [first, first + tuning::kStartTimeConstants x the slowest time
 /// constant (Eq. 40's 1/a, or 1/eta)), the nominal force scaled by its least-squares factor over
-/// those samples (a damper_scale not yet found must not pass for a start); a note says so when it
-/// differs from the first command by more
+/// those samples (a damper_scale not yet found must not pass for a start). It is taken only if it
+/// leaves less than tuning::kStartCurrentGain of the window's residual at the first command (a
+/// damper that hardly moves in the window cannot tell); a note says so when it differs from the first
+/// command by more
 /// than tuning::kStartCurrentNote of max i. Nothing to do without a damper, without current
 /// dynamics or with the current off at the start. Needs d's motion (SetForceMotion).
 void EstimateCurrentStart(Data* d, const ForcePredictor& fp, const NominalModel& model, std::vector<std::string>* notes);

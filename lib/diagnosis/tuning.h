@@ -30,6 +30,9 @@ inline constexpr double kStartTimeConstants = 5.0;
 inline constexpr double kStartCurrentNote = 0.05;
 /// ... its grid over [0, max i] before golden section, and the golden-section iterations.
 inline constexpr int kStartCurrentGrid = 11;
+/// ... and is taken only if it leaves less than this fraction of the window's residual at the first
+/// command's steady state (else the first command is kept and nothing is said).
+inline constexpr double kStartCurrentGain = 0.5;
 inline constexpr int kStartCurrentIters = 20;
 
 // --- unconfirmed effects (ApplyShrinkRule)

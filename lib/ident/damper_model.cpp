@@ -15,6 +15,9 @@ namespace {
 constexpr int kMeasurementRounds = 6;
 /// The profiles' smallest steps (ProfileMeasurement): the skew's [ms] (or a sample) and the mass's [kg].
 constexpr double kProfileSkewStepMs = 0.1;
+constexpr double kProfileSkewMaxStepMs = 1.0;
+/// How often the skew's profile may move to its cheaper end.
+constexpr int kProfileMoves = 3;
 constexpr double kProfileMassStepKg = 0.05;
 
 /// The fit the options ask for, without measurement effects.
@@ -78,25 +81,42 @@ void ProfileMeasurement(const std::vector<io::RigRecord>& records, const DamperF
                         const MeasurementOptions& m, DamperModelFit* fit) {
   const double dt_ms = 1e3 * records.front().dt_s;
   if (m.skew == MeasurementMode::kAuto) {
-    const double s0 = fit->measurement.skew_ms;
-    const double h = std::max({dt_ms, kProfileSkewStepMs, 3.0 * fit->measurement.skew_se_ms});
+    // The step: the finest record's sample (the skew's resolution), at least kProfileSkewStepMs and
+    // three conditional standard errors, at most kProfileSkewMaxStepMs; the points kept in the search
+    // range. When the cheapest point is an end of the five, the profile moves there (at most
+    // kProfileMoves times): the alternation's end may be off by more than two steps.
+    double dt_ms = 1e3 * records.front().dt_s;
+    for (const auto& r : records) dt_ms = std::min(dt_ms, 1e3 * r.dt_s);
+    const double h = std::min(std::max({dt_ms, kProfileSkewStepMs, 3.0 * fit->measurement.skew_se_ms}), kProfileSkewMaxStepMs);
+    const double se_held = fit->measurement.skew_se_ms;
+    double centre = fit->measurement.skew_ms;
     std::vector<std::pair<double, double>> pts;
     std::optional<DamperModelFit> best;
-    for (int j = -2; j <= 2; ++j) {
-      DamperModelFit f = RefitAt(records, o, m, *fit, s0 + j * h, std::nullopt);
-      pts.emplace_back(s0 + j * h, f.measurement.cost);
-      if (f.measurement.cost < (best ? best->measurement.cost : fit->measurement.cost)) best = std::move(f);
+    for (int move = 0; move <= kProfileMoves; ++move) {
+      pts.clear();
+      int best_j = 0;
+      for (int j = -2; j <= 2; ++j) {
+        const double sj = std::clamp(centre + j * h, -kMaxSkewMs, kMaxSkewMs);
+        if (!pts.empty() && sj == pts.back().first) continue;
+        DamperModelFit f = RefitAt(records, o, m, *fit, sj, std::nullopt);
+        pts.emplace_back(sj, f.measurement.cost);
+        if (f.measurement.cost < (best ? best->measurement.cost : fit->measurement.cost)) best = std::move(f), best_j = j;
+      }
+      const bool at_range_end = std::abs(centre + best_j * h) >= kMaxSkewMs;
+      if (std::abs(best_j) < 2 || at_range_end || move == kProfileMoves) break;
+      centre = best->measurement.skew_ms;  // the profile falls on past its end: move there
     }
-    const auto [b, c] = Parabola(pts, s0);
+    const auto [b, c] = Parabola(pts, centre);
     if (c > 0.0) {
-      const double v = std::clamp(s0 - b / (2.0 * c), s0 - 2.0 * h, s0 + 2.0 * h);
+      const double v = std::clamp(centre - b / (2.0 * c), pts.front().first, pts.back().first);
       DamperModelFit at_v = RefitAt(records, o, m, *fit, v, std::nullopt);
       if (at_v.measurement.cost < (best ? best->measurement.cost : fit->measurement.cost)) best = std::move(at_v);
     }
     const double se = c > 0.0 ? std::sqrt(fit->measurement.sigma2 * fit->measurement.tau / c)
                               : std::numeric_limits<double>::infinity();
     if (best) *fit = std::move(*best);
-    fit->measurement.skew_se_ms = se;
+    fit->measurement.skew_se_ms = std::max(se, se_held);
+    fit->measurement.skew_at_range_end = std::abs(fit->measurement.skew_ms) >= kMaxSkewMs - 1e-9;
     fit->measurement.profiled = true;
   }
   if (m.inertia == MeasurementMode::kAuto) {

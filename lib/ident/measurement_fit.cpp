@@ -122,6 +122,10 @@ std::string MeasurementFit::Report() const {
   if (options.skew != MeasurementMode::kOff)
     s += fmt::format("  channel skew (the force channel's lag behind the displacement's): {:.4g} ms{} ({})\n", skew_ms,
                      skew_se_ms > 0 ? fmt::format(" +- {:.2g} ms", skew_se_ms) : "", how(options.skew));
+  if (skew_at_range_end)
+    s += fmt::format("    the skew is at an end of its range (+-{:g} ms): the records ask for more, which is no DAQ's skew "
+                     "(the model's lag is wrong, or the force and motion columns are not paired sample by sample)\n",
+                     kMaxSkewMs);
   if (profiled && (skew_se_ms > 0 || mass_se_kg > 0))
     s += "    (+- one standard error, from the cost's profile with the damper model refitted at either side)\n";
   if (options.inertia != MeasurementMode::kOff) {
@@ -191,6 +195,7 @@ MeasurementFit FitMeasurement(const std::vector<io::RigRecord>& records, const s
   }
   const Eval e = Evaluate(recs, s, o);
   fit.skew_ms = 1e3 * s;
+  fit.skew_at_range_end = o.skew == MeasurementMode::kAuto && std::abs(fit.skew_ms) >= kMaxSkewMs * (1.0 - 1e-9);
   fit.mass_kg = e.m;
   const double tau = CorrelationTime(recs, s, e.m);
   const double sigma2 = e.J / static_cast<double>(std::max<std::size_t>(n, 1));

@@ -64,6 +64,8 @@ struct MeasurementFit {
   /// The standard errors are profiles (the damper model refitted at either side), not only J's
   /// curvature with the model held (DamperModelFit: the skew trades with the damper's own lag).
   bool profiled = false;
+  /// The fitted skew sits at an end of its search range (+-kMaxSkewMs): not a minimum; said in the report.
+  bool skew_at_range_end = false;
 
   bool Any() const { return options.Any(); }
   /// The force channel f_k predicted from the damper's force F_k [kN] on record r (file comment).

@@ -351,14 +351,15 @@ RigRecord ReadAnyRecord(const std::string& path, const ColumnMap* map, TimeAxis 
   std::getline(in, first);
   const auto t = Trim(first, kLineWhitespace);
   if (t.rfind("# rths rig record", 0) == 0 || t.rfind("Header Size", 0) == 0) return ReadRecordOrUtfsm(path, time);
-  if (map != nullptr) return ReadColumnsCsv(path, *map);
-  // A UTFSM damper file starts with a row of numbers; a header of names needs a map.
+  // A UTFSM damper file starts with a row of numbers: it has no header for a map to name, and is
+  // read by its own format, map or not (a map given for a lab's .mat beside it does not apply).
   const auto fields = Split(first, SeparatorOf(first));
   const bool numeric = !fields.empty() && std::all_of(fields.begin(), fields.end(), [](const std::string& f) {
     double v = 0.0;
     return Unquote(f).empty() || ParseNumber(Unquote(f), &v);
   });
   if (numeric) return ReadRecordOrUtfsm(path, time);
+  if (map != nullptr) return ReadColumnsCsv(path, *map);
   throw Error(path, fmt::format("not a rig record of ours (its first line is not \"# rths rig record v1\"): for a CSV "
                                 "with named columns give --columns ROLE=COLUMN[*SCALE][:UNIT],... (roles t, u, y, f, "
                                 "i, v, r; e.g. --columns t=t,y=D:cm,f=F:N,v=Y:V); this file's columns: {} "
