@@ -1,4 +1,4 @@
-// bench-diagnosis [--seeds N] [--first-seed S] [--duration S] [--blocks | --independent] [--noise-y MM] [--noise-f KN] [--verbose] [--no-pairs] [--only KIND ...] [--runtime-only]
+// bench-diagnosis [--seeds N] [--first-seed S] [--duration S] [--blocks | --independent] [--noise-y MM] [--noise-f KN] [--verbose] [--write-records DIR] [--no-pairs] [--only KIND ...] [--runtime-only]
 // The diagnosis's validation harness (lib/validation/harness.h, docs/diagnosis.md "Harness"):
 // records with known effects, diagnosed without the truth; prints one line per case, the
 // confusion table (true effect vs verdict), the held-out shrink per effect and the scores against
@@ -33,6 +33,7 @@ int main(int argc, char** argv) {
   app.add_option("--noise-y", o.noise_y_mm, "sensor noise rms on y [mm] (default 0.01)");
   app.add_option("--noise-f", o.noise_f_kN, "sensor noise rms on f [kN] (default 0.2)");
   app.add_flag("--verbose", o.verbose, "print every diagnosis summary");
+  app.add_option("--write-records", o.write_dir, "write each case's training and test records to this folder (rig record csv, for rths diagnose)");
   app.add_flag("--runtime-only", runtime_only, "only the 60 s runtime measurement");
   CLI11_PARSE(app, argc, argv);
   o.pairs = !no_pairs;

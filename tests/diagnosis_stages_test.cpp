@@ -366,3 +366,36 @@ TEST_CASE("WeighLostMotion: a play and a friction jump standing in for a short p
   st::WeighLostMotion(&y2.s(), y2.specs, Options{}, &w2);
   CHECK(y2.s().order == std::vector<std::string>{"backlash", "coulomb_friction"});
 }
+
+TEST_CASE("SplitLostMotion: one presliding loss standing in for a dead band beside a short travel is split") {
+  // The issue's miss, converse of the above: a valve dead band (0.3 mm) beside a short presliding
+  // travel (0.06 mm loss) fitted as one longer presliding loss; the pair's basin is reached from
+  // splits of that loss.
+  m::EffectSet e;
+  e.presliding_friction = m::PreslidingFriction{0.06, 0.025};
+  e.command_dead_band = m::CommandDeadBand{0.3};
+  YChannel y(e);
+  st::ScoreNominal(&y.s(), Options{});
+  REQUIRE(y.s().structured);
+  // The single as the greedy selection leaves it: its loss the pair's total lost motion.
+  st::Params one = {{"presliding_friction", {0.21, 0.1}}};
+  st::RefitAll(y.s().train, y.specs, &one, y.s().train.Sse(y.s().train.Predict(st::ToSet(y.specs, one))), 6, Options{});
+  y.Select(one, {"presliding_friction"});
+  std::vector<std::string> warnings;
+  st::SplitLostMotion(&y.s(), y.specs, Options{}, &warnings);
+  REQUIRE(y.s().order == std::vector<std::string>{"presliding_friction", "command_dead_band"});
+  CHECK(Mentions(warnings, "split into", "command_dead_band"));
+  CHECK(y.s().sel.at("command_dead_band")[0] == doctest::Approx(0.3).epsilon(0.2));
+  CHECK(y.s().sel.at("presliding_friction")[0] == doctest::Approx(0.06).epsilon(0.3));
+  // A presliding friction alone stays one effect.
+  m::EffectSet single;
+  single.presliding_friction = m::PreslidingFriction{0.2, 0.1};
+  YChannel y1(single);
+  st::ScoreNominal(&y1.s(), Options{});
+  st::Params p1 = {{"presliding_friction", {0.2, 0.1}}};
+  st::RefitAll(y1.s().train, y1.specs, &p1, y1.s().train.Sse(y1.s().train.Predict(st::ToSet(y1.specs, p1))), 6, Options{});
+  y1.Select(p1, {"presliding_friction"});
+  std::vector<std::string> w1;
+  st::SplitLostMotion(&y1.s(), y1.specs, Options{}, &w1);
+  CHECK(y1.s().order == std::vector<std::string>{"presliding_friction"});
+}

@@ -206,6 +206,7 @@ void RunStages(ChannelState* s, const std::vector<stages::CandidateSpec>& specs,
   if (o.progress) o.progress(base + 6, total, "channel " + ch + ": swaps and pruning");
   stages::SwapEffects(s, specs, o, &res->warnings);
   stages::PruneEffects(s, specs, o, &res->warnings);
+  stages::SplitLostMotion(s, specs, o, &res->warnings);
   stages::WeighLostMotion(s, specs, o, &res->warnings);
   if (o.progress) o.progress(base + 8, total, "channel " + ch + ": held-out test");
   stages::RetainOnTest(s, specs, o, &res->warnings);

@@ -1,4 +1,5 @@
-// WeighLostMotion of stages.h: two lost-motion effects weighed against one (docs/diagnosis.md "Lost motion").
+// SplitLostMotion and WeighLostMotion of stages.h: one lost-motion effect tried as two, two weighed
+// against one (docs/diagnosis.md "Lost motion").
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -41,7 +42,83 @@ struct Candidate {
   double sse = std::numeric_limits<double>::infinity();
 };
 
+const CandidateSpec* ChannelSpec(const std::vector<CandidateSpec>& specs, const std::string& name, char ch) {
+  for (const auto& c : specs)
+    if (c.name == name && c.channel == ch) return &c;
+  return nullptr;
+}
+
+/// The share of the excess `name` removes from the set p of training SSE sse: the set without it
+/// refitted, (SSE_without - sse) / (SSE_without - n sigma^2) (the selection's marginal share).
+double OwnShare(const ChannelState& s, const std::vector<CandidateSpec>& specs, const Params& p, double sse,
+                const std::string& name, const Options& o) {
+  Params q = p;
+  q.erase(name);
+  const double sq = RefitAll(s.train, specs, &q, s.train.Sse(s.train.Predict(ToSet(specs, q))), tuning::kPruneRefitRounds, o);
+  const double ex = sq - static_cast<double>(s.n_train) * s.var_floor;
+  return ex > 0 ? (sq - sse) / ex : 0.0;
+}
+
 }  // namespace
+
+void SplitLostMotion(ChannelState* sp, const std::vector<CandidateSpec>& specs, const Options& o,
+                     std::vector<std::string>* warnings) {
+  ChannelState& s = *sp;
+  std::vector<std::string> lost;
+  for (const auto& n : s.order)
+    if (IsLostMotion(n)) lost.push_back(n);
+  const double excess = s.sse - static_cast<double>(s.n_train) * s.var_floor;
+  if (lost.size() != 1 || !s.structured || static_cast<int>(s.order.size()) >= tuning::kMaxEffectsPerChannel ||
+      s.sse <= o.none_ratio * static_cast<double>(s.n_train) * s.var_floor || !(excess > 0))
+    return;
+  const std::string& one = lost.front();
+  const double L = LostMotionOf(one, s.sel.at(one));
+
+  const double tau = IntegratedCorrelationTime(s.train, s.pred_train);
+  const double n_eff = std::max(1.0, static_cast<double>(s.n_train) / tau);
+  const CandidateSpec* one_spec = ChannelSpec(specs, one, s.ch);
+  std::optional<Candidate> best;
+  for (const char* other : kLostMotion) {
+    const CandidateSpec* spec = ChannelSpec(specs, other, s.ch);
+    if (spec == nullptr || s.sel.count(other)) continue;
+    for (const double phi : tuning::kLostMotionSplits) {
+      for (const auto& start : StartsFrom(other, phi * L)) {
+        Params t = s.sel;
+        t[one][0] = std::clamp(t[one][0] * (1.0 - phi), one_spec->params[0].lo, one_spec->params[0].hi);
+        std::vector<double> v = start;
+        for (std::size_t j = 0; j < v.size(); ++j) v[j] = std::clamp(v[j], spec->params[j].lo, spec->params[j].hi);
+        t[other] = v;
+        FitEffect(s.train, specs, &t, other, o);
+        const double sse = RefitAll(s.train, specs, &t, s.train.Sse(s.train.Predict(ToSet(specs, t))), o.refit_rounds, o);
+        if (AtBound(*spec, t.at(other)) || !FormOf(*spec, t.at(other)).empty() || AtBound(*one_spec, t.at(one)) ||
+            !FormOf(*one_spec, t.at(one)).empty())
+          continue;
+        // Each must lose a fair share of the motion: a small second one is the first's form.
+        const double l1 = LostMotionOf(one, t.at(one)), l2 = LostMotionOf(other, t.at(other));
+        if (std::min(l1, l2) < tuning::kLostMotionMinShare * (l1 + l2)) continue;
+        if (!best || sse < best->sse) best = Candidate{other, t, sse};
+      }
+    }
+  }
+  if (!best) return;
+  const int p = FreeParams(SpecOf(specs, best->name), s.train.recs().size());
+  const double dbic = n_eff * std::log(std::max(best->sse, 1e-300) / std::max(s.sse, 1e-300)) + p * std::log(n_eff);
+  const double excess_red = (s.sse - best->sse) / excess;
+  if (!(dbic < 0.0) || excess_red < std::max(o.min_excess_reduction, tuning::kLostMotionSplitMinGain) ||
+      (s.sse - best->sse) < o.min_floor_gain * static_cast<double>(s.n_train) * s.var_floor)
+    return;
+  for (const std::string& n : {one, best->name})
+    if (OwnShare(s, specs, best->params, best->sse, n, o) < o.min_excess_reduction) return;
+  warnings->push_back(fmt::format("channel {}: {} split into {} + {}: the lost motion ({:.3g} mm a side) shared by "
+                                  "two effects fits better (training BIC {:.1f} lower, {:.0f} % of the remaining excess)",
+                                  s.summary.channel, one, one, best->name, L, -dbic, 100.0 * excess_red));
+  s.sel = best->params;
+  s.order.push_back(best->name);
+  s.sel_stats[best->name] = {excess_red, dbic};
+  s.pred_train = s.train.Predict(ToSet(specs, s.sel));
+  s.sse = s.train.Sse(s.pred_train);
+  s.last_trial.erase(best->name);
+}
 
 void WeighLostMotion(ChannelState* sp, const std::vector<CandidateSpec>& specs, const Options& o,
                      std::vector<std::string>* warnings) {

@@ -7,6 +7,7 @@
 ///   SelectEffects     greedy selection on the training records (rules (a)-(c) of diagnosis.h);
 ///   SwapEffects       an effect replaced by another candidate that fits the training records better;
 ///   PruneEffects      an effect whose own share of the excess is below min_excess_reduction removed;
+///   SplitLostMotion   one lost-motion effect tried as two, from splits of its lost motion;
 ///   WeighLostMotion   two lost-motion effects weighed against one that explains the same lost motion;
 ///   RetainOnTest      an effect that raises the test NRMSE by more than max_test_worsening dropped;
 ///   ScoreSelected     the selected effects' numbers, cumulative in selection order;
@@ -274,6 +275,21 @@ void PruneEffects(ChannelState* s, const std::vector<CandidateSpec>& specs, cons
 void WeighLostMotion(ChannelState* s, const std::vector<CandidateSpec>& specs, const Options& o,
                      std::vector<std::string>* warnings);
 
+/// The converse of WeighLostMotion: one lost-motion effect can stand in for two (a valve's dead
+/// band beside a short presliding travel fitted as one longer presliding loss), and the pair's joint
+/// optimum lies in a basin the selection's trials, started from the second effect's whole range
+/// beside the first's fit, do not reach. When the set holds exactly one lost-motion effect, with
+/// lost motion L, each other lost-motion effect E is tried beside it from splits of L: the one's
+/// lost motion scaled to (1 - phi) L, E started at phi L (gap or width 2 phi L), phi in
+/// tuning::kLostMotionSplits, then both refitted with the rest. The best pair is added as the
+/// selection adds an effect: if it passes the selection's rules (a)-(c) against the set (its BIC
+/// lower, both effects' own shares at least min_excess_reduction, neither at a bound nor another
+/// effect's form), each of the two loses at least tuning::kLostMotionMinShare of their lost motion
+/// and the pair removes at least tuning::kLostMotionSplitMinGain of the excess the one left (a
+/// second effect that only corrects the first's form does less). A warning says so.
+void SplitLostMotion(ChannelState* s, const std::vector<CandidateSpec>& specs, const Options& o,
+                     std::vector<std::string>* warnings);
+
 /// In selection order, an effect whose addition raises the channel's test NRMSE by more than
 /// o.max_test_worsening (relative) is dropped (a warning); if any was, the rest are refitted on the
 /// training records.
@@ -288,6 +304,11 @@ void ScoreSelected(const ChannelState& s, const std::vector<CandidateSpec>& spec
 /// after_test_pct and status, fin_test and pred_train_fin.
 void ApplyShrinkRule(ChannelState* s, const std::vector<CandidateSpec>& specs, const Options& o,
                      std::vector<std::string>* warnings, EffectResults* er);
+
+/// The chi^2 of parameter j of the selected effect `name` fitted per segment (AssessParameters'
+/// tuning::kDriftSegments segments of the training records, the rest of the set held) about the
+/// segments' se-weighted mean.
+double SegmentChi2(const ChannelState& s, const std::vector<CandidateSpec>& specs, const std::string& name, std::size_t j);
 
 /// The uncertainty and the constancy of the selected effects' parameters (after ApplyShrinkRule,
 /// retained or unconfirmed; docs/diagnosis.md "Drift"): per fitted parameter (supply_ripple's

@@ -72,6 +72,17 @@ inline constexpr double kPlayCreepSlope = 0.05;
 /// A selected effect's alternative is a close call if its BIC exceeds the selected one's by less
 /// than this (10: "very strong" evidence on the usual BIC scale).
 inline constexpr double kCloseCallBic = 10.0;
+/// SplitLostMotion's shares phi of one lost-motion effect's lost motion given to a second.
+inline constexpr double kLostMotionSplits[] = {0.25, 0.5, 0.75};
+/// SplitLostMotion: the least share of the pair's lost motion either effect must lose. A presliding
+/// curve of another form than the library's is fitted better with a second lost-motion effect of a
+/// fifth to a quarter of the motion beside it (independent generator, long travel); two effects of
+/// a rig (a dead band beside a short presliding travel) shared it 0.4-0.6.
+inline constexpr double kLostMotionMinShare = 1.0 / 3.0;
+/// SplitLostMotion: the least share of the excess the one effect left that the split removes. The
+/// second effect of a rig's pair took 73-98 % of it; a second effect standing in for a presliding
+/// curve of another form, 27-53 % (independent generator, seeds 6-10).
+inline constexpr double kLostMotionSplitMinGain = 0.6;
 
 // --- parameter uncertainty and drift (stages::AssessParameters)
 /// The training records' summed span is cut into this many segments in time, each fitted alone.

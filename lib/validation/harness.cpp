@@ -3,12 +3,14 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <filesystem>
 #include <map>
 #include <set>
 
 #include <fmt/format.h>
 
 #include "core/error.h"
+#include "io/rig_record.h"
 #include "models/rig_effects.h"
 #include "signal/random.h"
 
@@ -30,6 +32,7 @@ const std::vector<std::string> kPairs = {"pure_delay+damper_scale", "gain_error+
                                          "command_dead_band+current_lag", "pure_delay+presliding_friction",
                                          "gain_error+supply_ripple", "channel_skew+current_lag",
                                          "load_cell_inertia+damper_scale", "presliding_friction@short+oil_column_resonance",
+                                         "presliding_friction@short+command_dead_band",
                                          "servovalve_saturation@loop+damper_scale"};
 
 std::vector<std::string> Split(const std::string& s) {
@@ -394,6 +397,11 @@ HarnessCase RunHarnessCase(const std::string& kind, std::uint64_t seed, const Ha
     const auto make = o.generator == Generator::kRig ? &MakeRecordRig : &MakeRecordBlocks;
     rtr = make(tr, ttr, fmt::format("{}-s{}-train", kind, seed));
     rte = make(te, tte, fmt::format("{}-s{}-test", kind, seed));
+  }
+  if (!o.write_dir.empty()) {
+    std::filesystem::create_directories(o.write_dir);
+    io::WriteRigRecord(rtr, (std::filesystem::path(o.write_dir) / fmt::format("{}-s{}-train.csv", kind, seed)).string());
+    io::WriteRigRecord(rte, (std::filesystem::path(o.write_dir) / fmt::format("{}-s{}-test.csv", kind, seed)).string());
   }
   const auto t0 = std::chrono::steady_clock::now();
   const diagnosis::Result r = diagnosis::Diagnose({rtr}, {rte}, diagnosis::PaperModel(), diagnosis::Options{});

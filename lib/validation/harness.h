@@ -38,6 +38,9 @@ struct HarnessOptions {
   bool pairs = true;             ///< include the two-effect cases
   double noise_y_mm = 0.01, noise_f_kN = 0.2;
   bool verbose = false;          ///< print each diagnosis's Summary() to stdout
+  /// Non-empty: each case's training and test records are written there as rig records
+  /// (<kind>-s<seed>-train.csv, -test.csv; io::WriteRigRecord), for `rths diagnose` to rerun.
+  std::string write_dir;
   /// kIndependent: the ground acceleration [g] of the earthquake test commands (ReadGroundMotion;
   /// the caller reads the file, data/ground_motion/elcentro_1940_ns_g.txt).
   std::vector<double> ground_g;
