@@ -144,20 +144,6 @@ double Chi2(const std::vector<double>& v, const std::vector<double>& se) {
 
 }  // namespace
 
-double SegmentChi2(const ChannelState& s, const std::vector<CandidateSpec>& specs, const std::string& name, std::size_t j) {
-  const double tau = IntegratedCorrelationTime(s.train, s.pred_train);
-  const int K = tuning::kDriftSegments;
-  const ParamProbe probe(s, specs, name, j, tau);
-  const double v = s.sel.at(name)[j];
-  std::vector<double> values, se;
-  for (int q = 0; q < K; ++q) {
-    const SegmentFit f = probe.Fit(v, static_cast<double>(q) / K, static_cast<double>(q + 1) / K);
-    values.push_back(f.value);
-    se.push_back(f.se);
-  }
-  return Chi2(values, se);
-}
-
 void AssessParameters(const ChannelState& s, const std::vector<CandidateSpec>& specs, EffectResults* er,
                       std::vector<std::string>* warnings) {
   if (s.order.empty() || (!s.retained && s.unconfirmed.empty())) return;

@@ -305,11 +305,6 @@ void ScoreSelected(const ChannelState& s, const std::vector<CandidateSpec>& spec
 void ApplyShrinkRule(ChannelState* s, const std::vector<CandidateSpec>& specs, const Options& o,
                      std::vector<std::string>* warnings, EffectResults* er);
 
-/// The chi^2 of parameter j of the selected effect `name` fitted per segment (AssessParameters'
-/// tuning::kDriftSegments segments of the training records, the rest of the set held) about the
-/// segments' se-weighted mean.
-double SegmentChi2(const ChannelState& s, const std::vector<CandidateSpec>& specs, const std::string& name, std::size_t j);
-
 /// The uncertainty and the constancy of the selected effects' parameters (after ApplyShrinkRule,
 /// retained or unconfirmed; docs/diagnosis.md "Drift"): per fitted parameter (supply_ripple's
 /// are fitted per record and left out), its standard error on the whole training set and its fit on
