@@ -244,6 +244,52 @@ void RemoveDrift(char chan, std::vector<Data>* train, std::vector<Data>* test, c
   for (auto* recs : {train, test}) stages::RemoveSensorDrift(chan, recs, servo, fp, scratch.fin_set, warnings);
 }
 
+/// A channel whose training records sit at their noise floor while its test records do not: the
+/// training records do not exercise what the test shows (a flow limit the training commands never
+/// reach). Its effects are then selected with the roles swapped (the test records fitted, the
+/// training records as the check) and named as found on the test records only (their
+/// EffectResult::unconfirmed says so; not in the final model): nothing holds them out, so they
+/// must explain at least tuning::kTestOnlyMinExplained of the test's excess over the floor, else
+/// the channel stays unexplained (an effect outside the library).
+void TestOnlyEffects(ChannelState* s, std::vector<Data>* train, std::vector<Data>* test, const models::LinearServo& servo,
+                     const ForcePredictor* fp, const std::vector<stages::CandidateSpec>& specs, const Options& o,
+                     Result* res, EffectResults* er, std::vector<std::string>* verdict) {
+  const double floor = s->var_floor;
+  const double ratio_train = floor > 0 && s->n_train > 0 ? s->sse_nominal / static_cast<double>(s->n_train) / floor : 0.0;
+  if (!s->order.empty() || !s->unconfirmed.empty() || !s->summary.diagnosed || !(floor > 0) ||
+      ratio_train > o.none_ratio || !(s->summary.floor_ratio_test > o.none_ratio))
+    return;
+  Options quiet = o;
+  quiet.progress = nullptr;
+  ChannelState sw(s->ch, Channel(s->ch, test, &servo, fp), Channel(s->ch, train, &servo, fp));
+  sw.min_skew_s = s->min_skew_s;
+  stages::ScoreNominal(&sw, quiet);
+  std::vector<std::string> scratch;
+  stages::SelectEffects(&sw, specs, quiet);
+  stages::SwapEffects(&sw, specs, quiet, &scratch);
+  stages::PruneEffects(&sw, specs, quiet, &scratch);
+  if (sw.order.empty() || !(sw.excess_nominal > 0)) return;
+  const double explained = (sw.sse_nominal - sw.sse) / sw.excess_nominal;
+  if (explained < tuning::kTestOnlyMinExplained) return;
+  EffectResults found;
+  stages::ScoreSelected(sw, specs, &found);
+  const std::string why = fmt::format(
+      "found on the test records only: the training records sit at the noise floor ({:.2f} x) and do not exercise it, "
+      "so nothing holds it out (fitted on the test, it explains {:.0f} % of their excess)",
+      ratio_train, 100.0 * explained);
+  for (const auto& name : sw.order) {
+    EffectResult e = found.at(name);
+    std::swap(e.train_nrmse_after, e.test_nrmse_after);  // sw's training records are the test
+    e.shrink_pct = ShrinkPct(s->summary.gap_test_pct, e.test_nrmse_after);
+    e.unconfirmed = why;
+    (*er)[name] = e;
+    s->unconfirmed.push_back(name);
+    verdict->push_back(name);
+  }
+  s->summary.status = "test only";
+  res->warnings.push_back(fmt::format("channel {}: {} {}", s->summary.channel, fmt::join(sw.order, " + "), why));
+}
+
 }  // namespace
 
 Result Diagnose(const std::vector<io::RigRecord>& train_in, const std::vector<io::RigRecord>& test_in,
@@ -309,6 +355,7 @@ Result Diagnose(const std::vector<io::RigRecord>& train_in, const std::vector<io
     } else {
       const double base = 10.0 * static_cast<double>(st.size() - 1);  // this channel's index
       RunStages(&s, specs, o, base, 10.0 * static_cast<double>(chans.size()), &res, &er, &verdict);
+      TestOnlyEffects(&s, &train, &test, servo, fpp, specs, o, &res, &er, &verdict);
     }
     res.channels.push_back(s.summary);
   }

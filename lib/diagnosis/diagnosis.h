@@ -200,7 +200,7 @@ struct ChannelSummary {
   double floor_ratio = 0;                 ///< rho_c, train and test pooled
   double floor_ratio_test = 0;            ///< rho_c on the test records
   double whiteness = 0;                   ///< Ljung-Box-like: n sum_{l=1..20} r_l^2 (test); ~20 if white
-  std::string status;                     ///< "noise" | "explained" | "unconfirmed" | "unexplained" | "not diagnosed"
+  std::string status;                     ///< "noise" | "explained" | "unconfirmed" | "test only" | "unexplained" | "not diagnosed"
 };
 
 /// A stretch where a sensor channel holds one value while the rig moves: a stuck or clipped

@@ -43,6 +43,9 @@ inline constexpr int kStartCurrentIters = 20;
 inline constexpr double kUnconfirmedTestFootprint = 1.0;
 /// ... while changing the training prediction by at least this many times it.
 inline constexpr double kUnconfirmedTrainFootprint = 4.0;
+/// Effects found on the test records only (Diagnose's TestOnlyEffects: the training records at their
+/// floor) must explain at least this share of the test's excess over the floor: nothing holds them out.
+inline constexpr double kTestOnlyMinExplained = 0.9;
 
 // --- noise floor and residual statistics
 /// Welch segment length of the noise floor [samples]: 256 gives a PSD resolution of f_s / 256,
