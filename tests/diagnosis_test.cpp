@@ -922,3 +922,36 @@ TEST_CASE("a flow limit inside the servo loop is found in its own form") {
   CHECK(e->params.at("in_loop") == 1.0);
   CHECK(e->params.at("vmax_mm_per_s") == doctest::Approx(200.0).epsilon(0.03));
 }
+
+TEST_CASE("an effect only the test records exercise is named as found there, the training at its floor") {
+  // Training: a slow 0-2 Hz command far below a 150 mm/s flow limit (the training records cannot
+  // show it); test: a 0-25 Hz command that runs into it. Before, the verdict was unknown.
+  Truth t = Noisy();
+  t.effects.servovalve_saturation = m::ServovalveSaturation{150.0};
+  const auto [tr, te] = Records(
+      t, 6.0, 3,
+      [](Excitation* e) {
+        e->band_hz = 2.0;
+        e->rms_mm = 2.0;
+      },
+      &MakeRecordBlocks,
+      [](Excitation* e, Truth*) {
+        e->band_hz = 25.0;
+        e->rms_mm = 4.0;
+      });
+  const auto r = Diagnose({tr}, {te}, PaperModel(), Options{});
+  INFO(Summary(r));
+  REQUIRE(r.verdict == std::vector<std::string>{"servovalve_saturation"});
+  const auto* e = Find(r, "servovalve_saturation");
+  REQUIRE(e != nullptr);
+  CHECK_FALSE(e->selected);  // not in the final model
+  CHECK(e->unconfirmed.find("found on the test records only") != std::string::npos);
+  CHECK(e->params.at("vmax_mm_per_s") == doctest::Approx(150.0).epsilon(0.05));
+  CHECK(r.Channel("y")->status == "test only");
+  // A test that departs from the training by an effect outside the library stays unknown.
+  Truth u = Noisy();
+  const auto [tr2, te2] = Records(u, 6.0, 3, {}, &MakeRecordBlocks, [](Excitation*, Truth* tt) { tt->ripple_mm = 0.05; });
+  const auto r2 = Diagnose({tr2}, {te2}, PaperModel(), Options{});
+  INFO(Summary(r2));
+  CHECK(r2.verdict == std::vector<std::string>{"unknown"});
+}

@@ -282,6 +282,7 @@ void TestOnlyEffects(ChannelState* s, std::vector<Data>* train, std::vector<Data
     std::swap(e.train_nrmse_after, e.test_nrmse_after);  // sw's training records are the test
     e.shrink_pct = ShrinkPct(s->summary.gap_test_pct, e.test_nrmse_after);
     e.unconfirmed = why;
+    e.selected = false;  // not in the final model, as an unconfirmed effect
     (*er)[name] = e;
     s->unconfirmed.push_back(name);
     verdict->push_back(name);
