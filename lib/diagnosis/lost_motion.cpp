@@ -112,12 +112,7 @@ void SplitLostMotion(ChannelState* sp, const std::vector<CandidateSpec>& specs, 
   warnings->push_back(fmt::format("channel {}: {} split into {} + {}: the lost motion ({:.3g} mm a side) shared by "
                                   "two effects fits better (training BIC {:.1f} lower, {:.0f} % of the remaining excess)",
                                   s.summary.channel, one, one, best->name, L, -dbic, 100.0 * excess_red));
-  s.sel = best->params;
-  s.order.push_back(best->name);
-  s.sel_stats[best->name] = {excess_red, dbic};
-  s.pred_train = s.train.Predict(ToSet(specs, s.sel));
-  s.sse = s.train.Sse(s.pred_train);
-  s.last_trial.erase(best->name);
+  AddEffect(&s, specs, best->name, best->params, excess_red, dbic);
 }
 
 void WeighLostMotion(ChannelState* sp, const std::vector<CandidateSpec>& specs, const Options& o,

@@ -1,6 +1,7 @@
 #include <algorithm>
 #include <cmath>
 #include <optional>
+#include <utility>
 
 #include <fmt/format.h>
 
@@ -65,14 +66,21 @@ void SelectEffects(ChannelState* sp, const std::vector<CandidateSpec>& specs, co
     }
     if (!best) break;
     s.alternatives[best->name] = CloseCalls(s.last_trial, *best, n_eff, specs, s.train.recs().size());
-    s.sel = best->params;
-    s.order.push_back(best->name);
-    s.sel_stats[best->name] = {best->excess_red, best->dbic};
-    s.sse = RefitAll(s.train, specs, &s.sel, best->sse, o.refit_rounds, o);
-    s.pred_train = s.train.Predict(ToSet(specs, s.sel));
-    s.sse = s.train.Sse(s.pred_train);
-    s.last_trial.erase(best->name);
+    Params p = best->params;
+    RefitAll(s.train, specs, &p, best->sse, o.refit_rounds, o);
+    AddEffect(&s, specs, best->name, std::move(p), best->excess_red, best->dbic);
   }
+}
+
+void AddEffect(ChannelState* sp, const std::vector<CandidateSpec>& specs, const std::string& name, Params set,
+               double excess_red, double dbic) {
+  ChannelState& s = *sp;
+  s.sel = std::move(set);
+  s.order.push_back(name);
+  s.sel_stats[name] = {excess_red, dbic};
+  s.pred_train = s.train.Predict(ToSet(specs, s.sel));
+  s.sse = s.train.Sse(s.pred_train);
+  s.last_trial.erase(name);
 }
 
 void SwapEffects(ChannelState* sp, const std::vector<CandidateSpec>& specs, const Options& o,

@@ -243,6 +243,12 @@ void MarkNotDiagnosed(ChannelState* s);
 /// Sets sel, order, sse, pred_train, sel_stats, last_trial.
 void SelectEffects(ChannelState* s, const std::vector<CandidateSpec>& specs, const Options& o);
 
+/// Adds `name` to the selection as SelectEffects does: `set` (the whole set with it, fitted) becomes
+/// s.sel, name is appended to s.order with its rule (b) fraction and dBIC, and the training
+/// prediction and SSE are made anew.
+void AddEffect(ChannelState* s, const std::vector<CandidateSpec>& specs, const std::string& name, Params set,
+               double excess_red, double dbic);
+
 /// The close calls of the step that selects `best`: every other trial of the step that passed
 /// every rule and whose BIC, n_eff ln(SSE_t / SSE_best) + (p_t - p_best) ln n_eff, is below
 /// tuning::kCloseCallBic above best's (clipped at 0), closest first (EffectResult::alternatives).
