@@ -42,7 +42,7 @@ TEST_CASE("harness (effect blocks, one seed, the kinds of issue 42): confusion t
   o.only = rths_test::Issue42Kinds(CaseKinds(o.generator, true));
   const auto sc = rths_test::RunHarnessReported(o);
   REQUIRE(sc.single_n == 4);  // channel_skew, load_cell_inertia, short presliding, in-loop flow limit
-  REQUIRE(sc.pair_n == 4);
+  REQUIRE(sc.pair_n == 5);  // the four of issue 42 with their partners and short presliding + dead band
   REQUIRE(sc.none_n == 1);
   REQUIRE(sc.unknown_n == 1);
   rths_test::CheckHarnessTargets(sc);

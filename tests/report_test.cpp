@@ -143,6 +143,39 @@ TEST_CASE("plot errors are clear") {
   CHECK_THROWS_AS(Plot(fig, dir), rths::Error);
 }
 
+TEST_CASE("a gnuplot killed by Ctrl-C is an interrupt (exit 130 in the tools), not a failed figure") {
+  // Ctrl-C reaches the whole foreground group: gnuplot dies of SIGINT while a study plots. A
+  // stand-in gnuplot that does the same; one that fails (exit 1) stays a plot error.
+  const auto dir = TempDir("plot_interrupted");
+  const auto write_script = [&](const std::string& name, const std::string& body) {
+    const auto path = dir / name;
+    std::ofstream(path) << "#!/bin/sh\n" << body << "\n";
+    std::filesystem::permissions(path, std::filesystem::perms::owner_all);
+    return path.string();
+  };
+  Figure fig;
+  fig.name = "f";
+  Panel p = MakePanel("", "x [s]", "y [mm]");
+  Series s = MakeSeries("s");
+  s.x = {0, 1, 2};
+  s.y = {0, 1, 2};
+  p.series = {s};
+  fig.panels = {p};
+  fig.gnuplot = write_script("gnuplot-sigint", "kill -INT $$");
+  CHECK_THROWS_WITH_AS(Plot(fig, dir), doctest::Contains("interrupted (signal 2)"), rths::Interrupted);
+  fig.gnuplot = write_script("gnuplot-sigterm", "kill -TERM $$");
+  CHECK_THROWS_AS(Plot(fig, dir), rths::Interrupted);
+  fig.gnuplot = write_script("gnuplot-fails", "echo broken >&2; exit 1");
+  try {
+    Plot(fig, dir);
+    FAIL("no throw");
+  } catch (const rths::Interrupted&) {
+    FAIL("a failed gnuplot is not an interrupt");
+  } catch (const rths::Error& e) {
+    CHECK(std::string(e.what()).find("gnuplot failed (exit 1)") != std::string::npos);
+  }
+}
+
 // --- Figure conventions (io/plot.h, studies/figures.h) ------------------------------------
 
 namespace {

@@ -8,6 +8,8 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cstdlib>
+#include <fstream>
 #include <filesystem>
 #include <string>
 #include <thread>
@@ -22,8 +24,9 @@ using rths_test::Slurp;
 
 namespace {
 
-pid_t Start(const std::string& args, const fs::path& output) {
-  const std::string cmd = "exec " + std::string(RTHS_BIN_DIR) + "/rths-reproduce " + args + " > " + output.string() + " 2>&1";
+/// rths-reproduce `args` in a shell, its output to `output`; `env` (e.g. "PATH=...") before it.
+pid_t Start(const std::string& args, const fs::path& output, const std::string& env = "") {
+  const std::string cmd = "exec " + (env.empty() ? std::string() : "env " + env + " ") + std::string(RTHS_BIN_DIR) + "/rths-reproduce " + args + " > " + output.string() + " 2>&1";
   const pid_t pid = ::fork();
   if (pid == 0) {
     ::execl("/bin/sh", "sh", "-c", cmd.c_str(), static_cast<char*>(nullptr));
@@ -113,4 +116,27 @@ TEST_CASE("rths reproduce: Ctrl-C stops the study and says what it stopped; --re
   // The same tables as a study never interrupted.
   REQUIRE_MESSAGE(Wait(Start(common + " --out " + (dir / "c").string(), dir / "c.txt")) == 0, Slurp(dir / "c.txt"));
   CHECK(Tables(dir / "a" / "fig11.md") == Tables(dir / "c" / "fig11.md"));
+}
+
+TEST_CASE("rths reproduce: Ctrl-C while a figure is drawn is an interrupt too: exit 130 and the resume line") {
+  // Ctrl-C reaches gnuplot with the study (one process group): a stand-in gnuplot first on PATH
+  // that dies of SIGINT as the real one would. Before, this was "gnuplot failed (exit 130)", exit 2.
+  const fs::path dir = rths_test::TempDir("reproduce_plot_interrupt");
+  fs::create_directories(dir / "bin");
+  const fs::path fake = dir / "bin" / "gnuplot";
+  std::ofstream(fake) << "#!/bin/sh\nkill -INT $$\n";
+  fs::permissions(fake, fs::perms::owner_all);
+  const std::string path = (dir / "bin").string() + ":" + (std::getenv("PATH") ? std::getenv("PATH") : "/usr/bin:/bin");
+  const std::string common = "fig11 --quick --compact --jobs 2 --out " + (dir / "a").string();
+  const int code = Wait(Start(common, dir / "a.txt", "PATH=" + path));
+  const std::string out = Slurp(dir / "a.txt");
+  CAPTURE(out);
+  CHECK(code == 130);
+  CHECK(out.find("gnuplot was interrupted (signal 2)") != std::string::npos);
+  CHECK(out.find("gnuplot failed") == std::string::npos);
+  CHECK(out.find("Finish it (the runs that ended are kept): rths reproduce fig11 --out " + (dir / "a").string() +
+                 " --quick --resume") != std::string::npos);
+  // Resumed with the real gnuplot: the figures are drawn, the runs kept.
+  REQUIRE_MESSAGE(Wait(Start(common + " --resume", dir / "b.txt")) == 0, Slurp(dir / "b.txt"));
+  CHECK(fs::exists(dir / "a" / "fig11.md"));
 }

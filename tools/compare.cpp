@@ -66,6 +66,9 @@ int main(int argc, char** argv) {
     } else {
       std::printf("  scenario keys that differ: %s\n", fmt::format("{}", fmt::join(files.differing_keys, ", ")).c_str());
     }
+  } catch (const rths::Interrupted& e) {  // Ctrl-C, e.g. while gnuplot draws
+    std::fprintf(stderr, "rths compare: %s (interrupted; nothing after it was written)\n", e.what());
+    return 130;
   } catch (const rths::Error& e) {
     std::fprintf(stderr, "rths compare: %s\n", e.what());
     return e.where() == "rths compare" || e.where() == "--labels" || e.problem().find("share dt") != std::string::npos

@@ -132,6 +132,9 @@ int main(int argc, char** argv) {
     std::printf("rths diagnose\n%s%s%s", rths::diagnosis::Summary(r, detail).c_str(), report_note.c_str(),
                 model_note.c_str());
     std::printf("output: %s\n", dir.string().c_str());
+  } catch (const rths::Interrupted& e) {  // Ctrl-C, e.g. while gnuplot draws
+    std::fprintf(stderr, "rths diagnose: %s (interrupted; nothing after it was written)\n", e.what());
+    return 130;
   } catch (const rths::Error& e) {
     std::fprintf(stderr, "rths diagnose: %s\n", e.what());
     return 2;

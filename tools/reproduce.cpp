@@ -302,7 +302,7 @@ int main(int argc, char** argv) {
     std::signal(SIGINT, OnSignal);
     std::signal(SIGTERM, OnSignal);
     Reproduce(o, opts);
-  } catch (const rths::studies::BatchInterrupted& e) {
+  } catch (const rths::Interrupted& e) {  // a batch's runs, or a figure's gnuplot
     progress.Finish();
     std::fprintf(stderr, "rths reproduce %s: %s.\nFinish it (the runs that ended are kept): rths reproduce %s --out %s%s "
                          "--resume\n",

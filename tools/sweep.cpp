@@ -150,6 +150,9 @@ int main(int argc, char** argv) {
     std::printf("rths sweep: %s: %lld runs on Slurm\n", spec.path.c_str(), static_cast<long long>(spec.runs()));
     std::fflush(stdout);
     return Report(rths::sweep::RunSweepOnSlurm(spec, SlurmOptions(a, &spec)), a.out);
+  } catch (const rths::Interrupted& e) {  // Ctrl-C, e.g. while gnuplot draws
+    std::fprintf(stderr, "rths sweep: %s (interrupted; nothing after it was written)\n", e.what());
+    return 130;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "rths sweep: %s\n", e.what());
     return rths::lockstep::kExitUsage;

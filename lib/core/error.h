@@ -22,4 +22,11 @@ class Error : public std::runtime_error {
   std::string problem_;
 };
 
+/// The work was interrupted (Ctrl-C or a termination signal, at any stage: a run, a child such as
+/// gnuplot killed by the same signal): not bad input. Tools exit 130 on it and say how to resume.
+class Interrupted : public Error {
+ public:
+  using Error::Error;
+};
+
 }  // namespace rths

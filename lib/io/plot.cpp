@@ -1,5 +1,6 @@
 #include "io/plot.h"
 
+#include <csignal>
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
@@ -278,6 +279,9 @@ PlotFiles Plot(const Figure& fig, const fs::path& dir) {
   const int code = run.status;
   const std::string& output = run.output;
   if (code == 127) throw Error(where, fmt::format("cannot run {}: install gnuplot (apt-get install gnuplot-nox)", exe));
+  // Killed by SIGINT or SIGTERM (Ctrl-C reaches the whole foreground group): an interrupt, not a failure.
+  if (code == 128 + SIGINT || code == 128 + SIGTERM)
+    throw Interrupted(where, fmt::format("gnuplot was interrupted (signal {}) on {}", code - 128, files.gp.string()));
   if (code != 0) {
     throw Error(where, fmt::format("gnuplot failed (exit {}) on {}:\n{}", code, files.gp.string(), output));
   }

@@ -67,10 +67,10 @@ struct BatchControl {
 };
 
 /// A batch stopped by BatchControl::interrupted: what was done and what was not.
-class BatchInterrupted : public Error {
+class BatchInterrupted : public Interrupted {
  public:
   BatchInterrupted(std::size_t ended, std::size_t cut, std::size_t not_started)
-      : Error("", Describe(ended, cut, not_started)), ended_(ended), cut_(cut), not_started_(not_started) {}
+      : Interrupted("", Describe(ended, cut, not_started)), ended_(ended), cut_(cut), not_started_(not_started) {}
   std::size_t ended() const { return ended_; }              ///< runs that ended (their results stand)
   std::size_t cut() const { return cut_; }                  ///< runs stopped mid-way (summary.json "interrupted")
   std::size_t not_started() const { return not_started_; }  ///< runs never started
