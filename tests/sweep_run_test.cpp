@@ -75,6 +75,7 @@ TEST_CASE("a small sweep: a row per run, the table, --only re-makes a run bit fo
   const auto r2 = rths::sweep::RunSweep(spec, again);
   CHECK(r2.ran == 1);
   CHECK(r2.skipped == 3);
+  CHECK(r2.kept == std::vector<std::int64_t>{0, 2, 3});  // the runs whose rows it kept (the tool prints them)
   CHECK(Read(r2.table) == table);
 }
 

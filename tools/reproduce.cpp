@@ -85,7 +85,7 @@ void AddOptions(CLI::App& app, Options* o) {
                "table2: also the extended table (table2_extended.csv/.md/.png): ats, ambc and a PI + phase lead "
                "beside none, ff and ff_lqg; the paper's 36 rows unchanged");
   app.add_flag("--keep-logs", o->keep_logs,
-               "benchmark: keep every perturbed run's log.lcm (default: removed once scored; about 50 MB per full run)");
+               "benchmark: keep every perturbed run's log.lcm (default: removed once scored; about 72 MB per run)");
   app.add_option("--plant", o->plant, "plant for the lockstep runs (not benchmark: it has its own plant)")
       ->check(CLI::IsMember({"physical", "linear"}))
       ->capture_default_str();

@@ -26,6 +26,18 @@
 
 namespace {
 
+/// Ascending indices as ranges: {0, 1, 2, 5, 7, 8} -> "0-2, 5, 7-8".
+std::string IndexRanges(const std::vector<std::int64_t>& v) {
+  std::string out;
+  for (std::size_t a = 0; a < v.size();) {
+    std::size_t b = a;
+    while (b + 1 < v.size() && v[b + 1] == v[b] + 1) ++b;
+    out += (out.empty() ? "" : ", ") + (a == b ? std::to_string(v[a]) : std::to_string(v[a]) + "-" + std::to_string(v[b]));
+    a = b + 1;
+  }
+  return out;
+}
+
 void WarnAbsent(const std::vector<std::string>& fields) {
   for (const std::string& f : fields) {
     std::fprintf(stderr, "rths sweep: warning: no completed run's summary.json has the recorded field \"%s\" "
@@ -90,6 +102,7 @@ int RunLocal(const Args& a, const rths::sweep::Spec& spec) {
   const auto r = rths::sweep::RunSweep(spec, o);
   std::printf("ran %lld (not completed %lld), skipped %lld (rows already there)\n", static_cast<long long>(r.ran),
               static_cast<long long>(r.failed), static_cast<long long>(r.skipped));
+  if (!r.kept.empty()) std::printf("kept (--resume): runs %s\n", IndexRanges(r.kept).c_str());
   if (r.table.empty()) return r.failed > 0 ? 1 : 0;
   WarnAbsent(r.absent_fields);
   std::printf("rows %lld/%lld, not completed %lld\ntable: %s (and table.h5, summary.csv, plots/)\n",
@@ -106,7 +119,7 @@ int main(int argc, char** argv) {
   CLI::App app{"rths sweep: run a SPEC's grid, cases and random draws on this machine or on Slurm; a row per run and a table"};
   rths::tools::NameCommand(app, "sweep");
   Args a;
-  app.add_option("spec", a.spec_path, "the sweep's SPEC (TOML; lib/sweep/spec.h)");
+  app.add_option("spec", a.spec_path, "the sweep's SPEC (TOML; docs/sweeps.md)");
   app.add_option("--out", a.out, "output folder (default: runs/<time>-sweep-<name>; with slurm: required, shared with the nodes)");
   app.add_option("--executor", a.executor, "where the runs run: local (this machine) or slurm (a job array)")
       ->check(CLI::IsMember({"local", "slurm"}));

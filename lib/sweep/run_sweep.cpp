@@ -89,6 +89,7 @@ std::vector<std::int64_t> Todo(const Spec& spec, const SweepOptions& o, SweepOut
     if (i % o.chunks != o.chunk) continue;
     if (o.resume && fs::exists(RowFile(o.out, i))) {
       ++outcome->skipped;
+      outcome->kept.push_back(i);
       continue;
     }
     todo.push_back(i);

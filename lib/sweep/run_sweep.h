@@ -32,6 +32,7 @@ struct SweepOptions {
 
 struct SweepOutcome {
   std::int64_t ran = 0, skipped = 0, failed = 0;  ///< this call's runs; rows already there; this call's rows not "completed"
+  std::vector<std::int64_t> kept;  ///< with resume: the indices skipped (their rows kept), ascending
   /// With the table written: its rows, and those not "completed" (earlier attempts' included).
   std::int64_t rows = 0, not_completed = 0;
   std::vector<std::string> absent_fields;         ///< recorded fields no completed row has (AbsentFields)
