@@ -53,6 +53,13 @@ TEST_CASE("scenario keys: flattened, and those that differ between texts (or som
   CHECK(rths::report::DifferingKeys({a, b}) ==
         std::vector<std::string>{"plant.damper.list", "run.dt_s", "plant.damper.extra"});
   CHECK(rths::scenario::FlattenScenario("not toml [").empty());
+  // Floats as the shortest text that reads back (toml++ alone writes 0.00080000000000000004).
+  const auto f = rths::scenario::FlattenScenario("x = 0.0008\ny = [0.1, 2.0, 3]\nz = 1e-9\n");
+  REQUIRE(f.size() == 3);
+  CHECK(f[0].value == "0.0008");
+  CHECK(f[1].value == "[ 0.1, 2.0, 3 ]");
+  CHECK(std::stod(f[2].value) == 1e-9);
+  CHECK(f[2].value.size() <= 5);
 }
 
 TEST_CASE("rths compare: three runs in one page, aligned by step over the steps they all have") {
