@@ -23,6 +23,14 @@ bool IsLostMotion(const std::string& name) {
   return std::find(std::begin(kLostMotion), std::end(kLostMotion), name) != std::end(kLostMotion);
 }
 
+/// The lost-motion effects among `order`, in its order.
+std::vector<std::string> LostMotionEffects(const std::vector<std::string>& order) {
+  std::vector<std::string> lost;
+  for (const auto& n : order)
+    if (IsLostMotion(n)) lost.push_back(n);
+  return lost;
+}
+
 /// The motion an effect loses at a reversal, from each side [mm] (its half gap, loss or half width).
 double LostMotionOf(const std::string& name, const std::vector<double>& v) {
   if (name == "backlash" || name == "command_dead_band") return 0.5 * v[0];
@@ -64,9 +72,7 @@ double OwnShare(const ChannelState& s, const std::vector<CandidateSpec>& specs, 
 void SplitLostMotion(ChannelState* sp, const std::vector<CandidateSpec>& specs, const Options& o,
                      std::vector<std::string>* warnings) {
   ChannelState& s = *sp;
-  std::vector<std::string> lost;
-  for (const auto& n : s.order)
-    if (IsLostMotion(n)) lost.push_back(n);
+  const std::vector<std::string> lost = LostMotionEffects(s.order);
   const double excess = s.sse - static_cast<double>(s.n_train) * s.var_floor;
   if (lost.size() != 1 || !s.structured || static_cast<int>(s.order.size()) >= tuning::kMaxEffectsPerChannel ||
       s.sse <= o.none_ratio * static_cast<double>(s.n_train) * s.var_floor || !(excess > 0))
@@ -118,9 +124,7 @@ void SplitLostMotion(ChannelState* sp, const std::vector<CandidateSpec>& specs, 
 void WeighLostMotion(ChannelState* sp, const std::vector<CandidateSpec>& specs, const Options& o,
                      std::vector<std::string>* warnings) {
   ChannelState& s = *sp;
-  std::vector<std::string> lost;
-  for (const auto& n : s.order)
-    if (IsLostMotion(n)) lost.push_back(n);
+  const std::vector<std::string> lost = LostMotionEffects(s.order);
   if (lost.size() < 2) return;
   double L = 0.0;
   int p_lost = 0;
