@@ -14,6 +14,9 @@
 #include <nlohmann/json.hpp>
 
 #include "core/error.h"
+#include "ident/design_model.h"
+#include "models/servo_linear.h"
+#include "scenario/scenario.h"
 #include "participants/benchmark_run.h"
 #include "models/ground_response.h"
 #include "io/plot.h"
@@ -291,6 +294,49 @@ TEST_CASE("the shipped benchmark scenarios give docs/benchmark.md's lockstep row
     CAPTURE(out);
     CHECK(out.find("benchmark          " + row) != std::string::npos);
   }
+}
+
+TEST_CASE("a model-based controller designs on the plant it drives: the benchmark's Gp, not the damper rig's avg") {
+  // Issue 43: case 2 with controller.kind = ff_lqg was designed on the paper's avg servo model
+  // (9 ms of lag) where the benchmark plant has 25 ms: J2 5.42 %.
+  const std::string file = std::string(RTHS_SOURCE_DIR) + "/scenarios/benchmark/case2_example.toml";
+  auto s = rths::scenario::LoadScenario(file, {"controller.kind=ff_lqg"});
+  REQUIRE(s.controller.model.name == "avg");  // the default the file leaves
+  const std::string note = rths::ident::ResolveDesignModel(&s);
+  CAPTURE(note);
+  CHECK(note.find("designed on the benchmark plant's Gp") != std::string::npos);
+  CHECK(s.controller.model.name == "custom");
+  const double lag_ms = 1e3 * rths::models::TimeLagS(rths::models::LinearServo::Make(s.controller.model, s.run.dt_s), 1.0, false);
+  CHECK(lag_ms > 22.0);
+  CHECK(lag_ms < 28.0);
+  // Deterministic: the same scenario, the same model.
+  auto again = rths::scenario::LoadScenario(file, {"controller.kind=ff_lqg"});
+  rths::ident::ResolveDesignModel(&again);
+  CHECK(again.controller.model == s.controller.model);
+  // A preset of the damper rig named on the benchmark plant: kept, with a warning naming both.
+  auto rig_model = rths::scenario::LoadScenario(file, {"controller.kind=ff_lqg", "controller.model=\"0.0A\""});
+  const std::string warn = rths::ident::ResolveDesignModel(&rig_model);
+  CHECK(warn.rfind("warning:", 0) == 0);
+  CHECK(warn.find("\"0.0A\"") != std::string::npos);
+  CHECK(warn.find("benchmark") != std::string::npos);
+  CHECK(rig_model.controller.model.name == "0.0A");
+  // A controller without a model: nothing to say; the damper rig's default: avg, said.
+  auto lti = rths::scenario::LoadScenario(file);
+  CHECK(rths::ident::ResolveDesignModel(&lti).empty());
+  auto rig = rths::scenario::LoadScenario(std::string(RTHS_SOURCE_DIR) + "/scenarios/default.toml", {"controller.kind=ff_lqg"});
+  CHECK(rths::ident::ResolveDesignModel(&rig).find("\"avg\"") != std::string::npos);
+  CHECK(rig.controller.model.name == "avg");
+
+  // The run: designed on Gp, J2 as with the benchmark's model (2.48 %), the model in its scenario.toml.
+  const fs::path dir = TempDir("benchmark_design_model");
+  std::string out;
+  REQUIRE(RunCli(fmt::format("{} --set controller.kind=ff_lqg --transport memq --out {}", file, (dir / "run").string()),
+                 &out) == 0);
+  CAPTURE(out);
+  CHECK(out.find("rths run: controller: designed on the benchmark plant's Gp") != std::string::npos);
+  const nlohmann::json j = nlohmann::json::parse(Slurp(dir / "run" / "summary.json"));
+  CHECK(j["benchmark_criteria"]["J2_pct"].get<double>() < 3.0);
+  CHECK(Slurp(dir / "run" / "scenario.toml").find("model = { K = ") != std::string::npos);
 }
 
 TEST_CASE("structure.reference_file: resolved like structure.file, checked, written by ToToml") {

@@ -13,6 +13,7 @@
 #include <CLI/CLI.hpp>
 
 #include "control/design.h"
+#include "ident/design_model.h"
 #include "control/lti.h"
 #include "models/benchmark_plant.h"
 #include "scenario/scenario.h"
@@ -32,7 +33,8 @@ int main(int argc, char** argv) {
     return code;
   }
   try {
-    const rths::scenario::Scenario s = rths::scenario::LoadScenario(scenario_path, sets);
+    rths::scenario::Scenario s = rths::scenario::LoadScenario(scenario_path, sets);
+    const std::string design_note = rths::ident::ResolveDesignModel(&s);  // the plant's own model
     std::vector<rths::control::DesignPlant> plants;
     if (s.plant.kind == rths::models::PlantKind::kBenchmark) {
       // Gp is m/m, i.e. mm/mm: its ZOH model is the plant u -> y as the controller sees it.
@@ -46,6 +48,7 @@ int main(int argc, char** argv) {
     }
     std::printf("rths design: %s, dt = %g s%s\n", scenario_path.c_str(), s.run.dt_s,
                 s.run.dt_s == rths::scenario::RunConfig{}.dt_s ? " (the default: the file sets no [run] dt_s)" : "");
+    if (!design_note.empty()) std::printf("%s\n", design_note.c_str());
     const rths::control::DesignSummary d = rths::control::DesignController(s.controller, s.run.dt_s, plants);
     std::fputs(d.Report().c_str(), stdout);
     if (!out.empty()) {

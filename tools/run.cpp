@@ -15,6 +15,7 @@
 #include <fmt/core.h>
 
 #include "core/error.h"
+#include "ident/design_model.h"
 #include "core/progress.h"
 #include "lockstep/exit_code.h"
 #include "lockstep/transport.h"
@@ -155,6 +156,15 @@ sup::RunRequest RequestOf(const Options& o) {
     // absolute), loaded back so its hash is the file's, and given to every participant.
     r.scenario_header = o.scenario_path + " with";
     for (const auto& set : o.sets) r.scenario_header += " --set " + set;
+  }
+  // A model-based controller designs on the plant it drives (the benchmark's Gp where the file
+  // leaves controller.model at its default): the model is then part of the scenario that runs.
+  const auto model_before = r.scenario.controller.model;
+  const std::string design_note = rths::ident::ResolveDesignModel(&r.scenario);
+  if (!design_note.empty()) std::printf("rths run: %s\n", design_note.c_str());
+  if (!(r.scenario.controller.model == model_before)) {
+    r.scenario_header = (r.scenario_header.empty() ? o.scenario_path + " with" : r.scenario_header) +
+                        " controller.model fitted to the benchmark plant's Gp";
   }
   r.transport = TransportOf(o);
   r.port_per_channel = o.port_per_channel;

@@ -1,0 +1,72 @@
+#include "ident/design_model.h"
+
+#include <cmath>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "ident/identify.h"
+#include "models/benchmark_plant.h"
+#include "signal/blwn.h"
+
+namespace rths::ident {
+namespace {
+
+bool UsesModel(const control::ControllerConfig& c) {
+  using K = control::ControllerKind;
+  return c.kind == K::kFf || c.kind == K::kFfLp || c.kind == K::kFfLqg ||
+         (c.kind == K::kAmbc && c.ambc.start == control::AmbcStart::kModel);
+}
+
+/// Third-order fit of the benchmark plant's Gp from a noise-free BLWN record through it.
+FitSummary FitBenchmarkGp(const models::BenchmarkPlantParams& p, double dt_s) {
+  constexpr double kDurationS = 20.0, kBandHz = 30.0, kFitHiHz = 25.0, kRmsMm = 1.0;
+  constexpr std::uint64_t kSeed = 11;
+  const auto n = static_cast<std::size_t>(std::llround(kDurationS / dt_s));
+  const std::vector<double> u = signal::Blwn(std::min(kBandHz, 0.4 / dt_s), kRmsMm, dt_s, n, kSeed, 2.0);
+  const models::BenchmarkPlant plant = models::BenchmarkPlant::Make(p, dt_s);
+  models::BenchmarkPlantState st;
+  std::vector<double> y(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    y[k] = 1e3 * models::Output(plant, st);  // y_k from u_0 .. u_{k-1} [mm]
+    models::StepMm(plant, &st, u[k]);
+  }
+  IdentifyOptions o;
+  o.fit.poles = 3;
+  o.fit.band_lo_hz = 0.5;
+  o.fit.band_hi_hz = std::min(kFitHiHz, 0.3 / dt_s);
+  o.fit.zoh_dt_s = 0.0;  // a design model: the hold's half-sample lag in the fit, as the study's
+  return Identify(u, y, dt_s, o).fit;
+}
+
+}  // namespace
+
+std::string ResolveDesignModel(scenario::Scenario* s) {
+  control::ControllerConfig& c = s->controller;
+  if (!UsesModel(c)) return "";
+  if (s->plant.kind != models::PlantKind::kBenchmark) {
+    return c.model.name == "custom"
+               ? fmt::format("controller: designed on controller.model (K = {:.5g}, p = {:.5g}, b = {:.5g}, c = {:.5g})",
+                             c.model.K, c.model.p, c.model.b, c.model.c)
+               : fmt::format("controller: designed on the paper's servo model \"{}\" (controller.model)", c.model.name);
+  }
+  if (c.model.name == "avg") {
+    const FitSummary fit = FitBenchmarkGp(s->plant.benchmark.params, s->run.dt_s);
+    c.model = fit.model.ToServoModel3();
+    c.model.name = "custom";
+    return fmt::format("controller: designed on the benchmark plant's Gp, a third-order fit (K = {:.5g}, p = {:.5g}, "
+                       "b = {:.5g}, c = {:.5g}: DC gain {:.4f}, lag {:.2f} ms), not the paper's \"avg\" servo model "
+                       "(controller.model's default; set controller.model to design on another)",
+                       c.model.K, c.model.p, c.model.b, c.model.c, fit.model.DcGain(), 1e3 * fit.model.DcLagS());
+  }
+  if (c.model.name != "custom") {
+    return fmt::format("warning: controller: designed on the paper's servo model \"{}\" (controller.model), a model "
+                       "of the damper rig, not of the benchmark plant this scenario drives (plant.kind = "
+                       "\"benchmark\"); leave controller.model out to design on the plant's Gp",
+                       c.model.name);
+  }
+  return fmt::format("controller: designed on controller.model (K = {:.5g}, p = {:.5g}, b = {:.5g}, c = {:.5g})",
+                     c.model.K, c.model.p, c.model.b, c.model.c);
+}
+
+}  // namespace rths::ident

@@ -1,0 +1,25 @@
+#pragma once
+/// @file The model a model-based tracking controller is designed on, made to follow the plant the
+/// scenario drives (issue 43: a benchmark scenario with controller.kind = "ff_lqg" was designed on
+/// the paper's damper-rig servo model, 9 ms of lag, where the benchmark plant has 25 ms).
+#include <string>
+
+#include "scenario/scenario.h"
+
+namespace rths::ident {
+
+/// Sets the design model of a model-based controller (ff, ff_lp, ff_lqg, ambc started from the
+/// model) to the plant's own where the scenario leaves it at the default, and says which model the
+/// design uses:
+///   - plant.kind = "benchmark" and controller.model the paper's "avg" (its default): the model
+///     becomes a third-order fit of the benchmark's Gp, as `rths reproduce benchmark` identifies it
+///     (ident::Identify, 3 poles over 0.5-25 Hz, the hold's half-sample lag included) but on a
+///     noise-free 20 s BLWN record (0-30 Hz, 1 mm RMS, seed 11) through Gp itself, no run needed;
+///   - plant.kind = "benchmark" and another preset ("0.0A", "2.5A"): kept, with a warning that the
+///     design is on the paper's damper rig, not on the plant driven;
+///   - otherwise (the damper rig, a custom model): kept.
+/// Returns the line to print ("controller: designed on ..."); empty for a controller that uses no
+/// model. Deterministic: the same scenario gives the same model, bit for bit.
+std::string ResolveDesignModel(scenario::Scenario* s);
+
+}  // namespace rths::ident
