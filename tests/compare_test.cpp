@@ -116,3 +116,30 @@ TEST_CASE("rths compare: runs with different steps are refused, naming both") {
   CHECK(output.find("must share dt") != std::string::npos);
   CHECK_FALSE(fs::exists(dir / "c" / "compare.html"));
 }
+
+TEST_CASE("rths compare: benchmark runs show their J1-J9, in the terminal and on the page") {
+  const fs::path dir = TempDir("compare_benchmark");
+  std::vector<fs::path> runs;
+  for (const char* kind : {"lti", "ff_lqg"}) {
+    const fs::path out = dir / kind;
+    std::string output;
+    REQUIRE_MESSAGE(RunCli(std::string(RTHS_SOURCE_DIR) + "/scenarios/benchmark/case2_example.toml --transport memq "
+                           "--skip-space-check --set controller.kind=" + kind + " --out " + out.string(),
+                           &output) == 0,
+                    output);
+    runs.push_back(out);
+  }
+  std::string output;
+  const fs::path out = dir / "cmp";
+  REQUIRE_MESSAGE(Compare(fmt::format("{} {} --labels example,ff_lqg --out {}", runs[0].string(), runs[1].string(),
+                                      out.string()),
+                          &output) == 0,
+                  output);
+  CAPTURE(output);
+  // The example controller's documented row (docs/benchmark.md), and the ff_lqg run's own.
+  CHECK(output.find("  example: J1 4.6 ms  J2 9.78 %  J3 10.94 %") != std::string::npos);
+  CHECK(output.find("  ff_lqg: J1 ") != std::string::npos);
+  const std::string html = Slurp(out / "compare.html");
+  CHECK(html.find("<th>benchmark J2</th><td>9.78 %</td>") != std::string::npos);
+  CHECK(html.find("<th>benchmark J9</th>") != std::string::npos);
+}
