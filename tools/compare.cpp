@@ -5,7 +5,6 @@
 // folder's log.lcm, summary.json and scenario.toml. Exit 0 written, 2 bad input (a folder that is
 // not a run, runs with different dt, an output folder that is not new or empty), 1 the page could
 // not be made (gnuplot missing or failing, a file that cannot be written).
-#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <string>
@@ -68,13 +67,9 @@ int main(int argc, char** argv) {
       std::printf("  scenario keys that differ: %s\n", fmt::format("{}", fmt::join(files.differing_keys, ", ")).c_str());
     }
     for (std::size_t i = 0; i < runs.size(); ++i) {  // the benchmark's criteria, as the run printed them
-      const auto& sum = runs[i].summary;
-      if (!sum.is_object() || !sum.contains("benchmark_criteria")) continue;
-      const auto& c = sum["benchmark_criteria"];
-      std::string line = fmt::format("  {}: J1 {:.1f} ms", i < o.labels.size() ? o.labels[i] : runs[i].run_dir.filename().string(),
-                                     c.value("J1_ms", std::nan("")));
-      for (int j = 2; j <= 9; ++j) line += fmt::format("  J{} {:.2f} %", j, c.value(fmt::format("J{}_pct", j), std::nan("")));
-      std::printf("%s\n", line.c_str());
+      if (const auto c = rths::report::BenchmarkCriteriaOf(runs[i]))
+        std::printf("  %s: %s\n", (i < o.labels.size() ? o.labels[i] : runs[i].run_dir.filename().string()).c_str(),
+                    c->Format().c_str());
     }
   } catch (const rths::Interrupted& e) {  // Ctrl-C, e.g. while gnuplot draws
     std::fprintf(stderr, "rths compare: %s (interrupted; nothing after it was written)\n", e.what());

@@ -50,6 +50,7 @@ struct Candidate {
   double sse = std::numeric_limits<double>::infinity();
 };
 
+/// The candidate `name` of channel ch, or nullptr.
 const CandidateSpec* ChannelSpec(const std::vector<CandidateSpec>& specs, const std::string& name, char ch) {
   for (const auto& c : specs)
     if (c.name == name && c.channel == ch) return &c;
@@ -139,9 +140,7 @@ void WeighLostMotion(ChannelState* sp, const std::vector<CandidateSpec>& specs, 
   std::optional<Candidate> best;
   double best_dbic = std::numeric_limits<double>::infinity();
   for (const char* single : kLostMotion) {
-    const CandidateSpec* spec = nullptr;
-    for (const auto& c : specs)
-      if (c.name == single && c.channel == s.ch) spec = &c;
+    const CandidateSpec* spec = ChannelSpec(specs, single, s.ch);
     if (spec == nullptr) continue;
     Candidate c{single, {}, std::numeric_limits<double>::infinity()};
     // From its whole range, and from the lost motion of the set it would replace (a local refit).

@@ -44,13 +44,8 @@ FitSummary FitBenchmarkGp(const models::BenchmarkPlantParams& p, double dt_s) {
 std::string ResolveDesignModel(scenario::Scenario* s) {
   control::ControllerConfig& c = s->controller;
   if (!UsesModel(c)) return "";
-  if (s->plant.kind != models::PlantKind::kBenchmark) {
-    return c.model.name == "custom"
-               ? fmt::format("controller: designed on controller.model (K = {:.5g}, p = {:.5g}, b = {:.5g}, c = {:.5g})",
-                             c.model.K, c.model.p, c.model.b, c.model.c)
-               : fmt::format("controller: designed on the paper's servo model \"{}\" (controller.model)", c.model.name);
-  }
-  if (c.model.name == "avg") {
+  const bool benchmark = s->plant.kind == models::PlantKind::kBenchmark;
+  if (benchmark && c.model.name == "avg") {
     const FitSummary fit = FitBenchmarkGp(s->plant.benchmark.params, s->run.dt_s);
     c.model = fit.model.ToServoModel3();
     c.model.name = "custom";
@@ -59,14 +54,15 @@ std::string ResolveDesignModel(scenario::Scenario* s) {
                        "(controller.model's default; set controller.model to design on another)",
                        c.model.K, c.model.p, c.model.b, c.model.c, fit.model.DcGain(), 1e3 * fit.model.DcLagS());
   }
-  if (c.model.name != "custom") {
+  if (c.model.name == "custom")
+    return fmt::format("controller: designed on controller.model (K = {:.5g}, p = {:.5g}, b = {:.5g}, c = {:.5g})",
+                       c.model.K, c.model.p, c.model.b, c.model.c);
+  if (benchmark)
     return fmt::format("warning: controller: designed on the paper's servo model \"{}\" (controller.model), a model "
                        "of the damper rig, not of the benchmark plant this scenario drives (plant.kind = "
                        "\"benchmark\"); leave controller.model out to design on the plant's Gp",
                        c.model.name);
-  }
-  return fmt::format("controller: designed on controller.model (K = {:.5g}, p = {:.5g}, b = {:.5g}, c = {:.5g})",
-                     c.model.K, c.model.p, c.model.b, c.model.c);
+  return fmt::format("controller: designed on the paper's servo model \"{}\" (controller.model)", c.model.name);
 }
 
 }  // namespace rths::ident

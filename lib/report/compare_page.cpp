@@ -232,17 +232,14 @@ std::string SummaryTable(const std::vector<RunData>& runs, const std::vector<std
   });
   h += row("peak |y|", [](const RunData& r) { return fmt::format("{:.4g} mm", r.metrics.peak_displacement_mm); });
   h += row("peak |f|", [](const RunData& r) { return fmt::format("{:.4g} kN", r.metrics.peak_force_kN); });
-  // The benchmark's J1-J9 (summary.json "benchmark_criteria"), where any run has them.
-  const bool any_j = std::any_of(runs.begin(), runs.end(), [](const RunData& r) {
-    return r.summary.is_object() && r.summary.contains("benchmark_criteria");
-  });
-  if (any_j) {
+  // The benchmark's J1-J9 (summary.json "benchmark_criteria"), where any run has them, rounded as
+  // the benchmark reports them.
+  if (std::any_of(runs.begin(), runs.end(), [](const RunData& r) { return BenchmarkCriteriaOf(r).has_value(); })) {
     for (int j = 1; j <= 9; ++j) {
-      const std::string key = j == 1 ? "J1_ms" : fmt::format("J{}_pct", j);
       h += row(fmt::format("benchmark J{}", j), [&](const RunData& r) {
-        if (!r.summary.is_object() || !r.summary.contains("benchmark_criteria")) return std::string("-");
-        const auto v = JsonNumber(r.summary["benchmark_criteria"], key.c_str());
-        return v ? (j == 1 ? fmt::format("{:.1f} ms", *v) : fmt::format("{:.2f} %", *v)) : std::string("-");
+        const auto c = BenchmarkCriteriaOf(r);
+        const double v = c ? c->Rounded().At(j - 1) : std::nan("");
+        return !std::isfinite(v) ? std::string("-") : j == 1 ? fmt::format("{:.1f} ms", v) : fmt::format("{:.2f} %", v);
       });
     }
   }

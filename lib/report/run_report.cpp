@@ -144,6 +144,24 @@ std::string RunTitle(const RunData& d) {
 
 }  // namespace
 
+std::optional<signal::BenchmarkCriteria> BenchmarkCriteriaOf(const RunData& d) {
+  if (!d.summary.is_object() || !d.summary.contains("benchmark_criteria")) return std::nullopt;
+  const nlohmann::json& b = d.summary["benchmark_criteria"];
+  const auto num = [](const nlohmann::json& j, const char* key) {
+    return j.contains(key) && j[key].is_number() ? j[key].get<double>() : std::nan("");
+  };
+  signal::BenchmarkCriteria c;
+  c.J1_ms = num(b, "J1_ms");
+  const char* keys[] = {"J2_pct", "J3_pct", "J4_pct", "J5_pct", "J6_pct", "J7_pct", "J8_pct", "J9_pct"};
+  double* fields[] = {&c.J2_pct, &c.J3_pct, &c.J4_pct, &c.J5_pct, &c.J6_pct, &c.J7_pct, &c.J8_pct, &c.J9_pct};
+  for (int i = 0; i < 8; ++i) *fields[i] = num(b, keys[i]);
+  c.lag_samples = b.contains("lag_samples") && b["lag_samples"].is_number_integer() ? b["lag_samples"].get<int>() : -1;
+  if (b.contains("floors") && b["floors"].is_array())
+    for (const auto& f : b["floors"])
+      c.floors.push_back({f.value("floor", 0), num(f, "std_pct"), num(f, "max_pct")});
+  return c;
+}
+
 RunData LoadRunData(const fs::path& run_dir) {
   const fs::path log_path = io::RunFolderLog(run_dir);
   std::error_code ec;

@@ -34,6 +34,7 @@
 #include "io/run_log.h"
 #include "io/run_signals.h"
 #include "scenario/scenario.h"
+#include "signal/benchmark_criteria.h"
 
 namespace rths::report {
 
@@ -77,6 +78,10 @@ struct RunData {
 /// from the log's handshake (else the scenario). Throws rths::Error naming the folder or file if
 /// the folder or its log.lcm does not exist, the log cannot be read, or no step size is known.
 RunData LoadRunData(const std::filesystem::path& run_dir);
+
+/// The benchmark's J1-J9 of a run as its summary.json holds them ("benchmark_criteria", written by
+/// supervisor::RunSummary; a value that is null or absent is NaN); nullopt if it holds none.
+std::optional<signal::BenchmarkCriteria> BenchmarkCriteriaOf(const RunData& d);
 
 /// The files a report wrote, and what its page warns about.
 struct ReportFiles {
