@@ -7,6 +7,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
@@ -20,6 +21,9 @@
 
 #include "io/run_log.h"
 #include "lockstep/exit_code.h"
+#include "lockstep/live_feed.h"
+#include "lockstep/realtime.h"
+#include "monitor/in_process_feed.h"
 #include "monitor/live_view.h"
 #include "monitor/server.h"
 #include "supervisor/ports.h"
@@ -36,19 +40,37 @@ namespace {
 
 constexpr int kGo = 3, kAbort = 4, kClose = 7;
 
-/// Feeds steps [from, to) of run `id`: r = sin, u = r + 0.1, y = r - 0.01 (except a spike at k =
-/// `spike`), f = 2 y, i = 0.5; each step completes 0.1 ms after its release at t0 + k dt.
-void Feed(LiveView* v, std::int64_t id, std::int64_t from, std::int64_t to, double dt, std::int64_t spike = -1,
-          std::int64_t lose = -1, WallClock::time_point t0 = WallClock::now()) {
-  for (std::int64_t k = from; k < to; ++k) {
-    const auto release = t0 + std::chrono::duration_cast<WallClock::duration>(std::chrono::duration<double>(k * dt));
+/// A sink that hands the clock's records straight to a LiveView, losing the ones listed.
+struct ViewSink final : rths::lockstep::LiveSink {
+  LiveView* view;
+  std::vector<std::int64_t> lose;  ///< records (by order pushed) that never arrive
+  std::int64_t pushed = 0;
+  void Push(const rths::monitor_t& r) override {
+    if (std::find(lose.begin(), lose.end(), pushed++) == lose.end()) view->OnRecord(r, WallClock::now());
+  }
+};
+
+/// Runs the clock's feed over steps [0, n) of run `id` as ClockParticipant does: r = sin, u = r +
+/// 0.1, y = r - 0.01 (but r - 5 at `spike`), f = 2 y, i = 0.5; the latency 0.2 ms, 1.5 ms (a miss)
+/// for the steps in [miss_from, miss_to]. `*rt` ends as the clock's totals.
+void FeedClock(rths::lockstep::LiveFeed* feed, ViewSink* sink, std::int64_t id, std::int64_t n, double dt,
+               bool paced, std::int64_t spike, std::int64_t miss_from, std::int64_t miss_to,
+               rths::lockstep::RealtimeStats* rt) {
+  rt->paced = paced;
+  feed->Start(id, n, dt, paced, {152.4, 556.0, 25.0});
+  feed->Phase(rths::lockstep::kLiveRunning, sink);
+  std::int64_t run = 0;
+  for (std::int64_t k = 0; k < n; ++k) {
     const double r = std::sin(0.01 * static_cast<double>(k));
-    v->OnDesired(id, k, r, release);
-    v->OnCommand(id, k, r + 0.1);
-    if (k == lose) continue;
     const double y = k == spike ? r - 5.0 : r - 0.01;
-    v->OnMeasured(id, k, y, 2 * y, 0.5, release + std::chrono::microseconds(100));
-    if (k == 7) v->OnMeasured(id, k, y, 2 * y, 0.5, release);  // repaired: sent twice, heard once
+    const bool missed = paced && k >= miss_from && k <= miss_to;
+    const double latency_s = missed ? 1.5e-3 : 0.2e-3;
+    rt->latency.Add(latency_s);
+    ++rt->steps;
+    if (missed) ++rt->misses;
+    run = missed ? run + 1 : 0;
+    rt->max_consecutive_misses = std::max(rt->max_consecutive_misses, run);
+    feed->Add(k, r, r + 0.1, y, 2 * y, 0.5, latency_s, missed, *rt, sink);
   }
 }
 
@@ -82,64 +104,115 @@ class BackgroundRun {
 
 }  // namespace
 
-TEST_CASE("live view: a bucket keeps each signal's peak, a lost step is a gap, the phases follow the handshake") {
-  rths::monitor::LiveViewOptions o;
-  o.points_per_sim_s = 100;  // dt 1 ms: 10 steps a point
-  LiveView v(o);
+TEST_CASE("live feed and view: a bucket keeps each signal's peak, a lost record is a gap, the phases follow") {
+  LiveView v;
   CHECK(v.Status().phase == "waiting");
-  v.OnHandshake(7, kGo, "integrator", 1000, 0.001, "");
-  CHECK(v.Status().phase == "running");
-  Feed(&v, 7, 0, 505, 0.001, /*spike=*/203, /*lose=*/300);
+  ViewSink sink;
+  sink.view = &v;
+  sink.lose = {31};  // the phase record is pushed first: record 31 is the bucket of steps 300..309
+  rths::lockstep::LiveFeed feed;
+  rths::lockstep::RealtimeStats rt;
+  FeedClock(&feed, &sink, 7, 505, 0.001, false, /*spike=*/203, -1, -1, &rt);
+  CHECK(feed.bucket_steps() == 10);  // 100 records per simulated second at dt 1 ms
   const auto s = v.Status();
+  CHECK(s.phase == "running");
+  CHECK(s.n_steps == 505);
   CHECK(s.last_k == 504);
-  CHECK(s.steps_seen == 504);  // step 300 was lost
-  // Steps are joined kJoinLag behind the newest: 500 steps, 50 points.
+  // 50 full buckets and the last step's (the run's end closes a bucket): one of them lost.
   CHECK(v.PointsMade() == 50);
+  CHECK(s.records_expected == 51);
+  CHECK(s.records_heard == 50);
   const auto j = v.Since(0);
   REQUIRE(j["points"].size() == 50);
   const auto& p20 = j["points"][20];  // steps 200..209: the spike at 203 survives decimation
   CHECK(p20[0].get<double>() == doctest::Approx(0.209));
   CHECK(p20[4].get<double>() == doctest::Approx(5.0));  // e = r - y
   CHECK(p20[5].get<double>() == doctest::Approx(2 * (std::sin(2.03) - 5.0)));
-  CHECK(j["points"][30][4].get<double>() == doctest::Approx(0.01));  // the bucket with the lost step
-  CHECK(j["points"][5][7].is_null());  // unpaced: no latency
+  CHECK(j["points"][30][0].get<double>() == doctest::Approx(0.319));  // 300..309 lost: a gap
+  // The safety limits and the peaks against them.
+  CHECK(s.stroke_mm == 152.4);
+  CHECK(s.max_error_mm == 25.0);
+  CHECK(s.peak_error_mm == doctest::Approx(5.0));
+  CHECK(s.peak_force_kN == doctest::Approx(2 * (5.0 - std::sin(2.03))));
+  CHECK(j["status"]["limits"]["force_kN"] == 556.0);
+  CHECK(j["status"]["peaks"]["error_mm"].get<double>() == doctest::Approx(5.0));
   // A cursor: only what is new.
   CHECK(v.Since(48)["points"].size() == 2);
   CHECK(v.Since(50)["points"].empty());
-  // ABORT flushes the steps still waiting and names who and why.
-  v.OnHandshake(7, kAbort, "monitor", 0, 0, "operator abort from the monitor");
-  CHECK(v.PointsMade() == 51);
-  CHECK(v.Status().phase == "aborted");
-  CHECK(v.Status().abort_by == "monitor");
-  CHECK(v.Status().abort_reason == "operator abort from the monitor");
-  // A later CLOSE of the same run does not hide the abort; a new run starts over.
-  v.OnHandshake(7, kClose, "integrator", 1000, 0.001, "");
-  CHECK(v.Status().phase == "aborted");
+  // The clock's DONE and CLOSE, then an ABORT of the same run, which cannot hide the completion.
+  feed.Phase(rths::lockstep::kLiveFinishing, &sink);
+  CHECK(v.Status().phase == "finishing");
+  feed.Phase(rths::lockstep::kLiveCompleted, &sink);
+  CHECK(v.Status().phase == "completed");
+  CHECK(v.PointsMade() == 50);  // phase records are not points
+  v.OnHandshake(7, kAbort, "monitor", 0, 0, "late");
+  CHECK(v.Status().phase == "completed");
+  // A new run starts over; its ABORT names who and why.
   v.OnHandshake(9, 1, "integrator", 2000, 0.001, "");
   CHECK(v.Status().phase == "starting");
   CHECK(v.Status().n_steps == 2000);
   CHECK(v.PointsMade() == 0);
   CHECK(v.Since(51)["points"].empty());  // an old cursor is not an error
+  v.OnHandshake(9, kGo, "integrator", 2000, 0.001, "");
+  v.OnHandshake(9, kAbort, "monitor", 0, 0, "operator abort from the monitor");
+  CHECK(v.Status().phase == "aborted");
+  CHECK(v.Status().abort_by == "monitor");
+  CHECK(v.Status().abort_reason == "operator abort from the monitor");
+  v.OnHandshake(9, kClose, "integrator", 2000, 0.001, "");
+  CHECK(v.Status().phase == "aborted");
 }
 
-TEST_CASE("live view: a paced run's latency and the steps heard after their deadline") {
-  rths::monitor::LiveViewOptions o;
-  o.paced = true;
-  LiveView v(o);
-  v.OnHandshake(3, kGo, "integrator", 100, 0.001, "");
-  const auto t0 = WallClock::now();
-  auto at = [&](double s) { return t0 + std::chrono::duration_cast<WallClock::duration>(std::chrono::duration<double>(s)); };
-  for (int k = 0; k < 20; ++k) {
-    // Steps 10..12 complete 1.5 ms after their release: after their deadline t0 + (k + 1) dt.
-    const double done_s = (k >= 10 && k <= 12) ? 1.5e-3 : 0.2e-3;
-    v.OnDesired(3, k, 0.0, at(k * 1e-3));
-    v.OnMeasured(3, k, 0.0, 0.0, 0.0, at(k * 1e-3 + done_s));
-  }
+TEST_CASE("live feed and view: a paced run's latency and misses are the clock's own figures") {
+  LiveView v;
+  ViewSink sink;
+  sink.view = &v;
+  rths::lockstep::LiveFeed feed;
+  rths::lockstep::RealtimeStats rt;
+  FeedClock(&feed, &sink, 3, 100, 0.001, true, -1, /*misses:*/ 10, 12, &rt);
   const auto s = v.Status();
+  CHECK(s.paced);
+  CHECK(s.misses == rt.misses);
   CHECK(s.misses == 3);
+  CHECK(s.longest_miss_run == rt.max_consecutive_misses);
   CHECK(s.longest_miss_run == 3);
-  CHECK(s.latency_max_ms == doctest::Approx(1.5).epsilon(1e-6));
-  CHECK(s.latency_ms == doctest::Approx(0.2).epsilon(1e-6));
+  CHECK(s.latency_max_ms == doctest::Approx(1e3 * rt.latency.max_s()));
+  CHECK(s.latency_ms == doctest::Approx(0.2));
+  const auto j = v.Since(0);
+  REQUIRE(j["points"].size() == 10);
+  CHECK(j["points"][1][7].get<double>() == doctest::Approx(1.5));  // the bucket of steps 10..19
+  CHECK(j["points"][1][8] == 3);
+  CHECK(j["points"][0][8] == 0);
+}
+
+TEST_CASE("in-process feed: records cross the ring to the view; an abort is taken once and names the monitor") {
+  LiveView v;
+  rths::monitor::InProcessFeed feed(&v, 0.001);
+  CHECK(feed.RequestAbort("operator abort from the monitor") == "the run has not started yet");
+  feed.Start();
+  rths::lockstep::LiveFeed clock;
+  rths::lockstep::RealtimeStats rt;
+  clock.Start(5, 1000, 0.001, false, {});
+  clock.Phase(rths::lockstep::kLiveRunning, &feed);
+  for (std::int64_t k = 0; k < 200; ++k) {
+    ++rt.steps;
+    clock.Add(k, 1.0, 1.0, 1.0, 0.0, 0.0, 1e-4, false, rt, &feed);
+  }
+  for (int i = 0; i < 200 && v.Status().last_k < 199; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  CHECK(v.Status().last_k == 199);
+  CHECK(v.PointsMade() == 20);
+  std::string reason;
+  CHECK_FALSE(feed.TakeAbort(&reason));
+  CHECK(feed.RequestAbort("operator abort from the monitor") == "");
+  CHECK(feed.TakeAbort(&reason));
+  CHECK(reason == "operator abort from the monitor");
+  CHECK_FALSE(feed.TakeAbort(&reason));  // once
+  clock.Phase(rths::lockstep::kLiveAborted, &feed);  // what the clock does when it takes it
+  feed.Stop();
+  CHECK(v.Status().phase == "aborted");
+  CHECK(v.Status().abort_by == "monitor");
+  CHECK(v.Status().abort_reason == "operator abort from the monitor");
+  CHECK(feed.dropped() == 0);
+  CHECK(feed.RequestAbort("again") == "the run has already ended (aborted)");
 }
 
 TEST_CASE("monitor server: every request needs the token; Abort calls back and says whether it was sent") {
@@ -244,6 +317,133 @@ TEST_CASE("rths run --watch: the page in headless Chromium follows the run, and 
   CHECK(log.CompleteSteps() == summary["steps"].get<std::int64_t>());
   CHECK(log.CompleteSteps() > 1000);
   CHECK(log.CompleteSteps() < 600000);
+}
+
+TEST_CASE("rths run --watch --realtime: memq by default; the page's misses and latency are the run's, and a "
+          "snapshot is captured mid-run") {
+  rths_test::RequireTool("chromium", "chromium");
+  rths_test::RequireFile("/usr/share/javascript/dygraphs/dygraph.min.js", "libjs-dygraphs");
+  const fs::path dir = rths_test::TempDir("monitor_paced");
+  const fs::path out_txt = dir / "run.txt";
+  BackgroundRun run("exec " + std::string(RTHS_BIN_DIR) + "/rths-run " + RTHS_SOURCE_DIR +
+                    "/scenarios/default.toml --compact --realtime --set run.duration_s=12 --watch --watch-port 0 "
+                    "--out " + (dir / "run").string() + " > " + out_txt.string() + " 2>&1");
+  std::smatch m;
+  const std::regex line("monitor +http://127\\.0\\.0\\.1:([0-9]+)/\\?token=([0-9a-f]+)");
+  std::string text;
+  for (int i = 0; i < 300; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    text = rths_test::Slurp(out_txt);
+    if (std::regex_search(text, m, line)) break;
+  }
+  REQUIRE_MESSAGE(!m.empty(), text);
+  CHECK(text.find("transport memq") != std::string::npos);  // a paced run's default
+  const int port = std::stoi(m[1]);
+  const std::string token = m[2];
+  httplib::Client c("127.0.0.1", port);
+  auto state = [&] {
+    const auto res = c.Get("/state?token=" + token);
+    return res && res->status == 200 ? nlohmann::json::parse(res->body) : nlohmann::json();
+  };
+  nlohmann::json st;
+  for (int i = 0; i < 400; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    st = state();
+    if (!st.is_null() && st["status"]["phase"] == "running" && st["status"]["last_k"].get<std::int64_t>() > 4000) break;
+  }
+  REQUIRE_MESSAGE(st["status"]["phase"] == "running", st.dump());
+  CHECK(st["status"]["paced"] == true);
+  CHECK(st["status"]["latency_max_ms"].get<double>() > 0);  // the clock's latency, not 0.00
+  CHECK(st["status"]["limits"]["stroke_mm"].get<double>() > 0);
+  CHECK(st["status"]["peaks"]["disp_mm"].get<double>() > 0);
+  // A plain headless screenshot of the snapshot page returns while the run goes on.
+  const std::string shot = (dir / "snapshot.png").string();
+  const std::string url = "http://127.0.0.1:" + std::to_string(port) + "/?token=" + token + "&snapshot=1";
+  const int rc = std::system(("timeout 60 chromium --headless --no-sandbox --disable-gpu --hide-scrollbars "
+                              "--user-data-dir=" + (dir / "chromium").string() + " --window-size=1400,1000 "
+                              "--screenshot=" + shot + " '" + url + "' > /dev/null 2>&1").c_str());
+  CHECK(rc == 0);
+  REQUIRE(fs::exists(shot));
+  CHECK(fs::file_size(shot) > 20000);
+  CHECK(state()["status"]["phase"] == "running");  // captured mid-run
+  // The snapshot page holds the points and draws them without an event stream.
+  const auto page = c.Get("/?token=" + token + "&snapshot=1");
+  REQUIRE(page);
+  CHECK(page->body.find("window.rthsSnapshot = {") != std::string::npos);
+  // Follow the page to the end: its last word is the run's summary.
+  nlohmann::json last;
+  for (int i = 0; i < 600; ++i) {
+    const auto now = state();
+    if (now.is_null()) break;  // the monitor stopped with the run
+    last = now;
+    if (last["status"]["phase"] == "completed") break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  CHECK(run.Wait() == 0);
+  REQUIRE_MESSAGE(last["status"]["phase"] == "completed", last.dump());
+  const auto summary = nlohmann::json::parse(rths_test::Slurp(dir / "run" / "summary.json"));
+  const auto& rt = summary["realtime"];
+  CAPTURE(rt.dump());
+  CAPTURE(last.dump());
+  CHECK(last["status"]["last_k"].get<std::int64_t>() + 1 == summary["steps"].get<std::int64_t>());
+  CHECK(last["status"]["misses"] == rt["deadline_misses"]);
+  CHECK(last["status"]["longest_miss_run"] == rt["max_consecutive_misses"]);
+  CHECK(last["status"]["latency_max_ms"].get<double>() == doctest::Approx(rt["latency_max_us"].get<double>() / 1e3));
+  CHECK(last["status"]["records_heard"] == last["status"]["records_expected"]);  // in-process: nothing lost
+}
+
+TEST_CASE("rths run --watch --transport memq: the page's ABORT stops an in-process run as it stops a udpm one") {
+  rths_test::RequireFile("/usr/share/javascript/dygraphs/dygraph.min.js", "libjs-dygraphs");
+  const fs::path dir = rths_test::TempDir("monitor_memq_abort");
+  const fs::path out_txt = dir / "run.txt";
+  BackgroundRun run("exec " + std::string(RTHS_BIN_DIR) + "/rths-run " + RTHS_SOURCE_DIR +
+                    "/scenarios/default.toml --compact --transport memq --set run.duration_s=600 --watch "
+                    "--watch-port 0 --out " + (dir / "run").string() + " > " + out_txt.string() + " 2>&1");
+  std::smatch m;
+  const std::regex line("monitor +http://127\\.0\\.0\\.1:([0-9]+)/\\?token=([0-9a-f]+)");
+  std::string text;
+  for (int i = 0; i < 300; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    text = rths_test::Slurp(out_txt);
+    if (std::regex_search(text, m, line)) break;
+  }
+  REQUIRE_MESSAGE(!m.empty(), text);
+  httplib::Client c("127.0.0.1", std::stoi(m[1]));
+  const std::string token = m[2];
+  nlohmann::json st;
+  for (int i = 0; i < 400; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    const auto res = c.Get("/state?token=" + token);
+    if (!res || res->status != 200) continue;
+    st = nlohmann::json::parse(res->body);
+    if (st["status"]["phase"] == "running" && st["status"]["last_k"].get<std::int64_t>() > 2000) break;
+  }
+  REQUIRE_MESSAGE(st["status"]["phase"] == "running", st.dump());
+  CHECK(st["status"]["paced"] == false);
+  const auto abort = c.Post("/abort?token=" + token, "", "text/plain");
+  REQUIRE(abort);
+  CHECK(abort->status == 200);
+  nlohmann::json end;
+  for (int i = 0; i < 200; ++i) {
+    const auto res = c.Get("/state?token=" + token);
+    if (!res || res->status != 200) break;
+    end = nlohmann::json::parse(res->body);
+    if (end["status"]["phase"] == "aborted") break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  CHECK(end["status"]["abort_by"] == "monitor");
+  CHECK(end["status"]["abort_reason"] == "operator abort from the monitor");
+  CHECK(run.Wait() == rths::lockstep::kExitPeerAbort);
+  const std::string output = rths_test::Slurp(out_txt);
+  CAPTURE(output);
+  CHECK(output.find("rths run: ABORTED: monitor aborted the run: operator abort from the monitor") != std::string::npos);
+  const auto summary = nlohmann::json::parse(rths_test::Slurp(dir / "run" / "summary.json"));
+  CHECK(summary["status"] == "aborted");
+  CHECK(summary["stopped"] == "monitor aborted the run: operator abort from the monitor");
+  const auto log = rths::io::ReadRunLog((dir / "run" / "log.lcm").string());
+  CHECK_FALSE(log.truncated_tail);
+  CHECK(log.CompleteSteps() == summary["steps"].get<std::int64_t>());
+  CHECK(log.CompleteSteps() < 1200000);
 }
 
 TEST_CASE("rths watch --lcm-url: a run started elsewhere is watched and stopped; --exit-at-end ends with it") {

@@ -12,7 +12,9 @@
 #include <fmt/format.h>
 
 #include "alloc_counter.h"
+#include "lockstep/live_feed.h"
 #include "lockstep/transport.h"
+#include "monitor/in_process_feed.h"
 #include "models/mr_damper.h"
 #include "participants/group.h"
 #include "scenario/scenario.h"
@@ -24,13 +26,14 @@ namespace {
 // Allocations of a whole in-process run of `steps` steps; *clean: no message had to be re-requested
 // (on a loaded host a slow step is re-requested, and the repair path may allocate: it is not the
 // step path).
-long RunAllocations(const std::string& toml, int steps, const fs::path& out, bool* clean) {
+long RunAllocations(const std::string& toml, int steps, const fs::path& out, bool* clean,
+                    rths::lockstep::LiveSink* live) {
   const std::string text = toml + "\n[run]\ndt_s = 0.0005\nduration_s = " + std::to_string(steps * 0.0005) + "\n";
   const rths::scenario::Scenario s = rths::scenario::ParseScenario(text, (out / "scenario.toml").string());
   fs::remove_all(out);
   fs::create_directories(out);
   const long before = rths_test::AllocationCount();
-  const auto outcomes = rths::participants::RunGroupInProcess({s}, 7, out.string());
+  const auto outcomes = rths::participants::RunGroupInProcess({s}, 7, out.string(), {}, nullptr, live);
   const long used = rths_test::AllocationCount() - before;
   std::int64_t rerequests = 0, repairs = 0;
   for (const auto& o : outcomes) rerequests += o.stats.rerequests, repairs += o.stats.repair_requests;
@@ -43,15 +46,16 @@ long RunAllocations(const std::string& toml, int steps, const fs::path& out, boo
   return used;
 }
 
-void CheckNoAllocationPerStep(const std::string& name, const std::string& toml) {
+void CheckNoAllocationPerStep(const std::string& name, const std::string& toml,
+                              rths::lockstep::LiveSink* live = nullptr) {
   const fs::path dir = fs::temp_directory_path() / ("rths_participant_alloc_" + std::to_string(::getpid()));
   constexpr int kShort = 400, kLong = 2400;
   long a_short = 0, a_long = 0;
   bool clean = false;
   for (int attempt = 0; attempt < 10 && !clean; ++attempt) {
     bool clean_short = false, clean_long = false;
-    a_short = RunAllocations(toml, kShort, dir / "short", &clean_short);
-    a_long = RunAllocations(toml, kLong, dir / "long", &clean_long);
+    a_short = RunAllocations(toml, kShort, dir / "short", &clean_short, live);
+    a_long = RunAllocations(toml, kLong, dir / "long", &clean_long, live);
     clean = clean_short && clean_long;
   }
   const double per_step = static_cast<double>(a_long - a_short) / (kLong - kShort);
@@ -90,6 +94,21 @@ kind = "blwn"
 [controller]
 kind = "ff"
 )");
+}
+
+TEST_CASE("no allocation per step with a live monitor in this process: the clock's records cross its ring") {
+  rths::monitor::LiveView view;
+  rths::monitor::InProcessFeed feed(&view);  // not drained: the clock's side alone (a full ring drops)
+  CheckNoAllocationPerStep("default, watched", R"(
+[structure.ground]
+kind = "blwn"
+[controller]
+kind = "ff"
+)", &feed);
+  feed.Start();  // drained now: the runs did feed it
+  feed.Stop();
+  CHECK(view.PointsMade() > 0);
+  CHECK(view.Status().phase == "completed");
 }
 
 TEST_CASE("no allocation per step: the physical plant with current dynamics, clipped-optimal control, CSV") {

@@ -38,7 +38,7 @@ void OnSignal(int) { g_interrupted = 1; }
 /// The command line.
 struct Options {
   std::string scenario_path, default_scenario = "scenarios/default.toml";
-  std::string out, transport, bin_dir, url, external;  ///< transport "": TransportOf
+  std::string out, transport, bin_dir, url, external;  ///< transport "": ResolveTransport
   bool quiet = false, skip_space_check = false, port_per_channel = false, realtime = false;
   bool compact = false, report = false, watch = false;
   rths::tools::WatchFlags watch_flags;
@@ -52,9 +52,10 @@ void AddOptions(CLI::App& app, Options* o) {
   app.add_option("--default-scenario", o->default_scenario, "used when no scenario is given")->group("");
   app.add_option("--out", o->out, "output folder (default: a new folder under runs/)");
   app.add_option("--transport", o->transport,
-                 "udpm: one process per participant (the default); memq: one process; mixed: the built-in "
-                 "participants in one process, bridged to the --external ones on udpm (the default with "
-                 "--external; docs/lockstep.md, Transports)")
+                 "udpm: one process per participant (the default); memq: one process (the default of a paced "
+                 "run, --realtime: it holds the pace best; docs/realtime.md); mixed: the built-in participants "
+                 "in one process, bridged to the --external ones on udpm (the default with --external; "
+                 "docs/lockstep.md, Transports)")
       ->check(CLI::IsMember({"udpm", "memq", "mixed"}));
   app.add_option("--bin-dir", o->bin_dir, "where the rths-* programs are (default: next to this one)");
   app.add_flag("--quiet", o->quiet, "print only the output folder");
@@ -93,15 +94,26 @@ void AddOptions(CLI::App& app, Options* o) {
   app.add_flag("--report", o->report, "at the end, write RUN_DIR/report.html with figures (as `rths report RUN_DIR`)");
   app.add_flag("--watch", o->watch,
                "watch the run live in a browser, with an ABORT button: prints the monitor's address "
-               "(http://127.0.0.1:8765/?token=...; udpm transport; docs/monitor.md)");
+               "(http://127.0.0.1:8765/?token=...; any transport; docs/monitor.md)");
   o->watch_flags.Add(app, "--watch-");
 }
 
-/// The transport asked for, or the default: mixed with --external, else udpm.
-std::string TransportOf(const Options& o) {
-  if (!o.transport.empty()) return o.transport;
-  return o.external.empty() ? "udpm" : "mixed";
+/// The transport asked for, or the default (docs/realtime.md, "Which transport"): mixed with
+/// --external; memq for a paced run that names no udpm option (it holds the pace best: the step
+/// is a function call, not five processes' datagrams); else udpm. Resolved into o->transport
+/// once the scenario says whether the run is paced.
+void ResolveTransport(Options* o, bool paced) {
+  if (!o->transport.empty()) return;
+  if (!o->external.empty()) {
+    o->transport = "mixed";
+  } else if (paced && o->url.empty() && !o->port_per_channel) {
+    o->transport = "memq";
+  } else {
+    o->transport = "udpm";
+  }
 }
+
+const std::string& TransportOf(const Options& o) { return o.transport; }
 
 /// The roles of --external, checked against the transport; throws a message for the command line.
 sup::ExternalRoles ExternalRolesOf(const Options& o) {
@@ -125,10 +137,6 @@ std::string UrlOf(const Options& o) {
     throw std::runtime_error(
         fmt::format("--lcm-url {}: must be a udpm:// URL (e.g. udpm://239.255.76.67:7667?ttl=0)", o.url));
   }
-  if (o.watch && TransportOf(o) != "udpm") {
-    throw std::runtime_error("--watch needs the udpm transport (the monitor listens to the run's UDP port; " +
-                             TransportOf(o) + " keeps the built-in participants' messages inside one process)");
-  }
   if (o.port_per_channel && TransportOf(o) != "udpm") {
     throw std::runtime_error(o.external.empty() ? "--port-per-channel needs the udpm transport"
                                                 : "--port-per-channel needs --transport udpm (a mixed run, the "
@@ -144,13 +152,14 @@ std::string UrlOf(const Options& o) {
 }
 
 /// The request from the options: the scenario loaded (with --set, --compact and --realtime).
-sup::RunRequest RequestOf(const Options& o) {
+sup::RunRequest RequestOf(Options& o) {
   sup::RunRequest r;
-  r.external = ExternalRolesOf(o);
-  r.lcm_url = UrlOf(o);
   r.scenario_path = o.scenario_path;
   r.scenario = rths::scenario::LoadScenario(o.scenario_path, o.sets);
   if (o.realtime) r.scenario.realtime.enabled = true;
+  ResolveTransport(&o, r.scenario.realtime.enabled);
+  r.external = ExternalRolesOf(o);
+  r.lcm_url = UrlOf(o);
   if (!o.sets.empty()) {
     // The scenario that runs is the file with the overrides: written out in full (file paths
     // absolute), loaded back so its hash is the file's, and given to every participant.
@@ -271,14 +280,25 @@ int main(int argc, char** argv) {
   std::signal(SIGINT, OnSignal);
   std::signal(SIGTERM, OnSignal);
   std::unique_ptr<rths::monitor::Monitor> monitor;
+  const std::string title = "rths monitor: " + request.scenario.run.name;
+  if (o.watch && request.transport != "udpm") {
+    // The run's own process feeds the page: its clock's records through a lock-free ring.
+    try {
+      monitor = std::make_unique<rths::monitor::Monitor>(o.watch_flags.Options("", title));
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "rths run: --watch: %s\n", e.what());
+      return rths::lockstep::kExitUsage;
+    }
+    request.live_sink = monitor->live_sink();
+  }
   request.on_start = [&](const sup::RunPlan& plan) {
     if (!o.quiet) PrintHeader(o, plan);
     if (!request.external.roles.empty()) rths::tools::PrintExternal(request, plan, plan.scenario.steps());
     // A monitor that cannot start stops the run before its participants do (RunError, exit 2).
     if (o.watch) {
       try {
-        monitor = o.watch_flags.Start(plan.url, plan.scenario.realtime.enabled,
-                                      "rths monitor: " + plan.scenario.run.name, "run", stdout);
+        if (!monitor) monitor = o.watch_flags.Make(plan.url, title);  // udpm: it listens to the run's URL
+        o.watch_flags.Announce(monitor.get(), "run", stdout);
       } catch (const std::exception& e) {
         throw rths::Error("--watch", e.what());  // nothing runs: RunError, exit 2
       }
@@ -288,6 +308,11 @@ int main(int argc, char** argv) {
   try {
     const sup::RunResult result = sup::Run(request);
     if (monitor) {
+      const auto& sum = result.summary;
+      const std::string by = sum.status == "interrupted" ? "the operator (Ctrl-C)"
+                             : sum.failure                ? sum.failure->participant
+                                                          : "";
+      monitor->OnEnd(result.plan.run_id, sum.status, by, sum.stopped);
       std::this_thread::sleep_for(std::chrono::seconds(1));  // the page gets the run's end
       monitor->Stop();
     }

@@ -31,8 +31,9 @@ void SayPhase(const rths::monitor::LiveStatus& s) {
 
 int main(int argc, char** argv) {
   CLI::App app{"rths watch: watch a run live in a browser (scrolling r, u, y, tracking error, force, current; "
-               "step counter and rate; latency and misses when paced) with an ABORT button. It listens like "
-               "any LCM listener and never slows the run down. `rths run` prints the run's --lcm-url; "
+               "step counter and rate; the clock's latency and misses when paced; the safety limits) with an ABORT "
+               "button. It listens like any LCM listener to what the run's clock publishes and never slows the run "
+               "down. `rths run` prints the run's --lcm-url; "
                "`rths run --watch` starts a monitor itself"};
   std::string url;
   bool paced = false, exit_at_end = false;
@@ -40,7 +41,8 @@ int main(int argc, char** argv) {
   app.add_option("--lcm-url", url, "the run's udpm URL, as `rths run` printed it (udpm://GROUP:PORT?ttl=0...)")
       ->required();
   flags.Add(app, "--");
-  app.add_flag("--paced", paced, "the run is paced (run --realtime): show each step's latency and the misses");
+  // Before the clock fed the monitor, the user said whether the run was paced; its records say so now.
+  app.add_flag("--paced", paced, "(ignored: the run's clock says whether it is paced)")->group("");
   app.add_flag("--exit-at-end", exit_at_end, "exit 2 s after the run completes or is aborted");
   rths::tools::NameCommand(app, "watch");
   if (const int code = rths::tools::ParseCommandLine(app, argc, argv); code >= 0) return code;
@@ -52,7 +54,7 @@ int main(int argc, char** argv) {
   std::unique_ptr<rths::monitor::Monitor> monitor;
   try {
     std::printf("rths watch: %s\n", url.c_str());
-    monitor = flags.Start(url, paced, "rths monitor", "watch", stdout);
+    monitor = flags.Start(url, "rths monitor", "watch", stdout);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "rths watch: %s\n", e.what());
     return rths::lockstep::kExitUsage;

@@ -34,12 +34,11 @@ struct WatchFlags {
         ->group("");
   }
 
-  /// The monitor's options for a run on `lcm_url`; reads the plotting library (throws Error naming
-  /// the file and the package if it cannot).
-  monitor::MonitorOptions Options(const std::string& lcm_url, bool paced, const std::string& title) const {
+  /// The monitor's options for a run on `lcm_url` ("": a run in this process); reads the plotting
+  /// library (throws Error naming the file and the package if it cannot).
+  monitor::MonitorOptions Options(const std::string& lcm_url, const std::string& title) const {
     monitor::MonitorOptions o;
     o.lcm_url = lcm_url;
-    o.view.paced = paced;
     o.server.host = lan ? "0.0.0.0" : "127.0.0.1";
     o.server.port = port;
     o.server.title = title;
@@ -54,10 +53,12 @@ struct WatchFlags {
     return o;
   }
 
-  /// Starts a monitor on `lcm_url` and prints its address (and the LAN warning) on `out`.
-  std::unique_ptr<monitor::Monitor> Start(const std::string& lcm_url, bool paced, const std::string& title,
-                                          const std::string& command, std::FILE* out) const {
-    auto m = std::make_unique<monitor::Monitor>(Options(lcm_url, paced, title));
+  /// A monitor on `lcm_url` ("": a run in this process), not started.
+  std::unique_ptr<monitor::Monitor> Make(const std::string& lcm_url, const std::string& title) const {
+    return std::make_unique<monitor::Monitor>(Options(lcm_url, title));
+  }
+  /// Starts `m` and prints its address (and the LAN warning) on `out`.
+  void Announce(monitor::Monitor* m, const std::string& command, std::FILE* out) const {
     m->Start();
     if (lan) {
       std::fprintf(stderr,
@@ -67,6 +68,12 @@ struct WatchFlags {
     }
     std::fprintf(out, "  monitor          %s\n", m->Url().c_str());
     std::fflush(out);
+  }
+  /// Make and Announce.
+  std::unique_ptr<monitor::Monitor> Start(const std::string& lcm_url, const std::string& title,
+                                          const std::string& command, std::FILE* out) const {
+    auto m = Make(lcm_url, title);
+    Announce(m.get(), command, out);
     return m;
   }
 };

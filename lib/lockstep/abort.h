@@ -6,6 +6,9 @@
 
 namespace rths::lockstep {
 
+/// The sender name of the live monitor's ABORT (docs/monitor.md).
+inline constexpr const char* kMonitorSender = "monitor";
+
 /// Tells every participant of run `run_id` to stop: a handshake ABORT (phase 4) on the run's udpm
 /// `url` (a run with a port per channel: on the handshake channel's port), from `sender`, with
 /// `reason` and the step `k` being run (-1 if unknown), sent 3 times (udpm may drop one). False

@@ -6,6 +6,8 @@
 
 #include <fmt/core.h>
 
+#include "lockstep/abort.h"
+
 namespace rths::lockstep {
 
 namespace {
@@ -95,6 +97,7 @@ void ClockParticipant::OnHandshakeForClock(const rths::handshake_t& msg, SteadyC
     for (bool b : bye_) all = all && b;
     if (all) {
       SendHandshake(kClose, id_.n_steps);
+      live_.Phase(kLiveCompleted, live_sink_);
       Finish();
     }
   }
@@ -153,6 +156,8 @@ void ClockParticipant::SendGo() {
   for (std::string_view r : kRoster) roster.emplace_back(r);
   SendHandshake(kGo, 0, "", &roster);  // several copies; a lost GO is also repaired by step 0
   go_at_ = SteadyClock::now();
+  live_.Start(id_.run_id, id_.n_steps, id_.dt_s, rt_.paced, live_limits_);
+  live_.Phase(kLiveRunning, live_sink_);
   OnGo();
   try {
     IssueStep(0);
@@ -231,8 +236,14 @@ void ClockParticipant::CheckBarrier() {
     Fail(kExitSafety, std::string(stop), true, k_);
     return;
   }
-  if (!AccountStep(now)) return;
+  const bool missed = rt_.paced && now > ReleaseOf(k_ + 1);
+  if (!AccountStep(now)) {
+    live_.Phase(kLiveAborted, live_sink_);
+    return;
+  }
+  if (live_sink_) live_.Add(k_, desired_.r_mm, c->u_mm, m->y_mm, m->f_kN, m->current_A, Seconds(step_since_, now), missed, rt_, live_sink_);
   if (k_ + 1 >= id_.n_steps) {
+    live_.Phase(kLiveFinishing, live_sink_);
     done_ = true;
     rerequests_ = 0;
     step_since_ = last_send_ = SteadyClock::now();
@@ -308,8 +319,24 @@ SteadyClock::time_point ClockParticipant::PollDeadline() const {
                           timing_.RerequestAfterS(rerequests_ + 1, typical_step_s_)));
 }
 
+void ClockParticipant::PublishLive() {
+  publish_sink_ = std::make_unique<PublishSink>(this);
+  live_sink_ = publish_sink_.get();
+}
+
+void ClockParticipant::PublishSink::Push(const rths::monitor_t& record) {
+  Encode(record, &bytes_);
+  clock_->PublishBytes(kChMonitor, bytes_);
+}
+
 void ClockParticipant::Poll(SteadyClock::time_point now, bool idle) {
   if (finished()) return;
+  if (std::string reason; live_sink_ && live_sink_->TakeAbort(&reason)) {
+    // The operator pressed ABORT on a monitor in this process: as if "monitor" had sent it.
+    live_.Phase(kLiveAborted, live_sink_);
+    RelayAbort(kMonitorSender, reason, k_);
+    return;
+  }
   if (!done_) {
     if (const std::optional<PeerLoss> loss = watch_.Check(now)) {
       FailLost(*loss);
@@ -378,6 +405,7 @@ void ClockParticipant::PollDone(SteadyClock::time_point now, bool idle) {
     std::fprintf(stderr, "%s: every step committed, but no BYE from %s within %g s\n", name_.c_str(),
                  JoinNames(missing).c_str(), timing_.stall_budget_s);
     SendHandshake(kClose, id_.n_steps);
+    live_.Phase(kLiveCompleted, live_sink_);
     Finish();
     return;
   }

@@ -18,10 +18,12 @@
 /// Paced (LockstepConfig::pacing, docs/realtime.md): step k is released at GO + k dt of the wall clock,
 /// not as soon as step k-1 completes; every step's latency and deadline are accounted.
 #include <array>
+#include <memory>
 #include <string>
 #include <string_view>
 #include <vector>
 
+#include "lockstep/live_feed.h"
 #include "lockstep/participant.h"
 #include "lockstep/peer_watch.h"
 #include "lockstep/step_mailboxes.h"
@@ -45,6 +47,16 @@ class ClockParticipant : public Participant {
   /// What the clock saw of every participant of the roster (its own entry is empty).
   const std::array<PeerObservation, kRosterSize>* peers() const override { return &peers_; }
   SteadyClock::time_point ReleaseAt() const override { return release_; }
+
+  /// The live monitor (lockstep/live_feed.h): the clock's records of the run go to `sink` (in this
+  /// process, not owned; it outlives the run), and an abort the sink is asked for stops the run as
+  /// an ABORT from "monitor" would. nullptr: none (the default).
+  void SetLiveSink(LiveSink* sink) { live_sink_ = sink; }
+  /// The records are published on kChMonitor instead (a participant process: a monitor listens to
+  /// the run's URL).
+  void PublishLive();
+  /// The limits the monitor shows the run's peaks against (the safety monitor's).
+  void SetLiveLimits(const LiveLimits& limits) { live_limits_ = limits; }
   SteadyClock::duration SpinBeforeRelease() const override {
     return std::chrono::duration_cast<SteadyClock::duration>(std::chrono::duration<double>(timing_.pacing.spin_s));
   }
@@ -119,6 +131,20 @@ class ClockParticipant : public Participant {
   SteadyClock::time_point release_ = SteadyClock::time_point::max();
   RealtimeStats rt_;
   std::int64_t consecutive_misses_ = 0;
+  /// Publishes live records on kChMonitor through this participant's transport.
+  class PublishSink final : public LiveSink {
+   public:
+    explicit PublishSink(ClockParticipant* clock) : clock_(clock) {}
+    void Push(const rths::monitor_t& record) override;
+
+   private:
+    ClockParticipant* clock_;
+    Bytes bytes_;
+  };
+  LiveFeed live_;
+  LiveSink* live_sink_ = nullptr;
+  LiveLimits live_limits_;
+  std::unique_ptr<PublishSink> publish_sink_;
   SteadyClock::time_point last_send_;
   SteadyClock::time_point start_;
 };

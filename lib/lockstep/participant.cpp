@@ -430,6 +430,23 @@ void Participant::Fail(int exit_code, const std::string& reason, bool broadcast,
   fail_step_ = k;
 }
 
+void Participant::RelayAbort(const std::string& sender, const std::string& reason, std::int64_t k) {
+  if (finished_) return;
+  rths::handshake_t h{};
+  h.run_id = id_.run_id;
+  h.phase = kAbort;
+  h.participant = sender;
+  h.k = k;
+  h.n_roster = 0;
+  h.reason = reason;
+  Bytes bytes;
+  Encode(h, &bytes);
+  for (int i = 0; i < kControlCopies; ++i) Send(kChHandshake, bytes.data(), bytes.size());
+  OnAbortFrom(sender, reason);
+  OnStop();
+  Fail(kExitPeerAbort, fmt::format("{} aborted the run: {}", sender, reason), false, k);
+}
+
 void Participant::MaybeFault(std::int64_t k) {
   if (faults_.process == ProcessFault::kNone || k != faults_.at_step || fault_fired_) return;
   fault_fired_ = true;

@@ -174,6 +174,10 @@ class Participant {
             const std::string& culprit = "");
   /// Stops cleanly.
   void Finish();
+  /// An ABORT from someone outside the roster (`sender`, e.g. kMonitorSender) handed to this
+  /// participant in-process: sends it to every participant as that sender's handshake ABORT, then
+  /// stops as on hearing it (kExitPeerAbort, "<sender> aborted the run: <reason>").
+  void RelayAbort(const std::string& sender, const std::string& reason, std::int64_t k);
   /// Sends a handshake message of this participant; `roster` (GO only) lists who takes part,
   /// every one of them with this participant's scenario hash (the clock checked them).
   void SendHandshake(Phase phase, std::int64_t k = -1, const std::string& reason = "",

@@ -1,14 +1,14 @@
 #pragma once
-/// @file The live monitor's ear on a run (docs/monitor.md): an ordinary LCM listener on the run's
-/// udpm URL (one socket per channel when the run has a port per channel) that feeds a LiveView from
-/// a thread of its own. It never sends anything on the run's per-step channels and never answers a
-/// step, so it cannot slow the lockstep loop down or stop it, except by Abort().
+/// @file The live monitor's ear on a udpm run (docs/monitor.md): an ordinary LCM listener on the
+/// run's handshake port that hears the handshake and the clock's live records (RTHS_MONITOR,
+/// lockstep/live_feed.h) and feeds a LiveView from a thread of its own. It hears none of the
+/// per-step channels and never sends on them, so it cannot slow the lockstep loop down or stop
+/// it, except by Abort().
 #include <atomic>
 #include <cstdint>
 #include <memory>
 #include <string>
 #include <thread>
-#include <vector>
 
 #include <lcm/lcm-cpp.hpp>
 
@@ -18,8 +18,8 @@ namespace rths::monitor {
 
 class Listener {
  public:
-  /// Opens the run's udpm `url` (a plain LCM URL, or ours with port_per_channel=1) for the
-  /// handshake, desired, command and measured channels. Throws Error naming the URL if it cannot.
+  /// Opens the run's udpm `url` (a plain LCM URL, or ours with port_per_channel=1: then the
+  /// handshake's port). Throws Error naming the URL if it cannot.
   Listener(const std::string& url, LiveView* view);
   ~Listener();
   Listener(const Listener&) = delete;
@@ -41,7 +41,7 @@ class Listener {
 
   std::string url_;
   LiveView* view_;
-  std::vector<std::unique_ptr<lcm::LCM>> lcms_;
+  std::unique_ptr<lcm::LCM> lcm_;
   std::thread thread_;
   std::atomic<bool> stop_{false};
 };

@@ -1,10 +1,13 @@
 #pragma once
-/// @file What the live monitor knows of a run (docs/monitor.md): the run's phase from its
-/// handshake, the step counter and rate, the lateness of paced steps as this listener sees them,
-/// and a decimated history of r, u, y, the tracking error r - y, the force and the current.
+/// @file What the live monitor knows of a run (docs/monitor.md): the run's phase, and the clock's
+/// own account of it (lockstep/live_feed.h: one rths::monitor_t record per bucket of about 10 ms
+/// of simulated time): the step counter, the latency and deadline misses as the clock measures and
+/// counts them (so the page agrees with summary.json "realtime"), the safety limits and the run's
+/// peaks against them, and a history of the buckets' peaks of r, u, y, r - y, f and the current.
 ///
-/// Fed by a lossy listener (monitor/listener.h): a lost message leaves a gap in the plots and a
-/// count, never a wait. Every method locks one mutex; a browser reads what is new with Since().
+/// Fed by a lossy listener on a udpm run (monitor/listener.h) or by the run's own process
+/// (monitor/in_process_feed.h): a lost record leaves a gap in the plots and a count, never a wait.
+/// Every method locks one mutex; a browser reads what is new with Since().
 #include <chrono>
 #include <cstdint>
 #include <mutex>
@@ -13,23 +16,17 @@
 
 #include <nlohmann/json.hpp>
 
+#include "rths/monitor_t.hpp"
+
 namespace rths::monitor {
 
 using WallClock = std::chrono::steady_clock;
 
-/// How the view decimates and what it assumes of the run.
 struct LiveViewOptions {
-  /// Plotted points per second of simulated time [1/s]: a bucket is round(1 / (dt * this)) steps
-  /// (at least 1); each signal keeps its value of largest magnitude in the bucket, so a peak is
-  /// never decimated away.
-  double points_per_sim_s = 100.0;
   std::size_t capacity = 1 << 16;  ///< points kept for a browser that connects late (the newest)
-  /// The run is paced to the wall clock (`run --realtime`): report each step's lateness and count
-  /// the steps seen completing after their deadline. Unpaced: the lateness is not shown.
-  bool paced = false;
 };
 
-/// One plotted point: a bucket's peaks (NaN where no step of the bucket had the signal).
+/// One plotted point: a bucket's peaks, as the clock made them.
 struct LivePoint {
   double t_s = 0;          ///< simulated time of the bucket's last step, k * dt [s]
   double r_mm = 0;         ///< desired displacement [mm]
@@ -38,7 +35,8 @@ struct LivePoint {
   double e_mm = 0;         ///< tracking error r - y [mm]
   double f_kN = 0;         ///< measured force [kN]
   double i_A = 0;          ///< damper current [A]
-  double latency_ms = 0;   ///< paced: the bucket's largest step latency as heard [ms] (NaN unpaced)
+  double latency_ms = 0;   ///< the bucket's largest step latency, as the clock measures it [ms]
+  std::int32_t misses = 0; ///< paced: the bucket's steps that completed after their deadline
 };
 
 /// The run's state as the monitor sees it.
@@ -48,82 +46,54 @@ struct LiveStatus {
   std::string abort_by, abort_reason;  ///< phase aborted: the ABORT's sender and reason
   std::int64_t n_steps = 0;
   double dt_s = 0;
-  std::int64_t last_k = -1;       ///< the newest step measured
-  double steps_per_s = 0;         ///< over the last second of wall time [1/s]
-  std::int64_t steps_seen = 0;    ///< measured steps heard (a lost datagram: a step not seen)
+  std::int64_t last_k = -1;       ///< the newest committed step heard of
+  double steps_per_s = 0;         ///< over the last half second or more of wall time [1/s]
+  std::int64_t records_heard = 0;     ///< bucket records received
+  std::int64_t records_expected = 0;  ///< bucket records the clock has made up to last_k
   bool paced = false;
-  /// Paced runs, as this listener hears them (the clock's own figures are in summary.json): a
-  /// step's latency is its measured_t's arrival minus its desired_t's; its deadline is t0 + (k+1)
-  /// dt, t0 the earliest arrival of desired_t k minus k dt; a miss is a measured_t after it.
+  /// The clock's figures (lockstep/realtime.h): a step's latency is from its release to its
+  /// barrier being complete; a miss is a step complete after its deadline t0 + (k+1) dt.
   double latency_ms = 0;          ///< the newest step's latency [ms]
   double latency_max_ms = 0;      ///< the largest so far [ms]
-  std::int64_t misses = 0;        ///< steps heard completing after their deadline
-  std::int64_t longest_miss_run = 0;  ///< most misses in a row
+  std::int64_t misses = 0;        ///< paced: steps completed after their deadline
+  std::int64_t longest_miss_run = 0;  ///< paced: most misses in a row
+  /// The safety monitor's limits (0: none) and the run's peaks so far.
+  double stroke_mm = 0, force_kN = 0, max_error_mm = 0;
+  double peak_disp_mm = 0, peak_force_kN = 0, peak_error_mm = 0;
 };
 
-/// The state of one run at a time: a handshake with a new run id starts over.
+/// The state of one run at a time: a new run id starts over.
 class LiveView {
  public:
   explicit LiveView(LiveViewOptions options = {});
 
-  /// A handshake message (phases of lockstep/protocol.h): REQUEST/HELLO/GO start or identify the
-  /// run, GO sets its time origin, DONE/CLOSE end it, ABORT records who stopped it and why.
+  /// A handshake message (phases of lockstep/protocol.h; a udpm run): REQUEST starts or
+  /// identifies the run, GO runs it, DONE/CLOSE end it, ABORT records who stopped it and why.
   void OnHandshake(std::int64_t run_id, int phase, const std::string& sender, std::int64_t n_steps, double dt_s,
                    const std::string& reason);
-  /// desired_t of step k: r_k [mm]; `now` its arrival (the step's release, paced).
-  void OnDesired(std::int64_t run_id, std::int64_t k, double r_mm, WallClock::time_point now);
-  /// command_t of step k: u_k [mm].
-  void OnCommand(std::int64_t run_id, std::int64_t k, double u_mm);
-  /// measured_t of step k: y_k [mm], f_k [kN], current [A]; `now` its arrival. Step k - kJoinLag
-  /// is then joined with its r and u and goes into its bucket.
-  void OnMeasured(std::int64_t run_id, std::int64_t k, double y_mm, double f_kN, double i_A,
-                  WallClock::time_point now);
+  /// A record of the clock's (lockstep/live_feed.h); `now` its arrival.
+  void OnRecord(const rths::monitor_t& record, WallClock::time_point now);
+  /// The run ended as its supervisor reports it (a monitor in the run's own process): `status` as
+  /// summary.json's ("completed", "aborted", ...), `by` and `reason` of an abort.
+  void OnEnd(std::int64_t run_id, const std::string& status, const std::string& by, const std::string& reason);
 
   LiveStatus Status() const;
   /// The points after `cursor` (an index that only grows; the oldest kept if it fell out), at most
   /// `max_points`, and the status, as JSON: {"status": {...}, "cursor": next, "points": [[t, r, u,
-  /// y, e, f, i, late], ...]} (NaN as null).
+  /// y, e, f, i, latency, misses], ...]}.
   nlohmann::json Since(std::int64_t cursor, std::size_t max_points = 5000) const;
   /// Points made so far (the cursor after the newest).
   std::int64_t PointsMade() const;
 
-  /// Steps a measured message waits for its step's r and u (arrivals on other sockets may be out
-  /// of order by a few steps).
-  static constexpr std::int64_t kJoinLag = 4;
-
  private:
-  struct Slot {
-    std::int64_t k = -1;
-    double r = 0, u = 0, y = 0, f = 0, i = 0, latency_ms = 0;
-    WallClock::time_point released{};
-    bool has_r = false, has_u = false, has_y = false;
-  };
-  static constexpr std::size_t kSlots = 256;
-
   void StartRun(std::int64_t run_id, std::int64_t n_steps, double dt_s);
-  void SetStep(double dt_s);
-  Slot& SlotOf(std::int64_t k);
-  /// Puts step k's slot into the open bucket (closing it when full).
-  void Join(std::int64_t k);
-  void CloseBucket();
-  /// Joins every step still waiting (the run ended).
-  void Flush();
   void UpdateRate(WallClock::time_point now);
 
   LiveViewOptions options_;
   mutable std::mutex mutex_;
   LiveStatus status_;
-  double t0_s_ = 0;                 ///< paced: the release schedule's origin [s of WallClock]
-  bool have_t0_ = false;
-  std::int64_t bucket_steps_ = 1;
-  std::vector<Slot> slots_;
-  std::int64_t next_join_ = 0;      ///< the next step to join
-  LivePoint open_{};                ///< the bucket being filled
-  std::int64_t open_count_ = 0;     ///< steps in it
-  std::int64_t open_bucket_ = -1;   ///< its index, k / bucket_steps_
   std::vector<LivePoint> ring_;     ///< the newest points (ring of options_.capacity)
   std::int64_t made_ = 0;           ///< points made since the run started
-  std::int64_t miss_run_ = 0;
   WallClock::time_point rate_t_{};  ///< the rate's window start
   std::int64_t rate_k_ = -1;
 };

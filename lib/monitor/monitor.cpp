@@ -27,9 +27,15 @@ class BlockSignals {
 
 Monitor::Monitor(MonitorOptions options) : view_(options.view) {
   const BlockSignals blocked;
-  listener_ = std::make_unique<Listener>(options.lcm_url, &view_);
-  server_ = std::make_unique<MonitorServer>(std::move(options.server), &view_,
-                                            [this](const std::string& reason) { return listener_->Abort(reason); });
+  AbortFunction abort;
+  if (options.lcm_url.empty()) {
+    feed_ = std::make_unique<InProcessFeed>(&view_);
+    abort = [this](const std::string& reason) { return feed_->RequestAbort(reason); };
+  } else {
+    listener_ = std::make_unique<Listener>(options.lcm_url, &view_);
+    abort = [this](const std::string& reason) { return listener_->Abort(reason); };
+  }
+  server_ = std::make_unique<MonitorServer>(std::move(options.server), &view_, std::move(abort));
 }
 
 Monitor::~Monitor() { Stop(); }
@@ -37,12 +43,20 @@ Monitor::~Monitor() { Stop(); }
 void Monitor::Start() {
   const BlockSignals blocked;
   server_->Start();
-  listener_->Start();
+  if (listener_) listener_->Start();
+  if (feed_) feed_->Start();
 }
 
 void Monitor::Stop() {
   server_->Stop();
-  listener_->Stop();
+  if (listener_) listener_->Stop();
+  if (feed_) feed_->Stop();
+}
+
+void Monitor::OnEnd(std::int64_t run_id, const std::string& status, const std::string& by,
+                    const std::string& reason) {
+  if (feed_) feed_->Stop();  // every record the run made is in the view first
+  view_.OnEnd(run_id, status, by, reason);
 }
 
 }  // namespace rths::monitor

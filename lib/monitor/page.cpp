@@ -24,6 +24,9 @@ header h1 { font-size: 18px; margin: 0; font-weight: 600; }
 #abort:disabled { background: #9ca3af; border-color: #6b7280; cursor: default; }
 #stats { padding: 8px 18px; display: flex; flex-wrap: wrap; gap: 6px 22px; background: #fff; border-bottom: 1px solid #d9dde3; }
 #stats b { font-variant-numeric: tabular-nums; }
+#limits { padding: 6px 18px; display: flex; flex-wrap: wrap; gap: 6px 22px; background: #fff; border-bottom: 1px solid #d9dde3; }
+#limits b { font-variant-numeric: tabular-nums; } #limits b.near { color: #b45309; } #limits b.over { color: #b91c1c; }
+#stats i { color: #6b7280; font-style: normal; font-size: 12px; }
 #message { padding: 6px 18px; min-height: 20px; color: #b91c1c; font-weight: 600; }
 #controls { padding: 0 18px 6px; } #controls button { margin-right: 4px; }
 #controls button.on { background: #1c2330; color: #fff; }
@@ -41,7 +44,9 @@ header h1 { font-size: 18px; margin: 0; font-weight: 600; }
 <button id="abort" disabled title="Send ABORT to every participant: the run stops, its log complete to its last step">ABORT</button></header>
 <div id="stats"><span>step <b id="step">-</b></span><span>t <b id="time">-</b></span>
 <span>rate <b id="rate">-</b></span><span id="pacedstats" class="hidden">latency <b id="latency">-</b>,
-misses <b id="misses">-</b></span><span>monitor heard <b id="heard">-</b></span></div>
+misses <b id="misses">-</b> <i>(the clock's, as summary.json counts them)</i></span><span>monitor heard <b id="heard">-</b></span></div>
+<div id="limits"><span>safety limits, the run's peak so far:</span>
+<span>displacement <b id="lim_disp">-</b></span><span>force <b id="lim_force">-</b></span><span>|r &minus; y| <b id="lim_err">-</b></span></div>
 <div id="message"></div>
 <div id="controls">window <button data-s="2">2 s</button><button data-s="10" class="on">10 s</button><button data-s="0">all</button></div>
 <div class="grid">
@@ -49,7 +54,7 @@ misses <b id="misses">-</b></span><span>monitor heard <b id="heard">-</b></span>
 <div class="panel wide"><h2>Tracking error r &minus; y [mm]<span id="err_legend"></span></h2><div id="err" class="plot tall"></div></div>
 <div class="panel"><h2>Specimen force [kN]<span id="force_legend"></span></h2><div id="force" class="plot"></div></div>
 <div class="panel"><h2>Damper current [A]<span id="cur_legend"></span></h2><div id="cur" class="plot"></div></div>
-<div class="panel wide hidden" id="latpanel"><h2>Step latency as heard [ms] (red line: the deadline, dt)<span id="lat_legend"></span></h2><div id="lat" class="plot"></div></div>
+<div class="panel wide hidden" id="latpanel"><h2>Step latency, the clock's: release to barrier, largest per point [ms] (red line: the deadline, dt)<span id="lat_legend"></span></h2><div id="lat" class="plot"></div></div>
 </div>
 )HTML";
 
@@ -97,6 +102,14 @@ function redraw() {
   }
   st.updates++;
 }
+// The run's peak against its safety limit: "12.3 of 152.4 mm (8 %)", amber from 80 %, red at 100 %.
+function limit(id, peak, lim, unit, d) {
+  const e = $(id);
+  if (!(lim > 0)) { e.textContent = fmt(peak, d) + " " + unit + " (no limit)"; e.className = ""; return; }
+  const share = 100 * peak / lim;
+  e.textContent = fmt(peak, d) + " of " + fmt(lim, d) + " " + unit + " (" + fmt(share, 0) + " %)";
+  e.className = share >= 100 ? "over" : share >= 80 ? "near" : "";
+}
 function showStatus(s) {
   st.status = s;
   const badge = $("badge");
@@ -107,7 +120,11 @@ function showStatus(s) {
   $("time").textContent = s.dt_s > 0 ? fmt(k * s.dt_s, 2) + " s of " + fmt(n * s.dt_s, 1) + " s" : "-";
   $("rate").textContent = s.steps_per_s > 0 ? Math.round(s.steps_per_s).toLocaleString("en") + " steps/s (" +
       fmt(s.steps_per_s * s.dt_s, 2) + "x real time)" : "-";
-  $("heard").textContent = k > 0 ? fmt(100 * s.steps_seen / k, 1) + " % of the steps" : "-";
+  $("heard").textContent = s.records_expected > 0 ?
+      fmt(100 * s.records_heard / s.records_expected, 1) + " % of the clock's records" : "-";
+  limit("lim_disp", s.peaks.disp_mm, s.limits.stroke_mm, "mm", 1);
+  limit("lim_force", s.peaks.force_kN, s.limits.force_kN, "kN", 2);
+  limit("lim_err", s.peaks.error_mm, s.limits.max_error_mm, "mm", 2);
   $("pacedstats").classList.toggle("hidden", !s.paced);
   $("latpanel").classList.toggle("hidden", !s.paced);
   if (s.paced) {
@@ -137,11 +154,20 @@ function scheduleRedraw() {
   setTimeout(() => { redrawPending = false; lastRedraw = performance.now(); redraw(); },
              Math.max(0, 250 - (performance.now() - lastRedraw)));
 }
-const source = new EventSource("events?token=" + encodeURIComponent(token));
-source.onmessage = onEvent;
-source.onerror = () => { if (!st.status || (st.status.phase !== "completed" && st.status.phase !== "aborted"))
-  $("message").textContent = "lost the monitor (reconnecting)"; };
-source.onopen = () => { if ($("message").textContent.startsWith("lost")) $("message").textContent = ""; };
+if (window.rthsSnapshot) {
+  // A snapshot (?snapshot=1): the state at the moment the page was asked for, drawn at once and
+  // never updated, so `chromium --headless --screenshot` captures a run that is still going.
+  st.snapshot = true;
+  onEvent({ data: JSON.stringify(window.rthsSnapshot) });
+  redraw();
+  $("abort").disabled = true;
+} else {
+  const source = new EventSource("events?token=" + encodeURIComponent(token));
+  source.onmessage = onEvent;
+  source.onerror = () => { if (!st.status || (st.status.phase !== "completed" && st.status.phase !== "aborted"))
+    $("message").textContent = "lost the monitor (reconnecting)"; };
+  source.onopen = () => { if ($("message").textContent.startsWith("lost")) $("message").textContent = ""; };
+}
 $("abort").addEventListener("click", () => {
   $("abort").disabled = true;
   fetch("abort?token=" + encodeURIComponent(token), { method: "POST" })
@@ -163,10 +189,16 @@ for (const b of document.querySelectorAll("#controls button")) {
 
 }  // namespace
 
-std::string PageHtml(const std::string& title) {
+std::string PageHtml(const std::string& title, const std::string& snapshot_json) {
   std::string page = kHead;
   const std::string escaped = HtmlEscape(title);
   for (std::size_t at; (at = page.find("@TITLE@")) != std::string::npos;) page.replace(at, 7, escaped);
+  if (!snapshot_json.empty()) {
+    // Inside a script element "</" would end it early: JSON reads "<\/" as "</".
+    std::string json = snapshot_json;
+    for (std::size_t at = 0; (at = json.find("</", at)) != std::string::npos; at += 3) json.replace(at, 2, "<\\/");
+    page += "<script>window.rthsSnapshot = " + json + ";</script>\n";
+  }
   return page + kScript;
 }
 

@@ -6,6 +6,8 @@
 namespace rths::monitor {
 
 /// The page, titled `title` (HTML-escaped). Its script reads the token from the page's own URL.
-std::string PageHtml(const std::string& title);
+/// With `snapshot_json` (LiveView::Since's JSON) the page draws that state once and opens no event
+/// stream: a page that finishes loading, for a headless browser's screenshot of a running test.
+std::string PageHtml(const std::string& title, const std::string& snapshot_json = "");
 
 }  // namespace rths::monitor

@@ -3,6 +3,7 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <random>
 
@@ -14,6 +15,9 @@
 
 namespace rths::monitor {
 namespace {
+
+/// Points a snapshot page holds: 60 s of simulated time at the clock's 100 records per second.
+constexpr std::int64_t kSnapshotPoints = 6000;
 
 bool Authorized(const httplib::Request& req, const std::string& token) {
   return req.has_param("token") && req.get_param_value("token") == token;
@@ -54,7 +58,13 @@ void MonitorServer::Routes() {
   s.Get("/", [this](const httplib::Request& req, httplib::Response& res) {
     if (!Authorized(req, options_.token)) return Refuse(res);
     res.set_header("Cache-Control", "no-store");
-    res.set_content(PageHtml(options_.title), "text/html; charset=utf-8");
+    std::string snapshot;
+    if (req.has_param("snapshot")) {  // the newest kSnapshotPoints points, drawn once
+      const std::int64_t made = view_->PointsMade();
+      snapshot = view_->Since(std::max<std::int64_t>(0, made - kSnapshotPoints), kSnapshotPoints)
+                     .dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+    }
+    res.set_content(PageHtml(options_.title, snapshot), "text/html; charset=utf-8");
   });
   s.Get("/dygraph.min.js", [this](const httplib::Request&, httplib::Response& res) {
     res.set_content(options_.dygraphs_js, "text/javascript");

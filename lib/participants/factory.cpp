@@ -12,6 +12,7 @@
 
 #include "core/error.h"
 #include "io/reserved_file.h"
+#include "lockstep/clock.h"
 #include "lockstep/run_loop.h"
 #include "lockstep/transport.h"
 #include "participants/controller.h"
@@ -243,9 +244,15 @@ void RunOnTransport(std::string_view role, const scenario::Scenario& s, const Ro
   };
   const std::string url =
       a.follow ? FollowUrl(a.url, a.follow_recv_buf_bytes, ReadRmemMax(), std::string(role)) : a.url;
+  // The clock of a participant process publishes its live records for a monitor on the URL.
+  auto make = [&](lcm::LCM* lcm) {
+    auto p = MakeParticipant(role, s, IdentityOf(s, a.run_id), lcm, a.out_dir);
+    if (auto* clock = dynamic_cast<lockstep::ClockParticipant*>(p.get())) clock->PublishLive();
+    return p;
+  };
   if (lockstep::IsPortPerChannel(a.url)) {
     lockstep::UdpmChannels channels(*lockstep::UdpmUrl::Parse(a.url));
-    auto p = MakeParticipant(role, s, IdentityOf(s, a.run_id), nullptr, a.out_dir);
+    auto p = make(nullptr);
     std::string why = channels.error();
     if (why.empty()) {
       try {
@@ -261,7 +268,7 @@ void RunOnTransport(std::string_view role, const scenario::Scenario& s, const Ro
     o->exit_code = lockstep::kExitLockstep;
     o->message = fmt::format("cannot open LCM at {}{}", url, more());
   } else {
-    RunParticipant(a, MakeParticipant(role, s, IdentityOf(s, a.run_id), &lcm, a.out_dir).get(), &lcm, o);
+    RunParticipant(a, make(&lcm).get(), &lcm, o);
   }
 }
 }  // namespace

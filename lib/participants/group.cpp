@@ -8,6 +8,7 @@
 #include <fmt/core.h>
 
 #include "core/error.h"
+#include "lockstep/clock.h"
 #include "lockstep/step_table.h"
 #include "lockstep/bridge.h"
 #include "lockstep/transport.h"
@@ -241,7 +242,7 @@ namespace {
 std::vector<Outcome> RunGroupOn(lockstep::Channels* channels, const std::vector<scenario::Scenario>& per_role,
                                 const std::vector<std::string>& skip, std::int64_t run_id,
                                 const std::string& out_dir, const std::vector<RoleFault>& faults,
-                                const volatile std::sig_atomic_t* stop) {
+                                const volatile std::sig_atomic_t* stop, lockstep::LiveSink* live) {
   const auto& order = lockstep::kBuildOrder;  // the logger subscribes before anyone publishes
   if (per_role.size() != 1 && per_role.size() != order.size()) {
     throw Error("RunGroupInProcess", "give one scenario, or one per role");
@@ -275,6 +276,9 @@ std::vector<Outcome> RunGroupOn(lockstep::Channels* channels, const std::vector<
     }
     owned.push_back(MakeParticipant(order[i], s, IdentityOf(s, run_id), nullptr, out_dir, std::move(f)));
     owned.back()->Attach(channels);
+    if (auto* clock = dynamic_cast<lockstep::ClockParticipant*>(owned.back().get()); clock && live) {
+      clock->SetLiveSink(live);
+    }
     group.push_back(owned.back().get());
   }
   lockstep::RunLoop(channels, group, stop);
@@ -287,17 +291,17 @@ std::vector<Outcome> RunGroupOn(lockstep::Channels* channels, const std::vector<
 std::vector<Outcome> RunGroupInProcess(const std::vector<scenario::Scenario>& per_role,
                                        std::int64_t run_id, const std::string& out_dir,
                                        const std::vector<RoleFault>& faults,
-                                       const volatile std::sig_atomic_t* stop) {
+                                       const volatile std::sig_atomic_t* stop, lockstep::LiveSink* live) {
   lockstep::InprocChannels bus;
-  return RunGroupOn(&bus, per_role, {}, run_id, out_dir, faults, stop);
+  return RunGroupOn(&bus, per_role, {}, run_id, out_dir, faults, stop, live);
 }
 
 std::vector<Outcome> RunMixedGroup(const scenario::Scenario& s, const std::vector<std::string>& external,
                                    const std::string& udpm_url, std::int64_t run_id, const std::string& out_dir,
-                                   const volatile std::sig_atomic_t* stop) {
+                                   const volatile std::sig_atomic_t* stop, lockstep::LiveSink* live) {
   lockstep::BridgedChannels bridge(udpm_url, external, WiringOf(s));
   if (!bridge.good()) throw Error("", bridge.error());
-  return RunGroupOn(&bridge, {s}, external, run_id, out_dir, {}, stop);
+  return RunGroupOn(&bridge, {s}, external, run_id, out_dir, {}, stop, live);
 }
 
 namespace {

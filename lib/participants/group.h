@@ -13,6 +13,7 @@
 
 #include "lockstep/faults.h"
 #include "lockstep/link_stats.h"
+#include "lockstep/live_feed.h"
 #include "lockstep/participant.h"
 #include "lockstep/realtime.h"
 #include "scenario/scenario.h"
@@ -80,11 +81,13 @@ nlohmann::json StatsToJson(const lockstep::LinkStats& s);
 /// one scenario for every role, or five, in lockstep::kBuildOrder (tests give one role another file).
 /// Throws rths::Error if a participant cannot be built (bad model, unwritable output) or the
 /// scenario asks for a process fault that would take this whole process down (crash, kill, stop).
-/// `stop` (optional): set it (from a signal handler) to interrupt the run.
+/// `stop` (optional): set it (from a signal handler) to interrupt the run. `live` (optional): the
+/// clock's live records go there (a monitor in this process, lockstep/live_feed.h).
 std::vector<Outcome> RunGroupInProcess(const std::vector<scenario::Scenario>& per_role,
                                        std::int64_t run_id, const std::string& out_dir,
                                        const std::vector<RoleFault>& faults = {},
-                                       const volatile std::sig_atomic_t* stop = nullptr);
+                                       const volatile std::sig_atomic_t* stop = nullptr,
+                                       lockstep::LiveSink* live = nullptr);
 
 /// The outcome of external participant `role` as the clock observed it (`clock`: the clock's
 /// outcome, nullptr if unknown): how it ended (Outcome::observed), the exit code that stands for
@@ -98,7 +101,8 @@ Outcome ExternalOutcome(const std::string& role, const Outcome* clock);
 /// udpm:// URL). Throws as RunGroupInProcess, and if the bridge cannot open the URL.
 std::vector<Outcome> RunMixedGroup(const scenario::Scenario& s, const std::vector<std::string>& external,
                                    const std::string& udpm_url, std::int64_t run_id, const std::string& out_dir,
-                                   const volatile std::sig_atomic_t* stop = nullptr);
+                                   const volatile std::sig_atomic_t* stop = nullptr,
+                                   lockstep::LiveSink* live = nullptr);
 
 /// The outcome to blame for a failed run: one that failed on its own (a signal, an exception)
 /// before one that detected a failure (lockstep) before one that was told to stop; nullptr if

@@ -32,6 +32,7 @@ Integrator::Integrator(const scenario::Scenario& s, lockstep::RunIdentity id, lc
   if (substructure_.predefined() && s.structure.derivatives == models::Derivatives::kCentral) {
     central_ = control::CentralDerivatives(substructure_.r_mm, dt_s_);
   }
+  if (s.safety.enabled) SetLiveLimits({s.safety.stroke_mm, s.safety.force_kN, s.safety.max_error_mm});
 }
 
 void Integrator::ComputeDesired(std::int64_t k, const rths::measured_t* measured_prev,

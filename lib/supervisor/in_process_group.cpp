@@ -10,7 +10,7 @@ std::vector<participants::Outcome> RunInProcessGroup(const scenario::Scenario& s
                                                      const ExternalRoles* external, const std::string& udpm_url,
                                                      std::int64_t run_id, const std::string& out_dir,
                                                      const volatile std::sig_atomic_t* stop,
-                                                     lockstep::RealtimeSetup* setup) {
+                                                     lockstep::RealtimeSetup* setup, lockstep::LiveSink* live) {
   const bool bridged = external && !external->roles.empty();
   // How long the user's participants may take to say HELLO: a copy of the scenario only then.
   std::optional<scenario::Scenario> waiting;
@@ -27,8 +27,8 @@ std::vector<participants::Outcome> RunInProcessGroup(const scenario::Scenario& s
     // Every built-in participant runs on this thread: the set-up is this process's.
     *setup = lockstep::EnterRealtime(s.realtime);
   }
-  if (bridged) return participants::RunMixedGroup(joined, external->roles, udpm_url, run_id, out_dir, stop);
-  return participants::RunGroupInProcess({s}, run_id, out_dir, {}, stop);
+  if (bridged) return participants::RunMixedGroup(joined, external->roles, udpm_url, run_id, out_dir, stop, live);
+  return participants::RunGroupInProcess({s}, run_id, out_dir, {}, stop, live);
 }
 
 }  // namespace rths::supervisor

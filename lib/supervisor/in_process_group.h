@@ -18,11 +18,12 @@ namespace rths::supervisor {
 /// to the `external` roles on `udpm_url`, if `external` is not null and names any); out_dir
 /// receives log.lcm and signals.csv. A paced run (s.realtime.enabled, not a replay) first asks
 /// for SCHED_FIFO / mlockall for this process and says what it got in *setup. `stop` (optional)
-/// interrupts the run. Throws rths::Error as RunGroupInProcess, RunMixedGroup and RunReplay.
+/// interrupts the run; `live` (optional, not a replay) receives the clock's live records. Throws
+/// rths::Error as RunGroupInProcess, RunMixedGroup and RunReplay.
 std::vector<participants::Outcome> RunInProcessGroup(const scenario::Scenario& s, const ReplaySource* replay,
                                                      const ExternalRoles* external, const std::string& udpm_url,
                                                      std::int64_t run_id, const std::string& out_dir,
                                                      const volatile std::sig_atomic_t* stop,
-                                                     lockstep::RealtimeSetup* setup);
+                                                     lockstep::RealtimeSetup* setup, lockstep::LiveSink* live = nullptr);
 
 }  // namespace rths::supervisor

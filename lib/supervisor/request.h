@@ -13,6 +13,7 @@
 
 #include "core/error.h"
 #include "io/run_log.h"
+#include "lockstep/live_feed.h"
 #include "supervisor/run_summary.h"
 #include "scenario/scenario.h"
 #include "supervisor/disk.h"
@@ -83,6 +84,9 @@ struct RunRequest {
   /// Set it (a signal handler) to stop the run; udpm runs also set it on SIGINT / SIGTERM.
   /// Null: the run cannot be interrupted.
   volatile std::sig_atomic_t* interrupted = nullptr;
+  /// memq, mixed: the clock's live records go there (a monitor in this process,
+  /// lockstep/live_feed.h); udpm runs publish them on the run's URL instead. Not owned.
+  lockstep::LiveSink* live_sink = nullptr;
   std::function<void(const std::string&)> on_warning;  ///< e.g. "this run will write about 3 GB"
   /// Called once, just before the participants start; if it throws, nothing runs (RunError,
   /// kExitUsage, the folder made for the run removed).

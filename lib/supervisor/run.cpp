@@ -115,7 +115,7 @@ GroupEnd RunGroup(const RunRequest& r, const RunPlan& plan) {
     const RunProgress progress(plan.out / "log.lcm", plan.scenario, r.progress);
     if (r.transport == "memq" || r.transport == "mixed") {
       end.outcomes = RunInProcessGroup(plan.scenario, r.replay ? &*r.replay : nullptr, &r.external, plan.url,
-                                       plan.run_id, plan.out.string(), interrupted, &end.memq_setup);
+                                       plan.run_id, plan.out.string(), interrupted, &end.memq_setup, r.live_sink);
       // The built-in participants stopped at the interrupt; the external ones hear it here.
       if (r.transport == "mixed" && *interrupted) {
         lockstep::BroadcastAbort(plan.url, plan.run_id, "supervisor", "interrupted by the user");
