@@ -367,3 +367,28 @@ TEST_CASE("structure.reference_file: resolved like structure.file, checked, writ
   CHECK(ScenarioError(Scenario((dir / "bad.txt").string(), 1.0)).find("structure.reference_file: ") != std::string::npos);
   CHECK(ScenarioError(Scenario((dir / "bad.txt").string(), 1.0)).find("file ends inside M") != std::string::npos);
 }
+
+TEST_CASE("a model-based controller on a plant from an identified model designs on that model, not \"avg\"") {
+  const std::string file = std::string(RTHS_SOURCE_DIR) + "/scenarios/default.toml";
+  const std::vector<std::string> identified = {"plant.actuator={ K = 4.1e6, p = 60.0, b = 250.0, c = 68000.0 }"};
+  auto s = rths::scenario::LoadScenario(file, identified);
+  REQUIRE(s.plant.actuator.name == "custom");
+  REQUIRE(s.controller.model.name == "avg");
+  const std::string note = rths::ident::ResolveDesignModel(&s);
+  CAPTURE(note);
+  CHECK(note.find("designed on the plant's own model, plant.actuator") != std::string::npos);
+  CHECK(s.controller.model == s.plant.actuator);
+  // A preset named on purpose: kept, with a warning naming the plant's model.
+  auto preset_sets = identified;
+  preset_sets.push_back("controller.model=\"2.5A\"");
+  auto preset = rths::scenario::LoadScenario(file, preset_sets);
+  const std::string warn = rths::ident::ResolveDesignModel(&preset);
+  CHECK(warn.rfind("warning:", 0) == 0);
+  CHECK(warn.find("plant.actuator (K = 4.1e+06") != std::string::npos);
+  CHECK(preset.controller.model.name == "2.5A");
+  // The paper's own set-up (plant and design on presets) is untouched.
+  auto paper = rths::scenario::LoadScenario(file);
+  const auto before = paper.controller.model;
+  CHECK(rths::ident::ResolveDesignModel(&paper).find("\"avg\"") != std::string::npos);
+  CHECK(paper.controller.model == before);
+}

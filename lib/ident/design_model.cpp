@@ -54,6 +54,20 @@ std::string ResolveDesignModel(scenario::Scenario* s) {
                        "(controller.model's default; set controller.model to design on another)",
                        c.model.K, c.model.p, c.model.b, c.model.c, fit.model.DcGain(), 1e3 * fit.model.DcLagS());
   }
+  const bool identified_plant = s->plant.kind == models::PlantKind::kLinear && s->plant.actuator.name == "custom";
+  if (identified_plant && c.model.name == "avg") {
+    c.model = s->plant.actuator;
+    return fmt::format("controller: designed on the plant's own model, plant.actuator (K = {:.5g}, p = {:.5g}, "
+                       "b = {:.5g}, c = {:.5g}), not the paper's \"avg\" servo model (controller.model's default; "
+                       "set controller.model to design on another)",
+                       c.model.K, c.model.p, c.model.b, c.model.c);
+  }
+  if (identified_plant && c.model.name != "custom") {
+    return fmt::format("warning: controller: designed on the paper's servo model \"{}\" (controller.model), not on "
+                       "the identified model the plant runs, plant.actuator (K = {:.5g}, p = {:.5g}, b = {:.5g}, "
+                       "c = {:.5g}); leave controller.model out to design on it",
+                       c.model.name, s->plant.actuator.K, s->plant.actuator.p, s->plant.actuator.b, s->plant.actuator.c);
+  }
   if (c.model.name == "custom")
     return fmt::format("controller: designed on controller.model (K = {:.5g}, p = {:.5g}, b = {:.5g}, c = {:.5g})",
                        c.model.K, c.model.p, c.model.b, c.model.c);

@@ -17,7 +17,11 @@ namespace rths::ident {
 ///     noise-free 20 s BLWN record (0-30 Hz, 1 mm RMS, seed 11) through Gp itself, no run needed;
 ///   - plant.kind = "benchmark" and another preset ("0.0A", "2.5A"): kept, with a warning that the
 ///     design is on the paper's damper rig, not on the plant driven;
-///   - otherwise (the damper rig, a custom model): kept.
+///   - plant.kind = "linear" with an identified actuator (plant.actuator custom, e.g. the fragment
+///     `rths identify --out` writes) and controller.model "avg": the model becomes plant.actuator;
+///     another preset is kept, with a warning naming both (a custom controller.model, such as the
+///     continuous fit `rths identify --out` writes beside the plant's ZOH fit, is the user's choice);
+///   - otherwise (the damper rig's presets, a custom model): kept.
 /// Returns the line to print ("controller: designed on ..."); empty for a controller that uses no
 /// model. Deterministic: the same scenario gives the same model, bit for bit.
 std::string ResolveDesignModel(scenario::Scenario* s);
