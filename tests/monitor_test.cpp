@@ -326,7 +326,7 @@ TEST_CASE("rths run --watch --realtime: memq by default; the page's misses and l
   const fs::path dir = rths_test::TempDir("monitor_paced");
   const fs::path out_txt = dir / "run.txt";
   BackgroundRun run("exec " + std::string(RTHS_BIN_DIR) + "/rths-run " + RTHS_SOURCE_DIR +
-                    "/scenarios/default.toml --compact --realtime --set run.duration_s=12 --watch --watch-port 0 "
+                    "/scenarios/default.toml --compact --realtime --set run.duration_s=30 --watch --watch-port 0 "
                     "--out " + (dir / "run").string() + " > " + out_txt.string() + " 2>&1");
   std::smatch m;
   const std::regex line("monitor +http://127\\.0\\.0\\.1:([0-9]+)/\\?token=([0-9a-f]+)");
@@ -356,6 +356,23 @@ TEST_CASE("rths run --watch --realtime: memq by default; the page's misses and l
   CHECK(st["status"]["latency_max_ms"].get<double>() > 0);  // the clock's latency, not 0.00
   CHECK(st["status"]["limits"]["stroke_mm"].get<double>() > 0);
   CHECK(st["status"]["peaks"]["disp_mm"].get<double>() > 0);
+  {
+    // The live page in headless Chromium shows the clock's figures, not 0.00 ms.
+    rths_test::ChromiumPipe chromium(dir / "chromium_live");
+    const std::string page = chromium.Open("http://127.0.0.1:" + std::to_string(port) + "/?token=" + token);
+    REQUIRE(chromium.WaitFor(page, "window.rths && rths.status && rths.status.paced && rths.points > 20", 60));
+    const auto shown = chromium.Evaluate(page, "[document.getElementById('latency').textContent, "
+                                               "document.getElementById('misses').textContent, "
+                                               "document.getElementById('lim_disp').textContent, "
+                                               "String(rths.status.misses), String(rths.status.latency_max_ms)]");
+    CAPTURE(shown.dump());
+    const std::string latency = shown[0].get<std::string>();
+    CHECK(latency.find("(max 0.00 ms)") == std::string::npos);
+    CHECK(latency.find(" ms (max ") != std::string::npos);
+    CHECK(shown[1].get<std::string>().rfind(shown[3].get<std::string>(), 0) == 0);  // the status's count
+    CHECK(shown[2].get<std::string>().find(" of 152.4 mm (") != std::string::npos);
+    CHECK(std::stod(shown[4].get<std::string>()) > 0);
+  }
   // A plain headless screenshot of the snapshot page returns while the run goes on.
   const std::string shot = (dir / "snapshot.png").string();
   const std::string url = "http://127.0.0.1:" + std::to_string(port) + "/?token=" + token + "&snapshot=1";
@@ -372,7 +389,7 @@ TEST_CASE("rths run --watch --realtime: memq by default; the page's misses and l
   CHECK(page->body.find("window.rthsSnapshot = {") != std::string::npos);
   // Follow the page to the end: its last word is the run's summary.
   nlohmann::json last;
-  for (int i = 0; i < 600; ++i) {
+  for (int i = 0; i < 1200; ++i) {
     const auto now = state();
     if (now.is_null()) break;  // the monitor stopped with the run
     last = now;

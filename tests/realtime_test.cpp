@@ -225,7 +225,8 @@ TEST_CASE("rths run --realtime (udpm): summary and terminal report latency, miss
   const auto dir = TempDir("cli");
   const fs::path scenario = WriteScenario(dir, "[run]\nname = \"cli\"\nduration_s = 0.25\n");
   std::string out;
-  REQUIRE(RunCli("--realtime --out " + (dir / "run").string() + " " + scenario.string(), &out) == 0);
+  REQUIRE(RunCli("--realtime --transport udpm --out " + (dir / "run").string() + " " + scenario.string(), &out) == 0);
+  CHECK(out.find("transport udpm") != std::string::npos);
   CHECK(out.find("paced at 2000 Hz") != std::string::npos);
   CHECK(out.find("step latency       p50") != std::string::npos);
   CHECK(out.find("deadline misses") != std::string::npos);

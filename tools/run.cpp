@@ -154,12 +154,16 @@ std::string UrlOf(const Options& o) {
 /// The request from the options: the scenario loaded (with --set, --compact and --realtime).
 sup::RunRequest RequestOf(Options& o) {
   sup::RunRequest r;
+  // The command line's own contradictions first, before the scenario is read: only a run with no
+  // transport option waits for the scenario's pace to choose (and then nothing here can fail).
+  const bool pace_decides = o.transport.empty() && o.external.empty() && o.url.empty() && !o.port_per_channel;
+  if (!pace_decides) ResolveTransport(&o, false);
+  r.external = ExternalRolesOf(o);
+  r.lcm_url = UrlOf(o);
   r.scenario_path = o.scenario_path;
   r.scenario = rths::scenario::LoadScenario(o.scenario_path, o.sets);
   if (o.realtime) r.scenario.realtime.enabled = true;
   ResolveTransport(&o, r.scenario.realtime.enabled);
-  r.external = ExternalRolesOf(o);
-  r.lcm_url = UrlOf(o);
   if (!o.sets.empty()) {
     // The scenario that runs is the file with the overrides: written out in full (file paths
     // absolute), loaded back so its hash is the file's, and given to every participant.
