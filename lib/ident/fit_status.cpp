@@ -38,7 +38,34 @@ std::string Meaning(const ParameterStatus& p) {
 
 }  // namespace
 
+std::string Implausible::Warning() const {
+  return fmt::format("{} = {:.4g} {} is outside the plausible range {:.3g}..{:.3g} {} (docs/identification.md "
+                     "\"Plausible ranges\")",
+                     name, value, unit, lo, hi, unit);
+}
+
 bool FitStatus::Ok() const { return converged && Names(ParameterState::kAtBound).empty(); }
+
+std::string FitStatus::Mark() const {
+  std::string o;
+  if (!Ok()) {
+    const auto bound = Names(ParameterState::kAtBound);
+    o = "FIT FAILED: ";
+    if (!converged) o += "not converged";
+    if (!bound.empty()) {
+      std::string names;
+      for (const auto& n : bound) names += (names.empty() ? "" : ", ") + n;
+      o += fmt::format("{}{} on {} bound{}", converged ? "" : ", ", names, bound.size() == 1 ? "its" : "their",
+                       bound.size() == 1 ? "" : "s");
+    }
+  }
+  if (!implausible.empty()) {
+    std::string names;
+    for (const auto& p : implausible) names += (names.empty() ? "" : ", ") + p.name;
+    o += (o.empty() ? "" : "; ") + std::string("implausible: ") + names;
+  }
+  return o;
+}
 
 std::vector<std::string> FitStatus::Names(ParameterState state) const {
   std::vector<std::string> out;
@@ -70,6 +97,7 @@ std::string FitStatus::Details(const std::string& indent) const {
     else it->second += ", " + item;
   }
   for (const auto& [meaning, items] : lines) o += fmt::format("{}  {}: {}\n", indent, items, meaning);
+  for (const auto& p : implausible) o += fmt::format("{}  warning: {}\n", indent, p.Warning());
   return o;
 }
 
@@ -97,6 +125,9 @@ std::string FitStatus::TomlTable() const {
   o += "at_zero = " + List(Names(ParameterState::kAtZero)) + "\n";
   o += "held = " + List(Names(ParameterState::kHeld)) + "\n";
   o += "irrelevant = " + List(Names(ParameterState::kIrrelevant)) + "\n";
+  std::vector<std::string> flagged;
+  for (const auto& p : implausible) flagged.push_back(p.name);
+  o += "implausible = " + List(flagged) + "\n";
   return o;
 }
 
