@@ -334,6 +334,19 @@ TEST_CASE("fit status: a fit stopped early, and a parameter on a bound of its ra
     CHECK(WEXITSTATUS(status) == rths::ident::kExitFitFailed);
     CHECK(rths_test::Slurp(log).find("fit status: FAILED") != std::string::npos);
     CHECK(rths_test::Slurp(model).find("# FIT FAILED") != std::string::npos);
+    // What to try (ident/fit_advice.h): the parameter, the records that would determine it, --hold, accepting.
+    const std::string said = rths_test::Slurp(log);
+    CAPTURE(said);
+    CHECK(said.find("what to try") != std::string::npos);
+    CHECK(said.find("k0 = 100 on its upper bound") != std::string::npos);
+    CHECK(said.find("stiffness at large velocities") != std::string::npos);
+    CHECK(said.find("--hold k0=VALUE") != std::string::npos);
+    CHECK(said.find("--accept-unconverged exits 0") != std::string::npos);
+    // A malformed --hold is bad input (exit 2), named; one --hold takes one value, not the record after it.
+    const int bad = std::system(
+        fmt::format("{}/rths-identify --damper --hold k0 {} > {} 2>&1", RTHS_BIN_DIR, csv, log).c_str());
+    CHECK(WEXITSTATUS(bad) == 2);
+    CHECK(rths_test::Slurp(log).find("--hold: \"k0\": expected NAME=VALUE") != std::string::npos);
     std::filesystem::remove(model);
     const int accepted = std::system(
         fmt::format("{}/rths-identify --damper {} --out {} --accept-unconverged > {} 2>&1", RTHS_BIN_DIR, csv, model, log)
@@ -500,6 +513,17 @@ TEST_CASE("plausible ranges: Table 3 is plausible, c0_b = 71.5 kN s/mm is flagge
   CHECK(st.Mark() == "implausible: c0_b");
   st.parameters.push_back(At("alpha_c", 1000.0, 1e-4, 1e3));
   CHECK(st.Mark() == "FIT FAILED: alpha_c on its bound; implausible: c0_b");
+  // A rate whose law is flat (both ends at zero) changes nothing: not judged.
+  rths::ident::FitStatus flat;
+  flat.converged = true;
+  flat.parameters = {At("beta_a", 1e-9, 1e-9, 1e4), At("beta_b", 1e-9, 1e-9, 1e4), At("beta_c", 328.7, 1e-4, 1e3)};
+  flat.parameters[0].state = flat.parameters[1].state = rths::ident::ParameterState::kAtZero;
+  CHECK(rths::ident::FittedValues(flat).empty());
+  flat.parameters[1] = At("beta_b", 0.01, 1e-9, 1e4);
+  CHECK(CheckPlausible(rths::ident::FittedValues(flat), 300.0, false).size() == 1);  // beta_c = 328.7 1/A
+  // The mark is one line of a figure's title: two names at most, then how many more.
+  st.implausible = CheckPlausible({{"c0_b", 71.5}, {"c0_c", 1e-3}, {"beta_c", 300.0}}, 300.0, false);
+  CHECK(st.Mark() == "FIT FAILED: alpha_c on its bound; implausible: c0_b, c0_c +1");
   rths::ident::AdviceContext c;
   c.any_input = true;
   c.input_max = 1.0;

@@ -412,7 +412,8 @@ void AddDamperOptions(CLI::App* app, rths::ident::DamperFitOptions* o, double* c
   app->add_option("--hold", *hold,
                   "--damper: hold a parameter at a value, not fitted: NAME=VALUE in the model file's names and units "
                   "(alpha_c=6, c0_b=0.01, eta_1_s=100; at one current alpha, c0, c1, k0, beta, gamma); repeatable")
-      ->take_all();
+      ->type_name("NAME=VALUE")
+      ->allow_extra_args(false);
   app->add_option("--skew", *skew,
                   "--damper: the force channel's lag behind the displacement channel (channel_skew): auto (fitted, "
                   "with its uncertainty) or MS held (default: none)");

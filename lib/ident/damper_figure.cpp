@@ -8,8 +8,8 @@ namespace rths::ident {
 
 std::string DamperFigureTitle(const FitStatus& status, const std::string& what) {
   const std::string mark = status.Mark();
-  return fmt::format("{}MR damper {}: measured (blue) and fitted model (vermillion)", mark.empty() ? "" : mark + " | ",
-                     what);
+  if (mark.empty()) return fmt::format("MR damper {}: measured (blue) and fitted model (vermillion)", what);
+  return fmt::format("{} | MR damper {}: measured (blue), model (vermillion)", mark, what);
 }
 
 io::Figure DamperFitFigure(const DamperModelFit& fit, const std::vector<io::RigRecord>& training,

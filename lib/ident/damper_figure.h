@@ -12,9 +12,9 @@
 
 namespace rths::ident {
 
-/// The figure's title: "<mark> | MR damper <what>: measured (blue) and fitted model (vermillion)",
-/// the mark and its " | " left out for a fit that is ok and plausible. `what`: "at 1 A",
-/// "(current input)", ...
+/// The figure's title: "MR damper <what>: measured (blue) and fitted model (vermillion)" for a fit
+/// that is ok and plausible, else "<mark> | MR damper <what>: measured (blue), model (vermillion)"
+/// (shorter, so that the line fits the figure's width). `what`: "at 1 A", "(current input)", ...
 std::string DamperFigureTitle(const FitStatus& status, const std::string& what);
 
 /// The figure (file comment): two panels per record, over the record's last 60 % (the steady

@@ -10,6 +10,8 @@ namespace rths::ident {
 
 namespace {
 
+constexpr std::size_t kMarkNames = 2;  // implausible names in Mark()
+
 std::string List(const std::vector<std::string>& names) {
   std::string o = "[";
   for (std::size_t i = 0; i < names.size(); ++i) o += fmt::format("{}\"{}\"", i ? ", " : "", names[i]);
@@ -60,8 +62,11 @@ std::string FitStatus::Mark() const {
     }
   }
   if (!implausible.empty()) {
+    // At most kMarkNames names, then "+N": a figure's title has room for one line.
     std::string names;
-    for (const auto& p : implausible) names += (names.empty() ? "" : ", ") + p.name;
+    for (std::size_t i = 0; i < implausible.size() && i < kMarkNames; ++i)
+      names += (names.empty() ? "" : ", ") + implausible[i].name;
+    if (implausible.size() > kMarkNames) names += fmt::format(" +{}", implausible.size() - kMarkNames);
     o += (o.empty() ? "" : "; ") + std::string("implausible: ") + names;
   }
   return o;

@@ -64,7 +64,7 @@ struct FitStatus {
   bool Ok() const;
   /// What a figure of the fit says of it, "" for a fit that is ok and plausible: "FIT FAILED:
   /// alpha_c on its bound" (or "not converged", or "alpha_c, beta_c on their bounds"), then
-  /// "implausible: c0_b" (joined by "; ").
+  /// "implausible: c0_b" (at most two names, then "+N": "implausible: c0_b, c0_c +1"), joined by "; ".
   std::string Mark() const;
   /// The names of the parameters in `state`.
   std::vector<std::string> Names(ParameterState state) const;

@@ -1,6 +1,8 @@
 #include "ident/plausible_range.h"
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 
 namespace rths::ident {
 
@@ -67,11 +69,30 @@ std::vector<Implausible> CheckPlausible(const std::vector<std::pair<std::string,
   return out;
 }
 
+namespace {
+
+/// A rate "p_c" of `status` whose law is flat: its ends p_a, p_b both at zero, or equal within
+/// 0.1 %; the rate then changes nothing (as fit_status.h's "irrelevant", for a rate off its bounds).
+bool FlatLaw(const FitStatus& status, const std::string& rate) {
+  if (!EndsWith(rate, "_c") || rate == "eta_1_s") return false;
+  const std::string base = rate.substr(0, rate.size() - 2);
+  const ParameterStatus *a = nullptr, *b = nullptr;
+  for (const auto& p : status.parameters) {
+    if (p.name == base + "_a") a = &p;
+    if (p.name == base + "_b") b = &p;
+  }
+  if (!a || !b) return false;
+  return (a->state == ParameterState::kAtZero && b->state == ParameterState::kAtZero) ||
+         std::abs(a->value - b->value) <= 1e-3 * std::max(a->value, b->value);
+}
+
+}  // namespace
+
 std::vector<std::pair<std::string, double>> FittedValues(const FitStatus& status,
                                                          std::vector<std::pair<std::string, double>> extra) {
   std::vector<std::pair<std::string, double>> out;
   for (const auto& p : status.parameters)
-    if (p.state == ParameterState::kFree) out.emplace_back(p.name, p.value);
+    if (p.state == ParameterState::kFree && !FlatLaw(status, p.name)) out.emplace_back(p.name, p.value);
   out.insert(out.end(), extra.begin(), extra.end());
   return out;
 }

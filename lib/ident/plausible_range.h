@@ -41,7 +41,8 @@ std::vector<Implausible> CheckPlausible(const std::vector<std::pair<std::string,
 
 /// The (name, value) of the parameters of `status` that the data chose (free), plus the extra
 /// ones given (k1, which the fits solve apart): what CheckPlausible judges. A parameter at zero,
-/// at a bound (already a failure), held or irrelevant is not judged.
+/// at a bound (already a failure), held or irrelevant is not judged, nor a rate p_c whose law is
+/// flat (p_a and p_b both at zero, or equal within 0.1 %: the rate changes nothing).
 std::vector<std::pair<std::string, double>> FittedValues(const FitStatus& status,
                                                          std::vector<std::pair<std::string, double>> extra = {});
 
