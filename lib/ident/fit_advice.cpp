@@ -124,8 +124,7 @@ std::string WhatDetermines(std::string_view name, const AdviceContext& c) {
   return fmt::format("{}: records at more inputs, velocities and amplitudes", name);
 }
 
-std::string BoundAdvice(const ParameterStatus& p, const FitStatus& status, const AdviceContext& c) {
-  (void)status;
+std::string BoundAdvice(const ParameterStatus& p, const AdviceContext& c) {
   const NameParts n = Split(p.name);
   const bool upper = std::abs(std::log(p.value / p.hi)) < std::abs(std::log(p.value / p.lo));
   if (n.part == 'c') return RateAdvice(p, n, upper, c);
@@ -155,7 +154,7 @@ std::string ImplausibleAdvice(const Implausible& p, const FitStatus& status, con
 std::vector<std::string> FitAdvice(const FitStatus& status, const AdviceContext& c) {
   std::vector<std::string> out;
   for (const auto& p : status.parameters)
-    if (p.state == ParameterState::kAtBound) out.push_back(BoundAdvice(p, status, c));
+    if (p.state == ParameterState::kAtBound) out.push_back(BoundAdvice(p, c));
   if (!status.converged)
     out.push_back(fmt::format(
         "not converged in {} iterations: the cost is flat along some direction, parameters trading against each other "

@@ -27,10 +27,10 @@ struct AdviceContext {
 /// ...), as one clause: the part it plays in the model and where (which input) to measure it.
 std::string WhatDetermines(std::string_view name, const AdviceContext& c);
 
-/// Advice for a parameter of `status` on a bound of its range (ParameterState::kAtBound): what the
-/// bound means, which records would determine it, and `--hold name=value` (with a value for a
-/// rate, from the records' input levels). One line, no newline.
-std::string BoundAdvice(const ParameterStatus& p, const FitStatus& status, const AdviceContext& c);
+/// Advice for a parameter on a bound of its range (ParameterState::kAtBound): what the bound
+/// means, which records would determine it, and `--hold name=value` (with a value for a rate,
+/// from the records' input levels). One line, no newline.
+std::string BoundAdvice(const ParameterStatus& p, const AdviceContext& c);
 
 /// Advice for an implausible value of `status`: which records would determine it, and `--hold`;
 /// for a law's saturated end p_b whose rate puts it beyond the inputs fitted, says so. One line.
