@@ -15,8 +15,10 @@
 #include "core/error.h"
 #include "diagnosis/channel_models.h"
 #include "ident/damper_fit.h"
+#include "ident/damper_figure.h"
 #include "ident/damper_model.h"
 #include "models/rig_effects.h"
+#include "io/plot.h"
 #include "io/rig_record.h"
 #include "io/utfsm.h"
 #include "models/mr_damper.h"
@@ -367,4 +369,67 @@ TEST_CASE("FitDamperModel with --skew auto --inertia auto: the force channel's s
   const std::string toml = fit.ModelToml("test");
   CHECK(toml.find("[plant.effects.channel_skew]") != std::string::npos);
   CHECK(toml.find("[plant.effects.load_cell_inertia]") != std::string::npos);
+}
+
+TEST_CASE("an implausible value is flagged, advised on and marked on the figure; a fit that failed is marked too") {
+  // k1 = 0.05 kN/mm, five times the top of its plausible range (0.0091 kN/mm, plausible_range.h).
+  auto truth = Truth();
+  truth.k1 = 0.05;
+  const std::vector<rths::io::RigRecord> recs = {Synthetic(truth, 25.0, 0.5, 0.005, 6.0),
+                                                 Synthetic(truth, 5.0, 3.0, 0.001, 2.0)};
+  const auto fit = rths::ident::FitDamperModel(recs, Options(1.0));
+  CAPTURE(fit.Report());
+  REQUIRE(fit.at_current);
+  CHECK(fit.at_current->coef.k1 == doctest::Approx(0.05).epsilon(0.05));
+  CHECK(fit.status().Ok());  // a warning, not a failure
+  REQUIRE(fit.status().implausible.size() == 1);
+  CHECK(fit.status().implausible[0].name == "k1");
+  CHECK(fit.Report().find("warning: k1 = 0.05") != std::string::npos);
+  const std::string toml = fit.ModelToml("t");
+  CHECK(toml.find("implausible = [\"k1\"]") != std::string::npos);
+  CHECK(toml.find("#   warning: k1 = ") != std::string::npos);
+  const auto advice = fit.Advice();
+  REQUIRE(advice.size() == 1);
+  CHECK(advice[0].find("accumulator") != std::string::npos);
+  CHECK(advice[0].find("--accept-unconverged") == std::string::npos);  // nothing failed
+
+  // The figure's gnuplot script carries the mark in its title.
+  const auto dir = rths_test::TempDir("damper_figure");
+  const auto flagged = rths::io::Plot(rths::ident::DamperFitFigure(fit, recs, {}, "at 1 A"), dir / "flagged");
+  CHECK(rths_test::Slurp(flagged.gp).find("title 'implausible: k1 | MR damper at 1 A") != std::string::npos);
+
+  // A fit stopped after one iteration: FIT FAILED in the figure's title, advice to hold or accept.
+  auto o = Options(1.0);
+  o.max_iterations = 1;
+  o.start_iterations = 1;
+  const auto failed = rths::ident::FitDamperModel(recs, o);
+  REQUIRE_FALSE(failed.status().Ok());
+  const auto failed_files = rths::io::Plot(rths::ident::DamperFitFigure(failed, recs, {}, "at 1 A"), dir / "failed");
+  CHECK(rths_test::Slurp(failed_files.gp).find("title 'FIT FAILED: not converged") != std::string::npos);
+  const auto failed_advice = failed.Advice();
+  CHECK(failed_advice.front().find(fmt::format("not converged in {} iterations", failed.status().iterations)) != std::string::npos);
+  CHECK(failed_advice.back().find("--accept-unconverged") != std::string::npos);
+  // An ok, plausible fit's figure has no mark.
+  rths::ident::FitStatus ok;
+  ok.converged = true;
+  CHECK(rths::ident::DamperFigureTitle(ok, "at 1 A") ==
+        "MR damper at 1 A: measured (blue) and fitted model (vermillion)");
+}
+
+TEST_CASE("--hold at one current: the parameter stays at its value; a name of the other fit is refused") {
+  const auto truth = Truth();
+  const std::vector<rths::io::RigRecord> recs = {Synthetic(truth, 25.0, 0.5, 0.005, 6.0)};
+  auto o = Options(1.0);
+  o.max_iterations = 3;
+  o.hold = {{"k0", 0.004}};
+  const auto fit = rths::ident::FitDamper(recs, o);
+  CHECK(fit.coef.k0 == doctest::Approx(0.004).epsilon(1e-12));
+  CHECK(fit.status.Names(rths::ident::ParameterState::kHeld) == std::vector<std::string>{"k0"});
+  o.hold = {{"alpha_c", 6.0}};
+  try {
+    (void)rths::ident::FitDamper(recs, o);
+    FAIL("a rate was held in the fit at one current");
+  } catch (const rths::Error& e) {
+    CHECK(std::string(e.what()).find("it has alpha, c0, c1, k0, beta, gamma") != std::string::npos);
+  }
 }

@@ -10,6 +10,7 @@
 #include <fstream>
 #include <numbers>
 #include <random>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -19,6 +20,8 @@
 #include "core/error.h"
 #include "diagnosis/channel_models.h"
 #include "ident/damper_fit.h"
+#include "ident/fit_advice.h"
+#include "ident/plausible_range.h"
 #include "ident/spencer_fit.h"
 #include "io/rig_record.h"
 #include "io/utfsm.h"
@@ -331,6 +334,19 @@ TEST_CASE("fit status: a fit stopped early, and a parameter on a bound of its ra
     CHECK(WEXITSTATUS(status) == rths::ident::kExitFitFailed);
     CHECK(rths_test::Slurp(log).find("fit status: FAILED") != std::string::npos);
     CHECK(rths_test::Slurp(model).find("# FIT FAILED") != std::string::npos);
+    // What to try (ident/fit_advice.h): the parameter, the records that would determine it, --hold, accepting.
+    const std::string said = rths_test::Slurp(log);
+    CAPTURE(said);
+    CHECK(said.find("what to try") != std::string::npos);
+    CHECK(said.find("k0 = 100 on its upper bound") != std::string::npos);
+    CHECK(said.find("stiffness at large velocities") != std::string::npos);
+    CHECK(said.find("--hold k0=VALUE") != std::string::npos);
+    CHECK(said.find("--accept-unconverged exits 0") != std::string::npos);
+    // A malformed --hold is bad input (exit 2), named; one --hold takes one value, not the record after it.
+    const int bad = std::system(
+        fmt::format("{}/rths-identify --damper --hold k0 {} > {} 2>&1", RTHS_BIN_DIR, csv, log).c_str());
+    CHECK(WEXITSTATUS(bad) == 2);
+    CHECK(rths_test::Slurp(log).find("--hold: \"k0\": expected NAME=VALUE") != std::string::npos);
     std::filesystem::remove(model);
     const int accepted = std::system(
         fmt::format("{}/rths-identify --damper {} --out {} --accept-unconverged > {} 2>&1", RTHS_BIN_DIR, csv, model, log)
@@ -397,4 +413,180 @@ TEST_CASE("negative commands: a DAQ's small negative samples are taken as 0 with
     CHECK(what.find("negative") != std::string::npos);
     CHECK(what.find("at most 1 %") != std::string::npos);
   }
+}
+
+namespace {
+
+/// A parameter's status as a fit would leave it (fit_status.h).
+rths::ident::ParameterStatus At(const std::string& name, double value, double lo, double hi) {
+  return rths::ident::StatusOf(name, value, lo, hi, false);
+}
+
+}  // namespace
+
+TEST_CASE("fit advice: each failed parameter maps to what would determine it and how to hold it") {
+  using rths::ident::FitAdvice;
+  rths::ident::AdviceContext three;  // sinusoids at 0, 0.5 and 1 A, the fit with any input
+  three.any_input = true;
+  three.input_min = 0.0;
+  three.input_max = 1.0;
+  three.levels = {0.0, 0.5, 1.0};
+  rths::ident::FitStatus st;
+  st.converged = true;
+  st.iterations = 40;
+  st.parameters = {At("alpha_c", 1000.0, 1e-4, 1e3), At("c0_b", 0.01, 1e-7, 1e4), At("c0_c", 2.0, 1e-4, 1e3)};
+  REQUIRE(st.parameters[0].state == rths::ident::ParameterState::kAtBound);
+  auto advice = FitAdvice(st, three);
+  CAPTURE(advice);
+  REQUIRE(advice.size() == 2);  // alpha_c on its bound, and --accept-unconverged
+  // A rate on its upper bound: the law's change lies below the second level; records between 0 and
+  // 0.5 A would determine it, or hold it at 3 / 0.5 A (95 % of the change by 0.5 A).
+  CHECK(advice[0].find("alpha_c = 1000 1/A on its upper bound") != std::string::npos);
+  CHECK(advice[0].find("between 0 and 0.5 A") != std::string::npos);
+  CHECK(advice[0].find("--hold alpha_c=6 ") != std::string::npos);
+  CHECK(advice[1].find("--accept-unconverged") != std::string::npos);
+
+  // A rate on its lower bound: the law is linear, its saturated end beyond the records.
+  st.parameters[0] = At("alpha_c", 1e-4, 1e-4, 1e3);
+  advice = FitAdvice(st, three);
+  CHECK(advice[0].find("higher inputs, toward the damper's saturation") != std::string::npos);
+  CHECK(advice[0].find("--hold alpha_c=3 ") != std::string::npos);
+
+  // Law ends and coefficients: the records that show them (Spencer et al. 1997's roles).
+  st.parameters[0] = At("c0_b", 1e4, 1e-7, 1e4);
+  CHECK(FitAdvice(st, three)[0].find("higher velocities") != std::string::npos);
+  CHECK(FitAdvice(st, three)[0].find("at the highest input (1 A)") != std::string::npos);
+  CHECK(FitAdvice(st, three)[0].find("--hold c0_b=VALUE (plausible: 0.0001 to 3.2 kN s/mm)") != std::string::npos);
+  st.parameters[0] = At("c1_a", 1e4, 1e-7, 1e4);
+  CHECK(FitAdvice(st, three)[0].find("low velocities") != std::string::npos);
+  CHECK(FitAdvice(st, three)[0].find("at the lowest input (0 A)") != std::string::npos);
+  st.parameters[0] = At("eta_1_s", 1e5, 1.0, 1e5);
+  CHECK(FitAdvice(st, three)[0].find("command steps or pulses") != std::string::npos);
+  CHECK(FitAdvice(st, three)[0].find("--filter none") != std::string::npos);
+  rths::ident::AdviceContext one;  // the fit at one current
+  one.current_A = 0.5;
+  st.parameters = {At("gamma", 1e4, 1e-9, 1e4)};
+  CHECK(FitAdvice(st, one)[0].find("several amplitudes") != std::string::npos);
+  CHECK(FitAdvice(st, one)[0].find("at 0.5 A") != std::string::npos);
+
+  // Not converged: says so, and what to hold.
+  st.parameters = {At("gamma", 0.01, 1e-9, 1e4)};
+  st.converged = false;
+  advice = FitAdvice(st, one);
+  REQUIRE(advice.size() == 2);
+  CHECK(advice[0].find("not converged in 40 iterations") != std::string::npos);
+  CHECK(advice[0].find("--hold") != std::string::npos);
+  // A fit that is ok and plausible has none.
+  st.converged = true;
+  CHECK(FitAdvice(st, one).empty());
+}
+
+TEST_CASE("plausible ranges: Table 3 is plausible, c0_b = 71.5 kN s/mm is flagged, alpha's range scales with A") {
+  using rths::ident::CheckPlausible;
+  const auto t = m::MrDamperParams::Table3();
+  const std::vector<std::pair<std::string, double>> table3 = {
+      {"alpha_a", t.alpha_a}, {"alpha_b", t.alpha_b}, {"alpha_c", t.alpha_c}, {"c0_a", t.c0_a},
+      {"c0_b", t.c0_b},       {"c0_c", t.c0_c},       {"c1_a", t.c1_a},       {"c1_b", t.c1_b},
+      {"c1_c", t.c1_c},       {"beta_a", t.beta_a},   {"beta_b", t.beta_b},   {"beta_c", t.beta_c},
+      {"gamma_a", t.gamma_a}, {"gamma_b", t.gamma_b}, {"gamma_c", t.gamma_c}, {"k0", t.k0},
+      {"k1", t.k1},           {"eta_1_s", 190.0}};
+  CHECK(CheckPlausible(table3, 300.0, false).empty());
+  const auto flagged = CheckPlausible({{"c0_a", 0.01}, {"c0_b", 71.5}, {"x0", 1e6}}, 300.0, false);
+  REQUIRE(flagged.size() == 1);
+  CHECK(flagged[0].Warning() ==
+        "c0_b = 71.5 kN s/mm is outside the plausible range 0.0001..3.2 kN s/mm (docs/identification.md "
+        "\"Plausible ranges\")");
+  // alpha z is invariant under z -> z / s, A -> A / s, alpha -> s alpha: at A = 30, 10 x the range.
+  CHECK(CheckPlausible({{"alpha", 20.0}}, 300.0, false).size() == 1);
+  CHECK(CheckPlausible({{"alpha", 20.0}}, 30.0, false).empty());
+  // A rate per V has no published range; per A it has.
+  CHECK(CheckPlausible({{"alpha_c", 500.0}}, 300.0, true).empty());
+  CHECK(CheckPlausible({{"alpha_c", 500.0}}, 300.0, false).size() == 1);
+  // The status records it: a warning line, [fit] implausible, the figure's mark; the fit stays ok.
+  rths::ident::FitStatus st;
+  st.converged = true;
+  st.parameters = {At("c0_b", 71.5, 1e-7, 1e4)};
+  st.implausible = CheckPlausible(rths::ident::FittedValues(st), 300.0, false);
+  CHECK(st.Ok());
+  CHECK(st.TomlTable().find("implausible = [\"c0_b\"]") != std::string::npos);
+  CHECK(st.Comment().find("#   warning: c0_b = 71.5 kN s/mm is outside") != std::string::npos);
+  CHECK(st.Mark() == "implausible: c0_b");
+  st.parameters.push_back(At("alpha_c", 1000.0, 1e-4, 1e3));
+  CHECK(st.Mark() == "FIT FAILED: alpha_c on its bound; implausible: c0_b");
+  // A rate whose law is flat (both ends at zero) changes nothing: not judged.
+  rths::ident::FitStatus flat;
+  flat.converged = true;
+  flat.parameters = {At("beta_a", 1e-9, 1e-9, 1e4), At("beta_b", 1e-9, 1e-9, 1e4), At("beta_c", 328.7, 1e-4, 1e3)};
+  flat.parameters[0].state = flat.parameters[1].state = rths::ident::ParameterState::kAtZero;
+  CHECK(rths::ident::FittedValues(flat).empty());
+  flat.parameters[1] = At("beta_b", 0.01, 1e-9, 1e4);
+  CHECK(CheckPlausible(rths::ident::FittedValues(flat), 300.0, false).size() == 1);  // beta_c = 328.7 1/A
+  // The mark is one line of a figure's title: two names at most, then how many more.
+  st.implausible = CheckPlausible({{"c0_b", 71.5}, {"c0_c", 1e-3}, {"beta_c", 300.0}}, 300.0, false);
+  CHECK(st.Mark() == "FIT FAILED: alpha_c on its bound; implausible: c0_b, c0_c +1");
+  rths::ident::AdviceContext c;
+  c.any_input = true;
+  c.input_max = 1.0;
+  c.levels = {0.0, 0.5, 1.0};
+  const auto advice = rths::ident::FitAdvice(st, c);
+  CHECK(std::any_of(advice.begin(), advice.end(),
+                    [](const std::string& a) { return a.rfind("c0_b: c0_b is the viscous damping", 0) == 0; }));
+}
+
+TEST_CASE("plausible ranges: docs/identification.md's table is the code's") {
+  // Every row "| `name` | unit | lo .. hi | ..." of the table under "### Plausible ranges".
+  const std::string doc = rths_test::Slurp(RTHS_SOURCE_DIR "/docs/identification.md");
+  const auto at = doc.find("### Plausible ranges");
+  REQUIRE(at != std::string::npos);
+  std::istringstream in(doc.substr(at));
+  std::string line;
+  int rows = 0;
+  while (std::getline(in, line)) {
+    if (line.rfind("| `", 0) != 0) continue;
+    std::vector<std::string> cells;
+    std::istringstream row(line.substr(1));
+    for (std::string c; std::getline(row, c, '|');) cells.push_back(c.substr(c.find_first_not_of(' ')));
+    REQUIRE(cells.size() >= 3);
+    const std::string name = cells[0].substr(1, cells[0].find('`', 1) - 1);
+    CAPTURE(name);
+    const auto range = rths::ident::PlausibleRangeOf(name, 300.0, false);
+    REQUIRE(range.has_value());
+    CHECK(cells[1].rfind(range->unit, 0) == 0);
+    CHECK(cells[2].rfind(fmt::format("{:g} .. {:g}", range->lo, range->hi), 0) == 0);
+    ++rows;
+  }
+  CHECK(rows == 9);  // alpha, c0, c1, k0, k1, beta, gamma, the rates, eta
+}
+
+TEST_CASE("--hold: a parameter held at a value is not fitted; a name the fit lacks is refused, naming those it has") {
+  const auto rec = RigModeRecord(150.0, 0.0005, 10.0, 12.0, 6.0, 21, "hold");
+  rths::ident::DamperFitOptions o;
+  o.max_iterations = 2;
+  o.hold = {{"alpha_c", 6.0}, {"eta_1_s", 120.0}};
+  const auto fit = rths::ident::FitSpencer({rec}, o);
+  CHECK(fit.params.alpha_c == doctest::Approx(6.0).epsilon(1e-12));
+  CHECK(fit.driver.eta_1_s == doctest::Approx(120.0).epsilon(1e-12));
+  const auto held = fit.status.Names(rths::ident::ParameterState::kHeld);
+  CHECK(held == std::vector<std::string>{"alpha_c", "eta_1_s"});
+  CHECK(fit.Report().find("held, not fitted: held at 6 by --hold") != std::string::npos);
+  o.hold = {{"alpha", 0.1}};  // a name of the fit at one current
+  try {
+    (void)rths::ident::FitSpencer({rec}, o);
+    FAIL("an unknown parameter was held");
+  } catch (const rths::Error& e) {
+    CHECK(std::string(e.what()).find("not a parameter of this fit; it has alpha_a, alpha_b, alpha_c") !=
+          std::string::npos);
+  }
+  o.hold = {{"alpha_c", 1e6}};
+  try {
+    (void)rths::ident::FitSpencer({rec}, o);
+    FAIL("a value outside the range was held");
+  } catch (const rths::Error& e) {
+    CHECK(std::string(e.what()).find("alpha_c = 1e+06: outside the fit's range for it, 0.0001 to 1000") !=
+          std::string::npos);
+  }
+  CHECK(rths::ident::ParseHold("c0_b=0.25") == std::pair<std::string, double>{"c0_b", 0.25});
+  CHECK_THROWS_AS(rths::ident::ParseHold("c0_b"), rths::Error);
+  CHECK_THROWS_AS(rths::ident::ParseHold("c0_b=-1"), rths::Error);
+  CHECK_THROWS_AS(rths::ident::ParseHold("=1"), rths::Error);
 }

@@ -5,13 +5,15 @@
 // time-domain check. Prints the model as a scenario fragment; writes a Bode plot like the
 // paper's Fig. 6 with gnuplot.
 // rths identify --damper RECORD... --current A [--check RECORD...] [--A A] [--velocity-cutoff-hz F]
-//                        [--skew auto|MS] [--inertia auto|KG] [--out FILE.toml]
+//                        [--skew auto|MS] [--inertia auto|KG] [--hold NAME=VALUE...] [--out FILE.toml]
 // Fits the Spencer MR damper model (Eqs. 32-34) at one current to damper tests (rig records, LCM
 // logs, or UTFSM damper files: x = y_mm, F = f_kN) by least squares on the force, or without
 // --current its current- or voltage-dependent form (ident/damper_model.h); prints the parameters,
 // the force error per record (and per held-out --check record) and the model as a TOML fragment.
 // docs/identification.md. Exit 0 ok, 2 bad input, 3 a damper fit that failed (did not converge, or
-// a parameter on a bound of its range; ident/fit_status.h) unless --accept-unconverged.
+// a parameter on a bound of its range; ident/fit_status.h) unless --accept-unconverged; a failed fit
+// or an implausible value (ident/plausible_range.h: a warning) prints what to try
+// (ident/fit_advice.h) and marks the --plot figure's title.
 #include <unistd.h>
 
 #include <algorithm>
@@ -32,6 +34,7 @@
 #include "cli.h"
 #include "core/error.h"
 #include "core/progress.h"
+#include "ident/damper_figure.h"
 #include "ident/damper_model.h"
 #include "ident/identify.h"
 #include "io/output_folder.h"
@@ -181,52 +184,6 @@ void PlotBode(const std::string& png, const std::string& title, const rths::iden
   PlotTo(std::move(fig), png);
 }
 
-/// One record of the --damper plot: the record, whether it was fitted, the model's force [kN],
-/// the smoothed velocity [mm/s] and Eq. 31 on f [%].
-struct DamperPlotRecord {
-  const rths::io::RigRecord* rec;
-  bool fitted;
-  std::vector<double> F_kN, v_mm_s;
-  double nrmse_f_pct;
-};
-
-/// --damper plot: per record (training, then held-out), force against velocity and against
-/// displacement, measured and model, over the record's last 60 % (the steady cycles). No legend
-/// over the loops: the title names the colours.
-void PlotDamper(const std::string& png, const std::vector<DamperPlotRecord>& recs, const std::string& what) {
-  const std::string measured_color = rths::io::ReadableColors()[0], model_color = rths::io::ReadableColors()[1];
-  rths::io::Figure fig;
-  fig.title = fmt::format("MR damper {}: measured (blue) and fitted model (vermillion)", what);
-  fig.columns = 2;
-  fig.width_px = 1000;
-  fig.panel_height_px = 260;
-  for (const auto& r : recs) {
-    const auto& rec = *r.rec;
-    const std::string title = fmt::format("{} ({}, Eq. 31 on f {:.1f} %)", fs::path(rec.source).filename().string(),
-                                          r.fitted ? "fitted" : "held out", r.nrmse_f_pct);
-    auto fv = rths::io::MakePanel(title, "Velocity [mm/s]", "Force [kN]");
-    auto fx = rths::io::MakePanel(title, "Displacement [mm]", "Force [kN]");
-    rths::io::Series mv = rths::io::MakeSeries("", measured_color), pv = rths::io::MakeSeries("", model_color);
-    rths::io::Series mx = mv, px = pv;
-    for (std::size_t k = rec.size() * 2 / 5; k < rec.size(); ++k) {
-      mv.x.push_back(r.v_mm_s[k]);
-      mv.y.push_back(rec.f_kN[k]);
-      pv.x.push_back(r.v_mm_s[k]);
-      pv.y.push_back(r.F_kN[k]);
-      mx.x.push_back(rec.y_mm[k]);
-      mx.y.push_back(rec.f_kN[k]);
-      px.x.push_back(rec.y_mm[k]);
-      px.y.push_back(r.F_kN[k]);
-    }
-    fv.series = {mv, pv};
-    fx.series = {mx, px};
-    fv.key = fx.key = "off";
-    fig.panels.push_back(std::move(fv));
-    fig.panels.push_back(std::move(fx));
-  }
-  PlotTo(std::move(fig), png);
-}
-
 /// Options of the --damper mode beyond the fits' own.
 struct DamperCli {
   std::vector<std::string> records, checks;
@@ -330,9 +287,15 @@ int RunDamper(const DamperCli& c, rths::ident::DamperFitOptions o) {
                                ? fmt::format("rths identify --damper {} --current {}", Names(c.records), *o.current_A)
                                : fmt::format("rths identify --damper {} ({} input)", Names(c.records), input)),
              c.out);
-  // A failed fit (ident/fit_status.h) is written, marked, and exits kExitFitFailed unless accepted.
+  // A failed fit (ident/fit_status.h) is written, marked, and exits kExitFitFailed unless accepted;
+  // an implausible value is a warning. Either way, what to try (ident/fit_advice.h).
   const auto& status = fit.status();
   int code = 0;
+  for (const auto& p : status.implausible) std::fprintf(stderr, "rths identify: warning: %s\n", p.Warning().c_str());
+  if (const auto advice = fit.Advice(); !advice.empty()) {
+    std::fprintf(stderr, "rths identify: what to try (docs/identification.md \"When a fit fails\"):\n");
+    for (const auto& a : advice) std::fprintf(stderr, "  - %s\n", a.c_str());
+  }
   if (!status.Ok()) {
     std::fprintf(stderr, "rths identify: fit status: %s\n", status.Summary().c_str());
     if (c.accept_unconverged) {
@@ -346,17 +309,10 @@ int RunDamper(const DamperCli& c, rths::ident::DamperFitOptions o) {
     }
   }
   if (c.plot.empty()) return code;
-  std::vector<DamperPlotRecord> all;
-  auto add = [&](const rths::io::RigRecord& r, bool fitted) {
-    const double cutoff = fit.CutoffHz(r);
-    auto F = fit.PredictForce(r);
-    const double pct = rths::ident::ScoreForce(r, F, cutoff).nrmse_f_pct;
-    all.push_back({&r, fitted, std::move(F), rths::ident::SmoothVelocity(r.y_mm, r.dt_s, cutoff), pct});
-  };
-  for (const auto& r : recs) add(r, true);
-  for (const auto& r : held) add(r, false);
-  PlotDamper(c.plot, all,
-             fit.at_current ? fmt::format("at {} A", *o.current_A) : (voltage ? "(voltage input)" : "(current input)"));
+  PlotTo(rths::ident::DamperFitFigure(
+             fit, recs, held,
+             fit.at_current ? fmt::format("at {} A", *o.current_A) : (voltage ? "(voltage input)" : "(current input)")),
+         c.plot);
   std::printf("wrote %s\n", c.plot.c_str());
   return code;
 }
@@ -433,7 +389,8 @@ int RunActuator(const ActuatorCli& a) {
 
 /// The --damper options of the command line (their checks beyond DamperFitOptions::IsValid).
 void AddDamperOptions(CLI::App* app, rths::ident::DamperFitOptions* o, double* current_A, std::string* input,
-                      std::string* filter, bool* no_offset, std::string* skew, std::string* inertia) {
+                      std::string* filter, bool* no_offset, std::string* skew, std::string* inertia,
+                      std::vector<std::string>* hold) {
   app->add_option("--current", *current_A, "--damper: fit at this one current [A] (the records' constant current)");
   app->add_option("--A", o->A, "--damper: Bouc-Wen A [-], held fixed (Table 3)")->capture_default_str();
   app->add_option("--velocity-cutoff-hz", o->velocity_cutoff_hz,
@@ -452,6 +409,11 @@ void AddDamperOptions(CLI::App* app, rths::ident::DamperFitOptions* o, double* c
                 "--damper without --current: hold k1 = x0 = 0 and no force offset (no accumulator, no load-cell zero)");
   app->add_option("--threads", o->threads, "--damper without --current: threads for the Jacobian (0: one per core)")
       ->capture_default_str();
+  app->add_option("--hold", *hold,
+                  "--damper: hold a parameter at a value, not fitted: NAME=VALUE in the model file's names and units "
+                  "(alpha_c=6, c0_b=0.01, eta_1_s=100; at one current alpha, c0, c1, k0, beta, gamma); repeatable")
+      ->type_name("NAME=VALUE")
+      ->allow_extra_args(false);
   app->add_option("--skew", *skew,
                   "--damper: the force channel's lag behind the displacement channel (channel_skew): auto (fitted, "
                   "with its uncertainty) or MS held (default: none)");
@@ -469,6 +431,7 @@ int main(int argc, char** argv) {
   ActuatorCli ac;
   rths::ident::DamperFitOptions fo;
   std::string input, filter = "first_order", skew, inertia;
+  std::vector<std::string> hold;
   double current_A = 0.0;
   app.add_option("record", records,
                  "CSV rig record or LCM run log (log.lcm) of ours; with --damper one or more damper tests (also UTFSM "
@@ -483,7 +446,7 @@ int main(int argc, char** argv) {
                "fit the Spencer MR damper model instead: at one current (--current) or, without it, its current- or "
                "voltage-dependent form (Eqs. 32-39) with a control filter, from records with any input history");
   app.add_option("--check", checks, "--damper: held-out records to score the fitted model on");
-  AddDamperOptions(&app, &fo, &current_A, &input, &filter, &no_offset, &skew, &inertia);
+  AddDamperOptions(&app, &fo, &current_A, &input, &filter, &no_offset, &skew, &inertia, &hold);
   app.add_flag("--accept-unconverged", accept_unconverged,
                "--damper: exit 0 for a fit that did not converge or has a parameter on a bound of its range (it is "
                "written, marked FIT FAILED, either way; without this flag the exit code is 3)");
@@ -527,11 +490,12 @@ int main(int argc, char** argv) {
                                       : rths::ident::DamperInput::kAuto;
       fo.filter = *rths::ValueOf(rths::ident::kControlFilterNames, filter);
       fo.accumulator = !no_offset;
+      for (const auto& h : hold) fo.hold.push_back(rths::ident::ParseHold(h));
       DamperCli dc{records, checks, ac.out, ac.plot, ac.time, accept_unconverged, ac.map, {}};
       ParseMeasurement(skew, inertia, &dc.measurement);
       return RunDamper(dc, fo);
     }
-    if (!skew.empty() || !inertia.empty()) throw Error("--skew/--inertia", "only with --damper");
+    if (!skew.empty() || !inertia.empty() || !hold.empty()) throw Error("--skew/--inertia/--hold", "only with --damper");
     if (fo.current_A || !checks.empty() || accept_unconverged)
       throw Error("--current/--check/--accept-unconverged", "only with --damper");
     if (records.size() != 1)

@@ -4,12 +4,15 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <string>
+#include <vector>
 
 #include <Eigen/Dense>
 #include <fmt/format.h>
 
 #include "core/error.h"
 #include "ident/lm.h"
+#include "ident/plausible_range.h"
 #include "signal/butterworth.h"
 #include "signal/spectral.h"
 
@@ -52,15 +55,27 @@ models::MrDamperCoefficients FromTheta(const Theta& th, double A, double k1, dou
   return k;
 }
 
-// The box in theta (ln of the bounds).
-Theta LogBound(const std::array<double, kNonlinear>& b) {
-  Theta t;
-  for (int i = 0; i < kNonlinear; ++i) t[i] = std::log(b[i]);
-  return t;
-}
-const Theta kLogLo = LogBound(kLo), kLogHi = LogBound(kHi);
+// The parameters' names in the model file, in the order of theta.
+constexpr std::array<const char*, kNonlinear> kNames = {"alpha", "c0", "c1", "k0", "beta", "gamma"};
 
-Theta Clamp(const Theta& th) { return ClampToBox(th, kLogLo, kLogHi); }
+// The box in theta: ln of the bounds, a point for a parameter held by DamperFitOptions::hold.
+struct Box {
+  Theta lo, hi;
+  std::array<std::string, kNonlinear> held_why;  // "" = fitted
+
+  explicit Box(const DamperFitOptions& o) {
+    for (int i = 0; i < kNonlinear; ++i) lo[i] = std::log(kLo[i]), hi[i] = std::log(kHi[i]);
+    const std::vector<std::string> names(kNames.begin(), kNames.end());
+    const std::vector<double> l(kLo.begin(), kLo.end()), h(kHi.begin(), kHi.end());
+    for (const auto& held : o.hold) {
+      const int i = HeldIndex(held, names, l, h);
+      lo[i] = hi[i] = std::log(held.second);
+      held_why[static_cast<std::size_t>(i)] = fmt::format("held at {:g} by --hold", held.second);
+    }
+  }
+  bool Held(int i) const { return !held_why[static_cast<std::size_t>(i)].empty(); }
+  Theta Clamp(const Theta& th) const { return ClampToBox(th, lo, hi); }
+};
 
 // The model at theta on every record: residuals r = sqrt(w_r) (f - F) stacked, with k1 and
 // b = -k1 x0 solved by weighted linear least squares (file comment of damper_fit.h).
@@ -127,7 +142,7 @@ struct LmState {
 };
 
 // Levenberg-Marquardt iterations on theta, the step projected on the box.
-void Iterate(LmState* s, const std::vector<Prepared>& data, double A, int iterations) {
+void Iterate(LmState* s, const std::vector<Prepared>& data, double A, const Box& box, int iterations) {
   for (int it = 0; it < iterations && !s->converged; ++it) {
     const int m = MaxSubsteps(s->theta, data, A);
     const Evaluation base = Evaluate(s->theta, data, A, m);
@@ -137,9 +152,13 @@ void Iterate(LmState* s, const std::vector<Prepared>& data, double A, int iterat
     }
     Eigen::MatrixXd J(base.r.size(), kNonlinear);
     for (int i = 0; i < kNonlinear; ++i) {
+      if (box.Held(i)) {  // not fitted: no column (DampedStep keeps it)
+        J.col(i).setZero();
+        continue;
+      }
       Theta t = s->theta;
       double h = 1e-5;
-      if (t[i] + h > std::log(kHi[i])) h = -h;
+      if (t[i] + h > box.hi[i]) h = -h;
       t[i] += h;
       const Evaluation e = Evaluate(t, data, A, m);
       if (!std::isfinite(e.cost)) {
@@ -151,8 +170,8 @@ void Iterate(LmState* s, const std::vector<Prepared>& data, double A, int iterat
     const Eigen::MatrixXd H = J.transpose() * J;
     const Eigen::VectorXd g = J.transpose() * base.r;
     ++s->iterations;
-    DampedStep(H, g, &s->theta, &s->ev, &s->mu, [&](const Theta& t) { return Evaluate(t, data, A, 0); }, kLogLo,
-               kLogHi, 1e-7, 1e-6, &s->converged);
+    DampedStep(H, g, &s->theta, &s->ev, &s->mu, [&](const Theta& t) { return Evaluate(t, data, A, 0); }, box.lo,
+               box.hi, 1e-7, 1e-6, &s->converged);
   }
 }
 
@@ -403,7 +422,8 @@ Prepared PrepareRecord(const io::RigRecord& rec, const DamperFitOptions& o, Roug
 
 /// The starts (file comment of damper_fit.h): pre-yield travel delta [mm] x c1/c0, around the
 /// rough yield force Fy [kN] and viscous c [kN s/mm], evaluated.
-std::vector<LmState> Starts(double Fy, double c, double xmax, const std::vector<Prepared>& data, double A) {
+std::vector<LmState> Starts(double Fy, double c, double xmax, const std::vector<Prepared>& data, double A,
+                            const Box& box) {
   std::vector<LmState> starts;
   for (double delta : {0.1, 0.5, 2.0}) {
     for (double ratio : {1.0, 10.0}) {
@@ -414,7 +434,7 @@ std::vector<LmState> Starts(double Fy, double c, double xmax, const std::vector<
       const double k0 = 0.01 * Fy / std::max(xmax, 1e-3);
       LmState s;
       s.theta << std::log(alpha), std::log(c0), std::log(c1), std::log(k0), std::log(0.5 * bg), std::log(0.5 * bg);
-      s.theta = Clamp(s.theta);
+      s.theta = box.Clamp(s.theta);
       s.ev = Evaluate(s.theta, data, A, 0);
       starts.push_back(std::move(s));
     }
@@ -444,12 +464,13 @@ DamperFitResult FitDamper(const std::vector<io::RigRecord>& records, const Dampe
   if (!(Fy > 0.0)) Fy = 0.5 * fpeak;
   if (!(c > 0.0)) c = 0.1 * fpeak / vmax_all;
 
-  std::vector<LmState> starts = Starts(Fy, c, xmax, data, o.A);
+  const Box box(o);
+  std::vector<LmState> starts = Starts(Fy, c, xmax, data, o.A, box);
   DamperFitResult res;
   res.current_A = *o.current_A;
   int best = -1;
   for (std::size_t i = 0; i < starts.size(); ++i) {
-    if (std::isfinite(starts[i].ev.cost)) Iterate(&starts[i], data, o.A, o.start_iterations.value_or(kStartIterations));
+    if (std::isfinite(starts[i].ev.cost)) Iterate(&starts[i], data, o.A, box, o.start_iterations.value_or(kStartIterations));
     res.start_costs.push_back(starts[i].ev.cost);
     if (std::isfinite(starts[i].ev.cost) && (best < 0 || starts[i].ev.cost < starts[static_cast<std::size_t>(best)].ev.cost))
       best = static_cast<int>(i);
@@ -457,7 +478,7 @@ DamperFitResult FitDamper(const std::vector<io::RigRecord>& records, const Dampe
   if (best < 0) throw Error("FitDamper", "no start gives a finite force prediction");
   LmState& s = starts[static_cast<std::size_t>(best)];
   s.converged = false;
-  Iterate(&s, data, o.A, o.max_iterations.value_or(kMaxIterations));
+  Iterate(&s, data, o.A, box, o.max_iterations.value_or(kMaxIterations));
   res.best_start = best;
   res.iterations = s.iterations;
   res.converged = s.converged;
@@ -470,9 +491,12 @@ DamperFitResult FitDamper(const std::vector<io::RigRecord>& records, const Dampe
   res.status.iterations = s.iterations;
   res.status.max_iterations = o.max_iterations.value_or(kMaxIterations);
   // Every lower bound is a floor standing for 0 (the coefficients are >= 0: fit_status.h).
-  constexpr const char* kNames[kNonlinear] = {"alpha", "c0", "c1", "k0", "beta", "gamma"};
-  for (int i = 0; i < kNonlinear; ++i)
-    res.status.parameters.push_back(StatusOf(kNames[i], std::exp(s.theta[i]), kLo[i], kHi[i], true));
+  for (int i = 0; i < kNonlinear; ++i) {
+    auto p = StatusOf(kNames[static_cast<std::size_t>(i)], std::exp(s.theta[i]), kLo[i], kHi[i], true);
+    if (box.Held(i)) p.state = ParameterState::kHeld, p.why = box.held_why[static_cast<std::size_t>(i)];
+    res.status.parameters.push_back(std::move(p));
+  }
+  res.status.implausible = CheckPlausible(FittedValues(res.status, {{"k1", res.coef.k1}}), o.A, false);
   return res;
 }
 

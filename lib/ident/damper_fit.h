@@ -144,7 +144,9 @@ struct DamperFitResult {
 };
 
 /// Fits the model at options.current_A to the records (their y_mm as x, f_kN as F; see the file
-/// comment; the options of the other fit are not read). Throws rths::Error (where = the record's
+/// comment; the options of the other fit are not read), the parameters options.hold names held
+/// (throws rths::Error, where "--hold", for a name the fit lacks or a value outside its range); the
+/// status flags implausible values (plausible_range.h). Throws rths::Error (where = the record's
 /// source) if a record's current differs from current_A by more than the tolerance or its force
 /// is all zero; (where = "DamperFitOptions") for invalid options or no current_A; if no start
 /// gives a finite cost.

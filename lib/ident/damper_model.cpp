@@ -7,6 +7,8 @@
 
 #include <Eigen/Dense>
 
+#include "ident/fit_advice.h"
+
 namespace rths::ident {
 
 namespace {
@@ -169,6 +171,22 @@ std::string DamperModelFit::Report() const {
 }
 
 const FitStatus& DamperModelFit::status() const { return at_current ? at_current->status : any_input->status; }
+
+std::vector<std::string> DamperModelFit::Advice() const {
+  AdviceContext c;
+  if (at_current) {
+    c.current_A = at_current->current_A;
+    c.A = at_current->coef.A;
+  } else {
+    c.any_input = true;
+    c.voltage = any_input->voltage;
+    c.input_min = any_input->input_min;
+    c.input_max = any_input->input_max;
+    c.levels = any_input->levels;
+    c.A = any_input->params.A;
+  }
+  return FitAdvice(status(), c);
+}
 
 double DamperModelFit::CutoffHz(const io::RigRecord& record) const {
   return velocity_cutoff_hz > 0.0 ? velocity_cutoff_hz : VelocityCutoffHz(record);

@@ -30,6 +30,9 @@ struct DamperModelFit {
   bool voltage() const { return any_input && any_input->voltage; }
   /// How the fit ended (ident/fit_status.h).
   const FitStatus& status() const;
+  /// What to try (ident/fit_advice.h): a line per parameter on a bound or implausible, and for a
+  /// fit that failed; empty for a fit that is ok and plausible.
+  std::vector<std::string> Advice() const;
   /// The result's Report() (coefficients, derived quantities, the status, per-record errors).
   std::string Report() const;
   /// The velocity cut-off [Hz] used on a record: the options' or VelocityCutoffHz(record).

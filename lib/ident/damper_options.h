@@ -6,6 +6,8 @@
 #include <array>
 #include <optional>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "core/names.h"
 #include "core/progress.h"
@@ -36,6 +38,10 @@ struct DamperFitOptions {
   std::optional<int> start_iterations;
   /// ... for the best start, >= 1; unset: the fit's own (200 at one current; 150 with any input).
   std::optional<int> max_iterations;
+  /// Parameters held at a value, not fitted (`--hold name=value`): a model-file name the fit has
+  /// ("alpha", "k0" at one current; "alpha_c", "c0_b", "eta_1_s", ... with any input) and a value
+  /// > 0 inside the fit's range for it (the fit checks both and throws rths::Error naming them).
+  std::vector<std::pair<std::string, double>> hold;
 
   // --- at one current
   /// Largest |i_k - current_A| [A] accepted in a record (the fit is at one current), >= 0.
@@ -54,5 +60,15 @@ struct DamperFitOptions {
   /// True if every field is in range; else false and a message naming the field in *error (if not null).
   bool IsValid(std::string* error) const;
 };
+
+/// `--hold NAME=VALUE` -> (NAME, VALUE); throws rths::Error (where "--hold") unless NAME is not
+/// empty and VALUE a finite number > 0.
+std::pair<std::string, double> ParseHold(const std::string& text);
+
+/// The box index of a held parameter among `names` (the fit's parameters in theta order), or
+/// throws rths::Error (where "--hold") naming the parameter and the ones the fit has, or the
+/// range [lo, hi] (natural units) its value must lie in.
+int HeldIndex(const std::pair<std::string, double>& hold, const std::vector<std::string>& names,
+              const std::vector<double>& lo, const std::vector<double>& hi);
 
 }  // namespace rths::ident

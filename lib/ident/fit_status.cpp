@@ -10,6 +10,8 @@ namespace rths::ident {
 
 namespace {
 
+constexpr std::size_t kMarkNames = 2;  // implausible names in Mark()
+
 std::string List(const std::vector<std::string>& names) {
   std::string o = "[";
   for (std::size_t i = 0; i < names.size(); ++i) o += fmt::format("{}\"{}\"", i ? ", " : "", names[i]);
@@ -38,7 +40,37 @@ std::string Meaning(const ParameterStatus& p) {
 
 }  // namespace
 
+std::string Implausible::Warning() const {
+  return fmt::format("{} = {:.4g} {} is outside the plausible range {:.3g}..{:.3g} {} (docs/identification.md "
+                     "\"Plausible ranges\")",
+                     name, value, unit, lo, hi, unit);
+}
+
 bool FitStatus::Ok() const { return converged && Names(ParameterState::kAtBound).empty(); }
+
+std::string FitStatus::Mark() const {
+  std::string o;
+  if (!Ok()) {
+    const auto bound = Names(ParameterState::kAtBound);
+    o = "FIT FAILED: ";
+    if (!converged) o += "not converged";
+    if (!bound.empty()) {
+      std::string names;
+      for (const auto& n : bound) names += (names.empty() ? "" : ", ") + n;
+      o += fmt::format("{}{} on {} bound{}", converged ? "" : ", ", names, bound.size() == 1 ? "its" : "their",
+                       bound.size() == 1 ? "" : "s");
+    }
+  }
+  if (!implausible.empty()) {
+    // At most kMarkNames names, then "+N": a figure's title has room for one line.
+    std::string names;
+    for (std::size_t i = 0; i < implausible.size() && i < kMarkNames; ++i)
+      names += (names.empty() ? "" : ", ") + implausible[i].name;
+    if (implausible.size() > kMarkNames) names += fmt::format(" +{}", implausible.size() - kMarkNames);
+    o += (o.empty() ? "" : "; ") + std::string("implausible: ") + names;
+  }
+  return o;
+}
 
 std::vector<std::string> FitStatus::Names(ParameterState state) const {
   std::vector<std::string> out;
@@ -70,6 +102,7 @@ std::string FitStatus::Details(const std::string& indent) const {
     else it->second += ", " + item;
   }
   for (const auto& [meaning, items] : lines) o += fmt::format("{}  {}: {}\n", indent, items, meaning);
+  for (const auto& p : implausible) o += fmt::format("{}  warning: {}\n", indent, p.Warning());
   return o;
 }
 
@@ -97,6 +130,9 @@ std::string FitStatus::TomlTable() const {
   o += "at_zero = " + List(Names(ParameterState::kAtZero)) + "\n";
   o += "held = " + List(Names(ParameterState::kHeld)) + "\n";
   o += "irrelevant = " + List(Names(ParameterState::kIrrelevant)) + "\n";
+  std::vector<std::string> flagged;
+  for (const auto& p : implausible) flagged.push_back(p.name);
+  o += "implausible = " + List(flagged) + "\n";
   return o;
 }
 

@@ -16,7 +16,8 @@
 ///                so that the rate changes nothing.
 /// The fit *failed* (Ok() false) if Levenberg-Marquardt did not converge within its iterations or
 /// a parameter is `at bound`; `rths identify` then exits with kExitFitFailed unless
-/// --accept-unconverged.
+/// --accept-unconverged. A fitted value outside the plausible range of an MR damper
+/// (plausible_range.h) is *implausible*: a warning, printed and recorded, not a failure.
 #include <string>
 #include <vector>
 
@@ -40,28 +41,45 @@ struct ParameterStatus {
   std::string why;            ///< for kHeld and kIrrelevant: the reason
 };
 
+/// A fitted value outside its plausible range (plausible_range.h): a warning, not a failure.
+struct Implausible {
+  std::string name;   ///< as in the model file, e.g. "c0_b"
+  double value = 0.0;
+  double lo = 0.0, hi = 0.0;  ///< the plausible range at the fit's A (plausible_range.h)
+  std::string unit;   ///< e.g. "kN s/mm"
+  /// "c0_b = 71.5 kN s/mm is outside the plausible range 0.0001..3.2 kN s/mm (docs/identification.md
+  /// \"Plausible ranges\")".
+  std::string Warning() const;
+};
+
 /// How a fit ended (file comment).
 struct FitStatus {
   bool converged = false;
   int iterations = 0;
   int max_iterations = 0;
   std::vector<ParameterStatus> parameters;
+  std::vector<Implausible> implausible;  ///< fitted values outside their plausible range (warnings)
 
-  /// Converged, and no parameter at a bound.
+  /// Converged, and no parameter at a bound (an implausible value does not make it fail).
   bool Ok() const;
+  /// What a figure of the fit says of it, "" for a fit that is ok and plausible: "FIT FAILED:
+  /// alpha_c on its bound" (or "not converged", or "alpha_c, beta_c on their bounds"), then
+  /// "implausible: c0_b" (at most two names, then "+N": "implausible: c0_b, c0_c +1"), joined by "; ".
+  std::string Mark() const;
   /// The names of the parameters in `state`.
   std::vector<std::string> Names(ParameterState state) const;
   /// One line: "ok (converged in 54 iterations)" or "FAILED: not converged (150 iterations, the
   /// limit); alpha_c = 1000 on its upper bound".
   std::string Summary() const;
   /// Lines for the terminal, each starting with `indent`: the summary, then one line per
-  /// parameter that is not free (at zero, at bound, held, irrelevant) with its value and why.
+  /// parameter that is not free (at zero, at bound, held, irrelevant) with its value and why,
+  /// then one "warning: ..." line per implausible value.
   std::string Details(const std::string& indent) const;
   /// Model-file comment lines ('#'): the summary and the details; a failed fit's first line
   /// says "FIT FAILED" so that no reader takes the file for a working model.
   std::string Comment() const;
   /// The `[fit]` table: status = "ok" | "failed", converged, iterations, max_iterations and the
-  /// lists at_bound, at_zero, held, irrelevant (parameter names).
+  /// lists at_bound, at_zero, held, irrelevant, implausible (parameter names).
   std::string TomlTable() const;
 };
 

@@ -13,6 +13,7 @@
 #include "core/error.h"
 #include "ident/damper_fit.h"
 #include "ident/lm.h"
+#include "ident/plausible_range.h"
 
 namespace rths::ident {
 
@@ -538,12 +539,11 @@ std::vector<double> ConstantLevels(const std::vector<Prepared>& data, const Exte
 /// every record holds its command constant (the filter never acts), the rates p_c when the
 /// records hold two levels only (two points fix each law at those levels alone; p_c is then
 /// held at 3 / (level_2 - level_1): 95 % of the change between them is made by the upper one).
-Box DesignBox(const std::vector<Prepared>& data, const Extent& e, const DamperFitOptions& o, bool voltage) {
+/// Then the parameters the options hold (DamperFitOptions::hold), over the design's.
+Box DesignBox(const std::vector<double>& levels, const DamperFitOptions& o, bool voltage) {
   Box box(Dim(o.filter));
-  const auto levels = ConstantLevels(data, e);
-  if (levels.empty()) return box;
   const char* unit = voltage ? "V" : "A";
-  if (o.filter == ControlFilter::kFirstOrder)
+  if (!levels.empty() && o.filter == ControlFilter::kFirstOrder)
     box.Hold(kEta, o.eta_start_1_s,
              "every record holds its command constant, so the filter's time constant never shows: the value of "
              "the starts");
@@ -555,6 +555,12 @@ Box DesignBox(const std::vector<Prepared>& data, const Extent& e, const DamperFi
                            "between them the law is this assumption",
                            levels[0], levels[1], unit));
   }
+  const int dim = Dim(o.filter);
+  std::vector<std::string> names(kParamNames, kParamNames + dim);
+  std::vector<double> lo, hi;
+  for (int i = 0; i < dim; ++i) lo.push_back(LoBound(i)), hi.push_back(HiBound(i));
+  for (const auto& h : o.hold)
+    box.Hold(HeldIndex(h, names, lo, hi), h.second, fmt::format("held at {:g} by --hold", h.second));
   return box;
 }
 
@@ -605,7 +611,8 @@ SpencerFitResult FitSpencer(const std::vector<io::RigRecord>& records, const Dam
   Extent e;
   SpencerFitResult res;
   const std::vector<Prepared> data = PrepareRecords(records, voltage, o, &e, &res.warnings);
-  const Box box = DesignBox(data, e, o, voltage);
+  res.levels = ConstantLevels(data, e);
+  const Box box = DesignBox(res.levels, o, voltage);
   const int threads = o.threads > 0 ? o.threads : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
   const auto [ra, rb] = RoughEnds(data, e, PeakForce(records), o);
   // The starts run on the first part of every record (kStartShare of it, at least kStartMinS).
@@ -653,6 +660,7 @@ SpencerFitResult FitSpencer(const std::vector<io::RigRecord>& records, const Dam
   res.force_offset_kN = s.ev.offset;
   res.driver = DriverOf(s.theta, o.filter);
   res.status = StatusAt(s, box, max_iterations);
+  res.status.implausible = CheckPlausible(FittedValues(res.status, {{"k1", res.params.k1}}), o.A, voltage);
   for (const auto& d : data)
     res.records.push_back(
         ScoreSpencer(res.params, res.driver, o.filter, *d.rec, voltage, d.cutoff_hz, res.force_offset_kN));

@@ -58,6 +58,9 @@ struct SpencerFitResult {
   ControlFilter filter = ControlFilter::kFirstOrder;
   bool voltage = false;                     ///< the input is a voltage [V] (else a current [A])
   double input_min = 0.0, input_max = 0.0;  ///< range of the commands fitted [A or V]
+  /// The distinct input levels [A or V], ascending, if every record holds its command constant
+  /// (the design that decides what is held: fit_status.h); empty if a command varies.
+  std::vector<double> levels;
   std::vector<DamperRecordScore> records;   ///< per training record
   double cost = 0.0;
   int best_start = 0;
@@ -102,8 +105,9 @@ bool UsesVoltage(const std::vector<io::RigRecord>& records, DamperInput input);
 
 /// Fits the model to the records (file comment), driven by the input UsesVoltage(records,
 /// options.input) picks, through CommandForModel (options.current_A and current_tolerance_A are
-/// not read); what the records cannot determine is held (fit_status.h), and the result's status
-/// says how the fit ended. Throws rths::Error (where = the record's source) for a record without
+/// not read); what the records cannot determine is held (fit_status.h), and what options.hold
+/// names (over that), and the result's status says how the fit ended and which values are
+/// implausible (plausible_range.h). Throws rths::Error (where = the record's source) for a record without
 /// that column, too short, with zero force or a command CommandForModel refuses; (where = "DamperFitOptions") for bad options; if no start gives a finite cost.
 SpencerFitResult FitSpencer(const std::vector<io::RigRecord>& records, const DamperFitOptions& options = {});
 
