@@ -173,9 +173,22 @@ TEST_CASE("bad SPECs are refused naming the file, the key and what is allowed") 
   refused("[sweep]\nbase = \"b\"\n[draw]\n\"a\" = { dist = \"seed\" }\n", "sweep.draws >= 1");
   refused("[sweep]\nbase = \"b\"\ndraws = 3\n", "needs a [draw] table");
   refused("[sweep]\nbase = \"b\"\n[cases]\nfiles = [\"c\"]\n", "not both");
+  // [slurm] setup: shell lines, one per entry.
+  refused("[sweep]\nbase = \"b\"\n[slurm]\nsetup = \"module load gcc\"\n", "slurm.setup: must be an array of shell lines");
+  refused("[sweep]\nbase = \"b\"\n[slurm]\nsetup = [\"module load gcc\", 12]\n", "slurm.setup[1]: must be a string");
+  refused("[sweep]\nbase = \"b\"\n[slurm]\nsetup = [\"module load gcc\\nrm -rf x\"]\n", "slurm.setup[0]: holds a newline");
+  refused("[sweep]\nbase = \"b\"\n[slurm]\nsetup = [\"  \"]\n", "slurm.setup[0]: is empty");
   refused("[sweep]\nbase = \"b\"\ndraws = 100000\n[draw]\n\"a\" = { dist = \"seed\" }\n[grid]\n\"k\" = "
           "[1,2,3,4,5,6,7,8,9,10,11]\n\"l\" = [1,2,3,4,5,6,7,8,9,10]\n",
           "more than the");
+}
+
+TEST_CASE("[slurm] setup: the lines in order, as given") {
+  const auto spec = ParseSpec("[sweep]\nbase = \"b\"\n[slurm]\nsetup = [\"module load gcc/12 cmake\", "
+                              "\"source /etc/profile.d/modules.sh  # 'quotes' and \\\"more\\\"\"]\n",
+                              "/x/s.toml");
+  CHECK(spec.slurm.setup ==
+        std::vector<std::string>{"module load gcc/12 cmake", "source /etc/profile.d/modules.sh  # 'quotes' and \"more\""});
 }
 
 TEST_CASE("the named draw benchmark_plant: the benchmark's perturbed plant and, with it, its numerical substructure") {

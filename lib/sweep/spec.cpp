@@ -184,9 +184,20 @@ void ParseSlurmTable(const toml::table& slurm, const std::string& path, SlurmSet
         if (!s || s->rfind("-", 0) != 0) throw Error(where, "each entry must be one sbatch option starting with '-'");
         out->sbatch_args.push_back(*s);
       }
+    } else if (key == "setup") {
+      const auto* a = v.as_array();
+      if (!a) throw Error(where, "must be an array of shell lines (strings), e.g. [\"module load gcc/12\"]");
+      for (std::size_t i = 0; i < a->size(); ++i) {
+        const auto s = (*a)[i].value<std::string>();
+        if (!s) throw Error(fmt::format("{}[{}]", where, i), "must be a string: one shell line");
+        if (const std::string problem = SetupLineProblem(*s); !problem.empty()) {
+          throw Error(fmt::format("{}[{}]", where, i), problem);
+        }
+        out->setup.push_back(*s);
+      }
     } else {
       throw Error(where, "unknown key; allowed: partition, time, account, runs_per_task, cpus_per_task, retries, "
-                         "sbatch_args");
+                         "sbatch_args, setup");
     }
   }
 }
@@ -198,6 +209,16 @@ std::uint64_t SplitMix64(std::uint64_t* state) {
   z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
   z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
   return z ^ (z >> 31);
+}
+
+std::string SetupLineProblem(const std::string& line) {
+  if (line.find_first_not_of(" \t") == std::string::npos) return "is empty: give a shell line, e.g. \"module load gcc/12\"";
+  for (const unsigned char c : line) {
+    if (c < 0x20 && c != '\t') return "holds a newline or another control character: one entry is one line";
+    if (c == 0x7f) return "holds a control character (DEL)";
+  }
+  if (line.size() > 4096) return fmt::format("is {} bytes long: at most 4096", line.size());
+  return "";
 }
 
 std::int64_t Spec::combinations() const {

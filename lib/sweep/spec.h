@@ -26,6 +26,7 @@
 ///     partition = "normal"
 ///     time = "00:30:00"                        # per array task
 ///     runs_per_task = 25
+///     setup = ["module load gcc/12"]           # shell lines the job script runs before rths
 ///
 /// Run order (index 0 .. runs()-1): case (slowest), then the grid's combinations (keys in sorted
 /// order, the first key slowest), then the draw (fastest). Run i's values are `--set KEY=VALUE`
@@ -71,7 +72,14 @@ struct SlurmSettings {
   int cpus_per_task = 1;              ///< sbatch --cpus-per-task; each task runs that many runs at a time
   int retries = 1;                    ///< times a task whose runs left no row is submitted again
   std::vector<std::string> sbatch_args;  ///< more sbatch options, e.g. ["--qos=short", "--mem=2G"]
+  /// Shell lines the job script runs, in order, before the rths command, e.g. ["module load
+  /// gcc/12"] (each single-quoted and eval'd: a line that fails stops the task; SetupLineProblem)
+  std::vector<std::string> setup;
 };
+
+/// Why `line` cannot be a [slurm] setup line ("" if it can): empty or blank, or holding a control
+/// character such as a newline (one entry is one line of the script), or longer than 4096 bytes.
+std::string SetupLineProblem(const std::string& line);
 
 /// A parsed, validated SPEC (paths absolute).
 struct Spec {
