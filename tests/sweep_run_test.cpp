@@ -8,10 +8,12 @@
 #include <sstream>
 #include <string>
 
+#include <fmt/core.h>
 #include <nlohmann/json.hpp>
 
 #include "core/error.h"
 #include "io/command.h"
+#include "scenario/scenario.h"
 #include "sweep/run_sweep.h"
 #include "test_support.h"
 
@@ -199,4 +201,35 @@ TEST_CASE("cases: a case column, by file name, or by path where two cases share 
   const std::string summary = Read(o.out / "summary.csv");
   CHECK(summary.find("b/base.toml,ff,steps,1,0,1,100,0,100,100\n") != std::string::npos);
   CHECK(fs::exists(o.out / "plots" / "steps.png"));
+}
+
+TEST_CASE("a PI's gains swept: array levels of a grid and a drawn element, in the rows, the table and each run") {
+  const auto dir = rths_test::TempDir("sweep_pi");
+  const fs::path base = rths_test::WriteScenario(
+      dir, "[run]\nname = \"sweep_pi\"\nduration_s = 0.05\n[controller]\nkind = \"lti\"\n"
+           "[controller.lti]\nfeedback = { num = [0.5, 2.0], den = [1.0, 0.0] }\n");
+  std::ofstream(dir / "spec.toml") << "[sweep]\nname = \"pi\"\nbase = \"" << base.string() << "\"\nseed = 9\ndraws = 2\n"
+                                   << "record = [\"steps\"]\n"
+                                   << "[grid]\n\"controller.lti.feedback.den\" = [[1, 0], [1.0, 10.0]]\n"
+                                   << "[draw]\n\"controller.lti.feedback.num[0]\" = { dist = \"uniform\", lo = 0.4, hi = 0.6 }\n";
+  const auto spec = rths::sweep::LoadSpec((dir / "spec.toml").string());
+  rths::sweep::SweepOptions o;
+  o.out = dir / "out";
+  o.jobs = 2;
+  const auto r = rths::sweep::RunSweep(spec, o);
+  REQUIRE(r.not_completed == 0);
+  REQUIRE(r.rows == 4);
+  const std::string table = Read(r.table);
+  CHECK(table.rfind("index,status,scenario_sha256,controller.lti.feedback.den,controller.lti.feedback.num[0],steps\n", 0) == 0);
+  const auto row3 = nlohmann::json::parse(Read(o.out / "rows" / "3.json"));
+  CHECK(row3["set"]["controller.lti.feedback.den"] == "[1.0, 10.0]");  // the level's text
+  const double k_p = row3["set"]["controller.lti.feedback.num[0]"].get<double>();
+  CHECK(table.find(",\"[1.0, 10.0]\"," + fmt::format("{}", k_p) + ",100\n") != std::string::npos);
+  CHECK(table.find(",\"[1, 0]\",") != std::string::npos);
+  // The run's scenario: the drawn gain, the file's integral gain, the grid's denominator.
+  const auto s = rths::scenario::LoadScenario((o.out / "runs" / "3" / "scenario.toml").string());
+  CHECK(s.controller.lti.feedback.num == std::vector<double>{k_p, 2.0});
+  CHECK(s.controller.lti.feedback.den == std::vector<double>{1.0, 10.0});
+  // summary.csv groups by the level's text.
+  CHECK(Read(o.out / "summary.csv").find("\"[1.0, 10.0]\",steps,2,0,2,100,0,100,100\n") != std::string::npos);
 }

@@ -2,7 +2,9 @@
 // Debian's munged, slurmctld and slurmd, configured in a temp folder, no cgroups), 40 runs in 8
 // array tasks through `rths sweep --executor slurm`, the table equal byte for byte to the local
 // executor's; one array task cancelled makes its runs fail visibly, and a retry, then --resume,
-// complete them. The daemons are stopped whatever happens.
+// complete them. The daemons are stopped whatever happens. Without Slurm, with fake sbatch programs
+// on PATH: the job script runs the SPEC's [slurm] setup lines before the command, and a submission
+// that fails leaves no output folder.
 #include <doctest/doctest.h>
 
 #include <chrono>
@@ -45,6 +47,33 @@ rths::io::CommandResult Sweep(const std::vector<std::string>& args) {
   std::vector<std::string> argv = {std::string(RTHS_BIN_DIR) + "/rths-sweep"};
   argv.insert(argv.end(), args.begin(), args.end());
   return rths::io::RunCommand(argv);
+}
+
+/// `rths-sweep args` with `bin` first on PATH (fake sbatch, squeue, scontrol).
+rths::io::CommandResult SweepWithPath(const fs::path& bin, const std::vector<std::string>& args) {
+  const char* path = std::getenv("PATH");
+  std::vector<std::string> argv = {"/usr/bin/env", "PATH=" + bin.string() + ":" + (path ? path : "/usr/bin:/bin"),
+                                   std::string(RTHS_BIN_DIR) + "/rths-sweep"};
+  argv.insert(argv.end(), args.begin(), args.end());
+  return rths::io::RunCommand(argv);
+}
+
+/// An executable shell script `dir/name`.
+void FakeProgram(const fs::path& dir, const std::string& name, const std::string& body) {
+  fs::create_directories(dir);
+  std::ofstream(dir / name) << "#!/bin/sh\n" << body;
+  fs::permissions(dir / name, fs::perms::owner_all);
+}
+
+/// A SPEC of 4 short runs whose [slurm] table ends with `slurm_lines`.
+fs::path SmallSpec(const fs::path& dir, const std::string& slurm_lines) {
+  fs::create_directories(dir);
+  const fs::path base = rths_test::WriteScenario(dir, "[run]\nname = \"sweep_base\"\nduration_s = 0.05\n");
+  const fs::path spec = dir / "spec.toml";
+  std::ofstream(spec) << "[sweep]\nname = \"fake\"\nbase = \"" << base.string() << "\"\nrecord = [\"steps\"]\n"
+                      << "[grid]\n\"controller.kind\" = [\"none\", \"ff\"]\n\"structure.damping_ratio\" = [0.02, 0.05]\n"
+                      << "[slurm]\nruns_per_task = 4\n" << slurm_lines;
+  return spec;
 }
 
 double Seconds(std::chrono::steady_clock::time_point t0) {
@@ -200,4 +229,80 @@ TEST_CASE("a reproduction on Slurm: fig9's runs as a job array give its table by
     ++runs;
   }
   CHECK(runs == 36);
+}
+
+TEST_CASE("the job script runs [slurm] setup's lines in order, quoted, before the command; a failing line stops the task") {
+  rths_test::RequireBuilt("rths-sweep");
+  const fs::path dir = rths_test::TempDir("sweep_slurm_setup");
+  FakeProgram(dir / "bin", "sbatch", "echo 42\n");  // accepts any job: --detach returns at once
+  // Line 2 sees line 1's export; line 3 holds quotes and a comment, which must reach bash unchanged.
+  const fs::path spec = SmallSpec(dir, R"(setup = ["export RTHS_SETUP_MARK=from-line-1", 'echo "2: $RTHS_SETUP_MARK" > setup.txt', "echo 'three' >> setup.txt  # a comment"]
+)");
+  const fs::path out = dir / "out";
+  auto r = SweepWithPath(dir / "bin", {spec.string(), "--executor", "slurm", "--out", out.string(), "--detach"});
+  INFO(r.output);
+  REQUIRE(r.status == 0);
+  const std::string script = rths_test::Slurp(out / "slurm" / "task.sh");
+  INFO(script);
+  const std::size_t l1 = script.find("\neval 'export RTHS_SETUP_MARK=from-line-1' ||");
+  const std::size_t l2 = script.find("\neval 'echo \"2: $RTHS_SETUP_MARK\" > setup.txt' ||");
+  const std::size_t l3 = script.find(R"(
+eval 'echo '\''three'\'' >> setup.txt  # a comment' ||)");
+  const std::size_t command = script.find("\nexec '");
+  REQUIRE(l1 != std::string::npos);
+  REQUIRE(l2 != std::string::npos);
+  REQUIRE(l3 != std::string::npos);
+  REQUIRE(command != std::string::npos);
+  CHECK(l1 < l2);
+  CHECK(l2 < l3);
+  CHECK(l3 < command);
+  CHECK(nlohmann::json::parse(rths_test::Slurp(out / "slurm" / "sweep.json"))["setup"].size() == 3);
+  // The script as a node runs it (task 0 of 1): the setup's effects, then the runs' rows.
+  auto task = rths::io::RunCommand(
+      {"/usr/bin/env", "SLURM_ARRAY_TASK_ID=0", "/bin/bash", (out / "slurm" / "task.sh").string()}, out);
+  INFO(task.output);
+  CHECK(task.status == 0);
+  CHECK(rths_test::Slurp(out / "setup.txt") == "2: from-line-1\nthree\n");
+  CHECK(fs::exists(out / "rows" / "3.json"));
+  // A line that fails stops the task before the command, naming itself.
+  const fs::path spec2 = SmallSpec(dir / "two", "setup = [\"true\", \"module_that_is_not_here load gcc/12\"]\n");
+  const fs::path out2 = dir / "out2";
+  r = SweepWithPath(dir / "bin", {spec2.string(), "--executor", "slurm", "--out", out2.string(), "--detach"});
+  REQUIRE(r.status == 0);
+  task = rths::io::RunCommand(
+      {"/usr/bin/env", "SLURM_ARRAY_TASK_ID=0", "/bin/bash", (out2 / "slurm" / "task.sh").string()}, out2);
+  INFO(task.output);
+  CHECK(task.status == 1);
+  CHECK(task.output.find("rths: [slurm] setup line 2 failed (exit 127): module_that_is_not_here load gcc/12") !=
+        std::string::npos);
+  CHECK(fs::is_empty(out2 / "rows"));
+}
+
+TEST_CASE("a submission that fails leaves no output folder behind") {
+  rths_test::RequireBuilt("rths-sweep");
+  const fs::path dir = rths_test::TempDir("sweep_slurm_refused");
+  FakeProgram(dir / "bin", "sbatch",
+              "echo 'sbatch: error: Batch job submission failed: Invalid partition name specified' >&2\nexit 1\n");
+  FakeProgram(dir / "garbage", "sbatch", "echo 'Submitted batch job (not --parsable)'\n");
+  const fs::path spec = SmallSpec(dir, "partition = \"gpu\"\n");
+  for (const fs::path& bin : {dir / "bin", dir / "garbage"}) {
+    const fs::path out = dir / "out";
+    const auto r = SweepWithPath(bin, {spec.string(), "--executor", "slurm", "--out", out.string()});
+    INFO(r.output);
+    CHECK(r.status == 2);
+    CHECK(r.output.find("sbatch: refused the job array") != std::string::npos);
+    CHECK_FALSE(fs::exists(out));
+  }
+  CHECK(SweepWithPath(dir / "bin", {spec.string(), "--executor", "slurm", "--out", (dir / "out").string()})
+            .output.find("Invalid partition name specified") != std::string::npos);
+  // A folder that was there stays, without the folders the sweep made in it.
+  const fs::path mine = dir / "mine";
+  fs::create_directories(mine);
+  std::ofstream(mine / "notes.txt") << "mine\n";
+  const auto r = SweepWithPath(dir / "bin", {spec.string(), "--executor", "slurm", "--out", mine.string()});
+  CHECK(r.status == 2);
+  CHECK(fs::exists(mine / "notes.txt"));
+  CHECK_FALSE(fs::exists(mine / "rows"));
+  CHECK_FALSE(fs::exists(mine / "runs"));
+  CHECK_FALSE(fs::exists(mine / "slurm"));
 }

@@ -5,12 +5,14 @@
 
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <set>
 #include <string>
 
 #include "core/error.h"
 #include "models/benchmark_plant.h"
 #include "scenario/scenario.h"
+#include "sweep/element_keys.h"
 #include "sweep/spec.h"
 #include "test_support.h"
 
@@ -154,7 +156,15 @@ TEST_CASE("bad SPECs are refused naming the file, the key and what is allowed") 
   refused("[sweep]\nbase = \"b\"\nspeed = 1\n", "unknown key; allowed: name, base, seed, draws, record");
   refused("[sweep]\nbase = \"b\"\n[grids]\n", "unknown table");
   refused("[sweep]\nbase = \"b\"\n[grid]\n\"a.b\" = []\n", "non-empty array");
-  refused("[sweep]\nbase = \"b\"\n[grid]\n\"a.b\" = [[1]]\n", "values must be");
+  refused("[sweep]\nbase = \"b\"\n[grid]\n\"a.b\" = [[1, \"x\"]]\n", "values must be");  // [[1]]: one array level
+  refused("[sweep]\nbase = \"b\"\n[grid]\n\"a.b\" = [[]]\n", "values must be");
+  refused("[sweep]\nbase = \"b\"\n[grid]\n\"a.b\" = [[[1]]]\n", "values must be");
+  refused("[sweep]\nbase = \"b\"\n[grid]\n\"a.b[0]\" = [1.0]\n", "may be drawn in [draw]");
+  refused("[sweep]\nbase = \"b\"\n[set]\n\"a.b[0]\" = 1.0\n", "may be drawn in [draw]");
+  refused("[sweep]\nbase = \"b\"\ndraws = 2\n[draw]\n\"a.b[x]\" = { dist = \"seed\" }\n", "KEY[i], i an integer");
+  refused("[sweep]\nbase = \"b\"\ndraws = 2\n[draw]\n\"a.b[1\" = { dist = \"seed\" }\n", "KEY[i], i an integer");
+  refused("[sweep]\nbase = \"b\"\ndraws = 2\n[draw]\n\"a[0]\" = { dist = \"seed\" }\n\"a[00]\" = { dist = \"seed\" }\n",
+          "more than one");
   refused("[sweep]\nbase = \"b\"\ndraws = 2\n[draw]\n\"a\" = { dist = \"beta\" }\n", "allowed \"normal\"");
   refused("[sweep]\nbase = \"b\"\ndraws = 2\n[draw]\n\"a\" = { dist = \"normal\", mean = 0.0, std = -1.0 }\n",
           "out of range [0, inf)");
@@ -163,9 +173,22 @@ TEST_CASE("bad SPECs are refused naming the file, the key and what is allowed") 
   refused("[sweep]\nbase = \"b\"\n[draw]\n\"a\" = { dist = \"seed\" }\n", "sweep.draws >= 1");
   refused("[sweep]\nbase = \"b\"\ndraws = 3\n", "needs a [draw] table");
   refused("[sweep]\nbase = \"b\"\n[cases]\nfiles = [\"c\"]\n", "not both");
+  // [slurm] setup: shell lines, one per entry.
+  refused("[sweep]\nbase = \"b\"\n[slurm]\nsetup = \"module load gcc\"\n", "slurm.setup: must be an array of shell lines");
+  refused("[sweep]\nbase = \"b\"\n[slurm]\nsetup = [\"module load gcc\", 12]\n", "slurm.setup[1]: must be a string");
+  refused("[sweep]\nbase = \"b\"\n[slurm]\nsetup = [\"module load gcc\\nrm -rf x\"]\n", "slurm.setup[0]: holds a newline");
+  refused("[sweep]\nbase = \"b\"\n[slurm]\nsetup = [\"  \"]\n", "slurm.setup[0]: is empty");
   refused("[sweep]\nbase = \"b\"\ndraws = 100000\n[draw]\n\"a\" = { dist = \"seed\" }\n[grid]\n\"k\" = "
           "[1,2,3,4,5,6,7,8,9,10,11]\n\"l\" = [1,2,3,4,5,6,7,8,9,10]\n",
           "more than the");
+}
+
+TEST_CASE("[slurm] setup: the lines in order, as given") {
+  const auto spec = ParseSpec("[sweep]\nbase = \"b\"\n[slurm]\nsetup = [\"module load gcc/12 cmake\", "
+                              "\"source /etc/profile.d/modules.sh  # 'quotes' and \\\"more\\\"\"]\n",
+                              "/x/s.toml");
+  CHECK(spec.slurm.setup ==
+        std::vector<std::string>{"module load gcc/12 cmake", "source /etc/profile.d/modules.sh  # 'quotes' and \"more\""});
 }
 
 TEST_CASE("the named draw benchmark_plant: the benchmark's perturbed plant and, with it, its numerical substructure") {
@@ -224,4 +247,98 @@ TEST_CASE("structure.subtract_specimen: the nominal plant's numerical substructu
   // Refused where there is no benchmark specimen to subtract.
   const std::string e = rths_test::ParseError("[structure]\nsubtract_specimen = true\n");
   CHECK(e.find("structure.subtract_specimen") != std::string::npos);
+}
+
+namespace {
+
+/// The benchmark's case 1 (its example PI C(s) = (2 s + 95)/s: feedback num = [2.0, 95.0]).
+const fs::path kCase1 = fs::path(RTHS_SOURCE_DIR) / "scenarios" / "benchmark" / "case1_example.toml";
+
+rths::sweep::Spec SpecFile(const std::string& name, const std::string& tables) {
+  const fs::path file = rths_test::TempDir(name) / "s.toml";
+  std::ofstream(file) << "[sweep]\nbase = \"" << kCase1.string() << "\"\nseed = 4\n" << tables;
+  return rths::sweep::LoadSpec(file.string());
+}
+
+}  // namespace
+
+TEST_CASE("a grid of transfer function coefficients: array levels, as --set takes them, named by their text") {
+  const auto spec = SpecFile("sweep_array_grid", "[grid]\n\"controller.lti.feedback.num\" = [[2, 95], [3.0, 120.5]]\n"
+                                                 "[set]\n\"controller.lti.feedback.den\" = [1.0, 0.0]\n");
+  REQUIRE(spec.runs() == 2);
+  CHECK(spec.grid[0].values == std::vector<std::string>{"[2, 95]", "[3.0, 120.5]"});
+  CHECK(spec.fixed[0].second == "[1.0, 0.0]");
+  const auto p1 = PointOf(spec, 1);
+  CHECK(p1.sets.back() == "controller.lti.feedback.num=[3.0, 120.5]");
+  const auto s = rths::scenario::LoadScenario(p1.scenario, rths::sweep::ScenarioSets(p1));
+  CHECK(s.controller.lti.feedback.num == std::vector<double>{3.0, 120.5});
+  CHECK(s.controller.lti.feedback.den == std::vector<double>{1.0, 0.0});
+  // The same value through --set: the same scenario, hash included.
+  const auto by_set = rths::scenario::LoadScenario(kCase1.string(), {"controller.lti.feedback.den=[1.0, 0.0]",
+                                                                     "controller.lti.feedback.num=[3.0, 120.5]"});
+  CHECK(by_set.sha256 == s.sha256);
+}
+
+TEST_CASE("[draw] of one element of an array: the rest of the array is the scenario's, [set]'s or the grid's") {
+  const auto spec = SpecFile("sweep_element_draw", "draws = 50\n[draw]\n"
+                                                   "\"controller.lti.feedback.num[0]\" = { dist = \"normal\", mean = 2.0, std = 0.2 }\n"
+                                                   "\"controller.lti.feedback.num[1]\" = { dist = \"uniform\", lo = 80.0, hi = 110.0 }\n");
+  REQUIRE(spec.runs() == 50);
+  CHECK(rths::sweep::DrawColumns(spec.draw[0]) == std::vector<std::string>{"controller.lti.feedback.num[0]"});
+  double sum = 0;
+  std::set<double> kp;
+  for (std::int64_t i = 0; i < spec.runs(); ++i) {
+    const auto p = PointOf(spec, i);
+    REQUIRE(p.sets.size() == 2);
+    REQUIRE(p.sets[0].rfind("controller.lti.feedback.num[0]=", 0) == 0);
+    const double k_p = ValueOf(p.sets[0]), k_i = ValueOf(p.sets[1]);
+    const auto s = rths::scenario::LoadScenario(p.scenario, rths::sweep::ScenarioSets(p));
+    CHECK(s.controller.lti.feedback.num == std::vector<double>{k_p, k_i});  // both drawn, bit for bit
+    CHECK(s.controller.lti.feedback.den == std::vector<double>{1.0, 0.0});  // the case's
+    CHECK(k_i >= 80.0);
+    CHECK(k_i < 110.0);
+    sum += k_p;
+    kp.insert(k_p);
+  }
+  CHECK(kp.size() == 50);
+  CHECK(std::abs(sum / 50 - 2.0) < 5 * 0.2 / std::sqrt(50.0));
+  // One element drawn: the other is the case's value, or [set]'s.
+  const auto one = SpecFile("sweep_element_one", "draws = 2\n[draw]\n"
+                                                 "\"controller.lti.feedback.num[0]\" = { dist = \"normal\", mean = 2.0, std = 0.2 }\n");
+  const auto p = PointOf(one, 1);
+  const std::string drawn = p.sets[0].substr(p.sets[0].find('=') + 1);
+  CHECK(rths::sweep::ScenarioSets(p) == std::vector<std::string>{"controller.lti.feedback.num=[" + drawn + ", 95.0]"});
+  const auto with_set = SpecFile("sweep_element_set", "draws = 2\n[set]\n\"controller.lti.feedback.num\" = [3, 120]\n"
+                                                      "[draw]\n\"controller.lti.feedback.num[0]\" = { dist = \"normal\", mean = 2.0, std = 0.2 }\n");
+  const auto q = PointOf(with_set, 1);
+  CHECK(q.sets[1] == p.sets[0]);  // the same stream: (seed, index, key)
+  const auto s = rths::scenario::LoadScenario(q.scenario, rths::sweep::ScenarioSets(q));
+  CHECK(s.controller.lti.feedback.num == std::vector<double>{ValueOf(p.sets[0]), 120.0});
+}
+
+TEST_CASE("a drawn element beyond its array is refused naming the SPEC file, the key and the allowed range") {
+  const auto message = [](const std::string& name, const std::string& tables) {
+    try {
+      SpecFile(name, tables);
+    } catch (const rths::Error& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  const std::string draw = "draws = 2\n[draw]\n\"controller.lti.feedback.num[2]\" = { dist = \"normal\", mean = 2.0, std = 0.2 }\n";
+  std::string e = message("sweep_element_range", draw);
+  CHECK(e.find("sweep_element_range/s.toml: draw.\"controller.lti.feedback.num[2]\"") != std::string::npos);
+  CHECK(e.find("index 2 is out of range [0, 2)") != std::string::npos);
+  CHECK(e.find("[2.0, 95.0] in case1_example.toml") != std::string::npos);
+  // Checked against each level of a grid of the same array.
+  e = message("sweep_element_grid", draw + "[grid]\n\"controller.lti.feedback.num\" = [[1, 2, 3], [1, 2]]\n");
+  CHECK(e.find("index 2 is out of range [0, 2)") != std::string::npos);
+  CHECK(e.find("(grid controller.lti.feedback.num=[1, 2])") != std::string::npos);
+  CHECK(message("sweep_element_grid_ok", draw + "[grid]\n\"controller.lti.feedback.num\" = [[1, 2, 3], [4, 5, 6]]\n") ==
+        "accepted");
+  // Not an array.
+  e = message("sweep_element_scalar",
+              "draws = 2\n[draw]\n\"run.duration_s[0]\" = { dist = \"uniform\", lo = 1.0, hi = 2.0 }\n");
+  CHECK(e.find("sweep_element_scalar/s.toml: draw.\"run.duration_s[0]\"") != std::string::npos);
+  CHECK(e.find("is not an array") != std::string::npos);
 }

@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 
@@ -16,6 +17,7 @@ namespace rths::tools {
 /// The flags; unset ones (empty, -1) leave the settings they are applied to as they are.
 struct SlurmFlags {
   std::string partition, time, account;
+  std::vector<std::string> setup;  ///< --setup LINE (repeated): replaces the SPEC's [slurm] setup
   std::int64_t runs_per_task = -1;
   int cpus_per_task = -1, retries = -1;
   double poll_s = 2.0;  ///< seconds between squeue calls while waiting
@@ -30,6 +32,10 @@ struct SlurmFlags {
         ->check(CLI::Range(1, 4096));
     app.add_option("--retries", retries, "slurm: times a task that left runs undone is submitted again (default 1)")
         ->check(CLI::Range(0, 100));
+    app.add_option("--setup", setup, "slurm: a shell line the job script runs before rths, e.g. 'module load gcc/12' "
+                                     "(repeat for more, in order; replaces the SPEC's [slurm] setup)")
+        ->allow_extra_args(false)  // one line per --setup: a SPEC after it stays the SPEC
+        ->check([](const std::string& line) { return rths::sweep::SetupLineProblem(line); });
     app.add_option("--poll-s", poll_s, "slurm: seconds between squeue calls while waiting")->check(CLI::Range(0.05, 600.0));
   }
 
@@ -41,6 +47,7 @@ struct SlurmFlags {
     if (runs_per_task > 0) settings.runs_per_task = runs_per_task;
     if (cpus_per_task > 0) settings.cpus_per_task = cpus_per_task;
     if (retries >= 0) settings.retries = retries;
+    if (!setup.empty()) settings.setup = setup;
     return settings;
   }
 };

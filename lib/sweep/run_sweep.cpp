@@ -11,6 +11,7 @@
 #include "io/reserved_file.h"
 #include "scenario/scenario.h"
 #include "studies/batch.h"
+#include "sweep/element_keys.h"
 #include "sweep/table.h"
 
 namespace rths::sweep {
@@ -30,8 +31,10 @@ nlohmann::json Field(const nlohmann::json& summary, const std::string& dotted) {
   return *j;
 }
 
-/// A --set value (a TOML literal) as JSON: a string without its quotes, a boolean, or a number.
+/// A --set value (a TOML literal) as JSON: a string without its quotes, a boolean, a number, or
+/// an array of numbers as its text ("[2, 95]": the grid level's name in the table).
 nlohmann::json ValueOf(const std::string& literal) {
+  if (!literal.empty() && literal.front() == '[') return literal;
   if (literal.size() >= 2 && literal.front() == '"') {
     std::string out;
     for (std::size_t i = 1; i + 1 < literal.size(); ++i) {
@@ -107,7 +110,7 @@ void RunBlock(const Spec& spec, const SweepOptions& o, const std::vector<std::in
     const fs::path dir = o.out / "runs" / std::to_string(p.index);
     fs::remove_all(dir);  // what an interrupted attempt left
     try {
-      specs.push_back({fmt::format("run {} of sweep {}", p.index, spec.name), scenario::LoadScenario(p.scenario, p.sets),
+      specs.push_back({fmt::format("run {} of sweep {}", p.index, spec.name), scenario::LoadScenario(p.scenario, ScenarioSets(p)),
                        dir});
       points.push_back(p);
     } catch (const std::exception& e) {  // e.g. a drawn value out of the key's range: a row, not a crash

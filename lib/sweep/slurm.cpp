@@ -40,6 +40,7 @@ void Save(const fs::path& out, const State& s) {
                       {"account", s.settings.account},
                       {"cpus_per_task", s.settings.cpus_per_task},
                       {"sbatch_args", s.settings.sbatch_args},
+                      {"setup", s.settings.setup},
                       {"jobs", s.jobs}};
   if (!io::OverwriteFile(StatePath(out).string(), j.dump(2) + "\n")) {
     throw Error(StatePath(out).string(), "cannot write the sweep's Slurm state");
@@ -62,6 +63,7 @@ State Load(const fs::path& out) {
     s.settings.account = j.at("account").get<std::string>();
     s.settings.cpus_per_task = j.at("cpus_per_task").get<int>();
     s.settings.sbatch_args = j.at("sbatch_args").get<std::vector<std::string>>();
+    s.settings.setup = j.value("setup", std::vector<std::string>{});  // absent in sweeps submitted before [slurm] setup
     s.jobs = j.at("jobs").get<std::vector<std::string>>();
     return s;
   } catch (const std::exception& e) {
@@ -107,17 +109,39 @@ SlurmOutcome Finish(const Spec& spec, State s, const SlurmRunOptions& o, SlurmOu
 
 }  // namespace
 
+namespace {
+
+/// The folders RunSweepOnSlurm makes, removed again if the first submission fails: a refused
+/// sweep leaves no half-made DIR (or, in a DIR that was there, none of its own folders).
+class MadeFolders {
+ public:
+  explicit MadeFolders(const fs::path& out) {
+    for (const fs::path& p : {out, out / "rows", out / "runs", out / "slurm"}) {
+      if (!fs::exists(p)) made_.push_back(p);
+    }
+    for (const fs::path& p : made_) fs::create_directories(p);
+  }
+  /// Removes what the constructor made (the outermost folder first takes the rest with it).
+  void Undo() noexcept {
+    std::error_code ec;
+    for (const fs::path& p : made_) fs::remove_all(p, ec);
+  }
+
+ private:
+  std::vector<fs::path> made_;
+};
+
+}  // namespace
+
 SlurmOutcome RunSweepOnSlurm(const Spec& spec, const SlurmRunOptions& o) {
   if (o.sweep_program.empty() || !fs::path(o.sweep_program).is_absolute()) {
     throw Error("--executor slurm", "needs the absolute path of rths-sweep for the compute nodes");
   }
-  fs::create_directories(o.out / "rows");
-  fs::create_directories(o.out / "runs");
-  fs::create_directories(o.out / "slurm");
-  if (!o.resume && !fs::is_empty(o.out / "rows")) {
+  if (!o.resume && fs::exists(o.out / "rows") && !fs::is_empty(o.out / "rows")) {
     throw Error(o.out.string(), "holds rows of an earlier attempt: add --resume to submit only the runs without "
                                 "rows, or give another --out");
   }
+  MadeFolders made(o.out);
   State s;
   s.spec = spec.path;
   s.chunks = ChunkCount(spec.runs(), o.settings.runs_per_task);
@@ -135,7 +159,12 @@ SlurmOutcome RunSweepOnSlurm(const Spec& spec, const SlurmRunOptions& o) {
     Save(o.out, s);
     return Finish(spec, s, o, outcome);
   }
-  s.jobs.push_back(SubmitArray(w, todo, Runner(o, s)));
+  try {
+    s.jobs.push_back(SubmitArray(w, todo, Runner(o, s)));
+  } catch (...) {  // sbatch missing or refusing: nothing was submitted, so nothing of this call stays
+    made.Undo();
+    throw;
+  }
   outcome.job_ids.push_back(s.jobs.back());
   Save(o.out, s);
   Say(o, fmt::format("submitted job {}: array tasks {} of {} ({} runs each at most, {} cpus per task)", s.jobs.back(),

@@ -16,7 +16,8 @@
 /// tasks again (`retries` times). The table is written once every task has ended.
 ///
 /// Files: DIR/slurm/task.sh (the array's batch script), DIR/slurm/task-<job>_<c>.out (each task's
-/// output), DIR/slurm/sweep.json (the SPEC's path, T, the jobs submitted, retries left: what
+/// output), DIR/slurm/sweep.json (the SPEC's path, T, the jobs submitted, retries left, the
+/// settings with their setup lines: what
 /// `rths sweep --collect DIR` needs after `--detach`).
 #include <cstdint>
 #include <filesystem>
@@ -56,7 +57,8 @@ struct SlurmOutcome {
 /// Submits the array tasks whose runs have no row in DIR/rows yet (every task of a new DIR; only
 /// the unfinished ones of a resumed one), then, unless detached, waits, submits failed tasks
 /// again up to settings.retries times and writes the table. Throws rths::Error if sbatch refuses
-/// the job (with its message) or DIR cannot be written.
+/// the job (with its message) or DIR cannot be written; when the first submission fails, the
+/// folders this call made (DIR itself, or rows/, runs/, slurm/ in a DIR that was there) are removed.
 SlurmOutcome RunSweepOnSlurm(const Spec& spec, const SlurmRunOptions& o);
 
 /// `rths sweep --collect DIR`: for a sweep submitted with --detach, waits for its last job,

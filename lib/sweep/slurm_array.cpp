@@ -30,6 +30,21 @@ std::string Trim(std::string s) {
   return s;
 }
 
+/// The SPEC's [slurm] setup as script lines, in order, before the command: each line single-quoted
+/// (nothing in it can end the quoting or run into the script's own lines) and run by `eval` in the
+/// script's shell, so `module load` and `export` reach the command; a line that fails stops the
+/// task, naming the line and its exit code.
+std::string SetupText(const std::vector<std::string>& setup) {
+  if (setup.empty()) return "";
+  std::string t = "# [slurm] setup of the SPEC, in order; a line that fails stops the task.\n";
+  for (std::size_t k = 0; k < setup.size(); ++k) {
+    const std::string line = Quote(setup[k]);
+    t += fmt::format("eval {} || {{ rc=$?; echo \"rths: [slurm] setup line {} failed (exit $rc):\" {} >&2; exit 1; }}\n",
+                     line, k + 1, line);
+  }
+  return t;
+}
+
 void Say(const ArrayRun& r, const std::string& line) {
   if (r.say) r.say(line);
 }
@@ -122,8 +137,9 @@ std::string SubmitArray(const ArrayWork& w, const std::vector<std::int64_t>& tas
       "#!/bin/bash\n"
       "# One array task of rths-{} (lib/sweep/slurm_array.h): the {} i with i % {} == $SLURM_ARRAY_TASK_ID,\n"
       "# $SLURM_CPUS_PER_TASK at a time.\n"
+      "{}"
       "exec {}--chunk \"$SLURM_ARRAY_TASK_ID\" --chunks {} --jobs \"${{SLURM_CPUS_PER_TASK:-1}}\"\n",
-      w.name, w.noun, w.chunks, command, w.chunks);
+      w.name, w.noun, w.chunks, SetupText(r.settings.setup), command, w.chunks);
   if (!io::OverwriteFile(script.string(), text)) throw Error(script.string(), "cannot write the array's batch script");
   fs::permissions(script, fs::perms::owner_all | fs::perms::group_read | fs::perms::group_exec, fs::perm_options::add);
   std::vector<std::string> argv = {r.programs.sbatch, "--parsable", "--job-name=rths-" + w.name,

@@ -7,7 +7,9 @@
 /// all done after its job has ended failed (cancelled, timed out, its node lost), whatever Slurm
 /// says; the collector names it with what scontrol still knows and submits it again.
 ///
-/// Files: DIR/slurm/task.sh (the batch script), DIR/slurm/task-<job>_<c>.out (each task's output).
+/// Files: DIR/slurm/task.sh (the batch script: the settings' `setup` lines, each single-quoted and
+/// eval'd in order, a failing one stopping the task, then the command), DIR/slurm/task-<job>_<c>.out
+/// (each task's output).
 #include <cstdint>
 #include <filesystem>
 #include <functional>

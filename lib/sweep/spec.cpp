@@ -13,23 +13,22 @@
 
 #include "core/error.h"
 #include "models/benchmark_plant.h"
+#include "sweep/element_keys.h"
 
 namespace rths::sweep {
 
 namespace fs = std::filesystem;
 
-namespace {
-
-/// A double as a TOML float literal: the shortest text that reads back as the same double, bit
-/// for bit ("1.0", not "1").
 std::string FloatLiteral(double x) {
   std::string out = fmt::format("{}", x);
   if (out.find_first_of(".eEn") == std::string::npos) out += ".0";
   return out;
 }
 
-/// A TOML literal of a grid value, as `--set KEY=VALUE` takes it; "" for an unsupported type.
-std::string Literal(const toml::node& v) {
+namespace {
+
+/// A TOML literal of a scalar value, as `--set KEY=VALUE` takes it; "" for an unsupported type.
+std::string ScalarLiteral(const toml::node& v) {
   if (const auto* s = v.as_string()) {
     std::string out = "\"";
     for (const char c : s->get()) {
@@ -42,6 +41,29 @@ std::string Literal(const toml::node& v) {
   if (const auto* b = v.as_boolean()) return b->get() ? "true" : "false";
   if (const auto* d = v.as_floating_point()) return std::isfinite(d->get()) ? FloatLiteral(d->get()) : "";
   return "";
+}
+
+/// A TOML literal of a [set] value or a grid level, as `--set KEY=VALUE` takes it: a scalar, or a
+/// non-empty array of numbers ("[2, 95]", the level's text in the table); "" for anything else.
+std::string Literal(const toml::node& v) {
+  const auto* a = v.as_array();
+  if (a == nullptr) return ScalarLiteral(v);
+  std::string out = "[";
+  for (const toml::node& e : *a) {
+    if (!e.is_integer() && !e.is_floating_point()) return "";
+    const std::string x = ScalarLiteral(e);
+    if (x.empty()) return "";
+    out += (out.size() > 1 ? ", " : "") + x;
+  }
+  return a->empty() ? "" : out + "]";
+}
+
+/// Refuses KEY[i] outside [draw]: [set] and [grid] give whole arrays.
+void WholeKey(const std::string& key, const std::string& where) {
+  if (SplitElementKey(key, where)) {
+    throw Error(where, "one element of an array (KEY[i]) may be drawn in [draw]; here give the whole array, "
+                       "e.g. \"controller.lti.feedback.num\" = [[2.0, 95.0], [3.0, 120.0]] in [grid]");
+  }
 }
 
 /// FNV-1a of a key: its stream differs from every other key's.
@@ -162,9 +184,20 @@ void ParseSlurmTable(const toml::table& slurm, const std::string& path, SlurmSet
         if (!s || s->rfind("-", 0) != 0) throw Error(where, "each entry must be one sbatch option starting with '-'");
         out->sbatch_args.push_back(*s);
       }
+    } else if (key == "setup") {
+      const auto* a = v.as_array();
+      if (!a) throw Error(where, "must be an array of shell lines (strings), e.g. [\"module load gcc/12\"]");
+      for (std::size_t i = 0; i < a->size(); ++i) {
+        const auto s = (*a)[i].value<std::string>();
+        if (!s) throw Error(fmt::format("{}[{}]", where, i), "must be a string: one shell line");
+        if (const std::string problem = SetupLineProblem(*s); !problem.empty()) {
+          throw Error(fmt::format("{}[{}]", where, i), problem);
+        }
+        out->setup.push_back(*s);
+      }
     } else {
       throw Error(where, "unknown key; allowed: partition, time, account, runs_per_task, cpus_per_task, retries, "
-                         "sbatch_args");
+                         "sbatch_args, setup");
     }
   }
 }
@@ -176,6 +209,16 @@ std::uint64_t SplitMix64(std::uint64_t* state) {
   z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
   z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
   return z ^ (z >> 31);
+}
+
+std::string SetupLineProblem(const std::string& line) {
+  if (line.find_first_not_of(" \t") == std::string::npos) return "is empty: give a shell line, e.g. \"module load gcc/12\"";
+  for (const unsigned char c : line) {
+    if (c < 0x20 && c != '\t') return "holds a newline or another control character: one entry is one line";
+    if (c == 0x7f) return "holds a control character (DEL)";
+  }
+  if (line.size() > 4096) return fmt::format("is {} bytes long: at most 4096", line.size());
+  return "";
 }
 
 std::int64_t Spec::combinations() const {
@@ -207,12 +250,16 @@ void ParseAxes(const toml::table& root, const std::string& path, Spec* spec_ptr)
   if (const auto* grid = root["grid"].as_table()) {
     for (const auto& [k, v] : *grid) {
       const std::string where = fmt::format("{}: grid.\"{}\"", path, k.str());
+      WholeKey(std::string(k.str()), where);
       const auto* values = v.as_array();
       if (!values || values->empty()) throw Error(where, "must be a non-empty array of values");
       Axis axis{std::string(k.str()), {}};
       for (const auto& value : *values) {
         const std::string literal = Literal(value);
-        if (literal.empty()) throw Error(where, "values must be strings, integers, finite floats or booleans");
+        if (literal.empty()) {
+          throw Error(where, "values must be strings, integers, finite floats, booleans or non-empty arrays of "
+                             "numbers (levels of an array-valued key: [[2.0, 95.0], [3.0, 120.0]])");
+        }
         axis.values.push_back(literal);
       }
       spec.grid.push_back(std::move(axis));
@@ -220,16 +267,23 @@ void ParseAxes(const toml::table& root, const std::string& path, Spec* spec_ptr)
   }
   if (const auto* set = root["set"].as_table()) {
     for (const auto& [k, v] : *set) {
+      const std::string where = fmt::format("{}: set.\"{}\"", path, k.str());
+      WholeKey(std::string(k.str()), where);
       const std::string literal = Literal(v);
       if (literal.empty()) {
-        throw Error(fmt::format("{}: set.\"{}\"", path, k.str()), "must be a string, an integer, a finite float or a boolean");
+        throw Error(where, "must be a string, an integer, a finite float, a boolean or a non-empty array of numbers");
       }
       spec.fixed.emplace_back(std::string(k.str()), literal);
     }
   }
   if (const auto* draw = root["draw"].as_table()) {
     for (const auto& [k, v] : *draw) {
-      spec.draw.push_back(ParseDraw(std::string(k.str()), v, fmt::format("{}: draw.\"{}\"", path, k.str())));
+      const std::string where = fmt::format("{}: draw.\"{}\"", path, k.str());
+      std::string key(k.str());
+      if (const auto element = SplitElementKey(key, where)) {  // "num[00]" is "num[0]": one stream, one column
+        key = fmt::format("{}[{}]", element->array_key, element->index);
+      }
+      spec.draw.push_back(ParseDraw(key, v, where));
     }
   }
 }
@@ -293,7 +347,9 @@ Spec LoadSpec(const std::string& path) {
   if (!in) throw Error(path, "cannot read the sweep SPEC");
   std::stringstream text;
   text << in.rdbuf();
-  return ParseSpec(text.str(), fs::absolute(path).lexically_normal().string());
+  Spec spec = ParseSpec(text.str(), fs::absolute(path).lexically_normal().string());
+  CheckElementKeys(spec);
+  return spec;
 }
 
 std::vector<std::string> DrawColumns(const Draw& d) {

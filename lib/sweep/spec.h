@@ -17,13 +17,16 @@
 ///     [grid]                                   # every combination of these --set values
 ///     "controller.kind" = ["ff", "ff_lqg"]
 ///     "controller.lqg.q" = [1e2, 1e3, 1e4]
+///     "controller.lti.feedback.den" = [[1, 0], [1, 1]]   # levels may be arrays of numbers
 ///     [draw]                                   # drawn anew for each run
 ///     "structure.damping_ratio" = { dist = "normal", mean = 0.02, std = 0.002 }
+///     "controller.lti.feedback.num[0]" = { dist = "normal", mean = 2.0, std = 0.2 }  # one element
 ///     "plant.noise_seed" = { dist = "seed" }
 ///     [slurm]                                  # optional: for --executor slurm (lib/sweep/slurm.h)
 ///     partition = "normal"
 ///     time = "00:30:00"                        # per array task
 ///     runs_per_task = 25
+///     setup = ["module load gcc/12"]           # shell lines the job script runs before rths
 ///
 /// Run order (index 0 .. runs()-1): case (slowest), then the grid's combinations (keys in sorted
 /// order, the first key slowest), then the draw (fastest). Run i's values are `--set KEY=VALUE`
@@ -31,6 +34,7 @@
 /// stream of its own, seeded from (seed, i, key) by SplitMix64, with normal deviates by the
 /// Box-Muller transform written here (std::normal_distribution differs between libraries): the
 /// same SPEC and index give the same scenario on every machine, whatever else the sweep holds.
+/// A drawn KEY[i] is one element of an array-valued key (sweep/element_keys.h).
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -39,7 +43,9 @@ namespace rths::sweep {
 
 /// A distribution of a [draw] key.
 struct Draw {
-  std::string key;      ///< dotted scenario key, e.g. "structure.damping_ratio"
+  /// dotted scenario key, e.g. "structure.damping_ratio", or one element of an array-valued key,
+  /// "controller.lti.feedback.num[0]" (0-based; sweep/element_keys.h)
+  std::string key;
   /// "normal" (mean, std), "uniform" (lo, hi), "lognormal" (mu, sigma of log), "seed" (an integer in
   /// [1, 2^31 - 2]), or the named draw "benchmark_plant" (key "plant.benchmark": the RTHS benchmark's
   /// perturbed plant, models::PerturbedBenchmarkParams about the nominal constants, b1, b2, a3 and
@@ -49,7 +55,8 @@ struct Draw {
   double a = 0, b = 0;  ///< the parameters, in that order
 };
 
-/// One [grid] axis: a key and its values as TOML literals ("\"ff\"", "1000.0", "true").
+/// One [grid] axis: a key and its values as TOML literals ("\"ff\"", "1000.0", "true", or an
+/// array of numbers, "[2, 95]": a level's text in the table).
 struct Axis {
   std::string key;
   std::vector<std::string> values;
@@ -65,7 +72,14 @@ struct SlurmSettings {
   int cpus_per_task = 1;              ///< sbatch --cpus-per-task; each task runs that many runs at a time
   int retries = 1;                    ///< times a task whose runs left no row is submitted again
   std::vector<std::string> sbatch_args;  ///< more sbatch options, e.g. ["--qos=short", "--mem=2G"]
+  /// Shell lines the job script runs, in order, before the rths command, e.g. ["module load
+  /// gcc/12"] (each single-quoted and eval'd: a line that fails stops the task; SetupLineProblem)
+  std::vector<std::string> setup;
 };
+
+/// Why `line` cannot be a [slurm] setup line ("" if it can): empty or blank, or holding a control
+/// character such as a newline (one entry is one line of the script), or longer than 4096 bytes.
+std::string SetupLineProblem(const std::string& line);
 
 /// A parsed, validated SPEC (paths absolute).
 struct Spec {
@@ -93,7 +107,9 @@ struct RunPoint {
   std::int64_t index = 0;
   std::int64_t case_index = 0, combination = 0, draw = 0;
   std::string scenario;             ///< the case's file
-  std::vector<std::string> sets;    ///< "KEY=VALUE": [set] values, grid values, then drawn values (key order)
+  /// "KEY=VALUE": [set] values, grid values, then drawn values (key order); a drawn element is
+  /// "KEY[i]=VALUE", which ScenarioSets (sweep/element_keys.h) turns into the whole array
+  std::vector<std::string> sets;
 };
 
 /// The largest sweep accepted (runs()).
@@ -102,7 +118,8 @@ inline constexpr std::int64_t kMaxRuns = 10'000'000;
 /// Parses and validates SPEC text (`path` names it in errors and anchors relative paths). Throws
 /// rths::Error naming the file, the key and the allowed values.
 Spec ParseSpec(const std::string& text, const std::string& path);
-/// Reads and parses a SPEC file; throws rths::Error (unreadable file, as ParseSpec).
+/// Reads and parses a SPEC file, and checks its drawn elements against its cases
+/// (CheckElementKeys); throws rths::Error (unreadable file, as ParseSpec).
 Spec LoadSpec(const std::string& path);
 /// The scenario keys a draw sets, the table's columns for it: its key, or for "benchmark_plant"
 /// plant.benchmark.b1, .b2, .a3 and .k_e_N_per_m.
@@ -110,6 +127,10 @@ std::vector<std::string> DrawColumns(const Draw& d);
 
 /// Run `index` (0 <= index < spec.runs(); throws rths::Error otherwise).
 RunPoint PointOf(const Spec& spec, std::int64_t index);
+
+/// A double as a TOML float literal: the shortest text that reads back as the same double, bit
+/// for bit ("1.0", not "1").
+std::string FloatLiteral(double x);
 
 /// SplitMix64 (Steele, Lea and Flood 2014): the next value of the sequence after `state`,
 /// advancing it. A seed mixer with good avalanche, used to derive each run's streams.
