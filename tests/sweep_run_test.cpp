@@ -233,3 +233,22 @@ TEST_CASE("a PI's gains swept: array levels of a grid and a drawn element, in th
   // summary.csv groups by the level's text.
   CHECK(Read(o.out / "summary.csv").find("\"[1.0, 10.0]\",steps,2,0,2,100,0,100,100\n") != std::string::npos);
 }
+
+TEST_CASE("a sweep's model-based controller designs on the plant it drives, as rths run does") {
+  // Issue 43: ff_lqg on a benchmark scenario was designed on the damper rig's "avg" servo model.
+  const auto dir = rths_test::TempDir("sweep_design_model");
+  std::ofstream(dir / "spec.toml") << "[sweep]\nname = \"design\"\nbase = \"" << RTHS_SOURCE_DIR
+                                   << "/scenarios/benchmark/case2_example.toml\"\nrecord = [\"steps\"]\n"
+                                   << "[set]\n\"run.duration_s\" = 0.05\n"
+                                   << "[grid]\n\"controller.kind\" = [\"ff_lqg\", \"lti\"]\n";
+  const auto spec = rths::sweep::LoadSpec((dir / "spec.toml").string());
+  rths::sweep::SweepOptions o;
+  o.out = dir / "out";
+  const auto r = rths::sweep::RunSweep(spec, o);
+  REQUIRE(r.not_completed == 0);
+  REQUIRE(r.design_notes.size() == 1);  // ff_lqg's; lti uses no model
+  CHECK(r.design_notes[0].find("designed on the benchmark plant's Gp") != std::string::npos);
+  const auto s = rths::scenario::LoadScenario((o.out / "runs" / "0" / "scenario.toml").string());
+  CHECK(s.controller.kind == rths::control::ControllerKind::kFfLqg);
+  CHECK(s.controller.model.name == "custom");  // the fit, written into the run's scenario
+}

@@ -103,6 +103,9 @@ int RunLocal(const Args& a, const rths::sweep::Spec& spec) {
   std::printf("ran %lld (not completed %lld), skipped %lld (rows already there)\n", static_cast<long long>(r.ran),
               static_cast<long long>(r.failed), static_cast<long long>(r.skipped));
   if (!r.kept.empty()) std::printf("kept (--resume): runs %s\n", IndexRanges(r.kept).c_str());
+  for (const auto& note : r.design_notes) {
+    std::fprintf(note.rfind("warning:", 0) == 0 ? stderr : stdout, "rths sweep: %s\n", note.c_str());
+  }
   if (r.table.empty()) return r.failed > 0 ? 1 : 0;
   WarnAbsent(r.absent_fields);
   std::printf("rows %lld/%lld, not completed %lld\ntable: %s (and table.h5, summary.csv, plots/)\n",

@@ -1,5 +1,6 @@
 #include "sweep/run_sweep.h"
 
+#include <algorithm>
 #include <fstream>
 #include <map>
 #include <sstream>
@@ -8,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/error.h"
+#include "ident/design_model.h"
 #include "io/reserved_file.h"
 #include "scenario/scenario.h"
 #include "studies/batch.h"
@@ -110,8 +112,12 @@ void RunBlock(const Spec& spec, const SweepOptions& o, const std::vector<std::in
     const fs::path dir = o.out / "runs" / std::to_string(p.index);
     fs::remove_all(dir);  // what an interrupted attempt left
     try {
-      specs.push_back({fmt::format("run {} of sweep {}", p.index, spec.name), scenario::LoadScenario(p.scenario, ScenarioSets(p)),
-                       dir});
+      scenario::Scenario s = scenario::LoadScenario(p.scenario, ScenarioSets(p));
+      // A model-based controller designs on the plant the run drives, as in `rths run`.
+      const std::string note = ident::ResolveDesignModel(&s);
+      auto& notes = outcome->design_notes;
+      if (!note.empty() && std::find(notes.begin(), notes.end(), note) == notes.end()) notes.push_back(note);
+      specs.push_back({fmt::format("run {} of sweep {}", p.index, spec.name), std::move(s), dir});
       points.push_back(p);
     } catch (const std::exception& e) {  // e.g. a drawn value out of the key's range: a row, not a crash
       io::OverwriteFile(RowFile(o.out, p.index).string(),

@@ -33,6 +33,10 @@ struct SweepOptions {
 struct SweepOutcome {
   std::int64_t ran = 0, skipped = 0, failed = 0;  ///< this call's runs; rows already there; this call's rows not "completed"
   std::vector<std::int64_t> kept;  ///< with resume: the indices skipped (their rows kept), ascending
+  /// What model the model-based controllers of this call's runs were designed on, each distinct
+  /// line once (ident::ResolveDesignModel: a benchmark scenario's controller designs on the
+  /// plant's Gp; "warning: ..." where the design is on another plant's model).
+  std::vector<std::string> design_notes;
   /// With the table written: its rows, and those not "completed" (earlier attempts' included).
   std::int64_t rows = 0, not_completed = 0;
   std::vector<std::string> absent_fields;         ///< recorded fields no completed row has (AbsentFields)
