@@ -10,6 +10,7 @@
 
 #include <fmt/format.h>
 
+#include "diagnosis/channel_models.h"
 #include "participants/benchmark_run.h"
 #include "report/html.h"
 #include "signal/spectrum_axes.h"
@@ -235,23 +236,34 @@ std::optional<PageFigure> RealtimeLatency(const RunData& d, const RunReportOptio
   return pf;
 }
 
+double LoopVelocityCutoffHz(double dt_s) { return std::min(kLoopVelocityCutoffHz, 0.4 / dt_s); }
+
+std::vector<double> LoopVelocity(const std::vector<double>& y_mm, double dt_s) {
+  if (y_mm.size() < 4 || !AllFinite(y_mm)) return CentralDifference(y_mm, dt_s);
+  return diagnosis::SmoothMotion(y_mm, dt_s, LoopVelocityCutoffHz(dt_s)).v_mm_s;
+}
+
+std::string LoopVelocityLabel(double dt_s) { return fmt::format("y' [mm/s] (low-passed at {:g} Hz)", LoopVelocityCutoffHz(dt_s)); }
+
 PageFigure Loops(const io::RunSignals& s, const RunReportOptions& o) {
   const auto& y = s.At("y_mm").values;
   const auto& f = s.At("f_kN").values;
-  const std::vector<double> v = CentralDifference(y, s.dt_s);
+  const std::vector<double> v = LoopVelocity(y, s.dt_s);
   const auto idx = Strided(0, y.size(), o.max_loop_points);
   Panel fd = MakePanel("Force-displacement", "y [mm]", "f [kN]");
   fd.key = "off";
   fd.series = {Curve("f(y)", kColorF, y, f, idx)};
-  Panel fv = MakePanel("Force-velocity", "y' [mm/s] (central difference)", "f [kN]");
+  Panel fv = MakePanel("Force-velocity", LoopVelocityLabel(s.dt_s), "f [kN]");
   fv.key = "off";
   fv.series = {Curve("f(y')", kColorF, v, f, idx)};
   PageFigure pf{NewFigure("loops", o), "Force loops", ""};
   pf.figure.panels = {fd, fv};
   pf.figure.columns = 2;
   pf.figure.panel_height_px = 450;
-  pf.caption_html = "Measured force f [kN] against the measured displacement y [mm] and against its velocity "
-                    "y' = (y<sub>k+1</sub> - y<sub>k-1</sub>) / (2 dt) [mm/s].";
+  pf.caption_html = fmt::format("Measured force f [kN] against the measured displacement y [mm] and against its "
+                                "velocity y' [mm/s]: y low-passed at {:g} Hz (zero phase) and differentiated, so that "
+                                "sensor noise on y does not hide the loop.",
+                                LoopVelocityCutoffHz(s.dt_s));
   if (idx.size() < y.size())
     pf.caption_html += fmt::format(" Every {}th step drawn.", y.size() / std::max<std::size_t>(1, idx.size()));
   return pf;
