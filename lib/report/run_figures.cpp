@@ -333,9 +333,9 @@ void GyrFigure(const signal::CrossSpectra& cs, const signal::FrequencyResponseEs
   const std::size_t i_lo = band.i_lo, i_hi = band.i_hi;
   const std::span<const std::complex<double>> band_h(h1.h.data() + i_lo, i_hi - i_lo + 1);
   const std::vector<double> phase = signal::UnwrapPhase(band_h);
-  Panel mag = MakePanel("", "frequency [Hz]", "|G_yr| [-]");
-  Panel ph = MakePanel("", "frequency [Hz]", "phase [deg]");
-  Panel coh = MakePanel("", "frequency [Hz]", "coherence [-]");
+  Panel mag = MakePanel("Magnitude", "frequency [Hz]", "|G_yr| [-]");
+  Panel ph = MakePanel("Phase (unwrapped)", "frequency [Hz]", "phase [deg]");
+  Panel coh = MakePanel("Coherence", "frequency [Hz]", "coherence [-]");
   mag.key = ph.key = "off";
   coh.key = "bottom left";
   Series sm = MakeSeries("|G_yr|", kColorY), sph = MakeSeries("phase", kColorY);
@@ -376,6 +376,7 @@ void GyrFigure(const signal::CrossSpectra& cs, const signal::FrequencyResponseEs
     return;
   }
   PageFigure g{NewFigure("gyr", o), "G_yr = Y / R", ""};
+  g.figure.title = "G_yr = Y / R: measured displacement y over desired displacement r (H1 estimate)";
   // A simulation without sensor noise is a deterministic map from r to y: its coherence is 1 but
   // for the damper's slight nonlinearity, and a panel of it would be a flat line. It is drawn when
   // it says something.
@@ -383,7 +384,7 @@ void GyrFigure(const signal::CrossSpectra& cs, const signal::FrequencyResponseEs
   for (std::size_t i = i_lo; i <= i_hi; ++i) min_coherence = std::min(min_coherence, h1.coherence[i]);
   const bool coherence_flat = min_coherence > 1.0 - kFlatCoherence;
   g.figure.panels = coherence_flat ? std::vector<Panel>{mag, ph} : std::vector<Panel>{mag, ph, coh};
-  g.figure.panel_height_px = 260;
+  g.figure.panel_height_px = 280;
   g.caption_html = fmt::format(
       "H1 estimate of the tracking transfer function G<sub>yr</sub> = S<sub>ry</sub> / S<sub>rr</sub> (same "
       "segments as the spectra): magnitude [-], unwrapped phase [deg] and coherence &gamma;<sup>2</sup> [-] over the "
@@ -496,9 +497,13 @@ PageFigure BenchmarkFigure(const RunData& d, const signal::BenchmarkSignals& b, 
     e_t[k] = b.x_m[k] - b.x_t[k];
     e_r[k] = b.x_m[k] - b.x_r[ai][k];
   }
-  Panel err = MakePanel("Errors of the measured displacement", "t [s]", "error [mm]");
-  err.series = {History("x_m - x_t (J2, J3)", kColorE, t, e_t, m),
-                History(fmt::format("x_m - x_r,{} (J4, J5)", a), kColorF, t, e_r, m)};
+  // The two errors overlap in time: the one of larger RMS is drawn first, beneath, so that the
+  // smaller stays on top and visible (x_m - x_r,a is usually the larger: J4 > J2).
+  Panel err = MakePanel("Errors of the measured displacement (the smaller drawn over the larger)", "t [s]", "error [mm]");
+  Series s_et = History("x_m - x_t (J2, J3)", kColorE, t, e_t, m);
+  Series s_er = History(fmt::format("x_m - x_r,{} (J4, J5)", a), kColorF, t, e_r, m);
+  const bool target_larger = signal::Rms(e_t) > signal::Rms(e_r);
+  err.series = target_larger ? std::vector<Series>{s_et, s_er} : std::vector<Series>{s_er, s_et};
   PageFigure pf{NewFigure("benchmark", o), "Benchmark: measured, target and reference", ""};
   pf.figure.panels = {act, err};
   // The other floors: numerical against reference (J6-J9), at most 6 panels (the lowest 5 and the top).
