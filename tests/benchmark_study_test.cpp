@@ -164,7 +164,8 @@ TEST_CASE("benchmark.png: one legend above, perturbed rings over the nominal dot
   studies::BenchmarkResult res;
   res.perturbed = 2;
   const auto names = studies::BenchmarkControllerNames();
-  res.spread.assign(4, std::vector<std::vector<studies::BenchmarkSpread>>(names.size(), std::vector<studies::BenchmarkSpread>(9)));
+  using Spread = std::vector<studies::BenchmarkSpread>;
+  res.spread.assign(4, std::vector<Spread>(names.size(), Spread(9)));
   for (int cs = 1; cs <= 4; ++cs) {
     for (std::size_t c = 0; c < names.size(); ++c) {
       for (const char* run : {"nominal", "1", "2"}) {
@@ -204,7 +205,8 @@ TEST_CASE("benchmark.png: one legend above, perturbed rings over the nominal dot
     REQUIRE(c.size() >= 9);
     CHECK(c[0].title == "published (Table 3)");
     REQUIRE(c[0].y.size() == 4);
-    for (int cs = 1; cs <= 4; ++cs) CHECK(c[0].y[cs - 1] == doctest::Approx(studies::PublishedExampleCriteria()[cs - 1][js[p - 1]]));
+    for (int cs = 1; cs <= 4; ++cs)
+      CHECK(c[0].y[cs - 1] == doctest::Approx(studies::PublishedExampleCriteria()[cs - 1][js[p - 1]]));
     CHECK(c[0].x[0] < 1.0);  // beside the example controller's (first) tick
     for (int cs = 1; cs <= 4; ++cs) CHECK(c[cs].title == fmt::format("case {}", cs));
     CHECK(c[5].title == "perturbed (2 plants)");

@@ -212,7 +212,8 @@ TEST_CASE("rths compare: figures a reviewer can read (loops, differences, drawin
   REQUIRE(dy.size() == 2);
   CHECK(dy[0].title == "lti");
   double peak_dy = 0;
-  for (std::size_t k = 0; k < y[0].size() && k < y[2].size(); ++k) peak_dy = std::max(peak_dy, std::abs(y[2][k] - y[0][k]));
+  for (std::size_t k = 0; k < y[0].size() && k < y[2].size(); ++k)
+    peak_dy = std::max(peak_dy, std::abs(y[2][k] - y[0][k]));
   double drawn = 0;
   for (double v : dy[0].y) drawn = std::max(drawn, std::abs(v));
   CHECK(drawn == doctest::Approx(peak_dy).epsilon(1e-6));

@@ -113,7 +113,8 @@ CompareFigure Histories(const Overlay& ov, const CompareOptions& o) {
   // again as every other run's difference from the first, on its own axis.
   Panel disp = MakePanel("Displacement", "t [s]", "displacement [mm]");
   disp.series.push_back(Reference(History(ov, 0, "r_mm", "r (" + ov.labels[0] + ")", o)));
-  Panel disp_d = MakePanel("Displacement minus the first run's: y - y (" + ov.labels[0] + ")", "t [s]", "difference [mm]");
+  Panel disp_d =
+      MakePanel("Displacement minus the first run's: y - y (" + ov.labels[0] + ")", "t [s]", "difference [mm]");
   Panel force = MakePanel("Specimen force", "t [s]", "force [kN]");
   Panel force_d = MakePanel("Force minus the first run's: f - f (" + ov.labels[0] + ")", "t [s]", "difference [kN]");
   for (const std::size_t i : LargestFirst(ov, "e_mm")) {

@@ -243,7 +243,9 @@ std::vector<double> LoopVelocity(const std::vector<double>& y_mm, double dt_s) {
   return diagnosis::SmoothMotion(y_mm, dt_s, LoopVelocityCutoffHz(dt_s)).v_mm_s;
 }
 
-std::string LoopVelocityLabel(double dt_s) { return fmt::format("y' [mm/s] (low-passed at {:g} Hz)", LoopVelocityCutoffHz(dt_s)); }
+std::string LoopVelocityLabel(double dt_s) {
+  return fmt::format("y' [mm/s] (low-passed at {:g} Hz)", LoopVelocityCutoffHz(dt_s));
+}
 
 PageFigure Loops(const io::RunSignals& s, const RunReportOptions& o) {
   const auto& y = s.At("y_mm").values;
@@ -499,7 +501,8 @@ PageFigure BenchmarkFigure(const RunData& d, const signal::BenchmarkSignals& b, 
   }
   // The two errors overlap in time: the one of larger RMS is drawn first, beneath, so that the
   // smaller stays on top and visible (x_m - x_r,a is usually the larger: J4 > J2).
-  Panel err = MakePanel("Errors of the measured displacement (the smaller drawn over the larger)", "t [s]", "error [mm]");
+  Panel err =
+      MakePanel("Errors of the measured displacement (the smaller drawn over the larger)", "t [s]", "error [mm]");
   Series s_et = History("x_m - x_t (J2, J3)", kColorE, t, e_t, m);
   Series s_er = History(fmt::format("x_m - x_r,{} (J4, J5)", a), kColorF, t, e_r, m);
   const bool target_larger = signal::Rms(e_t) > signal::Rms(e_r);

@@ -21,8 +21,9 @@
 ///                       band of r, points of low coherence masked
 ///   benchmark.png       scenarios with structure.reference_file (the RTHS benchmark, docs/benchmark.md):
 ///                       x_t = r, x_m = y and the reference's actuator floor x_r,a; x_m - x_t and
-///                       x_m - x_r,a (the one of larger RMS beneath); each other floor x_n,i against x_r,i [mm] against t [s]. The page
-///                       then also has the table of J1-J9 (participants/benchmark_run.h).
+///                       x_m - x_r,a (the one of larger RMS beneath); each other floor x_n,i against
+///                       x_r,i [mm] against t [s]. The page then also has the table of J1-J9
+///                       (participants/benchmark_run.h).
 #include <cstdint>
 #include <filesystem>
 #include <optional>
