@@ -18,6 +18,7 @@
 #include "models/benchmark_structures.h"
 #include "models/structure_file.h"
 #include "studies/benchmark.h"
+#include "plot_data.h"
 #include "test_support.h"
 
 using namespace rths;
@@ -155,4 +156,67 @@ TEST_CASE("reproduce benchmark --quick: identification, benchmark.csv, controlle
   CHECK(again.J2_pct == row->j.J2_pct);
   CHECK(again.J4_pct == row->j.J4_pct);
   CHECK(again.J9_pct == row->j.J9_pct);
+}
+
+TEST_CASE("benchmark.png: one legend above, perturbed rings over the nominal dots, std not RMS, published beside") {
+  // A study's result made up (no runs): every controller's criteria in every case, one perturbed
+  // run equal to the nominal one (its ring must still show), one run stopped.
+  studies::BenchmarkResult res;
+  res.perturbed = 2;
+  const auto names = studies::BenchmarkControllerNames();
+  using Spread = std::vector<studies::BenchmarkSpread>;
+  res.spread.assign(4, std::vector<Spread>(names.size(), Spread(9)));
+  for (int cs = 1; cs <= 4; ++cs) {
+    for (std::size_t c = 0; c < names.size(); ++c) {
+      for (const char* run : {"nominal", "1", "2"}) {
+        studies::BenchmarkRow row;
+        row.case_number = cs;
+        row.controller = names[c];
+        row.run = run;
+        row.criteria_ok = true;
+        const double k = 1.0 + cs + 0.1 * static_cast<double>(c) + (std::string(run) == "2" ? 0.5 : 0.0);
+        row.j.J1_ms = k, row.j.J2_pct = 2 * k, row.j.J3_pct = 3 * k, row.j.J4_pct = 4 * k, row.j.J5_pct = 5 * k;
+        row.j.J6_pct = 6 * k, row.j.J7_pct = 7 * k, row.j.J8_pct = 8 * k, row.j.J9_pct = 9 * k;
+        if (cs == 3 && c == 1 && std::string(run) == "1") row.stopped = "stopped by the safety monitor";
+        res.rows.push_back(row);
+      }
+    }
+  }
+  const auto dir = TempDir("benchmark_png");
+  studies::ReproduceOptions o;
+  o.out_dir = dir;
+  studies::WriteBenchmarkOutputs(res, o);
+  const std::string gp = rths_test::Slurp(dir / "benchmark.gp");
+  const auto curves = rths_test::ReadPlotData(dir / "benchmark.dat");
+  // The statistic is a standard deviation (signal/benchmark_criteria.h): never called RMS.
+  CHECK(gp.find("RMS") == std::string::npos);
+  CHECK(gp.find("set title 'J2: std(x_m - x_t) / std(x_t)") != std::string::npos);
+  const int js[4] = {0, 1, 3, 6};
+  for (int p = 1; p <= 4; ++p) {
+    CAPTURE(p);
+    const std::string panel = rths_test::PanelScript(gp, p);
+    // The legend is not beside the axes (it took 40 % of the width): above the first panel only.
+    CHECK(panel.find("outside right") == std::string::npos);
+    CHECK(panel.find("set rmargin -1") != std::string::npos);
+    CHECK(panel.find(p == 1 ? "set key on outside top center horizontal" : "set key off") != std::string::npos);
+    CHECK(panel.find("set offsets graph") != std::string::npos);
+    const auto c = rths_test::PanelCurves(curves, p);
+    // Drawing order: published, the nominal dots, then the perturbed rings over them, then crosses.
+    REQUIRE(c.size() >= 9);
+    CHECK(c[0].title == "published (Table 3)");
+    REQUIRE(c[0].y.size() == 4);
+    for (int cs = 1; cs <= 4; ++cs)
+      CHECK(c[0].y[cs - 1] == doctest::Approx(studies::PublishedExampleCriteria()[cs - 1][js[p - 1]]));
+    CHECK(c[0].x[0] < 1.0);  // beside the example controller's (first) tick
+    for (int cs = 1; cs <= 4; ++cs) CHECK(c[cs].title == fmt::format("case {}", cs));
+    CHECK(c[5].title == "perturbed (2 plants)");
+    CHECK(c[5].x.size() == 2 * names.size());
+    for (std::size_t i = 6; i < 9; ++i) CHECK(c[i].title.empty());
+    // A perturbed ring sits apart from its nominal dot (run 1 has the nominal value).
+    CHECK(c[5].y[0] == doctest::Approx(c[1].y[0]));
+    CHECK(c[5].x[0] - c[1].x[0] > 0.02);
+    if (p == 1) CHECK(c.back().title == "stopped early");
+  }
+  // Perturbed rings are drawn with a larger marker than before (0.8: under the 1.6 dots).
+  CHECK(gp.find("with points pt 6 ps 1.1") != std::string::npos);
 }

@@ -5,6 +5,8 @@
 
 #include <sys/wait.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <string>
 #include <vector>
@@ -14,6 +16,7 @@
 
 #include "core/error.h"
 #include "report/compare_page.h"
+#include "plot_data.h"
 #include "test_support.h"
 
 namespace fs = std::filesystem;
@@ -142,4 +145,94 @@ TEST_CASE("rths compare: benchmark runs show their J1-J9, in the terminal and on
   const std::string html = Slurp(out / "compare.html");
   CHECK(html.find("<th>benchmark J2</th><td>9.78 %</td>") != std::string::npos);
   CHECK(html.find("<th>benchmark J9</th>") != std::string::npos);
+}
+
+TEST_CASE("rths compare: figures a reviewer can read (loops, differences, drawing order, legends)") {
+  // Three benchmark runs of case 2 (its spring specimen and sensor noise), the worst given last.
+  const fs::path dir = TempDir("compare_reviewer");
+  const std::vector<std::string> kinds = {"ff_lqg", "ff", "lti"};
+  std::vector<fs::path> runs;
+  for (const auto& kind : kinds) {
+    const fs::path out = dir / kind;
+    std::string output;
+    REQUIRE_MESSAGE(RunCli(std::string(RTHS_SOURCE_DIR) + "/scenarios/benchmark/case2_example.toml --transport memq "
+                           "--skip-space-check --set run.duration_s=12 --set controller.kind=" + kind + " --out " +
+                           out.string(),
+                           &output) == 0,
+                    output);
+    runs.push_back(out);
+  }
+  std::string output;
+  const fs::path out = dir / "cmp";
+  REQUIRE_MESSAGE(Compare(fmt::format("{} {} {} --out {}", runs[0].string(), runs[1].string(), runs[2].string(),
+                                      out.string()),
+                          &output) == 0,
+                  output);
+  const fs::path figs = out / "figures";
+  std::vector<double> peak_e;
+  std::vector<std::vector<double>> y;
+  for (const auto& r : runs) {
+    const auto d = rths::report::LoadRunData(r);
+    double p = 0;
+    for (double e : d.signals.At("e_mm").values) p = std::max(p, std::abs(e));
+    peak_e.push_back(p);
+    y.push_back(d.signals.At("y_mm").values);
+  }
+  REQUIRE(peak_e[2] > peak_e[1]);
+  REQUIRE(peak_e[1] > peak_e[0]);
+
+  // Force-velocity: the velocity is y's low-passed derivative, not its central difference, whose
+  // sensor noise (0.016 mm at 4096 Hz: 46 mm/s RMS) made the loop a cloud. A smooth curve changes
+  // little from one drawn point to the next; noise changes by its whole size.
+  const auto loops = rths_test::ReadPlotData(figs / "compare_loops.dat");
+  const auto fv = rths_test::PanelCurves(loops, 2);
+  REQUIRE(fv.size() == 3);
+  for (const auto& c : fv) {
+    CAPTURE(c.title);
+    double ss = 0, sd = 0;
+    for (std::size_t i = 1; i < c.x.size(); ++i) ss += c.x[i] * c.x[i], sd += std::pow(c.x[i] - c.x[i - 1], 2);
+    CHECK(std::sqrt(sd / ss) < 0.3);
+  }
+  CHECK(Slurp(figs / "compare_loops.gp").find("y'' [mm/s] (low-passed at 50 Hz)") != std::string::npos);
+
+  // The worst run is drawn first (beneath), the best last, in every overlay.
+  for (const char* fig : {"compare_error", "compare_loops"}) {
+    CAPTURE(fig);
+    const auto first = rths_test::PanelCurves(rths_test::ReadPlotData(figs / (std::string(fig) + ".dat")), 1);
+    REQUIRE(first.size() == 3);
+    CHECK(first[0].title == "lti");
+    CHECK(first[1].title == "ff");
+    CHECK(first[2].title == "ff_lqg");
+  }
+
+  // Histories: each other run's y and f minus the first run's, on their own axes; the difference
+  // of y keeps its peak (min/max decimation).
+  const auto hist = rths_test::ReadPlotData(figs / "compare_histories.dat");
+  const auto dy = rths_test::PanelCurves(hist, 2);
+  REQUIRE(dy.size() == 2);
+  CHECK(dy[0].title == "lti");
+  double peak_dy = 0;
+  for (std::size_t k = 0; k < y[0].size() && k < y[2].size(); ++k)
+    peak_dy = std::max(peak_dy, std::abs(y[2][k] - y[0][k]));
+  double drawn = 0;
+  for (double v : dy[0].y) drawn = std::max(drawn, std::abs(v));
+  CHECK(drawn == doctest::Approx(peak_dy).epsilon(1e-6));
+  REQUIRE(rths_test::PanelCurves(hist, 4).size() == 2);
+  const std::string hist_gp = Slurp(figs / "compare_histories.gp");
+  CHECK(hist_gp.find("difference [kN]") != std::string::npos);
+
+  // Legends: small, and once per figure (a run has one colour in every panel), again only where a
+  // panel adds an entry (the zoom's r).
+  auto keys = [](const std::string& gp) {
+    int on = 0;
+    for (std::size_t at = gp.find("set key on"); at != std::string::npos; at = gp.find("set key on", at + 1)) {
+      ++on;
+      CHECK(gp.substr(at, gp.find('\n', at) - at).find("font ',9'") != std::string::npos);
+    }
+    return on;
+  };
+  CHECK(keys(hist_gp) == 1);
+  CHECK(keys(Slurp(figs / "compare_loops.gp")) == 1);
+  CHECK(keys(Slurp(figs / "compare_spectra.gp")) == 1);  // r and the runs over y's; e's adds none
+  CHECK(keys(Slurp(figs / "compare_error.gp")) == 2);    // the runs over e; the zoom adds r
 }

@@ -21,6 +21,7 @@
 #include "core/error.h"
 #include "report/html.h"
 #include "report/run_report.h"
+#include "plot_data.h"
 #include "test_support.h"
 
 namespace fs = std::filesystem;
@@ -410,4 +411,34 @@ TEST_CASE("a reviewer's figures: a constant current is a line of text, the spect
   for (const auto& m : dp.summary["realtime"]["latency_windows"]["misses"]) missed_windows += m.get<int>() > 0 ? 1 : 0;
   CHECK(Slurp(paced_files.html).find(fmt::format("{} window(s) held deadline misses (marked)", missed_windows)) !=
         std::string::npos);
+}
+
+TEST_CASE("a benchmark run's report: the smaller error curve drawn over the larger, G_yr with a title") {
+  const auto dir = TempDir("report_benchmark_figures");
+  std::string out;
+  REQUIRE_MESSAGE(RunCli(std::string(RTHS_SOURCE_DIR) + "/scenarios/benchmark/case2_example.toml --transport memq "
+                         "--skip-space-check --set run.duration_s=12 --out " + (dir / "run").string(),
+                         &out) == 0,
+                  out);
+  rths::report::WriteRunReport(dir / "run");
+  const fs::path figs = dir / "run" / "figures";
+  // The errors x_m - x_t (J2) and x_m - x_r,1 (J4) overlap: the one of larger RMS first, beneath.
+  const auto errors = rths_test::PanelCurves(rths_test::ReadPlotData(figs / "benchmark.dat"), 2);
+  REQUIRE(errors.size() == 2);
+  auto rms = [](const std::vector<double>& v) {
+    double s = 0;
+    for (double x : v) s += x * x;
+    return std::sqrt(s / static_cast<double>(v.size()));
+  };
+  CHECK(rms(errors[0].y) > rms(errors[1].y));
+  CHECK(errors[0].title.find("x_r,1") != std::string::npos);  // J4 > J2 for the example controller
+  // G_yr has a title over its panels, and each panel its own.
+  const std::string gyr = Slurp(figs / "gyr.gp");
+  const auto multiplot = gyr.find("set multiplot layout ");
+  REQUIRE(multiplot != std::string::npos);
+  CHECK(gyr.substr(multiplot, gyr.find('\n', multiplot) - multiplot).find(",1 title 'G_yr = Y / R: ") != std::string::npos);
+  CHECK(gyr.find("set title 'Magnitude'") != std::string::npos);
+  CHECK(gyr.find("set title 'Phase (unwrapped)'") != std::string::npos);
+  // The force-velocity loop's velocity is the low-passed derivative of y, not its noisy central difference.
+  CHECK(Slurp(figs / "loops.gp").find("y'' [mm/s] (low-passed at 50 Hz)") != std::string::npos);
 }

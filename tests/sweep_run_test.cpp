@@ -15,6 +15,8 @@
 #include "io/command.h"
 #include "scenario/scenario.h"
 #include "sweep/run_sweep.h"
+#include "sweep/table.h"
+#include "plot_data.h"
 #include "test_support.h"
 
 namespace fs = std::filesystem;
@@ -251,4 +253,101 @@ TEST_CASE("a sweep's model-based controller designs on the plant it drives, as r
   const auto s = rths::scenario::LoadScenario((o.out / "runs" / "0" / "scenario.toml").string());
   CHECK(s.controller.kind == rths::control::ControllerKind::kFfLqg);
   CHECK(s.controller.model.name == "custom");  // the fit, written into the run's scenario
+}
+
+// --- plots (issue 43 item 7): a line per level of the other factor, points off the frame --------
+
+namespace sweep_plots {
+
+/// A table of `field` over the grid controller.kind x structure.damping_ratio (and `draws` runs
+/// per point), row i's value `value(kind, zeta, draw)`; one row not completed.
+rths::sweep::Table GridTable(const rths::sweep::Spec& spec, double (*value)(int, double, int)) {
+  rths::sweep::Table t;
+  t.columns = rths::sweep::TableColumns(spec);
+  const std::int64_t per = std::max<std::int64_t>(spec.draws, 1);
+  std::int64_t i = 0;
+  for (int k = 0; k < 2; ++k) {
+    for (const double zeta : {0.01, 0.02, 0.05}) {
+      for (int d = 0; d < per; ++d, ++i) {
+        std::vector<nlohmann::json> row = {i, i == 3 ? "failed: x" : "completed", "sha"};
+        if (spec.grid.size() == 2) row.push_back(k == 0 ? "none" : "ff");
+        row.push_back(zeta);
+        row.push_back(value(k, zeta, d));
+        t.rows.push_back(row);
+        t.group.push_back(i / per);
+      }
+    }
+  }
+  return t;
+}
+
+}  // namespace sweep_plots
+
+TEST_CASE("sweep plots: two factors, each field against one with a line per level of the other, off the frame") {
+  const auto dir = rths_test::TempDir("sweep_plots_two");
+  rths::sweep::Spec spec;
+  spec.name = "two";
+  spec.cases = {"base.toml"};
+  spec.record = {"tracking_nrmse_pct"};
+  spec.grid = {{"controller.kind", {"none", "ff"}}, {"structure.damping_ratio", {"0.01", "0.02", "0.05"}}};
+  const auto t = sweep_plots::GridTable(spec, [](int k, double zeta, int) { return (k + 1) * 100.0 * zeta; });
+  const auto pngs = rths::sweep::WritePlots(spec, t, dir);
+  REQUIRE(pngs.size() == 1);
+  const auto curves = rths_test::ReadPlotData(dir / "tracking_nrmse_pct.dat");
+  // Against the controller: a line per damping ratio (row 3, zeta 0.01 of ff, failed, is left out).
+  const auto by_kind = rths_test::PanelCurves(curves, 1);
+  REQUIRE(by_kind.size() == 3);
+  CHECK(by_kind[0].title == "0.01");
+  CHECK(by_kind[0].x == std::vector<double>{0.0});  // none only: ff's run failed
+  CHECK(by_kind[2].title == "0.05");
+  CHECK(by_kind[2].x == std::vector<double>{0.0, 1.0});
+  CHECK(by_kind[2].y == std::vector<double>{5.0, 10.0});
+  // Against the damping ratio: a line per controller, through its points in x order.
+  const auto by_zeta = rths_test::PanelCurves(curves, 2);
+  REQUIRE(by_zeta.size() == 2);
+  CHECK(by_zeta[0].title == "none");
+  CHECK(by_zeta[0].x == std::vector<double>{0.01, 0.02, 0.05});
+  CHECK(by_zeta[1].title == "ff");
+  CHECK(by_zeta[1].x == std::vector<double>{0.02, 0.05});
+  CHECK(by_zeta[1].y == std::vector<double>{4.0, 10.0});
+  const std::string gp = rths_test::Slurp(dir / "tracking_nrmse_pct.gp");
+  for (int p = 1; p <= 2; ++p) {
+    CAPTURE(p);
+    const std::string panel = rths_test::PanelScript(gp, p);
+    CHECK(panel.find("set offsets graph 0.05, graph 0.05, graph 0.05, graph 0.05") != std::string::npos);
+    CHECK(panel.find("with linespoints") != std::string::npos);
+    CHECK(panel.find("set key on outside right top") != std::string::npos);
+    CHECK(panel.find("set rmargin 14") != std::string::npos);  // the key's column: "0.01" + 10, not 40 % of the width
+    CHECK(panel.find("lc rgb '#D55E00'") != std::string::npos);  // the second level's colour
+  }
+  CHECK(rths_test::PanelScript(gp, 1).find("set title 'a curve per structure.damping_ratio'") != std::string::npos);
+}
+
+TEST_CASE("sweep plots: one factor with draws, a line through the means, the runs as points, off the frame") {
+  const auto dir = rths_test::TempDir("sweep_plots_one");
+  rths::sweep::Spec spec;
+  spec.name = "one";
+  spec.cases = {"base.toml"};
+  spec.record = {"peak_force_kN"};
+  spec.draws = 2;
+  spec.grid = {{"structure.damping_ratio", {"0.01", "0.02", "0.05"}}};
+  spec.draw = {rths::sweep::Draw{}};
+  spec.draw[0].key = "plant.noise_seed";
+  spec.draw[0].dist = "seed";
+  auto t = sweep_plots::GridTable(spec, [](int k, double zeta, int d) { return 100.0 * zeta + k + d; });
+  for (auto& row : t.rows) row.insert(row.end() - 1, nlohmann::json(7));  // the seed column
+  REQUIRE(t.columns.size() == t.rows[0].size());
+  REQUIRE(rths::sweep::WritePlots(spec, t, dir).size() == 1);
+  const auto curves = rths_test::PanelCurves(rths_test::ReadPlotData(dir / "peak_force_kN.dat"), 1);
+  REQUIRE(curves.size() == 2);  // the runs, then the line through their means
+  CHECK(curves[0].title.empty());
+  CHECK(curves[1].x == std::vector<double>{0.01, 0.02, 0.05});
+  // The mean of a point's completed runs: zeta 0.01 holds 1, 2, 2, 3; at 0.02 row 3 (3) failed: 2, 3, 4.
+  CHECK(curves[1].y[0] == doctest::Approx(2.0));
+  CHECK(curves[1].y[1] == doctest::Approx(3.0));
+  CHECK(curves[0].x.size() == 11);
+  const std::string gp = rths_test::Slurp(dir / "peak_force_kN.gp");
+  CHECK(gp.find("set offsets graph 0.05") != std::string::npos);
+  CHECK(gp.find("with linespoints") != std::string::npos);
+  CHECK(gp.find("set key off") != std::string::npos);
 }

@@ -189,6 +189,12 @@ void WritePanel(std::ostringstream& gp, const Panel& panel, std::size_t p, const
     gp << ")\n";
   }
   gp << fmt::format("set boxwidth {} absolute\nset style fill solid 0.85 border -1\n", Num(panel.box_width));
+  if (panel.margin_fraction > 0) {
+    const std::string f = Num(panel.margin_fraction);
+    gp << fmt::format("set offsets graph {0}, graph {0}, graph {0}, graph {0}\n", f);
+  } else {
+    gp << "unset offsets\n";
+  }
   gp << "unset object 1\n";
   if (panel.shade_x) {
     gp << fmt::format("set object 1 rect from {},graph 0 to {},graph 1 behind fc rgb '#ebebeb' fs solid 1.0 noborder\n",

@@ -50,6 +50,10 @@ struct Panel {
   /// An x interval [x units] shaded light grey behind the data over the panel's height (a fitted
   /// band, say); unset = none.
   std::optional<std::pair<double, double>> shade_x;
+  /// Space left between the data and the frame, as a fraction of the plot area on every side of
+  /// an autoscaled axis (gnuplot `set offsets graph f, ...`): points at the data's extremes stay
+  /// off the frame. 0 = none (gnuplot's autoscale, extremes on the frame when they fall on a tic).
+  double margin_fraction = 0.0;
 };
 
 struct Figure {

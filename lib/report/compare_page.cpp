@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <future>
+#include <limits>
 #include <map>
 #include <set>
 
@@ -53,13 +54,33 @@ std::vector<double> Head(const std::vector<double>& x, std::size_t n) {
   return {x.begin(), x.begin() + static_cast<std::ptrdiff_t>(std::min(n, x.size()))};
 }
 
-/// The legends go above the axes, in a row: with several runs overlaid no corner of the data is
-/// free, and beside the axes they would take a third of the width. Stacked axes line up.
+/// The legends go above the axes, in a row, in a smaller font with short samples: with several
+/// runs overlaid no corner of the data is free, and beside the axes they would take a third of the
+/// width. A panel whose entries (title and colour) an earlier panel's legend already shows has none:
+/// a run has one colour in every panel. Stacked axes line up.
 void KeysAbove(Figure* f) {
+  std::set<std::pair<std::string, std::string>> shown;
   for (auto& p : f->panels) {
-    p.key = "outside top center horizontal";
+    bool news = false;
+    for (const auto& s : p.series) news = news || (!s.title.empty() && !shown.count({s.title, s.color}));
+    p.key = news ? "outside top center horizontal font ',9' samplen 3" : "off";
+    for (const auto& s : p.series) shown.insert({s.title, s.color});
     if (f->columns == 1) p.left_margin_chars = 11;
   }
+}
+
+/// The runs in drawing order: the largest peak |column| first, the smallest last, so that a run
+/// that strays far is drawn beneath and the runs close together stay visible over it.
+std::vector<std::size_t> LargestFirst(const Overlay& ov, const char* column) {
+  std::vector<std::size_t> order(ov.labels.size());
+  std::vector<double> peak(order.size());
+  for (std::size_t i = 0; i < order.size(); ++i) {
+    order[i] = i;
+    peak[i] = signal::PeakAbs(Head(ov.Col(i, column), ov.n));
+    if (!std::isfinite(peak[i])) peak[i] = std::numeric_limits<double>::infinity();
+  }
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return peak[a] > peak[b]; });
+  return order;
 }
 
 Figure NewFigure(const std::string& name, const CompareOptions& o) { return run_figures::PageFrame(name, o.gnuplot); }
@@ -79,19 +100,38 @@ Series Reference(Series s) {
   return s;
 }
 
+/// Run `run`'s column minus the first run's, step by step, over the common steps.
+Series Difference(const Overlay& ov, std::size_t run, const char* column, const CompareOptions& o) {
+  std::vector<double> d = Head(ov.Col(run, column), ov.n);
+  const std::vector<double>& first = ov.Col(0, column);
+  for (std::size_t k = 0; k < d.size(); ++k) d[k] -= first[k];
+  return run_figures::History(ov.labels[run], ov.colors[run], Head(ov.Col(run, "t_s"), ov.n), d, o.max_plot_points);
+}
+
 CompareFigure Histories(const Overlay& ov, const CompareOptions& o) {
+  // Runs that track well lie on one another at the scale of the motion: each quantity is drawn
+  // again as every other run's difference from the first, on its own axis.
   Panel disp = MakePanel("Displacement", "t [s]", "displacement [mm]");
   disp.series.push_back(Reference(History(ov, 0, "r_mm", "r (" + ov.labels[0] + ")", o)));
+  Panel disp_d =
+      MakePanel("Displacement minus the first run's: y - y (" + ov.labels[0] + ")", "t [s]", "difference [mm]");
   Panel force = MakePanel("Specimen force", "t [s]", "force [kN]");
-  for (std::size_t i = 0; i < ov.labels.size(); ++i) {
-    disp.series.push_back(History(ov, i, "y_mm", "y " + ov.labels[i], o));
-    force.series.push_back(History(ov, i, "f_kN", "f " + ov.labels[i], o));
+  Panel force_d = MakePanel("Force minus the first run's: f - f (" + ov.labels[0] + ")", "t [s]", "difference [kN]");
+  for (const std::size_t i : LargestFirst(ov, "e_mm")) {
+    disp.series.push_back(History(ov, i, "y_mm", ov.labels[i], o));
+    force.series.push_back(History(ov, i, "f_kN", ov.labels[i], o));
+    if (i == 0) continue;
+    disp_d.series.push_back(Difference(ov, i, "y_mm", o));
+    force_d.series.push_back(Difference(ov, i, "f_kN", o));
   }
   CompareFigure cf{NewFigure("compare_histories", o), "Time histories", ""};
-  cf.figure.panels = {disp, force};
+  cf.figure.panels = {disp, disp_d, force, force_d};
+  cf.figure.panel_height_px = 260;
   cf.caption_html = "Measured displacement y of every run with the desired displacement r of the first (dashed) "
-                    "[mm]; measured force f [kN]. Aligned by step (t = k dt); each curve keeps the minimum and "
-                    "maximum of its samples per bucket (every peak).";
+                    "[mm], and each other run's y minus the first run's [mm]; measured force f [kN], and each other "
+                    "run's f minus the first run's [kN]. Aligned by step (t = k dt); the run with the largest "
+                    "tracking error drawn first, beneath; each curve keeps the minimum and maximum of its samples "
+                    "per bucket (every peak).";
   return cf;
 }
 
@@ -99,8 +139,8 @@ CompareFigure ErrorFigure(const Overlay& ov, const CompareOptions& o) {
   Panel err = MakePanel("Tracking error e = r - y", "t [s]", "e [mm]");
   std::size_t at = 0, worst_run = 0;
   double worst = -1;
+  for (const std::size_t i : LargestFirst(ov, "e_mm")) err.series.push_back(History(ov, i, "e_mm", ov.labels[i], o));
   for (std::size_t i = 0; i < ov.labels.size(); ++i) {
-    err.series.push_back(History(ov, i, "e_mm", ov.labels[i], o));
     std::size_t k = 0;
     const double p = signal::PeakAbs(Head(ov.Col(i, "e_mm"), ov.n), &k);
     if (p > worst) worst = p, at = k, worst_run = i;
@@ -114,33 +154,41 @@ CompareFigure ErrorFigure(const Overlay& ov, const CompareOptions& o) {
                          "t [s]", "displacement [mm]");
   zoom.x_range = {{t[lo], t[hi - 1]}};
   zoom.series.push_back(Reference(Curve("r (" + ov.labels[0] + ")", "black", t, ov.Col(0, "r_mm"), idx)));
-  for (std::size_t i = 0; i < ov.labels.size(); ++i) {
-    zoom.series.push_back(Curve("y " + ov.labels[i], ov.colors[i], t, ov.Col(i, "y_mm"), idx));
+  for (const std::size_t i : LargestFirst(ov, "e_mm")) {
+    zoom.series.push_back(Curve(ov.labels[i], ov.colors[i], t, ov.Col(i, "y_mm"), idx));
   }
   CompareFigure cf{NewFigure("compare_error", o), "Tracking error", ""};
   cf.figure.panels = {err, zoom};
   cf.figure.panel_height_px = 340;
   cf.caption_html = "Top: e = r - y of every run [mm], each against its own r. Bottom: r of the first run (dashed) "
-                    "and every y [mm] over the 0.5 s around the largest |e| of any run, every step.";
+                    "and every y [mm] over the 0.5 s around the largest |e| of any run, every step. The run with the "
+                    "largest |e| is drawn first, beneath the others.";
   return cf;
 }
 
 CompareFigure Loops(const Overlay& ov, const CompareOptions& o) {
   Panel fd = MakePanel("Force-displacement", "y [mm]", "f [kN]");
-  Panel fv = MakePanel("Force-velocity", "y' [mm/s] (central difference)", "f [kN]");
+  // The paper's axes (Fig. 11): the specimen's force against its displacement and velocity, the
+  // measured y and its low-passed derivative (run_figures::LoopVelocity says why not y's central
+  // difference or r'). A nearly elastic specimen (the benchmark's spring) draws a line against y:
+  // its loop is the one against y'.
+  Panel fv = MakePanel("Force-velocity", run_figures::LoopVelocityLabel(ov.dt_s), "f [kN]");
   const auto idx = Strided(0, ov.n, o.max_loop_points);
-  for (std::size_t i = 0; i < ov.labels.size(); ++i) {
+  for (const std::size_t i : LargestFirst(ov, "e_mm")) {
     const std::vector<double> y = Head(ov.Col(i, "y_mm"), ov.n);
     const std::vector<double> f = Head(ov.Col(i, "f_kN"), ov.n);
     fd.series.push_back(Curve(ov.labels[i], ov.colors[i], y, f, idx));
-    fv.series.push_back(Curve(ov.labels[i], ov.colors[i], CentralDifference(y, ov.dt_s), f, idx));
+    fv.series.push_back(Curve(ov.labels[i], ov.colors[i], run_figures::LoopVelocity(y, ov.dt_s), f, idx));
   }
   CompareFigure cf{NewFigure("compare_loops", o), "Force loops", ""};
   cf.figure.panels = {fd, fv};
   cf.figure.columns = 2;
   cf.figure.panel_height_px = 450;
-  cf.caption_html = "Measured force f [kN] against y [mm] and against y' = (y<sub>k+1</sub> - y<sub>k-1</sub>) / "
-                    "(2 dt) [mm/s], every run over the common steps.";
+  cf.caption_html = fmt::format("Measured force f [kN] against y [mm] and against y' [mm/s] (y low-passed at {:g} Hz, "
+                                "zero phase, and differentiated: sensor noise on y does not hide the loop), every run "
+                                "over the common steps, the run with the largest tracking error drawn first. A nearly "
+                                "elastic specimen draws a line against y; its loop is the one against y'.",
+                                run_figures::LoopVelocityCutoffHz(ov.dt_s));
   return cf;
 }
 

@@ -4,8 +4,11 @@
 /// differ between them, and figures that overlay them, aligned by step (t = k dt):
 ///   compare_error.png      e = r - y of every run [mm] over the run, and r with every y over the
 ///                          0.5 s around the largest |e| of any run
-///   compare_histories.png  y of every run with r of the first [mm]; f of every run [kN]
-///   compare_loops.png      f against y [kN, mm] and against y' [mm/s], every run
+///   compare_histories.png  y of every run with r of the first [mm], each other run's y minus the
+///                          first's [mm]; f of every run [kN], each other run's f minus the first's [kN]
+///   compare_loops.png      f against y [kN, mm] and against y' [mm/s] (run_figures::LoopVelocity),
+///                          every run
+/// The run with the largest tracking error is drawn first (beneath); one legend per figure, above.
 ///   compare_spectra.png    Welch PSDs of e [mm^2/Hz] over the band that carries r
 #include <filesystem>
 #include <string>

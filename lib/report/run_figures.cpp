@@ -10,6 +10,7 @@
 
 #include <fmt/format.h>
 
+#include "diagnosis/channel_models.h"
 #include "participants/benchmark_run.h"
 #include "report/html.h"
 #include "signal/spectrum_axes.h"
@@ -235,23 +236,36 @@ std::optional<PageFigure> RealtimeLatency(const RunData& d, const RunReportOptio
   return pf;
 }
 
+double LoopVelocityCutoffHz(double dt_s) { return std::min(kLoopVelocityCutoffHz, 0.4 / dt_s); }
+
+std::vector<double> LoopVelocity(const std::vector<double>& y_mm, double dt_s) {
+  if (y_mm.size() < 4 || !AllFinite(y_mm)) return CentralDifference(y_mm, dt_s);
+  return diagnosis::SmoothMotion(y_mm, dt_s, LoopVelocityCutoffHz(dt_s)).v_mm_s;
+}
+
+std::string LoopVelocityLabel(double dt_s) {
+  return fmt::format("y' [mm/s] (low-passed at {:g} Hz)", LoopVelocityCutoffHz(dt_s));
+}
+
 PageFigure Loops(const io::RunSignals& s, const RunReportOptions& o) {
   const auto& y = s.At("y_mm").values;
   const auto& f = s.At("f_kN").values;
-  const std::vector<double> v = CentralDifference(y, s.dt_s);
+  const std::vector<double> v = LoopVelocity(y, s.dt_s);
   const auto idx = Strided(0, y.size(), o.max_loop_points);
   Panel fd = MakePanel("Force-displacement", "y [mm]", "f [kN]");
   fd.key = "off";
   fd.series = {Curve("f(y)", kColorF, y, f, idx)};
-  Panel fv = MakePanel("Force-velocity", "y' [mm/s] (central difference)", "f [kN]");
+  Panel fv = MakePanel("Force-velocity", LoopVelocityLabel(s.dt_s), "f [kN]");
   fv.key = "off";
   fv.series = {Curve("f(y')", kColorF, v, f, idx)};
   PageFigure pf{NewFigure("loops", o), "Force loops", ""};
   pf.figure.panels = {fd, fv};
   pf.figure.columns = 2;
   pf.figure.panel_height_px = 450;
-  pf.caption_html = "Measured force f [kN] against the measured displacement y [mm] and against its velocity "
-                    "y' = (y<sub>k+1</sub> - y<sub>k-1</sub>) / (2 dt) [mm/s].";
+  pf.caption_html = fmt::format("Measured force f [kN] against the measured displacement y [mm] and against its "
+                                "velocity y' [mm/s]: y low-passed at {:g} Hz (zero phase) and differentiated, so that "
+                                "sensor noise on y does not hide the loop.",
+                                LoopVelocityCutoffHz(s.dt_s));
   if (idx.size() < y.size())
     pf.caption_html += fmt::format(" Every {}th step drawn.", y.size() / std::max<std::size_t>(1, idx.size()));
   return pf;
@@ -321,9 +335,9 @@ void GyrFigure(const signal::CrossSpectra& cs, const signal::FrequencyResponseEs
   const std::size_t i_lo = band.i_lo, i_hi = band.i_hi;
   const std::span<const std::complex<double>> band_h(h1.h.data() + i_lo, i_hi - i_lo + 1);
   const std::vector<double> phase = signal::UnwrapPhase(band_h);
-  Panel mag = MakePanel("", "frequency [Hz]", "|G_yr| [-]");
-  Panel ph = MakePanel("", "frequency [Hz]", "phase [deg]");
-  Panel coh = MakePanel("", "frequency [Hz]", "coherence [-]");
+  Panel mag = MakePanel("Magnitude", "frequency [Hz]", "|G_yr| [-]");
+  Panel ph = MakePanel("Phase (unwrapped)", "frequency [Hz]", "phase [deg]");
+  Panel coh = MakePanel("Coherence", "frequency [Hz]", "coherence [-]");
   mag.key = ph.key = "off";
   coh.key = "bottom left";
   Series sm = MakeSeries("|G_yr|", kColorY), sph = MakeSeries("phase", kColorY);
@@ -364,6 +378,7 @@ void GyrFigure(const signal::CrossSpectra& cs, const signal::FrequencyResponseEs
     return;
   }
   PageFigure g{NewFigure("gyr", o), "G_yr = Y / R", ""};
+  g.figure.title = "G_yr = Y / R: measured displacement y over desired displacement r (H1 estimate)";
   // A simulation without sensor noise is a deterministic map from r to y: its coherence is 1 but
   // for the damper's slight nonlinearity, and a panel of it would be a flat line. It is drawn when
   // it says something.
@@ -371,7 +386,7 @@ void GyrFigure(const signal::CrossSpectra& cs, const signal::FrequencyResponseEs
   for (std::size_t i = i_lo; i <= i_hi; ++i) min_coherence = std::min(min_coherence, h1.coherence[i]);
   const bool coherence_flat = min_coherence > 1.0 - kFlatCoherence;
   g.figure.panels = coherence_flat ? std::vector<Panel>{mag, ph} : std::vector<Panel>{mag, ph, coh};
-  g.figure.panel_height_px = 260;
+  g.figure.panel_height_px = 280;
   g.caption_html = fmt::format(
       "H1 estimate of the tracking transfer function G<sub>yr</sub> = S<sub>ry</sub> / S<sub>rr</sub> (same "
       "segments as the spectra): magnitude [-], unwrapped phase [deg] and coherence &gamma;<sup>2</sup> [-] over the "
@@ -484,9 +499,14 @@ PageFigure BenchmarkFigure(const RunData& d, const signal::BenchmarkSignals& b, 
     e_t[k] = b.x_m[k] - b.x_t[k];
     e_r[k] = b.x_m[k] - b.x_r[ai][k];
   }
-  Panel err = MakePanel("Errors of the measured displacement", "t [s]", "error [mm]");
-  err.series = {History("x_m - x_t (J2, J3)", kColorE, t, e_t, m),
-                History(fmt::format("x_m - x_r,{} (J4, J5)", a), kColorF, t, e_r, m)};
+  // The two errors overlap in time: the one of larger RMS is drawn first, beneath, so that the
+  // smaller stays on top and visible (x_m - x_r,a is usually the larger: J4 > J2).
+  Panel err =
+      MakePanel("Errors of the measured displacement (the smaller drawn over the larger)", "t [s]", "error [mm]");
+  Series s_et = History("x_m - x_t (J2, J3)", kColorE, t, e_t, m);
+  Series s_er = History(fmt::format("x_m - x_r,{} (J4, J5)", a), kColorF, t, e_r, m);
+  const bool target_larger = signal::Rms(e_t) > signal::Rms(e_r);
+  err.series = target_larger ? std::vector<Series>{s_et, s_er} : std::vector<Series>{s_er, s_et};
   PageFigure pf{NewFigure("benchmark", o), "Benchmark: measured, target and reference", ""};
   pf.figure.panels = {act, err};
   // The other floors: numerical against reference (J6-J9), at most 6 panels (the lowest 5 and the top).

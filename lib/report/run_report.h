@@ -13,7 +13,7 @@
 ///   tracking_error.png  e = r - y [mm] against t [s], and r, u, y over 0.25 s around the largest |e|
 ///   time_histories.png  r, u, y [mm]; f [kN]; damper current i_cmd, i_eff [A] against t [s] (a
 ///                       constant current is a line of the caption instead)
-///   loops.png           force-displacement f(y) and force-velocity f(y') (y' by central difference)
+///   loops.png           force-displacement f(y) and force-velocity f(y') (run_figures::LoopVelocity)
 ///   spectra.png         Welch PSDs of r, y, e [mm^2/Hz] (signal/spectral.h) over the band that
 ///                       carries r, at most 8 decades (signal/spectrum_axes.h)
 ///   gyr.png             G_yr = Y/R by H1: magnitude [-], phase [deg] and coherence [-] (left out
@@ -21,8 +21,9 @@
 ///                       band of r, points of low coherence masked
 ///   benchmark.png       scenarios with structure.reference_file (the RTHS benchmark, docs/benchmark.md):
 ///                       x_t = r, x_m = y and the reference's actuator floor x_r,a; x_m - x_t and
-///                       x_m - x_r,a; each other floor x_n,i against x_r,i [mm] against t [s]. The page
-///                       then also has the table of J1-J9 (participants/benchmark_run.h).
+///                       x_m - x_r,a (the one of larger RMS beneath); each other floor x_n,i against
+///                       x_r,i [mm] against t [s]. The page then also has the table of J1-J9
+///                       (participants/benchmark_run.h).
 #include <cstdint>
 #include <filesystem>
 #include <optional>

@@ -141,57 +141,76 @@ void WriteLoopAndPlantsCsv(const BenchmarkResult& res, const fs::path& dir) {
   }
 }
 
+/// benchmark.png: J1, J2, J4 and J7 of every run, a panel each, the controllers side by side, the
+/// cases in their colours: the nominal plant's run filled, the perturbed plants' open rings drawn
+/// over it (and a little to its right, so that one equal to the nominal one still shows), the
+/// example controller's published values (Table 3) as black diamonds to its left, runs that
+/// stopped (scored over the steps they ran) crossed out. One legend, above the first panel, in a row.
 void WriteFigure(const BenchmarkResult& res, const ReproduceOptions& opts) {
   const auto names = BenchmarkControllerNames();
   io::Figure fig;
   fig.name = "benchmark";
-  fig.width_px = 1400;
-  fig.panel_height_px = 330;
-  const char* colors[4] = {"#0072B2", "#E69F00", "#009E73", "#CC79A7"};
-
+  fig.width_px = 1200;
+  fig.panel_height_px = 300;
+  const auto& colors = io::ReadableColors();  // cases 1-4: blue, vermillion, bluish green, reddish purple
+  // J2, J4 and J7 are ratios of standard deviations (signal/benchmark_criteria.h: the mean of each
+  // record removed), not of RMS values.
   const std::array<std::pair<int, const char*>, 4> panels = {
-      {{0, "J1: time delay [ms]"}, {1, "J2: RMS tracking error [%]"}, {3, "J4: RMS error vs the reference [%]"},
-       {6, "J7: RMS error of floor 3 vs the reference [%]"}}};
+      {{0, "J1: time delay of x_m behind x_t"},
+       {1, "J2: std(x_m - x_t) / std(x_t), tracking error"},
+       {3, "J4: std(x_m - x_r) / std(x_r), error against the reference structure"},
+       {6, "J7: std(x_n,3 - x_r,3) / std(x_r,3), floor 3 against the reference structure"}}};
   for (const auto& [j, title] : panels) {
-    io::Panel p = io::MakePanel(fmt::format("{} (filled: nominal plant; open: {} perturbed plants{})", title,
-                                            res.perturbed, opts.quick ? ", --quick" : ""),
-                                "controller", fmt::format("J{} [{}]", j + 1, j == 0 ? "ms" : "%"));
+    const bool first_panel = fig.panels.empty();
+    io::Panel p = io::MakePanel(title, "", fmt::format("J{} [{}]", j + 1, j == 0 ? "ms" : "%"));
     p.x_range = std::make_pair(0.5, names.size() + 0.5);
     for (std::size_t c = 0; c < names.size(); ++c) p.x_tics.emplace_back(static_cast<double>(c + 1), names[c]);
-    // A run the safety monitor (or anything) stopped is scored over the steps it ran: crossed out.
-    io::Series stopped;
-    stopped.title = "run stopped early (criteria over the steps it ran)";
-    stopped.with = "points pt 2 ps 2.2";
-    stopped.color = "#D55E00";
-    p.key = "outside right top";
+    p.key = first_panel ? "outside top center horizontal" : "off";
+    p.left_margin_chars = 10;  // the panels' axes line up
     p.log_y = j != 0;
+    p.margin_fraction = 0.04;  // no marker on the frame
+    // A run the safety monitor (or anything) stopped is scored over the steps it ran: crossed out.
+    io::Series stopped = io::MakeSeries("stopped early", "#882255");
+    stopped.with = "points pt 2 ps 2.2";
+    io::Series published = io::MakeSeries("published (Table 3)", "#000000");
+    published.with = "points pt 12 ps 1.8";
+    std::vector<io::Series> nominal, perturbed;
     for (int cs = 1; cs <= 4; ++cs) {
-      io::Series nom, pert;
-      nom.title = fmt::format("case {}", cs);
-      nom.with = "points pt 7 ps 1.6";
-      nom.color = colors[cs - 1];
-      pert.title = "";
-      pert.with = "points pt 6 ps 0.8";
-      pert.color = colors[cs - 1];
+      const double offset = 0.14 * (cs - 2.5);  // the case's place beside the controller's tick
+      io::Series nom = io::MakeSeries(fmt::format("case {}", cs), colors[cs - 1]);
+      nom.with = "points pt 7 ps 1.4";
+      io::Series pert = io::MakeSeries(
+          cs == 1 ? fmt::format("perturbed ({} plants{})", res.perturbed, opts.quick ? ", --quick" : "") : "",
+          colors[cs - 1]);
+      pert.with = "points pt 6 ps 1.1";
       for (std::size_t c = 0; c < names.size(); ++c) {
         for (const auto& row : res.rows) {
           if (row.case_number != cs || row.controller != names[c] || !row.criteria_ok) continue;
           const double v = row.j.At(j);
           if (!std::isfinite(v) || (p.log_y && !(v > 0))) continue;
           io::Series& s = row.run == "nominal" ? nom : pert;
-          s.x.push_back(static_cast<double>(c + 1) + 0.12 * (cs - 2.5) + (row.run == "nominal" ? 0.0 : 0.04));
+          s.x.push_back(static_cast<double>(c + 1) + offset + (row.run == "nominal" ? 0.0 : 0.035));
           s.y.push_back(v);
           if (row.stopped != "no") {
             stopped.x.push_back(s.x.back());
             stopped.y.push_back(v);
           }
         }
+        const double pub = PublishedExampleCriteria()[cs - 1][j];
+        if (names[c] == "example_pi_lead" && std::isfinite(pub)) {
+          published.x.push_back(static_cast<double>(c + 1) + offset - 0.035);
+          published.y.push_back(pub);
+        }
       }
-      p.series.push_back(pert);
-      p.series.push_back(nom);
+      nominal.push_back(nom);
+      perturbed.push_back(pert);
     }
+    // Drawing order: published and nominal first, the smaller perturbed rings over them, the
+    // crosses of stopped runs last.
+    p.series.push_back(published);
+    p.series.insert(p.series.end(), nominal.begin(), nominal.end());
+    p.series.insert(p.series.end(), perturbed.begin(), perturbed.end());
     if (!stopped.x.empty()) p.series.push_back(stopped);
-    p.right_margin_chars = io::KeyMarginChars({&p});
     fig.panels.push_back(p);
   }
   fig.gnuplot = opts.gnuplot;

@@ -290,6 +290,7 @@ namespace {
 struct AxisColumn {
   std::string name;
   std::vector<std::string> labels;  ///< per row
+  bool drawn = false;               ///< a [draw] key: a value per run, not levels shared by runs
 };
 
 /// The axes: the case (when there are several), each grid key, each drawn key (not seeds).
@@ -323,7 +324,7 @@ std::vector<AxisColumn> PlotAxes(const Spec& spec, const Table& t) {
   for (const Draw& d : spec.draw) {
     for (const std::string& key : DrawColumns(d)) {
       if (d.dist != "seed") {  // a seed is no axis
-        AxisColumn a{key, {}};
+        AxisColumn a{key, {}, true};
         for (const auto& row : t.rows) a.labels.push_back(Cell(row[column]));
         axes.push_back(std::move(a));
       }
@@ -333,35 +334,95 @@ std::vector<AxisColumn> PlotAxes(const Spec& spec, const Table& t) {
   return axes;
 }
 
-/// Column c of the completed rows against axis `a`: numeric axis values at their value; text
-/// values (a case, a controller) at 0, 1, 2, ... in order of first appearance, labelled.
-io::Panel PlotPanel(const Table& t, std::size_t c, const AxisColumn& a) {
-  io::Panel p = io::MakePanel("", a.name, t.columns[c]);
-  p.key = "off";
-  io::Series s = io::MakeSeries("");
-  s.with = "points";
-  std::map<std::string, double> category;
+/// The axis whose levels split the panel of axes[a] into curves: the first other axis that is the
+/// case or a grid key (levels shared by many runs); nullptr if there is none.
+const AxisColumn* SplitAxis(const std::vector<AxisColumn>& axes, std::size_t a) {
+  for (std::size_t b = 0; b < axes.size(); ++b) {
+    if (b != a && !axes[b].drawn) return &axes[b];
+  }
+  return nullptr;
+}
+
+/// Each row's x on axis `a`: numeric values at their value; text values (a case, a controller)
+/// at 0, 1, 2, ... in order of first appearance, labelled on the panel's x tics.
+std::vector<double> XPositions(const AxisColumn& a, io::Panel* p) {
   bool numeric = true;
   for (const std::string& l : a.labels) {
     char* end = nullptr;
     std::strtod(l.c_str(), &end);
     numeric = numeric && !l.empty() && end && *end == '\0';
   }
-  for (std::size_t r = 0; r < t.rows.size(); ++r) {
-    if (!Completed(t.rows[r])) continue;
-    double x = 0;
+  std::vector<double> x;
+  std::map<std::string, double> category;
+  for (const std::string& l : a.labels) {
     if (numeric) {
-      x = std::strtod(a.labels[r].c_str(), nullptr);
-    } else {
-      auto [it, fresh] = category.emplace(a.labels[r], static_cast<double>(category.size()));
-      if (fresh) p.x_tics.emplace_back(it->second, a.labels[r]);
-      x = it->second;
+      x.push_back(std::strtod(l.c_str(), nullptr));
+      continue;
     }
-    s.x.push_back(x);
-    s.y.push_back(AsDouble(t.rows[r][c]));
+    auto [it, fresh] = category.emplace(l, static_cast<double>(category.size()));
+    if (fresh) p->x_tics.emplace_back(it->second, l);
+    x.push_back(it->second);
   }
-  if (!numeric) p.x_range = std::pair(-0.5, static_cast<double>(category.size()) - 0.5);
-  p.series.push_back(std::move(s));
+  if (!numeric) p->x_range = std::pair(-0.5, static_cast<double>(category.size()) - 0.5);
+  return x;
+}
+
+/// Column c of the completed rows against axis axes[a], a curve per level of the other factor
+/// (SplitAxis; one curve without one), with space between the points and the frame. Against a
+/// case or grid key, each curve is a line through the mean of its runs at each x, its runs as
+/// small open points where an x has several (draws); against a drawn key, points only.
+io::Panel PlotPanel(const Table& t, std::size_t c, const std::vector<AxisColumn>& axes, std::size_t a) {
+  const AxisColumn& axis = axes[a];
+  io::Panel p = io::MakePanel("", axis.name, t.columns[c]);
+  p.margin_fraction = 0.05;
+  const std::vector<double> x = XPositions(axis, &p);
+  const AxisColumn* split = SplitAxis(axes, a);
+  std::vector<std::string> levels;  // of `split`, in order of first appearance among completed rows
+  std::vector<std::size_t> level_of(t.rows.size(), 0);
+  for (std::size_t r = 0; r < t.rows.size(); ++r) {
+    if (!Completed(t.rows[r]) || split == nullptr) continue;
+    const auto it = std::find(levels.begin(), levels.end(), split->labels[r]);
+    level_of[r] = static_cast<std::size_t>(it - levels.begin());
+    if (it == levels.end()) levels.push_back(split->labels[r]);
+  }
+  if (levels.empty()) levels.push_back("");
+  if (split != nullptr) p.title = "a curve per " + split->name;
+  p.key = split != nullptr ? "outside right top" : "off";  // short entries (the levels): a narrow column
+  const auto& palette = io::ReadableColors();
+  for (std::size_t l = 0; l < levels.size(); ++l) {
+    const std::string color = palette[l % palette.size()];
+    io::Series runs = io::MakeSeries("", color);
+    std::map<double, std::vector<double>> at_x;  // finite values per x, for the means
+    for (std::size_t r = 0; r < t.rows.size(); ++r) {
+      if (!Completed(t.rows[r]) || level_of[r] != l) continue;
+      const double y = AsDouble(t.rows[r][c]);
+      runs.x.push_back(x[r]);
+      runs.y.push_back(y);
+      if (std::isfinite(y)) at_x[x[r]].push_back(y);
+    }
+    if (axis.drawn) {  // a value per run: a scatter, coloured by the level
+      runs.title = levels[l];
+      runs.with = "points pt 7 ps 0.8";
+      p.series.push_back(std::move(runs));
+      continue;
+    }
+    io::Series mean = io::MakeSeries(levels[l], color);
+    mean.with = "linespoints pt 7 ps 1.2";
+    bool repeated = false;
+    for (const auto& [xv, ys] : at_x) {
+      double sum = 0;
+      for (const double y : ys) sum += y;
+      mean.x.push_back(xv);
+      mean.y.push_back(sum / static_cast<double>(ys.size()));
+      repeated = repeated || ys.size() > 1;
+    }
+    if (repeated) {
+      runs.with = "points pt 6 ps 0.7";
+      p.series.push_back(std::move(runs));
+    }
+    p.series.push_back(std::move(mean));
+  }
+  if (split != nullptr) p.right_margin_chars = io::KeyMarginChars({&p});
   return p;
 }
 
@@ -377,11 +438,14 @@ std::vector<fs::path> WritePlots(const Spec& spec, const Table& t, const fs::pat
     for (char& ch : fig.name) {
       if (!std::isalnum(static_cast<unsigned char>(ch)) && ch != '-' && ch != '_' && ch != '.') ch = '_';
     }
-    fig.title = fmt::format("{}: {} against each axis (completed runs)", spec.name, t.columns[c]);
+    fig.title = fmt::format("{}: {} against each axis (completed runs; lines through the mean of a point's runs)",
+                            spec.name, t.columns[c]);
     fig.columns = axes.size() > 1 ? 2 : 1;
-    for (const AxisColumn& a : axes) fig.panels.push_back(PlotPanel(t, c, a));
+    for (std::size_t a = 0; a < axes.size(); ++a) fig.panels.push_back(PlotPanel(t, c, axes, a));
     const bool drawable = std::all_of(fig.panels.begin(), fig.panels.end(), [](const io::Panel& p) {
-      return std::any_of(p.series[0].y.begin(), p.series[0].y.end(), [](double y) { return std::isfinite(y); });
+      return std::any_of(p.series.begin(), p.series.end(), [](const io::Series& s) {
+        return std::any_of(s.y.begin(), s.y.end(), [](double y) { return std::isfinite(y); });
+      });
     });
     if (fig.panels.empty() || !drawable) continue;
     pngs.push_back(io::Plot(fig, dir).png);

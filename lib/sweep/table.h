@@ -15,7 +15,11 @@
 ///                     draws) and recorded numeric field: runs, failures (rows not "completed"), n
 ///                     (completed rows with a finite value), mean, sample std, min, max
 ///   DIR/plots/<field>.png  each recorded numeric field against each axis (case, grid keys,
-///                     drawn keys), a panel per axis, completed runs as points (gnuplot; skipped,
+///                     drawn keys), a panel per axis, completed runs only, a curve (colour) per
+///                     level of the other factor (the first other case or grid axis): against a
+///                     case or grid key a line through the mean of each point's runs (the runs as
+///                     open points when there are draws), against a drawn key the runs as points;
+///                     5 % of the plot area between the data and the frame (gnuplot; skipped,
 ///                     with a note, where gnuplot is not installed)
 #include <filesystem>
 #include <string>
