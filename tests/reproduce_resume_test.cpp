@@ -140,3 +140,26 @@ TEST_CASE("rths reproduce: Ctrl-C while a figure is drawn is an interrupt too: e
   REQUIRE_MESSAGE(Wait(Start(common + " --resume", dir / "b.txt")) == 0, Slurp(dir / "b.txt"));
   CHECK(fs::exists(dir / "a" / "fig11.md"));
 }
+
+TEST_CASE("rths reproduce: Ctrl-C while gnuplot draws, gnuplot catching it and exiting 1 as the real one does") {
+  // The real gnuplot catches SIGINT and exits 1; Ctrl-C reaches the study's process too (one
+  // foreground group). Before, this was "gnuplot failed (exit 1)", exit 2, a half-drawn PNG kept
+  // and no resume line. The stand-in sends SIGINT to its parent (the study), then exits 1.
+  const fs::path dir = rths_test::TempDir("reproduce_plot_interrupt_exit1");
+  fs::create_directories(dir / "bin");
+  const fs::path fake = dir / "bin" / "gnuplot";
+  std::ofstream(fake) << "#!/bin/sh\nkill -INT $PPID\nsleep 0.2\nexit 1\n";
+  fs::permissions(fake, fs::perms::owner_all);
+  const std::string path = (dir / "bin").string() + ":" + (std::getenv("PATH") ? std::getenv("PATH") : "/usr/bin:/bin");
+  const std::string common = "fig11 --quick --compact --jobs 2 --out " + (dir / "a").string();
+  const int code = Wait(Start(common, dir / "a.txt", "PATH=" + path));
+  const std::string out = Slurp(dir / "a.txt");
+  CAPTURE(out);
+  CHECK(code == 130);
+  CHECK(out.find("interrupted while gnuplot drew") != std::string::npos);
+  CHECK(out.find("gnuplot failed") == std::string::npos);
+  CHECK(out.find("Finish it (the runs that ended are kept): rths reproduce fig11 --out " + (dir / "a").string() +
+                 " --quick --resume") != std::string::npos);
+  REQUIRE_MESSAGE(Wait(Start(common + " --resume", dir / "b.txt")) == 0, Slurp(dir / "b.txt"));
+  CHECK(fs::exists(dir / "a" / "fig11.md"));
+}

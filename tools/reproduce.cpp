@@ -18,6 +18,7 @@
 #include "cli.h"
 #include "slurm_flags.h"
 #include "core/error.h"
+#include "core/interrupt.h"
 #include "io/output_folder.h"
 #include "studies/benchmark.h"
 #include "studies/fig11.h"
@@ -60,8 +61,8 @@ void PrintCheck(bool holds, const std::string& text, const std::string& detail, 
               standing.c_str());
 }
 
-volatile std::sig_atomic_t g_interrupted = 0;
-void OnSignal(int) { g_interrupted = 1; }
+/// Ctrl-C or SIGTERM: the batch's runs stop, and so does any figure still to draw.
+void OnSignal(int) { rths::RequestInterrupt(); }
 
 struct Options {
   std::string name, out, plant = "physical";
@@ -282,7 +283,7 @@ int main(int argc, char** argv) {
   opts.jobs = o.jobs;
   opts.overrides = o.sets;
   opts.extended = o.extended;
-  opts.batch.interrupted = &g_interrupted;
+  opts.batch.interrupted = rths::InterruptFlag();
   opts.batch.resume = o.resume;
   opts.gnuplot = rths::tools::ProgramOnPath("gnuplot");
   if (const char* dir = std::getenv("RTHS_SOURCE_DIR"); dir != nullptr && *dir != '\0') opts.source_dir = dir;

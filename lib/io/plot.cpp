@@ -13,6 +13,7 @@
 #include <fmt/format.h>
 
 #include "core/error.h"
+#include "core/interrupt.h"
 #include "io/command.h"
 
 namespace rths::io {
@@ -281,13 +282,21 @@ PlotFiles Plot(const Figure& fig, const fs::path& dir) {
 
   std::error_code ec;
   fs::remove(files.png, ec);
+  // An interrupt before the figure (Ctrl-C after the last run ended): no figure is drawn.
+  if (InterruptRequested()) throw Interrupted(where, "interrupted before " + files.png.filename().string() + " was drawn");
   const CommandResult run = RunCommand({exe, fig.name + ".gp"}, dir);
   const int code = run.status;
   const std::string& output = run.output;
   if (code == 127) throw Error(where, fmt::format("cannot run {}: install gnuplot (apt-get install gnuplot-nox)", exe));
-  // Killed by SIGINT or SIGTERM (Ctrl-C reaches the whole foreground group): an interrupt, not a failure.
-  if (code == 128 + SIGINT || code == 128 + SIGTERM)
-    throw Interrupted(where, fmt::format("gnuplot was interrupted (signal {}) on {}", code - 128, files.gp.string()));
+  // Ctrl-C reaches the whole foreground group: gnuplot killed by it, or (the real one) catching it
+  // and exiting 1 while this process's handler recorded it. An interrupt, not a failure; the
+  // half-drawn PNG goes.
+  if (code == 128 + SIGINT || code == 128 + SIGTERM || (code != 0 && InterruptRequested())) {
+    fs::remove(files.png, ec);
+    throw Interrupted(where, code > 128 ? fmt::format("gnuplot was interrupted (signal {}) on {}", code - 128,
+                                                      files.gp.string())
+                                        : fmt::format("interrupted while gnuplot drew {}", files.png.string()));
+  }
   if (code != 0) {
     throw Error(where, fmt::format("gnuplot failed (exit {}) on {}:\n{}", code, files.gp.string(), output));
   }

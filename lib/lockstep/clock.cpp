@@ -241,7 +241,10 @@ void ClockParticipant::CheckBarrier() {
     live_.Phase(kLiveAborted, live_sink_);
     return;
   }
-  if (live_sink_) live_.Add(k_, desired_.r_mm, c->u_mm, m->y_mm, m->f_kN, m->current_A, Seconds(step_since_, now), missed, rt_, live_sink_);
+  if (live_sink_) {
+    live_.Add(k_, desired_.r_mm, c->u_mm, m->y_mm, m->f_kN, m->current_A, Seconds(step_since_, now), missed, rt_,
+              live_sink_);
+  }
   if (k_ + 1 >= id_.n_steps) {
     live_.Phase(kLiveFinishing, live_sink_);
     done_ = true;
