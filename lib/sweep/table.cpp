@@ -270,7 +270,8 @@ void WriteGroupSummary(const Spec& spec, const Table& t, const fs::path& file) {
       double mean = 0, var = 0;
       for (const double x : v) mean += x / static_cast<double>(v.size());
       for (const double x : v) var += (x - mean) * (x - mean);
-      const double sd = v.size() > 1 ? std::sqrt(var / static_cast<double>(v.size() - 1)) : 0.0;
+      // The sample standard deviation (n - 1) of one run is undefined: an empty cell, not 0.
+      const std::string sd = v.size() > 1 ? fmt::format("{}", std::sqrt(var / static_cast<double>(v.size() - 1))) : "";
       const auto [lo, hi] = v.empty() ? std::pair(0.0, 0.0) : std::pair(*std::min_element(v.begin(), v.end()),
                                                                          *std::max_element(v.begin(), v.end()));
       if (v.empty()) {
