@@ -352,3 +352,19 @@ TEST_CASE("sweep plots: one factor with draws, a line through the means, the run
   CHECK(gp.find("with linespoints") != std::string::npos);
   CHECK(gp.find("set key off") != std::string::npos);
 }
+
+TEST_CASE("sweep plots: a Monte Carlo alone (no case or grid axis) is drawn as points, and its title says no lines") {
+  const auto dir = rths_test::TempDir("sweep_plots_draws_only");
+  const fs::path base = rths_test::WriteScenario(dir, "[run]\nname = \"mc\"\nduration_s = 0.05\n");
+  std::ofstream(dir / "spec.toml") << "[sweep]\nname = \"mc\"\nbase = \"" << base.string() << "\"\nseed = 5\ndraws = 3\n"
+                                   << "record = [\"peak_force_kN\"]\n"
+                                   << "[draw]\n\"structure.damping_ratio\" = { dist = \"uniform\", lo = 0.01, hi = 0.05 }\n";
+  const auto spec = rths::sweep::LoadSpec((dir / "spec.toml").string());
+  rths::sweep::SweepOptions o;
+  o.out = dir / "out";
+  const auto r = rths::sweep::RunSweep(spec, o);
+  REQUIRE(r.not_completed == 0);
+  const std::string gp = rths_test::Slurp(o.out / "plots" / "peak_force_kN.gp");
+  CHECK(gp.find("against each axis (completed runs)") != std::string::npos);
+  CHECK(gp.find("lines through the mean") == std::string::npos);
+}

@@ -439,8 +439,10 @@ std::vector<fs::path> WritePlots(const Spec& spec, const Table& t, const fs::pat
     for (char& ch : fig.name) {
       if (!std::isalnum(static_cast<unsigned char>(ch)) && ch != '-' && ch != '_' && ch != '.') ch = '_';
     }
-    fig.title = fmt::format("{}: {} against each axis (completed runs; lines through the mean of a point's runs)",
-                            spec.name, t.columns[c]);
+    // Lines only against a case or grid axis; against a drawn key the runs are points.
+    const bool lines = std::any_of(axes.begin(), axes.end(), [](const AxisColumn& a) { return !a.drawn; });
+    fig.title = fmt::format("{}: {} against each axis (completed runs{})", spec.name, t.columns[c],
+                            lines ? "; lines through the mean of a point's runs" : "");
     fig.columns = axes.size() > 1 ? 2 : 1;
     for (std::size_t a = 0; a < axes.size(); ++a) fig.panels.push_back(PlotPanel(t, c, axes, a));
     const bool drawable = std::all_of(fig.panels.begin(), fig.panels.end(), [](const io::Panel& p) {
