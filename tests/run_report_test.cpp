@@ -439,6 +439,8 @@ TEST_CASE("a benchmark run's report: the smaller error curve drawn over the larg
   CHECK(gyr.substr(multiplot, gyr.find('\n', multiplot) - multiplot).find(",1 title 'G_yr = Y / R: ") != std::string::npos);
   CHECK(gyr.find("set title 'Magnitude'") != std::string::npos);
   CHECK(gyr.find("set title 'Phase (unwrapped)'") != std::string::npos);
+  // The spectra have a title of their own in the PNG too, not only the page's heading.
+  CHECK(Slurp(figs / "spectra.gp").find("title 'Power spectral densities of r (desired)") != std::string::npos);
   // The force-velocity loop's velocity is the low-passed derivative of y, not its noisy central difference.
   CHECK(Slurp(figs / "loops.gp").find("y'' [mm/s] (low-passed at 50 Hz)") != std::string::npos);
 }

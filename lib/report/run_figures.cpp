@@ -296,6 +296,7 @@ PageFigure SpectraFigure(const signal::CrossSpectra& cs, const std::vector<doubl
   sy.dash = 2;
   psd.series = {sr, sy, se};
   PageFigure sp{NewFigure("spectra", o), "Spectra", ""};
+  sp.figure.title = "Power spectral densities of r (desired), y (measured) and e = r - y (Welch)";
   sp.figure.panels = {psd};
   sp.figure.panel_height_px = 450;
   sp.caption_html = fmt::format("Welch power spectral densities of r, y and e [mm<sup>2</sup>/Hz]: every step, "
