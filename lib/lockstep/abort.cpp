@@ -8,11 +8,7 @@
 
 namespace rths::lockstep {
 
-bool BroadcastAbort(const std::string& url, std::int64_t run_id, const std::string& sender, const std::string& reason,
-                    std::int64_t k) {
-  const auto parsed = UdpmUrl::Parse(url);
-  lcm::LCM lcm(parsed ? parsed->ChannelUrl(kChHandshake) : url);
-  if (!lcm.good()) return false;
+Bytes EncodeAbort(std::int64_t run_id, const std::string& sender, const std::string& reason, std::int64_t k) {
   rths::handshake_t h{};
   h.run_id = run_id;
   h.phase = kAbort;
@@ -22,6 +18,15 @@ bool BroadcastAbort(const std::string& url, std::int64_t run_id, const std::stri
   h.reason = reason;
   Bytes bytes;
   Encode(h, &bytes);
+  return bytes;
+}
+
+bool BroadcastAbort(const std::string& url, std::int64_t run_id, const std::string& sender, const std::string& reason,
+                    std::int64_t k) {
+  const auto parsed = UdpmUrl::Parse(url);
+  lcm::LCM lcm(parsed ? parsed->ChannelUrl(kChHandshake) : url);
+  if (!lcm.good()) return false;
+  const Bytes bytes = EncodeAbort(run_id, sender, reason, k);
   for (int i = 0; i < 3; ++i) lcm.publish(kChHandshake, bytes.data(), bytes.size());
   return true;
 }

@@ -10,6 +10,7 @@
 
 #include <fmt/core.h>
 
+#include "lockstep/abort.h"
 #include "lockstep/step_table.h"
 #include "lockstep/transport.h"
 
@@ -303,10 +304,7 @@ void Participant::OnHandshake(const lcm::ReceiveBuffer* rbuf) {
   if (hs_in_.participant == name_) return;  // our own message, looped back
   const auto now = SteadyClock::now();
   if (hs_in_.phase == kAbort) {
-    OnAbortFrom(hs_in_.participant, hs_in_.reason);
-    OnStop();
-    Fail(kExitPeerAbort, fmt::format("{} aborted the run: {}", hs_in_.participant, hs_in_.reason), false,
-         hs_in_.k);
+    StopOnAbortFrom(hs_in_.participant, hs_in_.reason, hs_in_.k);
     return;
   }
   if (is_clock_) {
@@ -432,16 +430,12 @@ void Participant::Fail(int exit_code, const std::string& reason, bool broadcast,
 
 void Participant::RelayAbort(const std::string& sender, const std::string& reason, std::int64_t k) {
   if (finished_) return;
-  rths::handshake_t h{};
-  h.run_id = id_.run_id;
-  h.phase = kAbort;
-  h.participant = sender;
-  h.k = k;
-  h.n_roster = 0;
-  h.reason = reason;
-  Bytes bytes;
-  Encode(h, &bytes);
+  const Bytes bytes = EncodeAbort(id_.run_id, sender, reason, k);
   for (int i = 0; i < kControlCopies; ++i) Send(kChHandshake, bytes.data(), bytes.size());
+  StopOnAbortFrom(sender, reason, k);
+}
+
+void Participant::StopOnAbortFrom(const std::string& sender, const std::string& reason, std::int64_t k) {
   OnAbortFrom(sender, reason);
   OnStop();
   Fail(kExitPeerAbort, fmt::format("{} aborted the run: {}", sender, reason), false, k);

@@ -178,6 +178,8 @@ class Participant {
   /// participant in-process: sends it to every participant as that sender's handshake ABORT, then
   /// stops as on hearing it (kExitPeerAbort, "<sender> aborted the run: <reason>").
   void RelayAbort(const std::string& sender, const std::string& reason, std::int64_t k);
+  /// Stops as on an ABORT heard from `sender` (kExitPeerAbort, "<sender> aborted the run: <reason>").
+  void StopOnAbortFrom(const std::string& sender, const std::string& reason, std::int64_t k);
   /// Sends a handshake message of this participant; `roster` (GO only) lists who takes part,
   /// every one of them with this participant's scenario hash (the clock checked them).
   void SendHandshake(Phase phase, std::int64_t k = -1, const std::string& reason = "",
