@@ -74,6 +74,27 @@ void FeedClock(rths::lockstep::LiveFeed* feed, ViewSink* sink, std::int64_t id, 
   }
 }
 
+/// The monitor's address as `rths run --watch` printed it in `out_txt` (waits up to 15 s).
+struct MonitorAddress {
+  int port = 0;
+  std::string token;
+  std::string printed;  ///< the run's output so far
+};
+MonitorAddress WaitForMonitor(const fs::path& out_txt) {
+  const std::regex line("monitor +http://127\\.0\\.0\\.1:([0-9]+)/\\?token=([0-9a-f]+)");
+  MonitorAddress a;
+  std::smatch m;
+  for (int i = 0; i < 300; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    a.printed = rths_test::Slurp(out_txt);
+    if (std::regex_search(a.printed, m, line)) break;
+  }
+  REQUIRE_MESSAGE(!m.empty(), a.printed);
+  a.port = std::stoi(m[1]);
+  a.token = m[2];
+  return a;
+}
+
 /// A command run by `sh -c` in the background; interrupted (SIGINT) and waited for if the test
 /// ends before Wait().
 class BackgroundRun {
@@ -328,18 +349,11 @@ TEST_CASE("rths run --watch --realtime: memq by default; the page's misses and l
   BackgroundRun run("exec " + std::string(RTHS_BIN_DIR) + "/rths-run " + RTHS_SOURCE_DIR +
                     "/scenarios/default.toml --compact --realtime --set run.duration_s=30 --watch --watch-port 0 "
                     "--out " + (dir / "run").string() + " > " + out_txt.string() + " 2>&1");
-  std::smatch m;
-  const std::regex line("monitor +http://127\\.0\\.0\\.1:([0-9]+)/\\?token=([0-9a-f]+)");
-  std::string text;
-  for (int i = 0; i < 300; ++i) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(50));
-    text = rths_test::Slurp(out_txt);
-    if (std::regex_search(text, m, line)) break;
-  }
-  REQUIRE_MESSAGE(!m.empty(), text);
+  const MonitorAddress a = WaitForMonitor(out_txt);
+  const std::string& text = a.printed;
   CHECK(text.find("transport memq") != std::string::npos);  // a paced run's default
-  const int port = std::stoi(m[1]);
-  const std::string token = m[2];
+  const int port = a.port;
+  const std::string token = a.token;
   httplib::Client c("127.0.0.1", port);
   auto state = [&] {
     const auto res = c.Get("/state?token=" + token);
@@ -416,17 +430,10 @@ TEST_CASE("rths run --watch --transport memq: the page's ABORT stops an in-proce
   BackgroundRun run("exec " + std::string(RTHS_BIN_DIR) + "/rths-run " + RTHS_SOURCE_DIR +
                     "/scenarios/default.toml --compact --transport memq --set run.duration_s=600 --watch "
                     "--watch-port 0 --out " + (dir / "run").string() + " > " + out_txt.string() + " 2>&1");
-  std::smatch m;
-  const std::regex line("monitor +http://127\\.0\\.0\\.1:([0-9]+)/\\?token=([0-9a-f]+)");
-  std::string text;
-  for (int i = 0; i < 300; ++i) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(50));
-    text = rths_test::Slurp(out_txt);
-    if (std::regex_search(text, m, line)) break;
-  }
-  REQUIRE_MESSAGE(!m.empty(), text);
-  httplib::Client c("127.0.0.1", std::stoi(m[1]));
-  const std::string token = m[2];
+  const MonitorAddress a = WaitForMonitor(out_txt);
+  const std::string& text = a.printed;
+  httplib::Client c("127.0.0.1", a.port);
+  const std::string token = a.token;
   nlohmann::json st;
   for (int i = 0; i < 400; ++i) {
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
