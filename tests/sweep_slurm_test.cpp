@@ -306,3 +306,37 @@ TEST_CASE("a submission that fails leaves no output folder behind") {
   CHECK_FALSE(fs::exists(mine / "runs"));
   CHECK_FALSE(fs::exists(mine / "slurm"));
 }
+
+TEST_CASE("--dry-run writes the job script and prints the sbatch command, submitting nothing") {
+  rths_test::RequireBuilt("rths-sweep");
+  const fs::path dir = rths_test::TempDir("sweep_slurm_dry_run");
+  // An sbatch that leaves a mark if it is ever called: a dry run must not call it.
+  FakeProgram(dir / "bin", "sbatch", "touch \"$0.called\"\necho 42\n");
+  const fs::path spec = SmallSpec(dir, "partition = \"short\"\ntime = \"00:10:00\"\nsbatch_args = [\"--qos=low prio\"]\n"
+                                       "setup = [\"module load gcc/12\"]\n");
+  const fs::path out = dir / "out";
+  const auto r = SweepWithPath(dir / "bin", {spec.string(), "--executor", "slurm", "--out", out.string(), "--dry-run",
+                                             "--account", "lab1"});
+  INFO(r.output);
+  REQUIRE(r.status == 0);
+  CHECK_FALSE(fs::exists(dir / "bin" / "sbatch.called"));
+  CHECK_FALSE(fs::exists(out / "slurm" / "sweep.json"));
+  CHECK(rths_test::Slurp(out / "slurm" / "task.sh").find("\neval 'module load gcc/12' ||") != std::string::npos);
+  CHECK(r.output.find("dry run: nothing submitted") != std::string::npos);
+  // The command as a shell line: 4 runs at 4 per task are one array task; the flags and the SPEC's
+  // [slurm] in order, a value with a space quoted.
+  const std::string expected = "sbatch --parsable --job-name=rths-sweep-fake --array=0 --cpus-per-task=1 --output=" +
+                               (out / "slurm" / "task-%A_%a.out").string() + " --chdir=" + out.string() +
+                               " --partition=short --time=00:10:00 --account=lab1 '--qos=low prio' " +
+                               (out / "slurm" / "task.sh").string() + "\n";
+  CHECK(r.output.find("\n  " + expected) != std::string::npos);
+  // A real submission after it starts afresh.
+  const auto real = SweepWithPath(dir / "bin", {spec.string(), "--executor", "slurm", "--out", out.string(), "--detach"});
+  INFO(real.output);
+  CHECK(real.status == 0);
+  CHECK(fs::exists(dir / "bin" / "sbatch.called"));
+  // Not for the local executor.
+  const auto local = SweepWithPath(dir / "bin", {spec.string(), "--out", (dir / "local").string(), "--dry-run"});
+  CHECK(local.status == 2);
+  CHECK(local.output.find("--dry-run: is for --executor slurm") != std::string::npos);
+}

@@ -49,7 +49,7 @@ struct Args {
   std::string spec_path, out, executor = "local", collect, batch;
   int jobs = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   std::int64_t only = -1, chunk = 0, chunks = 1;
-  bool resume = false, keep_logs = false, task = false, detach = false;
+  bool resume = false, keep_logs = false, task = false, detach = false, dry_run = false;
   rths::tools::SlurmFlags slurm;  // override the SPEC's [slurm]
 };
 
@@ -58,7 +58,8 @@ rths::sweep::SlurmRunOptions SlurmOptions(const Args& a, const rths::sweep::Spec
   o.out = std::filesystem::absolute(a.out.empty() ? a.collect : a.out);
   o.settings = a.slurm.Applied(spec ? spec->slurm : rths::sweep::SlurmSettings{});
   o.sweep_program = rths::tools::SweepProgram();
-  o.programs = rths::tools::SlurmProgramsOnPath();
+  o.programs = a.dry_run ? rths::sweep::SlurmPrograms{} : rths::tools::SlurmProgramsOnPath();
+  o.dry_run = a.dry_run;
   o.keep_logs = a.keep_logs;
   o.detach = a.detach;
   o.resume = a.resume;
@@ -71,6 +72,11 @@ rths::sweep::SlurmRunOptions SlurmOptions(const Args& a, const rths::sweep::Spec
 }
 
 int Report(const rths::sweep::SlurmOutcome& r, const std::string& out) {
+  if (!r.dry_run_command.empty()) {
+    std::printf("dry run: nothing submitted; the job script every array task runs: %s/slurm/task.sh\n"
+                "sbatch would be called as:\n  %s\n", out.c_str(), r.dry_run_command.c_str());
+    return 0;
+  }
   WarnAbsent(r.absent_fields);
   if (r.detached) {
     std::printf("detached: collect the sweep with: rths sweep --collect %s\n", out.c_str());
@@ -137,6 +143,7 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(std::int64_t{1}, std::int64_t{1} << 40));
   app.add_flag("--task", a.task, "run as one array task: --resume, no table, no progress line");
   a.slurm.Add(app);
+  app.add_flag("--dry-run", a.dry_run, "slurm: write OUT/slurm/task.sh and print the sbatch command; submit nothing");
   app.add_flag("--detach", a.detach, "slurm: submit and return; then `rths sweep --collect OUT`");
   app.add_option("--collect", a.collect, "slurm: wait for a detached sweep in DIR, retry, write its table");
   app.add_option("--batch", a.batch, "run chunk --chunk of a study's batch file (what `rths reproduce --executor slurm` "
@@ -158,6 +165,7 @@ int main(int argc, char** argv) {
     if (a.spec_path.empty()) throw rths::Error("rths sweep", "needs a SPEC (or --collect DIR)");
     const rths::sweep::Spec spec = rths::sweep::LoadSpec(a.spec_path);
     if (a.resume && a.out.empty()) throw rths::Error("--resume", "needs --out DIR, the sweep's folder to resume");
+    if (a.dry_run && a.executor != "slurm") throw rths::Error("--dry-run", "is for --executor slurm");
     if (a.executor == "local") return RunLocal(a, spec);
     if (a.out.empty()) throw rths::Error("--executor slurm", "needs --out DIR on a filesystem the compute nodes share");
     if (a.only >= 0 || a.task || a.chunks != 1) {

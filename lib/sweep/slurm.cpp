@@ -159,6 +159,11 @@ SlurmOutcome RunSweepOnSlurm(const Spec& spec, const SlurmRunOptions& o) {
     Save(o.out, s);
     return Finish(spec, s, o, outcome);
   }
+  if (o.dry_run) {
+    WriteTaskScript(w, Runner(o, s));
+    outcome.dry_run_command = ShellLine(SbatchCommand(w, todo, Runner(o, s)));
+    return outcome;
+  }
   try {
     s.jobs.push_back(SubmitArray(w, todo, Runner(o, s)));
   } catch (...) {  // sbatch missing or refusing: nothing was submitted, so nothing of this call stays

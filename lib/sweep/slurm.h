@@ -38,6 +38,8 @@ struct SlurmRunOptions {
   bool keep_logs = false;              ///< passed to the tasks
   bool resume = false;                 ///< DIR may hold rows already (else it must have none)
   bool detach = false;                 ///< submit, write sweep.json and return
+  /// Write DIR/slurm/task.sh and say the sbatch command, submitting nothing (sbatch need not exist)
+  bool dry_run = false;
   double poll_s = 2.0;                 ///< squeue every poll_s while waiting [s]
   std::function<void(const std::string&)> say;  ///< progress and failures, a line each (optional)
 };
@@ -51,6 +53,7 @@ struct SlurmOutcome {
   std::vector<std::string> job_ids;    ///< every submission of this call, in order
   std::vector<std::string> absent_fields;  ///< recorded fields no completed row has (AbsentFields)
   bool detached = false;
+  std::string dry_run_command;         ///< dry run: the sbatch command as a shell line (else empty)
   std::filesystem::path table;         ///< DIR/table.csv (not written when detached)
 };
 
@@ -59,6 +62,8 @@ struct SlurmOutcome {
 /// again up to settings.retries times and writes the table. Throws rths::Error if sbatch refuses
 /// the job (with its message) or DIR cannot be written; when the first submission fails, the
 /// folders this call made (DIR itself, or rows/, runs/, slurm/ in a DIR that was there) are removed.
+/// With o.dry_run: writes DIR/slurm/task.sh only and returns the sbatch command it would run
+/// (dry_run_command); no sweep.json, so a later real submission starts afresh.
 SlurmOutcome RunSweepOnSlurm(const Spec& spec, const SlurmRunOptions& o);
 
 /// `rths sweep --collect DIR`: for a sweep submitted with --detach, waits for its last job,

@@ -127,7 +127,7 @@ std::vector<std::int64_t> UnfinishedTasks(const ArrayWork& w) {
   return tasks;
 }
 
-std::string SubmitArray(const ArrayWork& w, const std::vector<std::int64_t>& tasks, const ArrayRun& r) {
+std::filesystem::path WriteTaskScript(const ArrayWork& w, const ArrayRun& r) {
   const fs::path slurm = w.dir / "slurm";
   fs::create_directories(slurm);
   const fs::path script = slurm / "task.sh";
@@ -142,6 +142,11 @@ std::string SubmitArray(const ArrayWork& w, const std::vector<std::int64_t>& tas
       w.name, w.noun, w.chunks, SetupText(r.settings.setup), command, w.chunks);
   if (!io::OverwriteFile(script.string(), text)) throw Error(script.string(), "cannot write the array's batch script");
   fs::permissions(script, fs::perms::owner_all | fs::perms::group_read | fs::perms::group_exec, fs::perm_options::add);
+  return script;
+}
+
+std::vector<std::string> SbatchCommand(const ArrayWork& w, const std::vector<std::int64_t>& tasks, const ArrayRun& r) {
+  const fs::path slurm = w.dir / "slurm";
   std::vector<std::string> argv = {r.programs.sbatch, "--parsable", "--job-name=rths-" + w.name,
                                    "--array=" + ArrayList(tasks),
                                    fmt::format("--cpus-per-task={}", r.settings.cpus_per_task),
@@ -150,8 +155,23 @@ std::string SubmitArray(const ArrayWork& w, const std::vector<std::int64_t>& tas
   if (!r.settings.time.empty()) argv.push_back("--time=" + r.settings.time);
   if (!r.settings.account.empty()) argv.push_back("--account=" + r.settings.account);
   for (const std::string& a : r.settings.sbatch_args) argv.push_back(a);
-  argv.push_back(script.string());
-  const io::CommandResult res = io::RunCommand(argv);
+  argv.push_back((slurm / "task.sh").string());
+  return argv;
+}
+
+std::string ShellLine(const std::vector<std::string>& argv) {
+  std::string line;
+  for (const std::string& a : argv) {
+    const bool plain = !a.empty() && a.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ"
+                                                         "0123456789-_=./,:%+@") == std::string::npos;
+    line += (line.empty() ? "" : " ") + (plain ? a : Quote(a));
+  }
+  return line;
+}
+
+std::string SubmitArray(const ArrayWork& w, const std::vector<std::int64_t>& tasks, const ArrayRun& r) {
+  WriteTaskScript(w, r);
+  const io::CommandResult res = io::RunCommand(SbatchCommand(w, tasks, r));
   const std::string id = Trim(res.output.substr(0, res.output.find(';')));
   const bool numeric = !id.empty() && id.find_first_not_of("0123456789") == std::string::npos;
   if (res.status != 0 || !numeric) {

@@ -55,7 +55,17 @@ struct ArrayRun {
 
 /// The tasks with items not done.
 std::vector<std::int64_t> UnfinishedTasks(const ArrayWork& w);
-/// Writes DIR/slurm/task.sh and submits tasks `tasks` (sbatch --array=LIST); returns the job id.
+/// Writes DIR/slurm/task.sh (the batch script every array task runs) and returns its path.
+/// Throws rths::Error if it cannot be written.
+std::filesystem::path WriteTaskScript(const ArrayWork& w, const ArrayRun& r);
+/// The sbatch command (program and arguments) that submits tasks `tasks` of DIR/slurm/task.sh:
+/// --parsable, the job's name, --array=LIST, --cpus-per-task, --output, --chdir=DIR, then the
+/// settings' partition, time, account and sbatch_args.
+std::vector<std::string> SbatchCommand(const ArrayWork& w, const std::vector<std::int64_t>& tasks, const ArrayRun& r);
+/// `argv` as one line a shell reads back (arguments with other than [A-Za-z0-9-_=./,:%+@]
+/// single-quoted), to show a command.
+std::string ShellLine(const std::vector<std::string>& argv);
+/// WriteTaskScript, then runs SbatchCommand; returns the job id.
 /// Throws rths::Error with sbatch's message if it refuses.
 std::string SubmitArray(const ArrayWork& w, const std::vector<std::int64_t>& tasks, const ArrayRun& r);
 /// Waits until job `id` has left the queue, saying how many items are done as it goes.
