@@ -4,6 +4,7 @@
 #include <doctest/doctest.h>
 
 #include <filesystem>
+#include <cstdlib>
 #include <fstream>
 #include <sstream>
 #include <string>
@@ -13,6 +14,7 @@
 
 #include "core/error.h"
 #include "io/command.h"
+#include "io/plot.h"
 #include "scenario/scenario.h"
 #include "sweep/run_sweep.h"
 #include "sweep/table.h"
@@ -367,4 +369,53 @@ TEST_CASE("sweep plots: a Monte Carlo alone (no case or grid axis) is drawn as p
   const std::string gp = rths_test::Slurp(o.out / "plots" / "peak_force_kN.gp");
   CHECK(gp.find("against each axis (completed runs)") != std::string::npos);
   CHECK(gp.find("lines through the mean") == std::string::npos);
+}
+
+TEST_CASE("sweep plots: array levels labelled as written, a level that failed everywhere named, ticks that fit") {
+  const auto dir = rths_test::TempDir("sweep_plots_labels");
+  rths::sweep::Spec spec;
+  spec.name = "labels";
+  spec.cases = {"base.toml"};
+  spec.record = {"peak_force_kN"};
+  spec.draws = 4;
+  spec.grid = {{"controller.lti.feedback.den", {"[1, 0]", "[1.0, 10.0]", "[1, 100]"}}};
+  spec.draw = {rths::sweep::Draw{}};
+  spec.draw[0].key = "controller.lti.feedback.num[0]";
+  spec.draw[0].dist = "uniform";
+  rths::sweep::Table t;
+  t.columns = rths::sweep::TableColumns(spec);
+  std::int64_t i = 0;
+  for (const std::string level : {"[1, 0]", "[1.0, 10.0]", "[1, 100]"}) {
+    for (int d = 0; d < 4; ++d, ++i) {
+      const double gain = 0.000123456 + 0.0001234567 * static_cast<double>(i);  // long tick labels
+      const bool failed = level == "[1, 100]";
+      t.rows.push_back({i, failed ? "failed: unstable" : "completed", "sha", level, gain,
+                        failed ? nlohmann::json() : nlohmann::json(1.0 + gain)});
+      t.group.push_back(i / 4);
+    }
+  }
+  REQUIRE(t.columns.size() == t.rows[0].size());
+  REQUIRE(rths::sweep::WritePlots(spec, t, dir).size() == 1);
+  const std::string gp = rths_test::Slurp(dir / "peak_force_kN.gp");
+  INFO(gp);
+  // Against the denominator: its levels as the SPEC writes them, without the CSV's quotes.
+  const std::string by_den = rths_test::PanelScript(gp, 1);
+  CHECK(by_den.find("'[1.0, 10.0]' 1") != std::string::npos);
+  CHECK(by_den.find("\"[1.0, 10.0]\"") == std::string::npos);
+  // Against the drawn gain, a curve per denominator: the one with no completed run is named.
+  const std::string by_gain = rths_test::PanelScript(gp, 2);
+  CHECK(by_gain.find("a curve per controller.lti.feedback.den; no completed run: [1, 100]") != std::string::npos);
+  const auto curves = rths_test::PanelCurves(rths_test::ReadPlotData(dir / "peak_force_kN.dat"), 2);
+  REQUIRE(curves.size() == 2);
+  CHECK(curves[1].title == "[1.0, 10.0]");
+  // Its ticks: a fixed step with few enough labels ("0.0012" is 6 characters) for a narrow panel.
+  const std::size_t at = by_gain.find("set xtics ");
+  REQUIRE(at != std::string::npos);
+  const double step = std::strtod(by_gain.c_str() + at + 10, nullptr);
+  REQUIRE(step > 0);
+  const double span = 0.0001234567 * 7;  // the completed runs' gains and the failed ones' too
+  CHECK(span / step + 1 <= 5.0);
+  CHECK(rths::io::NiceTicStep(0.0, 0.00095, 5) == doctest::Approx(0.0005));
+  CHECK(rths::io::NiceTicStep(0.0, 1.0, 11) == doctest::Approx(0.1));
+  CHECK(rths::io::NiceTicStep(3.0, 3.0, 5) == 0.0);
 }

@@ -104,6 +104,19 @@ int KeyMarginChars(const std::vector<const Panel*>& panels) {
   return std::max(12, static_cast<int>(longest) + 10);
 }
 
+double NiceTicStep(double lo, double hi, int max_tics) {
+  const double span = hi - lo;
+  if (!std::isfinite(span) || span <= 0 || max_tics < 2) return 0.0;
+  const double least = span / (max_tics - 1);
+  double decade = std::pow(10.0, std::floor(std::log10(least)));
+  for (;;) {
+    for (const double m : {1.0, 2.0, 5.0}) {
+      if (m * decade >= least * (1 - 1e-12)) return m * decade;
+    }
+    decade *= 10;
+  }
+}
+
 bool GnuplotAvailable(const std::string& program) { return !FindProgram(program).empty(); }
 
 namespace {
@@ -181,7 +194,15 @@ void WritePanel(std::ostringstream& gp, const Panel& panel, std::size_t p, const
   gp << fmt::format("set lmargin {}\nset rmargin {}\n", panel.left_margin_chars < 0 ? -1 : panel.left_margin_chars,
                     panel.right_margin_chars < 0 ? -1 : panel.right_margin_chars);
   if (panel.x_tics.empty()) {
-    gp << "set xtics autofreq\n";
+    double lo = INFINITY, hi = -INFINITY;
+    for (const Series& ser : panel.series) {
+      for (const double x : ser.x) {
+        if (std::isfinite(x)) lo = std::min(lo, x), hi = std::max(hi, x);
+      }
+    }
+    const double step = panel.log_x ? 0.0 : NiceTicStep(lo, hi, panel.max_x_tics);
+    // With a fixed step, the range stays the data's (plus the offsets), not widened to a tick.
+    gp << (step > 0 ? fmt::format("set xtics {}\nset autoscale xfix\n", Num(step)) : std::string("set xtics autofreq\n"));
   } else {
     gp << "set xtics (";
     for (std::size_t i = 0; i < panel.x_tics.size(); ++i) {
@@ -189,6 +210,7 @@ void WritePanel(std::ostringstream& gp, const Panel& panel, std::size_t p, const
     }
     gp << ")\n";
   }
+  gp << (panel.rotate_x_tics ? "set xtics rotate by -25\n" : "set xtics norotate\n");
   gp << fmt::format("set boxwidth {} absolute\nset style fill solid 0.85 border -1\n", Num(panel.box_width));
   if (panel.margin_fraction > 0) {
     const std::string f = Num(panel.margin_fraction);

@@ -46,6 +46,11 @@ struct Panel {
   int left_margin_chars = -1, right_margin_chars = -1;
   /// Labelled x ticks (x, label), e.g. categories of a bar chart; empty = numeric ticks.
   std::vector<std::pair<double, std::string>> x_tics;
+  /// Numeric x ticks (x_tics empty, linear axis): at most this many, at a step of 1, 2 or 5 x 10^k
+  /// over the curves' x span, so that long tick labels on a narrow panel do not run into each
+  /// other; 0 = gnuplot's choice.
+  int max_x_tics = 0;
+  bool rotate_x_tics = false;                      ///< x tick labels slanted (long category names)
   double box_width = 0.8;                          ///< width of "boxes" bars [x units]
   /// An x interval [x units] shaded light grey behind the data over the panel's height (a fitted
   /// band, say); unset = none.
@@ -110,6 +115,10 @@ inline constexpr double kMaxReadableLuminance = 0.30;
 /// characters for the sample line, padding and Plot's `width 1`, ~1 character from the figure's
 /// edge; the rest is the gap to the axes. Measured with sans 11 on pngcairo.)
 int KeyMarginChars(const std::vector<const Panel*>& panels);
+
+/// The tick step for at most `max_tics` ticks over [lo, hi]: the smallest 1, 2 or 5 x 10^k with
+/// (hi - lo) / step <= max_tics - 1; 0 for an empty or non-finite span or max_tics < 2.
+double NiceTicStep(double lo, double hi, int max_tics);
 
 struct PlotFiles {
   std::filesystem::path dat, gp, png;

@@ -21,10 +21,16 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string Cell(const nlohmann::json& v) {
+/// A value as text: a string itself, a float the shortest text that reads back bit for bit, else
+/// its JSON ("" for null).
+std::string Text(const nlohmann::json& v) {
   if (v.is_null()) return "";
-  if (v.is_number_float()) return fmt::format("{}", v.get<double>());  // the shortest text that reads back bit for bit
-  std::string s = v.is_string() ? v.get<std::string>() : v.dump();
+  if (v.is_number_float()) return fmt::format("{}", v.get<double>());
+  return v.is_string() ? v.get<std::string>() : v.dump();
+}
+
+std::string Cell(const nlohmann::json& v) {
+  std::string s = Text(v);
   if (s.find_first_of(",\"\n") == std::string::npos) return s;
   std::string q = "\"";
   for (const char c : s) q += c == '"' ? std::string("\"\"") : std::string(1, c);
@@ -318,7 +324,7 @@ std::vector<AxisColumn> PlotAxes(const Spec& spec, const Table& t) {
   std::size_t column = FirstSetColumn(spec);  // the grid's and the draws' columns
   for (const Axis& g : spec.grid) {
     AxisColumn a{g.key, {}};
-    for (const auto& row : t.rows) a.labels.push_back(Cell(row[column]));
+    for (const auto& row : t.rows) a.labels.push_back(Text(row[column]));
     axes.push_back(std::move(a));
     ++column;
   }
@@ -326,7 +332,7 @@ std::vector<AxisColumn> PlotAxes(const Spec& spec, const Table& t) {
     for (const std::string& key : DrawColumns(d)) {
       if (d.dist != "seed") {  // a seed is no axis
         AxisColumn a{key, {}, true};
-        for (const auto& row : t.rows) a.labels.push_back(Cell(row[column]));
+        for (const auto& row : t.rows) a.labels.push_back(Text(row[column]));
         axes.push_back(std::move(a));
       }
       ++column;
@@ -368,6 +374,35 @@ std::vector<double> XPositions(const AxisColumn& a, io::Panel* p) {
   return x;
 }
 
+/// Keeps the x tick labels of a panel `width_chars` characters wide (its plot area, about) from
+/// running into each other: category names are slanted when they do not fit side by side; numeric
+/// ticks are thinned to as many labels as fit (NiceTicStep's steps, each label's length measured
+/// as gnuplot writes it).
+void FitXTicks(io::Panel* p, const std::vector<double>& x, int width_chars) {
+  if (!p->x_tics.empty()) {
+    std::size_t chars = 0;
+    for (const auto& [at, label] : p->x_tics) chars += label.size() + 2;
+    p->rotate_x_tics = static_cast<int>(chars) > width_chars;
+    return;
+  }
+  double lo = INFINITY, hi = -INFINITY;
+  for (const double v : x) {
+    if (std::isfinite(v)) lo = std::min(lo, v), hi = std::max(hi, v);
+  }
+  for (int n = 8; n >= 2; --n) {
+    const double step = io::NiceTicStep(lo, hi, n);
+    if (step <= 0) return;
+    std::size_t longest = 1;
+    for (double t = std::ceil(lo / step) * step; t <= hi + step * 1e-9; t += step) {
+      longest = std::max(longest, fmt::format("{:.6g}", std::abs(t) < step * 1e-9 ? 0.0 : t).size());
+    }
+    if (static_cast<int>((n + 1) * (longest + 2)) <= width_chars || n == 2) {
+      p->max_x_tics = n;
+      return;
+    }
+  }
+}
+
 /// Column c of the completed rows against axis axes[a], a curve per level of the other factor
 /// (SplitAxis; one curve without one), with space between the points and the frame. Against a
 /// case or grid key, each curve is a line through the mean of its runs at each x, its runs as
@@ -386,8 +421,16 @@ io::Panel PlotPanel(const Table& t, std::size_t c, const std::vector<AxisColumn>
     level_of[r] = static_cast<std::size_t>(it - levels.begin());
     if (it == levels.end()) levels.push_back(split->labels[r]);
   }
+  std::vector<std::string> lost;  // levels of `split` with no completed run: no curve, said in the title
+  for (std::size_t r = 0; split != nullptr && r < t.rows.size(); ++r) {
+    const std::string& l = split->labels[r];
+    if (std::find(levels.begin(), levels.end(), l) == levels.end() && std::find(lost.begin(), lost.end(), l) == lost.end()) {
+      lost.push_back(l);
+    }
+  }
   if (levels.empty()) levels.push_back("");
   if (split != nullptr) p.title = "a curve per " + split->name;
+  for (std::size_t i = 0; i < lost.size(); ++i) p.title += (i ? ", " : "; no completed run: ") + lost[i];
   p.key = split != nullptr ? "outside right top" : "off";  // short entries (the levels): a narrow column
   const auto& palette = io::ReadableColors();
   for (std::size_t l = 0; l < levels.size(); ++l) {
@@ -424,6 +467,10 @@ io::Panel PlotPanel(const Table& t, std::size_t c, const std::vector<AxisColumn>
     p.series.push_back(std::move(mean));
   }
   if (split != nullptr) p.right_margin_chars = io::KeyMarginChars({&p});
+  // The panel's plot area in characters: its share of the figure (io::Figure's 1000 px, about 7.5 px
+  // a character at its font, measured on its PNGs: 7.2) less the y axis's labels and the key's column.
+  const int panel_chars = static_cast<int>((io::Figure{}.width_px / (axes.size() > 1 ? 2 : 1)) / 7.5);
+  FitXTicks(&p, x, panel_chars - 10 - std::max(p.right_margin_chars, 2));
   return p;
 }
 
