@@ -182,14 +182,14 @@ void WriteFigure(const BenchmarkResult& res, const ReproduceOptions& opts) {
       io::Series pert = io::MakeSeries(
           cs == 1 ? fmt::format("perturbed ({} plants{})", res.perturbed, opts.quick ? ", --quick" : "") : "",
           colors[cs - 1]);
-      pert.with = "points pt 6 ps 1.1";
+      pert.with = "points pt 6 ps 1.3";  // open rings beside (not under) the case's nominal dot
       for (std::size_t c = 0; c < names.size(); ++c) {
         for (const auto& row : res.rows) {
           if (row.case_number != cs || row.controller != names[c] || !row.criteria_ok) continue;
           const double v = row.j.At(j);
           if (!std::isfinite(v) || (p.log_y && !(v > 0))) continue;
           io::Series& s = row.run == "nominal" ? nom : pert;
-          s.x.push_back(static_cast<double>(c + 1) + offset + (row.run == "nominal" ? 0.0 : 0.035));
+          s.x.push_back(static_cast<double>(c + 1) + offset + (row.run == "nominal" ? -0.02 : 0.045));
           s.y.push_back(v);
           if (row.stopped != "no") {
             stopped.x.push_back(s.x.back());
@@ -198,7 +198,7 @@ void WriteFigure(const BenchmarkResult& res, const ReproduceOptions& opts) {
         }
         const double pub = PublishedExampleCriteria()[cs - 1][j];
         if (names[c] == "example_pi_lead" && std::isfinite(pub)) {
-          published.x.push_back(static_cast<double>(c + 1) + offset - 0.035);
+          published.x.push_back(static_cast<double>(c + 1) + offset - 0.055);
           published.y.push_back(pub);
         }
       }
@@ -211,6 +211,13 @@ void WriteFigure(const BenchmarkResult& res, const ReproduceOptions& opts) {
     p.series.insert(p.series.end(), nominal.begin(), nominal.end());
     p.series.insert(p.series.end(), perturbed.begin(), perturbed.end());
     if (!stopped.x.empty()) p.series.push_back(stopped);
+    if (!p.log_y) {  // J1, a delay: from 0 (a margin below it would show negative delays)
+      double top = 0.0;
+      for (const io::Series& s : p.series) {
+        for (const double y : s.y) top = std::max(top, y);
+      }
+      if (top > 0) p.y_range = std::make_pair(0.0, 1.08 * top);
+    }
     fig.panels.push_back(p);
   }
   fig.gnuplot = opts.gnuplot;
