@@ -443,4 +443,20 @@ TEST_CASE("a benchmark run's report: the smaller error curve drawn over the larg
   CHECK(Slurp(figs / "spectra.gp").find("title 'Power spectral densities of r (desired)") != std::string::npos);
   // The force-velocity loop's velocity is the low-passed derivative of y, not its noisy central difference.
   CHECK(Slurp(figs / "loops.gp").find("y'' [mm/s] (low-passed at 50 Hz)") != std::string::npos);
+  // Peaks off the frame (time histories: above and below only) and legends above the axes, where
+  // they cover no curve; a loop's extremes off the frame on every side.
+  for (const char* name : {"time_histories.gp", "tracking_error.gp"}) {
+    CAPTURE(name);
+    const std::string gp = Slurp(figs / name);
+    for (int p = 1; p <= 2; ++p) {
+      CAPTURE(p);
+      const std::string panel = rths_test::PanelScript(gp, p);
+      CHECK(panel.find("set offsets graph 0, graph 0, graph 0.06, graph 0.06") != std::string::npos);
+      CHECK((panel.find("set key off") != std::string::npos ||
+             panel.find("set key on outside top center horizontal") != std::string::npos));
+    }
+  }
+  const std::string loops = Slurp(figs / "loops.gp");
+  CHECK(rths_test::PanelScript(loops, 1).find("set offsets graph 0.06, graph 0.06, graph 0.06, graph 0.06") !=
+        std::string::npos);
 }

@@ -212,9 +212,10 @@ void WritePanel(std::ostringstream& gp, const Panel& panel, std::size_t p, const
   }
   gp << (panel.rotate_x_tics ? "set xtics rotate by -25\n" : "set xtics norotate\n");
   gp << fmt::format("set boxwidth {} absolute\nset style fill solid 0.85 border -1\n", Num(panel.box_width));
-  if (panel.margin_fraction > 0) {
-    const std::string f = Num(panel.margin_fraction);
-    gp << fmt::format("set offsets graph {0}, graph {0}, graph {0}, graph {0}\n", f);
+  if (panel.margin_fraction > 0 || panel.y_margin_fraction > 0) {
+    const std::string fx = Num(panel.margin_fraction);
+    const std::string fy = Num(std::max(panel.margin_fraction, panel.y_margin_fraction));
+    gp << fmt::format("set offsets graph {0}, graph {0}, graph {1}, graph {1}\n", fx, fy);
   } else {
     gp << "unset offsets\n";
   }

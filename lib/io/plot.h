@@ -59,6 +59,9 @@ struct Panel {
   /// an autoscaled axis (gnuplot `set offsets graph f, ...`): points at the data's extremes stay
   /// off the frame. 0 = none (gnuplot's autoscale, extremes on the frame when they fall on a tic).
   double margin_fraction = 0.0;
+  /// The same above and below only (a time history keeps its ends on the frame, its peaks off
+  /// it); the larger of the two applies to y.
+  double y_margin_fraction = 0.0;
 };
 
 struct Figure {

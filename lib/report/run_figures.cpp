@@ -36,6 +36,10 @@ constexpr double kZoomHalfS = 0.125;
 /// A coherence within this of 1 over the whole band is a flat line at 1 on the page (a run without
 /// sensor noise: our simulations reach 0.9997 at worst): not drawn.
 constexpr double kFlatCoherence = 1e-3;
+/// Space between a curve's peaks and the frame, as a fraction of the plot's height.
+constexpr double kPeakMargin = 0.06;
+/// A legend above the axes, in a row: it covers no curve (inside, it hid the peaks).
+constexpr const char* kKeyAbove = "outside top center horizontal";
 // Colours of the signals, the same in every figure.
 constexpr const char* kColorR = "black";
 constexpr const char* kColorU = "#1f77b4";
@@ -118,6 +122,11 @@ PageFigure TimeHistories(const io::RunSignals& s, const RunReportOptions& o) {
     fd.width = 1.0;
     force.series.push_back(fd);
   }
+  // Peaks off the frame, and the legends above the axes where they cover no curve.
+  for (Panel* p : {&disp, &force}) {
+    p->y_margin_fraction = kPeakMargin;
+    p->key = kKeyAbove;
+  }
   PageFigure pf{NewFigure("time_histories", o), "Time histories", ""};
   pf.figure.panels = {disp, force};
   pf.caption_html = "Desired displacement r, actuator command u and measured displacement y [mm]; measured force f [kN]";
@@ -131,6 +140,8 @@ PageFigure TimeHistories(const io::RunSignals& s, const RunReportOptions& o) {
   } else {
     Panel cur = MakePanel("Damper current", "t [s]", "current [A]");
     cur.series = {History("i_cmd (commanded)", kColorI, t, i_cmd, m), History("i_eff (effective)", kColorE, t, i_eff, m)};
+    cur.y_margin_fraction = kPeakMargin;
+    cur.key = kKeyAbove;
     pf.figure.panels.push_back(cur);
     pf.caption_html += "; commanded and effective damper current [A].";
   }
@@ -147,6 +158,7 @@ PageFigure TrackingError(const io::RunSignals& s, const RunReportOptions& o) {
   const auto& e = s.At("e_mm").values;
   Panel err = MakePanel("Tracking error e = r - y", "t [s]", "e [mm]");
   err.key = "off";
+  err.y_margin_fraction = kPeakMargin;
   err.series = {History("e", kColorE, t, e, o.max_plot_points)};
 
   // r, u, y around the largest |e|: +-kZoomHalfS (or the whole run if it is shorter), where the
@@ -163,6 +175,8 @@ PageFigure TrackingError(const io::RunSignals& s, const RunReportOptions& o) {
                  Curve("u (command)", kColorU, t, s.At("u_mm").values, idx),
                  Curve("y (measured)", kColorY, t, s.At("y_mm").values, idx)};
   zoom.x_range = std::make_pair(t[lo], t[hi - 1]);
+  zoom.y_margin_fraction = kPeakMargin;
+  zoom.key = kKeyAbove;
   PageFigure pf{NewFigure("tracking_error", o), "Tracking error", ""};
   pf.figure.panels = {err, zoom};
   pf.figure.panel_height_px = 360;
@@ -258,6 +272,7 @@ PageFigure Loops(const io::RunSignals& s, const RunReportOptions& o) {
   Panel fv = MakePanel("Force-velocity", LoopVelocityLabel(s.dt_s), "f [kN]");
   fv.key = "off";
   fv.series = {Curve("f(y')", kColorF, v, f, idx)};
+  fd.margin_fraction = fv.margin_fraction = kPeakMargin;  // the loop's extremes off the frame
   PageFigure pf{NewFigure("loops", o), "Force loops", ""};
   pf.figure.panels = {fd, fv};
   pf.figure.columns = 2;
