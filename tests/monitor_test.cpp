@@ -452,9 +452,10 @@ TEST_CASE("rths run --watch --transport memq: the page's ABORT stops an in-proce
     const auto res = c.Get("/state?token=" + token);
     if (!res || res->status != 200) break;
     end = nlohmann::json::parse(res->body);
-    if (end["status"]["phase"] == "aborted") break;
+    if (end["status"]["phase"] == "aborted" && end["status"]["ended"] == true) break;
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
+  CHECK(end["status"]["ended"] == true);
   CHECK(end["status"]["abort_by"] == "monitor");
   CHECK(end["status"]["abort_reason"] == "operator abort from the monitor");
   CHECK(run.Wait() == rths::lockstep::kExitPeerAbort);
@@ -468,6 +469,8 @@ TEST_CASE("rths run --watch --transport memq: the page's ABORT stops an in-proce
   CHECK_FALSE(log.truncated_tail);
   CHECK(log.CompleteSteps() == summary["steps"].get<std::int64_t>());
   CHECK(log.CompleteSteps() < 1200000);
+  // The page's last word on the step count is the run's own (it was one behind after an abort).
+  CHECK(end["status"]["last_k"].get<std::int64_t>() + 1 == summary["steps"].get<std::int64_t>());
 }
 
 TEST_CASE("rths watch --lcm-url: a run started elsewhere is watched and stopped; --exit-at-end ends with it") {

@@ -316,7 +316,7 @@ int main(int argc, char** argv) {
       const std::string by = sum.status == "interrupted" ? "the operator (Ctrl-C)"
                              : sum.failure                ? sum.failure->participant
                                                           : "";
-      monitor->OnEnd(result.plan.run_id, sum.status, by, sum.stopped);
+      monitor->OnEnd(result.plan.run_id, sum.status, by, sum.stopped, sum.steps);
       std::this_thread::sleep_for(std::chrono::seconds(1));  // the page gets the run's end
       monitor->Stop();
     }

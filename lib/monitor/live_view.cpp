@@ -92,10 +92,12 @@ void LiveView::OnRecord(const rths::monitor_t& m, WallClock::time_point now) {
 }
 
 void LiveView::OnEnd(std::int64_t run_id, const std::string& status, const std::string& by,
-                     const std::string& reason) {
+                     const std::string& reason, std::int64_t steps) {
   std::lock_guard lock(mutex_);
   if (run_id != status_.run_id) return;
   status_.phase = status == "completed" ? "completed" : "aborted";
+  status_.last_k = steps - 1;
+  status_.ended = true;
   if (status_.phase == "aborted" && status_.abort_by.empty()) {
     status_.abort_by = by;
     status_.abort_reason = reason;
@@ -140,6 +142,7 @@ nlohmann::json LiveView::Since(std::int64_t cursor, std::size_t max_points) cons
       {"records_heard", st.records_heard},
       {"records_expected", st.records_expected},
       {"paced", st.paced},
+      {"ended", st.ended},
       {"latency_ms", st.latency_ms},
       {"latency_max_ms", st.latency_max_ms},
       {"misses", st.misses},

@@ -60,6 +60,10 @@ struct LiveStatus {
   /// The safety monitor's limits (0: none) and the run's peaks so far.
   double stroke_mm = 0, force_kN = 0, max_error_mm = 0;
   double peak_disp_mm = 0, peak_force_kN = 0, peak_error_mm = 0;
+  /// The run's supervisor has reported its end (OnEnd): last_k + 1 is then summary.json's `steps`
+  /// (the log's complete steps), which may be one more than the clock had committed when it was
+  /// stopped.
+  bool ended = false;
 };
 
 /// The state of one run at a time: a new run id starts over.
@@ -74,8 +78,10 @@ class LiveView {
   /// A record of the clock's (lockstep/live_feed.h); `now` its arrival.
   void OnRecord(const rths::monitor_t& record, WallClock::time_point now);
   /// The run ended as its supervisor reports it (a monitor in the run's own process): `status` as
-  /// summary.json's ("completed", "aborted", ...), `by` and `reason` of an abort.
-  void OnEnd(std::int64_t run_id, const std::string& status, const std::string& by, const std::string& reason);
+  /// summary.json's ("completed", "aborted", ...), `by` and `reason` of an abort, `steps` its
+  /// complete steps.
+  void OnEnd(std::int64_t run_id, const std::string& status, const std::string& by, const std::string& reason,
+             std::int64_t steps);
 
   LiveStatus Status() const;
   /// The points after `cursor` (an index that only grows; the oldest kept if it fell out), at most

@@ -54,9 +54,9 @@ void Monitor::Stop() {
 }
 
 void Monitor::OnEnd(std::int64_t run_id, const std::string& status, const std::string& by,
-                    const std::string& reason) {
+                    const std::string& reason, std::int64_t steps) {
   if (feed_) feed_->Stop();  // every record the run made is in the view first
-  view_.OnEnd(run_id, status, by, reason);
+  view_.OnEnd(run_id, status, by, reason, steps);
 }
 
 }  // namespace rths::monitor

@@ -39,8 +39,10 @@ class Monitor {
   /// A run in this process: where its clock's records go (RunRequest::live_sink); nullptr for a
   /// monitor on a URL.
   lockstep::LiveSink* live_sink() { return feed_.get(); }
-  /// A run in this process has ended as its summary says (status, and who stopped it why).
-  void OnEnd(std::int64_t run_id, const std::string& status, const std::string& by, const std::string& reason);
+  /// A run in this process has ended as its summary says (status, who stopped it why, its
+  /// complete steps).
+  void OnEnd(std::int64_t run_id, const std::string& status, const std::string& by, const std::string& reason,
+             std::int64_t steps);
 
  private:
   LiveView view_;

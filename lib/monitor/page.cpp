@@ -46,7 +46,7 @@ header h1 { font-size: 18px; margin: 0; font-weight: 600; }
 <span>rate <b id="rate">-</b></span><span id="pacedstats" class="hidden">latency <b id="latency">-</b>,
 misses <b id="misses">-</b> <i>(the clock's, as summary.json counts them)</i></span><span>monitor heard <b id="heard">-</b></span></div>
 <div id="limits"><span>safety limits, the run's peak so far:</span>
-<span>displacement <b id="lim_disp">-</b></span><span>force <b id="lim_force">-</b></span><span>|r &minus; y| <b id="lim_err">-</b></span></div>
+<span>stroke (max |r|, |u|, |y|) <b id="lim_disp">-</b></span><span>force <b id="lim_force">-</b></span><span>|r &minus; y| <b id="lim_err">-</b></span></div>
 <div id="message"></div>
 <div id="controls">window <button data-s="2">2 s</button><button data-s="10" class="on">10 s</button><button data-s="0">all</button></div>
 <div class="grid">
