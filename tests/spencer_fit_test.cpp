@@ -531,6 +531,15 @@ TEST_CASE("plausible ranges: Table 3 is plausible, c0_b = 71.5 kN s/mm is flagge
   const auto advice = rths::ident::FitAdvice(st, c);
   CHECK(std::any_of(advice.begin(), advice.end(),
                     [](const std::string& a) { return a.rfind("c0_b: c0_b is the viscous damping", 0) == 0; }));
+  // An implausible rate gets a value to hold it at: too slow (c0_c = 0.001, a linear law) saturates
+  // by the highest input, 3 / 1 A; too fast (beta_c = 300) by the second level, 3 / 0.5 A.
+  auto line = [&](const std::string& name) {
+    for (const auto& a : advice)
+      if (a.rfind(name + ": ", 0) == 0) return a;
+    return std::string();
+  };
+  CHECK(line("c0_c").find("--hold c0_c=3 (95 % of the change by 1 A) (plausible: 0.1 to 52 1/A)") != std::string::npos);
+  CHECK(line("beta_c").find("--hold beta_c=6 (95 % of the change by 0.5 A)") != std::string::npos);
 }
 
 TEST_CASE("plausible ranges: docs/identification.md's table is the code's") {

@@ -54,6 +54,12 @@ std::string HoldHint(std::string_view name, const AdviceContext& c) {
   return fmt::format("or hold it at a value you trust: --hold {}=VALUE", name);
 }
 
+/// `--hold NAME=VALUE` for a rate: the value that puts 95 % of the law's change `by` above the
+/// lowest input, 3 / (by - lowest) (1 - e^-3 = 0.95).
+std::string HoldRate(std::string_view name, double by, const AdviceContext& c) {
+  return fmt::format("--hold {}={:.3g} (95 % of the change by {:g} {})", name, 3.0 / (by - c.input_min), by, Unit(c));
+}
+
 /// A rate on a bound (fit file comment).
 std::string RateAdvice(const ParameterStatus& p, const NameParts& n, bool upper, const AdviceContext& c) {
   const char* u = Unit(c);
@@ -66,10 +72,9 @@ std::string RateAdvice(const ParameterStatus& p, const NameParts& n, bool upper,
     if (l2 > 0.0) {
       o += fmt::format(
           "the lowest level above {:g} {} that the records hold ({:g} {}), so they cannot say how fast. Records at "
-          "inputs between {:g} and {:g} {} (e.g. {:.2g} and {:.2g} {}) would determine it; or hold it: --hold {}={:.3g} "
-          "(95 % of the change by {:g} {})",
+          "inputs between {:g} and {:g} {} (e.g. {:.2g} and {:.2g} {}) would determine it; or hold it: {}",
           c.input_min, u, l2, u, c.input_min, l2, u, c.input_min + (l2 - c.input_min) / 3.0,
-          c.input_min + 2.0 * (l2 - c.input_min) / 3.0, u, p.name, 3.0 / (l2 - c.input_min), l2, u);
+          c.input_min + 2.0 * (l2 - c.input_min) / 3.0, u, HoldRate(p.name, l2, c));
     } else {
       o += fmt::format(
           "any input the records dwell at, so they cannot say how fast. Records whose command dwells at low inputs, "
@@ -78,12 +83,12 @@ std::string RateAdvice(const ParameterStatus& p, const NameParts& n, bool upper,
     }
     return o;
   }
-  const double span = c.input_max - c.input_min;
   return fmt::format(
       "{} = {:.4g} 1/{} on its lower bound: {} changes linearly over the inputs fitted and {}_b, its saturated value, "
       "lies far beyond them (an extrapolation). Records at higher inputs, toward the damper's saturation, would "
-      "determine it; or hold it: --hold {}={:.3g} (95 % of the change by {:g} {}, the highest input)",
-      p.name, p.value, u, n.base, n.base, p.name, span > 0.0 ? 3.0 / span : 1.0, c.input_max, u);
+      "determine it; or hold it: {}, the highest input",
+      p.name, p.value, u, n.base, n.base,
+      c.input_max > c.input_min ? HoldRate(p.name, c.input_max, c) : "--hold " + p.name + "=VALUE");
 }
 
 }  // namespace
@@ -148,6 +153,14 @@ std::string ImplausibleAdvice(const Implausible& p, const FitStatus& status, con
   }
   if (n.base == "alpha" || n.base == "beta" || n.base == "gamma")
     o += "; alpha, beta and gamma trade with A (held): read alpha z_max and the pre-yield travel";
+  if (n.part == 'c' && c.any_input && c.input_max > c.input_min) {
+    // A rate too slow: the law is nearly linear over the records, so saturate it by the highest
+    // input; too fast: by the second level the records hold (or the highest input).
+    const double l2 = SecondLevel(c);
+    const double by = p.value < p.lo || l2 <= c.input_min ? c.input_max : l2;
+    return o + fmt::format("; or hold it: {} (plausible: {:.3g} to {:.3g} {})", HoldRate(p.name, by, c), p.lo, p.hi,
+                           p.unit);
+  }
   return o + "; " + HoldHint(p.name, c);
 }
 
