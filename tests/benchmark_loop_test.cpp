@@ -8,6 +8,7 @@
 
 #include "core/error.h"
 #include "participants/benchmark_run.h"
+#include "studies/benchmark.h"
 #include "studies/benchmark_loop.h"
 #include "scenario/scenario.h"
 #include "test_support.h"
@@ -55,6 +56,44 @@ TEST_CASE("closed as the lockstep closes it, the loop gives a memq run's J1-J9 b
     const auto loop = RunBenchmarkLoop(s, rths::studies::LockstepLoop());
     CheckEqual(loop.j, lockstep);
     CHECK(loop.steps == s.steps());
+  }
+}
+
+TEST_CASE("structure.integrator = rk4_unit_delay: the lockstep run is the reference code's loop, bit for bit") {
+  // RK4 of the substructure with the force one sample late, the reference continuous; no converters
+  // (they belong to the reference code's example controller, not to the loop).
+  rths::scenario::Scenario s = rths::scenario::LoadScenario(
+      kScenarios + "case2_example.toml", {"run.duration_s=12", "structure.integrator=rk4_unit_delay"});
+  const fs::path dir = rths_test::TempDir("loop_rk4_unit_delay");
+  const rths_test::MemqRun run = rths_test::RunMemq({s}, dir);
+  REQUIRE(run.code == 0);
+  const auto lockstep = rths::participants::BenchmarkCriteriaOfRun((dir / "log.lcm").string(), s);
+  LoopOptions o = rths::studies::ReferenceCodeLoop();
+  o.quantise_m = 0.0;
+  CheckEqual(RunBenchmarkLoop(s, o).j, lockstep);
+  // and not the central difference's: J4 moves by points (docs/benchmark.md).
+  s.structure.integrator = rths::models::StructureIntegrator::kCentralDifference;
+  CHECK(RunBenchmarkLoop(s, rths::studies::LockstepLoop()).j.J4_pct < lockstep.J4_pct - 1.0);
+}
+
+TEST_CASE("rk4_unit_delay: the four shipped example cases, run through the lockstep, give Table 3") {
+  // The acceptance of issue 44: J1 within 0.3 ms, J2-J9 within max(1.5 points, 10 %) of the
+  // published example controller's row, the whole record, each case's shipped file as it is.
+  for (int c = 1; c <= 4; ++c) {
+    CAPTURE(c);
+    const rths::scenario::Scenario s = rths::scenario::LoadScenario(
+        kScenarios + "case" + std::to_string(c) + "_example.toml", {"structure.integrator=rk4_unit_delay"});
+    const fs::path dir = rths_test::TempDir("table3_rk4_case" + std::to_string(c));
+    const rths_test::MemqRun run = rths_test::RunMemq({s}, dir);
+    REQUIRE(run.code == 0);
+    const auto j = rths::participants::BenchmarkCriteriaOfRun((dir / "log.lcm").string(), s);
+    const auto& published = rths::studies::PublishedExampleCriteria()[c - 1];
+    CHECK(std::abs(j.J1_ms - published[0]) <= 0.3);
+    for (int i = 1; i < 9; ++i) {
+      CAPTURE(i + 1);
+      CAPTURE(j.At(i));
+      CHECK(std::abs(j.At(i) - published[i]) <= std::max(1.5, 0.1 * published[i]));
+    }
   }
 }
 

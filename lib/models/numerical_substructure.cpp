@@ -2,6 +2,8 @@
 
 #include <utility>
 
+#include "core/error.h"
+
 namespace rths::models {
 
 NumericalSubstructure NumericalSubstructure::Predefined(std::vector<double> r_mm) {
@@ -14,27 +16,73 @@ NumericalSubstructure NumericalSubstructure::Integrated(const LinearStructure& s
                                                         std::vector<double> ground_mm_s2) {
   NumericalSubstructure m;
   m.cd = CentralDifference::Make(structure, dt_s);
+  m.dt_s = dt_s;
   m.dof = structure.actuator_dof;
   m.ground_mm_s2 = std::move(ground_mm_s2);
   return m;
 }
 
-StructureState MakeState(const NumericalSubstructure& m) {
-  if (m.cd) return MakeState(*m.cd);
-  StructureState s;
-  s.x = Eigen::VectorXd::Zero(1);
-  s.abs_acc_prev = Eigen::VectorXd::Zero(1);
+NumericalSubstructure NumericalSubstructure::Rk4UnitDelay(const LinearStructure& structure, double dt_s,
+                                                          std::vector<double> ground_mm_s2,
+                                                          std::vector<double> ground_half_mm_s2) {
+  if (ground_half_mm_s2.size() != 2 * ground_mm_s2.size() + 1)
+    throw Error("rk4_unit_delay", "needs a_g at the half steps: 2N + 1 values for N steps");
+  NumericalSubstructure m = Integrated(structure, dt_s, std::move(ground_mm_s2));
+  m.rk4 = ContinuousStructure::Make(structure);
+  m.ground_half_mm_s2 = std::move(ground_half_mm_s2);
+  return m;
+}
+
+SubstructureState MakeState(const NumericalSubstructure& m) {
+  SubstructureState s;
+  if (m.cd) {
+    s.structure = MakeState(*m.cd);
+  } else {
+    s.structure.x = Eigen::VectorXd::Zero(1);
+    s.structure.abs_acc_prev = Eigen::VectorXd::Zero(1);
+  }
+  if (m.rk4) {
+    s.z = Eigen::VectorXd::Zero(2 * m.rk4->n);
+    s.rk = Rk4Workspace::Make(*m.rk4);
+  }
   return s;
 }
 
-double Step(const NumericalSubstructure& m, StructureState* s, std::int64_t k, double f_prev_kN) {
+namespace {
+
+/// rk4_unit_delay's step k > 0: z_{k-1} -> z_k with f_{k-2} held, then the outputs.
+void StepRk4(const NumericalSubstructure& m, SubstructureState* s, std::int64_t k, double f_prev_kN) {
+  const auto j = static_cast<std::size_t>(2 * (k - 1));
+  const double ag[3] = {m.ground_half_mm_s2[j], m.ground_half_mm_s2[j + 1], m.ground_half_mm_s2[j + 2]};
+  s->structure.vel_prev = s->z.tail(m.rk4->n);  // x'_{k-1}
+  Rk4Step(*m.rk4, &s->rk, &s->z, m.dt_s, ag, s->f_delayed_kN);
+  s->f_delayed_kN = f_prev_kN;
+  const int n = m.rk4->n;
+  StructureState& out = s->structure;
+  out.k = k;
+  out.x_prev = out.x;
+  out.x = s->z.head(n);
+  // The first stage is the rate at t_{k-1}: its lower half the relative accelerations there.
+  out.acc_prev = s->rk.k1.tail(n);
+  out.abs_acc_prev = out.acc_prev + m.cd->iota * m.ground_mm_s2[static_cast<std::size_t>(k - 1)];
+}
+
+}  // namespace
+
+double Step(const NumericalSubstructure& m, SubstructureState* s, std::int64_t k, double f_prev_kN) {
   if (m.predefined()) {
     const double r = m.r_mm[static_cast<std::size_t>(k)];
-    s->x[0] = r;
+    s->structure.x[0] = r;
     return r;
   }
-  if (k > 0) Advance(*m.cd, s, m.ground_mm_s2[static_cast<std::size_t>(k - 1)], f_prev_kN);
-  return s->x[m.dof];
+  if (k > 0) {
+    if (m.rk4) {
+      StepRk4(m, s, k, f_prev_kN);
+    } else {
+      Advance(*m.cd, &s->structure, m.ground_mm_s2[static_cast<std::size_t>(k - 1)], f_prev_kN);
+    }
+  }
+  return s->structure.x[m.dof];
 }
 
 }  // namespace rths::models

@@ -42,6 +42,13 @@ enum class Derivatives { kExtrapolated, kCentral };
 inline constexpr std::array<Named<Derivatives>, 2> kDerivativesNames = {
     {{Derivatives::kExtrapolated, "extrapolated"}, {Derivatives::kCentral, "central"}}};
 
+/// How mode "rths" integrates the numerical substructure (StructureConfig::integrator;
+/// docs/structures.md "Integrators").
+enum class StructureIntegrator { kCentralDifference, kRk4UnitDelay };
+inline constexpr std::array<Named<StructureIntegrator>, 2> kStructureIntegratorNames = {
+    {{StructureIntegrator::kCentralDifference, "central_difference"},
+     {StructureIntegrator::kRk4UnitDelay, "rk4_unit_delay"}}};
+
 /// M [kN s^2/mm], K [kN/mm], C [kN s/mm], and the ground influence vector iota [-] (empty: ones).
 struct StructureMatrices {
   Eigen::MatrixXd M, K, C;
@@ -62,6 +69,12 @@ struct StructureConfig {
   /// mode = "rths": "sdof" (mass, frequency, damping below) | "file" (M, K, C from `file`, a
   /// structure file: docs/structures.md; e.g. data/buildings/ohtori9_ns.txt).
   StructureKind kind = StructureKind::kSdof;
+  /// mode = "rths": "central_difference" (Eqs. 1-3: x_k+1 from the force measured at k, the
+  /// lockstep's own) | "rk4_unit_delay" (the RTHS benchmark's reference-code loop: classical RK4 of
+  /// the continuous substructure with the measured force held over the step and one sample late,
+  /// and the benchmark criteria's reference structure integrated continuously too;
+  /// models/continuous_structure.h).
+  StructureIntegrator integrator = StructureIntegrator::kCentralDifference;
   std::string file;           ///< kind = "file": path, relative to the scenario file's folder
   /// mode = "rths", kind = "file", optional: the monolithic reference structure of a partitioned
   /// test (a structure file with as many DOFs as `file`; e.g. data/buildings/silva3_reference_case1.txt),

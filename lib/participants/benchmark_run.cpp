@@ -3,8 +3,10 @@
 #include <fmt/format.h>
 
 #include "core/error.h"
+#include "models/continuous_structure.h"
 #include "models/ground_response.h"
 #include "models/structure_file.h"
+#include "signal/history.h"
 
 namespace rths::participants {
 
@@ -37,7 +39,14 @@ signal::BenchmarkSignals BenchmarkSignalsFromRun(const io::RunSignals& signals, 
   b.x_t = signals.At("r_mm").values;
   for (int i = 1; i <= dofs; ++i) b.x_n.push_back(signals.At(fmt::format("x{}_mm", i)).values);
   try {
-    b.x_r = models::GroundResponse(ref, signals.dt_s, signals.At("ground_acc_mm_s2").values);
+    if (s.structure.integrator == models::StructureIntegrator::kRk4UnitDelay) {
+      // As the reference code scores it: the reference integrated continuously (lsim), a_g at the
+      // half steps from the scenario's record.
+      const std::size_t n = b.x_m.size();
+      b.x_r = models::GroundResponseRk4(ref, signals.dt_s, signal::MakeSignal(s.structure.ground, 0.5 * signals.dt_s, 2 * n + 1));
+    } else {
+      b.x_r = models::GroundResponse(ref, signals.dt_s, signals.At("ground_acc_mm_s2").values);
+    }
   } catch (const Error& e) {
     throw Error(fmt::format("{}: structure.reference_file", s.path), e.what());
   }

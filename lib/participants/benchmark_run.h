@@ -7,7 +7,9 @@
 /// (supervisor/run_summary.h), the run report and the benchmark study.
 ///
 /// Reference response: models::GroundResponse (models/ground_response.h) at the run's dt, driven by
-/// desired_t.ground_acc_mm_s2 of each logged step.
+/// desired_t.ground_acc_mm_s2 of each logged step; for structure.integrator = "rk4_unit_delay" (the
+/// reference code's loop) models::GroundResponseRk4, continuous as the reference code's lsim, with
+/// a_g at the half steps from the scenario's ground record.
 ///
 /// The criteria's records, per logged step k (io/run_signals.h column names, mm):
 ///     x_m = y_mm (measured_t.y_mm),  x_t = r_mm (desired_t.r_mm),

@@ -16,7 +16,13 @@ models::NumericalSubstructure MakeSubstructure(const scenario::Scenario& s, std:
   if (s.structure.mode == models::StructureMode::kPredefined) {
     return models::NumericalSubstructure::Predefined(signal::MakeSignal(s.structure.desired, s.run.dt_s, n));
   }
-  auto m = models::NumericalSubstructure::Integrated(models::StructureFromScenario(s.structure), s.run.dt_s, {});
+  const models::LinearStructure structure = models::StructureFromScenario(s.structure);
+  if (s.structure.integrator == models::StructureIntegrator::kRk4UnitDelay) {
+    return models::NumericalSubstructure::Rk4UnitDelay(structure, s.run.dt_s,
+                                                       signal::MakeSignal(s.structure.ground, s.run.dt_s, n),
+                                                       signal::MakeSignal(s.structure.ground, 0.5 * s.run.dt_s, 2 * n + 1));
+  }
+  auto m = models::NumericalSubstructure::Integrated(structure, s.run.dt_s, {});
   m.ground_mm_s2 = signal::MakeSignal(s.structure.ground, s.run.dt_s, n);  // after the structure's checks
   return m;
 }
@@ -52,15 +58,16 @@ void Integrator::ComputeDesired(std::int64_t k, const rths::measured_t* measured
   out->acc_prev_mm_s2 = d.acc_prev;
   out->vel_prev_mm_s = d.vel_prev;
   out->ground_acc_mm_s2 = ground;
-  const int n = static_cast<int>(state_.x.size());
+  const models::StructureState& st = state_.structure;
+  const int n = static_cast<int>(st.x.size());
   if (out->n_dof != n) {  // sized once, on the first step
     out->n_dof = n;
     out->x_mm.resize(n);
     out->abs_acc_mm_s2.resize(n);
   }
   for (int j = 0; j < n; ++j) {
-    out->x_mm[j] = state_.x[j];
-    out->abs_acc_mm_s2[j] = (predefined || k == 0) ? 0.0 : state_.abs_acc_prev[j];
+    out->x_mm[j] = st.x[j];
+    out->abs_acc_mm_s2[j] = (predefined || k == 0) ? 0.0 : st.abs_acc_prev[j];
   }
 }
 

@@ -38,7 +38,7 @@ class Integrator final : public lockstep::ClockParticipant {
  private:
   const double dt_s_;
   const models::NumericalSubstructure substructure_;
-  models::StructureState state_;
+  models::SubstructureState state_;
   std::optional<control::DerivativeRecords> central_;  ///< offline derivatives, if chosen
   control::ExtrapolationState extrapolation_{};
   safety::Monitor safety_;

@@ -41,6 +41,7 @@ void StructureFields(V& v, models::StructureConfig& st, const Context& cx) {
   v.Number("specimen_count", st.specimen_count, OpenClosed(0.0, 1000.0));
   v.Choice("derivatives", st.derivatives, models::kDerivativesNames);
   v.Choice("kind", st.kind, models::kStructureKindNames);
+  v.Choice("integrator", st.integrator, models::kStructureIntegratorNames);
   v.String("file", st.file);
   v.String("reference_file", st.reference_file);  // ValidateStructure: only with kind = "file"
   v.Integer("actuator_dof", st.actuator_dof);  // ValidateStructure: when kind = "file"

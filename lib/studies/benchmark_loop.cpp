@@ -12,6 +12,7 @@
 #include "control/lti_controller.h"
 #include "core/error.h"
 #include "participants/benchmark_run.h"
+#include "models/continuous_structure.h"
 #include "models/ground_response.h"
 #include "models/rig.h"
 #include "models/structure.h"
@@ -22,39 +23,6 @@
 namespace rths::studies {
 
 namespace {
-
-/// x' = A x + b_g a_g + b_f f for a structure's state x = [x; x'] [mm, mm/s]:
-///   A = [[0, I], [-M^-1 K, -M^-1 C]],  b_g = [0; -iota],  b_f = [0; -M^-1 s].
-struct ContinuousStructure {
-  Eigen::MatrixXd A;
-  Eigen::VectorXd b_g, b_f;
-  int n = 0;
-};
-
-ContinuousStructure Continuous(const models::LinearStructure& st) {
-  ContinuousStructure c;
-  c.n = st.dofs();
-  const Eigen::MatrixXd minv = st.M.inverse();
-  c.A = Eigen::MatrixXd::Zero(2 * c.n, 2 * c.n);
-  c.A.topRightCorner(c.n, c.n) = Eigen::MatrixXd::Identity(c.n, c.n);
-  c.A.bottomLeftCorner(c.n, c.n) = -minv * st.K;
-  c.A.bottomRightCorner(c.n, c.n) = -minv * st.C;
-  c.b_g = Eigen::VectorXd::Zero(2 * c.n);
-  c.b_g.tail(c.n) = -st.iota;
-  c.b_f = Eigen::VectorXd::Zero(2 * c.n);
-  if (st.specimen_dir.size() == c.n) c.b_f.tail(c.n) = -minv * st.specimen_dir;
-  return c;
-}
-
-/// One classical RK4 step over dt with the force held and a_g at t, t + dt/2, t + dt.
-void Rk4(const ContinuousStructure& c, Eigen::VectorXd* x, double dt, const double ag[3], double f) {
-  auto rate = [&](const Eigen::VectorXd& z, double a) -> Eigen::VectorXd { return c.A * z + c.b_g * a + c.b_f * f; };
-  const Eigen::VectorXd k1 = rate(*x, ag[0]);
-  const Eigen::VectorXd k2 = rate(*x + 0.5 * dt * k1, ag[1]);
-  const Eigen::VectorXd k3 = rate(*x + 0.5 * dt * k2, ag[1]);
-  const Eigen::VectorXd k4 = rate(*x + dt * k3, ag[2]);
-  *x += dt / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
-}
 
 /// Rounds x [mm] to a multiple of q [m] (a Simulink Quantizer on metres); q = 0: unchanged.
 double Quantise(double x_mm, double q_m) {
@@ -112,17 +80,9 @@ void CheckLoop(const scenario::Scenario& s, const LoopOptions& o) {
 /// structure with a_g at the half steps (ground_half), or models::GroundResponse (central difference).
 std::vector<std::vector<double>> ReferenceResponse(const models::LinearStructure& ref, LoopIntegration how, double dt,
                                                    const std::vector<double>& ground,
-                                                   const std::vector<double>& ground_half, std::size_t n) {
+                                                   const std::vector<double>& ground_half) {
   if (how != LoopIntegration::kRk4) return models::GroundResponse(ref, dt, ground);
-  const ContinuousStructure cr = Continuous(ref);
-  Eigen::VectorXd z = Eigen::VectorXd::Zero(2 * ref.dofs());
-  std::vector<std::vector<double>> x_r(ref.dofs(), std::vector<double>(n));
-  for (std::size_t k = 0; k < n; ++k) {
-    for (int i = 0; i < ref.dofs(); ++i) x_r[i][k] = z(i);
-    const double ag[3] = {ground_half[2 * k], ground_half[2 * k + 1], ground_half[2 * k + 2]};
-    Rk4(cr, &z, dt, ag, 0.0);
-  }
-  return x_r;
+  return models::GroundResponseRk4(ref, dt, ground_half);
 }
 
 }  // namespace
@@ -150,7 +110,8 @@ LoopResult RunBenchmarkLoop(const scenario::Scenario& s, const LoopOptions& o) {
 
   const models::CentralDifference cd = models::CentralDifference::Make(st, dt);
   models::StructureState cd_state = models::MakeState(cd);
-  const ContinuousStructure cs = Continuous(st);
+  const models::ContinuousStructure cs = models::ContinuousStructure::Make(st);
+  models::Rk4Workspace rk_work = models::Rk4Workspace::Make(cs);
   Eigen::VectorXd rk_state = Eigen::VectorXd::Zero(2 * st.dofs());
 
   signal::BenchmarkSignals rec;
@@ -183,7 +144,7 @@ LoopResult RunBenchmarkLoop(const scenario::Scenario& s, const LoopOptions& o) {
     const double f_used = o.force_delay_steps == 1 ? f_prev : f;
     if (rk4) {
       const double ag[3] = {ground_half[2 * k], ground_half[2 * k + 1], ground_half[2 * k + 2]};
-      Rk4(cs, &rk_state, dt, ag, f_used);
+      models::Rk4Step(cs, &rk_work, &rk_state, dt, ag, f_used);
     } else {
       models::Advance(cd, &cd_state, ground[k], f_used);
     }
@@ -191,7 +152,7 @@ LoopResult RunBenchmarkLoop(const scenario::Scenario& s, const LoopOptions& o) {
   }
   out.steps = static_cast<std::int64_t>(n);
 
-  rec.x_r = ReferenceResponse(ref, o.reference, dt, ground, ground_half, n);
+  rec.x_r = ReferenceResponse(ref, o.reference, dt, ground, ground_half);
   out.j = signal::BenchmarkCriteriaFrom(rec);
   return out;
 }
