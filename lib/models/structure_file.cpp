@@ -10,6 +10,7 @@
 #include <fmt/format.h>
 
 #include "core/error.h"
+#include "models/nonlinear_building.h"
 
 namespace rths::models {
 
@@ -173,18 +174,8 @@ StructureMatrices ShearBuilding(const std::vector<double>& floor_masses_kg,
     throw Error("ShearBuilding", "one story stiffness per floor mass is needed");
   }
   StructureMatrices m;
-  m.M = Eigen::MatrixXd::Zero(n, n);
-  m.K = Eigen::MatrixXd::Zero(n, n);
-  for (int i = 0; i < n; ++i) {
-    m.M(i, i) = floor_masses_kg[i] * kKgToProject;
-    const double k = story_stiffness_kN_per_mm[i];  // story i+1, below floor i+1
-    m.K(i, i) += k;
-    if (i > 0) {
-      m.K(i - 1, i - 1) += k;
-      m.K(i - 1, i) -= k;
-      m.K(i, i - 1) -= k;
-    }
-  }
+  m.M = MassMatrix(floor_masses_kg);
+  m.K = StoryStiffnessMatrix(story_stiffness_kN_per_mm);
   m.C = ModalDampingMatrix(m.M, m.K, zeta);
   return m;
 }
