@@ -72,7 +72,7 @@ TEST_CASE("structure.integrator = rk4_unit_delay: the lockstep run is the refere
   o.quantise_m = 0.0;
   CheckEqual(RunBenchmarkLoop(s, o).j, lockstep);
   // and not the central difference's: J4 moves by points (docs/benchmark.md).
-  s.structure.integrator = rths::models::StructureIntegrator::kCentralDifference;
+  s.structure.integrator.kind = rths::models::IntegratorKind::kCentralDifference;
   CHECK(RunBenchmarkLoop(s, rths::studies::LockstepLoop()).j.J4_pct < lockstep.J4_pct - 1.0);
 }
 

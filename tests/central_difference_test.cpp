@@ -58,7 +58,9 @@ TEST_CASE("SDOF in project units") {
   CHECK(s.iota(0) == 1.0);
   CHECK_THROWS_AS(LinearStructure::Sdof(0.0, 5.0, 0.02, 1.0), rths::Error);
   CHECK_THROWS_AS(LinearStructure::Sdof(1.0, 5.0, 1.0, 1.0), rths::Error);
-  CHECK_THROWS_AS(LinearStructure::Sdof(1.0, 5.0, 0.02, 0.0), rths::Error);
+  CHECK_THROWS_AS(LinearStructure::Sdof(1.0, 5.0, 0.02, -1.0), rths::Error);
+  // specimen_count = 0 (issue 44's reference case): the specimen's force does not act.
+  CHECK(LinearStructure::Sdof(1.0, 5.0, 0.02, 0.0).specimen_dir(0) == 0.0);
 }
 
 TEST_CASE("free vibration of a damped SDOF: second-order convergence to the closed form") {

@@ -123,6 +123,31 @@ mode = "clipped_optimal"
 )");
 }
 
+TEST_CASE("no allocation per step: a yielding SDOF (Bouc-Wen) by each stepped integrator") {
+  for (const char* integrator : {"central_difference", "cr", "alpha_os", "newmark_implicit"}) {
+    CAPTURE(integrator);
+    CheckNoAllocationPerStep(std::string("bouc_wen, ") + integrator, fmt::format(R"(
+[structure]
+integrator = "{}"
+[structure.spring]
+kind = "bouc_wen"
+x_y_mm = 0.5
+[structure.ground]
+kind = "blwn"
+rms_mm_s2 = 3000.0
+)", integrator));
+  }
+}
+
+TEST_CASE("no allocation per step: rk4_unit_delay (the benchmark's reference-code loop) on a linear SDOF") {
+  CheckNoAllocationPerStep("rk4_unit_delay", R"(
+[structure]
+integrator = "rk4_unit_delay"
+[structure.ground]
+kind = "blwn"
+)");
+}
+
 TEST_CASE("no allocation per step: the ideal plant with pulsed current") {
   CheckNoAllocationPerStep("ideal, pulse", R"(
 [plant]

@@ -33,8 +33,25 @@ NumericalSubstructure NumericalSubstructure::Rk4UnitDelay(const LinearStructure&
   return m;
 }
 
+NumericalSubstructure NumericalSubstructure::Stepped(const StructureIntegrator& integrator,
+                                                     std::vector<double> ground_mm_s2) {
+  NumericalSubstructure m;
+  m.stepped = integrator;
+  m.dt_s = integrator.dt_s;
+  m.dof = integrator.building.actuator_dof;
+  m.ground_mm_s2 = std::move(ground_mm_s2);
+  return m;
+}
+
 SubstructureState MakeState(const NumericalSubstructure& m) {
   SubstructureState s;
+  if (m.stepped) {
+    const int n = m.stepped->building.dofs();
+    s.stepped = MakeIntegratorState(m.stepped->building);
+    s.structure.x = s.structure.x_prev = s.structure.vel_prev = s.structure.acc_prev = s.structure.abs_acc_prev =
+        Eigen::VectorXd::Zero(n);
+    return s;
+  }
   if (m.cd) {
     s.structure = MakeState(*m.cd);
   } else {
@@ -67,6 +84,19 @@ void StepRk4(const NumericalSubstructure& m, SubstructureState* s, std::int64_t 
   out.abs_acc_prev = out.acc_prev + m.cd->iota * m.ground_mm_s2[static_cast<std::size_t>(k - 1)];
 }
 
+/// Stepped's step k > 0: the method's k-1 -> k with f_{k-1}, then the outputs.
+void StepStepped(const NumericalSubstructure& m, SubstructureState* s, std::int64_t k, double f_prev_kN) {
+  const double ag_prev = m.ground_mm_s2[static_cast<std::size_t>(k - 1)];
+  Advance(*m.stepped, &s->stepped, ag_prev, m.ground_mm_s2[static_cast<std::size_t>(k)], f_prev_kN);
+  StructureState& out = s->structure;
+  out.k = k;
+  out.x_prev = out.x;
+  out.x = s->stepped.x;
+  out.vel_prev = s->stepped.v;
+  out.acc_prev = s->stepped.a;
+  out.abs_acc_prev = s->stepped.a + m.stepped->building.iota * ag_prev;
+}
+
 }  // namespace
 
 double Step(const NumericalSubstructure& m, SubstructureState* s, std::int64_t k, double f_prev_kN) {
@@ -76,7 +106,9 @@ double Step(const NumericalSubstructure& m, SubstructureState* s, std::int64_t k
     return r;
   }
   if (k > 0) {
-    if (m.rk4) {
+    if (m.stepped) {
+      StepStepped(m, s, k, f_prev_kN);
+    } else if (m.rk4) {
       StepRk4(m, s, k, f_prev_kN);
     } else {
       Advance(*m.cd, &s->structure, m.ground_mm_s2[static_cast<std::size_t>(k - 1)], f_prev_kN);

@@ -11,6 +11,7 @@
 
 #include "models/continuous_structure.h"
 #include "models/structure.h"
+#include "models/structure_integrator.h"
 
 namespace rths::models {
 
@@ -29,10 +30,16 @@ struct NumericalSubstructure {
   static NumericalSubstructure Rk4UnitDelay(const LinearStructure& structure, double dt_s,
                                             std::vector<double> ground_mm_s2, std::vector<double> ground_half_mm_s2);
 
-  bool predefined() const { return !cd.has_value(); }
+  /// "rths" with a hysteretic structure or another integrator (cr, alpha_os, newmark_implicit;
+  /// models/structure_integrator.h): x_k = Advance(x_{k-1}, a_g,k-1, a_g,k, f_{k-1}), the measured
+  /// force entering as each method prescribes (its header).
+  static NumericalSubstructure Stepped(const StructureIntegrator& integrator, std::vector<double> ground_mm_s2);
+
+  bool predefined() const { return !cd.has_value() && !stepped.has_value(); }
 
   std::optional<CentralDifference> cd;  ///< "rths" mode (also for rk4: its stability limit and sizes)
   std::optional<ContinuousStructure> rk4;  ///< "rths" with rk4_unit_delay
+  std::optional<StructureIntegrator> stepped;  ///< "rths" by Stepped
   double dt_s = 0.0;                    ///< step [s]
   int dof = 0;                          ///< the actuator's degree of freedom ("rths" mode)
   std::vector<double> r_mm;             ///< r_k for every step ("predefined" mode) [mm]
@@ -41,12 +48,14 @@ struct NumericalSubstructure {
 };
 
 /// Per-step state: `structure` holds x = x_k and, after the first step, abs_acc_prev (the
-/// absolute accelerations at k-1) whichever the integrator; the rest is RK4's.
+/// absolute accelerations at k-1; for Stepped, the method's newest acceleration plus iota a_g,k-1)
+/// whichever the integrator; the rest is the integrator's own.
 struct SubstructureState {
   StructureState structure;
   Eigen::VectorXd z;         ///< rk4: [x_k; x'_k] [mm, mm/s]
   Rk4Workspace rk;           ///< rk4: the stages
   double f_delayed_kN = 0.0; ///< rk4: the force measured at k-1, used in the next step [kN]
+  IntegratorState stepped;   ///< Stepped: the method's state, springs included
 };
 
 /// At rest at k = 0, every vector sized once (x has one entry in "predefined" mode).

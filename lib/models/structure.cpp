@@ -46,9 +46,9 @@ LinearStructure LinearStructure::Make(const Eigen::MatrixXd& M, const Eigen::Mat
   if (actuator_dof < 0 || actuator_dof >= n)
     throw Error("LinearStructure: actuator_dof",
                 fmt::format("must be in [0, {}] (got {})", n - 1, actuator_dof));
-  if (!(specimen_count > 0.0) || !std::isfinite(specimen_count))
+  if (!(specimen_count >= 0.0) || !std::isfinite(specimen_count))
     throw Error("LinearStructure: specimen_count",
-                fmt::format("must be > 0 (got {})", specimen_count));
+                fmt::format("must be >= 0 (got {}; 0: the measured force does not act)", specimen_count));
   LinearStructure s;
   s.M = M, s.C = C, s.K = K;
   s.iota = Eigen::VectorXd::Ones(n);

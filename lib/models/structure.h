@@ -33,12 +33,12 @@ struct LinearStructure {
 
   /// SDOF: m = mass_kg * 1e-6 [kN s^2/mm], K = m w^2, C = 2 zeta m w, w = 2 pi frequency_hz,
   /// specimen_dir = [specimen_count]. Throws rths::Error for mass, frequency <= 0, damping
-  /// outside [0, 1) or specimen_count <= 0.
+  /// outside [0, 1) or specimen_count < 0 (0: no specimen force acts, a structure alone).
   static LinearStructure Sdof(double mass_kg, double frequency_hz, double damping_ratio,
                               double specimen_count);
   /// General n-DOF model from matrices in project units, iota = ones. Throws rths::Error for
   /// mismatched sizes, an M that is not symmetric positive definite, an actuator_dof out of
-  /// range or specimen_count <= 0.
+  /// range or specimen_count < 0.
   static LinearStructure Make(const Eigen::MatrixXd& M, const Eigen::MatrixXd& C,
                               const Eigen::MatrixXd& K, int actuator_dof, double specimen_count);
   int dofs() const { return static_cast<int>(M.rows()); }

@@ -209,4 +209,15 @@ LinearStructure StructureFromScenario(const models::StructureConfig& st) {
   return s;
 }
 
+NonlinearBuilding NonlinearSdofFromScenario(const StructureConfig& st) {
+  const LinearStructure lin = LinearStructure::Sdof(st.mass_kg, st.frequency_hz, st.damping_ratio, st.specimen_count);
+  SpringParams spring = st.spring;
+  spring.k_kN_per_mm = lin.K(0, 0);  // m w^2, the initial stiffness
+  return NonlinearBuilding::Make({st.mass_kg}, {spring}, lin.C, 0, st.specimen_count);
+}
+
+StructureIntegrator SteppedIntegratorFromScenario(const StructureConfig& st, double dt_s) {
+  return StructureIntegrator::Make(NonlinearSdofFromScenario(st), dt_s, st.integrator);
+}
+
 }  // namespace rths::models

@@ -24,6 +24,10 @@
 #include <Eigen/Core>
 
 #include "core/names.h"
+#include "models/integrator_config.h"
+#include "models/nonlinear_building.h"
+#include "models/structure_integrator.h"
+#include "models/story_spring.h"
 #include "models/structure.h"
 #include "signal/history.h"
 
@@ -41,13 +45,6 @@ inline constexpr std::array<Named<StructureKind>, 2> kStructureKindNames = {
 enum class Derivatives { kExtrapolated, kCentral };
 inline constexpr std::array<Named<Derivatives>, 2> kDerivativesNames = {
     {{Derivatives::kExtrapolated, "extrapolated"}, {Derivatives::kCentral, "central"}}};
-
-/// How mode "rths" integrates the numerical substructure (StructureConfig::integrator;
-/// docs/structures.md "Integrators").
-enum class StructureIntegrator { kCentralDifference, kRk4UnitDelay };
-inline constexpr std::array<Named<StructureIntegrator>, 2> kStructureIntegratorNames = {
-    {{StructureIntegrator::kCentralDifference, "central_difference"},
-     {StructureIntegrator::kRk4UnitDelay, "rk4_unit_delay"}}};
 
 /// M [kN s^2/mm], K [kN/mm], C [kN s/mm], and the ground influence vector iota [-] (empty: ones).
 struct StructureMatrices {
@@ -69,12 +66,12 @@ struct StructureConfig {
   /// mode = "rths": "sdof" (mass, frequency, damping below) | "file" (M, K, C from `file`, a
   /// structure file: docs/structures.md; e.g. data/buildings/ohtori9_ns.txt).
   StructureKind kind = StructureKind::kSdof;
-  /// mode = "rths": "central_difference" (Eqs. 1-3: x_k+1 from the force measured at k, the
-  /// lockstep's own) | "rk4_unit_delay" (the RTHS benchmark's reference-code loop: classical RK4 of
-  /// the continuous substructure with the measured force held over the step and one sample late,
-  /// and the benchmark criteria's reference structure integrated continuously too;
-  /// models/continuous_structure.h).
-  StructureIntegrator integrator = StructureIntegrator::kCentralDifference;
+  /// mode = "rths": how the substructure is stepped (models/integrator_config.h): structure.integrator
+  /// ("central_difference", the lockstep's own Eqs. 1-3; "rk4_unit_delay", the RTHS benchmark's
+  /// reference-code loop, with the criteria's reference integrated continuously too; "cr",
+  /// "alpha_os", "newmark_implicit") and its options structure.substeps, structure.alpha_os_alpha,
+  /// structure.newton_iterations.
+  IntegratorConfig integrator{};
   std::string file;           ///< kind = "file": path, relative to the scenario file's folder
   /// mode = "rths", kind = "file", optional: the monolithic reference structure of a partitioned
   /// test (a structure file with as many DOFs as `file`; e.g. data/buildings/silva3_reference_case1.txt),
@@ -91,7 +88,12 @@ struct StructureConfig {
   double mass_kg = 20000.0;          ///< (0, 1e9]
   double frequency_hz = 5.0;         ///< natural frequency (0, 1/(pi dt)) -- central-difference limit omega dt < 2
   double damping_ratio = 0.02;       ///< [0, 1)
-  double specimen_count = 1.0;       ///< measured force multiplier (18 dampers act as one) (0, 1000]
+  double specimen_count = 1.0;       ///< measured force multiplier (18 dampers act as one) [0, 1000]; 0: none acts
+  /// kind = "sdof": the story spring ([structure.spring]; models/story_spring.h): "linear" (today's
+  /// K = m w^2), "bouc_wen" or "bilinear" with the initial stiffness k = m w^2 from mass_kg and
+  /// frequency_hz (spring.k_kN_per_mm is set from them; the file does not give it), the damping
+  /// 2 zeta m w at that initial stiffness.
+  SpringParams spring{};
   signal::SignalSpec ground{};               ///< ground acceleration [mm/s^2]
   // mode = "predefined": the desired displacement itself [mm].
   signal::SignalSpec desired{signal::SignalKind::kBlwn, 5.0, 2.78, 1, 2.0, "", 0.0, 1.0, 0.5};
@@ -102,6 +104,16 @@ struct StructureConfig {
   StructureMatrices matrices{};
   /// The matrices of `reference_file`; empty if there is none.
   StructureMatrices reference{};
+  /// A hysteretic spring somewhere (mode "rths"): the substructure is a NonlinearBuilding.
+  bool Nonlinear() const { return mode == StructureMode::kRths && kind == StructureKind::kSdof && spring.kind != SpringKind::kLinear; }
+  /// Stepped by models::StructureIntegrator (a NonlinearBuilding), not by today's linear paths: a
+  /// hysteretic spring, cr, alpha_os, newmark_implicit, or central difference with sub-steps.
+  bool Stepped() const {
+    const IntegratorKind k = integrator.kind;
+    return mode == StructureMode::kRths &&
+           (Nonlinear() || k == IntegratorKind::kCr || k == IntegratorKind::kAlphaOs ||
+            k == IntegratorKind::kNewmarkImplicit || (k == IntegratorKind::kCentralDifference && integrator.substeps > 1));
+  }
   bool operator==(const StructureConfig&) const = default;
 };
 
@@ -138,5 +150,14 @@ Modes ModalAnalysis(const StructureMatrices& m);
 /// structure.actuator_dof (1-based). Throws rths::Error naming "structure.file" if the matrices
 /// were not read, or "structure.actuator_dof" if it exceeds their DOFs (the loader checks both).
 LinearStructure StructureFromScenario(const models::StructureConfig& st);
+
+/// The SDOF of [structure] with its [structure.spring] as a NonlinearBuilding of one story: the
+/// spring's initial stiffness k = m w^2 (w = 2 pi frequency_hz), damping 2 zeta m w at it, the
+/// specimen at the one DOF times specimen_count. Throws rths::Error naming the spring's field.
+NonlinearBuilding NonlinearSdofFromScenario(const models::StructureConfig& st);
+/// The integrator of a structure that StructureConfig::Stepped() says is stepped by
+/// models::StructureIntegrator: NonlinearSdofFromScenario(st) with st.integrator at dt_s [s].
+/// Throws rths::Error (the integrator's checks, e.g. central difference's stability limit).
+StructureIntegrator SteppedIntegratorFromScenario(const models::StructureConfig& st, double dt_s);
 
 }  // namespace rths::models

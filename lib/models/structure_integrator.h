@@ -17,35 +17,15 @@
 #include <variant>
 #include <vector>
 
-#include "core/names.h"
 #include "models/integrator_alpha_os.h"
 #include "models/integrator_cd.h"
+#include "models/integrator_config.h"
 #include "models/integrator_cr.h"
 #include "models/integrator_newmark.h"
 #include "models/integrator_state.h"
 #include "models/nonlinear_building.h"
 
 namespace rths::models {
-
-enum class IntegratorKind { kCentralDifference, kCr, kAlphaOs, kNewmarkImplicit };
-inline constexpr std::array<Named<IntegratorKind>, 4> kIntegratorKindNames = {
-    {{IntegratorKind::kCentralDifference, "central_difference"},
-     {IntegratorKind::kCr, "cr"},
-     {IntegratorKind::kAlphaOs, "alpha_os"},
-     {IntegratorKind::kNewmarkImplicit, "newmark_implicit"}}};
-
-/// Plain config (structure.integrator and its options).
-struct IntegratorConfig {
-  IntegratorKind kind = IntegratorKind::kCentralDifference;
-  /// central_difference, cr: numerical steps per RTHS step [1, 1000] (force held, ground
-  /// interpolated); 1 for the others.
-  int substeps = 1;
-  double alpha = -0.05;        ///< alpha_os: [-1/3, 0]
-  int newton_iterations = 2;   ///< newmark_implicit: [1, 100]
-  /// Throws rths::Error(field, "must be ...") naming the field and its range.
-  void Validate() const;
-  bool operator==(const IntegratorConfig&) const = default;
-};
 
 struct StructureIntegrator {
   NonlinearBuilding building;
@@ -54,7 +34,8 @@ struct StructureIntegrator {
   std::variant<NonlinearCentralDifference, ChenRicles, AlphaOs, NewmarkImplicit> method;
 
   /// Validates config and precomputes the method. Throws rths::Error (central_difference: also at
-  /// or above its stability limit).
+  /// or above its stability limit; rk4_unit_delay: not for a NonlinearBuilding, see
+  /// numerical_substructure.h).
   static StructureIntegrator Make(const NonlinearBuilding& b, double dt_s, const IntegratorConfig& config);
 };
 

@@ -39,7 +39,7 @@ signal::BenchmarkSignals BenchmarkSignalsFromRun(const io::RunSignals& signals, 
   b.x_t = signals.At("r_mm").values;
   for (int i = 1; i <= dofs; ++i) b.x_n.push_back(signals.At(fmt::format("x{}_mm", i)).values);
   try {
-    if (s.structure.integrator == models::StructureIntegrator::kRk4UnitDelay) {
+    if (s.structure.integrator.kind == models::IntegratorKind::kRk4UnitDelay) {
       // As the reference code scores it: the reference integrated continuously (lsim), a_g at the
       // half steps from the scenario's record.
       const std::size_t n = b.x_m.size();

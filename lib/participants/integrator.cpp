@@ -16,8 +16,12 @@ models::NumericalSubstructure MakeSubstructure(const scenario::Scenario& s, std:
   if (s.structure.mode == models::StructureMode::kPredefined) {
     return models::NumericalSubstructure::Predefined(signal::MakeSignal(s.structure.desired, s.run.dt_s, n));
   }
+  if (s.structure.Stepped()) {
+    return models::NumericalSubstructure::Stepped(models::SteppedIntegratorFromScenario(s.structure, s.run.dt_s),
+                                                  signal::MakeSignal(s.structure.ground, s.run.dt_s, n));
+  }
   const models::LinearStructure structure = models::StructureFromScenario(s.structure);
-  if (s.structure.integrator == models::StructureIntegrator::kRk4UnitDelay) {
+  if (s.structure.integrator.kind == models::IntegratorKind::kRk4UnitDelay) {
     return models::NumericalSubstructure::Rk4UnitDelay(structure, s.run.dt_s,
                                                        signal::MakeSignal(s.structure.ground, s.run.dt_s, n),
                                                        signal::MakeSignal(s.structure.ground, 0.5 * s.run.dt_s, 2 * n + 1));

@@ -30,6 +30,21 @@ void RunFields(V& v, RunConfig& r, const Context&) {
   v.Integer("csv_every", r.csv_every, Closed(0.0, 1e9));
 }
 
+/// [structure.spring]: an SDOF's story spring (models/story_spring.h); k is the SDOF's m w^2, not a key.
+template <typename V>
+void SpringFields(V& v, models::SpringParams& p) {
+  v.Choice("kind", p.kind, models::kSpringKindNames);
+  v.Number("alpha", p.alpha, ClosedOpen(0.0, 1.0));
+  v.Number("x_y_mm", p.x_y_mm, OpenClosed(0.0, 1e6));
+  v.Number("n", p.n, Closed(1.0, 20.0));
+  v.Number("beta", p.beta, Closed(0.0, 10.0));
+  v.Number("gamma", p.gamma, Closed(-10.0, 10.0));
+  v.Number("delta_nu", p.delta_nu, Closed(0.0, 10.0));
+  v.Number("delta_eta", p.delta_eta, Closed(0.0, 10.0));
+  v.Number("b", p.b, ClosedOpen(0.0, 1.0));
+  v.Number("f_y_kN", p.f_y_kN, OpenClosed(0.0, 1e9));
+}
+
 template <typename V>
 void StructureFields(V& v, models::StructureConfig& st, const Context& cx) {
   v.Choice("mode", st.mode, models::kStructureModeNames);
@@ -38,14 +53,18 @@ void StructureFields(V& v, models::StructureConfig& st, const Context& cx) {
   v.Number("frequency_hz", st.frequency_hz,
            {0.0, 1.0 / (kPi * cx.dt_s), true, true, "central-difference stability limit 1/(pi run.dt_s)"});
   v.Number("damping_ratio", st.damping_ratio, ClosedOpen(0.0, 1.0));
-  v.Number("specimen_count", st.specimen_count, OpenClosed(0.0, 1000.0));
+  v.Number("specimen_count", st.specimen_count, Closed(0.0, 1000.0));
   v.Choice("derivatives", st.derivatives, models::kDerivativesNames);
   v.Choice("kind", st.kind, models::kStructureKindNames);
-  v.Choice("integrator", st.integrator, models::kStructureIntegratorNames);
+  v.Choice("integrator", st.integrator.kind, models::kIntegratorKindNames);
+  v.Integer("substeps", st.integrator.substeps, Closed(1.0, 1000.0));  // 1 unless cr/central_difference: validate.cpp
+  v.Number("alpha_os_alpha", st.integrator.alpha, Closed(-1.0 / 3.0, 0.0));
+  v.Integer("newton_iterations", st.integrator.newton_iterations, Closed(1.0, 100.0));
   v.String("file", st.file);
   v.String("reference_file", st.reference_file);  // ValidateStructure: only with kind = "file"
   v.Integer("actuator_dof", st.actuator_dof);  // ValidateStructure: when kind = "file"
   v.Bool("subtract_specimen", st.subtract_specimen);  // ValidateStructure: with a reference_file, a benchmark plant
+  v.Table("spring", [&](V& t) { SpringFields(t, st.spring); });
   v.Table("ground", [&](V& t) { SignalFields(t, st.ground, "rms_mm_s2", cx); });
   v.Table("desired", [&](V& t) { SignalFields(t, st.desired, "rms_mm", cx); });
 }

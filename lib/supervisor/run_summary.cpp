@@ -51,6 +51,15 @@ nlohmann::json RunSummary::ToJson() const {
     j["benchmark_criteria"] = b;
   }
   if (!benchmark_error.empty()) j["benchmark_criteria_error"] = benchmark_error;
+  if (structure_response) {
+    const participants::StructureResponse& r = *structure_response;
+    j["structure_peak_displacement_mm"] = r.peak_displacement_mm;
+    j["structure_residual_displacement_mm"] = r.residual_displacement_mm;
+    j["structure_hysteretic_energy_kN_mm"] = r.hysteretic_energy_kN_mm;
+    j["structure_floor"] = r.floor;
+    if (r.yield_displacement_mm > 0) j["structure_ductility"] = r.Ductility();
+  }
+  if (!structure_error.empty()) j["structure_error"] = structure_error;
   j["status"] = status;
   j["exit_code"] = exit_code;
   j["stopped"] = stopped;
@@ -84,6 +93,14 @@ std::string RunSummary::Report(double dt_s) const {
   }
   if (benchmark_criteria) o += "  benchmark          " + benchmark_criteria->Format() + "\n";
   if (!benchmark_error.empty()) o += "  benchmark          no J1-J9: " + benchmark_error + "\n";
+  if (structure_response) {
+    const participants::StructureResponse& r = *structure_response;
+    o += fmt::format("  structure          floor {}: peak {:.4g} mm{}, residual {:.4g} mm, hysteretic energy {:.4g} kN mm\n",
+                     r.floor, r.peak_displacement_mm,
+                     r.yield_displacement_mm > 0 ? fmt::format(" (ductility {:.3g})", r.Ductility()) : std::string(),
+                     r.residual_displacement_mm, r.hysteretic_energy_kN_mm);
+  }
+  if (!structure_error.empty()) o += "  structure          " + structure_error + "\n";
   if (realtime.is_object() && realtime.contains("steps")) {
     const auto& rt = realtime;
     const double period_us = rt["period_us"].get<double>();
@@ -135,17 +152,28 @@ void ReadLog(const std::string& log_path, RunSummary* s) {
 void ReadLog(const std::string& log_path, const scenario::Scenario& scenario, RunSummary* s) {
   s->benchmark_criteria.reset();
   s->benchmark_error.clear();
-  if (scenario.structure.reference_file.empty()) {
+  s->structure_response.reset();
+  s->structure_error.clear();
+  if (scenario.structure.reference_file.empty() && !scenario.structure.Stepped()) {
     ReadLog(log_path, s);
     return;
   }
   try {
     const io::RunLog log = io::ReadRunLog(log_path);
     ReadLog(log, s);
-    try {
-      s->benchmark_criteria = BenchmarkCriteriaOfRun(log, scenario);
-    } catch (const std::exception& e) {
-      s->benchmark_error = e.what();
+    if (!scenario.structure.reference_file.empty()) {
+      try {
+        s->benchmark_criteria = BenchmarkCriteriaOfRun(log, scenario);
+      } catch (const std::exception& e) {
+        s->benchmark_error = e.what();
+      }
+    }
+    if (scenario.structure.Stepped()) {
+      try {
+        s->structure_response = participants::StructureResponseOfRun(log, scenario);
+      } catch (const std::exception& e) {
+        s->structure_error = e.what();
+      }
     }
   } catch (const std::exception& e) {
     s->steps = 0;

@@ -14,6 +14,7 @@
 #include "lockstep/link_stats.h"
 #include "participants/group.h"
 #include "scenario/scenario.h"
+#include "participants/structure_response.h"
 #include "signal/benchmark_criteria.h"
 
 namespace rths::supervisor {
@@ -41,6 +42,9 @@ struct RunSummary {
   /// structure.reference_file (ReadLog with the scenario; participants/benchmark_run.h).
   std::optional<signal::BenchmarkCriteria> benchmark_criteria;
   std::string benchmark_error;    ///< why they could not be computed ("" if they were or were not asked for)
+  /// A stepped (yielding) structure's response (participants/structure_response.h), or why not.
+  std::optional<participants::StructureResponse> structure_response;
+  std::string structure_error;
 
   // From the outcomes (SetOutcomes, SetVerdict).
   double stepping_s = 0.0;        ///< [s] the clock's GO to its last committed step
@@ -77,7 +81,9 @@ struct RunSummary {
 void ReadLog(const std::string& log_path, RunSummary* s);
 /// ReadLog, then, if `scenario` has a structure.reference_file, the benchmark's J1-J9 over the
 /// log's complete steps (BenchmarkCriteriaOfRun) into benchmark_criteria, or why not into
-/// benchmark_error (too few steps, a diverged run, ...; never thrown).
+/// benchmark_error (too few steps, a diverged run, ...; never thrown); and for a stepped structure
+/// (a hysteretic spring, cr, alpha_os, newmark_implicit) its response into structure_response, or
+/// why not into structure_error.
 void ReadLog(const std::string& log_path, const scenario::Scenario& scenario, RunSummary* s);
 
 /// Sets participants, stepping_s (the clock's) and link (summed over the participants whose
