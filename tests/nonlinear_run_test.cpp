@@ -45,7 +45,7 @@ TEST_CASE("reference_sdof as shipped: every integrator through the lockstep give
   // The reference, independently of the integrators: the continuous model by CVODE's BDF.
   const auto n = static_cast<std::size_t>(s.steps());
   const auto ground = rths::signal::MakeSignal(s.structure.ground, s.run.dt_s, n);
-  const auto ref = rths::models::SolveReference(rths::models::NonlinearSdofFromScenario(s.structure), s.run.dt_s, ground);
+  const auto ref = rths::models::SolveReference(rths::models::NonlinearFromScenario(s.structure), s.run.dt_s, ground);
   const auto summary = rths::models::Summarize(ref.x_mm);
   MESSAGE(fmt::format("reference ({}): peak {:.4f} mm, residual {:.4f} mm, E_h {:.2f} kN mm", ref.method,
                       summary.peak_roof_mm, summary.residual_roof_mm, ref.hysteretic_energy_kN_mm));
@@ -69,7 +69,38 @@ TEST_CASE("reference_sdof as shipped: every integrator through the lockstep give
     CHECK(std::abs(residual - summary.residual_roof_mm) < 0.01 * summary.peak_roof_mm);
     CHECK(j["structure_ductility"].get<double>() == doctest::Approx(peak / 4.0));
     CHECK(output.find("  structure          floor 1: peak ") != std::string::npos);
+    CHECK(j["structure_peak_drift_mm"].get<double>() == peak);  // an SDOF: its drift is its displacement
   }
+}
+
+TEST_CASE("the 9-story building with Bouc-Wen stories, semiactive, as shipped: it yields; linear stories are today's run") {
+  const std::string shipped = std::string(RTHS_SOURCE_DIR) + "/scenarios/nonlinear/ohtori9_semiactive.toml";
+  const fs::path dir = rths_test::TempDir("nonlinear_ohtori9");
+  std::string output;
+  REQUIRE(rths_test::RunCli(shipped + " --transport memq --compact --out " + (dir / "run").string(), &output) == 0);
+  CAPTURE(output);
+  const auto j = Summary(dir / "run");
+  CHECK(j["structure_floor"] == 9);
+  CHECK(j["structure_peak_drift_story"] == 1);  // the dampers' story, the softest (65 kN/mm)
+  CHECK(j["structure_ductility"].get<double>() > 1.5);  // it yields (2.3 measured, the scenario's comment)
+  CHECK(j["structure_hysteretic_energy_kN_mm"].get<double>() > 0.0);
+  // The same building with linear stories (a shear-building file) runs today's path: its log is the
+  // matrix file's (data/buildings/ohtori9_ns.txt) bit for bit.
+  std::string text = "n 9\nfloors kg\n505000 494500 494500 494500 494500 494500 494500 494500 535000\n";
+  for (const char* k : {"65.0", "295.6", "355.9", "191.9", "193.3", "141.9", "157.9", "80.2", "194.4"})
+    text += std::string("story linear k_kN_per_mm=") + k + "\n";
+  std::ofstream(dir / "linear9.txt") << text << "damping modal 0.02\n";
+  const auto matrix = rths::scenario::LoadScenario(std::string(RTHS_SOURCE_DIR) + "/scenarios/fig11_base.toml",
+                                                   {"run.duration_s=2"});
+  auto shear = rths::scenario::LoadScenario(std::string(RTHS_SOURCE_DIR) + "/scenarios/fig11_base.toml",
+                                            {"run.duration_s=2", "structure.file=" + (dir / "linear9.txt").string()});
+  CHECK_FALSE(shear.structure.Stepped());
+  fs::create_directories(dir / "matrix");
+  fs::create_directories(dir / "shear");
+  REQUIRE(rths_test::RunMemq({matrix}, dir / "matrix").code == 0);
+  REQUIRE(rths_test::RunMemq({shear}, dir / "shear").code == 0);
+  CHECK(rths::io::PayloadDigest(rths::io::ReadRunLog((dir / "shear" / "log.lcm").string())) ==
+        rths::io::PayloadDigest(rths::io::ReadRunLog((dir / "matrix" / "log.lcm").string())));
 }
 
 TEST_CASE("a yielding structure's run is bit-identical on memq and udpm") {
@@ -100,12 +131,20 @@ TEST_CASE("[structure.spring] and structure.integrator: bad values are refused n
         std::string::npos);
   CHECK(LoadError({"structure.integrator=euler"}).find("structure.integrator") != std::string::npos);
   CHECK(LoadError({"structure.specimen_count=-1"}).find("structure.specimen_count") != std::string::npos);
-  // A structure file has no story springs yet: the stepped integrators are for the SDOF.
-  const std::string benchmark = std::string(RTHS_SOURCE_DIR) + "/scenarios/benchmark/case1_example.toml";
+  // A matrix file (M, K, C) has no story springs: the stepped integrators need a shear-building file.
+  const std::string benchmark = std::string(RTHS_SOURCE_DIR) + "/scenarios/fig11_base.toml";
   try {
     rths::scenario::LoadScenario(benchmark, {"structure.integrator=cr"});
-    FAIL("cr on a structure file loaded");
+    FAIL("cr on a matrix file loaded");
   } catch (const rths::Error& e) {
-    CHECK(std::string(e.what()).find("structure.integrator") != std::string::npos);
+    CHECK(std::string(e.what()).find("structure.integrator: cr needs story springs") != std::string::npos);
+  }
+  // rk4_unit_delay on the yielding 9-story building: refused.
+  try {
+    rths::scenario::LoadScenario(std::string(RTHS_SOURCE_DIR) + "/scenarios/nonlinear/ohtori9_semiactive.toml",
+                                 {"structure.integrator=rk4_unit_delay"});
+    FAIL("rk4_unit_delay on a yielding building loaded");
+  } catch (const rths::Error& e) {
+    CHECK(std::string(e.what()).find("rk4_unit_delay runs linear structures only") != std::string::npos);
   }
 }

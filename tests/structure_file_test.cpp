@@ -62,6 +62,63 @@ TEST_CASE("structure files round-trip, and bad files are refused naming file and
         std::string::npos);
 }
 
+TEST_CASE("a shear-building file: story springs; all linear it is the matrix file's building exactly") {
+  const fs::path dir = fs::temp_directory_path() / "rths_structure_file_test";
+  fs::create_directories(dir);
+  const std::string root = RTHS_SOURCE_DIR;
+  // The 9-story building with linear springs: the same M, K, C as ohtori9_ns.txt (made by ShearBuilding).
+  std::string text = "n 9\nfloors kg\n505000 494500 494500 494500 494500 494500 494500 494500 535000\n";
+  for (const double k : {65.0, 295.6, 355.9, 191.9, 193.3, 141.9, 157.9, 80.2, 194.4})
+    text += "story linear k_kN_per_mm=" + std::to_string(k) + "\n";
+  text += "damping modal 0.02\n";
+  std::ofstream(dir / "linear9.txt") << text;
+  const auto lin = LoadStructureFile((dir / "linear9.txt").string());
+  const auto mat = LoadStructureFile(root + "/data/buildings/ohtori9_ns.txt");
+  CHECK((lin.M - mat.M).cwiseAbs().maxCoeff() == 0.0);
+  CHECK((lin.K - mat.K).cwiseAbs().maxCoeff() < 1e-12);
+  CHECK((lin.C - mat.C).cwiseAbs().maxCoeff() < 1e-12 * mat.C.cwiseAbs().maxCoeff());
+  REQUIRE(lin.springs.size() == 9);
+  CHECK(mat.springs.empty());
+  // The shipped yielding variant: the same initial building, Bouc-Wen stories.
+  const auto bw = LoadStructureFile(root + "/data/buildings/ohtori9_ns_bouc_wen.txt");
+  CHECK((bw.K - mat.K).cwiseAbs().maxCoeff() < 1e-12);
+  REQUIRE(bw.springs.size() == 9);
+  CHECK(bw.springs[0].kind == SpringKind::kBoucWen);
+  CHECK(bw.springs[0].x_y_mm == 20.0);
+  CHECK(bw.springs[7].k_kN_per_mm == 80.2);
+  // Rayleigh damping: 2 % in modes 1 and 3.
+  std::ofstream(dir / "rayleigh.txt") << "n 2\nfloors kg\n1000 1000\nstory bilinear k_kN_per_mm=10 b=0.05 f_y_kN=2\n"
+                                         "story linear k_kN_per_mm=5\ndamping rayleigh 1 0.02 2 0.02\n";
+  const auto r = LoadStructureFile((dir / "rayleigh.txt").string());
+  for (double z : ModalAnalysis(r).damping_ratio) CHECK(z == doctest::Approx(0.02));
+  CHECK(r.springs[0].kind == SpringKind::kBilinear);
+  CHECK(r.springs[0].f_y_kN == 2.0);
+
+  auto error_of = [&](const std::string& body) -> std::string {
+    std::ofstream(dir / "bad.txt") << "n 2\nfloors kg\n1000 1000\n" << body;
+    try {
+      LoadStructureFile((dir / "bad.txt").string());
+    } catch (const rths::Error& e) {
+      return e.what();
+    }
+    return "";
+  };
+  CHECK(error_of("story linear k_kN_per_mm=1\nstory linear k_kN_per_mm=1\ndamping modal 0.02\n").empty());
+  CHECK(error_of("story bouc_wen k_kN_per_mm=1 alpha=1.5\nstory linear k_kN_per_mm=1\ndamping modal 0.02\n")
+            .find("bad.txt:4: story 1: alpha: must be in [0, 1)") != std::string::npos);
+  CHECK(error_of("story linear k_kN_per_mm=1\nstory linear stiffness=1\ndamping modal 0.02\n")
+            .find("bad.txt:5: story 2: \"stiffness=1\" is not key=value with a key of k_kN_per_mm") != std::string::npos);
+  CHECK(error_of("story linear k_kN_per_mm=1\nstory elastic k_kN_per_mm=1\ndamping modal 0.02\n")
+            .find("story 2: kind: \"elastic\" is not allowed") != std::string::npos);
+  CHECK(error_of("story linear alpha=0.1\nstory linear k_kN_per_mm=1\ndamping modal 0.02\n")
+            .find("story 1: k_kN_per_mm=... (its initial stiffness) is missing") != std::string::npos);
+  CHECK(error_of("story linear k_kN_per_mm=1\ndamping modal 0.02\n").find("expected story 2") != std::string::npos);
+  CHECK(error_of("story linear k_kN_per_mm=1\nstory linear k_kN_per_mm=1\ndamping viscous 0.02\n")
+            .find("bad.txt:6: damping: \"viscous\"") != std::string::npos);
+  CHECK(error_of("story linear k_kN_per_mm=1\nstory linear k_kN_per_mm=1\ndamping modal 1.5\n")
+            .find("zeta: 1.5 is out of range [0, 1)") != std::string::npos);
+}
+
 TEST_CASE("semiactive schedules: the 0.5 Hz, 50 % pulse of Table 2 and the constant modes") {
   rths::control::SemiactiveConfig cfg;
   cfg.mode = rths::control::SemiactiveMode::kPulse;

@@ -1,5 +1,7 @@
 #include "models/structure_file.h"
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <fstream>
 #include <numbers>
@@ -89,6 +91,86 @@ void CheckSymmetric(const std::string& path, const Eigen::MatrixXd& a, const cha
 }
 }  // namespace
 
+namespace {
+
+/// One "story KIND key=value ..." line's spring: its words up to the next "story" or "damping".
+SpringParams StoryLine(const std::string& path, Tokens* t, int story) {
+  const std::string where = Where(path, *t);
+  if (t->next >= t->words.size() || t->words[t->next] != "story")
+    throw Error(where, fmt::format("expected story {}: \"story KIND key=value ...\" (one line per story, story 1 first)", story));
+  ++t->next;
+  SpringParams p;
+  const std::string kind = t->next < t->words.size() ? t->words[t->next++] : "";
+  p.kind = ParseName(kSpringKindNames, kind, fmt::format("{}: story {}: kind", where, story));
+  const std::array<std::pair<const char*, double*>, 10> keys = {{{"k_kN_per_mm", &p.k_kN_per_mm}, {"alpha", &p.alpha},
+                                                                 {"x_y_mm", &p.x_y_mm}, {"n", &p.n}, {"beta", &p.beta},
+                                                                 {"gamma", &p.gamma}, {"delta_nu", &p.delta_nu},
+                                                                 {"delta_eta", &p.delta_eta}, {"b", &p.b},
+                                                                 {"f_y_kN", &p.f_y_kN}}};
+  bool has_k = false;
+  while (t->next < t->words.size() && t->words[t->next] != "story" && t->words[t->next] != "damping") {
+    const std::string w = t->words[t->next];
+    const std::size_t eq = w.find('=');
+    const auto key = std::find_if(keys.begin(), keys.end(), [&](const auto& k) { return w.substr(0, eq) == k.first; });
+    if (eq == std::string::npos || key == keys.end()) {
+      std::string names;
+      for (const auto& k : keys) names += std::string(names.empty() ? "" : ", ") + k.first;
+      throw Error(Where(path, *t), fmt::format("story {}: \"{}\" is not key=value with a key of {}", story, w, names));
+    }
+    t->words[t->next] = w.substr(eq + 1);  // the value, read as a number where it stands
+    *key->second = Number(path, t, key->first);
+    has_k = has_k || key->second == &p.k_kN_per_mm;
+  }
+  if (!has_k) throw Error(where, fmt::format("story {}: k_kN_per_mm=... (its initial stiffness) is missing", story));
+  try {
+    p.Validate();
+  } catch (const Error& e) {
+    throw Error(where, fmt::format("story {}: {}: {}", story, e.where(), e.problem()));
+  }
+  return p;
+}
+
+/// The shear-building form after "n N": floor masses, a spring per story, the damping.
+StructureMatrices ShearBuildingFile(const std::string& path, Tokens* t, int n) {
+  Expect(path, t, "floors", "kg");
+  std::vector<double> masses(static_cast<std::size_t>(n));
+  for (double& m : masses) {
+    const std::string where = Where(path, *t);
+    m = Number(path, t, "floors");
+    if (!(m > 0.0 && m <= 1e9)) throw Error(where, fmt::format("floor mass {} kg is out of range (0, 1e9]", m));
+  }
+  StructureMatrices out;
+  for (int i = 1; i <= n; ++i) out.springs.push_back(StoryLine(path, t, i));
+  const std::string where = Where(path, *t);
+  Expect(path, t, "damping", "");
+  out.M = MassMatrix(masses);
+  out.K = InitialStiffness(out.springs);
+  const std::string how = t->next < t->words.size() ? t->words[t->next++] : "";
+  try {
+    if (how == "modal") {
+      const double zeta = Number(path, t, "damping modal ZETA");
+      if (!(zeta >= 0.0 && zeta < 1.0)) throw Error("zeta", fmt::format("{} is out of range [0, 1)", zeta));
+      out.C = ModalDampingMatrix(out.M, out.K, zeta);
+    } else if (how == "rayleigh") {
+      const int i = static_cast<int>(Number(path, t, "damping rayleigh MODE_I"));
+      const double zi = Number(path, t, "damping rayleigh ZETA_I");
+      const int j = static_cast<int>(Number(path, t, "damping rayleigh MODE_J"));
+      const double zj = Number(path, t, "damping rayleigh ZETA_J");
+      out.C = RayleighDampingMatrix(out.M, out.K, i, zi, j, zj);
+    } else {
+      throw Error("damping", fmt::format("\"{}\": \"damping modal ZETA\" or \"damping rayleigh MODE_I ZETA_I MODE_J "
+                                         "ZETA_J\" (of the initial stiffness)",
+                                         how));
+    }
+  } catch (const Error& e) {
+    throw Error(where, fmt::format("{}: {}", e.where(), e.problem()));
+  }
+  if (t->next != t->words.size()) throw Error(Where(path, *t), "unexpected text after the damping line");
+  return out;
+}
+
+}  // namespace
+
 StructureMatrices LoadStructureFile(const std::string& path) {
   Tokens t = Tokenize(path);
   Expect(path, &t, "n", "");
@@ -97,6 +179,7 @@ StructureMatrices LoadStructureFile(const std::string& path) {
     throw Error(Where(path, t), fmt::format("n = {} is out of range [1, 10000] (whole number)", nd));
   }
   const int n = static_cast<int>(nd);
+  if (t.next < t.words.size() && t.words[t.next] == "floors") return ShearBuildingFile(path, &t, n);
   StructureMatrices m;
   Expect(path, &t, "M", "kg");
   m.M = Matrix(path, &t, n, "M") * kKgToProject;
@@ -209,15 +292,25 @@ LinearStructure StructureFromScenario(const models::StructureConfig& st) {
   return s;
 }
 
-NonlinearBuilding NonlinearSdofFromScenario(const StructureConfig& st) {
-  const LinearStructure lin = LinearStructure::Sdof(st.mass_kg, st.frequency_hz, st.damping_ratio, st.specimen_count);
-  SpringParams spring = st.spring;
-  spring.k_kN_per_mm = lin.K(0, 0);  // m w^2, the initial stiffness
-  return NonlinearBuilding::Make({st.mass_kg}, {spring}, lin.C, 0, st.specimen_count);
+NonlinearBuilding NonlinearFromScenario(const StructureConfig& st) {
+  if (st.kind == StructureKind::kSdof) {
+    const LinearStructure lin = LinearStructure::Sdof(st.mass_kg, st.frequency_hz, st.damping_ratio, st.specimen_count);
+    SpringParams spring = st.spring;
+    spring.k_kN_per_mm = lin.K(0, 0);  // m w^2, the initial stiffness
+    return NonlinearBuilding::Make({st.mass_kg}, {spring}, lin.C, 0, st.specimen_count);
+  }
+  const StructureMatrices& m = st.matrices;
+  if (m.springs.empty())
+    throw Error("structure.file", fmt::format("{}: a matrix file has no story springs; cr, alpha_os, newmark_implicit "
+                                              "and sub-steps need a shear-building file (floors, story lines)",
+                                              st.file));
+  std::vector<double> masses(static_cast<std::size_t>(m.M.rows()));
+  for (std::size_t i = 0; i < masses.size(); ++i) masses[i] = m.M(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(i)) / kKgToProject;
+  return NonlinearBuilding::Make(masses, m.springs, m.C, st.actuator_dof - 1, st.specimen_count);
 }
 
 StructureIntegrator SteppedIntegratorFromScenario(const StructureConfig& st, double dt_s) {
-  return StructureIntegrator::Make(NonlinearSdofFromScenario(st), dt_s, st.integrator);
+  return StructureIntegrator::Make(NonlinearFromScenario(st), dt_s, st.integrator);
 }
 
 }  // namespace rths::models

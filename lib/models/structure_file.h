@@ -48,8 +48,10 @@ inline constexpr std::array<Named<Derivatives>, 2> kDerivativesNames = {
 
 /// M [kN s^2/mm], K [kN/mm], C [kN s/mm], and the ground influence vector iota [-] (empty: ones).
 struct StructureMatrices {
-  Eigen::MatrixXd M, K, C;
+  Eigen::MatrixXd M, K, C;  ///< for a shear-building file: K the initial stiffness, C from it
   Eigen::VectorXd iota;  ///< n entries, or empty for ones (a shear building)
+  /// A shear-building file's story springs, story 1 first (empty for a matrix file).
+  std::vector<SpringParams> springs;
   /// iota if it is set, else ones (n = M.rows()).
   Eigen::VectorXd IotaOrOnes() const;
   /// Same sizes and the same values (empty matrices are equal).
@@ -104,8 +106,14 @@ struct StructureConfig {
   StructureMatrices matrices{};
   /// The matrices of `reference_file`; empty if there is none.
   StructureMatrices reference{};
-  /// A hysteretic spring somewhere (mode "rths"): the substructure is a NonlinearBuilding.
-  bool Nonlinear() const { return mode == StructureMode::kRths && kind == StructureKind::kSdof && spring.kind != SpringKind::kLinear; }
+  /// A hysteretic spring somewhere (mode "rths"): the SDOF's, or a story of a shear-building file.
+  bool Nonlinear() const {
+    if (mode != StructureMode::kRths) return false;
+    if (kind == StructureKind::kSdof) return spring.kind != SpringKind::kLinear;
+    for (const SpringParams& p : matrices.springs)
+      if (p.kind != SpringKind::kLinear) return true;
+    return false;
+  }
   /// Stepped by models::StructureIntegrator (a NonlinearBuilding), not by today's linear paths: a
   /// hysteretic spring, cr, alpha_os, newmark_implicit, or central difference with sub-steps.
   bool Stepped() const {
@@ -120,6 +128,15 @@ struct StructureConfig {
 /// Reads a structure file; throws rths::Error naming the file, line and problem (missing or
 /// malformed matrix, wrong size, non-symmetric M or K, M not positive definite, an iota line
 /// without n values). iota is left empty when the file has no iota line.
+///
+/// Or a shear building with a spring per story (docs/structures.md "A shear building with story
+/// springs"), after "n N":
+///     floors kg            then n floor masses [kg], floor 1 first
+///     story KIND key=value ...   n lines, story 1 (ground to floor 1) first; KIND linear |
+///                          bouc_wen | bilinear; keys of SpringParams (k_kN_per_mm required)
+///     damping modal ZETA | damping rayleigh MODE_I ZETA_I MODE_J ZETA_J   (of the initial stiffness)
+/// M, K (the initial stiffness), C are filled from them and `springs` holds the stories; an error
+/// names the file, line, story and key.
 StructureMatrices LoadStructureFile(const std::string& path);
 /// Writes a structure file (masses back in kg), with `comment` lines after the header; the iota
 /// line only if m.iota is set and not all ones.
@@ -151,12 +168,14 @@ Modes ModalAnalysis(const StructureMatrices& m);
 /// were not read, or "structure.actuator_dof" if it exceeds their DOFs (the loader checks both).
 LinearStructure StructureFromScenario(const models::StructureConfig& st);
 
-/// The SDOF of [structure] with its [structure.spring] as a NonlinearBuilding of one story: the
-/// spring's initial stiffness k = m w^2 (w = 2 pi frequency_hz), damping 2 zeta m w at it, the
-/// specimen at the one DOF times specimen_count. Throws rths::Error naming the spring's field.
-NonlinearBuilding NonlinearSdofFromScenario(const models::StructureConfig& st);
+/// The numerical substructure as a NonlinearBuilding: the SDOF of [structure] with its
+/// [structure.spring] (one story, initial stiffness k = m w^2, w = 2 pi frequency_hz, damping
+/// 2 zeta m w at it), or a shear-building file's floors, story springs and damping; the specimen at
+/// structure.actuator_dof times specimen_count. Throws rths::Error naming the key ("structure.file"
+/// for a matrix file: it has no story springs).
+NonlinearBuilding NonlinearFromScenario(const models::StructureConfig& st);
 /// The integrator of a structure that StructureConfig::Stepped() says is stepped by
-/// models::StructureIntegrator: NonlinearSdofFromScenario(st) with st.integrator at dt_s [s].
+/// models::StructureIntegrator: NonlinearFromScenario(st) with st.integrator at dt_s [s].
 /// Throws rths::Error (the integrator's checks, e.g. central difference's stability limit).
 StructureIntegrator SteppedIntegratorFromScenario(const models::StructureConfig& st, double dt_s);
 

@@ -22,9 +22,12 @@ struct StructureResponse {
   double peak_displacement_mm = 0.0;    ///< max_k |x_k| at that floor, relative to the ground [mm]
   double residual_displacement_mm = 0.0;  ///< x at the last logged step [mm]
   double hysteretic_energy_kN_mm = 0.0;   ///< dissipated by every story spring by then [kN mm]
-  double yield_displacement_mm = 0.0;   ///< the top story spring's (0 if linear) [mm]
-  /// peak / yield (0 if linear).
-  double Ductility() const { return yield_displacement_mm > 0 ? peak_displacement_mm / yield_displacement_mm : 0.0; }
+  /// The story whose peak drift is the largest multiple of its spring's yield drift (of the
+  /// largest drift if no story yields), 1-based, its peak drift max_k |x_i - x_i-1| [mm] and that
+  /// multiple, the peak ductility (0 if every story is linear).
+  int story = 1;
+  double peak_drift_mm = 0.0;
+  double ductility = 0.0;
 };
 
 /// The response of the run logged in `log` (its complete steps) whose scenario is `s`, whose

@@ -39,6 +39,15 @@ void ReadStructureFiles(const std::string& path, const detail::Check& check, con
     return;
   }
   st->matrices = models::LoadStructureFile(file);  // its own errors name the file and line
+  if (st->Stepped() && st->matrices.springs.empty())
+    check.Fail("structure.integrator",
+               fmt::format("{}{} needs story springs: {} is a matrix file (M, K, C); give a shear-building file "
+                           "(floors, story lines: docs/structures.md) or use central_difference or rk4_unit_delay",
+                           NameOf(models::kIntegratorKindNames, st->integrator.kind),
+                           st->integrator.substeps > 1 ? " with substeps" : "", st->file));
+  if (st->integrator.kind == models::IntegratorKind::kRk4UnitDelay && st->Nonlinear())
+    check.Fail("structure.integrator", "rk4_unit_delay runs linear structures only (the benchmark's reference-code "
+                                       "loop): choose central_difference, cr, alpha_os or newmark_implicit");
   const auto dofs = st->matrices.M.rows();
   if (!st->reference_file.empty() && st->reference.M.rows() != dofs) {
     check.Fail("structure.reference_file", fmt::format("{} has {} DOFs but structure.file ({}) has {}: they must match",

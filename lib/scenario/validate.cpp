@@ -114,12 +114,6 @@ void ValidateStructure(const models::StructureConfig& st, const std::string& sce
       check.Fail("structure.spring." + e.where(), e.problem());
     }
   }
-  if (st.Stepped() && st.kind != models::StructureKind::kSdof)
-    check.Fail("structure.integrator", fmt::format("{}{}: for kind = \"sdof\" only in this version (a structure file "
-                                                   "has no story springs yet); kind = \"file\" runs central_difference "
-                                                   "or rk4_unit_delay",
-                                                   NameOf(models::kIntegratorKindNames, st.integrator.kind),
-                                                   st.integrator.substeps > 1 ? " with substeps" : ""));
   if (st.integrator.kind == models::IntegratorKind::kRk4UnitDelay && st.Nonlinear())
     check.Fail("structure.integrator", "rk4_unit_delay runs linear structures only (the benchmark's reference-code "
                                        "loop): choose central_difference, cr, alpha_os or newmark_implicit");

@@ -57,7 +57,9 @@ nlohmann::json RunSummary::ToJson() const {
     j["structure_residual_displacement_mm"] = r.residual_displacement_mm;
     j["structure_hysteretic_energy_kN_mm"] = r.hysteretic_energy_kN_mm;
     j["structure_floor"] = r.floor;
-    if (r.yield_displacement_mm > 0) j["structure_ductility"] = r.Ductility();
+    j["structure_peak_drift_mm"] = r.peak_drift_mm;
+    j["structure_peak_drift_story"] = r.story;
+    j["structure_ductility"] = r.ductility;
   }
   if (!structure_error.empty()) j["structure_error"] = structure_error;
   j["status"] = status;
@@ -95,10 +97,10 @@ std::string RunSummary::Report(double dt_s) const {
   if (!benchmark_error.empty()) o += "  benchmark          no J1-J9: " + benchmark_error + "\n";
   if (structure_response) {
     const participants::StructureResponse& r = *structure_response;
-    o += fmt::format("  structure          floor {}: peak {:.4g} mm{}, residual {:.4g} mm, hysteretic energy {:.4g} kN mm\n",
-                     r.floor, r.peak_displacement_mm,
-                     r.yield_displacement_mm > 0 ? fmt::format(" (ductility {:.3g})", r.Ductility()) : std::string(),
-                     r.residual_displacement_mm, r.hysteretic_energy_kN_mm);
+    o += fmt::format("  structure          floor {}: peak {:.4g} mm, residual {:.4g} mm; story {}: peak drift {:.4g} mm "
+                     "(ductility {:.3g}); hysteretic energy {:.4g} kN mm\n",
+                     r.floor, r.peak_displacement_mm, r.residual_displacement_mm, r.story, r.peak_drift_mm, r.ductility,
+                     r.hysteretic_energy_kN_mm);
   }
   if (!structure_error.empty()) o += "  structure          " + structure_error + "\n";
   if (realtime.is_object() && realtime.contains("steps")) {
