@@ -103,6 +103,24 @@ TEST_CASE("the 9-story building with Bouc-Wen stories, semiactive, as shipped: i
         rths::io::PayloadDigest(rths::io::ReadRunLog((dir / "matrix" / "log.lcm").string())));
 }
 
+TEST_CASE("every scenario in scenarios/nonlinear runs as shipped, and its structure yields") {
+  int n = 0;
+  for (const auto& e : fs::directory_iterator(std::string(RTHS_SOURCE_DIR) + "/scenarios/nonlinear")) {
+    if (e.path().extension() != ".toml") continue;
+    CAPTURE(e.path().string());
+    ++n;
+    const fs::path dir = rths_test::TempDir("shipped_" + e.path().stem().string());
+    std::string output;
+    CHECK(rths_test::RunCli(e.path().string() + " --transport memq --compact --out " + (dir / "run").string(), &output) ==
+          0);
+    CAPTURE(output);
+    const auto j = Summary(dir / "run");
+    CHECK(j["status"] == "completed");
+    CHECK(j["structure_ductility"].get<double>() > 1.5);
+  }
+  CHECK(n >= 3);
+}
+
 TEST_CASE("a yielding structure's run is bit-identical on memq and udpm") {
   const auto s = rths::scenario::LoadScenario(kReference, {"run.duration_s=3", "structure.integrator=alpha_os",
                                                            "structure.specimen_count=1"});
