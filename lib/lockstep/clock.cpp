@@ -12,6 +12,8 @@ namespace rths::lockstep {
 
 namespace {
 constexpr double kHandshakeRepeatS = 0.1;
+/// How long the loss of a participant that exited on an ABORT waits for that ABORT [s].
+constexpr double kAbortGraceS = 1.0;
 
 double Seconds(SteadyClock::time_point a, SteadyClock::time_point b) {
   return std::chrono::duration<double>(b - a).count();
@@ -341,9 +343,19 @@ void ClockParticipant::Poll(SteadyClock::time_point now, bool idle) {
     return;
   }
   if (!done_) {
-    if (const std::optional<PeerLoss> loss = watch_.Check(now)) {
-      FailLost(*loss);
+    if (pending_loss_ && now >= pending_loss_until_) {  // the ABORT it stopped on never came
+      FailLost(*pending_loss_);
       return;
+    }
+    if (const std::optional<PeerLoss> loss = watch_.Check(now)) {
+      if (loss->died && loss->status_known && loss->exit_code == kExitPeerAbort && !pending_loss_) {
+        pending_loss_ = loss;
+        pending_loss_until_ = now + std::chrono::duration_cast<SteadyClock::duration>(
+                                        std::chrono::duration<double>(kAbortGraceS));
+      } else {
+        FailLost(*loss);
+        return;
+      }
     }
   }
   if (k_ < 0) {

@@ -18,6 +18,7 @@
 /// Paced (LockstepConfig::pacing, docs/realtime.md): step k is released at GO + k dt of the wall clock,
 /// not as soon as step k-1 completes; every step's latency and deadline are accounted.
 #include <array>
+#include <optional>
 #include <memory>
 #include <string>
 #include <string_view>
@@ -116,6 +117,11 @@ class ClockParticipant : public Participant {
 
   std::array<bool, kRosterSize> hello_{};
   PeerWatch watch_;
+  /// A participant that exited with kExitPeerAbort stopped on an ABORT (a monitor's, say) that
+  /// may still be on its way here: its loss waits a grace (kAbortGraceS, 1 s) for that ABORT,
+  /// which then stops the run as an abort, not as a lost participant.
+  std::optional<PeerLoss> pending_loss_;
+  SteadyClock::time_point pending_loss_until_{};
   std::array<PeerObservation, kRosterSize> peers_{};
   std::array<int, kChannelCodes> owner_{};  ///< roster index of the role answering each channel (-1: none)
   std::array<bool, kRosterSize> bye_{};
