@@ -402,9 +402,10 @@ TEST_CASE("sweep plots: array levels labelled as written, a level that failed ev
   const std::string by_den = rths_test::PanelScript(gp, 1);
   CHECK(by_den.find("'[1.0, 10.0]' 1") != std::string::npos);
   CHECK(by_den.find("\"[1.0, 10.0]\"") == std::string::npos);
+  CHECK(by_den.find("set title 'no completed run: [1, 100]'") != std::string::npos);  // its empty tick named
   // Against the drawn gain, a curve per denominator: the one with no completed run is named.
   const std::string by_gain = rths_test::PanelScript(gp, 2);
-  CHECK(by_gain.find("a curve per controller.lti.feedback.den; no completed run: [1, 100]") != std::string::npos);
+  CHECK(by_gain.find("coloured by controller.lti.feedback.den; no completed run: [1, 100]") != std::string::npos);
   const auto curves = rths_test::PanelCurves(rths_test::ReadPlotData(dir / "peak_force_kN.dat"), 2);
   REQUIRE(curves.size() == 2);
   CHECK(curves[1].title == "[1.0, 10.0]");

@@ -508,8 +508,11 @@ PageFigure BenchmarkFigure(const RunData& d, const signal::BenchmarkSignals& b, 
   Panel act = MakePanel(fmt::format("Actuator floor {}", a), "t [s]", "displacement [mm]");
   Series sxr = History(fmt::format("x_r,{} (reference)", a), "black", t, b.x_r[ai], m);
   sxr.dash = 2;
-  act.series = {History("x_t = r (target)", kColorU, t, b.x_t, m), History("x_m = y (measured)", kColorY, t, b.x_m, m),
-                sxr};
+  // The target last and dashed, over the measured and the reference it lies under (they differ by
+  // a few per cent): drawn first, it was hidden though the legend listed it.
+  Series sxt = History("x_t = r (target)", kColorU, t, b.x_t, m);
+  sxt.dash = 3;
+  act.series = {History("x_m = y (measured)", kColorY, t, b.x_m, m), sxr, sxt};
   std::vector<double> e_t(b.x_m.size()), e_r(b.x_m.size());
   for (std::size_t k = 0; k < e_t.size(); ++k) {
     e_t[k] = b.x_m[k] - b.x_t[k];
@@ -547,6 +550,7 @@ PageFigure BenchmarkFigure(const RunData& d, const signal::BenchmarkSignals& b, 
     p.key = "outside right top";
     p.left_margin_chars = 10;
     p.right_margin_chars = right;
+    p.y_margin_fraction = kPeakMargin;  // peaks off the frame
   }
   pf.caption_html = fmt::format(
       "Top: the target x<sub>t</sub> = r, the measured x<sub>m</sub> = y and the reference structure's floor {0} "

@@ -211,12 +211,12 @@ void WriteFigure(const BenchmarkResult& res, const ReproduceOptions& opts) {
     p.series.insert(p.series.end(), nominal.begin(), nominal.end());
     p.series.insert(p.series.end(), perturbed.begin(), perturbed.end());
     if (!stopped.x.empty()) p.series.push_back(stopped);
-    if (!p.log_y) {  // J1, a delay: from 0 (a margin below it would show negative delays)
+    if (!p.log_y) {  // J1, a delay: 0 at the bottom, a sliver below it so that J1 = 0 sits off the frame
       double top = 0.0;
       for (const io::Series& s : p.series) {
         for (const double y : s.y) top = std::max(top, y);
       }
-      if (top > 0) p.y_range = std::make_pair(0.0, 1.08 * top);
+      if (top > 0) p.y_range = std::make_pair(-0.04 * top, 1.08 * top);
     }
     fig.panels.push_back(p);
   }

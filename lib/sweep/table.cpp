@@ -421,16 +421,20 @@ io::Panel PlotPanel(const Table& t, std::size_t c, const std::vector<AxisColumn>
     level_of[r] = static_cast<std::size_t>(it - levels.begin());
     if (it == levels.end()) levels.push_back(split->labels[r]);
   }
-  std::vector<std::string> lost;  // levels of `split` with no completed run: no curve, said in the title
-  for (std::size_t r = 0; split != nullptr && r < t.rows.size(); ++r) {
-    const std::string& l = split->labels[r];
-    if (std::find(levels.begin(), levels.end(), l) == levels.end() && std::find(lost.begin(), lost.end(), l) == lost.end()) {
+  // Levels with no completed run, said in the title: of `split` (no curve), or, with no split, of
+  // this axis itself (an empty tick).
+  const AxisColumn* of = split != nullptr ? split : (axis.drawn ? nullptr : &axis);
+  std::vector<std::string> lost, done;
+  for (std::size_t r = 0; of != nullptr && r < t.rows.size(); ++r)
+    if (Completed(t.rows[r])) done.push_back(of->labels[r]);
+  for (std::size_t r = 0; of != nullptr && r < t.rows.size(); ++r) {
+    const std::string& l = of->labels[r];
+    if (std::find(done.begin(), done.end(), l) == done.end() && std::find(lost.begin(), lost.end(), l) == lost.end())
       lost.push_back(l);
-    }
   }
   if (levels.empty()) levels.push_back("");
-  if (split != nullptr) p.title = "a curve per " + split->name;
-  for (std::size_t i = 0; i < lost.size(); ++i) p.title += (i ? ", " : "; no completed run: ") + lost[i];
+  if (split != nullptr) p.title = (axis.drawn ? "coloured by " : "a curve per ") + split->name;
+  for (std::size_t i = 0; i < lost.size(); ++i) p.title += (i ? ", " : (p.title.empty() ? "no completed run: " : "; no completed run: ")) + lost[i];
   p.key = split != nullptr ? "outside right top" : "off";  // short entries (the levels): a narrow column
   const auto& palette = io::ReadableColors();
   for (std::size_t l = 0; l < levels.size(); ++l) {
