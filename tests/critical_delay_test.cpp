@@ -163,4 +163,9 @@ TEST_CASE("rths reproduce nonlinear --quick writes its table, its Markdown and i
   CHECK(md.find("| cr | yielding |") != std::string::npos);
   rths_test::RequireTool("gnuplot", "gnuplot-nox");
   CHECK(fs::file_size(out / "critical_delay.png") > 1000);
+  // No lockstep runs: --set is refused, not silently ignored.
+  const std::string set = std::string(RTHS_BIN_DIR) + "/rths-reproduce nonlinear --quick --set run.dt_s=0.001 --out " +
+                          (out.parent_path() / "nonlinear_set").string() + " > /dev/null 2>&1";
+  const int status = std::system(set.c_str());
+  CHECK((WIFEXITED(status) ? WEXITSTATUS(status) : -1) == 2);
 }
