@@ -26,6 +26,7 @@
 #include "studies/fig6.h"
 #include "studies/fig78.h"
 #include "studies/fig9.h"
+#include "studies/nonlinear_delay.h"
 #include "studies/table2.h"
 #include "sweep/study_on_slurm.h"
 #include "set_hint.h"
@@ -48,6 +49,8 @@ std::string Standing(const std::string& name, const std::string& plant, bool qui
     s = "reported: what docs/benchmark.md says, checked on these numbers";
   } else if (name == "fig11") {
     s = "reported: the paper's statement checked on our numbers (docs/reproduce_fig11.md)";
+  } else if (name == "nonlinear") {
+    s = "required: the test suite asserts the linear rows against the closed form (docs/reproduce_nonlinear.md)";
   } else {
     s = "reported: the paper's claim checked on our numbers (docs/experiments.md)";
   }
@@ -76,7 +79,7 @@ struct Options {
 void AddOptions(CLI::App& app, Options* o) {
   app.add_option("name", o->name, "what to reproduce")
       ->required()
-      ->check(CLI::IsMember({"fig5", "fig6", "fig7", "fig8", "fig9", "fig11", "table2", "benchmark"}));
+      ->check(CLI::IsMember({"fig5", "fig6", "fig7", "fig8", "fig9", "fig11", "table2", "benchmark", "nonlinear"}));
   app.add_option("--out", o->out, "output folder (default: a new folder under runs/); never overwritten");
   app.add_flag("--resume", o->resume,
                "finish the study an interrupted `rths reproduce NAME --out DIR` left in DIR: the runs that ended "
@@ -168,6 +171,32 @@ void Fig9(const rths::studies::ReproduceOptions& opts) {
   std::printf("fig9: %zu runs in %.1f s; fig9.csv, fig9.md, fig9.png\n", r.rows.size(), r.wall_s);
 }
 
+/// The critical-delay table (issue 44): tau_cr [ms] per integrator and structure, and the check of
+/// the linear rows against the closed-form delay margin.
+void Nonlinear(const Options& o, const rths::studies::ReproduceOptions& opts) {
+  const auto r = rths::studies::ReproduceNonlinear(opts);  // studies/nonlinear_delay.h
+  auto cell = [](const rths::studies::CriticalDelay& c) {
+    return c.found ? fmt::format("{:.3f}", 1e3 * c.tau_s) : fmt::format("> {:.0f}", 1e3 * c.tau_s);
+  };
+  std::printf("\ncritical delay [ms] (critical_delay.md explains the columns)\n%-18s %-9s %8s %10s %8s %8s %8s %9s\n",
+              "integrator", "structure", "none", "diverges", "poly3", "lead", "ff", "analytic");
+  double worst = 0.0;
+  for (const auto& row : r.rows) {
+    std::printf("%-18s %-9s %8s %10s %8s %8s %8s %9s\n", row.integrator.c_str(), row.yielding ? "yielding" : "linear",
+                cell(row.none).c_str(), cell(row.none_divergence).c_str(), cell(row.poly3).c_str(),
+                cell(row.lead).c_str(), cell(row.ff).c_str(),
+                row.yielding ? "" : fmt::format("{:.3f}", 1e3 * row.analytic.tau_s).c_str());
+    // newmark_implicit holds the force one sample late: its margin is one dt shorter (the docs say why).
+    if (!row.yielding && row.integrator != "newmark_implicit" && row.none.found) {
+      worst = std::max(worst, std::abs(row.none.tau_s / row.analytic.tau_s - 1.0));
+    }
+  }
+  std::printf("\n%zu searches in %.1f s; critical_delay.csv, critical_delay.md, critical_delay.png\n\n",
+              r.rows.size() * rths::studies::NonlinearDelayColumns().size(), r.wall_s);
+  PrintCheck(worst <= 0.02, "linear rows (central_difference, cr, alpha_os) within 2 % of the closed-form delay margin",
+             fmt::format("largest difference {:.2f} %", 100 * worst), Standing(o.name, o.plant, o.quick));
+}
+
 void Fig11(const Options& o, const rths::studies::ReproduceOptions& opts) {
   const auto r = rths::studies::ReproduceFig11(opts);  // studies/fig11.h; table in fig11.md
   std::printf("fig11: %zu RTHS + %zu numerical runs in %.1f s; fig11_summary.json, fig11.md, PNGs\n\n", r.runs.size(),
@@ -234,6 +263,8 @@ void Reproduce(const Options& o, const rths::studies::ReproduceOptions& opts) {
     Fig9(opts);
   } else if (o.name == "fig11") {
     Fig11(o, opts);
+  } else if (o.name == "nonlinear") {
+    Nonlinear(o, opts);
   } else if (o.name == "benchmark") {
     Benchmark(o, opts);
   } else if (o.name == "fig6") {
@@ -248,6 +279,11 @@ int CheckOptions(Options* o) {
   if (o->compact) o->sets.push_back("run.csv_every=0");
   if (!o->sets.empty() && o->name == "fig5") {
     std::fprintf(stderr, "rths reproduce fig5: --set/--compact: fig5 runs the damper model alone, no scenario\n");
+    return rths::lockstep::kExitUsage;
+  }
+  if ((!o->sets.empty() || o->executor == "slurm") && o->name == "nonlinear") {
+    std::fprintf(stderr, "rths reproduce nonlinear: --set/--compact/--executor slurm: nonlinear runs its loops in this "
+                         "process, no lockstep runs\n");
     return rths::lockstep::kExitUsage;
   }
   if (o->resume && o->out.empty()) {
