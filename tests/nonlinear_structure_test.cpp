@@ -6,9 +6,12 @@
 #include <vector>
 
 #include <doctest/doctest.h>
+#include <fmt/format.h>
 
 #include "alloc_counter.h"
 #include "core/error.h"
+#include "models/benchmark_structures.h"
+#include "models/equivalent_shear.h"
 #include "models/nonlinear_building.h"
 #include "models/story_spring.h"
 #include "models/structure.h"
@@ -168,6 +171,38 @@ TEST_CASE("spring and building validation name the field and the range") {
   CHECK_THROWS_WITH(c.Validate(), "alpha: must be in [-1/3, 0] (got -0.5)");
   c.alpha = 0, c.substeps = 2;
   CHECK_THROWS_WITH(c.Validate(), "substeps: must be 1 for alpha_os (got 2)");
+}
+
+TEST_CASE("the first-mode equivalent shear building: a shear building's own stories; the benchmark's first mode") {
+  using rths::models::FirstModeStoryStiffness;
+  // A shear building gives back its own story stiffnesses (its K is what the stories make).
+  const std::vector<double> k = {65.0, 295.6, 355.9, 191.9};
+  const auto own = FirstModeStoryStiffness(rths::models::MassMatrix({5e5, 4.9e5, 4.9e5, 5.3e5}),
+                                           rths::models::StoryStiffnessMatrix(k));
+  REQUIRE(own.size() == k.size());
+  for (std::size_t i = 0; i < k.size(); ++i) CHECK(own[i] == doctest::Approx(k[i]).epsilon(1e-10));
+  // The benchmark's full K (Silva et al. 2020): the shear building keeps the first frequency and mode
+  // shape exactly, and the shipped yielding variant's stories are these stiffnesses.
+  const auto ref = rths::models::Silva3Structures().reference;
+  const auto shear = FirstModeStoryStiffness(ref.M, ref.K);
+  const auto file = rths::models::LoadStructureFile(std::string(RTHS_SOURCE_DIR) +
+                                                    "/data/buildings/silva3_shear_bouc_wen.txt");
+  REQUIRE(file.springs.size() == 3);
+  for (std::size_t i = 0; i < 3; ++i) {
+    CAPTURE(i);
+    CHECK(file.springs[i].k_kN_per_mm == doctest::Approx(shear[i]).epsilon(1e-6));
+  }
+  const auto f_ref = rths::models::ModalAnalysis(ref).frequency_hz;
+  const auto f_shear = rths::models::ModalAnalysis(file).frequency_hz;
+  MESSAGE(fmt::format("stories {:.6f} {:.6f} {:.6f} kN/mm; f {:.4f} {:.4f} {:.4f} Hz (benchmark {:.4f} {:.4f} {:.4f})",
+                      shear[0], shear[1], shear[2], f_shear[0], f_shear[1], f_shear[2], f_ref[0], f_ref[1], f_ref[2]));
+  CHECK(f_shear[0] == doctest::Approx(f_ref[0]).epsilon(1e-6));
+  CHECK(f_shear[1] < f_ref[1]);  // the frame's higher modes are stiffer than any shear building's with this mode
+  // A first mode that reverses has no shear building: refused, naming K.
+  Eigen::MatrixXd K(2, 2);
+  K << 1.0, 0.9, 0.9, 1.0;  // the lowest mode is (1, -1)
+  CHECK_THROWS_WITH_AS(FirstModeStoryStiffness(Eigen::MatrixXd::Identity(2, 2), K),
+                       doctest::Contains("no shear building has this first mode"), rths::Error);
 }
 
 TEST_CASE("Rayleigh damping gives the two modes their ratios") {

@@ -1,10 +1,12 @@
 #include "models/integrator_accuracy.h"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
 #include <fmt/format.h>
 
+#include "core/error.h"
 #include "signal/history.h"
 
 namespace rths::models {
@@ -32,10 +34,25 @@ std::string Describe(const IntegratorConfig& c) {
   return s;
 }
 
-AccuracyStudy MeasureAccuracy(const NonlinearBuilding& b, double dt, const std::function<std::vector<double>(double)>& ground,
-                              int levels, const std::vector<IntegratorConfig>& configs) {
+std::vector<double> ResampleLinear(const std::vector<double>& samples, int r) {
+  if (r < 1) throw Error("ResampleLinear", fmt::format("the ratio must be >= 1 (got {})", r));
+  const std::size_t n = samples.size();
+  std::vector<double> out(n * static_cast<std::size_t>(r));
+  for (std::size_t k = 0; k < n; ++k) {
+    const double next = samples[std::min(k + 1, n - 1)];
+    for (int i = 0; i < r; ++i)
+      out[k * static_cast<std::size_t>(r) + static_cast<std::size_t>(i)] =
+          samples[k] + (next - samples[k]) * (static_cast<double>(i) / r);
+  }
+  return out;
+}
+
+AccuracyStudy MeasureAccuracy(const NonlinearBuilding& b, double dt, const SampledHistory& ground, int levels,
+                              const std::vector<IntegratorConfig>& configs, const SampledHistory& force,
+                              double rtol) {
+  const auto force_at = [&](double h) { return force ? force(h) : std::vector<double>{}; };
   AccuracyStudy out;
-  out.reference = SolveReference(b, dt, ground(dt), {}, 1e-12);
+  out.reference = SolveReference(b, dt, ground(dt), force_at(dt), rtol);
   out.reference_summary = Summarize(out.reference.x_mm);
   const Eigen::Index roof = b.dofs() - 1, N = out.reference.x_mm.cols();
   const Eigen::RowVectorXd ref = out.reference.x_mm.row(roof);
@@ -44,7 +61,7 @@ AccuracyStudy MeasureAccuracy(const NonlinearBuilding& b, double dt, const std::
     for (int j = 0; j < levels; ++j) {
       const int r = 1 << j;
       const double h = dt / r;
-      const SimulatedRun run = Simulate(StructureIntegrator::Make(b, h, c), ground(h));
+      const SimulatedRun run = Simulate(StructureIntegrator::Make(b, h, c), ground(h), force_at(h));
       Eigen::MatrixXd x(b.dofs(), N);  // at the RTHS samples
       for (Eigen::Index k = 0; k < N; ++k) x.col(k) = run.x_mm.col(k * r);
       AccuracyRow row;

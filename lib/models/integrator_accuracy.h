@@ -45,13 +45,21 @@ struct AccuracyStudy {
   std::vector<AccuracyRow> rows; ///< per config: dt, dt/2, ... (levels rows each)
 };
 
+/// A history sampled at step h [s] (one sample per step).
+using SampledHistory = std::function<std::vector<double>(double h_s)>;
+
 /// Runs every config at dt_s / 2^j, j = 0 .. levels - 1, on ground(dt) (a record sampled at step
-/// dt [mm/s^2], the same continuous record at every step), against the reference at dt_s
-/// (SolveReference at rtol 1e-12).
+/// dt [mm/s^2], the same continuous record at every step) and, if given, the specimen force
+/// force(dt) [kN] (e.g. a run's measured force, ResampleLinear), against the reference at dt_s
+/// (SolveReference at rtol, the force linear between its samples).
 /// Throws what the integrators and the reference throw.
-AccuracyStudy MeasureAccuracy(const NonlinearBuilding& b, double dt_s,
-                              const std::function<std::vector<double>(double dt_s)>& ground, int levels,
-                              const std::vector<IntegratorConfig>& configs);
+AccuracyStudy MeasureAccuracy(const NonlinearBuilding& b, double dt_s, const SampledHistory& ground, int levels,
+                              const std::vector<IntegratorConfig>& configs, const SampledHistory& force = {},
+                              double rtol = 1e-12);
+
+/// samples [any unit] at step dt_s, linear between them, at step dt_s / r (r >= 1 an integer):
+/// samples.size() * r values, the last sample held after the end. Throws rths::Error for r < 1.
+std::vector<double> ResampleLinear(const std::vector<double>& samples, int r);
 
 /// A short name of a config: "central_difference", "cr x4" (4 sub-steps), "alpha_os(-0.05)",
 /// "newmark_implicit(2 it)".
