@@ -467,7 +467,7 @@ TEST_CASE("Java types jar: built with the tree, and buildable in a tree configur
     const auto o = Shell("octave-cli --no-gui --norc --eval \"" + script + "\"");
     INFO(o.out, o.err);
     REQUIRE_MESSAGE(o.out.find("nojvm") == std::string::npos,
-                    "Octave has no JVM: apt-get install default-jdk-headless (scripts/bootstrap.sh installs it)");
+                    "Octave has no JVM: apt-get install default-jdk-headless (scripts/bootstrap.sh --tests installs it)");
     REQUIRE(o.code == 0);
     const auto kv = KeyValues(o.out);
     REQUIRE(kv.count("end"));

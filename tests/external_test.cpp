@@ -89,7 +89,7 @@ TEST_CASE("a plant written in Java (examples/java_plant) joins with --external; 
   const fs::path classes = fs::path(RTHS_BIN_DIR).parent_path() / "examples" / "java_plant";
   const fs::path types = fs::path(RTHS_BIN_DIR).parent_path() / "rths_lcmtypes.jar";
   if (!fs::exists(classes / "JavaPlant.class") || !fs::exists(types) || !fs::exists("/usr/share/java/lcm.jar")) {
-    FAIL("the Java example is not built: install default-jdk-headless and liblcm-java (scripts/bootstrap.sh does), "
+    FAIL("the Java example is not built: install default-jdk-headless and liblcm-java (scripts/bootstrap.sh --tests does), "
          "then reconfigure and build");
   }
   if (!UdpmAvailable()) FAIL("udpm cannot run on this host: " << rths::lockstep::CheckMulticastRoute());
@@ -111,10 +111,10 @@ TEST_CASE("a plant written in Python (examples/python_plant) joins with --extern
   const fs::path types = fs::path(RTHS_BIN_DIR).parent_path() / "examples" / "python_plant";
   const fs::path script = fs::path(RTHS_SOURCE_DIR) / "examples" / "python_plant" / "plant.py";
   if (!fs::exists("/usr/bin/python3")) {
-    FAIL("the Python example needs /usr/bin/python3: install python3 (scripts/bootstrap.sh does)");
+    FAIL("the Python example needs /usr/bin/python3: install python3 (scripts/bootstrap.sh --tests does)");
   }
   if (std::system("/usr/bin/python3 -c 'import numpy' > /dev/null 2>&1") != 0) {
-    FAIL("the Python example needs numpy: install python3-numpy (scripts/bootstrap.sh does)");
+    FAIL("the Python example needs numpy: install python3-numpy (scripts/bootstrap.sh --tests does)");
   }
   if (!fs::exists(types / "rths" / "measured_t.py")) {
     FAIL("the Python message types are not built (" << types.string()
@@ -144,7 +144,7 @@ TEST_CASE("a plant written in Octave (examples/octave_plant) joins with --extern
   const fs::path example = fs::path(RTHS_SOURCE_DIR) / "examples" / "octave_plant";
   const fs::path types = fs::path(RTHS_BIN_DIR).parent_path() / "rths_lcmtypes.jar";
   REQUIRE_MESSAGE(fs::exists(types), types.string() << " is not built: install default-jdk-headless and liblcm-java "
-                                                       "(scripts/bootstrap.sh does), then reconfigure and build");
+                                                       "(scripts/bootstrap.sh --tests does), then reconfigure and build");
   if (!UdpmAvailable()) FAIL("udpm cannot run on this host: " << rths::lockstep::CheckMulticastRoute());
   const auto dir = TempDir("octave");
   // 1000 steps: the plant reads n_steps = round(duration_s / dt_s) from the file. Measured on a

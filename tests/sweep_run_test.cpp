@@ -160,7 +160,7 @@ TEST_CASE("the results: table.h5 holds table.csv's columns (read by Python's h5p
   const auto got = rths::io::RunCommand({"/usr/bin/python3", py.string(), (o.out / "table.h5").string(), "-"});
   INFO(got.output);
   REQUIRE_MESSAGE(got.output.find("No module named 'h5py'") == std::string::npos,
-                  "h5py is not installed: apt-get install python3-h5py (scripts/bootstrap.sh installs it)");
+                  "h5py is not installed: apt-get install python3-h5py (scripts/bootstrap.sh --tests installs it)");
   REQUIRE(got.status == 0);
   CHECK(got.output == Read(r.table));
   // summary.csv: a line per group (controller) and numeric field; the failures counted.

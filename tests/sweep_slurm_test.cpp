@@ -87,7 +87,7 @@ TEST_CASE("a sweep on a one-node Slurm: the local table, a cancelled task seen, 
   for (const char* tool : {"munged", "slurmctld", "slurmd"}) {
     REQUIRE_MESSAGE(!rths::io::FindProgram(tool).empty(),
                     tool << " is not installed: apt-get install slurmctld slurmd slurm-client munge "
-                            "(scripts/bootstrap.sh installs them)");
+                            "(scripts/bootstrap.sh --tests installs them)");
   }
   for (const char* tool : {"sbatch", "squeue", "scontrol", "scancel"}) rths_test::RequireTool(tool, "slurm-client");
   rths_test::RequireBuilt("rths-sweep");

@@ -106,7 +106,7 @@ inline std::string ParseError(std::string_view text, const std::string& path = "
 inline bool UdpmAvailable() { return rths::lockstep::CheckMulticastRoute().empty(); }
 
 // One policy for tests that need something outside the build: they fail, naming the Debian package
-// that provides it (scripts/bootstrap.sh installs every one, and CI runs it), never pass silently.
+// that provides it (scripts/bootstrap.sh --tests installs every one, and CI runs it), never pass silently.
 // What cannot be had without root is an explicit, counted skip: TEST_CASE(... * doctest::skip(!IsRoot())).
 
 /// Whether `program` is on PATH.
@@ -117,13 +117,13 @@ inline bool OnPath(const std::string& program) {
 /// Fails the test unless `program` is on PATH; the message names `package`, which installs it.
 inline void RequireTool(const std::string& program, const std::string& package) {
   REQUIRE_MESSAGE(OnPath(program), program << " is not installed: apt-get install " << package
-                                           << " (scripts/bootstrap.sh installs it)");
+                                           << " (scripts/bootstrap.sh --tests installs it)");
 }
 
 /// Fails the test unless `file` exists; the message names `package`, which installs it.
 inline void RequireFile(const fs::path& file, const std::string& package) {
   REQUIRE_MESSAGE(fs::exists(file), file.string() << " is missing: apt-get install " << package
-                                                  << " (scripts/bootstrap.sh installs it)");
+                                                  << " (scripts/bootstrap.sh --tests installs it)");
 }
 
 /// Fails the test unless RTHS_BIN_DIR/`program` is built (the default target builds every program).
