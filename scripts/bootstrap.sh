@@ -25,6 +25,7 @@ packages=(
   bsdutils util-linux mount        # script (a terminal for cli_test), unshare and mount (reliability_test)
   python3 python3-numpy            # examples/python_plant (a plant participant in Python) and its test
   slurmctld slurmd slurm-client munge  # the test that runs a sweep on a one-node Slurm (tests/slurm/one_node.sh)
+  busybox-static                   # the bundle's test: a chroot with busybox's shell only (tests/bundle/chroot.sh)
 )
 missing=()
 for p in "${packages[@]}"; do
