@@ -99,12 +99,11 @@ done
 cp "$src/rths" "$root/rths"
 cp -r "$src/scenarios" "$src/data" "$src/examples" "$src/docs" "$root/"
 cp "$src/README.md" "$root/"
-rm -f "$root/examples/CMakeLists.txt"
 
 # What the host needs: the kernel the bundled glibc was built for (its ABI note), nothing else.
 glibc="$("$root/build/bin/ld-linux-x86-64.so.2" --version | sed -n '1s/.*version \([0-9][0-9.]*[0-9]\).*/\1/p')"
 kernel="$(readelf -n "$root/build/lib/libc.so.6" | sed -n 's/.*OS: Linux, ABI: \([0-9.]*\).*/\1/p')"
-commit="$(git -C "$src" rev-parse --short HEAD 2>/dev/null || echo unknown)"
+commit="$(git -C "$src" describe --always --dirty 2>/dev/null || echo unknown)"
 cat > "$root/BUNDLE.txt" <<EOF
 rths $version (commit $commit) for x86-64 Linux, made by scripts/bundle.sh on $(. /etc/os-release; echo "$PRETTY_NAME").
 
