@@ -98,7 +98,7 @@ done
 # The front end, the files the programs read (scenarios, data, examples) and the docs.
 cp "$src/rths" "$root/rths"
 cp -r "$src/scenarios" "$src/data" "$src/examples" "$src/docs" "$root/"
-cp "$src/README.md" "$root/"
+(cd "$src" && cp README.md "$root/")
 
 # What the host needs: the kernel the bundled glibc was built for (its ABI note), nothing else.
 glibc="$("$root/build/bin/ld-linux-x86-64.so.2" --version | sed -n '1s/.*version \([0-9][0-9.]*[0-9]\).*/\1/p')"
