@@ -42,6 +42,7 @@ test_packages=(
   bsdutils util-linux mount        # script (a terminal for cli_test), unshare and mount (reliability_test)
   python3 python3-numpy            # examples/python_plant (a plant participant in Python) and its test
   slurmctld slurmd slurm-client munge  # the test that runs a sweep on a one-node Slurm (tests/slurm/one_node.sh)
+  busybox-static                   # the bundle's test: a chroot with busybox's shell only (tests/bundle/chroot.sh)
 )
 if ((tests)); then packages+=("${test_packages[@]}"); fi
 missing=()

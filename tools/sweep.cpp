@@ -19,6 +19,7 @@
 #include "slurm_flags.h"
 #include "core/error.h"
 #include "io/output_folder.h"
+#include "io/plot.h"
 #include "lockstep/exit_code.h"
 #include "sweep/run_sweep.h"
 #include "sweep/slurm.h"
@@ -43,6 +44,15 @@ void WarnAbsent(const std::vector<std::string>& fields) {
     std::fprintf(stderr, "rths sweep: warning: no completed run's summary.json has the recorded field \"%s\" "
                          "(misspelt? docs/sweeps.md lists the fields)\n", f.c_str());
   }
+}
+
+/// Says so when DIR/plots/ stays empty because gnuplot is missing here (a cluster node, the bundle of
+/// scripts/bundle.sh): the table is the result, and `--resume` where gnuplot is draws the figures.
+/// `redo` is the command that writes the table and figures again without running anything.
+void NoteNoPlots(const std::string& redo) {
+  if (rths::io::GnuplotAvailable()) return;
+  std::printf("plots/: none drawn: gnuplot is not installed here (apt-get install gnuplot-nox). The table is the "
+              "result; to draw them, on a machine with gnuplot: %s (it runs nothing again)\n", redo.c_str());
 }
 
 struct Args {
@@ -85,6 +95,7 @@ int Report(const rths::sweep::SlurmOutcome& r, const std::string& out) {
   std::printf("rows %lld/%lld, not completed %lld, array tasks still failing %zu\ntable: %s\n",
               static_cast<long long>(r.rows), static_cast<long long>(r.runs), static_cast<long long>(r.not_completed),
               r.failed_tasks.size(), r.table.string().c_str());
+  NoteNoPlots("rths sweep --collect " + out);
   return r.rows < r.runs || r.not_completed > 0 ? 1 : 0;
 }
 
@@ -117,6 +128,7 @@ int RunLocal(const Args& a, const rths::sweep::Spec& spec) {
   std::printf("rows %lld/%lld, not completed %lld\ntable: %s (and table.h5, summary.csv, plots/)\n",
               static_cast<long long>(r.rows), static_cast<long long>(spec.runs()),
               static_cast<long long>(r.not_completed), r.table.string().c_str());
+  NoteNoPlots("rths sweep " + spec.path + " --out " + r.table.parent_path().string() + " --resume");
   // The exit code speaks for the whole sweep (rows of earlier attempts too), or for the one run asked.
   if (a.only >= 0 || a.chunks > 1) return r.failed > 0 ? 1 : 0;
   return r.not_completed > 0 || r.rows < spec.runs() ? 1 : 0;
