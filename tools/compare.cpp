@@ -54,7 +54,7 @@ int main(int argc, char** argv) {
     rths::io::RequireNewOrEmptyFolder(out, "--out");
   } catch (const std::exception& e) {
     std::fprintf(stderr, "rths compare: %s\n", e.what());
-    return rths::lockstep::kExitUsage;
+    return rths::kExitUsage;
   }
   o.out_dir = out;
   try {
@@ -73,15 +73,15 @@ int main(int argc, char** argv) {
     }
   } catch (const rths::Interrupted& e) {  // Ctrl-C, e.g. while gnuplot draws
     std::fprintf(stderr, "rths compare: %s (interrupted; nothing after it was written)\n", e.what());
-    return 130;
+    return rths::kExitInterrupted;
   } catch (const rths::Error& e) {
     std::fprintf(stderr, "rths compare: %s\n", e.what());
     return e.where() == "rths compare" || e.where() == "--labels" || e.problem().find("share dt") != std::string::npos
-               ? rths::lockstep::kExitUsage
+               ? rths::kExitUsage
                : 1;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "rths compare: %s\n", e.what());
-    return 1;
+    return rths::kExitInternal;
   }
   return 0;
 }

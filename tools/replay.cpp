@@ -24,7 +24,7 @@
 #include "core/error.h"
 #include "io/output_folder.h"
 #include "io/run_log.h"
-#include "lockstep/exit_code.h"
+#include "core/exit_code.h"
 #include "participants/replay.h"
 #include "scenario/scenario.h"
 #include "supervisor/replay_report.h"
@@ -180,13 +180,13 @@ void PrintHeader(const Options& o, const Replay& r) {
 int Finish(const Replay& r, const sup::ReplayReport& report) {
   for (const auto& line : report.lines) std::printf("  %s\n", line.c_str());
   if (!report.log_error.empty()) std::fprintf(stderr, "rths replay: %s\n", report.log_error.c_str());
-  int code = report.compared && !report.identical ? rths::lockstep::kLogDiffer : rths::lockstep::kLogOk;
+  int code = report.compared && !report.identical ? rths::kExitNegative : rths::kExitOk;
   if (report.failed) {
-    code = g_interrupted ? 130 : (report.verdict.exit_code != 0 ? report.verdict.exit_code : rths::lockstep::kExitLockstep);
+    code = g_interrupted ? rths::kExitInterrupted : (report.verdict.exit_code != 0 ? report.verdict.exit_code : rths::kExitLockstep);
     std::fprintf(stderr, "rths replay: FAILED after %lld steps: %s\n", static_cast<long long>(report.replayed),
                  g_interrupted ? "interrupted" : report.verdict.what.c_str());
   } else {
-    std::printf(code == rths::lockstep::kLogOk ? "identical: the live outputs reproduce the recording bit for bit\n"
+    std::printf(code == rths::kExitOk ? "identical: the live outputs reproduce the recording bit for bit\n"
                                    : "different: the live outputs differ from the recording (see above)\n");
   }
   std::ofstream(r.out / "replay.json") << report.ToJson(code).dump(2) << "\n";
@@ -211,7 +211,7 @@ int main(int argc, char** argv) {
     r = Prepare(o);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "rths replay: %s\n", e.what());
-    return rths::lockstep::kLogBadInput;
+    return rths::kExitUsage;
   }
   sup::RunRequest request;
   request.scenario = r.s;
@@ -220,7 +220,7 @@ int main(int argc, char** argv) {
     request.external = rths::tools::ParseExternalRoles(o.external, o.join_timeout_s);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "rths replay: %s\n", e.what());
-    return rths::lockstep::kLogBadInput;
+    return rths::kExitUsage;
   }
   request.transport = request.external.roles.empty() ? "memq" : "mixed";
   request.lcm_url = o.url;
@@ -239,7 +239,7 @@ int main(int argc, char** argv) {
     result = sup::Run(request);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "rths replay: %s\n", e.what());
-    return rths::lockstep::kLogBadInput;
+    return rths::kExitUsage;
   }
   const sup::ReplayFacts facts{o.run_dir, r.live, r.steps, r.s.sha256, r.recorded_sha};
   return Finish(r, sup::CompareReplay(facts, r.record, r.out, result.summary.participants, g_interrupted != 0));

@@ -50,7 +50,7 @@ int main(int argc, char** argv) {
     data = rths::report::LoadRunData(run_dir);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "rths report: %s\n", e.what());
-    return rths::lockstep::kExitUsage;
+    return rths::kExitUsage;
   }
   try {
     const rths::report::ReportFiles files = rths::report::WriteRunReport(data, o);
@@ -60,7 +60,7 @@ int main(int argc, char** argv) {
     for (const auto& w : files.warnings) std::printf("  note: %s\n", w.c_str());
   } catch (const std::exception& e) {
     std::fprintf(stderr, "rths report: %s\n", e.what());
-    return 1;
+    return rths::kExitInternal;
   }
   return 0;
 }

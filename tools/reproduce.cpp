@@ -279,26 +279,26 @@ int CheckOptions(Options* o) {
   if (o->compact) o->sets.push_back("run.csv_every=0");
   if (!o->sets.empty() && o->name == "fig5") {
     std::fprintf(stderr, "rths reproduce fig5: --set/--compact: fig5 runs the damper model alone, no scenario\n");
-    return rths::lockstep::kExitUsage;
+    return rths::kExitUsage;
   }
   if ((!o->sets.empty() || o->executor == "slurm") && o->name == "nonlinear") {
     std::fprintf(stderr, "rths reproduce nonlinear: --set/--compact/--executor slurm: nonlinear runs its loops in this "
                          "process, no lockstep runs\n");
-    return rths::lockstep::kExitUsage;
+    return rths::kExitUsage;
   }
   if (o->resume && o->out.empty()) {
     std::fprintf(stderr, "rths reproduce %s: --resume needs --out DIR: the folder of the interrupted study\n",
                  o->name.c_str());
-    return rths::lockstep::kExitUsage;
+    return rths::kExitUsage;
   }
   if (o->resume && o->executor == "slurm") {
     std::fprintf(stderr, "rths reproduce %s: --resume is for local runs; a Slurm study resumes with rths sweep --collect "
                          "(docs/cluster.md)\n", o->name.c_str());
-    return rths::lockstep::kExitUsage;
+    return rths::kExitUsage;
   }
   if (o->extended && o->name != "table2") {
     std::fprintf(stderr, "rths reproduce %s: --extended is for table2 only\n", o->name.c_str());
-    return rths::lockstep::kExitUsage;
+    return rths::kExitUsage;
   }
   return -1;
 }
@@ -311,7 +311,7 @@ int main(int argc, char** argv) {
   AddOptions(app, &o);
   rths::tools::NameCommand(app, "reproduce");
   if (const int code = rths::tools::ParseCommandLine(app, argc, argv); code >= 0) {
-    if (code == rths::lockstep::kExitUsage) rths::tools::PrintSetHints(app, argc, argv, "reproduce");
+    if (code == rths::kExitUsage) rths::tools::PrintSetHints(app, argc, argv, "reproduce");
     return code;
   }
   if (const int code = CheckOptions(&o); code >= 0) return code;
@@ -352,15 +352,15 @@ int main(int argc, char** argv) {
                          "--resume\n",
                  o.name.c_str(), e.what(), o.name.c_str(), opts.out_dir.string().c_str(),
                  o.quick ? " --quick" : "");
-    return 130;
+    return rths::kExitInterrupted;
   } catch (const rths::Error& e) {
     progress.Finish();
     std::fprintf(stderr, "rths reproduce %s: %s\n", o.name.c_str(), e.what());
-    return 2;
+    return rths::kExitUsage;
   } catch (const std::exception& e) {
     progress.Finish();
     std::fprintf(stderr, "rths reproduce %s: internal error: %s\n", o.name.c_str(), e.what());
-    return 1;
+    return rths::kExitInternal;
   }
   progress.Finish();
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

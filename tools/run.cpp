@@ -17,7 +17,7 @@
 #include "core/error.h"
 #include "ident/design_model.h"
 #include "core/progress.h"
-#include "lockstep/exit_code.h"
+#include "core/exit_code.h"
 #include "lockstep/transport.h"
 #include "report/run_report.h"
 #include "scenario/scenario.h"
@@ -242,11 +242,11 @@ int PrintEnd(const Options& o, const sup::RunResult& result) {
   const std::string what = sum.failure ? sum.failure->what : "";
   if (g_interrupted) {
     std::fprintf(stderr, "rths run: interrupted; the group was stopped\n");
-  } else if (sum.exit_code == rths::lockstep::kExitSafety) {
+  } else if (sum.exit_code == rths::kExitSafety) {
     std::fprintf(stderr, "rths run: STOPPED by the safety monitor: %s\n", what.c_str());
-  } else if (sum.exit_code == rths::lockstep::kExitPeerAbort) {
+  } else if (sum.exit_code == rths::kExitPeerAbort) {
     std::fprintf(stderr, "rths run: ABORTED: %s\n", what.c_str());
-  } else if (sum.exit_code == rths::lockstep::kExitRealtime) {
+  } else if (sum.exit_code == rths::kExitRealtime) {
     std::fprintf(stderr, "rths run: STOPPED by the real-time miss policy: %s\n", what.c_str());
   } else {
     std::fprintf(stderr, "rths run: FAILED: %s\n", what.c_str());
@@ -268,7 +268,7 @@ int main(int argc, char** argv) {
   AddOptions(app, &o);
   rths::tools::NameCommand(app, "run");
   if (const int code = rths::tools::ParseCommandLine(app, argc, argv); code >= 0) {
-    if (code == rths::lockstep::kExitUsage) rths::tools::PrintSetHints(app, argc, argv, "run");
+    if (code == rths::kExitUsage) rths::tools::PrintSetHints(app, argc, argv, "run");
     return code;
   }
   if (o.scenario_path.empty()) o.scenario_path = o.default_scenario;
@@ -279,7 +279,7 @@ int main(int argc, char** argv) {
     request = RequestOf(o);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "rths run: %s\n", e.what());
-    return rths::lockstep::kExitUsage;
+    return rths::kExitUsage;
   }
   std::signal(SIGINT, OnSignal);
   std::signal(SIGTERM, OnSignal);
@@ -291,7 +291,7 @@ int main(int argc, char** argv) {
       monitor = std::make_unique<rths::monitor::Monitor>(o.watch_flags.Options("", title));
     } catch (const std::exception& e) {
       std::fprintf(stderr, "rths run: --watch: %s\n", e.what());
-      return rths::lockstep::kExitUsage;
+      return rths::kExitUsage;
     }
     request.live_sink = monitor->live_sink();
   }

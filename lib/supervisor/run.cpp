@@ -8,7 +8,7 @@
 #include "io/output_folder.h"
 #include "io/reserved_file.h"
 #include "lockstep/abort.h"
-#include "lockstep/exit_code.h"
+#include "core/exit_code.h"
 #include "lockstep/faults.h"
 #include "lockstep/protocol.h"
 #include "lockstep/step_table.h"
@@ -31,7 +31,7 @@ namespace {
 /// A udpm run's URL: the user's, or the multicast group on a free port (a port per channel if
 /// asked), with the scenario's receive buffer size.
 std::string UdpmUrl(const RunRequest& r) {
-  if (const std::string hint = lockstep::CheckMulticastRoute(); !hint.empty()) throw Error("", hint);
+  if (const std::string hint = participants::MulticastRouteAdvice(); !hint.empty()) throw Error("", hint);
   std::string url = !r.lcm_url.empty()     ? r.lcm_url
                     : r.port_per_channel ? fmt::format("udpm://239.255.76.67:{}?ttl=0&port_per_channel=1",
                                                        FreeUdpPorts(static_cast<int>(lockstep::kPortChannels.size())))
@@ -97,7 +97,7 @@ void PrepareFolder(const RunRequest& r, RunPlan* plan) {
   } catch (const std::exception& e) {
     std::error_code ec;
     if (plan->created_out && !r.study) fs::remove_all(plan->out, ec);
-    throw RunError(lockstep::kExitUsage, e.what(), SummaryHead(r, *plan));
+    throw RunError(rths::kExitUsage, e.what(), SummaryHead(r, *plan));
   }
 }
 
@@ -132,7 +132,7 @@ GroupEnd RunGroup(const RunRequest& r, const RunPlan& plan) {
     if (plan.created_out && !r.study && !fs::exists(plan.out / "log.lcm")) fs::remove_all(plan.out, ec);
     RunSummary head = SummaryHead(r, plan);
     head.wall_s = std::chrono::duration<double>(Clock::now() - t0).count();
-    throw RunError(group_started ? lockstep::kExitLockstep : lockstep::kExitUsage, e.what(), head);
+    throw RunError(group_started ? rths::kExitLockstep : rths::kExitUsage, e.what(), head);
   }
   end.wall_s = std::chrono::duration<double>(Clock::now() - t0).count();
   end.interrupted = *interrupted != 0;
@@ -154,7 +154,7 @@ RunResult Run(const RunRequest& request) {
   try {
     result.plan = Plan(request);
   } catch (const std::exception& e) {
-    throw RunError(lockstep::kExitUsage, e.what(), {});
+    throw RunError(rths::kExitUsage, e.what(), {});
   }
   PrepareFolder(request, &result.plan);
   const GroupEnd end = RunGroup(request, result.plan);

@@ -2,7 +2,7 @@
 
 #include <fmt/format.h>
 
-#include "lockstep/exit_code.h"
+#include "core/exit_code.h"
 #include "supervisor/realtime_figures.h"
 
 namespace rths::supervisor {
@@ -53,7 +53,7 @@ void MarkStudyFailure(const std::string& error, RunSummary* sum) {
   sum->stopped = error;
   if (sum->status == "completed") {
     sum->status = "failed";
-    sum->exit_code = lockstep::kExitLockstep;
+    sum->exit_code = rths::kExitLockstep;
   }
 }
 
