@@ -60,13 +60,6 @@ double StepOfRun(const rths::io::RunLog& log, const fs::path& scenario) {
   return rths::scenario::LoadScenario(scenario.string()).run.dt_s;
 }
 
-/// The scenario hash the participants agreed on ("" if no handshake says).
-std::string ScenarioHash(const rths::io::RunLog& log) {
-  for (const auto& h : log.handshakes)
-    if (!h.scenario_sha256.empty()) return h.scenario_sha256;
-  return "";
-}
-
 /// ", 40.8 kB" for a regular file; "" for a device or FIFO.
 std::string SizeText(const fs::path& p) {
   std::error_code ec;
@@ -125,7 +118,7 @@ int main(int argc, char** argv) {
     meta.complete = log.Complete();
     meta.status = log.Complete() ? "finished" : log.TruncationReason();
     meta.scenario_toml = ReadText(scenario_path);
-    meta.scenario_sha256 = ScenarioHash(log);
+    meta.scenario_sha256 = log.ScenarioSha256();
     meta.source_log = fs::absolute(log_path).lexically_normal().string();
 
     std::printf("rths export: %s: %lld steps of %g s, %zu signals (run %lld, %s)\n", log_path.c_str(),

@@ -22,6 +22,7 @@
 #include "report/run_report.h"
 #include "scenario/scenario.h"
 #include "supervisor/run.h"
+#include "supervisor/run_text.h"
 #include "cli.h"
 #include "external_block.h"
 #include "watch_flags.h"
@@ -98,57 +99,9 @@ void AddOptions(CLI::App& app, Options* o) {
   o->watch_flags.Add(app, "--watch-");
 }
 
-/// The transport asked for, or the default (docs/realtime.md, "Which transport"): mixed with
-/// --external; memq for a paced run that names no udpm option (it holds the pace best: the step
-/// is a function call, not five processes' datagrams); else udpm. Resolved into o->transport
-/// once the scenario says whether the run is paced.
+/// The transport asked for, or the default (sup::DefaultTransport), into o->transport.
 void ResolveTransport(Options* o, bool paced) {
-  if (!o->transport.empty()) return;
-  if (!o->external.empty()) {
-    o->transport = "mixed";
-  } else if (paced && o->url.empty() && !o->port_per_channel) {
-    o->transport = "memq";
-  } else {
-    o->transport = "udpm";
-  }
-}
-
-const std::string& TransportOf(const Options& o) { return o.transport; }
-
-/// The roles of --external, checked against the transport; throws a message for the command line.
-sup::ExternalRoles ExternalRolesOf(const Options& o) {
-  sup::ExternalRoles external = rths::tools::ParseExternalRoles(o.external, o.join_timeout_s);
-  if (!external.roles.empty()) {
-    if (TransportOf(o) == "memq") {
-      throw std::runtime_error("--external needs the mixed (default) or udpm transport (an external process cannot "
-                               "join memq, which lives inside one process)");
-    }
-  } else if (TransportOf(o) == "mixed") {
-    throw std::runtime_error("--transport mixed needs --external ROLE (the participants to bridge to on udpm)");
-  }
-  return external;
-}
-
-/// --lcm-url and --port-per-channel, checked against the transport; returns the URL to use ("":
-/// the supervisor picks one). Throws a message for the command line.
-std::string UrlOf(const Options& o) {
-  if (!o.url.empty() && TransportOf(o) == "memq") throw std::runtime_error("--lcm-url needs the udpm or mixed transport");
-  if (!o.url.empty() && o.url.rfind("udpm://", 0) != 0) {
-    throw std::runtime_error(
-        fmt::format("--lcm-url {}: must be a udpm:// URL (e.g. udpm://239.255.76.67:7667?ttl=0)", o.url));
-  }
-  if (o.port_per_channel && TransportOf(o) != "udpm") {
-    throw std::runtime_error(o.external.empty() ? "--port-per-channel needs the udpm transport"
-                                                : "--port-per-channel needs --transport udpm (a mixed run, the "
-                                                  "default with --external, bridges on one port)");
-  }
-  if (o.url.empty()) return "";
-  std::string why;
-  auto parsed = rths::lockstep::UdpmUrl::Parse(o.url, &why);
-  if (!parsed) throw std::runtime_error("--lcm-url " + why);
-  if (!o.port_per_channel || parsed->port_per_channel) return o.url;
-  parsed->port_per_channel = true;
-  return parsed->ToString();
+  if (o->transport.empty()) o->transport = sup::DefaultTransport(!o->external.empty(), paced, o->url, o->port_per_channel);
 }
 
 /// The request from the options: the scenario loaded (with --set, --compact and --realtime).
@@ -158,8 +111,11 @@ sup::RunRequest RequestOf(Options& o) {
   // transport option waits for the scenario's pace to choose (and then nothing here can fail).
   const bool pace_decides = o.transport.empty() && o.external.empty() && o.url.empty() && !o.port_per_channel;
   if (!pace_decides) ResolveTransport(&o, false);
-  r.external = ExternalRolesOf(o);
-  r.lcm_url = UrlOf(o);
+  r.external = rths::tools::ParseExternalRoles(o.external, o.join_timeout_s);
+  r.lcm_url = o.url;
+  r.port_per_channel = o.port_per_channel;
+  r.transport = pace_decides ? "udpm" : o.transport;  // pace_decides: every transport goes with these options
+  if (std::string why; !r.IsValid(&why)) throw std::runtime_error(why);
   r.scenario_path = o.scenario_path;
   r.scenario = rths::scenario::LoadScenario(o.scenario_path, o.sets);
   if (o.realtime) r.scenario.realtime.enabled = true;
@@ -179,8 +135,7 @@ sup::RunRequest RequestOf(Options& o) {
     r.scenario_header = (r.scenario_header.empty() ? o.scenario_path + " with" : r.scenario_header) +
                         " controller.model fitted to the benchmark plant's Gp";
   }
-  r.transport = TransportOf(o);
-  r.port_per_channel = o.port_per_channel;
+  r.transport = o.transport;
   r.out = o.out;
   r.bin_dir = o.bin_dir.empty() ? fs::read_symlink("/proc/self/exe").parent_path() : fs::path(o.bin_dir);
   r.run_id = o.run_id;
@@ -192,26 +147,11 @@ sup::RunRequest RequestOf(Options& o) {
   return r;
 }
 
-/// What the run will be, before it starts: the scenario, steps, transport and output size.
+/// What the run will be, before it starts (sup::PlanHeader), the scenario as the user named it.
 void PrintHeader(const Options& o, const sup::RunPlan& plan) {
-  const auto& s = plan.scenario;
-  std::string shown = o.scenario_path;  // as the user named it, with the overrides
+  std::string shown = o.scenario_path;
   for (const auto& set : o.sets) shown += " --set " + set;
-  std::printf("rths run: %s (%lld steps of %g s), transport %s\n", shown.c_str(), static_cast<long long>(s.steps()),
-              s.run.dt_s, TransportOf(o).c_str());
-  // log.lcm's size is exact; a CSV row's length depends on the numbers (%.17g), so its size is
-  // a bound (a 20 s default run: 6.5 MB written of 11.8 MB at most).
-  const auto& z = plan.sizes;
-  if (s.run.csv_every == 0) {
-    std::printf("  output           %s: log.lcm %s, no signals.csv (run.csv_every = 0, as --compact)\n",
-                sup::Megabytes(z.total_bytes).c_str(), sup::Megabytes(z.log_bytes).c_str());
-  } else {
-    std::printf("  output           at most %s: log.lcm %s, signals.csv up to %s%s\n",
-                sup::Megabytes(z.total_bytes).c_str(), sup::Megabytes(z.log_bytes).c_str(),
-                sup::Megabytes(z.csv_bytes).c_str(),
-                s.run.csv_every == 1 ? " (--compact: none)" : fmt::format(" (every {} steps)", s.run.csv_every).c_str());
-  }
-  if (plan.url.rfind("udpm://", 0) == 0) std::printf("  lcm url          %s\n", plan.url.c_str());
+  std::fputs(sup::PlanHeader(plan, shown, o.transport).c_str(), stdout);
 }
 
 /// The report of what was logged (also of a run that stopped: its complete steps). A report that
@@ -239,18 +179,7 @@ int PrintEnd(const Options& o, const sup::RunResult& result) {
     std::printf("output: %s\n", out.string().c_str());
     return 0;
   }
-  const std::string what = sum.failure ? sum.failure->what : "";
-  if (g_interrupted) {
-    std::fprintf(stderr, "rths run: interrupted; the group was stopped\n");
-  } else if (sum.exit_code == rths::kExitSafety) {
-    std::fprintf(stderr, "rths run: STOPPED by the safety monitor: %s\n", what.c_str());
-  } else if (sum.exit_code == rths::kExitPeerAbort) {
-    std::fprintf(stderr, "rths run: ABORTED: %s\n", what.c_str());
-  } else if (sum.exit_code == rths::kExitRealtime) {
-    std::fprintf(stderr, "rths run: STOPPED by the real-time miss policy: %s\n", what.c_str());
-  } else {
-    std::fprintf(stderr, "rths run: FAILED: %s\n", what.c_str());
-  }
+  std::fprintf(stderr, "rths run: %s\n", sup::EndMessage(sum, g_interrupted != 0).c_str());
   if (sum.steps > 0) {
     std::printf("output: %s (log complete up to step %lld)\n", out.string().c_str(), static_cast<long long>(sum.steps) - 1);
   } else {
