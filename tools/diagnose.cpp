@@ -4,7 +4,7 @@
 // predicts them with the nominal model, localises the residual, fits every effect of the library
 // on the training records, selects greedily, scores the shrink on the test records. Writes DIR/diagnosis.json and DIR/report.html (+ PNG plots), prints a
 // summary (--brief: the verdict and each channel's shrink only). Exit 0 ok, 2 bad input (a bad
-// record names its file and line), 1 other failure.
+// record names its file and line), 5 other failure (core/exit_code.h).
 #include <cstdio>
 #include <filesystem>
 #include <fstream>

@@ -5,7 +5,8 @@
 // figures in figures/: time histories, tracking error, force loops, spectra and G_yr. Read from
 // log.lcm (not signals.csv); a run that stopped is reported over its complete steps, and says so.
 // Exit 0 written, 2 bad input (no such run folder, no or unreadable log.lcm, a bad option),
-// 1 the report could not be made (gnuplot missing or failing, a file that cannot be written).
+// 5 the report could not be made (gnuplot missing or failing, a file that cannot be written;
+// core/exit_code.h).
 #include <cstdio>
 #include <filesystem>
 #include <string>

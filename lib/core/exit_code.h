@@ -17,8 +17,9 @@ enum ExitCode : int {
   kExitUsage = 2,
   kExitLockstep = 3,       ///< a protocol failure (a participant stopped answering, hash mismatch)
   kExitPeerAbort = 4,      ///< stopped because another participant (or the supervisor) said ABORT
-  /// An exception in the program's own computation: a participant's, or a tool's (an internal
-  /// error, a bug to report).
+  /// The program failed in its own work, not on bad input: an exception in a participant's
+  /// computation; a tool that could not make its output (gnuplot missing or failing, a file it
+  /// could not write) or hit an internal error. (A tool's was 1 before issue 45, = kExitNegative.)
   kExitInternal = 5,
   kExitSafety = 6,         ///< the safety monitor stopped the run (a limit was left)
   kExitOutput = 7,         ///< the run's output could not be written (disk full, I/O error)
