@@ -637,7 +637,7 @@ TEST_CASE("plant.cvode_rtol: the old name of plant.ode_rtol keeps working; both 
   const Scenario new_name = ParseScenario("[plant]\node_rtol = 1e-7\n", "new.toml");
   CHECK(new_name.plant.ode_rtol == 1e-7);
   CheckContains(ErrorOf("[plant]\node_rtol = 1e-7\ncvode_rtol = 1e-6\n"),
-                {"plant.cvode_rtol: is the old name of ode_rtol; both are given: keep ode_rtol only"});
+                {"plant.cvode_rtol: is the old name of plant.ode_rtol; both are given: keep plant.ode_rtol only"});
   // What is written is the new name, and it reads back the same.
   const std::string text = rths::scenario::ToToml(old_name);
   CHECK(text.find("\node_rtol = ") != std::string::npos);

@@ -55,7 +55,8 @@ class Reader {
     section_->Number(old_key, &v);  // declares the key
     if (!section_->Has(old_key)) return;
     if (section_->Has(key)) {
-      section_->Fail(old_key, fmt::format("is the old name of {0}; both are given: keep {0} only", key));
+      section_->Fail(old_key,
+                     fmt::format("is the old name of {0}; both are given: keep {0} only", section_->DottedName(key)));
     }
     static std::atomic<bool> noted{false};
     if (!noted.exchange(true)) {
