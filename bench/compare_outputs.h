@@ -22,6 +22,8 @@
 #include <vector>
 #include <stdexcept>
 
+#include "studies/study_table.h"
+
 namespace outputs {
 
 namespace fs = std::filesystem;
@@ -34,14 +36,15 @@ struct Command {
   std::string line;
 };
 
-/// The commands: every reproduction, `design` on every shipped scenario, the real-data study and
+/// The commands: every reproduction of studies::Studies(), `design` on every shipped scenario, the real-data study and
 /// a rig-mode run diagnosed (train: the shipped seeds; test: desired seed 4, noise seed 8).
 inline std::vector<Command> Commands(const fs::path& root, bool full, const std::string& only) {
   const std::string quick = full ? "" : " --quick";
   std::vector<Command> c;
   const auto want = [&](const std::string& group) { return only.empty() || only.find(group) != std::string::npos; };
   if (want("reproduce")) {
-    for (const char* n : {"fig5", "fig6", "fig7", "fig8", "table2", "fig9", "fig11", "benchmark"}) {
+    for (const auto& study : rths::studies::Studies()) {  // the one list of studies (studies/study_table.h)
+      const std::string& n = study.name;
       c.push_back({fmt::format("reproduce_{}", n),
                    fmt::format("{{rths}} reproduce {}{} {{set}} --out {{out}}/reproduce_{}", n, quick, n)});
     }

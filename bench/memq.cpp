@@ -352,7 +352,7 @@ DamperFigures TimeDamper(const rths::scenario::Scenario& s, const std::vector<Ro
   DamperFigures d;
   double ref_us;
   const auto ref = DamperForces(x, s.run.dt_s, rows, 1e-12, rths::models::OdeMethod::kBdf, &ref_us);
-  const double rtol = s.plant.cvode_rtol;
+  const double rtol = s.plant.ode_rtol;
   const auto erk = DamperForces(x, s.run.dt_s, rows, rtol, rths::models::OdeMethod::kErk, &d.erk_us);
   const auto bdf = DamperForces(x, s.run.dt_s, rows, rtol, rths::models::OdeMethod::kBdf, &d.bdf_us);
   ErrorOf(erk, ref, &d.erk_rms, &d.erk_peak);
@@ -429,7 +429,7 @@ int main(int argc, char** argv) {
               Median(logging_old) / p.logging);
   std::printf("  transport on LCM's memq:// (former)  %7.2f us  = %.2fx the current one\n", Median(transport_lcm),
               Median(transport_lcm) / p.transport);
-  std::printf("MR damper step alone, the run's motion and current, rtol %g:\n", s.plant.cvode_rtol);
+  std::printf("MR damper step alone, the run's motion and current, rtol %g:\n", s.plant.ode_rtol);
   std::printf("  ARKODE ERK DP5(4) (default) %7.2f us/step, force error vs CVODE 1e-12: RMS %.2e, peak %.2e\n",
               Median(erk_us), damper.erk_rms, damper.erk_peak);
   std::printf("  CVODE BDF (former default)  %7.2f us/step, force error vs CVODE 1e-12: RMS %.2e, peak %.2e\n",

@@ -10,7 +10,7 @@
 //   - u = BLWN 0-50 Hz, RMS 0.254 mm, seed 1, discard 2 s, faded in over 0.5 s (MakeSignal of
 //     the scenario's desired-displacement spec), S seconds at dt = 0.5 ms;
 //   - the PhysicalRig with the MR damper at a constant current (driver at steady state), current
-//     dynamics on, integrated by CVODE (--cvode, the plant's integrator) or by fixed-step RK4 at
+//     dynamics on, integrated by ARKODE (--cvode, the plant's integrator; the flag's name is historical) or by fixed-step RK4 at
 //     dt/4 (default here: about 80x faster; docs/plant.md: they agree to 1e-7 mm);
 //   - ident::Identify with the fig6 options (3 poles, 0.5-40 Hz, ZOH-consistent at dt).
 // The 8 relative errors e_j = fitted / Eq. - 1 of K, p, b, c at 0.0 A (Eq. 28) and 2.5 A (Eq. 29)
@@ -132,7 +132,7 @@ ident::IdentifyResult RunE1(const models::PhysicalActuatorConfig& cfg, double cu
   return ident::Identify(u, y, kDt, io);
 }
 
-// The damper's equivalent spring-dashpot on the E1 record of the loaded rig (CVODE): least squares
+// The damper's equivalent spring-dashpot on the E1 record of the loaded rig (ARKODE): least squares
 // F = k x + c x' over the record after the fade-in, and the residual's RMS relative to F's.
 void PrintEquivalent(const models::PhysicalActuatorConfig& cfg, const std::vector<double>& u) {
   for (double current_A : {0.0, 2.5}) {
@@ -258,7 +258,7 @@ int main(int argc, char** argv) {
                         {"dp", 0.0},
                         {"dphz", 1.0}};
   app.add_option("--seconds", seconds, "record length [s]");
-  app.add_flag("--cvode", cvode, "integrate with CVODE (the plant's integrator) instead of RK4 at dt/4");
+  app.add_flag("--cvode", cvode, "integrate with ARKODE (the plant's integrator; the flag's name is historical) instead of RK4 at dt/4");
   app.add_option("--iters", iters, "Nelder-Mead iterations (0: evaluate only)");
   app.add_option("--free", free_list, "free parameters, comma-separated");
   std::string objective = "coef";

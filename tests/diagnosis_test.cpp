@@ -1,5 +1,5 @@
 // The sim-to-real gap diagnosis (lib/diagnosis, docs/rig_record.md, docs/diagnosis.md):
-// arithmetic, the force predictor against CVODE, each effect recovered from a synthetic record,
+// arithmetic, the force predictor against the ARKODE damper, each effect recovered from a synthetic record,
 // none / unknown, the JSON of the contract, the model file, bad input.
 #include <unistd.h>
 #include <sys/wait.h>
@@ -72,7 +72,7 @@ TEST_CASE("NRMSE (Eq. 31 on the residual) and shrink arithmetic") {
   CHECK_THROWS_AS(Nrmse(meas, std::vector<double>{1.0}), rths::Error);
 }
 
-TEST_CASE("force predictor (RK4, model-aided motion) agrees with the CVODE damper at 1e-8") {
+TEST_CASE("force predictor (RK4, model-aided motion) agrees with the ARKODE damper at 1e-8") {
   // A prescribed sinusoid x = 10 sin(2 pi 2 t) at constant currents, no current dynamics.
   const double dt = 0.0005;
   const std::size_t n = 4000;

@@ -16,7 +16,7 @@
 
 #include "external_support.h"
 #include "io/run_log.h"
-#include "lockstep/exit_code.h"
+#include "core/exit_code.h"
 #include "test_support.h"
 
 namespace fs = std::filesystem;
@@ -111,13 +111,13 @@ TEST_CASE("an external plant that sends ABORT with a reason is named with its re
   // The built-in plant, run as the user's, fails in its own step 300 and says why in its ABORT.
   const fs::path scenario = WriteScenario(
       dir, "[run]\nname = \"abort\"\nduration_s = 0.5\n[faults.process]\nrole = \"plant\"\nkind = \"throw\"\nat_step = 300\n");
-  CHECK(RunWithExternalPlant(dir, RunArgs(dir, scenario), "", "") == rths::lockstep::kExitExternalAbort);
+  CHECK(RunWithExternalPlant(dir, RunArgs(dir, scenario), "", "") == rths::kExitExternalAbort);
   const auto j = nlohmann::json::parse(ReadFile(dir / "out" / "summary.json"));
   const std::string stopped = j["stopped"].get<std::string>();
   CHECK(stopped.find("plant (external) aborted the run") != std::string::npos);
   CHECK(stopped.find("injected fault") != std::string::npos);  // its own reason
   CHECK(j["participants"]["plant"]["observed"] == "aborted");
-  CHECK(j["participants"]["logger"]["exit_code"] == rths::lockstep::kExitPeerAbort);  // told to stop, not blamed
+  CHECK(j["participants"]["logger"]["exit_code"] == rths::kExitPeerAbort);  // told to stop, not blamed
   CHECK(rths::io::ReadRunLog((dir / "out" / "log.lcm").string()).CompleteSteps() >= 299);
 }
 
@@ -134,7 +134,7 @@ TEST_CASE("a participant from another host (no pid): lost after 5 missed heartbe
     const double took_s = KillPlantAndWait(dir, run, plant);
     MESSAGE("the run exited " << took_s << " s after kill -9 of a plant beating every 0.1 s");
     const auto j = WaitExternalRun(run, dir / "out");
-    CHECK(j["exit_code"] == rths::lockstep::kExitExternalLost);
+    CHECK(j["exit_code"] == rths::kExitExternalLost);
     const auto& peer = j["participants"]["integrator"]["peers"]["plant"];
     CHECK(peer["pid"] == 0);
     CHECK(peer["heartbeat_s"] == doctest::Approx(0.1));
@@ -153,7 +153,7 @@ TEST_CASE("a participant from another host (no pid): lost after 5 missed heartbe
     const double took_s = KillPlantAndWait(dir, run, plant);
     MESSAGE("the run exited " << took_s << " s after kill -9 of a plant in another namespace beating every 0.1 s");
     const auto j = WaitExternalRun(run, dir / "out");
-    CHECK(j["exit_code"] == rths::lockstep::kExitExternalLost);
+    CHECK(j["exit_code"] == rths::kExitExternalLost);
     CHECK(j["participants"]["integrator"]["peers"]["plant"]["pid"] == 0);
     CHECK(j["participants"]["plant"]["observed"] == "lost");
   }
@@ -165,7 +165,7 @@ TEST_CASE("a participant from another host (no pid): lost after 5 missed heartbe
     const pid_t plant = StartPlant(dir, run, url);
     KillPlantAndWait(dir, run, plant);
     const auto j = WaitExternalRun(run, dir / "out");
-    CHECK(j["exit_code"] == rths::lockstep::kExitLockstep);
+    CHECK(j["exit_code"] == rths::kExitLockstep);
     const std::string stopped = j["stopped"].get<std::string>();
     CHECK(stopped.find("plant stopped answering") != std::string::npos);
     CHECK(stopped.find("neither its pid nor a heartbeat") != std::string::npos);

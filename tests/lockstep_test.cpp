@@ -17,7 +17,7 @@
 
 #include "io/event_log.h"
 #include "io/run_log.h"
-#include "lockstep/exit_code.h"
+#include "core/exit_code.h"
 #include "lockstep/faults.h"
 #include "lockstep/protocol.h"
 #include "lockstep/transport.h"
@@ -119,7 +119,7 @@ TEST_CASE("a silent participant stops the run, named, with the log valid up to t
   f.process = rths::lockstep::ProcessFault::kStall;
   f.at_step = 321;
   const auto r = RunMemq({s}, dir, "plant", f);
-  CHECK(r.code == rths::lockstep::kExitLockstep);
+  CHECK(r.code == rths::kExitLockstep);
   const std::string& clock_error = r.errors.back();  // integrator is last
   CAPTURE(clock_error);
   // The plant's answer to command_t 320 is measured_t 321, part of the barrier of step 320
@@ -139,13 +139,13 @@ TEST_CASE("an exception in a participant aborts the run cleanly, named") {
   f.process = rths::lockstep::ProcessFault::kThrow;
   f.at_step = 77;
   const auto r = RunMemq({s}, dir, "controller", f);
-  CHECK(r.code == rths::lockstep::kExitInternal);
+  CHECK(r.code == rths::kExitInternal);
   for (std::size_t i = 0; i < r.exit_codes.size(); ++i) {
     if (r.exit_codes[i].first == "controller") {
-      CHECK(r.exit_codes[i].second == rths::lockstep::kExitInternal);
+      CHECK(r.exit_codes[i].second == rths::kExitInternal);
       CHECK(r.errors[i].find("step 77") != std::string::npos);
     } else {
-      CHECK(r.exit_codes[i].second == rths::lockstep::kExitPeerAbort);
+      CHECK(r.exit_codes[i].second == rths::kExitPeerAbort);
     }
   }
   CHECK(ReadRunLog((dir / "log.lcm").string()).CompleteSteps() == 77);
@@ -160,7 +160,7 @@ TEST_CASE("the handshake refuses participants that loaded a different scenario")
   REQUIRE(a.sha256 != b.sha256);
   // logger, plant, controller, semiactive, integrator: the plant loaded b.
   const auto r = RunMemq({a, b, a, a, a}, dir);
-  CHECK(r.code == rths::lockstep::kExitLockstep);
+  CHECK(r.code == rths::kExitLockstep);
   CHECK(r.errors.back().find("scenario mismatch: plant") != std::string::npos);
   CHECK(ReadRunLog((dir / "log.lcm").string()).CompleteSteps() == 0);
 }
@@ -214,7 +214,7 @@ TEST_CASE("supervisor: a crashed process is named, the group torn down, the log 
   CHECK(summary["stopped"].get<std::string>().rfind("plant", 0) == 0);
 
   // An existing run is never overwritten.
-  CHECK(RunCli(scen.string() + " --out " + out.string(), &output) == rths::lockstep::kExitUsage);
+  CHECK(RunCli(scen.string() + " --out " + out.string(), &output) == rths::kExitUsage);
   CHECK(output.find("refusing to overwrite") != std::string::npos);
   CHECK(ReadRunLog((out / "log.lcm").string()).CompleteSteps() == 250);
 }
@@ -224,7 +224,7 @@ TEST_CASE("supervisor: a bad scenario is refused before anything runs, naming fi
   const auto scen = WriteScenario(dir, "[run]\ndt_s = 0.5\n");
   const fs::path out = dir / "run";
   std::string output;
-  CHECK(RunCli(scen.string() + " --out " + out.string(), &output) == rths::lockstep::kExitUsage);
+  CHECK(RunCli(scen.string() + " --out " + out.string(), &output) == rths::kExitUsage);
   CAPTURE(output);
   CHECK(output.find("scenario.toml") != std::string::npos);
   CHECK(output.find("run.dt_s") != std::string::npos);

@@ -20,7 +20,7 @@
 #include <nlohmann/json.hpp>
 
 #include "io/run_log.h"
-#include "lockstep/exit_code.h"
+#include "core/exit_code.h"
 #include "lockstep/live_feed.h"
 #include "lockstep/realtime.h"
 #include "monitor/in_process_feed.h"
@@ -327,7 +327,7 @@ TEST_CASE("rths run --watch: the page in headless Chromium follows the run, and 
   const int code = run.Wait();
   const std::string output = rths_test::Slurp(out_txt);
   CAPTURE(output);
-  CHECK(code == rths::lockstep::kExitPeerAbort);
+  CHECK(code == rths::kExitPeerAbort);
   CHECK(output.find("rths run: ABORTED: monitor aborted the run: operator abort from the monitor") != std::string::npos);
   const auto summary = nlohmann::json::parse(rths_test::Slurp(dir / "run" / "summary.json"));
   CHECK(summary["status"] == "aborted");
@@ -458,7 +458,7 @@ TEST_CASE("rths run --watch --transport memq: the page's ABORT stops an in-proce
   CHECK(end["status"]["ended"] == true);
   CHECK(end["status"]["abort_by"] == "monitor");
   CHECK(end["status"]["abort_reason"] == "operator abort from the monitor");
-  CHECK(run.Wait() == rths::lockstep::kExitPeerAbort);
+  CHECK(run.Wait() == rths::kExitPeerAbort);
   const std::string output = rths_test::Slurp(out_txt);
   CAPTURE(output);
   CHECK(output.find("rths run: ABORTED: monitor aborted the run: operator abort from the monitor") != std::string::npos);
@@ -511,7 +511,7 @@ TEST_CASE("rths watch --lcm-url: a run started elsewhere is watched and stopped;
   const auto abort = c.Post("/abort?token=" + token, "", "text/plain");
   REQUIRE(abort);
   CHECK(abort->status == 200);
-  CHECK(run.Wait() == rths::lockstep::kExitPeerAbort);
+  CHECK(run.Wait() == rths::kExitPeerAbort);
   CHECK(watch.Wait() == 0);  // --exit-at-end: it ends with the run
   const std::string said = rths_test::Slurp(dir / "watch.txt");
   CAPTURE(said);
@@ -538,7 +538,7 @@ TEST_CASE("rths run --watch on a port in use: nothing runs, exit 2, the option a
                                      " --out " + (dir / "run").string(),
                                      &out);
   CAPTURE(out);
-  CHECK(code == rths::lockstep::kExitUsage);
+  CHECK(code == rths::kExitUsage);
   CHECK(out.find("rths run: --watch: cannot serve on 127.0.0.1:" + std::to_string(taken.port())) != std::string::npos);
   CHECK_FALSE(fs::exists(dir / "run" / "log.lcm"));
   taken.Stop();

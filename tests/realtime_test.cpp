@@ -146,7 +146,7 @@ max_consecutive_misses = 3
   const auto outcomes = rths::participants::RunGroupInProcess({s}, 9, dir.string());
   const auto v = rths::participants::Judge(outcomes);
   CHECK(v.failed);
-  CHECK(v.exit_code == rths::lockstep::kExitRealtime);
+  CHECK(v.exit_code == rths::kExitRealtime);
   CHECK(v.role == "integrator");
   CHECK(v.step == 2);  // steps 0, 1, 2 missed
   CHECK(v.what.find("3 consecutive deadline misses") != std::string::npos);

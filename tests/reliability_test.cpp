@@ -243,7 +243,7 @@ role = ")") + role + "\"\n");
     for (const auto& [name, p] : j["participants"].items()) {
       if (name == role) continue;
       CAPTURE(name);
-      CHECK(p["exit_code"] == rths::lockstep::kExitPeerAbort);
+      CHECK(p["exit_code"] == rths::kExitPeerAbort);
       CHECK(p["killed_by_supervisor"] == false);
     }
   }
@@ -274,7 +274,7 @@ TEST_CASE("a stopped participant: a short stop only slows the run; a long one is
     std::string output;
     const int code = RunCli(scen.string() + " --out " + (dir / "run").string(), &output);
     CAPTURE(output);
-    CHECK(code == rths::lockstep::kExitLockstep);
+    CHECK(code == rths::kExitLockstep);
     // It stops before measured_t 200, its answer to command_t 199: part of the barrier of step 199.
     CHECK(output.find("FAILED: step 199: plant stopped answering: no measured_t 200") != std::string::npos);
     CHECK(output.find("the supervisor killed plant") != std::string::npos);
@@ -287,7 +287,7 @@ TEST_CASE("a stopped participant: a short stop only slows the run; a long one is
     CHECK(j["participants"]["plant"]["was_stopped"] == true);
     // Those that only waited are not blamed.
     for (const char* role : {"controller", "semiactive", "logger"}) {
-      CHECK(j["participants"][role]["exit_code"] == rths::lockstep::kExitPeerAbort);
+      CHECK(j["participants"][role]["exit_code"] == rths::kExitPeerAbort);
     }
     CHECK(ReadRunLog((dir / "run" / "log.lcm").string()).CompleteSteps() == 200);
   }
@@ -298,7 +298,7 @@ TEST_CASE("a stopped participant: a short stop only slows the run; a long one is
     std::string output;
     const int code = RunCli(scen.string() + " --out " + (dir / "run").string(), &output);
     CAPTURE(output);
-    CHECK(code == rths::lockstep::kExitLockstep);
+    CHECK(code == rths::kExitLockstep);
     CHECK(output.find("the clock (integrator) stopped answering") != std::string::npos);
     CHECK(output.find("the supervisor killed integrator") != std::string::npos);
     const auto j = Summary(dir / "run");
@@ -319,7 +319,7 @@ void Unmount(const fs::path& dir) { std::system(("umount " + dir.string() + " 2>
 /// Checks a run stopped by a write error: exit 7, named file and error, summary, files cut back.
 void CheckWriteFailure(const fs::path& run, int code, const std::string& output, const std::string& error) {
   CAPTURE(output);
-  CHECK(code == rths::lockstep::kExitOutput);
+  CHECK(code == rths::kExitOutput);
   CHECK(output.find("FAILED: logger exited with code 7: logger: writing " + (run / "log.lcm").string() +
                     " failed: " + error) != std::string::npos);
   const auto log = ReadRunLog((run / "log.lcm").string());
@@ -335,7 +335,7 @@ void CheckWriteFailure(const fs::path& run, int code, const std::string& output,
   CHECK(output.find("the log and signals.csv end on step " + std::to_string(steps - 1)) != std::string::npos);
   const auto j = Summary(run);
   CHECK(j["status"] == "failed");
-  CHECK(j["exit_code"] == rths::lockstep::kExitOutput);
+  CHECK(j["exit_code"] == rths::kExitOutput);
   CHECK(j["failure"]["participant"] == "logger");
   CHECK(j["failure"]["what"].get<std::string>().find(error) != std::string::npos);
   CHECK(j["steps"] == steps);
@@ -366,7 +366,7 @@ TEST_CASE("disk full on a 2 MB tmpfs (ENOSPC): refused up front; filled during t
   std::string output;
   // Checked up front, the run is refused and nothing is created ...
   int code = RunCli(scen.string() + " --out " + (mnt / "run").string(), &output);
-  CHECK(code == rths::lockstep::kExitUsage);
+  CHECK(code == rths::kExitUsage);
   CHECK(output.find("not enough free disk space: this run writes about 28") != std::string::npos);
   CHECK_FALSE(fs::exists(mnt / "run"));
   // ... and when the disk fills up during the run anyway, the run stops cleanly.
@@ -406,7 +406,7 @@ TEST_CASE("interrupt: a run that will write gigabytes is announced; Ctrl-C stops
   const std::string output((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   CAPTURE(output);
   if (exited) {  // this host lacks the space: refused up front, nothing made
-    CHECK(WEXITSTATUS(status) == rths::lockstep::kExitUsage);
+    CHECK(WEXITSTATUS(status) == rths::kExitUsage);
     CHECK(output.find("not enough free disk space") != std::string::npos);
     CHECK_FALSE(fs::exists(run));
     return;
@@ -424,7 +424,7 @@ TEST_CASE("interrupt: a run that will write gigabytes is announced; Ctrl-C stops
   // (seen once in CI on a loaded host), so either reason is a clean stop.
   for (const auto& [name, p] : j["participants"].items()) {
     CAPTURE(name);
-    CHECK(p["exit_code"] == rths::lockstep::kExitPeerAbort);
+    CHECK(p["exit_code"] == rths::kExitPeerAbort);
     const std::string why = p["message"].get<std::string>();
     CHECK((why == "stopped by a signal (SIGINT or SIGTERM)" ||
            why == "supervisor aborted the run: interrupted by the user"));
@@ -446,7 +446,7 @@ TEST_CASE("no multicast route: one clear message, nothing left behind, memq work
   std::string output;
   output.assign((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   CAPTURE(output);
-  CHECK(WEXITSTATUS(code) == rths::lockstep::kExitUsage);
+  CHECK(WEXITSTATUS(code) == rths::kExitUsage);
   CHECK(output.rfind("rths run: this host has no route for multicast", 0) == 0);
   CHECK(output.find("rths run: rths run:") == std::string::npos);
   CHECK(output.find("ip route add 224.0.0.0/4 dev lo") != std::string::npos);

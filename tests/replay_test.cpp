@@ -18,7 +18,7 @@
 
 #include "io/log_compare.h"
 #include "io/run_log.h"
-#include "lockstep/exit_code.h"
+#include "core/exit_code.h"
 #include "lockstep/protocol.h"
 #include "participants/replay.h"
 #include "scenario/scenario.h"
@@ -257,7 +257,7 @@ TEST_CASE("follow mode under CPU load: lcm-logplayer at speed 1 into rths-plant 
   // What it printed is what it wrote, and its exit code says whether every step was exact.
   CHECK(r.printed.find(fmt::format("follow: run {}, {} steps: {} exact, {} held, {} resumed after a hold, {} unseen",
                                    record.run_id, n, exact, held, resumed, unseen)) != std::string::npos);
-  CHECK(r.exit_code == (exact == n ? 0 : rths::lockstep::kExitFollowInexact));
+  CHECK(r.exit_code == (exact == n ? 0 : rths::kExitFollowInexact));
   // The feed ran to its end: the plant saw the last step.
   CHECK(unseen == 0);
   // Every exact step the listener heard is the recorded answer, bit for bit; a held one is listed.
@@ -284,7 +284,7 @@ TEST_CASE("follow mode: nothing of the run heard is exit 11, and said; the logge
                             (rec / "scenario.toml").string() + " --lcm-url '" + url + "' --out " + dir.string();
   const std::string out = (dir / "plant.out").string();
   int status = std::system((plant + " --run-id 12345 > " + out + " 2>&1").c_str());
-  CHECK(WEXITSTATUS(status) == rths::lockstep::kExitFollowInexact);
+  CHECK(WEXITSTATUS(status) == rths::kExitFollowInexact);
   std::string text = Slurp(out);
   CAPTURE(text);
   // Step 0 needs no input (at rest): answered, as recorded; nothing else.
@@ -292,14 +292,14 @@ TEST_CASE("follow mode: nothing of the run heard is exit 11, and said; the logge
         std::string::npos);
   CHECK(text.find("heard nothing of run 12345") != std::string::npos);
   const auto j = ReadJson(dir / "logs" / "plant.json");
-  CHECK(j["exit_code"] == rths::lockstep::kExitFollowInexact);
+  CHECK(j["exit_code"] == rths::kExitFollowInexact);
   CHECK(j["follow"]["unseen"] == 999);
   CHECK(j["follow"]["messages"] == 0);
   for (const char* role : {"logger", "integrator"}) {
     status = std::system((std::string(RTHS_BIN_DIR) + "/rths-" + role + " --follow --scenario " +
                           (rec / "scenario.toml").string() + " --lcm-url '" + url + "' --run-id 1 > " + out + " 2>&1")
                              .c_str());
-    CHECK(WEXITSTATUS(status) == rths::lockstep::kExitUsage);
+    CHECK(WEXITSTATUS(status) == rths::kExitUsage);
     CHECK(Slurp(out).find("--follow: ") != std::string::npos);
   }
 }

@@ -124,7 +124,7 @@ rerequest_ms = 200.0
 }
 
 void CheckStopped(const fs::path& dir, const MemqRun& r, const std::string& reason_part) {
-  CHECK(r.code == rths::lockstep::kExitSafety);
+  CHECK(r.code == rths::kExitSafety);
   const std::string& why = r.errors.back();  // the integrator (clock) is last
   CAPTURE(why);
   CHECK(why.rfind("safety: step ", 0) == 0);

@@ -116,7 +116,7 @@ TEST_CASE("omitted keys keep the struct defaults") {
   CHECK(empty.structure.desired.band_hz == 5.0);
   CHECK(empty.structure.desired.rms == 2.78);
   CHECK(empty.plant.noise_seed == 7);
-  CHECK(empty.plant.cvode_rtol == 1e-8);
+  CHECK(empty.plant.ode_rtol == 1e-8);
   CHECK(empty.lockstep.stall_budget_s == 10.0);
   CHECK(empty.sha256.empty());
 
@@ -215,7 +215,9 @@ TEST_CASE("out-of-range values name the key, the value and the range") {
   CheckContains(ErrorOf("[structure]\nmass_kg = -5\n"), {"structure.mass_kg: -5 is out of range (0, 1000000000]"});
   CheckContains(ErrorOf("[structure]\ndamping_ratio = 1.0\n"), {"structure.damping_ratio: 1 is out of range [0, 1)"});
   CheckContains(ErrorOf("[structure]\ndamping_ratio = nan\n"), {"structure.damping_ratio: nan is out of range"});
-  CheckContains(ErrorOf("[plant]\ncvode_rtol = 0.1\n"), {"plant.cvode_rtol: 0.1 is out of range (0, 0.01]"});
+  CheckContains(ErrorOf("[plant]\node_rtol = 0.1\n"), {"plant.ode_rtol: 0.1 is out of range (0, 0.01]"});
+  // The old name (until issue 45) is checked as the new one.
+  CheckContains(ErrorOf("[plant]\ncvode_rtol = 0.1\n"), {"plant.ode_rtol: 0.1 is out of range (0, 0.01]"});
   CheckContains(ErrorOf("[plant]\nnoise_f_kN_rms = 200\n"), {"plant.noise_f_kN_rms: 200 is out of range [0, 100]"});
   CheckContains(ErrorOf("[lockstep]\nrerequest_ms = 1\n"), {"lockstep.rerequest_ms: 1 is out of range [5, 10000]"});
   CheckContains(ErrorOf("[lockstep]\nstall_budget_s = 0.5\n"),
@@ -453,7 +455,7 @@ Scenario EveryFieldChanged(const fs::path& dir, bool rig_mode) {
   p.noise_y_mm_rms = 0.01;
   p.noise_f_kN_rms = 0.02;
   p.noise_seed = 9;
-  p.cvode_rtol = 1e-7;
+  p.ode_rtol = 1e-7;
   auto& d = p.damper;
   for (double* v : {&d.alpha_a, &d.alpha_b, &d.alpha_c, &d.c0_a, &d.c0_b, &d.c0_c, &d.c1_a, &d.c1_b, &d.c1_c,
                     &d.beta_a, &d.beta_b, &d.beta_c, &d.gamma_a, &d.gamma_b, &d.gamma_c, &d.A}) {
@@ -627,4 +629,18 @@ file = "desired.txt"
   three.replace(three.find("actuator_dof = 2"), 16, "actuator_dof = 3");
   CheckContains(ErrorOf(three, (dir / "x.toml").string()),
                 {"x.toml: structure.actuator_dof", "3 is out of range [1, 2]", (dir / "two.txt").string() + " has 2 DOFs"});
+}
+
+TEST_CASE("plant.cvode_rtol: the old name of plant.ode_rtol keeps working; both at once are refused") {
+  const Scenario old_name = ParseScenario("[plant]\ncvode_rtol = 1e-7\n", "old.toml");
+  CHECK(old_name.plant.ode_rtol == 1e-7);
+  const Scenario new_name = ParseScenario("[plant]\node_rtol = 1e-7\n", "new.toml");
+  CHECK(new_name.plant.ode_rtol == 1e-7);
+  CheckContains(ErrorOf("[plant]\node_rtol = 1e-7\ncvode_rtol = 1e-6\n"),
+                {"plant.cvode_rtol: is the old name of plant.ode_rtol; both are given: keep plant.ode_rtol only"});
+  // What is written is the new name, and it reads back the same.
+  const std::string text = rths::scenario::ToToml(old_name);
+  CHECK(text.find("\node_rtol = ") != std::string::npos);
+  CHECK(text.find("cvode_rtol") == std::string::npos);
+  CHECK(ParseScenario(text, "old.toml").plant.ode_rtol == 1e-7);
 }

@@ -103,7 +103,7 @@ mode = "passive_on"
   auto st = rths::models::MakeState(cd);
   // Plant offline: the rig driven by the logged commands and currents.
   const auto rig = rths::models::LinearRig::Make(s.plant.actuator, s.run.dt_s, true,
-                                                 rths::models::MrDamperParams::Table3(), s.plant.cvode_rtol);
+                                                 rths::models::MrDamperParams::Table3(), s.plant.ode_rtol);
   rths::models::LinearRigStepper stepper(rig);
   rths::models::LinearRigState ps{};
   int mismatches = 0;

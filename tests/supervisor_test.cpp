@@ -120,7 +120,7 @@ TEST_CASE("Run refuses before a byte is written: a memq run with a process fault
     sup::Run(Request(scenario, dir / "memq", "memq"));
     FAIL("no RunError");
   } catch (const sup::RunError& e) {
-    CHECK(e.exit_code() == rths::lockstep::kExitUsage);
+    CHECK(e.exit_code() == rths::kExitUsage);
     CHECK(std::string(e.what()).find("use --transport udpm") != std::string::npos);
   }
   CHECK_FALSE(fs::exists(dir / "memq"));
@@ -131,7 +131,7 @@ TEST_CASE("Run refuses before a byte is written: a memq run with a process fault
     sup::Run(Request(ok, dir / "used", "memq"));
     FAIL("no RunError");
   } catch (const sup::RunError& e) {
-    CHECK(e.exit_code() == rths::lockstep::kExitUsage);
+    CHECK(e.exit_code() == rths::kExitUsage);
     CHECK(std::string(e.what()).find("refusing to overwrite") != std::string::npos);
   }
 }

@@ -14,7 +14,7 @@
 
 #include <CLI/CLI.hpp>
 
-#include "lockstep/exit_code.h"
+#include "core/exit_code.h"
 
 #include "core/progress.h"
 
@@ -32,7 +32,7 @@ inline void NameCommand(CLI::App& app, const std::string& sub) {
 }
 
 /// Parses the command line. Returns -1 to go on, or the code to exit with: 0 after --help,
-/// lockstep::kExitUsage after a usage error (message already printed). A non-empty RTHS_NO_PROGRESS in the
+/// rths::kExitUsage after a usage error (message already printed). A non-empty RTHS_NO_PROGRESS in the
 /// environment turns the progress lines off (core/progress.h).
 inline int ParseCommandLine(CLI::App& app, int argc, char** argv) {
   if (const char* off = std::getenv("RTHS_NO_PROGRESS"); off != nullptr && *off != '\0') ProgressLine::TurnOff();
@@ -40,7 +40,7 @@ inline int ParseCommandLine(CLI::App& app, int argc, char** argv) {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     const int code = app.exit(e);
-    return code == 0 ? 0 : lockstep::kExitUsage;
+    return code == 0 ? 0 : rths::kExitUsage;
   }
   return -1;
 }

@@ -3,8 +3,8 @@
 // the runs' summary figures in one table, the scenario keys that differ, and figures that overlay
 // their time histories, tracking errors, force loops and spectra, aligned by step. Read from each
 // folder's log.lcm, summary.json and scenario.toml. Exit 0 written, 2 bad input (a folder that is
-// not a run, runs with different dt, an output folder that is not new or empty), 1 the page could
-// not be made (gnuplot missing or failing, a file that cannot be written).
+// not a run, runs with different dt, an output folder that is not new or empty), 5 the page could
+// not be made (gnuplot missing or failing, a file that cannot be written; core/exit_code.h).
 #include <cstdio>
 #include <filesystem>
 #include <string>
@@ -54,7 +54,7 @@ int main(int argc, char** argv) {
     rths::io::RequireNewOrEmptyFolder(out, "--out");
   } catch (const std::exception& e) {
     std::fprintf(stderr, "rths compare: %s\n", e.what());
-    return rths::lockstep::kExitUsage;
+    return rths::kExitUsage;
   }
   o.out_dir = out;
   try {
@@ -73,15 +73,15 @@ int main(int argc, char** argv) {
     }
   } catch (const rths::Interrupted& e) {  // Ctrl-C, e.g. while gnuplot draws
     std::fprintf(stderr, "rths compare: %s (interrupted; nothing after it was written)\n", e.what());
-    return 130;
+    return rths::kExitInterrupted;
   } catch (const rths::Error& e) {
     std::fprintf(stderr, "rths compare: %s\n", e.what());
     return e.where() == "rths compare" || e.where() == "--labels" || e.problem().find("share dt") != std::string::npos
-               ? rths::lockstep::kExitUsage
-               : 1;
+               ? rths::kExitUsage
+               : rths::kExitInternal;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "rths compare: %s\n", e.what());
-    return 1;
+    return rths::kExitInternal;
   }
   return 0;
 }

@@ -29,7 +29,7 @@ int main(int argc, char** argv) {
   rths::tools::AddSetOption(app, &sets);
   rths::tools::NameCommand(app, "design");
   if (const int code = rths::tools::ParseCommandLine(app, argc, argv); code >= 0) {
-    if (code == rths::lockstep::kExitUsage) rths::tools::PrintSetHints(app, argc, argv, "design");
+    if (code == rths::kExitUsage) rths::tools::PrintSetHints(app, argc, argv, "design");
     return code;
   }
   try {
@@ -60,6 +60,6 @@ int main(int argc, char** argv) {
     return 0;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "rths design: %s\n", e.what());
-    return 2;
+    return rths::kExitUsage;
   }
 }

@@ -4,7 +4,7 @@
 // predicts them with the nominal model, localises the residual, fits every effect of the library
 // on the training records, selects greedily, scores the shrink on the test records. Writes DIR/diagnosis.json and DIR/report.html (+ PNG plots), prints a
 // summary (--brief: the verdict and each channel's shrink only). Exit 0 ok, 2 bad input (a bad
-// record names its file and line), 1 other failure.
+// record names its file and line), 5 other failure (core/exit_code.h).
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -104,7 +104,7 @@ int main(int argc, char** argv) {
     if (!(o.none_ratio >= 1.0)) throw rths::Error("--none-ratio", fmt::format("{}: must be >= 1", o.none_ratio));
   } catch (const std::exception& e) {
     std::fprintf(stderr, "rths diagnose: %s\n", e.what());
-    return 2;
+    return rths::kExitUsage;
   }
   try {
     rths::diagnosis::Traces traces;
@@ -134,13 +134,13 @@ int main(int argc, char** argv) {
     std::printf("output: %s\n", dir.string().c_str());
   } catch (const rths::Interrupted& e) {  // Ctrl-C, e.g. while gnuplot draws
     std::fprintf(stderr, "rths diagnose: %s (interrupted; nothing after it was written)\n", e.what());
-    return 130;
+    return rths::kExitInterrupted;
   } catch (const rths::Error& e) {
     std::fprintf(stderr, "rths diagnose: %s\n", e.what());
-    return 2;
+    return rths::kExitUsage;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "rths diagnose: %s\n", e.what());
-    return 1;
+    return rths::kExitInternal;
   }
   return 0;
 }

@@ -20,14 +20,14 @@
 #include "io/output_folder.h"
 #include "io/run_log.h"
 #include "io/run_signals.h"
-#include "lockstep/exit_code.h"
+#include "core/exit_code.h"
 #include "scenario/scenario.h"
 
 namespace fs = std::filesystem;
 
 namespace {
 
-/// The exit codes (lockstep::LogExitCode) in the --help footer.
+/// The exit codes (core/exit_code.h) in the --help footer.
 constexpr const char* kExitHelp =
     "Layout of the .mat file (docs/export.md): one struct 'rths' with rths.signals.<name> (n x 1 double\n"
     "per signal), rths.units.<name>, rths.descriptions.<name>, rths.names (comma-separated, column order) and\n"
@@ -37,11 +37,12 @@ constexpr const char* kExitHelp =
     "\n"
     "Exit codes:\n"
     "  0  exported every step of a finished run\n"
-    "  1  internal failure\n"
     "  2  bad input: RUN_DIR is not a folder or has no log.lcm, the log is not an LCM event log of a run\n"
     "     (the message names the file and the byte offset), it has no complete step, an output cannot be\n"
     "     written (named; no half-written file is left), this matio cannot write v7.3; or a usage error\n"
-    "  3  the log is truncated (the run did not finish): its complete steps were exported";
+    "  5  internal failure\n"
+    "  12 the log is truncated (the run did not finish): its complete steps were exported\n"
+    "(one table for every rths program: docs/lockstep.md \"Exit codes\"; 12 was 3, 5 was 1 before issue 45)";
 
 /// The whole file, or "" if it cannot be read.
 std::string ReadText(const fs::path& p) {
@@ -57,13 +58,6 @@ double StepOfRun(const rths::io::RunLog& log, const fs::path& scenario) {
   if (!fs::exists(scenario))
     throw rths::Error(log.source, fmt::format("no handshake says the step dt and there is no {}", scenario.string()));
   return rths::scenario::LoadScenario(scenario.string()).run.dt_s;
-}
-
-/// The scenario hash the participants agreed on ("" if no handshake says).
-std::string ScenarioHash(const rths::io::RunLog& log) {
-  for (const auto& h : log.handshakes)
-    if (!h.scenario_sha256.empty()) return h.scenario_sha256;
-  return "";
 }
 
 /// ", 40.8 kB" for a regular file; "" for a device or FIFO.
@@ -124,7 +118,7 @@ int main(int argc, char** argv) {
     meta.complete = log.Complete();
     meta.status = log.Complete() ? "finished" : log.TruncationReason();
     meta.scenario_toml = ReadText(scenario_path);
-    meta.scenario_sha256 = ScenarioHash(log);
+    meta.scenario_sha256 = log.ScenarioSha256();
     meta.source_log = fs::absolute(log_path).lexically_normal().string();
 
     std::printf("rths export: %s: %lld steps of %g s, %zu signals (run %lld, %s)\n", log_path.c_str(),
@@ -143,14 +137,14 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "rths export: note: %s: %s; exported its %lld complete steps (k = 0..%lld)\n",
                    log_path.c_str(), log.TruncationReason().c_str(), static_cast<long long>(steps),
                    static_cast<long long>(steps - 1));
-      return rths::lockstep::kLogTruncated;
+      return rths::kExitTruncated;
     }
-    return rths::lockstep::kLogOk;
+    return rths::kExitOk;
   } catch (const rths::Error& e) {
     std::fprintf(stderr, "rths export: %s\n", e.what());
-    return ExitNow(rths::lockstep::kLogBadInput);
+    return ExitNow(rths::kExitUsage);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "rths export: internal failure: %s\n", e.what());
-    return ExitNow(rths::lockstep::kLogInternal);
+    return ExitNow(rths::kExitInternal);
   }
 }

@@ -30,7 +30,7 @@ int main(int argc, char** argv) {
     log_path = rths::io::RunFolderLog(run_dir);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "rths record: %s\n", e.what());
-    return 2;
+    return rths::kExitUsage;
   }
   try {
     if (out.empty()) out = (fs::path(run_dir) / "record.csv").string();
@@ -52,7 +52,7 @@ int main(int argc, char** argv) {
     for (const auto& w : rec.warnings) std::fprintf(stderr, "rths record: warning: %s\n", w.c_str());
   } catch (const std::exception& e) {
     std::fprintf(stderr, "rths record: %s\n", e.what());
-    return 2;
+    return rths::kExitUsage;
   }
   return 0;
 }

@@ -5,7 +5,8 @@
 // figures in figures/: time histories, tracking error, force loops, spectra and G_yr. Read from
 // log.lcm (not signals.csv); a run that stopped is reported over its complete steps, and says so.
 // Exit 0 written, 2 bad input (no such run folder, no or unreadable log.lcm, a bad option),
-// 1 the report could not be made (gnuplot missing or failing, a file that cannot be written).
+// 5 the report could not be made (gnuplot missing or failing, a file that cannot be written;
+// core/exit_code.h).
 #include <cstdio>
 #include <filesystem>
 #include <string>
@@ -50,7 +51,7 @@ int main(int argc, char** argv) {
     data = rths::report::LoadRunData(run_dir);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "rths report: %s\n", e.what());
-    return rths::lockstep::kExitUsage;
+    return rths::kExitUsage;
   }
   try {
     const rths::report::ReportFiles files = rths::report::WriteRunReport(data, o);
@@ -60,7 +61,7 @@ int main(int argc, char** argv) {
     for (const auto& w : files.warnings) std::printf("  note: %s\n", w.c_str());
   } catch (const std::exception& e) {
     std::fprintf(stderr, "rths report: %s\n", e.what());
-    return 1;
+    return rths::kExitInternal;
   }
   return 0;
 }

@@ -46,6 +46,6 @@ int main(int argc, char** argv) {
     return 0;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "rths structure: %s\n", e.what());
-    return 2;
+    return rths::kExitUsage;
   }
 }

@@ -19,8 +19,8 @@
 #include "slurm_flags.h"
 #include "core/error.h"
 #include "io/output_folder.h"
+#include "core/exit_code.h"
 #include "io/plot.h"
-#include "lockstep/exit_code.h"
 #include "sweep/run_sweep.h"
 #include "sweep/slurm.h"
 #include "sweep/study_on_slurm.h"
@@ -96,7 +96,7 @@ int Report(const rths::sweep::SlurmOutcome& r, const std::string& out) {
               static_cast<long long>(r.rows), static_cast<long long>(r.runs), static_cast<long long>(r.not_completed),
               r.failed_tasks.size(), r.table.string().c_str());
   NoteNoPlots("rths sweep --collect " + out);
-  return r.rows < r.runs || r.not_completed > 0 ? 1 : 0;
+  return r.rows < r.runs || r.not_completed > 0 ? rths::kExitNegative : rths::kExitOk;
 }
 
 int RunLocal(const Args& a, const rths::sweep::Spec& spec) {
@@ -123,15 +123,15 @@ int RunLocal(const Args& a, const rths::sweep::Spec& spec) {
   for (const auto& note : r.design_notes) {
     std::fprintf(note.rfind("warning:", 0) == 0 ? stderr : stdout, "rths sweep: %s\n", note.c_str());
   }
-  if (r.table.empty()) return r.failed > 0 ? 1 : 0;
+  if (r.table.empty()) return r.failed > 0 ? rths::kExitNegative : rths::kExitOk;
   WarnAbsent(r.absent_fields);
   std::printf("rows %lld/%lld, not completed %lld\ntable: %s (and table.h5, summary.csv, plots/)\n",
               static_cast<long long>(r.rows), static_cast<long long>(spec.runs()),
               static_cast<long long>(r.not_completed), r.table.string().c_str());
   NoteNoPlots("rths sweep " + spec.path + " --out " + r.table.parent_path().string() + " --resume");
   // The exit code speaks for the whole sweep (rows of earlier attempts too), or for the one run asked.
-  if (a.only >= 0 || a.chunks > 1) return r.failed > 0 ? 1 : 0;
-  return r.not_completed > 0 || r.rows < spec.runs() ? 1 : 0;
+  if (a.only >= 0 || a.chunks > 1) return r.failed > 0 ? rths::kExitNegative : rths::kExitOk;
+  return r.not_completed > 0 || r.rows < spec.runs() ? rths::kExitNegative : rths::kExitOk;
 }
 
 }  // namespace
@@ -188,9 +188,9 @@ int main(int argc, char** argv) {
     return Report(rths::sweep::RunSweepOnSlurm(spec, SlurmOptions(a, &spec)), a.out);
   } catch (const rths::Interrupted& e) {  // Ctrl-C, e.g. while gnuplot draws
     std::fprintf(stderr, "rths sweep: %s (interrupted; nothing after it was written)\n", e.what());
-    return 130;
+    return rths::kExitInterrupted;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "rths sweep: %s\n", e.what());
-    return rths::lockstep::kExitUsage;
+    return rths::kExitUsage;
   }
 }

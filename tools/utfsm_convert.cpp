@@ -43,7 +43,7 @@ int main(int argc, char** argv) {
     for (const auto& [k, v] : rec.metadata) std::printf("  %s: %s\n", k.c_str(), v.c_str());
   } catch (const std::exception& e) {
     std::fprintf(stderr, "rths utfsm-convert: %s\n", e.what());
-    return 2;
+    return rths::kExitUsage;
   }
   return 0;
 }

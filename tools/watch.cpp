@@ -9,7 +9,7 @@
 #include <CLI/CLI.hpp>
 
 #include "cli.h"
-#include "lockstep/exit_code.h"
+#include "core/exit_code.h"
 #include "lockstep/transport.h"
 #include "watch_flags.h"
 
@@ -49,7 +49,7 @@ int main(int argc, char** argv) {
   if (!rths::lockstep::UdpmUrl::Parse(url)) {
     std::fprintf(stderr, "rths watch: --lcm-url %s: not a udpm:// URL (e.g. udpm://239.255.76.67:7667?ttl=0)\n",
                  url.c_str());
-    return rths::lockstep::kExitUsage;
+    return rths::kExitUsage;
   }
   std::unique_ptr<rths::monitor::Monitor> monitor;
   try {
@@ -57,7 +57,7 @@ int main(int argc, char** argv) {
     monitor = flags.Start(url, "rths monitor", "watch", stdout);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "rths watch: %s\n", e.what());
-    return rths::lockstep::kExitUsage;
+    return rths::kExitUsage;
   }
   std::signal(SIGINT, OnSignal);
   std::signal(SIGTERM, OnSignal);

@@ -1,11 +1,14 @@
 #pragma once
 // The live monitor's flags, shared by `rths watch` and `rths run --watch`, and the plotting
 // library read here at the edge (docs/monitor.md).
+#include <chrono>
+#include <cstdint>
 #include <cstdio>
 #include <fstream>
 #include <memory>
 #include <sstream>
 #include <string>
+#include <thread>
 
 #include <CLI/CLI.hpp>
 
@@ -76,6 +79,45 @@ struct WatchFlags {
     Announce(m.get(), command, out);
     return m;
   }
+};
+
+/// The monitor of `rths run --watch` (docs/monitor.md) through the run: a run in this process
+/// (memq, mixed) feeds it through a live sink made before the run; a udpm run's monitor listens to
+/// the run's URL, made when it is known. Announced just before the participants start; told the
+/// run's end (the page shows it for a second) and stopped after it.
+class RunWatch {
+ public:
+  RunWatch(const WatchFlags& flags, std::string title) : flags_(flags), title_(std::move(title)) {}
+
+  /// For a run in this process: the monitor, its live sink for RunRequest::live_sink. Throws
+  /// Error if it cannot be made (the plotting library).
+  lockstep::LiveSink* InProcessSink() {
+    monitor_ = std::make_unique<monitor::Monitor>(flags_.Options("", title_));
+    return monitor_->live_sink();
+  }
+  /// Just before the participants start (RunRequest::on_start): makes a udpm run's monitor on
+  /// `url` and starts and announces it on stdout. Throws Error("--watch") if it cannot: nothing runs.
+  void Start(const std::string& url) {
+    try {
+      if (!monitor_) monitor_ = flags_.Make(url, title_);
+      flags_.Announce(monitor_.get(), "run", stdout);
+    } catch (const std::exception& e) {
+      throw Error("--watch", e.what());
+    }
+  }
+  /// The run ended: the page shows how (status, who stopped it, why, its steps) for a second.
+  void End(std::int64_t run_id, const std::string& status, const std::string& by, const std::string& stopped,
+           std::int64_t steps) {
+    if (!monitor_) return;
+    monitor_->OnEnd(run_id, status, by, stopped, steps);
+    std::this_thread::sleep_for(std::chrono::seconds(1));
+    monitor_->Stop();
+  }
+
+ private:
+  const WatchFlags& flags_;
+  std::string title_;
+  std::unique_ptr<monitor::Monitor> monitor_;
 };
 
 }  // namespace rths::tools

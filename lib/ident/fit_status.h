@@ -21,10 +21,12 @@
 #include <string>
 #include <vector>
 
+#include "core/exit_code.h"
+
 namespace rths::ident {
 
 /// Exit code of `rths identify --damper` for a failed fit (FitStatus::Ok() false).
-inline constexpr int kExitFitFailed = 3;
+inline constexpr int kExitFitFailed = rths::kExitFitFailed;  // the one table: core/exit_code.h
 
 /// |ln p - ln b| below which a parameter is on its bound b.
 inline constexpr double kBoundTolerance = 1e-6;

@@ -106,4 +106,47 @@ std::string Describe(const ChannelDiff& d) {
   return s;
 }
 
+std::vector<PayloadDifference> CompareLogs(const RunLog& a, const RunLog& b) {
+  std::vector<PayloadDifference> out;
+  for (const auto& [ch, pa] : a.payload) {
+    const auto it = b.payload.find(ch);
+    if (it == b.payload.end()) {
+      out.push_back({PayloadDifference::kOnlyInA, ch, pa.size(), 0, -1, ""});
+      continue;
+    }
+    const auto& pb = it->second;
+    if (pa.size() != pb.size()) {
+      out.push_back({PayloadDifference::kStepCount, ch, pa.size(), pb.size(), -1, ""});
+      continue;
+    }
+    for (std::size_t k = 0; k < pa.size(); ++k) {
+      if (pa[k] == pb[k]) continue;
+      PayloadDifference d{PayloadDifference::kPayload, ch, pa.size(), pb.size(), static_cast<std::int64_t>(k), ""};
+      if (ch == "RTHS_DESIRED" || ch == "RTHS_COMMAND" || ch == "RTHS_MEASURED" || ch == "RTHS_CURRENT") {
+        // How much, field by field (B - A): Describe's lines after its first.
+        const std::string text = Describe(CompareChannel(a, b, ch, static_cast<std::int64_t>(pa.size())));
+        if (const auto nl = text.find('\n'); nl != std::string::npos) d.fields = text.substr(nl + 1);
+      }
+      out.push_back(std::move(d));
+      break;
+    }
+  }
+  for (const auto& [ch, pb] : b.payload) {
+    if (!a.payload.count(ch)) out.push_back({PayloadDifference::kOnlyInB, ch, 0, pb.size(), -1, ""});
+  }
+  return out;
+}
+
+std::string Describe(const PayloadDifference& d, const std::string& name_a, const std::string& name_b) {
+  switch (d.kind) {
+    case PayloadDifference::kOnlyInA: return fmt::format("{}: only in {} ({} steps)\n", d.channel, name_a, d.steps_a);
+    case PayloadDifference::kOnlyInB: return fmt::format("{}: only in {} ({} steps)\n", d.channel, name_b, d.steps_b);
+    case PayloadDifference::kStepCount: return fmt::format("{}: {} vs {} steps\n", d.channel, d.steps_a, d.steps_b);
+    case PayloadDifference::kPayload: break;
+  }
+  std::string s = fmt::format("{}: first difference at k = {}\n", d.channel, d.first_k);
+  if (!d.fields.empty()) s += d.fields + "\n";
+  return s;
+}
+
 }  // namespace rths::io

@@ -249,6 +249,12 @@ std::filesystem::path RunFolderLog(const std::filesystem::path& run_dir) {
   return log;
 }
 
+std::string RunLog::ScenarioSha256() const {
+  for (const auto& h : handshakes)
+    if (!h.scenario_sha256.empty()) return h.scenario_sha256;
+  return "";
+}
+
 double RunLog::StepS() const {
   for (const auto& h : handshakes) {
     if (h.dt_s > 0.0 && std::isfinite(h.dt_s)) return h.dt_s;

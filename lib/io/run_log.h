@@ -61,6 +61,9 @@ struct RunLog {
   /// The step of the lockstep clock [s] the handshakes carry (the first positive, finite dt_s);
   /// 0 if no handshake says.
   double StepS() const;
+  /// The scenario hash the participants announced: the first handshake's non-empty
+  /// scenario_sha256 ("" if no handshake says). The one reading of it (export, replay).
+  std::string ScenarioSha256() const;
   /// The ABORT reason in the log ("" if none).
   std::string AbortReason() const;
   /// True if the run finished and its log is whole: DONE is in it and no event is cut short.

@@ -21,7 +21,7 @@
 
 #include "lockstep/answer_cache.h"
 #include "lockstep/config.h"
-#include "lockstep/exit_code.h"
+#include "core/exit_code.h"
 #include "lockstep/faults.h"
 #include "lockstep/follow_ledger.h"
 #include "lockstep/link_stats.h"

@@ -391,8 +391,7 @@ std::string CheckMulticastRoute() {
     if ((group & mask) == dest && (flags & 0x1)) return "";
   }
   return "this host has no route for multicast (224.0.0.0/4), so LCM's udpm transport cannot work.\n"
-         "Fix (as root):  ip route add 224.0.0.0/4 dev lo\n"
-         "or run in one process instead:  ./rths run --transport memq";
+         "Fix (as root):  ip route add 224.0.0.0/4 dev lo";
 }
 
 }  // namespace rths::lockstep

@@ -190,7 +190,8 @@ int RunLoop(Channels* channels, const std::vector<Participant*>& participants,
             const volatile std::sig_atomic_t* stop = nullptr);
 
 /// Checks the host can do LCM multicast on loopback (`udpm`); returns "" if fine, or a message
-/// telling the user how to fix it (ip route add 224.0.0.0/4 dev lo).
+/// telling the user how to fix the host (ip route add 224.0.0.0/4 dev lo). What a program can do
+/// instead is the program's to say (participants::MulticastRouteAdvice).
 std::string CheckMulticastRoute();
 
 }  // namespace rths::lockstep

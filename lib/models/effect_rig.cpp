@@ -54,7 +54,7 @@ EffectRigModel EffectRigModel::Make(const models::PlantConfig& plant, double dt_
   if (!(std::isfinite(u.fade_per_s) && std::abs(u.fade_per_s) <= 1.0))
     throw Error("plant.unmodelled.fade_per_s", fmt::format("{} is out of range [-1, 1]", u.fade_per_s));
   EffectRigModel m;
-  m.rig = LinearRig::Make(plant.actuator, dt_s, damper, plant.damper, plant.cvode_rtol, plant.current_dynamics,
+  m.rig = LinearRig::Make(plant.actuator, dt_s, damper, plant.damper, plant.ode_rtol, plant.current_dynamics,
                           plant.current_driver);
   m.effects = plant.effects;
   m.unmodelled = plant.unmodelled;

@@ -14,7 +14,7 @@
 ///             limit in the loop, servovalve_saturation in_loop = 1: FlowLimitedServo, RK4)
 ///     y_{k+1} = DisplacementEffects::Post(x_{k+1}, f_k)        oil column, saturation, load
 ///                                                              coupling, friction, backlash (**)
-///     damper  Eqs. 32-33 integrated by CVODE over the step, driven by the specimen motion
+///     damper  Eqs. 32-33 integrated by ARKODE over the step, driven by the specimen motion
 ///             y(t) = x(t) + d_k + (d_{k+1} - d_k) (t - t_k) / dt,   d = y - x      (*)
 ///             y'(t) = x'(t) + (d_{k+1} - d_k) / dt
 ///             with x(t), x'(t) the servo's continuous motion (its states in the same ODE)
@@ -65,7 +65,7 @@ namespace rths::models {
 
 /// Immutable description of the rig with effects.
 struct EffectRigModel {
-  LinearRig rig;                           ///< servo, damper, current dynamics, CVODE tolerance
+  LinearRig rig;                           ///< servo, damper, current dynamics, ODE tolerance
   EffectSet effects;                       ///< library effects that are on
   models::UnmodelledConfig unmodelled;   ///< ripple on y, extra spring on f
   std::uint64_t noise_seed = 7;            ///< plant.noise_seed (the stream is derived from it)

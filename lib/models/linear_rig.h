@@ -4,13 +4,13 @@
 ///
 /// One step k -> k+1 with the command u_k [mm] and the damper current i_k [A] held over
 /// [t_k, t_{k+1}):
-///  - CVODE integrates the augmented 5-state ODE w = [z (3), y_d, z_bw]:
+///  - ARKODE (models/ode.h, the default OdeMethod::kErk) integrates the augmented 5-state ODE w = [z (3), y_d, z_bw]:
 ///        z' = A z + B u_k,  x = C z,  x' = C A z   (the actuator's continuous motion),
 ///        [y_d, z_bw]' = Eqs. 32-33 at (x, x') with the coefficients at i_k (Eqs. 35-39);
 ///  - then z_{k+1} is overwritten with the exact ZOH result Phi z_k + Gamma u_k, so the
 ///    measured displacement is bit-identical to LinearServo's Step(); the damper does not load
 ///    the linear servo (its effect is inside the identified G).
-/// The servo is authoritative for y; the damper states are accurate to CVODE's tolerance.
+/// The servo is authoritative for y; the damper states are accurate to the ODE solver's tolerance.
 ///
 /// Current dynamics (optional, lib/models/current_driver.h): the commanded current i_k passes
 /// through Eq. 40 and the 75 Hz low-pass; the damper sees the effective current i_c(t), evaluated
@@ -28,7 +28,7 @@ struct LinearRig {
   LinearServo servo;       ///< actuator model and its ZOH matrices (dt = servo.dt_s)
   MrDamperParams damper;   ///< specimen (Table 3)
   bool has_damper = true;  ///< false: no specimen, force is 0
-  double rtol = 1e-8;      ///< CVODE relative tolerance (0, 1e-2]
+  double rtol = 1e-8;      ///< the ODE solver's relative tolerance (0, 1e-2] (plant.ode_rtol)
   bool current_dynamics = false;  ///< Eq. 40 + low-pass between commanded and effective current
   CurrentDriver driver;           ///< used if current_dynamics
 
@@ -57,9 +57,9 @@ double EffectiveCurrentA(const LinearRig& rig, const LinearRigState& s);
 /// MeasuredForceKn at the state's effective current.
 double MeasuredForceKn(const LinearRig& rig, const LinearRigState& s);
 
-/// Advances a LinearRigState by one step. Holds a copy of the rig and the CVODE workspace,
+/// Advances a LinearRigState by one step. Holds a copy of the rig and the ODE solver's workspace,
 /// created once; Step() allocates nothing and depends only on (state, u, i), never on earlier
-/// calls. Non-copyable, non-movable (CVODE keeps a pointer to it).
+/// calls. Non-copyable, non-movable (the solver keeps a pointer to it).
 class LinearRigStepper {
  public:
   explicit LinearRigStepper(const LinearRig& rig);

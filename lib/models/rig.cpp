@@ -149,19 +149,19 @@ std::unique_ptr<Rig> MakeRig(const models::PlantConfig& plant, double dt_s) {
     case PlantKind::kLinear:  // the nominal linear rig, unchanged
       return std::make_unique<LinearRigAdapter>(LinearRig::Make(plant.actuator, dt_s, damper,
                                                                 plant.damper,
-                                                                plant.cvode_rtol,
+                                                                plant.ode_rtol,
                                                                 plant.current_dynamics,
                                                                 plant.current_driver));
     case PlantKind::kPhysical:
       return std::make_unique<PhysicalRigAdapter>(
           PhysicalRig::Make(plant.physical, dt_s, damper ? RigLoad::kMrDamper : RigLoad::kNone,
                             plant.current_dynamics, plant.damper, {},
-                            plant.cvode_rtol, plant.current_driver));
+                            plant.ode_rtol, plant.current_driver));
     case PlantKind::kIdeal:
-      if (!(plant.cvode_rtol > 0.0 && plant.cvode_rtol <= 1e-2))
-        throw Error("plant.cvode_rtol", fmt::format("must be in (0, 1e-2] (got {})", plant.cvode_rtol));
+      if (!(plant.ode_rtol > 0.0 && plant.ode_rtol <= 1e-2))
+        throw Error("plant.ode_rtol", fmt::format("must be in (0, 1e-2] (got {})", plant.ode_rtol));
       return std::make_unique<IdealRig>(plant.damper, damper, plant.current_dynamics, dt_s,
-                                        plant.cvode_rtol, plant.current_driver);
+                                        plant.ode_rtol, plant.current_driver);
     case PlantKind::kBenchmark:  // the specimen is the benchmark's experimental substructure, inside Gp
       return std::make_unique<BenchmarkRigAdapter>(BenchmarkRig::Make(plant.benchmark, dt_s));
   }

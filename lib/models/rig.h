@@ -63,7 +63,7 @@ struct PlantConfig {
   double noise_y_mm_rms = 0.0;         ///< Gaussian sensor noise on y [mm], [0, 10]
   double noise_f_kN_rms = 0.0;         ///< Gaussian sensor noise on f [kN], [0, 100]
   std::uint64_t noise_seed = 7;
-  double cvode_rtol = 1e-8;            ///< CVODE relative tolerance, (0, 1e-2]
+  double ode_rtol = 1e-8;              ///< the step integrator's relative tolerance (ARKODE by default; scenario key plant.ode_rtol, old name plant.cvode_rtol), (0, 1e-2]
   /// The Spencer MR damper of every rig (`[plant.damper]`, Eqs. 32-39; default Table 3).
   MrDamperParams damper{};
   /// Rig mode (docs/rig_mode.md): effects of the library switched on, `[plant.effects.<name>]`
@@ -114,7 +114,7 @@ class Rig {
 /// (x = r_k, x' = that velocity).
 ///
 /// The rig that `plant` describes ("linear" | "physical" | "ideal"; specimen "mr_damper" | "none";
-/// current_dynamics; cvode_rtol; the damper parameters plant.damper), stepping at dt_s [s];
+/// current_dynamics; ode_rtol; the damper parameters plant.damper), stepping at dt_s [s];
 /// "benchmark": the benchmark's plant of plant.benchmark (specimen, damper and current settings
 /// ignored; current_A() is 0).
 /// With effects or unmodelled disturbances on (plant.RigMode()), the rig mode of

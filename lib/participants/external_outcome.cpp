@@ -3,7 +3,7 @@
 
 #include <fmt/core.h>
 
-#include "lockstep/exit_code.h"
+#include "core/exit_code.h"
 #include "participants/group.h"
 
 namespace rths::participants {
@@ -27,13 +27,13 @@ Outcome ExternalOutcome(const std::string& role, const Outcome* clock) {
   o.step = clock->step;
   if (p.aborted) {
     o.observed = "aborted";
-    o.exit_code = lockstep::kExitExternalAbort;
+    o.exit_code = rths::kExitExternalAbort;
     o.message = fmt::format("{} (external) aborted the run: {}", role, p.abort_reason);
     return o;
   }
   if (!p.hello) {
     o.observed = "never joined";
-    o.exit_code = clock->culprit == role ? lockstep::kExitLockstep : 0;
+    o.exit_code = clock->culprit == role ? rths::kExitLockstep : 0;
     o.message = clock->culprit == role ? clock->message : "";
     return o;
   }
@@ -49,7 +49,7 @@ Outcome ExternalOutcome(const std::string& role, const Outcome* clock) {
       o.exit_code = l.exit_code;
     } else {
       o.observed = "lost";
-      o.exit_code = lockstep::kExitExternalLost;
+      o.exit_code = rths::kExitExternalLost;
     }
     return o;
   }
@@ -57,14 +57,14 @@ Outcome ExternalOutcome(const std::string& role, const Outcome* clock) {
     o.observed = "finished";
     return o;
   }
-  if (clock->exit_code == lockstep::kExitLockstep && clock->culprit == role) {
+  if (clock->exit_code == rths::kExitLockstep && clock->culprit == role) {
     o.observed = "silent";
-    o.exit_code = lockstep::kExitLockstep;
+    o.exit_code = rths::kExitLockstep;
     o.message = clock->message;
     return o;
   }
   o.observed = clock->exit_code == 0 ? "finished" : "stopped";
-  o.exit_code = clock->exit_code == 0 ? 0 : lockstep::kExitPeerAbort;
+  o.exit_code = clock->exit_code == 0 ? 0 : rths::kExitPeerAbort;
   return o;
 }
 

@@ -171,7 +171,7 @@ int ParseRoleArgs(const std::string& name, int argc, char** argv, RoleArgs* a) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e) == 0 ? 0 : lockstep::kExitUsage;
+    return app.exit(e) == 0 ? 0 : rths::kExitUsage;
   }
   return -1;
 }
@@ -191,7 +191,7 @@ void JudgeFollow(const RoleArgs& a, Outcome* o) {
               static_cast<long long>(f.at("unseen").get<std::int64_t>()), OutcomePath(a.out_dir, o->role).c_str());
   std::fflush(stdout);
   if (o->exit_code != 0 || exact == n) return;
-  o->exit_code = lockstep::kExitFollowInexact;
+  o->exit_code = rths::kExitFollowInexact;
   if (f.at("messages").get<std::int64_t>() == 0) {
     o->message = fmt::format("follow: heard nothing of run {} on {} (is lcm-logplayer playing that run's log on "
                              "this URL, with this --run-id?)",
@@ -235,11 +235,20 @@ void RunParticipant(const RoleArgs& a, lockstep::Participant* p, Transport* tran
   if (a.follow) JudgeFollow(a, o);
 }
 
+}  // namespace
+
+std::string MulticastRouteAdvice() {
+  const std::string hint = lockstep::CheckMulticastRoute();
+  return hint.empty() ? hint : hint + "\nor run in one process instead:  ./rths run --transport memq";
+}
+
+namespace {
+
 /// Builds the participant on the transport of `a.url` (one LCM instance, or a port per channel:
 /// this process then receives only its channels) and runs it.
 void RunOnTransport(std::string_view role, const scenario::Scenario& s, const RoleArgs& a, Outcome* o) {
   auto more = [] {  // how to fix the host, if that is the reason
-    const std::string hint = lockstep::CheckMulticastRoute();
+    const std::string hint = MulticastRouteAdvice();
     return hint.empty() ? hint : "\n" + hint;
   };
   const std::string url =
@@ -262,10 +271,10 @@ void RunOnTransport(std::string_view role, const scenario::Scenario& s, const Ro
       }
     }
     if (why.empty()) return RunParticipant(a, p.get(), static_cast<lockstep::Channels*>(&channels), o);
-    o->exit_code = lockstep::kExitLockstep;
+    o->exit_code = rths::kExitLockstep;
     o->message = fmt::format("cannot open the channels of {}: {}{}", a.url, why, more());
   } else if (lcm::LCM lcm(url); !lcm.good()) {
-    o->exit_code = lockstep::kExitLockstep;
+    o->exit_code = rths::kExitLockstep;
     o->message = fmt::format("cannot open LCM at {}{}", url, more());
   } else {
     RunParticipant(a, make(&lcm).get(), &lcm, o);
@@ -281,7 +290,7 @@ int RoleMain(std::string_view role, int argc, char** argv) {
     std::fprintf(stderr, "rths-%s: --follow: %s\n", name.c_str(),
                  role == "logger" ? "the logger records a lockstep run; record a replay with lcm-logger"
                                   : "the integrator is the clock: it cannot follow");
-    return lockstep::kExitUsage;
+    return rths::kExitUsage;
   }
   // A file grown past RLIMIT_FSIZE must fail the write (EFBIG), not kill the process.
   std::signal(SIGXFSZ, SIG_IGN);
@@ -313,10 +322,10 @@ int RoleMain(std::string_view role, int argc, char** argv) {
     }
     RunOnTransport(role, s, a, &o);
   } catch (const Error& e) {
-    o.exit_code = lockstep::kExitUsage;
+    o.exit_code = rths::kExitUsage;
     o.message = e.what();
   } catch (const std::exception& e) {
-    o.exit_code = lockstep::kExitInternal;
+    o.exit_code = rths::kExitInternal;
     o.message = fmt::format("internal error: {}", e.what());
   }
   if (o.exit_code != 0) std::fprintf(stderr, "%s: %s\n", name.c_str(), o.message.c_str());

@@ -45,6 +45,10 @@ std::unique_ptr<lockstep::Participant> MakeParticipant(std::string_view role, co
 /// fails) is refused before any process starts. Throws rths::Error.
 void CheckBuildable(const scenario::Scenario& s);
 
+/// lockstep::CheckMulticastRoute() and, if the host has no multicast route, what to run instead
+/// (`./rths run --transport memq`); "" if the route is there.
+std::string MulticastRouteAdvice();
+
 /// What a run of `s` stores [bytes]: log.lcm (every step) and signals.csv (every run.csv_every-th
 /// step; an upper bound per row). For the disk-space check and the size said before a run.
 struct OutputBytes {
@@ -54,7 +58,7 @@ struct OutputBytes {
 OutputBytes EstimateOutputBytes(const scenario::Scenario& s);
 
 /// main() of procs/<role>: `--scenario FILE --lcm-url URL --run-id N [--out DIR]`.
-/// Exit codes: lockstep::ExitCode. At exit it writes `DIR/logs/<role>.json` (its outcome and
+/// Exit codes: ExitCode (core/exit_code.h). At exit it writes `DIR/logs/<role>.json` (its outcome and
 /// link statistics, participants::OutcomeToJson) for the supervisor.
 int RoleMain(std::string_view role, int argc, char** argv);
 

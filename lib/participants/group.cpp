@@ -310,9 +310,9 @@ namespace {
 int Blame(const Outcome& o) {
   if (o.signal != 0) return o.killed_by_supervisor ? 1 : 4;
   switch (o.exit_code) {
-    case lockstep::kExitOk: return 0;
-    case lockstep::kExitPeerAbort: return 1;
-    case lockstep::kExitLockstep: return 2;
+    case rths::kExitOk: return 0;
+    case rths::kExitPeerAbort: return 1;
+    case rths::kExitLockstep: return 2;
     default: return 3;
   }
 }
@@ -350,7 +350,7 @@ Verdict Judge(const std::vector<Outcome>& outcomes) {
       if (worst->culprit.empty() && !o.culprit.empty()) worst = &o;
     }
     v.role = worst->culprit.empty() ? worst->role : worst->culprit;
-    v.exit_code = lockstep::kExitLockstep;
+    v.exit_code = rths::kExitLockstep;
     v.step = worst->step;
     v.what = worst->message;
     if (const Outcome* c = Find(outcomes, v.role); c && c != worst) {
@@ -382,7 +382,7 @@ Verdict Judge(const std::vector<Outcome>& outcomes) {
   v.exit_code = worst->exit_code;
   // Everyone was told to stop (an ABORT from outside the group: the monitor's Abort button, a
   // user's tool): the abort's own words, "<sender> aborted the run: <reason>".
-  const bool told = worst->exit_code == lockstep::kExitPeerAbort && !worst->message.empty();
+  const bool told = worst->exit_code == rths::kExitPeerAbort && !worst->message.empty();
   v.what = (worst->external || told) && !worst->message.empty()
                ? worst->message
                : fmt::format("{} exited with code {}{}{}", worst->role, worst->exit_code,

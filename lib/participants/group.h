@@ -30,7 +30,7 @@ struct RoleFault {
 /// How one participant ended.
 struct Outcome {
   std::string role;
-  int exit_code = 0;     ///< lockstep::ExitCode, or 128 + signal for a process
+  int exit_code = 0;     ///< ExitCode (core/exit_code.h), or 128 + signal for a process
   int signal = 0;        ///< the signal that killed the process (0 if none)
   std::string message;   ///< why it failed ("" if it did not)
   std::string culprit;   ///< whom it blames for the failure ("" if none or itself)
@@ -113,7 +113,7 @@ const Outcome* RootCause(const std::vector<Outcome>& outcomes);
 struct Verdict {
   bool failed = false;
   std::string role;          ///< the participant to blame
-  int exit_code = 0;         ///< the run's exit code (lockstep::ExitCode or 128 + signal)
+  int exit_code = 0;         ///< the run's exit code (ExitCode (core/exit_code.h) or 128 + signal)
   std::string what;          ///< one sentence: what happened to whom, at which step
   std::int64_t step = -1;    ///< the step it happened at (-1 if unknown)
 };

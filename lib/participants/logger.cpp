@@ -118,7 +118,7 @@ void Logger::FailWrite(const std::string& why, std::int64_t k) {
                                    !cut_log ? "; cutting the log back failed"
                                    : !csv_ok ? "; signals.csv ends earlier, on a whole row"
                                              : "");
-  Fail(lockstep::kExitOutput, "logger: " + reason, true, k);
+  Fail(rths::kExitOutput, "logger: " + reason, true, k);
 }
 
 std::string Logger::AddCsvRow(const char* row, std::size_t size) {

@@ -51,6 +51,7 @@ class Checker {
     fields(sub);
   }
   void Renamed(std::string_view, const std::string&) {}
+  void Alias(std::string_view, std::string_view, double&, std::string_view) {}  // checked under its key
   /// The library's ranges (models::kEffects) at run.dt_s.
   void Effects(std::string_view key, models::EffectSet& e, bool&) {
     for (const models::EffectInfo& info : models::kEffects) {

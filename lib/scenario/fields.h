@@ -8,6 +8,8 @@
 ///   String(key, std::string&)        Choice(key, E&, names)              Servo(key, ServoModel3&)
 ///   Table(key, fields, present = true)   Effects(key, EffectSet&, bool& same_sample)
 ///   Renamed(key, message)  (a key that was renamed: the reader refuses it with the message)
+///   Alias(old, key, double&, why)  (an old name of the number `key`: the reader takes it, with a note
+///                             printed once; giving both is refused; the writer writes `key`)
 /// Ranges may depend on other fields and on dt (given by the Context); checks that need files
 /// or several keys at once are in validate.cpp, after the walk.
 #include "scenario/fields_controller.h"

@@ -59,7 +59,9 @@ void PlantFields(V& v, models::PlantConfig& p, const Context& cx) {
   v.Number("noise_y_mm_rms", p.noise_y_mm_rms, Closed(0.0, 10.0));
   v.Number("noise_f_kN_rms", p.noise_f_kN_rms, Closed(0.0, 100.0));
   v.Integer("noise_seed", p.noise_seed);
-  v.Number("cvode_rtol", p.cvode_rtol, OpenClosed(0.0, 1e-2));
+  v.Number("ode_rtol", p.ode_rtol, OpenClosed(0.0, 1e-2));
+  // The key's name until issue 45; the integrator was CVODE until issue 15, ARKODE since.
+  v.Alias("cvode_rtol", "ode_rtol", p.ode_rtol, "the plant's step integrator is ARKODE's Dormand-Prince 5(4), not CVODE");
   v.Table("physical", [&](V& t) { PhysicalFields(t, p.physical); });
   v.Table("benchmark", [&](V& t) { BenchmarkFields(t, p.benchmark); });
   v.Table("damper", [&](V& t) { DamperFields(t, p.damper); });

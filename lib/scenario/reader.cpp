@@ -1,4 +1,6 @@
 /// @file The Reader: TOML -> structs (keys and types; ranges are the Checker's).
+#include <atomic>
+#include <cstdio>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -46,6 +48,22 @@ class Reader {
   }
   void Renamed(std::string_view key, std::string message) {
     if (section_->Has(key)) section_->Fail(key, std::move(message));
+  }
+  /// `old_key`, an old name of the number `key`: read into v (after `key`, so giving both is
+  /// refused), with a note on stderr once per process saying `why` it was renamed.
+  void Alias(std::string_view old_key, std::string_view key, double& v, std::string_view why) {
+    section_->Number(old_key, &v);  // declares the key
+    if (!section_->Has(old_key)) return;
+    if (section_->Has(key)) {
+      section_->Fail(old_key,
+                     fmt::format("is the old name of {0}; both are given: keep {0} only", section_->DottedName(key)));
+    }
+    static std::atomic<bool> noted{false};
+    if (!noted.exchange(true)) {
+      std::fprintf(stderr, "rths: note: %s is the old name of %s (%.*s); it is read as %s and keeps working\n",
+                   section_->DottedName(old_key).c_str(), section_->DottedName(key).c_str(),
+                   static_cast<int>(why.size()), why.data(), section_->DottedName(key).c_str());
+    }
   }
 
   /// [plant.effects]: one sub-table per effect that is on (models::kEffects); an unknown name is

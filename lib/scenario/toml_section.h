@@ -208,6 +208,9 @@ class Section {
     }
   }
 
+  /// The key's dotted name in the scenario ("plant.ode_rtol").
+  std::string DottedName(std::string_view key) const { return Dotted(key); }
+
   [[noreturn]] void Fail(std::string_view key, std::string problem) const {
     throw Error(fmt::format("{}: {}", file_, Dotted(key)), std::move(problem));
   }

@@ -81,6 +81,7 @@ class Writer {
     tables_ += sub.Text();
   }
   void Renamed(std::string_view, const std::string&) {}
+  void Alias(std::string_view, std::string_view, double&, std::string_view) {}  // written under its key
   void Effects(std::string_view key, models::EffectSet& e, bool& same_sample) {
     for (const models::EffectInfo& info : models::kEffects) {
       if (!info.is_on(e)) continue;

@@ -177,8 +177,9 @@ RunResult RunOne(const RunSpec& spec, const std::string& origin, const BatchCont
   request.scenario_header = ScenarioHeader(spec, origin);
   request.transport = "memq";
   request.out = spec.dir;
-  request.checks = false;  // Preflight did
-  request.study = true;
+  request.check_before_start = false;  // Preflight did
+  request.keep_folder = true;
+  request.batch_summary = true;
   request.label = spec.label;
   request.interrupted = control.interrupted;
   supervisor::RunSummary sum;

@@ -103,12 +103,14 @@ Fig6Result Fig6Table(const std::vector<RunResult>& results, const ReproduceOptio
       m.max_diff_pct = std::max(m.max_diff_pct, 100.0 * std::abs(v.second / v.first - 1.0));
     }
   }
-  res.verdict.text = fmt::format("E1: the 3-pole fits recover K, p, b, c of Eqs. 28 and 29 within {:g} % ({} plant)",
+  Claim e1;
+  e1.text = fmt::format("E1: the 3-pole fits recover K, p, b, c of Eqs. 28 and 29 within {:g} % ({} plant)",
                                  res.tolerance_pct, opts.plant);
-  res.verdict.holds = res.models[0].max_diff_pct <= res.tolerance_pct && res.models[1].max_diff_pct <= res.tolerance_pct;
-  res.verdict.detail = fmt::format("largest parameter difference: 0.0 A {:.2f} %, 2.5 A {:.2f} % (average "
-                                   "condition against Eq. 30: {:.2f} %)",
-                                   res.models[0].max_diff_pct, res.models[1].max_diff_pct, res.models[2].max_diff_pct);
+  e1.holds = res.models[0].max_diff_pct <= res.tolerance_pct && res.models[1].max_diff_pct <= res.tolerance_pct;
+  e1.detail = fmt::format("largest parameter difference: 0.0 A {:.2f} %, 2.5 A {:.2f} % (average "
+                          "condition against Eq. 30: {:.2f} %)",
+                          res.models[0].max_diff_pct, res.models[1].max_diff_pct, res.models[2].max_diff_pct);
+  res.claims = {e1};
   return res;
 }
 
@@ -181,8 +183,8 @@ void WriteMarkdown(const Fig6Result& res, const ReproduceOptions& opts, double d
                         100.0 * (v.second / v.first - 1.0));
     }
   }
-  md << fmt::format("\n**{}** {}.  \n{}\n", res.verdict.holds ? "Holds:" : "Does not hold:", res.verdict.text,
-                    res.verdict.detail);
+  const Claim& e1 = res.claims.at(0);
+  md << fmt::format("\n**{}** {}.  \n{}\n", e1.holds ? "Holds:" : "Does not hold:", e1.text, e1.detail);
   md << fmt::format("\nFit quality over {:g}-{:g} Hz (our fit against our measured response), and how far our measured "
                     "response is from the paper's model (ZOH at 2 kHz) over the same band. Three-pole parameters trade "
                     "off against each other: a response a few percent away can move K, b, c by tens of percent.\n\n"

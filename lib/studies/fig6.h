@@ -21,7 +21,7 @@ struct Fig6Result {
   std::vector<BodeCurve> measured;  ///< H1 of G_yu at 0.0 A and 2.5 A
   std::vector<Fig6Model> models;    ///< 0.0A, 2.5A, avg
   double tolerance_pct = 0.0;       ///< E1: 3 % on the linear plant, 8 % on the physical one
-  Claim verdict;                    ///< E1 on the 0.0 A and 2.5 A fits
+  std::vector<Claim> claims;        ///< E1 on the 0.0 A and 2.5 A fits (one claim; was `verdict`)
 };
 /// E1: BLWN 0-50 Hz, RMS 0.254 mm commanded with no controller at 0.0 A and 2.5 A (60 s;
 /// --quick 16 s); H1 with coherence; 3-pole fits over 0.5-40 Hz. Writes fig6.png (magnitude,

@@ -162,7 +162,7 @@ void WriteMarkdown(const Fig78Result& res, const ReproduceOptions& opts, const s
              ? "The plant is the design model of the condition's controllers (Eq. 28 / 29), as E2 asks.\n\n"
              : "E2 states these for a plant equal to the design model (`--plant linear`); on the physical plant "
                "they are reported, not required.\n\n");
-  for (const auto& c : res.checks) {
+  for (const auto& c : res.claims) {
     md << ClaimMarkdown(c);
   }
 }
@@ -181,7 +181,7 @@ Fig78Result ReproduceFig78(const ReproduceOptions& opts, const std::string& figu
       RunFrequencyBatch(Fig78Specs(opts, figure, controllers, duration, res.condition), opts, figure);
   Segmentation seg;
   res.curves = Fig78Curves(results, controllers, &seg);
-  res.checks = CheckE2(res.curves, res.condition);
+  res.claims = CheckE2(res.curves, res.condition);
   WriteCurvesCsv(opts.out_dir / (figure + ".csv"), "controller", res.curves);
   io::Plot(Fig78Figure(res, opts, figure), opts.out_dir);
   WriteMarkdown(res, opts, figure, duration, seg);

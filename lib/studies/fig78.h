@@ -13,7 +13,7 @@ namespace rths::studies {
 struct Fig78Result {
   std::string condition;            ///< "0.0A" (Fig. 7) or "2.5A" (Fig. 8)
   std::vector<BodeCurve> curves;    ///< G_yr per controller, in Table 1's order
-  std::vector<Claim> checks;        ///< E2's statements, measured on the curves
+  std::vector<Claim> claims;        ///< E2's statements, measured on the curves (was `checks`)
 };
 /// The Table 2 controllers of one condition, in order ("0.0A" or "2.5A").
 std::vector<Table2Controller> ControllersOf(const std::string& condition);

@@ -8,8 +8,10 @@
 ///     table   a function turns the RunResults (and the runs' logs) into the study's rows;
 ///     outputs a function writes its files into opts.out_dir.
 ///
-/// tools/reproduce.cpp (`rths reproduce NAME`) parses options and calls the studies' Reproduce*
-/// (studies/fig5.h ... studies/benchmark.h); tests call them directly. Every Reproduce* writes into
+/// tools/reproduce.cpp (`rths reproduce NAME`) parses options and runs the study of the table in
+/// studies/study_table.h, which calls the studies' Reproduce* (studies/fig5.h ...
+/// studies/nonlinear_delay.h) and says what to print; tests call them directly. Every result
+/// carries its claims (`claims`). Every Reproduce* writes into
 /// opts.out_dir (created; refused if it exists and is not empty): CSV tables (RFC 4180, io/csv.h),
 /// Markdown where there is a table, PNG figures made with gnuplot (io/plot.h) and, for lockstep
 /// studies, every run's folder under out_dir/runs/.
@@ -45,6 +47,8 @@ struct ReproduceOptions {
   /// compensators and a PI + phase lead beside the paper's proposed controllers. The paper's 36
   /// rows and their files are the same with or without it.
   bool extended = false;
+  /// benchmark only: keep every perturbed run's log.lcm (default: removed once scored).
+  bool keep_logs = false;
   /// Where the lockstep runs are made: empty, here, `jobs` at a time (RunBatch); else this
   /// function makes them (e.g. as a Slurm job array, sweep/study_on_slurm.h) and returns their
   /// results in spec order, calling `progress` after each as RunBatch does.

@@ -68,13 +68,16 @@ struct RunRequest {
   std::vector<std::string> role_args; ///< udpm: extra arguments for every participant process
   /// Check before a byte is written that the scenario builds, the transport can carry it, the
   /// folder is new or empty and (check_disk_space) the disk has room. Off for a study's batch and a
-  /// replay: they check beforehand.
-  bool checks = true;
+  /// replay: they check beforehand. (RunRequest::IsValid is checked always.) Was `checks`.
+  bool check_before_start = true;
   bool check_disk_space = true;       ///< refuse a run that will not fit on the disk
-  /// A run of a study's batch (report::RunBatch): never removes its folder; its summary has the
-  /// label and neither the URL nor the output estimate, and a run that did not complete every step
-  /// is marked failed (supervisor/summary_builder.h).
-  bool study = false;
+  /// Never remove the output folder, also of a run that could not start (a study's batch,
+  /// studies::RunBatch: the folder is the study's record of the run). Was half of `study`.
+  bool keep_folder = false;
+  /// The summary of a batch's run (supervisor/summary_builder.h): the label, neither the URL nor
+  /// the output estimate, and a run that did not complete every step marked failed. Was the other
+  /// half of `study`.
+  bool batch_summary = false;
   std::optional<ReplaySource> replay;  ///< memq: replay a recorded run instead
   /// The summary's file in the output folder, reserved before the run and written at its end
   /// ("": none; a replay writes replay.json, supervisor/replay_report.h).
@@ -91,6 +94,20 @@ struct RunRequest {
   /// Called once, just before the participants start; if it throws, nothing runs (RunError,
   /// kExitUsage, the folder made for the run removed).
   std::function<void(const RunPlan&)> on_start;
+
+  /// Whether the transport, the URL, the external roles, the port per channel, the live sink
+  /// (`--watch` in this process) and a replay go together: the one place of these rules, for
+  /// `rths run`, `rths replay` and supervisor::Run. If not, *why (if given) says which, naming the
+  /// command-line flags ("--external needs the mixed (default) or udpm transport ...").
+  ///   - transport is udpm, memq or mixed;
+  ///   - --external: mixed or udpm (an external process cannot join memq); mixed needs --external;
+  ///   - --lcm-url: udpm or mixed, a valid udpm:// URL (lockstep::UdpmUrl);
+  ///   - --port-per-channel (or a URL with port_per_channel=1): udpm only (a mixed run bridges on
+  ///     one port);
+  ///   - a live sink (--watch fed in this process): memq or mixed (a udpm run's monitor listens to
+  ///     its URL);
+  ///   - a replay: memq, or mixed with --external.
+  bool IsValid(std::string* why = nullptr) const;
 };
 
 /// A finished run (also one that failed: its summary says how).

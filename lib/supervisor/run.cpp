@@ -8,7 +8,7 @@
 #include "io/output_folder.h"
 #include "io/reserved_file.h"
 #include "lockstep/abort.h"
-#include "lockstep/exit_code.h"
+#include "core/exit_code.h"
 #include "lockstep/faults.h"
 #include "lockstep/protocol.h"
 #include "lockstep/step_table.h"
@@ -28,11 +28,21 @@ namespace fs = std::filesystem;
 
 namespace {
 
+/// The user's --lcm-url, with port_per_channel=1 if --port-per-channel asks for it (RunRequest::IsValid
+/// checked the URL).
+std::string UserUrl(const RunRequest& r) {
+  if (!r.port_per_channel || lockstep::IsPortPerChannel(r.lcm_url)) return r.lcm_url;
+  auto parsed = lockstep::UdpmUrl::Parse(r.lcm_url);
+  if (!parsed) throw Error("--lcm-url", r.lcm_url + ": not a udpm URL");
+  parsed->port_per_channel = true;
+  return parsed->ToString();
+}
+
 /// A udpm run's URL: the user's, or the multicast group on a free port (a port per channel if
 /// asked), with the scenario's receive buffer size.
 std::string UdpmUrl(const RunRequest& r) {
-  if (const std::string hint = lockstep::CheckMulticastRoute(); !hint.empty()) throw Error("", hint);
-  std::string url = !r.lcm_url.empty()     ? r.lcm_url
+  if (const std::string hint = participants::MulticastRouteAdvice(); !hint.empty()) throw Error("", hint);
+  std::string url = !r.lcm_url.empty()     ? UserUrl(r)
                     : r.port_per_channel ? fmt::format("udpm://239.255.76.67:{}?ttl=0&port_per_channel=1",
                                                        FreeUdpPorts(static_cast<int>(lockstep::kPortChannels.size())))
                                          : fmt::format("udpm://239.255.76.67:{}?ttl=0", FreeUdpPort());
@@ -50,7 +60,8 @@ RunPlan Plan(const RunRequest& r) {
   plan.url = "memq://";
   plan.run_id = r.run_id > 0 ? r.run_id : lockstep::NewRunId();
   plan.out = r.out;
-  if (!r.checks) {
+  if (std::string why; !r.IsValid(&why)) throw Error("", why);
+  if (!r.check_before_start) {
     if (r.transport != "memq") plan.url = UdpmUrl(r);
     return plan;
   }
@@ -61,10 +72,6 @@ RunPlan Plan(const RunRequest& r) {
     throw Error(r.scenario_path + ": faults.process.kind",
                 fmt::format("\"{}\" would take every participant down with the one {} process: use --transport udpm",
                             NameOf(lockstep::kProcessFaultNames, s.faults.process_kind), r.transport));
-  }
-  if (r.transport == "mixed" && (r.port_per_channel || lockstep::IsPortPerChannel(r.lcm_url))) {
-    throw Error("--port-per-channel", "a mixed run bridges its external participants on one udpm port: use "
-                                      "--transport udpm for a port per channel");
   }
   if (r.transport != "memq") plan.url = UdpmUrl(r);
   if (plan.out.empty()) plan.out = io::NewOutputFolder(s.run.name);
@@ -96,8 +103,8 @@ void PrepareFolder(const RunRequest& r, RunPlan* plan) {
     }
   } catch (const std::exception& e) {
     std::error_code ec;
-    if (plan->created_out && !r.study) fs::remove_all(plan->out, ec);
-    throw RunError(lockstep::kExitUsage, e.what(), SummaryHead(r, *plan));
+    if (plan->created_out && !r.keep_folder) fs::remove_all(plan->out, ec);
+    throw RunError(rths::kExitUsage, e.what(), SummaryHead(r, *plan));
   }
 }
 
@@ -129,10 +136,10 @@ GroupEnd RunGroup(const RunRequest& r, const RunPlan& plan) {
     }
   } catch (const std::exception& e) {
     std::error_code ec;
-    if (plan.created_out && !r.study && !fs::exists(plan.out / "log.lcm")) fs::remove_all(plan.out, ec);
+    if (plan.created_out && !r.keep_folder && !fs::exists(plan.out / "log.lcm")) fs::remove_all(plan.out, ec);
     RunSummary head = SummaryHead(r, plan);
     head.wall_s = std::chrono::duration<double>(Clock::now() - t0).count();
-    throw RunError(group_started ? lockstep::kExitLockstep : lockstep::kExitUsage, e.what(), head);
+    throw RunError(group_started ? rths::kExitLockstep : rths::kExitUsage, e.what(), head);
   }
   end.wall_s = std::chrono::duration<double>(Clock::now() - t0).count();
   end.interrupted = *interrupted != 0;
@@ -154,7 +161,7 @@ RunResult Run(const RunRequest& request) {
   try {
     result.plan = Plan(request);
   } catch (const std::exception& e) {
-    throw RunError(lockstep::kExitUsage, e.what(), {});
+    throw RunError(rths::kExitUsage, e.what(), {});
   }
   PrepareFolder(request, &result.plan);
   const GroupEnd end = RunGroup(request, result.plan);

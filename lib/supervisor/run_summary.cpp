@@ -217,12 +217,12 @@ void SetVerdict(Verdict verdict, bool interrupted, RunSummary* s) {
   s->status = "completed";
   if (interrupted) {
     s->status = "interrupted";
-    s->exit_code = 130;
+    s->exit_code = kExitInterrupted;
   } else if (verdict.failed) {
-    s->exit_code = verdict.exit_code != 0 ? verdict.exit_code : lockstep::kExitLockstep;
-    s->status = s->exit_code == lockstep::kExitSafety     ? "stopped by the safety monitor"
-                : s->exit_code == lockstep::kExitRealtime ? "stopped by the miss policy"
-                : s->exit_code == lockstep::kExitPeerAbort ? "aborted"
+    s->exit_code = verdict.exit_code != 0 ? verdict.exit_code : rths::kExitLockstep;
+    s->status = s->exit_code == rths::kExitSafety     ? "stopped by the safety monitor"
+                : s->exit_code == rths::kExitRealtime ? "stopped by the miss policy"
+                : s->exit_code == rths::kExitPeerAbort ? "aborted"
                                                            : "failed";
   }
   s->stopped = interrupted ? std::string("interrupted by the user") : verdict.failed ? verdict.what : "no";

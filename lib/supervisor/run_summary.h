@@ -10,7 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "io/run_log.h"
-#include "lockstep/exit_code.h"
+#include "core/exit_code.h"
 #include "lockstep/link_stats.h"
 #include "participants/group.h"
 #include "scenario/scenario.h"
@@ -51,7 +51,7 @@ struct RunSummary {
   std::string status = "completed";  ///< completed | interrupted | stopped by the safety monitor |
                                      ///< stopped by the miss policy | aborted (an ABORT from outside
                                      ///< the group, e.g. the monitor's button) | failed
-  int exit_code = 0;              ///< the run's exit code (lockstep::ExitCode, 130 interrupted, 128 + signal)
+  int exit_code = 0;              ///< the run's exit code (ExitCode (core/exit_code.h), 130 interrupted, 128 + signal)
   std::string stopped = "no";     ///< "no", or why the run stopped
   struct Failure {
     std::string participant;      ///< whom the verdict blames

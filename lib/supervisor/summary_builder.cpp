@@ -2,7 +2,7 @@
 
 #include <fmt/format.h>
 
-#include "lockstep/exit_code.h"
+#include "core/exit_code.h"
 #include "supervisor/realtime_figures.h"
 
 namespace rths::supervisor {
@@ -15,7 +15,7 @@ RunSummary SummaryHead(const RunRequest& request, const RunPlan& plan) {
   sum.run_id = plan.run_id;
   sum.transport = request.transport;
   sum.steps_expected = plan.scenario.steps();
-  if (!request.study) {
+  if (!request.batch_summary) {
     sum.lcm_url = plan.url;
     sum.output_estimate_bytes = static_cast<std::int64_t>(plan.sizes.total_bytes);
   }
@@ -34,7 +34,7 @@ RunSummary BuildSummary(const RunRequest& request, const RunPlan& plan, const Gr
   if (plan.scenario.realtime.enabled) {
     sum.realtime = RealtimeFigures(plan.scenario, end.outcomes, request.transport, end.memq_setup);
   }
-  if (request.study) {
+  if (request.batch_summary) {
     if (const std::string error = StudyError(sum); !error.empty()) MarkStudyFailure(error, &sum);
   }
   return sum;
@@ -53,7 +53,7 @@ void MarkStudyFailure(const std::string& error, RunSummary* sum) {
   sum->stopped = error;
   if (sum->status == "completed") {
     sum->status = "failed";
-    sum->exit_code = lockstep::kExitLockstep;
+    sum->exit_code = rths::kExitLockstep;
   }
 }
 

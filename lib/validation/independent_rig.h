@@ -12,7 +12,7 @@
 ///   dynamics), fixed-step classical RK4 with M substeps per record step (M >= `substeps`, raised
 ///   where the local stiffness lambda needs it, M >= dt lambda), the command held over each record
 ///   step (ZOH) and split exactly where a delayed command switches. Ours: exact ZOH matrices for
-///   the servo, CVODE (rig mode) or RK4 over a Hermite motion (blocks) for the damper.
+///   the servo, ARKODE (rig mode) or RK4 over a Hermite motion (blocks) for the damper.
 ///   The servo is realised in cascade form, G(s) = K / ((s + p)(s^2 + b s + c)):
 ///       w' = -p w + K u_s,   x'' = w - b x' - c x.
 ///   Current dynamics (Eq. 40 and the 75 Hz low-pass) as states:
