@@ -15,6 +15,8 @@
 #include "report/html.h"
 #include "signal/spectrum_axes.h"
 #include "signal/benchmark_criteria.h"
+#include "signal/bode.h"
+#include "signal/derivative.h"
 #include "signal/metrics.h"
 #include "signal/spectral.h"
 
@@ -30,7 +32,6 @@ namespace run_figures {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-constexpr double kPi = 3.14159265358979323846;
 /// Half the window of the tracking error's zoom [s].
 constexpr double kZoomHalfS = 0.125;
 /// A coherence within this of 1 over the whole band is a flat line at 1 on the page (a run without
@@ -253,7 +254,7 @@ std::optional<PageFigure> RealtimeLatency(const RunData& d, const RunReportOptio
 double LoopVelocityCutoffHz(double dt_s) { return std::min(kLoopVelocityCutoffHz, 0.4 / dt_s); }
 
 std::vector<double> LoopVelocity(const std::vector<double>& y_mm, double dt_s) {
-  if (y_mm.size() < 4 || !AllFinite(y_mm)) return CentralDifference(y_mm, dt_s);
+  if (y_mm.size() < 4 || !AllFinite(y_mm)) return signal::Derivative(y_mm, dt_s);
   return diagnosis::SmoothMotion(y_mm, dt_s, LoopVelocityCutoffHz(dt_s)).v_mm_s;
 }
 
@@ -349,8 +350,10 @@ std::optional<ExcitedBand> FindExcitedBand(const signal::CrossSpectra& cs, doubl
 void GyrFigure(const signal::CrossSpectra& cs, const signal::FrequencyResponseEstimate& h1, const ExcitedBand& band,
                const RunReportOptions& o, FrequencyFigures* out) {
   const std::size_t i_lo = band.i_lo, i_hi = band.i_hi;
-  const std::span<const std::complex<double>> band_h(h1.h.data() + i_lo, i_hi - i_lo + 1);
-  const std::vector<double> phase = signal::UnwrapPhase(band_h);
+  const std::size_t n = i_hi - i_lo + 1;
+  const signal::BodeCurve gyr = signal::BodeFromResponse("G_yr", std::span<const double>(h1.f_hz).subspan(i_lo, n),
+                                                         std::span<const std::complex<double>>(h1.h).subspan(i_lo, n),
+                                                         std::span<const double>(h1.coherence).subspan(i_lo, n));
   Panel mag = MakePanel("Magnitude", "frequency [Hz]", "|G_yr| [-]");
   Panel ph = MakePanel("Phase (unwrapped)", "frequency [Hz]", "phase [deg]");
   Panel coh = MakePanel("Coherence", "frequency [Hz]", "coherence [-]");
@@ -363,8 +366,8 @@ void GyrFigure(const signal::CrossSpectra& cs, const signal::FrequencyResponseEs
   for (std::size_t i = i_lo; i <= i_hi; ++i) {
     const double f = h1.f_hz[i];
     const bool ok = h1.coherence[i] >= o.min_coherence && cs.s_uu[i] >= band.floor;
-    const double m = std::abs(h1.h[i]);
-    const double p_deg = phase[i - i_lo] * 180.0 / kPi;
+    const double m = gyr.magnitude[i - i_lo];
+    const double p_deg = gyr.phase_deg[i - i_lo];
     sm.x.push_back(f);
     sm.y.push_back(ok ? m : kNaN);
     sph.x.push_back(f);
@@ -374,7 +377,7 @@ void GyrFigure(const signal::CrossSpectra& cs, const signal::FrequencyResponseEs
     if (ok) {
       ++kept;
       mags.push_back(m);
-      lag_ms.push_back(-phase[i - i_lo] / (2.0 * kPi * f) * 1e3);
+      lag_ms.push_back(gyr.lag_ms[i - i_lo]);
     }
   }
   const double f_lo = h1.f_hz[i_lo], f_hi = h1.f_hz[i_hi];
@@ -592,16 +595,6 @@ bool Drawable(const Figure& fig) {
 }
 
 }  // namespace run_figures
-
-std::vector<double> CentralDifference(const std::vector<double>& x, double dt_s) {
-  const std::size_t n = x.size();
-  std::vector<double> v(n, 0.0);
-  if (n < 2) return v;
-  v[0] = (x[1] - x[0]) / dt_s;
-  v[n - 1] = (x[n - 1] - x[n - 2]) / dt_s;
-  for (std::size_t k = 1; k + 1 < n; ++k) v[k] = (x[k + 1] - x[k - 1]) / (2.0 * dt_s);
-  return v;
-}
 
 std::vector<std::size_t> MinMaxDecimate(const std::vector<double>& x, std::size_t max_points) {
   const std::size_t n = x.size();
