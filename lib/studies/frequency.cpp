@@ -23,46 +23,6 @@ using io::Figure;
 using io::MakePanel;
 using io::CsvWriter;
 
-BodeCurve BodeFromEstimate(const std::string& name, const signal::FrequencyResponseEstimate& est, double f_max_hz) {
-  BodeCurve c;
-  c.name = name;
-  std::vector<std::complex<double>> h;
-  for (std::size_t i = 1; i < est.f_hz.size() && est.f_hz[i] <= f_max_hz + 1e-9; ++i) {
-    c.f_hz.push_back(est.f_hz[i]);
-    h.push_back(est.h[i]);
-    c.coherence.push_back(est.coherence[i]);
-  }
-  const std::vector<double> phase = signal::UnwrapPhase(h);
-  for (std::size_t i = 0; i < h.size(); ++i) {
-    c.magnitude.push_back(std::abs(h[i]));
-    c.phase_deg.push_back(phase[i] * 180.0 / std::numbers::pi);
-    c.lag_ms.push_back(-phase[i] / (2.0 * std::numbers::pi * c.f_hz[i]) * 1e3);
-  }
-  return c;
-}
-
-BodeCurve BodeFromModel(const std::string& name, const ident::PoleModel& model, const std::vector<double>& f_hz,
-                        double zoh_dt_s) {
-  BodeCurve c;
-  c.name = name;
-  c.f_hz = f_hz;
-  std::vector<std::complex<double>> h;
-  if (zoh_dt_s > 0.0) {
-    const ident::ZohModel d = ident::Discretise(model, zoh_dt_s);
-    for (double f : f_hz) h.push_back(ident::ZohResponse(d, f));
-  } else {
-    for (double f : f_hz) h.push_back(model.Response(f));
-  }
-  const std::vector<double> phase = signal::UnwrapPhase(h);
-  for (std::size_t i = 0; i < h.size(); ++i) {
-    c.magnitude.push_back(std::abs(h[i]));
-    c.phase_deg.push_back(phase[i] * 180.0 / std::numbers::pi);
-    c.lag_ms.push_back(-phase[i] / (2.0 * std::numbers::pi * f_hz[i]) * 1e3);
-    c.coherence.push_back(1.0);
-  }
-  return c;
-}
-
 signal::SignalSpec FrequencyExcitation() {
   signal::SignalSpec spec;
   spec.kind = signal::SignalKind::kBlwn;
