@@ -60,61 +60,41 @@ signal::BodeCurve MeasuredCurve(const IdentifyResult& r, double fmax_hz) {
   return signal::BodeFromResponse("measured H1", f, h, coherence);
 }
 
-/// `style` with x = the curve's frequencies and y = `column`.
-io::Series Drawn(io::Series style, const signal::BodeCurve& c, const std::vector<double>& column) {
-  style.x = c.f_hz;
-  style.y = column;
-  return style;
-}
-
 }  // namespace
 
 io::Figure ActuatorFit::Bode(const std::string& title) const {
-  using io::MakePanel;
-  using io::MakeSeries;
-  using io::Series;
   const double fmax = std::min(50.0, 0.5 / continuous.dt_s);
   std::vector<double> grid;
   for (int i = 1; i <= 500; ++i) grid.push_back(fmax * i / 500.0);
-  const auto m = MeasuredCurve(continuous, fmax);
-  const auto c = BodeFromModel("Eq. 15 fit", continuous.fit.model, grid, 0.0);
-  const auto z = BodeFromModel("ZOH-consistent fit", zoh.fit.model, grid, zoh.dt_s);
-  Series m_style = MakeSeries(m.name, io::ReadableColors()[0]);
-  m_style.width = 2.0;
-  Series c_style = MakeSeries(c.name, "#000000", 2);
-  c_style.width = 2.0;
-  Series z_style = MakeSeries(z.name, io::ReadableColors()[1], 3);
-  z_style.width = 3.5;
-  // The models' time-lag range [ms], for the lag axis (the measured lag scatters at low f).
+  std::vector<io::BodeTrace> traces(3);
+  traces[0].curve = MeasuredCurve(continuous, fmax);
+  traces[0].style = io::MakeSeries("measured H1", io::ReadableColors()[0]);
+  traces[0].style.width = 2.0;
+  traces[0].coherence_style = traces[0].style;
+  traces[1].curve = BodeFromModel("Eq. 15 fit", continuous.fit.model, grid, 0.0);
+  traces[1].style = io::MakeSeries("Eq. 15 fit", "#000000", 2);
+  traces[1].style.width = 2.0;
+  traces[2].curve = BodeFromModel("ZOH-consistent fit", zoh.fit.model, grid, zoh.dt_s);
+  traces[2].style = io::MakeSeries("ZOH-consistent fit", io::ReadableColors()[1], 3);
+  traces[2].style.width = 3.5;
+  // The lag axis: the models' time-lag range [ms] (the measured lag scatters at low f).
   double lag_lo = 1e300, lag_hi = -1e300;
-  for (const auto* curve : {&c, &z}) {
-    for (double l : curve->lag_ms) lag_lo = std::min(lag_lo, l), lag_hi = std::max(lag_hi, l);
-  }
-  io::Figure fig;
+  for (std::size_t i = 1; i < traces.size(); ++i)
+    for (double l : traces[i].curve.lag_ms) lag_lo = std::min(lag_lo, l), lag_hi = std::max(lag_hi, l);
+  io::BodeLayout layout;
+  layout.f_range_hz = {0.0, fmax};
+  layout.magnitude_title =
+      fmt::format("shaded: the fitted band, {:.4g}-{:.4g} Hz", continuous.fitted_lo_hz, continuous.fitted_hi_hz);
+  layout.magnitude_label = "Magnitude |G_yu| [mm/mm]";
+  layout.lag_label = "Time lag -phase/ω [ms]";
+  layout.lag_range_ms = std::make_pair(0.7 * lag_lo, 1.3 * lag_hi);
+  layout.coherence_panel = true;
+  layout.left_margin_chars = 12;
+  layout.shade_hz = std::make_pair(continuous.fitted_lo_hz, continuous.fitted_hi_hz);
+  io::Figure fig = io::BodeFigure(layout, traces);
   fig.title = title;
   fig.width_px = 1100;
   fig.panel_height_px = 270;
-  auto mag = MakePanel("", "Frequency [Hz]", "Magnitude |G_yu| [mm/mm]");
-  mag.series = {Drawn(m_style, m, m.magnitude), Drawn(c_style, c, c.magnitude), Drawn(z_style, z, z.magnitude)};
-  auto pha = MakePanel("", "Frequency [Hz]", "Phase [deg]");
-  pha.series = {Drawn(m_style, m, m.phase_deg), Drawn(c_style, c, c.phase_deg), Drawn(z_style, z, z.phase_deg)};
-  auto lag = MakePanel("", "Frequency [Hz]", "Time lag -phase/ω [ms]");
-  lag.series = {Drawn(m_style, m, m.lag_ms), Drawn(c_style, c, c.lag_ms), Drawn(z_style, z, z.lag_ms)};
-  lag.y_range = std::make_pair(0.7 * lag_lo, 1.3 * lag_hi);
-  auto coh = MakePanel("", "Frequency [Hz]", "Coherence γ² [-]");
-  coh.series = {Drawn(m_style, m, m.coherence)};
-  coh.y_range = std::make_pair(0.0, 1.05);
-  // One legend, beside the first panel; every panel the same margins so the axes line up.
-  const int right = io::KeyMarginChars({&mag});
-  for (auto* p : {&mag, &pha, &lag, &coh}) {
-    p->x_range = std::make_pair(0.0, fmax);
-    p->shade_x = std::make_pair(continuous.fitted_lo_hz, continuous.fitted_hi_hz);
-    p->key = p == &mag ? "outside right top" : "off";
-    p->left_margin_chars = 12;
-    p->right_margin_chars = right;
-  }
-  mag.title = fmt::format("shaded: the fitted band, {:.4g}-{:.4g} Hz", continuous.fitted_lo_hz, continuous.fitted_hi_hz);
-  fig.panels = {mag, pha, lag, coh};
   return fig;
 }
 

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "ident/identify.h"
+#include "io/bode_figure.h"
 #include "io/plot.h"
 #include "signal/bode.h"
 

@@ -27,6 +27,20 @@ BodeCurve BodeFromResponse(const std::string& name, std::span<const double> f_hz
   return c;
 }
 
+BodeCurve BodeBand(const BodeCurve& c, double lo_hz, double hi_hz) {
+  BodeCurve b;
+  b.name = c.name;
+  for (std::size_t i = 0; i < c.f_hz.size(); ++i) {
+    if (!(c.f_hz[i] > 0.0 && c.f_hz[i] >= lo_hz && c.f_hz[i] <= hi_hz)) continue;
+    b.f_hz.push_back(c.f_hz[i]);
+    b.magnitude.push_back(c.magnitude[i]);
+    b.phase_deg.push_back(c.phase_deg[i]);
+    b.lag_ms.push_back(c.lag_ms[i]);
+    b.coherence.push_back(c.coherence[i]);
+  }
+  return b;
+}
+
 BodeCurve BodeFromEstimate(const std::string& name, const FrequencyResponseEstimate& est, double f_max_hz) {
   std::vector<double> f, coherence;
   std::vector<std::complex<double>> h;

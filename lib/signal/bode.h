@@ -23,11 +23,15 @@ struct BodeCurve {
   std::vector<double> coherence;    ///< gamma^2 [-] (1 for a model)
 };
 
-/// The curve of the responses h at f_hz (> 0, ascending, h's length), phase unwrapped from the
-/// first point up; `coherence` of the same length, or empty for a model (then 1 everywhere).
-/// Throws rths::Error if the lengths differ.
+/// The curve of the responses h at f_hz (ascending, h's length), phase unwrapped from the first
+/// point up; `coherence` of the same length, or empty for a model (then 1 everywhere). The time lag
+/// of a point at f = 0 is not finite (a curve unwrapped from DC: BodeBand drops it). Throws
+/// rths::Error if the lengths differ.
 BodeCurve BodeFromResponse(const std::string& name, std::span<const double> f_hz,
                            std::span<const std::complex<double>> h, std::span<const double> coherence = {});
+
+/// The points of c with lo_hz <= f <= hi_hz and f > 0, in order (the phase as unwrapped in c).
+BodeCurve BodeBand(const BodeCurve& c, double lo_hz, double hi_hz);
 
 /// The H1 estimate on (0, f_max_hz], phase unwrapped from the lowest frequency up.
 BodeCurve BodeFromEstimate(const std::string& name, const FrequencyResponseEstimate& est, double f_max_hz);

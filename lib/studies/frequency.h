@@ -49,10 +49,11 @@ scenario::Scenario FrequencyScenario(const std::string& condition, const control
 std::vector<RunResult> RunFrequencyBatch(std::vector<RunSpec> specs, const ReproduceOptions& opts,
                                          const std::string& what);
 
-/// Three stacked panels (magnitude, phase, time lag) for a set of curves: `solid` in their
-/// controller's style (studies/figures.h; `proposed` drawn prominent, other names in palette
-/// order), then `styled` as given. One legend, beside the magnitude panel; the same margins in
-/// all three panels so their frequency axes line up.
+/// The Bode figure (io/bode_figure.h) of Figs. 6-8: three stacked panels (magnitude, phase, time
+/// lag, its axis over the curves from 2 Hz up) for a set of curves: `solid` in their controller's
+/// style (studies/figures.h; `proposed` drawn prominent, other names in palette order), then
+/// `styled` as given. One legend, beside the magnitude panel; the same margins in all three panels
+/// so their frequency axes line up.
 io::Figure BodeFigure(const std::string& name, const std::string& title, const std::vector<BodeCurve>& solid,
                       const std::vector<std::pair<BodeCurve, io::Series>>& styled, const std::string& proposed = "");
 
