@@ -173,7 +173,7 @@ io::Figure FrfFigure(const Traces::Record& t, std::size_t first) {
   // enough (if anywhere it is), magnitude and phase left out.
   const signal::FrequencyResponseEstimate* est[3] = {&hm, &hn, &hf};
   const char* titles[3] = {"measured", "nominal model", "with the verdict's effects"};
-  const char* colors[3] = {kMeasuredColor, kNominalColor, kFinalColor};
+  const std::string colors[3] = {kMeasuredColor, kNominalColor, kFinalColor};
   std::vector<io::BodeTrace> traces(same ? 2 : 3);
   for (std::size_t i = 0; i < traces.size(); ++i) {
     const auto& e = *est[i];
