@@ -28,20 +28,6 @@ Ev Residual(const Vec& theta, const Vec& b) {
   return e;
 }
 
-/// Eq. 15's fit's rule (ident/fit.cpp).
-LmDamping FitRule() {
-  LmDamping r;
-  r.up = r.down = 10.0;
-  r.mu_min = 1e-12;
-  r.mu_max = std::numeric_limits<double>::infinity();
-  r.max_tries = 40;
-  r.diag_floor = 1e-30;
-  r.active_set = false;
-  r.accept_equal = true;
-  r.skip_nonfinite_step = true;
-  return r;
-}
-
 }  // namespace
 
 TEST_CASE("LmIterate: the box's minimum of a separable problem, a coordinate held where it was put") {
@@ -89,7 +75,7 @@ TEST_CASE("DampedStep: the damper fits' rule refuses an equal cost and gives up 
     Ev ev = Residual(theta, b);
     double mu = 1e-3;
     const auto step = rths::ident::DampedStep(H, g, &theta, &ev, &mu, [&](const Vec& t) { return Residual(t, b); },
-                                              lo, hi, FitRule());
+                                              lo, hi, rths::ident::PoleFitDamping());
     CHECK(step.accepted);
     CHECK(step.solved_norm == 0.0);
     CHECK(mu == doctest::Approx(1e-4));  // / 10
@@ -110,7 +96,7 @@ TEST_CASE("DampedStep: a step that is not finite is skipped unevaluated (40 tria
         ++evaluations;
         return Residual(t, b);
       },
-      lo, hi, FitRule());
+      lo, hi, rths::ident::PoleFitDamping());
   CHECK(!step.accepted);
   CHECK(evaluations == 0);
   CHECK(mu == doctest::Approx(1e-3 * 1e40).epsilon(1e-9));

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <numbers>
 
 #include <Eigen/Dense>
@@ -366,17 +365,8 @@ double LevenbergMarquardt(const std::vector<Point>& pts, const PoleModel& start,
   };
   Cost ev{r.squaredNorm()};
   double lambda = 1e-3;
-  // The damped step of lm.h with this fit's damping: x10 either way, at most 40 trials, no active
-  // set (the box is far outside any fitted band's rates), a cost that stays equal accepted.
-  LmDamping rule;
-  rule.up = rule.down = 10.0;
-  rule.mu_min = 1e-12;
-  rule.mu_max = std::numeric_limits<double>::infinity();
-  rule.max_tries = 40;
-  rule.diag_floor = 1e-30;
-  rule.active_set = false;
-  rule.accept_equal = true;
-  rule.skip_nonfinite_step = true;
+  // The damped step of lm.h with this fit's damping (PoleFitDamping).
+  const LmDamping rule = PoleFitDamping();
   const auto evaluate = [&](const Eigen::VectorXd& trial) {
     Evaluate(trial, odd, pts, o.zoh_dt_s, &rn, nullptr);
     return Cost{rn.squaredNorm()};

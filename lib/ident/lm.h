@@ -76,6 +76,22 @@ struct LmDamping {
   bool skip_nonfinite_step = false;  ///< a step d that is not finite counts as rejected, unevaluated
 };
 
+/// Eq. 15's fit's damping (fit.h): x10 either way (mu at least 1e-12), at most 40 trials a step,
+/// no active set (its box lies far outside any fitted band's rates), D's floor 1e-30, an equal
+/// cost accepted, a step that is not finite skipped. (The damper fits: LmDamping's defaults.)
+inline LmDamping PoleFitDamping() {
+  LmDamping r;
+  r.up = r.down = 10.0;
+  r.mu_min = 1e-12;
+  r.mu_max = std::numeric_limits<double>::infinity();
+  r.max_tries = 40;
+  r.diag_floor = 1e-30;
+  r.active_set = false;
+  r.accept_equal = true;
+  r.skip_nonfinite_step = true;
+  return r;
+}
+
 /// What one DampedStep did.
 struct LmStep {
   bool accepted = false;
