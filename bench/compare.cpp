@@ -58,18 +58,14 @@
 #include <nlohmann/json.hpp>
 
 #include "compare_outputs.h"
+#include "signal/stats.h"
 
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 
 namespace {
 
-double Median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  if (v.empty()) return 0.0;
-  const std::size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
+using rths::signal::Median;  // timings: the middle one, or the mean of the two middle ones
 
 std::string Quote(const std::string& s) {
   std::string q = "'";

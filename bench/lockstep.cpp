@@ -47,6 +47,7 @@
 
 #include "external_run.h"
 #include "lockstep/transport.h"
+#include "signal/stats.h"
 
 namespace fs = std::filesystem;
 namespace ls = rths::lockstep;
@@ -233,10 +234,7 @@ Run LockstepRun(const fs::path& bin, const fs::path& scenario, const std::string
   return {j["steps_per_s"].get<double>(), (CpuSeconds(RUSAGE_CHILDREN) - cpu0) / static_cast<double>(steps)};
 }
 
-double Median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v.empty() ? 0.0 : v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
-}
+using rths::signal::Median;  // timings: the middle one, or the mean of the two middle ones
 
 }  // namespace
 

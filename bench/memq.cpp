@@ -49,6 +49,7 @@
 #include "rths/measured_t.hpp"
 #include "scenario/scenario.h"
 #include "signal/history.h"
+#include "signal/stats.h"
 
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
@@ -57,10 +58,7 @@ namespace {
 
 double Seconds(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
-double Median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v.empty() ? 0.0 : v[v.size() / 2];
-}
+using rths::signal::Median;  // timings: the middle one, or the mean of the two middle ones
 
 // Write and read system calls of this process so far (/proc/self/io: syscw, syscr).
 void SysCalls(long* writes, long* reads) {

@@ -27,6 +27,7 @@
 #include <nlohmann/json.hpp>
 
 #include "../tests/chromium_pipe.h"
+#include "signal/stats.h"
 
 namespace fs = std::filesystem;
 
@@ -39,11 +40,7 @@ std::string Slurp(const fs::path& p) {
   return ss.str();
 }
 
-double Median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n == 0 ? 0 : n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
+using rths::signal::Median;  // timings: the middle one, or the mean of the two middle ones
 
 enum class Browser { kNone, kMonitorPage, kBlankPage };
 

@@ -16,6 +16,7 @@
 
 #include "models/integrator_accuracy.h"
 #include "models/structure_file.h"
+#include "signal/stats.h"
 
 using namespace rths::models;
 using Clock = std::chrono::steady_clock;
@@ -75,10 +76,9 @@ int main(int argc, char** argv) {
       for (std::size_t k = 0; k + 1 < ag.size(); ++k) Advance(integ, &s, ag[k], ag[k + 1], 0.0);
       us.push_back(std::chrono::duration<double, std::micro>(Clock::now() - t0).count() / (ag.size() - 1));
     }
-    std::sort(us.begin(), us.end());
     run = Simulate(integ, ag);
     const ResponseSummary sum = Summarize(run.x_mm);
-    const double med = us[us.size() / 2];
+    const double med = rths::signal::Median(us);
     if (us_cd == 0.0) us_cd = med;
     fmt::print("{:<24} {:>10.3f} {:>12.2f} {:>9.3f} {:>10.3f} {:>12.1f} {:>10.4f}\n", Describe(c), med, med / us_cd,
                100.0 * med * 1e-6 / dt,

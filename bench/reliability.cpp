@@ -27,6 +27,7 @@
 
 #include "lockstep/step_table.h"
 #include "lockstep/transport.h"
+#include "signal/stats.h"
 
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
@@ -156,7 +157,7 @@ int main(int argc, char** argv) {
       continue;
     }
     std::printf("  %-11s  min %6.1f ms   median %6.1f ms   max %6.1f ms   (stall budget: 10000 ms)\n", role.c_str(),
-                1e3 * t.front(), 1e3 * t[t.size() / 2], 1e3 * t.back());
+                1e3 * t.front(), 1e3 * rths::signal::Median(t), 1e3 * t.back());
   }
 
   // 2. Message faults: the same run clean, with 5 % of each fault, with 2 kB socket buffers.

@@ -22,16 +22,13 @@
 #include "io/source_tree.h"
 #include "sweep/run_sweep.h"
 #include "sweep/table.h"
+#include "signal/stats.h"
 
 namespace fs = std::filesystem;
 
 namespace {
 
-double Median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
+using rths::signal::Median;  // timings: the middle one, or the mean of the two middle ones
 
 /// The table's rows without the timing fields (steps_per_s, wall_s), to compare passes.
 std::vector<std::vector<nlohmann::json>> Comparable(const rths::sweep::Table& t) {

@@ -1,7 +1,9 @@
 // Identification (ident/fit.h, ident/identify.h): exact recovery from exact frequency responses,
 // E1 on the linear plants (docs/experiments.md), and the real UTFSM chirp record.
+#include <algorithm>
 #include <cmath>
 #include <complex>
+#include <numbers>
 #include <string>
 #include <vector>
 
@@ -9,6 +11,7 @@
 #include <fmt/format.h>
 
 #include "core/error.h"
+#include "ident/actuator_fit.h"
 #include "ident/fit.h"
 #include "ident/identify.h"
 #include "io/utfsm.h"
@@ -220,6 +223,68 @@ TEST_CASE("E1 on the linear plants: BLWN 0-50 Hz, 0.254 mm RMS, 60 s through the
       CHECK(sc.controller.model.b == doctest::Approx(c.b).epsilon(1e-9));
     }
   }
+}
+
+TEST_CASE("FitActuator: both fits of one record, their report, model file and Bode figure") {
+  const double dt = 0.0005;
+  const auto rec = SimulateE1(kEq28, dt);
+  rths::ident::IdentifyOptions o;
+  o.fit.zoh_dt_s = 0.123;  // not used: the continuous fit has 0, the ZOH-consistent one dt
+  const auto fit = rths::ident::FitActuator(rec.u, rec.y, dt, o);
+  CHECK(fit.continuous.options.fit.zoh_dt_s == 0.0);
+  CHECK(fit.zoh.options.fit.zoh_dt_s == dt);
+  const auto z = fit.zoh.fit.model.ToServoModel3();
+  CHECK(std::abs(Rel(z.K, kEq28.K)) < 0.03);
+  CHECK(std::abs(Rel(z.c, kEq28.c)) < 0.03);
+  // The report: the continuous fit's, then the ZOH-consistent fit's with its time-domain error.
+  const std::string report = fit.Report();
+  CHECK(report.rfind(fit.continuous.Report(), 0) == 0);
+  CHECK(report.find("ZOH-consistent fit (the continuous model whose zero-order-hold discretisation at dt = 0.0005 s") !=
+        std::string::npos);
+  CHECK(report.find(fit.zoh.fit.Report()) != std::string::npos);
+  CHECK(report.find(fmt::format("time domain: Eq. 31 error of the predicted y {:.3f} %", fit.zoh.prediction.model_error_pct)) !=
+        std::string::npos);
+  CHECK(fit.ModelToml("E1") == rths::ident::ScenarioFragment(fit.continuous, fit.zoh, "E1"));
+
+  const auto fig = fit.Bode("G_yu test");
+  CHECK(fig.title == "G_yu test");
+  REQUIRE(fig.panels.size() == 4);
+  const auto& mag = fig.panels[0];
+  const auto& phase = fig.panels[1];
+  REQUIRE(mag.series.size() == 3);
+  REQUIRE(phase.series.size() == 3);
+  CHECK(fig.panels[3].series.size() == 1);  // coherence: the measurement only
+  // Models on 500 points up to 50 Hz (below the 1 kHz Nyquist frequency).
+  const auto& cont = phase.series[1];
+  REQUIRE(cont.x.size() == 500);
+  CHECK(cont.x.back() == doctest::Approx(50.0));
+  // The continuous model's phase, unwrapped: the sum of its factors' phases (no 2 pi jumps).
+  const auto m = fit.continuous.fit.model.ToServoModel3();
+  for (std::size_t i : {std::size_t{0}, std::size_t{249}, std::size_t{499}}) {
+    const double w = 2.0 * std::numbers::pi * cont.x[i];
+    const double want = -(std::atan2(w, m.p) + std::atan2(m.b * w, m.c - w * w)) * 180.0 / std::numbers::pi;
+    CHECK(cont.y[i] == doctest::Approx(want).epsilon(1e-9));
+    CHECK(mag.series[1].y[i] == doctest::Approx(std::abs(fit.continuous.fit.model.Response(cont.x[i]))).epsilon(1e-12));
+    const double zoh_mag =
+        std::abs(rths::ident::ZohResponse(rths::ident::Discretise(fit.zoh.fit.model, dt), cont.x[i]));
+    CHECK(mag.series[2].y[i] == doctest::Approx(zoh_mag).epsilon(1e-12));
+  }
+  // The measurement: excited points of (0, 50] Hz only, the fitted band shaded.
+  const auto& meas = mag.series[0];
+  REQUIRE(!meas.x.empty());
+  CHECK(meas.x.front() > 0.0);
+  CHECK(meas.x.back() <= 50.0);
+  REQUIRE(mag.shade_x.has_value());
+  CHECK(mag.shade_x->first == fit.continuous.fitted_lo_hz);
+  CHECK(mag.shade_x->second == fit.continuous.fitted_hi_hz);
+  // The lag axis spans the models' lags with 30 % either side.
+  const auto& lag = fig.panels[2];
+  double lo = 1e300, hi = -1e300;
+  for (std::size_t s = 1; s < 3; ++s)
+    for (double l : lag.series[s].y) lo = std::min(lo, l), hi = std::max(hi, l);
+  REQUIRE(lag.y_range.has_value());
+  CHECK(lag.y_range->first == doctest::Approx(0.7 * lo));
+  CHECK(lag.y_range->second == doctest::Approx(1.3 * hi));
 }
 
 TEST_CASE("chirp_0A (UTFSM rig): identify on the first half, predict the second half") {

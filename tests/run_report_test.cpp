@@ -135,14 +135,6 @@ TEST_CASE("MinMaxDecimate keeps every peak, in time order; CentralDifference; Ht
   CHECK(std::find(idx.begin(), idx.end(), 1234u) != idx.end());
   CHECK(std::find(idx.begin(), idx.end(), 8765u) != idx.end());
   CHECK(rths::report::MinMaxDecimate(std::vector<double>(50, 1.0), 400).size() == 50);
-
-  // A parabola: the central difference is exact inside, one-sided at the ends.
-  std::vector<double> y;
-  for (int k = 0; k < 5; ++k) y.push_back(3.0 * (0.1 * k) * (0.1 * k));
-  const auto v = rths::report::CentralDifference(y, 0.1);
-  CHECK(v[2] == doctest::Approx(6.0 * 0.2));
-  CHECK(v[1] == doctest::Approx(6.0 * 0.1));
-  CHECK(v[0] == doctest::Approx((y[1] - y[0]) / 0.1));
   CHECK(rths::report::HtmlEscape("a<b & \"c\"") == "a&lt;b &amp; &quot;c&quot;");
 }
 

@@ -18,10 +18,14 @@
 #include "core/error.h"
 #include "scenario/scenario.h"
 #include "signal/blwn.h"
+#include "signal/bode.h"
 #include "signal/butterworth.h"
+#include "signal/derivative.h"
 #include "signal/history.h"
 #include "signal/metrics.h"
 #include "signal/random.h"
+#include "signal/stats.h"
+#include "signal/zero_phase.h"
 
 namespace sig = rths::signal;
 using std::numbers::pi;
@@ -492,4 +496,117 @@ TEST_CASE("per-step functions allocate nothing") {
   CHECK(after == before);
   CHECK(std::isfinite(sink));
   CHECK(acc.Percent() == doctest::Approx(50.0));
+}
+
+TEST_CASE("zero-phase low-pass: no lag in the band, |H|^2 above it, the ends as reflection and start say") {
+  const double dt = 0.001, fc = 50.0;
+  const std::size_t n = 4000;
+  std::vector<double> slow(n), noisy(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    const double t = static_cast<double>(k) * dt;
+    slow[k] = std::sin(2.0 * pi * 2.0 * t);
+    noisy[k] = slow[k] + std::sin(2.0 * pi * 200.0 * t);
+  }
+  for (int order : {2, 4}) {
+    const auto out = sig::ZeroPhaseLowpass(noisy, dt, fc, order, 600, sig::Reflection::kOdd);
+    REQUIRE(out.size() == n);
+    // 2 Hz passes without lag (a causal pass would delay it); 200 Hz is left at |H(200 Hz)|^2 of
+    // one pass (order 2: 0.0022; order 4: 5e-6).
+    double worst = 0.0;
+    for (std::size_t k = 500; k + 500 < n; ++k) worst = std::max(worst, std::abs(out[k] - slow[k]));
+    CHECK(worst < (order == 2 ? 0.003 : 1e-4));
+    if (order == 2) CHECK(worst > 0.001);
+  }
+  // A ramp, extended by odd reflection, is a ramp: the filter leaves it as it is.
+  std::vector<double> ramp(1000);
+  for (std::size_t k = 0; k < ramp.size(); ++k) ramp[k] = 0.5 + 0.01 * static_cast<double>(k);
+  const auto r = sig::ZeroPhaseLowpass(ramp, dt, fc, 2, 999, sig::Reflection::kOdd, sig::FilterStart::kSteadyState);
+  for (std::size_t k = 0; k < ramp.size(); k += 111) CHECK(r[k] == doctest::Approx(ramp[k]).epsilon(1e-6));
+  // A constant without padding: from rest each pass rises to it (the ends are wrong); from the
+  // first value's steady state it stays.
+  const std::vector<double> level(200, 3.0);
+  const auto rest = sig::ZeroPhaseLowpass(level, dt, fc, 2, 0, sig::Reflection::kEven);
+  const auto steady = sig::ZeroPhaseLowpass(level, dt, fc, 2, 0, sig::Reflection::kEven, sig::FilterStart::kSteadyState);
+  CHECK(std::abs(rest.front() - 3.0) > 0.1);
+  CHECK(std::abs(rest.back() - 3.0) > 0.1);
+  for (double v : steady) CHECK(v == doctest::Approx(3.0).epsilon(1e-12));
+  CHECK(sig::ZeroPhaseLowpass(std::vector<double>{}, dt, fc, 2, 10, sig::Reflection::kOdd).empty());
+  CHECK_THROWS_AS(sig::ZeroPhaseLowpass(level, dt, 600.0, 2, 10, sig::Reflection::kOdd), rths::Error);
+}
+
+TEST_CASE("derivative: central difference inside, one-sided at the ends") {
+  // A parabola y = 3 t^2: the central difference is exact inside (6 t), the ends one-sided.
+  std::vector<double> y;
+  for (int k = 0; k < 5; ++k) y.push_back(3.0 * (0.1 * k) * (0.1 * k));
+  const auto v = sig::Derivative(y, 0.1);
+  REQUIRE(v.size() == 5);
+  CHECK(v[1] == doctest::Approx(0.6));
+  CHECK(v[2] == doctest::Approx(1.2));
+  CHECK(v[3] == doctest::Approx(1.8));
+  CHECK(v[0] == doctest::Approx(0.3));   // (0.03 - 0) / 0.1
+  CHECK(v[4] == doctest::Approx(2.1));   // (0.48 - 0.27) / 0.1
+  CHECK(sig::Derivative(std::vector<double>{1.0, 3.0}, 0.5) == std::vector<double>{4.0, 4.0});
+  CHECK(sig::Derivative(std::vector<double>{7.0}, 0.5) == std::vector<double>{0.0});
+}
+
+TEST_CASE("Eq. 31 of sums: the accumulator's percent, NaN without a reference") {
+  sig::RmsErrorAccumulator acc;
+  acc.Add(4.0, 1.0);  // e = 3
+  acc.Add(3.0, 3.0);  // e = 0
+  CHECK(acc.Percent() == doctest::Approx(100.0 * std::sqrt(9.0 / 25.0)));
+  CHECK(sig::RmsErrorAccumulator{9.0, 25.0, 0}.Percent() == doctest::Approx(60.0));
+  CHECK(std::isnan(sig::RmsErrorAccumulator{9.0, 0.0, 0}.Percent()));
+}
+
+TEST_CASE("stats: spread (mean, sample std, min, max) and median") {
+  const std::vector<double> v{4.0, 1.0, 3.0, 2.0};
+  const auto s = sig::SpreadOf(v);
+  CHECK(s.n == 4);
+  CHECK(s.mean == doctest::Approx(2.5));
+  CHECK(s.std == doctest::Approx(std::sqrt(5.0 / 3.0)));  // (2.25 + 0.25 + 0.25 + 2.25) / 3
+  CHECK(s.min == 1.0);
+  CHECK(s.max == 4.0);
+  const auto one = sig::SpreadOf(std::vector<double>{7.0});
+  CHECK(one.std == 0.0);
+  CHECK(one.mean == 7.0);
+  const auto none = sig::SpreadOf(std::vector<double>{});
+  CHECK(none.n == 0);
+  CHECK(std::isnan(none.mean));
+  CHECK(std::isnan(none.std));
+  CHECK(sig::Median(v) == 2.5);
+  CHECK(sig::Median({3.0, 1.0, 2.0}) == 2.0);
+  CHECK(sig::Median({5.0}) == 5.0);
+  CHECK(std::isnan(sig::Median({})));
+}
+
+TEST_CASE("bode: phase unwrapped across -180 deg, time lag from it, coherence 1 for a model") {
+  // h_k = 2 exp(-i k) at f = k + 1 Hz: the phase falls by 1 rad a point, past -pi at k = 4.
+  std::vector<double> f;
+  std::vector<std::complex<double>> h;
+  for (int k = 0; k < 10; ++k) {
+    f.push_back(k + 1.0);
+    h.push_back(std::polar(2.0, -1.0 * k));
+  }
+  const auto c = sig::BodeFromResponse("model", f, h);
+  REQUIRE(c.phase_deg.size() == 10);
+  for (int k = 0; k < 10; ++k) {
+    CHECK(c.phase_deg[k] == doctest::Approx(-k * 180.0 / pi));
+    CHECK(c.lag_ms[k] == doctest::Approx(k / (2.0 * pi * f[k]) * 1e3));
+    CHECK(c.magnitude[k] == doctest::Approx(2.0));
+    CHECK(c.coherence[k] == 1.0);
+  }
+  CHECK(c.name == "model");
+  const std::vector<double> coh(10, 0.5);
+  CHECK(sig::BodeFromResponse("m", f, h, coh).coherence[3] == 0.5);
+  CHECK_THROWS_AS(sig::BodeFromResponse("m", std::vector<double>{1.0}, h), rths::Error);
+  // An estimate: the points of (0, f_max], DC left out.
+  sig::FrequencyResponseEstimate est;
+  est.f_hz = {0.0, 1.0, 2.0, 3.0};
+  est.h = {1.0, std::polar(1.0, -0.5), std::polar(1.0, -1.0), std::polar(1.0, -1.5)};
+  est.coherence = {1.0, 0.9, 0.8, 0.7};
+  const auto e = sig::BodeFromEstimate("H1", est, 2.0);
+  REQUIRE(e.f_hz.size() == 2);
+  CHECK(e.f_hz[0] == 1.0);
+  CHECK(e.coherence[1] == 0.8);
+  CHECK(e.phase_deg[1] == doctest::Approx(-1.0 * 180.0 / pi));
 }

@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 
 #include "core/error.h"
+#include "signal/derivative.h"
 
 namespace rths::control {
 
@@ -58,13 +59,14 @@ DerivativeRecords CentralDerivatives(const std::vector<double>& r, double dt) {
   }
   const std::size_t n = r.size();
   DerivativeRecords d;
-  d.rd.assign(n, 0.0);
+  // r' by signal::Derivative, its one-sided ends set to zero as the other derivatives' are.
+  d.rd = signal::Derivative(r, dt);
+  if (n > 0) d.rd.front() = d.rd.back() = 0.0;
   d.rdd.assign(n, 0.0);
   d.rddd.assign(n, 0.0);
   const double dt2 = dt * dt;
   const double dt3 = dt2 * dt;
   for (std::size_t i = 1; i + 1 < n; ++i) {
-    d.rd[i] = (r[i + 1] - r[i - 1]) / (2.0 * dt);
     d.rdd[i] = (r[i + 1] - 2.0 * r[i] + r[i - 1]) / dt2;
   }
   for (std::size_t i = 2; i + 2 < n; ++i) {

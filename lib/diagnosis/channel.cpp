@@ -12,18 +12,15 @@
 #include "diagnosis/tuning.h"
 #include "models/mr_damper.h"
 #include "models/rig_effects.h"
+#include "signal/metrics.h"
 
 namespace rths::diagnosis {
 
 double Nrmse(std::span<const double> meas, std::span<const double> pred, std::size_t first) {
   if (meas.size() != pred.size()) throw Error("Nrmse", "lengths differ");
-  double se = 0, sm = 0;
-  for (std::size_t k = first; k < meas.size(); ++k) {
-    const double e = meas[k] - pred[k];
-    se += e * e;
-    sm += meas[k] * meas[k];
-  }
-  return sm > 0 ? 100.0 * std::sqrt(se / sm) : std::nan("");
+  signal::RmsErrorAccumulator eq31;  // Eq. 31 with the measurement in the role of r
+  for (std::size_t k = first; k < meas.size(); ++k) eq31.Add(meas[k], pred[k]);
+  return eq31.Percent();
 }
 
 double ShrinkPct(double before_pct, double after_pct) { return 100.0 * (1.0 - after_pct / before_pct); }
@@ -255,7 +252,9 @@ double Channel::Sse(const std::vector<std::vector<double>>& pred) const {
   return s;
 }
 
-double Channel::NrmsePct(double sse) const { return meas2_ > 0 ? 100.0 * std::sqrt(sse / meas2_) : std::nan(""); }
+double Channel::NrmsePct(double sse) const {
+  return signal::RmsErrorAccumulator{sse, meas2_, 0}.Percent();  // Eq. 31 of the sums
+}
 
 std::span<const double> Channel::Meas(std::size_t r) const { return ch_ == 'y' ? (*recs_)[r].y : (*recs_)[r].f; }
 

@@ -12,7 +12,8 @@
 #include "core/error.h"
 #include "scenario/from_toml.h"
 #include "models/servo_flow_limit.h"
-#include "signal/butterworth.h"
+#include "signal/derivative.h"
+#include "signal/zero_phase.h"
 
 namespace rths::diagnosis {
 
@@ -61,47 +62,11 @@ NominalModel LoadModel(const std::string& path) {
   return m;
 }
 
-namespace {
-
-/// Runs the cascade over x in place (causal), from rest.
-void FilterInPlace(const signal::Sos& sos, std::vector<double>* x) {
-  auto st = signal::SosAtRest(sos);
-  for (double& v : *x) v = signal::SosStep(sos, &st, v);
-}
-
-}  // namespace
-
-/// v = dx/dt of samples x: the fourth-order central difference
-/// (-x_{k+2} + 8 x_{k+1} - 8 x_{k-1} + x_{k-2}) / (12 dt) inside (relative error (w dt)^4 / 30 at
-/// angular frequency w), the second-order one next to the ends, one-sided at the ends.
 void Differentiate(const std::vector<double>& x, double dt_s, std::vector<double>* v) {
+  *v = signal::Derivative(x, dt_s);  // second order next to the ends, one-sided at them
   const std::size_t n = x.size();
-  v->assign(n, 0.0);
   for (std::size_t k = 2; k + 2 < n; ++k)
     (*v)[k] = (-x[k + 2] + 8.0 * x[k + 1] - 8.0 * x[k - 1] + x[k - 2]) / (12.0 * dt_s);
-  for (std::size_t k : {std::size_t{1}, n - 2})
-    if (k >= 1 && k + 1 < n) (*v)[k] = (x[k + 1] - x[k - 1]) / (2.0 * dt_s);
-  (*v)[0] = (x[1] - x[0]) / dt_s;
-  (*v)[n - 1] = (x[n - 1] - x[n - 2]) / dt_s;
-}
-
-std::vector<double> ZeroPhaseLowpass(std::span<const double> x, double dt_s, double fc_hz, std::size_t pad,
-                                     Reflection reflection) {
-  const std::size_t n = x.size();
-  if (n == 0) return {};
-  pad = std::min(pad, n - 1);
-  const auto sos = signal::ButterworthLowpass(2, fc_hz, 1.0 / dt_s);
-  const bool odd = reflection == Reflection::kOdd;
-  std::vector<double> w;
-  w.reserve(n + 2 * pad);
-  for (std::size_t j = pad; j >= 1; --j) w.push_back(odd ? 2.0 * x[0] - x[j] : x[j]);
-  for (double v : x) w.push_back(v);
-  for (std::size_t j = 1; j <= pad; ++j) w.push_back(odd ? 2.0 * x[n - 1] - x[n - 1 - j] : x[n - 1 - j]);
-  FilterInPlace(sos, &w);
-  std::reverse(w.begin(), w.end());
-  FilterInPlace(sos, &w);
-  std::reverse(w.begin(), w.end());
-  return {w.begin() + static_cast<std::ptrdiff_t>(pad), w.begin() + static_cast<std::ptrdiff_t>(pad + n)};
 }
 
 SmoothedMotion SmoothMotion(std::span<const double> y_mm, double dt_s, double smooth_hz) {
@@ -112,7 +77,7 @@ SmoothedMotion SmoothMotion(std::span<const double> y_mm, double dt_s, double sm
   // Odd reflection about both ends: 6 time constants of the filter, at most n - 1 samples.
   const std::size_t pad = std::min<std::size_t>(n - 1, static_cast<std::size_t>(std::ceil(6.0 / (smooth_hz * dt_s))) + 8);
   SmoothedMotion m;
-  m.x_mm = ZeroPhaseLowpass(y_mm, dt_s, smooth_hz, pad, Reflection::kOdd);
+  m.x_mm = signal::ZeroPhaseLowpass(y_mm, dt_s, smooth_hz, 2, pad, signal::Reflection::kOdd);
   m.v_mm_s.resize(n);
   Differentiate(m.x_mm, dt_s, &m.v_mm_s);
   return m;

@@ -91,20 +91,10 @@ struct SmoothedMotion {
   /// through (x, v, a) at both ends, else the cubic through (x, v) (ForcePredictor).
   std::vector<double> a_mm_s2;
 };
-/// How ZeroPhaseLowpass extends a signal x_0 .. x_{n-1} past its ends.
-enum class Reflection {
-  kOdd,   ///< about the end samples: 2 x_0 - x_j before, 2 x_{n-1} - x_{n-1-j} after (keeps the slope)
-  kEven,  ///< mirrored: x_j before, x_{n-1-j} after (keeps the level; no step from a noisy end sample)
-};
-
-/// x through a 2nd-order Butterworth low-pass at fc_hz (sample step dt_s) forward, then backward
-/// (zero phase, |H|^4 overall), over x extended at both ends by `pad` samples (at most n - 1) as
-/// `reflection` says; the n samples of x's span returned.
-std::vector<double> ZeroPhaseLowpass(std::span<const double> x, double dt_s, double fc_hz, std::size_t pad,
-                                     Reflection reflection);
-
-/// v = dx/dt of samples x [unit/s]: the fourth-order central difference inside, second order next to
-/// the ends, one-sided at the ends (n >= 2).
+/// v = dx/dt of samples x [unit/s]: the fourth-order central difference
+/// (-x_{k+2} + 8 x_{k+1} - 8 x_{k-1} + x_{k-2}) / (12 dt) inside (relative error (w dt)^4 / 30 at
+/// angular frequency w), signal::Derivative's second-order one next to the ends, one-sided at the
+/// ends (n >= 2).
 void Differentiate(const std::vector<double>& x, double dt_s, std::vector<double>* v);
 
 /// Throws rths::Error unless smooth_hz is in (0, 0.5/dt_s) and y has at least 4 samples.

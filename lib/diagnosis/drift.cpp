@@ -6,6 +6,7 @@
 
 #include "diagnosis/stages.h"
 #include "diagnosis/tuning.h"
+#include "signal/zero_phase.h"
 
 namespace rths::diagnosis::stages {
 
@@ -18,7 +19,7 @@ namespace {
 std::vector<double> SlowPart(std::span<const double> meas, const std::vector<double>& pred, double dt) {
   std::vector<double> res(meas.size());
   for (std::size_t k = 0; k < res.size(); ++k) res[k] = meas[k] - pred[k];
-  return ZeroPhaseLowpass(res, dt, std::min(tuning::kDriftHz, 0.25 / dt), res.size(), Reflection::kEven);
+  return signal::ZeroPhaseLowpass(res, dt, std::min(tuning::kDriftHz, 0.25 / dt), 2, res.size(), signal::Reflection::kEven);
 }
 
 }  // namespace

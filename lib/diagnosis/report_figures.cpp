@@ -8,7 +8,9 @@
 
 #include "core/error.h"
 #include "diagnosis/localise.h"
+#include "io/bode_figure.h"
 #include "io/plot.h"
+#include "signal/bode.h"
 #include "signal/spectral.h"
 #include "signal/spectrum_axes.h"
 
@@ -163,53 +165,47 @@ io::Figure FrfFigure(const Traces::Record& t, std::size_t first) {
   const auto hm = signal::H1FromSpectra(sm);
   const auto hn = signal::H1Estimate(u, yn, t.dt_s, L);
   const auto hf = signal::H1Estimate(u, yf, t.dt_s, L);
-  const auto phm = signal::UnwrapPhase(hm.h), phn = signal::UnwrapPhase(hn.h), phf = signal::UnwrapPhase(hf.h);
   bool mask = false;
   const std::pair<double, double> axis = FrfAxis(sm, hm, &mask);
   const double lo = axis.first, hi = axis.second;
-  io::Figure fig;
+  const bool same = SameAsNominal(t.y_nom, t.y_fin);
+  // The responses over the axis, phase unwrapped from DC; where the measurement is not coherent
+  // enough (if anywhere it is), magnitude and phase left out.
+  const signal::FrequencyResponseEstimate* est[3] = {&hm, &hn, &hf};
+  const char* titles[3] = {"measured", "nominal model", "with the verdict's effects"};
+  const std::string colors[3] = {kMeasuredColor, kNominalColor, kFinalColor};
+  std::vector<io::BodeTrace> traces(same ? 2 : 3);
+  for (std::size_t i = 0; i < traces.size(); ++i) {
+    const auto& e = *est[i];
+    io::BodeTrace& tr = traces[i];
+    tr.curve = signal::BodeBand(signal::BodeFromResponse(titles[i], e.f_hz, e.h, e.coherence), lo, hi);
+    for (std::size_t k = 0; k < tr.curve.f_hz.size(); ++k) {
+      if (mask && !(traces[0].curve.coherence[k] >= kFrfMinCoherence))  // the same grid
+        tr.curve.magnitude[k] = tr.curve.phase_deg[k] = NAN;
+    }
+    tr.style = io::MakeSeries(i == 1 ? NominalTitle(titles[i], same) : titles[i], colors[i], static_cast<int>(i) + 1);
+  }
+  traces[0].style.width = 2.0;
+  if (traces.size() > 2) traces[2].style.width = 2.5;  // on top of the measured curve it follows
+  traces[0].coherence_style = io::MakeSeries("coherence", kMeasuredColor);
+  auto threshold = io::MakeSeries(fmt::format("{:g}: the points below are left out", kFrfMinCoherence), "#666666", 2);
+  threshold.x = {lo, hi};
+  threshold.y = {kFrfMinCoherence, kFrfMinCoherence};
+  io::BodeLayout layout;
+  layout.f_range_hz = {lo, hi};
+  layout.magnitude_label = "|G_yu| [mm/mm]";
+  layout.lag_panel = false;
+  layout.coherence_panel = true;
+  layout.coherence_label = "Coherence u -> y_meas [-]";
+  layout.coherence_extra = {threshold};
+  layout.magnitude_key = layout.coherence_key = "top right";  // then above the panels (KeyAbove)
+  layout.key_margin = false;
+  io::Figure fig = io::BodeFigure(layout, traces);
   fig.name = "frf_y";
   fig.title = fmt::format("u -> y: measured vs model (H1, test record), over the input's {:g} % energy band {:.3g}-{:.3g} Hz; {}",
                           100 * kFrfEnergyFraction, lo, hi,
                           mask ? fmt::format("points with coherence < {:g} left out", kFrfMinCoherence)
                                : fmt::format("coherence < {:g} everywhere: nothing left out", kFrfMinCoherence));
-  auto pm = io::MakePanel("", "Frequency [Hz]", "|G_yu| [mm/mm]");
-  auto pp = io::MakePanel("", "Frequency [Hz]", "Phase [deg]");
-  auto pc = io::MakePanel("", "Frequency [Hz]", "Coherence u -> y_meas [-]");
-  for (auto* p : {&pm, &pp, &pc}) p->x_range = std::make_pair(lo, hi);
-  const bool same = SameAsNominal(t.y_nom, t.y_fin);
-  auto a1 = io::MakeSeries("measured", kMeasuredColor),
-       a2 = io::MakeSeries(NominalTitle("nominal model", same), kNominalColor, 2),
-       a3 = io::MakeSeries("with the verdict's effects", kFinalColor, 3);
-  a1.width = 2.0;
-  a3.width = 2.5;  // on top of the measured curve it follows
-  auto b1 = a1, b2 = a2, b3 = a3;
-  auto c1 = io::MakeSeries("coherence", kMeasuredColor);
-  auto c2 = io::MakeSeries(fmt::format("{:g}: the points below are left out", kFrfMinCoherence), "#666666", 2);
-  for (std::size_t j = 1; j < hm.f_hz.size(); ++j) {
-    const double f = hm.f_hz[j];
-    if (f < lo || f > hi) continue;
-    const bool keep = !mask || hm.coherence[j] >= kFrfMinCoherence;
-    auto put = [&](io::Series& s, double v) {
-      s.x.push_back(f);
-      s.y.push_back(keep ? v : NAN);
-    };
-    put(a1, std::abs(hm.h[j]));
-    put(a2, std::abs(hn.h[j]));
-    put(a3, std::abs(hf.h[j]));
-    put(b1, phm[j] * 180 / M_PI);
-    put(b2, phn[j] * 180 / M_PI);
-    put(b3, phf[j] * 180 / M_PI);
-    c1.x.push_back(f), c1.y.push_back(hm.coherence[j]);
-  }
-  c2.x = {lo, hi};
-  c2.y = {kFrfMinCoherence, kFrfMinCoherence};
-  pm.series = same ? std::vector<io::Series>{a1, a2} : std::vector<io::Series>{a1, a2, a3};
-  pp.series = same ? std::vector<io::Series>{b1, b2} : std::vector<io::Series>{b1, b2, b3};
-  pp.key = "off";
-  pc.series = {c1, c2};
-  pc.y_range = std::make_pair(0.0, 1.05);
-  fig.panels = {pm, pp, pc};
   fig.panel_height_px = 260;
   KeyAbove(&fig);
   return fig;

@@ -11,10 +11,13 @@
 #include <fmt/format.h>
 
 #include "core/error.h"
+#include "ident/bouc_wen_rk4.h"
 #include "ident/lm.h"
 #include "ident/plausible_range.h"
-#include "signal/butterworth.h"
+#include "signal/derivative.h"
+#include "signal/metrics.h"
 #include "signal/spectral.h"
+#include "signal/zero_phase.h"
 
 namespace rths::ident {
 
@@ -59,23 +62,17 @@ models::MrDamperCoefficients FromTheta(const Theta& th, double A, double k1, dou
 constexpr std::array<const char*, kNonlinear> kNames = {"alpha", "c0", "c1", "k0", "beta", "gamma"};
 
 // The box in theta: ln of the bounds, a point for a parameter held by DamperFitOptions::hold.
-struct Box {
-  Theta lo, hi;
-  std::array<std::string, kNonlinear> held_why;  // "" = fitted
-
-  explicit Box(const DamperFitOptions& o) {
-    for (int i = 0; i < kNonlinear; ++i) lo[i] = std::log(kLo[i]), hi[i] = std::log(kHi[i]);
-    const std::vector<std::string> names(kNames.begin(), kNames.end());
-    const std::vector<double> l(kLo.begin(), kLo.end()), h(kHi.begin(), kHi.end());
-    for (const auto& held : o.hold) {
-      const int i = HeldIndex(held, names, l, h);
-      lo[i] = hi[i] = std::log(held.second);
-      held_why[static_cast<std::size_t>(i)] = fmt::format("held at {:g} by --hold", held.second);
-    }
-  }
-  bool Held(int i) const { return !held_why[static_cast<std::size_t>(i)].empty(); }
-  Theta Clamp(const Theta& th) const { return ClampToBox(th, lo, hi); }
-};
+using Box = LmBox<Theta>;
+Box MakeBox(const DamperFitOptions& o) {
+  Box box(
+      kNonlinear, [](int i) { return std::log(kLo[static_cast<std::size_t>(i)]); },
+      [](int i) { return std::log(kHi[static_cast<std::size_t>(i)]); });
+  const std::vector<std::string> names(kNames.begin(), kNames.end());
+  const std::vector<double> l(kLo.begin(), kLo.end()), h(kHi.begin(), kHi.end());
+  for (const auto& held : o.hold)
+    box.Hold(HeldIndex(held, names, l, h), std::log(held.second), fmt::format("held at {:g} by --hold", held.second));
+  return box;
+}
 
 // The model at theta on every record: residuals r = sqrt(w_r) (f - F) stacked, with k1 and
 // b = -k1 x0 solved by weighted linear least squares (file comment of damper_fit.h).
@@ -133,46 +130,19 @@ int MaxSubsteps(const Theta& th, const std::vector<Prepared>& data, double A) {
   return m;
 }
 
-struct LmState {
-  Theta theta;
-  Evaluation ev;
-  double mu = 1e-3;
-  int iterations = 0;
-  bool converged = false;
-};
+using State = LmState<Theta, Evaluation>;
 
-// Levenberg-Marquardt iterations on theta, the step projected on the box.
-void Iterate(LmState* s, const std::vector<Prepared>& data, double A, const Box& box, int iterations) {
-  for (int it = 0; it < iterations && !s->converged; ++it) {
-    const int m = MaxSubsteps(s->theta, data, A);
-    const Evaluation base = Evaluate(s->theta, data, A, m);
-    if (!std::isfinite(base.cost)) {
-      s->converged = true;
-      return;
-    }
-    Eigen::MatrixXd J(base.r.size(), kNonlinear);
-    for (int i = 0; i < kNonlinear; ++i) {
-      if (box.Held(i)) {  // not fitted: no column (DampedStep keeps it)
-        J.col(i).setZero();
-        continue;
-      }
-      Theta t = s->theta;
-      double h = 1e-5;
-      if (t[i] + h > box.hi[i]) h = -h;
-      t[i] += h;
-      const Evaluation e = Evaluate(t, data, A, m);
-      if (!std::isfinite(e.cost)) {
-        J.col(i).setZero();
-      } else {
-        J.col(i) = (e.r - base.r) / h;
-      }
-    }
-    const Eigen::MatrixXd H = J.transpose() * J;
-    const Eigen::VectorXd g = J.transpose() * base.r;
-    ++s->iterations;
-    DampedStep(H, g, &s->theta, &s->ev, &s->mu, [&](const Theta& t) { return Evaluate(t, data, A, 0); }, box.lo,
-               box.hi, 1e-7, 1e-6, &s->converged);
-  }
+// Levenberg-Marquardt iterations on theta (lm.h), the Jacobian at the base point's substeps.
+void Iterate(State* s, const std::vector<Prepared>& data, double A, const Box& box, int iterations) {
+  int m = 1;  // substeps of the base point, kept by its Jacobian's columns
+  LmIterate(
+      s, box, iterations,
+      [&](const Theta& t) {
+        m = MaxSubsteps(t, data, A);
+        return Evaluate(t, data, A, m);
+      },
+      [&](const Theta& t, const Evaluation&, int) { return Evaluate(t, data, A, m); },
+      [&](const Theta& t) { return Evaluate(t, data, A, 0); }, 1e-7, 1e-6);
 }
 
 }  // namespace
@@ -182,29 +152,13 @@ std::vector<double> SmoothVelocity(std::span<const double> x, double dt, double 
   if (n < 3) throw Error("SmoothVelocity", fmt::format("{} samples: need at least 3", n));
   if (!(dt > 0.0)) throw Error("SmoothVelocity", fmt::format("dt_s = {}: must be > 0", dt));
   if (!(cutoff_hz > 0.0)) throw Error("SmoothVelocity", fmt::format("cutoff_hz = {}: must be > 0", cutoff_hz));
-  std::vector<double> d(n);
-  d[0] = (x[1] - x[0]) / dt;
-  d[n - 1] = (x[n - 1] - x[n - 2]) / dt;
-  for (std::size_t k = 1; k + 1 < n; ++k) d[k] = (x[k + 1] - x[k - 1]) / (2.0 * dt);
+  const std::vector<double> d = signal::Derivative(x, dt);
   const double fs = 1.0 / dt;
   const double fc = std::min(cutoff_hz, 0.45 * fs);
-  const auto sos = signal::ButterworthLowpass(4, fc, fs);
-  // Odd reflection about both ends, about 3 time constants of the filter (at least 12 samples).
+  // Odd reflection about both ends, about 3 time constants of the filter (at least 12 samples);
+  // each pass starts at its first value's steady state.
   const std::size_t pad = std::min<std::size_t>(n - 1, std::max<std::size_t>(12, static_cast<std::size_t>(3.0 * fs / fc)));
-  std::vector<double> ext;
-  ext.reserve(n + 2 * pad);
-  for (std::size_t i = pad; i >= 1; --i) ext.push_back(2.0 * d[0] - d[i]);
-  ext.insert(ext.end(), d.begin(), d.end());
-  for (std::size_t i = 1; i <= pad; ++i) ext.push_back(2.0 * d[n - 1] - d[n - 1 - i]);
-  auto run = [&](auto begin, auto end) {
-    auto st = signal::SosAtRest(sos);
-    // Start at the first value's steady state: run the filter on a constant first.
-    for (int i = 0; i < 400; ++i) signal::SosStep(sos, &st, *begin);
-    for (auto it = begin; it != end; ++it) *it = signal::SosStep(sos, &st, *it);
-  };
-  run(ext.begin(), ext.end());
-  run(ext.rbegin(), ext.rend());
-  return {ext.begin() + static_cast<std::ptrdiff_t>(pad), ext.begin() + static_cast<std::ptrdiff_t>(pad + n)};
+  return signal::ZeroPhaseLowpass(d, dt, fc, 4, pad, signal::Reflection::kOdd, signal::FilterStart::kSteadyState);
 }
 
 double VelocityCutoffHz(const io::RigRecord& rec) {
@@ -245,10 +199,10 @@ std::string TomlFloat(double v) {
 }
 
 int DamperSubsteps(const models::MrDamperCoefficients& k, double dt, double vmax) {
-  const double lambda = 2.0 * std::sqrt(k.A * std::max(k.beta + k.gamma, 0.0)) * std::abs(vmax) +
-                        (k.A * k.alpha + k.k0) / (k.c0 + k.c1);
+  const double lambda =
+      BoucWenRateBound(k.A, std::max(k.beta + k.gamma, 0.0), std::abs(vmax), (k.A * k.alpha + k.k0) / (k.c0 + k.c1));
   if (!std::isfinite(lambda)) return 4000;
-  const double m = std::ceil(dt * lambda / 0.8);
+  const double m = SubstepsFor(dt, lambda);
   return static_cast<int>(std::clamp(m, 1.0, 4000.0));
 }
 
@@ -264,11 +218,7 @@ std::vector<double> SimulateDamperForce(const models::MrDamperCoefficients& k, s
     for (double vi : v) vmax = std::max(vmax, std::abs(vi));
     substeps = DamperSubsteps(k, dt, vmax);
   }
-  const double h = dt / substeps;
   models::MrDamperState s{x[0], 0.0};
-  auto rates = [&](const models::MrDamperState& st, double xm, double vm) {
-    return models::DamperRates(k, st, xm, vm);
-  };
   for (std::size_t j = 0; j < n; ++j) {
     f[j] = models::DamperForceKn(k, s, x[j], v[j]);
     if (!std::isfinite(f[j]) || !std::isfinite(s.y_mm) || !std::isfinite(s.z_mm)) {
@@ -277,19 +227,11 @@ std::vector<double> SimulateDamperForce(const models::MrDamperCoefficients& k, s
     }
     if (j + 1 == n) break;
     const double dx = x[j + 1] - x[j], dv = v[j + 1] - v[j];
-    for (int i = 0; i < substeps; ++i) {
-      const double a0 = static_cast<double>(i) / substeps, a1 = (i + 0.5) / substeps,
-                   a2 = static_cast<double>(i + 1) / substeps;
-      const double xa = x[j] + a0 * dx, va = v[j] + a0 * dv;
-      const double xb = x[j] + a1 * dx, vb = v[j] + a1 * dv;
-      const double xc = x[j] + a2 * dx, vc = v[j] + a2 * dv;
-      const auto r1 = rates(s, xa, va);
-      const auto r2 = rates({s.y_mm + 0.5 * h * r1.ydot_mm_s, s.z_mm + 0.5 * h * r1.zdot_mm_s}, xb, vb);
-      const auto r3 = rates({s.y_mm + 0.5 * h * r2.ydot_mm_s, s.z_mm + 0.5 * h * r2.zdot_mm_s}, xb, vb);
-      const auto r4 = rates({s.y_mm + h * r3.ydot_mm_s, s.z_mm + h * r3.zdot_mm_s}, xc, vc);
-      s.y_mm += h / 6.0 * (r1.ydot_mm_s + 2.0 * r2.ydot_mm_s + 2.0 * r3.ydot_mm_s + r4.ydot_mm_s);
-      s.z_mm += h / 6.0 * (r1.zdot_mm_s + 2.0 * r2.zdot_mm_s + 2.0 * r3.zdot_mm_s + r4.zdot_mm_s);
-    }
+    Rk4Substeps(substeps, dt, &s.y_mm, &s.z_mm, [&](double a, double y, double z, double* ydot, double* zdot) {
+      const auto r = models::DamperRates(k, {y, z}, x[j] + a * dx, v[j] + a * dv);
+      *ydot = r.ydot_mm_s;
+      *zdot = r.zdot_mm_s;
+    });
   }
   return f;
 }
@@ -321,14 +263,13 @@ DamperRecordScore ScoreForce(const io::RigRecord& rec, std::span<const double> F
   s.samples = rec.size();
   s.dt_s = rec.dt_s;
   s.velocity_cutoff_hz = velocity_cutoff_hz;
-  double se = 0.0, sf = 0.0;
+  signal::RmsErrorAccumulator eq31;  // Eq. 31 with f in the role of r
   for (std::size_t k = 0; k < rec.size(); ++k) {
-    se += (rec.f_kN[k] - F[k]) * (rec.f_kN[k] - F[k]);
-    sf += rec.f_kN[k] * rec.f_kN[k];
+    eq31.Add(rec.f_kN[k], F[k]);
     s.peak_force_kN = std::max(s.peak_force_kN, std::abs(rec.f_kN[k]));
   }
-  s.nrmse_f_pct = sf > 0.0 ? std::sqrt(se / sf) * 100.0 : std::numeric_limits<double>::quiet_NaN();
-  if (!std::isfinite(se)) s.nrmse_f_pct = std::numeric_limits<double>::infinity();
+  s.nrmse_f_pct = eq31.Percent();
+  if (!std::isfinite(eq31.sum_error2)) s.nrmse_f_pct = std::numeric_limits<double>::infinity();
   return s;
 }
 
@@ -422,9 +363,9 @@ Prepared PrepareRecord(const io::RigRecord& rec, const DamperFitOptions& o, Roug
 
 /// The starts (file comment of damper_fit.h): pre-yield travel delta [mm] x c1/c0, around the
 /// rough yield force Fy [kN] and viscous c [kN s/mm], evaluated.
-std::vector<LmState> Starts(double Fy, double c, double xmax, const std::vector<Prepared>& data, double A,
-                            const Box& box) {
-  std::vector<LmState> starts;
+std::vector<State> Starts(double Fy, double c, double xmax, const std::vector<Prepared>& data, double A,
+                          const Box& box) {
+  std::vector<State> starts;
   for (double delta : {0.1, 0.5, 2.0}) {
     for (double ratio : {1.0, 10.0}) {
       const double c0 = c * (1.0 + ratio) / ratio, c1 = ratio * c0;
@@ -432,7 +373,7 @@ std::vector<LmState> Starts(double Fy, double c, double xmax, const std::vector<
       const double bg = 1.0 / (A * delta * delta);      // beta + gamma
       const double alpha = Fy / zmax * (c0 + c1) / c1;  // alpha z_max c1 / (c0 + c1) = F_y
       const double k0 = 0.01 * Fy / std::max(xmax, 1e-3);
-      LmState s;
+      State s;
       s.theta << std::log(alpha), std::log(c0), std::log(c1), std::log(k0), std::log(0.5 * bg), std::log(0.5 * bg);
       s.theta = box.Clamp(s.theta);
       s.ev = Evaluate(s.theta, data, A, 0);
@@ -464,8 +405,8 @@ DamperFitResult FitDamper(const std::vector<io::RigRecord>& records, const Dampe
   if (!(Fy > 0.0)) Fy = 0.5 * fpeak;
   if (!(c > 0.0)) c = 0.1 * fpeak / vmax_all;
 
-  const Box box(o);
-  std::vector<LmState> starts = Starts(Fy, c, xmax, data, o.A, box);
+  const Box box = MakeBox(o);
+  std::vector<State> starts = Starts(Fy, c, xmax, data, o.A, box);
   DamperFitResult res;
   res.current_A = *o.current_A;
   int best = -1;
@@ -476,7 +417,7 @@ DamperFitResult FitDamper(const std::vector<io::RigRecord>& records, const Dampe
       best = static_cast<int>(i);
   }
   if (best < 0) throw Error("FitDamper", "no start gives a finite force prediction");
-  LmState& s = starts[static_cast<std::size_t>(best)];
+  State& s = starts[static_cast<std::size_t>(best)];
   s.converged = false;
   Iterate(&s, data, o.A, box, o.max_iterations.value_or(kMaxIterations));
   res.best_start = best;

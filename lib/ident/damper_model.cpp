@@ -6,6 +6,7 @@
 #include <optional>
 
 #include <Eigen/Dense>
+#include <fmt/format.h>
 
 #include "ident/fit_advice.h"
 
@@ -215,6 +216,53 @@ DamperRecordScore DamperModelFit::Score(const io::RigRecord& r) const {
 
 std::string DamperModelFit::ModelToml(const std::string& title) const {
   return (at_current ? DamperTomlFragment(*at_current, title) : SpencerModelToml(*any_input, title)) + measurement.Toml();
+}
+
+std::string DamperModelFit::HeldOutReport(const std::vector<io::RigRecord>& held) const {
+  if (held.empty()) return "";
+  std::string o = "  held-out force error (Eq. 31 on f), same model:\n";
+  const int width = at_current ? 6 : 7;
+  for (const auto& h : held) {
+    const auto sc = Score(h);
+    if (std::isfinite(sc.nrmse_f_pct)) {
+      o += fmt::format("    {:<40} {:>{}} samples at {:g} s, peak {:.4g} kN: {:.3f} %\n", sc.source, sc.samples, width,
+                       sc.dt_s, sc.peak_force_kN, sc.nrmse_f_pct);
+      continue;
+    }
+    // The prediction stopped being finite: say where, not "inf %".
+    const auto F = PredictForce(h);
+    std::size_t k = 0;
+    while (k < F.size() && std::isfinite(F[k])) ++k;
+    o += fmt::format("    {:<40} {:>{}} samples at {:g} s, peak {:.4g} kN: no score: the model's force stops being "
+                     "finite at t = {:.4g} s (sample {}): the model is too stiff for this record's motion (more than "
+                     "{} substeps a sample) or its state diverges there\n",
+                     sc.source, sc.samples, width, sc.dt_s, sc.peak_force_kN, static_cast<double>(k) * h.dt_s, k,
+                     kMaxSpencerSubsteps);
+  }
+  return o;
+}
+
+DamperModelFit::Verdict DamperModelFit::Judge(const std::string& tool, bool accept_unconverged) const {
+  // A failed fit (fit_status.h) is written, marked, and exits kExitFitFailed unless accepted; an
+  // implausible value is a warning. Either way, what to try (fit_advice.h).
+  Verdict v;
+  const auto& st = status();
+  for (const auto& p : st.implausible) v.messages += fmt::format("{}: warning: {}\n", tool, p.Warning());
+  if (const auto advice = Advice(); !advice.empty()) {
+    v.messages += fmt::format("{}: what to try (docs/identification.md \"When a fit fails\"):\n", tool);
+    for (const auto& a : advice) v.messages += fmt::format("  - {}\n", a);
+  }
+  if (st.Ok()) return v;
+  v.messages += fmt::format("{}: fit status: {}\n", tool, st.Summary());
+  if (accept_unconverged) {
+    v.messages += fmt::format("{}: --accept-unconverged: exit 0 all the same\n", tool);
+  } else {
+    v.messages += fmt::format("{}: exit {} (the model file says FIT FAILED; --accept-unconverged exits 0; "
+                              "docs/identification.md \"When a fit fails\")\n",
+                              tool, kExitFitFailed);
+    v.exit_code = kExitFitFailed;
+  }
+  return v;
 }
 
 }  // namespace rths::ident

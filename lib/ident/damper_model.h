@@ -46,6 +46,20 @@ struct DamperModelFit {
   DamperRecordScore Score(const io::RigRecord& record) const;
   /// The model as a TOML file (DamperTomlFragment or SpencerModelToml) with `title` in its first comment.
   std::string ModelToml(const std::string& title) const;
+  /// The held-out check `rths identify --damper --check` prints: a heading, then a line per record
+  /// with its samples, step [s], peak force [kN] and Score [%], or where the prediction stops
+  /// being finite (the model too stiff for the record's motion, or diverging); "" for no records.
+  std::string HeldOutReport(const std::vector<io::RigRecord>& held) const;
+
+  /// What a tool says after the model file, and the exit code it returns (the exit rule of
+  /// ident/fit_status.h).
+  struct Verdict {
+    std::string messages;  ///< lines for stderr, each starting "`tool`: ": warnings, what to try, the status
+    int exit_code = 0;     ///< 0, or kExitFitFailed for a fit that failed unless accepted
+  };
+  /// The implausible values (warnings), what to try (Advice), and for a fit that failed its
+  /// status and exit code: kExitFitFailed, or 0 with `accept_unconverged` (--accept-unconverged).
+  Verdict Judge(const std::string& tool, bool accept_unconverged) const;
 };
 
 /// Fits the damper model options ask for (options.current_A set: FitDamper; else FitSpencer) to

@@ -9,6 +9,7 @@
 #include <unsupported/Eigen/MatrixFunctions>
 
 #include "core/error.h"
+#include "ident/lm.h"
 
 namespace rths::ident {
 
@@ -359,41 +360,28 @@ double LevenbergMarquardt(const std::vector<Point>& pts, const PoleModel& start,
   theta = theta.cwiseMax(lower).cwiseMin(upper);
   Eigen::MatrixXd J;
   Evaluate(theta, odd, pts, o.zoh_dt_s, &r, &J);
-  double cost = r.squaredNorm(), lambda = 1e-3;
+  struct Cost {
+    double cost;
+  };
+  Cost ev{r.squaredNorm()};
+  double lambda = 1e-3;
+  // The damped step of lm.h with this fit's damping (PoleFitDamping).
+  const LmDamping rule = PoleFitDamping();
+  const auto evaluate = [&](const Eigen::VectorXd& trial) {
+    Evaluate(trial, odd, pts, o.zoh_dt_s, &rn, nullptr);
+    return Cost{rn.squaredNorm()};
+  };
   int it = 0;
   for (; it < o.max_iterations; ++it) {
     const Eigen::MatrixXd JtJ = J.transpose() * J;
     const Eigen::VectorXd g = J.transpose() * r;
-    bool accepted = false;
-    double step = 0.0, new_cost = cost;
-    for (int tries = 0; tries < 40 && !accepted; ++tries) {
-      Eigen::MatrixXd Aug = JtJ;
-      for (Eigen::Index i = 0; i < Aug.rows(); ++i) Aug(i, i) += lambda * std::max(JtJ(i, i), 1e-30);
-      const Eigen::VectorXd delta = Aug.ldlt().solve(-g);
-      if (!delta.allFinite()) {
-        lambda *= 10.0;
-        continue;
-      }
-      const Eigen::VectorXd trial = (theta + delta).cwiseMax(lower).cwiseMin(upper);
-      Evaluate(trial, odd, pts, o.zoh_dt_s, &rn, nullptr);
-      new_cost = rn.squaredNorm();
-      if (std::isfinite(new_cost) && new_cost <= cost) {
-        step = delta.norm();
-        theta = trial;
-        accepted = true;
-        lambda = std::max(lambda / 10.0, 1e-12);
-      } else {
-        lambda *= 10.0;
-      }
-    }
-    if (!accepted) {  // no descent direction left: at a minimum (to rounding)
+    const LmStep step = DampedStep(JtJ, g, &theta, &ev, &lambda, evaluate, lower, upper, rule);
+    if (!step.accepted) {  // no descent direction left: at a minimum (to rounding)
       out->converged = true;
       break;
     }
-    const double drop = cost - new_cost;
-    cost = new_cost;
     Evaluate(theta, odd, pts, o.zoh_dt_s, &r, &J);
-    if (step < 1e-12 || drop <= 1e-15 * std::max(cost, 1e-300)) {
+    if (step.solved_norm < 1e-12 || step.old_cost - step.new_cost <= 1e-15 * std::max(ev.cost, 1e-300)) {
       out->converged = true;
       ++it;
       break;
@@ -401,7 +389,7 @@ double LevenbergMarquardt(const std::vector<Point>& pts, const PoleModel& start,
   }
   out->iterations = it;
   out->model = FromTheta(theta, odd);
-  return cost;
+  return ev.cost;
 }
 
 /// The fitted response's errors at the points (of its ZOH discretisation if o.zoh_dt_s > 0).

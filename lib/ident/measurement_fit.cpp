@@ -9,6 +9,7 @@
 #include "core/error.h"
 #include "ident/damper_fit.h"
 #include "models/rig_effects.h"
+#include "signal/derivative.h"
 
 namespace rths::ident {
 
@@ -87,14 +88,7 @@ double CorrelationTime(const std::vector<Rec>& recs, double skew_s, double m) {
 }  // namespace
 
 std::vector<double> SmoothAcceleration(const io::RigRecord& r, double cutoff_hz) {
-  const auto v = SmoothVelocity(r.y_mm, r.dt_s, cutoff_hz);
-  const std::size_t n = v.size();
-  std::vector<double> a(n, 0.0);
-  if (n < 2) return a;
-  for (std::size_t k = 1; k + 1 < n; ++k) a[k] = (v[k + 1] - v[k - 1]) / (2.0 * r.dt_s);
-  a[0] = (v[1] - v[0]) / r.dt_s;
-  a[n - 1] = (v[n - 1] - v[n - 2]) / r.dt_s;
-  return a;
+  return signal::Derivative(SmoothVelocity(r.y_mm, r.dt_s, cutoff_hz), r.dt_s);
 }
 
 std::vector<double> MeasurementFit::Measured(std::span<const double> F_kN, const io::RigRecord& r, double cutoff_hz) const {

@@ -12,6 +12,7 @@
 
 #include "core/error.h"
 #include "ident/damper_fit.h"
+#include "ident/bouc_wen_rk4.h"
 #include "ident/lm.h"
 #include "ident/plausible_range.h"
 
@@ -54,23 +55,10 @@ constexpr const char* kParamNames[kEta + 1] = {"alpha_a", "alpha_b", "alpha_c", 
                                                "gamma_a", "gamma_b", "gamma_c", "k0",      "eta_1_s"};
 
 // The box the fit searches theta in: ln of the bounds, or a point for a held parameter.
-struct Box {
-  Eigen::VectorXd lo, hi;
-  std::vector<std::string> held_why;  // per coordinate: why it is held ("" = fitted)
-
-  explicit Box(int dim) : lo(dim), hi(dim), held_why(static_cast<std::size_t>(dim)) {
-    for (int i = 0; i < dim; ++i) {
-      lo[i] = std::log(LoBound(i));
-      hi[i] = std::log(HiBound(i));
-    }
-  }
-  void Hold(int i, double value, std::string why) {
-    lo[i] = hi[i] = std::log(value);
-    held_why[static_cast<std::size_t>(i)] = std::move(why);
-  }
-  bool Held(int i) const { return !held_why[static_cast<std::size_t>(i)].empty(); }
-  Eigen::VectorXd Clamp(const Eigen::VectorXd& th) const { return ClampToBox(th, lo, hi); }
-};
+using Box = LmBox<Eigen::VectorXd>;
+Box MakeBox(int dim) {
+  return Box(dim, [](int i) { return std::log(LoBound(i)); }, [](int i) { return std::log(HiBound(i)); });
+}
 
 models::MrDamperParams ParamsOf(const Eigen::VectorXd& th, double A) {
   models::MrDamperParams p;
@@ -132,9 +120,9 @@ int LocalSubsteps(const models::MrDamperCoefficients& c0, const models::MrDamper
                   double v0, double v1, double dt) {
   const double bg = std::max(c0.beta + c0.gamma, c1.beta + c1.gamma);
   const double slow = std::max((A * c0.alpha + k0) / (c0.c0 + c0.c1), (A * c1.alpha + k0) / (c1.c0 + c1.c1));
-  const double lambda = 2.0 * std::sqrt(A * bg) * std::max(std::abs(v0), std::abs(v1)) + slow;
+  const double lambda = BoucWenRateBound(A, bg, std::max(std::abs(v0), std::abs(v1)), slow);
   if (!(lambda < 1e300)) return kMaxSpencerSubsteps + 1;
-  const double m = std::ceil(dt * lambda / 0.8);
+  const double m = SubstepsFor(dt, lambda);
   return m > kMaxSpencerSubsteps ? kMaxSpencerSubsteps + 1 : std::max(1, static_cast<int>(m));
 }
 
@@ -184,18 +172,8 @@ bool SimulateNonlinear(const models::MrDamperParams& p, const models::CurrentDri
       if (mj > kMaxSpencerSubsteps) return false;
       (*msteps)[j] = static_cast<std::uint8_t>(mj);
     }
-    const int m = (*msteps)[j];
-    const double h = dt / m;
-    for (int i = 0; i < m; ++i) {
-      const double s0 = static_cast<double>(i) / m, s1 = (i + 0.5) / m, s2 = static_cast<double>(i + 1) / m;
-      double dy1, dz1, dy2, dz2, dy3, dz3, dy4, dz4;
-      rates(j, s0, y, z, &dy1, &dz1);
-      rates(j, s1, y + 0.5 * h * dy1, z + 0.5 * h * dz1, &dy2, &dz2);
-      rates(j, s1, y + 0.5 * h * dy2, z + 0.5 * h * dz2, &dy3, &dz3);
-      rates(j, s2, y + h * dy3, z + h * dz3, &dy4, &dz4);
-      y += h / 6.0 * (dy1 + 2.0 * dy2 + 2.0 * dy3 + dy4);
-      z += h / 6.0 * (dz1 + 2.0 * dz2 + 2.0 * dz3 + dz4);
-    }
+    Rk4Substeps((*msteps)[j], dt, &y, &z,
+                [&](double s, double ys, double zs, double* dy, double* dz) { rates(j, s, ys, zs, dy, dz); });
   }
   return true;
 }
@@ -264,60 +242,20 @@ class Problem {
   std::size_t total_ = 0;
 };
 
-struct LmState {
-  Eigen::VectorXd theta;
-  Evaluation ev;
-  double mu = 1e-3;
-  int iterations = 0;
-  bool converged = false;
-};
+using State = LmState<Eigen::VectorXd, Evaluation>;
 
-/// `on_iteration`: called after each iteration (may be empty).
-void Iterate(LmState* s, const Problem& pb, int iterations, int threads,
-             const std::function<void()>& on_iteration = {}) {
-  const int P = pb.dim();
+/// Levenberg-Marquardt iterations (lm.h), the Jacobian's columns on `threads` threads at the base
+/// point's substeps. `on_iteration`: called after each iteration (may be empty).
+void Iterate(State* s, const Problem& pb, int iterations, int threads, const std::function<void()>& on_iteration = {}) {
   std::vector<Workspace> ws(static_cast<std::size_t>(threads));
   std::vector<std::vector<double>> fnl(static_cast<std::size_t>(threads));
-  for (int it = 0; it < iterations && !s->converged; ++it) {
-    const Evaluation base = pb.Evaluate(s->theta, nullptr, &ws[0], &fnl[0]);
-    if (!std::isfinite(base.cost)) {
-      s->converged = true;
-      return;
-    }
-    Eigen::MatrixXd J(base.r.size(), P);
-    auto column = [&](int i, int t) {
-      if (pb.box().Held(i)) {  // not fitted: no column (DampedStep keeps it)
-        J.col(i).setZero();
-        return;
-      }
-      Eigen::VectorXd th = s->theta;
-      double h = 1e-5;
-      if (th[i] + h > pb.box().hi[i]) h = -h;
-      th[i] += h;
-      const Evaluation e = pb.Evaluate(th, &base, &ws[static_cast<std::size_t>(t)], &fnl[static_cast<std::size_t>(t)]);
-      if (std::isfinite(e.cost))
-        J.col(i) = (e.r - base.r) / h;
-      else
-        J.col(i).setZero();
-    };
-    if (threads <= 1) {
-      for (int i = 0; i < P; ++i) column(i, 0);
-    } else {
-      std::vector<std::thread> pool;
-      for (int t = 0; t < threads; ++t)
-        pool.emplace_back([&, t] {
-          for (int i = t; i < P; i += threads) column(i, t);
-        });
-      for (auto& th : pool) th.join();
-    }
-    const Eigen::MatrixXd H = J.transpose() * J;
-    const Eigen::VectorXd g = J.transpose() * base.r;
-    ++s->iterations;
-    DampedStep(
-        H, g, &s->theta, &s->ev, &s->mu, [&](const Eigen::VectorXd& t) { return pb.Evaluate(t, nullptr, &ws[0], &fnl[0]); },
-        pb.box().lo, pb.box().hi, 1e-9, 1e-7, &s->converged);
-    if (on_iteration) on_iteration();
-  }
+  LmIterate(
+      s, pb.box(), iterations, [&](const Eigen::VectorXd& t) { return pb.Evaluate(t, nullptr, &ws[0], &fnl[0]); },
+      [&](const Eigen::VectorXd& t, const Evaluation& base, int k) {
+        return pb.Evaluate(t, &base, &ws[static_cast<std::size_t>(k)], &fnl[static_cast<std::size_t>(k)]);
+      },
+      [&](const Eigen::VectorXd& t) { return pb.Evaluate(t, nullptr, &ws[0], &fnl[0]); }, 1e-9, 1e-7, threads,
+      on_iteration);
 }
 
 // Rough f ~ F_y sgn(x') + c x' + k x + b on the samples with `use`, weighted per record.
@@ -465,13 +403,13 @@ std::pair<Rough, Rough> RoughEnds(const std::vector<Prepared>& data, const Exten
 
 /// The starts (file comment): pre-yield travel at each end of the input range x c1/c0 from the
 /// rough ends ra, rb, evaluated on pb (the first part of every record).
-std::vector<LmState> Starts(const Rough& ra, const Rough& rb, const Extent& e, const Problem& pb,
-                            const DamperFitOptions& o) {
-  std::vector<LmState> starts;
+std::vector<State> Starts(const Rough& ra, const Rough& rb, const Extent& e, const Problem& pb,
+                          const DamperFitOptions& o) {
+  std::vector<State> starts;
   const std::pair<double, double> travels[] = {{0.1, 0.1}, {0.1, 0.5}, {0.5, 0.5}, {0.5, 2.0}, {2.0, 2.0}};
   for (const auto& [delta_a, delta_b] : travels) {
     for (double ratio : {1.0, 10.0}) {
-      LmState s;
+      State s;
       s.theta.resize(pb.dim());
       const double rate = 2.0 / std::max(e.in_hi, 1e-6);
       const Rough* ends[2] = {&ra, &rb};
@@ -502,7 +440,7 @@ std::vector<LmState> Starts(const Rough& ra, const Rough& rb, const Extent& e, c
 /// The start to continue on all the data: the best by its cost on the first part whose cost on
 /// all of it (pb) is finite (a start may meet a stiffer stretch later in the records); its ev is
 /// re-evaluated on all the data. -1 if none.
-int BestOnAllData(std::vector<LmState>* starts, const Problem& pb) {
+int BestOnAllData(std::vector<State>* starts, const Problem& pb) {
   std::vector<std::size_t> order(starts->size());
   for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
   std::stable_sort(order.begin(), order.end(),
@@ -541,16 +479,16 @@ std::vector<double> ConstantLevels(const std::vector<Prepared>& data, const Exte
 /// held at 3 / (level_2 - level_1): 95 % of the change between them is made by the upper one).
 /// Then the parameters the options hold (DamperFitOptions::hold), over the design's.
 Box DesignBox(const std::vector<double>& levels, const DamperFitOptions& o, bool voltage) {
-  Box box(Dim(o.filter));
+  Box box = MakeBox(Dim(o.filter));
   const char* unit = voltage ? "V" : "A";
   if (!levels.empty() && o.filter == ControlFilter::kFirstOrder)
-    box.Hold(kEta, o.eta_start_1_s,
+    box.Hold(kEta, std::log(o.eta_start_1_s),
              "every record holds its command constant, so the filter's time constant never shows: the value of "
              "the starts");
   if (levels.size() == 2) {
     const double rate = 3.0 / (levels[1] - levels[0]);
     for (int l = 0; l < kLaws; ++l)
-      box.Hold(3 * l + 2, std::clamp(rate, kRateLo, kRateHi),
+      box.Hold(3 * l + 2, std::log(std::clamp(rate, kRateLo, kRateHi)),
                fmt::format("the records hold two input levels, {:.4g} and {:.4g} {}, which fix each law there only: "
                            "between them the law is this assumption",
                            levels[0], levels[1], unit));
@@ -560,12 +498,12 @@ Box DesignBox(const std::vector<double>& levels, const DamperFitOptions& o, bool
   std::vector<double> lo, hi;
   for (int i = 0; i < dim; ++i) lo.push_back(LoBound(i)), hi.push_back(HiBound(i));
   for (const auto& h : o.hold)
-    box.Hold(HeldIndex(h, names, lo, hi), h.second, fmt::format("held at {:g} by --hold", h.second));
+    box.Hold(HeldIndex(h, names, lo, hi), std::log(h.second), fmt::format("held at {:g} by --hold", h.second));
   return box;
 }
 
 /// How the fit ended (fit_status.h) at theta.
-FitStatus StatusAt(const LmState& s, const Box& box, int max_iterations) {
+FitStatus StatusAt(const State& s, const Box& box, int max_iterations) {
   FitStatus st;
   st.converged = s.converged;
   st.iterations = s.iterations;
@@ -621,7 +559,7 @@ SpencerFitResult FitSpencer(const std::vector<io::RigRecord>& records, const Dam
     d.n = std::min(d.rec->size(), std::max(static_cast<std::size_t>(kStartShare * static_cast<double>(d.rec->size())),
                                            static_cast<std::size_t>(kStartMinS / d.rec->dt_s)));
   const Problem pb_part(part, o, box), pb(data, o, box);
-  std::vector<LmState> starts = Starts(ra, rb, e, pb_part, o);
+  std::vector<State> starts = Starts(ra, rb, e, pb_part, o);
   const int start_iterations = o.start_iterations.value_or(kStartIterations);
   const int max_iterations = o.max_iterations.value_or(kMaxIterations);
   res.filter = o.filter;
@@ -645,7 +583,7 @@ SpencerFitResult FitSpencer(const std::vector<io::RigRecord>& records, const Dam
   if (!any) throw Error("FitSpencer", "no start gives a finite force prediction");
   const int best = BestOnAllData(&starts, pb);
   if (best < 0) throw Error("FitSpencer", "no start gives a finite force prediction on all the data");
-  LmState& s = starts[static_cast<std::size_t>(best)];
+  State& s = starts[static_cast<std::size_t>(best)];
   s.converged = false;
   done = 0.25 * static_cast<double>(starts.size() * static_cast<std::size_t>(start_iterations));
   Iterate(&s, pb, max_iterations, threads, [&] { step(1.0, "least squares on the whole record"); });

@@ -1,5 +1,7 @@
 #include "io/plot.h"
 
+#include <unistd.h>
+
 #include <csignal>
 #include <algorithm>
 #include <cerrno>
@@ -327,6 +329,23 @@ PlotFiles Plot(const Figure& fig, const fs::path& dir) {
     throw Error(where, fmt::format("gnuplot made no PNG from {}:\n{}", files.gp.string(), output));
   }
   return files;
+}
+
+void PlotPng(Figure fig, const fs::path& png) {
+  const fs::path dir = fs::temp_directory_path() / fmt::format("rths_plot_{}", ::getpid());
+  std::error_code ec;
+  fs::remove_all(dir, ec);
+  fs::create_directories(dir);
+  fig.name = "plot";
+  try {
+    const auto files = Plot(fig, dir);
+    fs::copy_file(files.png, png, fs::copy_options::overwrite_existing, ec);
+    if (ec) throw Error(png.string(), "cannot write the plot: " + ec.message());
+  } catch (...) {
+    fs::remove_all(dir, ec);
+    throw;
+  }
+  fs::remove_all(dir, ec);
 }
 
 }  // namespace rths::io

@@ -133,6 +133,11 @@ struct PlotFiles {
 /// or if gnuplot fails (with its messages) or leaves no PNG.
 PlotFiles Plot(const Figure& figure, const std::filesystem::path& dir);
 
+/// Draws `figure` with Plot in a private temporary folder and puts only its PNG at `png` (for a
+/// user who asked for a picture, not gnuplot's data and script). Throws what Plot throws, or
+/// rths::Error naming `png` if it cannot be written.
+void PlotPng(Figure figure, const std::filesystem::path& png);
+
 /// True if `program` can be run (an executable path, or a name found in /usr/local/bin, /usr/bin
 /// or /bin; a main program looks the user's PATH up itself: tools/cli.h ProgramOnPath).
 bool GnuplotAvailable(const std::string& program = "gnuplot");

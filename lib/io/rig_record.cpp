@@ -72,6 +72,8 @@ std::string OutOfBounds(std::string_view column, double v) {
 
 bool DtInRange(double dt) { return dt >= kMinDtS && dt <= kMaxDtS; }
 
+/// The upper median: one of the record's own steps (not signal::Median, which averages the two
+/// middle values of an even count, and would move a record's step).
 double Median(std::vector<double> v) {
   std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
   return v[v.size() / 2];

@@ -191,6 +191,8 @@ ResponseSummary Summarize(const Eigen::MatrixXd& x) {
 double NrmsePct(const Eigen::Ref<const Eigen::RowVectorXd>& x, const Eigen::Ref<const Eigen::RowVectorXd>& ref) {
   if (x.size() != ref.size())
     throw Error("NrmsePct", fmt::format("sizes differ ({} vs {})", x.size(), ref.size()));
+  // Eq. 31 by Eigen's (vectorised) sums, not signal::RmsErrorPercent's sample-by-sample ones: the
+  // two can differ in the last bit, and the structure tables print these numbers.
   const double den = ref.squaredNorm();
   return den > 0.0 ? 100.0 * std::sqrt((x - ref).squaredNorm() / den) : 0.0;
 }

@@ -11,10 +11,13 @@
 #include <fmt/format.h>
 
 #include "diagnosis/channel_models.h"
+#include "io/bode_figure.h"
 #include "participants/benchmark_run.h"
 #include "report/html.h"
 #include "signal/spectrum_axes.h"
 #include "signal/benchmark_criteria.h"
+#include "signal/bode.h"
+#include "signal/derivative.h"
 #include "signal/metrics.h"
 #include "signal/spectral.h"
 
@@ -30,7 +33,6 @@ namespace run_figures {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-constexpr double kPi = 3.14159265358979323846;
 /// Half the window of the tracking error's zoom [s].
 constexpr double kZoomHalfS = 0.125;
 /// A coherence within this of 1 over the whole band is a flat line at 1 on the page (a run without
@@ -253,7 +255,7 @@ std::optional<PageFigure> RealtimeLatency(const RunData& d, const RunReportOptio
 double LoopVelocityCutoffHz(double dt_s) { return std::min(kLoopVelocityCutoffHz, 0.4 / dt_s); }
 
 std::vector<double> LoopVelocity(const std::vector<double>& y_mm, double dt_s) {
-  if (y_mm.size() < 4 || !AllFinite(y_mm)) return CentralDifference(y_mm, dt_s);
+  if (y_mm.size() < 4 || !AllFinite(y_mm)) return signal::Derivative(y_mm, dt_s);
   return diagnosis::SmoothMotion(y_mm, dt_s, LoopVelocityCutoffHz(dt_s)).v_mm_s;
 }
 
@@ -349,59 +351,64 @@ std::optional<ExcitedBand> FindExcitedBand(const signal::CrossSpectra& cs, doubl
 void GyrFigure(const signal::CrossSpectra& cs, const signal::FrequencyResponseEstimate& h1, const ExcitedBand& band,
                const RunReportOptions& o, FrequencyFigures* out) {
   const std::size_t i_lo = band.i_lo, i_hi = band.i_hi;
-  const std::span<const std::complex<double>> band_h(h1.h.data() + i_lo, i_hi - i_lo + 1);
-  const std::vector<double> phase = signal::UnwrapPhase(band_h);
-  Panel mag = MakePanel("Magnitude", "frequency [Hz]", "|G_yr| [-]");
-  Panel ph = MakePanel("Phase (unwrapped)", "frequency [Hz]", "phase [deg]");
-  Panel coh = MakePanel("Coherence", "frequency [Hz]", "coherence [-]");
-  mag.key = ph.key = "off";
-  coh.key = "bottom left";
-  Series sm = MakeSeries("|G_yr|", kColorY), sph = MakeSeries("phase", kColorY);
-  Series sc = MakeSeries("gamma^2", kColorU), sth = MakeSeries(fmt::format("mask below {:g}", o.min_coherence), "black", 2);
+  const std::size_t n = i_hi - i_lo + 1;
+  const signal::BodeCurve gyr = signal::BodeFromResponse("G_yr", std::span<const double>(h1.f_hz).subspan(i_lo, n),
+                                                         std::span<const std::complex<double>>(h1.h).subspan(i_lo, n),
+                                                         std::span<const double>(h1.coherence).subspan(i_lo, n));
+  // Masked: the points with a low coherence, or below the band's floor, left out of magnitude and
+  // phase (their coherence is drawn).
+  io::BodeTrace trace;
+  trace.curve = gyr;
+  trace.style = MakeSeries("|G_yr|", kColorY);
+  trace.phase_title = "phase";
+  trace.coherence_style = MakeSeries("gamma^2", kColorU);
   std::vector<double> lag_ms, mags;
   std::size_t kept = 0;
   for (std::size_t i = i_lo; i <= i_hi; ++i) {
-    const double f = h1.f_hz[i];
     const bool ok = h1.coherence[i] >= o.min_coherence && cs.s_uu[i] >= band.floor;
-    const double m = std::abs(h1.h[i]);
-    const double p_deg = phase[i - i_lo] * 180.0 / kPi;
-    sm.x.push_back(f);
-    sm.y.push_back(ok ? m : kNaN);
-    sph.x.push_back(f);
-    sph.y.push_back(ok ? p_deg : kNaN);
-    sc.x.push_back(f);
-    sc.y.push_back(h1.coherence[i]);
     if (ok) {
       ++kept;
-      mags.push_back(m);
-      lag_ms.push_back(-phase[i - i_lo] / (2.0 * kPi * f) * 1e3);
+      mags.push_back(gyr.magnitude[i - i_lo]);
+      lag_ms.push_back(gyr.lag_ms[i - i_lo]);
+    } else {
+      trace.curve.magnitude[i - i_lo] = trace.curve.phase_deg[i - i_lo] = kNaN;
     }
   }
   const double f_lo = h1.f_hz[i_lo], f_hi = h1.f_hz[i_hi];
-  sth.x = {f_lo, f_hi};
-  sth.y = {o.min_coherence, o.min_coherence};
-  sth.width = 1.0;
-  const std::pair<double, double> xr{f_lo, f_hi > f_lo ? f_hi : f_lo + cs.df_hz};
-  mag.x_range = ph.x_range = coh.x_range = xr;
-  coh.y_range = std::make_pair(0.0, 1.05);
-  mag.series = {sm};
-  ph.series = {sph};
-  coh.series = {sc, sth};
   if (kept == 0) {
     out->notes.push_back(fmt::format("no G_yr: no frequency of the excited band {:.3g}-{:.3g} Hz has a coherence "
                                      ">= {:g}",
                                      f_lo, f_hi, o.min_coherence));
     return;
   }
-  PageFigure g{NewFigure("gyr", o), "G_yr = Y / R", ""};
-  g.figure.title = "G_yr = Y / R: measured displacement y over desired displacement r (H1 estimate)";
+  Series sth = MakeSeries(fmt::format("mask below {:g}", o.min_coherence), "black", 2);
+  sth.x = {f_lo, f_hi};
+  sth.y = {o.min_coherence, o.min_coherence};
+  sth.width = 1.0;
   // A simulation without sensor noise is a deterministic map from r to y: its coherence is 1 but
   // for the damper's slight nonlinearity, and a panel of it would be a flat line. It is drawn when
   // it says something.
   double min_coherence = 1.0;
   for (std::size_t i = i_lo; i <= i_hi; ++i) min_coherence = std::min(min_coherence, h1.coherence[i]);
   const bool coherence_flat = min_coherence > 1.0 - kFlatCoherence;
-  g.figure.panels = coherence_flat ? std::vector<Panel>{mag, ph} : std::vector<Panel>{mag, ph, coh};
+  io::BodeLayout layout;
+  layout.f_range_hz = {f_lo, f_hi > f_lo ? f_hi : f_lo + cs.df_hz};
+  layout.x_label = "frequency [Hz]";
+  layout.magnitude_title = "Magnitude";
+  layout.magnitude_label = "|G_yr| [-]";
+  layout.phase_title = "Phase (unwrapped)";
+  layout.phase_label = "phase [deg]";
+  layout.lag_panel = false;
+  layout.coherence_panel = !coherence_flat;
+  layout.coherence_title = "Coherence";
+  layout.coherence_label = "coherence [-]";
+  layout.coherence_extra = {sth};
+  layout.magnitude_key = "off";
+  layout.coherence_key = "bottom left";
+  layout.key_margin = false;
+  PageFigure g{NewFigure("gyr", o), "G_yr = Y / R", ""};
+  g.figure.title = "G_yr = Y / R: measured displacement y over desired displacement r (H1 estimate)";
+  g.figure.panels = io::BodeFigure(layout, {trace}).panels;
   g.figure.panel_height_px = 280;
   g.caption_html = fmt::format(
       "H1 estimate of the tracking transfer function G<sub>yr</sub> = S<sub>ry</sub> / S<sub>rr</sub> (same "
@@ -592,16 +599,6 @@ bool Drawable(const Figure& fig) {
 }
 
 }  // namespace run_figures
-
-std::vector<double> CentralDifference(const std::vector<double>& x, double dt_s) {
-  const std::size_t n = x.size();
-  std::vector<double> v(n, 0.0);
-  if (n < 2) return v;
-  v[0] = (x[1] - x[0]) / dt_s;
-  v[n - 1] = (x[n - 1] - x[n - 2]) / dt_s;
-  for (std::size_t k = 1; k + 1 < n; ++k) v[k] = (x[k + 1] - x[k - 1]) / (2.0 * dt_s);
-  return v;
-}
 
 std::vector<std::size_t> MinMaxDecimate(const std::vector<double>& x, std::size_t max_points) {
   const std::size_t n = x.size();

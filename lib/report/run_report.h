@@ -103,10 +103,6 @@ ReportFiles WriteRunReport(const RunData& data, const RunReportOptions& options 
 /// LoadRunData(run_dir), then WriteRunReport: the call for `rths run --report`.
 ReportFiles WriteRunReport(const std::filesystem::path& run_dir, const RunReportOptions& options = {});
 
-/// The velocity of x by central difference, (x_{k+1} - x_{k-1}) / (2 dt) [unit/s], one-sided at
-/// the ends (0 for fewer than 2 samples).
-std::vector<double> CentralDifference(const std::vector<double>& x, double dt_s);
-
 /// Indices of the samples of x that a plot keeps: every sample if x.size() <= max_points, else the
 /// minimum and the maximum of each of max_points / 2 consecutive buckets, in time order (so the
 /// envelope and every peak survive). max_points >= 4.

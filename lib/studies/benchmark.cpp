@@ -67,9 +67,11 @@ BenchmarkIdentification Identify(const scenario::Scenario& base, const Reproduce
   fit_opts.fit.poles = 3;
   fit_opts.fit.band_lo_hz = 0.5;
   fit_opts.fit.band_hi_hz = kBenchmarkFitHiHz;
-  fit_opts.fit.zoh_dt_s = 0.0;  // a design model: the hold's half-sample lag included (as `rths identify`'s [controller] model)
   const double dt = specs[0].scenario.run.dt_s;
-  id.fit = ident::Identify(u, y, dt, fit_opts);
+  // What `rths identify --out` fits; the continuous fit is the design model (the hold's
+  // half-sample lag included, as `rths identify`'s [controller] model).
+  const ident::ActuatorFit fit = ident::FitActuator(u, y, dt, fit_opts);
+  id.fit = fit.continuous;
   id.model = id.fit.fit.model.ToServoModel3();
   id.model.name = "custom";
   id.model_lag_ms = 1e3 * id.fit.fit.model.DcLagS();
@@ -78,14 +80,9 @@ BenchmarkIdentification Identify(const scenario::Scenario& base, const Reproduce
   id.plant_dc_gain = plant.DcGain();
   id.plant_lag_ms = 1e3 * models::TimeLagS(plant, 1.0, false);
 
-  {  // what `rths identify --out` writes, and its report
-    ident::IdentifyOptions zo = fit_opts;
-    zo.fit.zoh_dt_s = dt;
-    const ident::IdentifyResult zoh = ident::Identify(u, y, dt, zo);
-    std::ofstream(opts.out_dir / "identify.toml")
-        << ident::ScenarioFragment(id.fit, zoh, "benchmark plant (nominal), BLWN identification record");
-    std::ofstream(opts.out_dir / "identify.txt") << id.fit.Report();
-  }
+  // What `rths identify --out` writes, and the continuous fit's report.
+  std::ofstream(opts.out_dir / "identify.toml") << fit.ModelToml("benchmark plant (nominal), BLWN identification record");
+  std::ofstream(opts.out_dir / "identify.txt") << id.fit.Report();
   if (opts.log) {
     opts.log(fmt::format("benchmark: fitted K = {:.5g}, p = {:.5g}, b = {:.5g}, c = {:.5g}: DC gain {:.4f}, lag {:.2f} ms "
                          "(the plant: {:.4f}, {:.2f} ms at 1 Hz)",
@@ -93,24 +90,6 @@ BenchmarkIdentification Identify(const scenario::Scenario& base, const Reproduce
                          id.plant_dc_gain, id.plant_lag_ms));
   }
   return id;
-}
-
-BenchmarkSpread Spread(const std::vector<double>& v) {
-  BenchmarkSpread s;
-  s.n = static_cast<int>(v.size());
-  if (v.empty()) {
-    s.mean = s.std = s.min = s.max = std::nan("");
-    return s;
-  }
-  double sum = 0.0;
-  for (double x : v) sum += x;
-  s.mean = sum / s.n;
-  double ss = 0.0;
-  for (double x : v) ss += (x - s.mean) * (x - s.mean);
-  s.std = s.n > 1 ? std::sqrt(ss / (s.n - 1)) : 0.0;
-  s.min = *std::min_element(v.begin(), v.end());
-  s.max = *std::max_element(v.begin(), v.end());
-  return s;
 }
 
 /// The example controller's nominal loop closed four ways (studies/benchmark_loop.h).
@@ -270,7 +249,7 @@ void Spreads(BenchmarkResult* res) {
           if (row.case_number == cs && row.controller == names[c] && row.run != "nominal" && row.criteria_ok)
             v.push_back(row.j.At(j));
         }
-        res->spread[cs - 1][c][j] = Spread(v);
+        res->spread[cs - 1][c][j] = signal::SpreadOf(v);
       }
     }
   }

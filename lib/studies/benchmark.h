@@ -25,11 +25,13 @@
 #include <vector>
 
 #include "control/controller_config.h"
+#include "ident/actuator_fit.h"
 #include "ident/identify.h"
 #include "models/benchmark_plant.h"
 #include "studies/study.h"
 #include "scenario/scenario.h"
 #include "signal/benchmark_criteria.h"
+#include "signal/stats.h"
 
 namespace rths::studies {
 
@@ -92,10 +94,7 @@ struct BenchmarkRow {
 
 /// Mean, sample standard deviation, min and max of one criterion over a controller's perturbed
 /// runs in one case (those whose criteria could be computed).
-struct BenchmarkSpread {
-  double mean = 0.0, std = 0.0, min = 0.0, max = 0.0;
-  int n = 0;
-};
+using BenchmarkSpread = signal::Spread;
 
 /// One closing of the example controller's nominal loop (studies/benchmark_loop.h).
 struct BenchmarkLoopRow {

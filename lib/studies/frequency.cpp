@@ -5,12 +5,11 @@
 
 #include <algorithm>
 #include <cmath>
-#include <complex>
-#include <numbers>
 
 #include <fmt/format.h>
 
 #include "core/error.h"
+#include "io/bode_figure.h"
 #include "io/csv.h"
 #include "studies/figures.h"
 
@@ -18,50 +17,8 @@ namespace rths::studies {
 
 namespace fs = std::filesystem;
 using io::Series;
-using io::Panel;
 using io::Figure;
-using io::MakePanel;
 using io::CsvWriter;
-
-BodeCurve BodeFromEstimate(const std::string& name, const signal::FrequencyResponseEstimate& est, double f_max_hz) {
-  BodeCurve c;
-  c.name = name;
-  std::vector<std::complex<double>> h;
-  for (std::size_t i = 1; i < est.f_hz.size() && est.f_hz[i] <= f_max_hz + 1e-9; ++i) {
-    c.f_hz.push_back(est.f_hz[i]);
-    h.push_back(est.h[i]);
-    c.coherence.push_back(est.coherence[i]);
-  }
-  const std::vector<double> phase = signal::UnwrapPhase(h);
-  for (std::size_t i = 0; i < h.size(); ++i) {
-    c.magnitude.push_back(std::abs(h[i]));
-    c.phase_deg.push_back(phase[i] * 180.0 / std::numbers::pi);
-    c.lag_ms.push_back(-phase[i] / (2.0 * std::numbers::pi * c.f_hz[i]) * 1e3);
-  }
-  return c;
-}
-
-BodeCurve BodeFromModel(const std::string& name, const ident::PoleModel& model, const std::vector<double>& f_hz,
-                        double zoh_dt_s) {
-  BodeCurve c;
-  c.name = name;
-  c.f_hz = f_hz;
-  std::vector<std::complex<double>> h;
-  if (zoh_dt_s > 0.0) {
-    const ident::ZohModel d = ident::Discretise(model, zoh_dt_s);
-    for (double f : f_hz) h.push_back(ident::ZohResponse(d, f));
-  } else {
-    for (double f : f_hz) h.push_back(model.Response(f));
-  }
-  const std::vector<double> phase = signal::UnwrapPhase(h);
-  for (std::size_t i = 0; i < h.size(); ++i) {
-    c.magnitude.push_back(std::abs(h[i]));
-    c.phase_deg.push_back(phase[i] * 180.0 / std::numbers::pi);
-    c.lag_ms.push_back(-phase[i] / (2.0 * std::numbers::pi * f_hz[i]) * 1e3);
-    c.coherence.push_back(1.0);
-  }
-  return c;
-}
 
 signal::SignalSpec FrequencyExcitation() {
   signal::SignalSpec spec;
@@ -114,50 +71,39 @@ std::vector<RunResult> RunFrequencyBatch(std::vector<RunSpec> specs, const Repro
 
 Figure BodeFigure(const std::string& name, const std::string& title, const std::vector<BodeCurve>& solid,
                   const std::vector<std::pair<BodeCurve, Series>>& styled, const std::string& proposed) {
-  Figure fig;
-  fig.name = name;
-  fig.title = title;
-  fig.width_px = 1200;
-  fig.panel_height_px = 330;
-  Panel mag = MakePanel("", "Frequency [Hz]", "Magnitude [mm/mm]");
-  Panel ph = MakePanel("", "Frequency [Hz]", "Phase [deg]");
-  Panel lag = MakePanel("", "Frequency [Hz]", "Time lag [ms]");
-  for (Panel* p : {&mag, &ph, &lag}) {
-    p->x_range = std::make_pair(0.0, kFreqPlotMaxHz);
-    p->left_margin_chars = 10;
-    p->key = "off";
-  }
-  mag.key = "outside right top";
-  auto add = [&](const BodeCurve& c, Series style) {
-    Series m = style, p = style, l = style;
-    m.x = p.x = l.x = c.f_hz;
-    m.y = c.magnitude;
-    p.y = c.phase_deg;
-    l.y = c.lag_ms;
-    mag.series.push_back(m);
-    ph.series.push_back(p);
-    lag.series.push_back(l);
+  std::vector<io::BodeTrace> traces;
+  auto add = [&traces](const BodeCurve& c, Series style) {
+    io::BodeTrace t;
+    t.curve = c;
+    t.style = std::move(style);
+    traces.push_back(std::move(t));
   };
   for (std::size_t i = 0; i < solid.size(); ++i) {
     const BodeCurve& c = solid[i];
     add(c, StyledSeries(c.name, ControllerStyle(c.name, !proposed.empty() && c.name == proposed, i)));
   }
   for (const auto& [c, style] : styled) add(c, style);
+  io::BodeLayout layout;
+  layout.f_range_hz = {0.0, kFreqPlotMaxHz};
+  layout.left_margin_chars = 10;
   // Time lag: the range of the curves from 2 Hz up. Below, -phase / (2 pi f) divides the
   // estimate's phase noise by a small f and would squeeze the rest into a few pixels.
   double lo = 1e300, hi = -1e300;
-  for (const auto& s : lag.series) {
-    for (std::size_t i = 0; i < s.x.size(); ++i) {
-      if (s.x[i] >= 2.0 && std::isfinite(s.y[i])) lo = std::min(lo, s.y[i]), hi = std::max(hi, s.y[i]);
+  for (const auto& t : traces) {
+    for (std::size_t i = 0; i < t.curve.f_hz.size(); ++i) {
+      const double l = t.curve.lag_ms[i];
+      if (t.curve.f_hz[i] >= 2.0 && std::isfinite(l)) lo = std::min(lo, l), hi = std::max(hi, l);
     }
   }
   if (lo <= hi) {
     const double pad = std::max(0.5, 0.1 * (hi - lo));
-    lag.y_range = std::make_pair(std::floor(lo - pad), std::ceil(hi + pad));
+    layout.lag_range_ms = std::make_pair(std::floor(lo - pad), std::ceil(hi + pad));
   }
-  const int key_margin = io::KeyMarginChars({&mag});
-  for (Panel* p : {&mag, &ph, &lag}) p->right_margin_chars = key_margin;
-  fig.panels = {mag, ph, lag};
+  Figure fig = io::BodeFigure(layout, traces);
+  fig.name = name;
+  fig.title = title;
+  fig.width_px = 1200;
+  fig.panel_height_px = 330;
   return fig;
 }
 

@@ -8,9 +8,11 @@
 #include <utility>
 #include <vector>
 
+#include "ident/actuator_fit.h"
 #include "ident/fit.h"
 #include "io/plot.h"
 #include "scenario/scenario.h"
+#include "signal/bode.h"
 #include "signal/spectral.h"
 #include "studies/study.h"
 
@@ -27,22 +29,10 @@ inline constexpr double kFreqFitLoHz = 0.5, kFreqFitHiHz = 40.0;
 inline constexpr double kFreqPlotMaxHz = 50.0;
 inline constexpr double kFreqDtS = 0.0005;
 
-/// A measured or modelled frequency response on a grid, as the paper plots it.
-struct BodeCurve {
-  std::string name;                 ///< legend entry
-  std::vector<double> f_hz;         ///< frequencies [Hz], > 0
-  std::vector<double> magnitude;    ///< |G| [mm/mm]
-  std::vector<double> phase_deg;    ///< unwrapped phase [deg]
-  std::vector<double> lag_ms;       ///< time lag -phase / (2 pi f) [ms] (> 0: the output lags)
-  std::vector<double> coherence;    ///< gamma^2 (1 for a model)
-};
-/// The H1 estimate on (0, f_max_hz], phase unwrapped from the lowest frequency up.
-BodeCurve BodeFromEstimate(const std::string& name, const signal::FrequencyResponseEstimate& est,
-                           double f_max_hz);
-/// A model's response on the grid f_hz: continuous if zoh_dt_s = 0, else that of its
-/// zero-order-hold discretisation at zoh_dt_s (what a ZOH plant sampled at the same rate shows).
-BodeCurve BodeFromModel(const std::string& name, const ident::PoleModel& model, const std::vector<double>& f_hz,
-                        double zoh_dt_s);
+/// A frequency response as the paper plots it (signal/bode.h); a model's by ident::BodeFromModel.
+using signal::BodeCurve;
+using signal::BodeFromEstimate;
+using ident::BodeFromModel;
 
 /// The excitation of E1 and E2: BLWN 0-50 Hz, RMS 0.254 mm, seed 1, 2 s discarded, faded in over
 /// 0.5 s (the command of E1; the desired displacement of E2).
@@ -59,10 +49,11 @@ scenario::Scenario FrequencyScenario(const std::string& condition, const control
 std::vector<RunResult> RunFrequencyBatch(std::vector<RunSpec> specs, const ReproduceOptions& opts,
                                          const std::string& what);
 
-/// Three stacked panels (magnitude, phase, time lag) for a set of curves: `solid` in their
-/// controller's style (studies/figures.h; `proposed` drawn prominent, other names in palette
-/// order), then `styled` as given. One legend, beside the magnitude panel; the same margins in
-/// all three panels so their frequency axes line up.
+/// The Bode figure (io/bode_figure.h) of Figs. 6-8: three stacked panels (magnitude, phase, time
+/// lag, its axis over the curves from 2 Hz up) for a set of curves: `solid` in their controller's
+/// style (studies/figures.h; `proposed` drawn prominent, other names in palette order), then
+/// `styled` as given. One legend, beside the magnitude panel; the same margins in all three panels
+/// so their frequency axes line up.
 io::Figure BodeFigure(const std::string& name, const std::string& title, const std::vector<BodeCurve>& solid,
                       const std::vector<std::pair<BodeCurve, io::Series>>& styled, const std::string& proposed = "");
 

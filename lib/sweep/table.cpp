@@ -273,6 +273,8 @@ void WriteGroupSummary(const Spec& spec, const Table& t, const fs::path& file) {
         const double x = AsDouble(t.rows[r][c]);
         if (Completed(t.rows[r]) && std::isfinite(x)) v.push_back(x);
       }
+      // Not signal::SpreadOf: its mean, sum / n, can differ from this sum of x / n in the last
+      // bit, and the summary prints the shortest exact form; the files keep their numbers.
       double mean = 0, var = 0;
       for (const double x : v) mean += x / static_cast<double>(v.size());
       for (const double x : v) var += (x - mean) * (x - mean);

@@ -1,0 +1,34 @@
+#include "signal/stats.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace rths::signal {
+
+Spread SpreadOf(std::span<const double> v) {
+  Spread s;
+  s.n = static_cast<int>(v.size());
+  if (v.empty()) {
+    s.mean = s.std = s.min = s.max = std::numeric_limits<double>::quiet_NaN();
+    return s;
+  }
+  double sum = 0.0;
+  for (double x : v) sum += x;
+  s.mean = sum / s.n;
+  double ss = 0.0;
+  for (double x : v) ss += (x - s.mean) * (x - s.mean);
+  s.std = s.n > 1 ? std::sqrt(ss / (s.n - 1)) : 0.0;
+  s.min = *std::min_element(v.begin(), v.end());
+  s.max = *std::max_element(v.begin(), v.end());
+  return s;
+}
+
+double Median(std::vector<double> v) {
+  if (v.empty()) return std::numeric_limits<double>::quiet_NaN();
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+}  // namespace rths::signal
