@@ -10,7 +10,7 @@
 // logs, or UTFSM damper files: x = y_mm, F = f_kN) by least squares on the force, or without
 // --current its current- or voltage-dependent form (ident/damper_model.h); prints the parameters,
 // the force error per record (and per held-out --check record) and the model as a TOML fragment.
-// docs/identification.md. Exit 0 ok, 2 bad input, 3 a damper fit that failed (did not converge, or
+// docs/identification.md. Exit 0 ok, 2 bad input, 13 a damper fit that failed (did not converge, or
 // a parameter on a bound of its range; ident/fit_status.h) unless --accept-unconverged; a failed fit
 // or an implausible value (ident/plausible_range.h: a warning) prints what to try
 // (ident/fit_advice.h) and marks the --plot figure's title.
