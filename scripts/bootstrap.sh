@@ -69,7 +69,7 @@ if ! ip route show 224.0.0.0/4 2>/dev/null | grep -q .; then
   fi
 fi
 
-cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo
+cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release  # -O2 without -g (CMakeLists.txt)
 if ((tests)); then
   cmake --build build -j"$(nproc)"
   # The libFuzzer targets (docs/fuzzing.md), with clang in a tree of their own; ctest runs them.
