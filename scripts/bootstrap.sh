@@ -69,7 +69,9 @@ if ! ip route show 224.0.0.0/4 2>/dev/null | grep -q .; then
   fi
 fi
 
-cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release  # -O2 without -g (CMakeLists.txt)
+# Release: -O2 without -g (CMakeLists.txt); unity: a library's sources compiled 8 to a file, each
+# template instantiated once per batch. Both leave the code as it was and halve the compile time.
+cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DCMAKE_UNITY_BUILD=ON
 if ((tests)); then
   cmake --build build -j"$(nproc)"
   # The libFuzzer targets (docs/fuzzing.md), with clang in a tree of their own; ctest runs them.

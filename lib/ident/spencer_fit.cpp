@@ -31,7 +31,7 @@ constexpr int kEta = kK0 + 1;
 // Bounds of each law's ends a, b (natural units) and of the rates [1/A or 1/V].
 constexpr double kEndLo[kLaws] = {1e-7, 1e-7, 1e-7, 1e-9, 1e-9};
 constexpr double kEndHi[kLaws] = {1e3, 1e4, 1e4, 1e4, 1e4};
-constexpr double kRateLo = 1e-4, kRateHi = 1e3;
+constexpr double kFitRateLo = 1e-4, kFitRateHi = 1e3;
 constexpr double kK0Lo = 1e-8, kK0Hi = 1e2;
 constexpr double kEtaLo = 1.0, kEtaHi = 1e5;
 // The starts' share of every record (and its least length [s]).
@@ -40,11 +40,11 @@ constexpr double kStartShare = 0.25, kStartMinS = 3.0;
 int Dim(ControlFilter f) { return f == ControlFilter::kFirstOrder ? kEta + 1 : kK0 + 1; }
 
 double LoBound(int i) {
-  if (i < kK0) return i % 3 == 2 ? kRateLo : kEndLo[i / 3];
+  if (i < kK0) return i % 3 == 2 ? kFitRateLo : kEndLo[i / 3];
   return i == kK0 ? kK0Lo : kEtaLo;
 }
 double HiBound(int i) {
-  if (i < kK0) return i % 3 == 2 ? kRateHi : kEndHi[i / 3];
+  if (i < kK0) return i % 3 == 2 ? kFitRateHi : kEndHi[i / 3];
   return i == kK0 ? kK0Hi : kEtaHi;
 }
 // The lower bound of theta_i stands for 0 (fit_status.h): the laws' ends and k0, not the rates or eta.
@@ -488,7 +488,7 @@ Box DesignBox(const std::vector<double>& levels, const DamperFitOptions& o, bool
   if (levels.size() == 2) {
     const double rate = 3.0 / (levels[1] - levels[0]);
     for (int l = 0; l < kLaws; ++l)
-      box.Hold(3 * l + 2, std::log(std::clamp(rate, kRateLo, kRateHi)),
+      box.Hold(3 * l + 2, std::log(std::clamp(rate, kFitRateLo, kFitRateHi)),
                fmt::format("the records hold two input levels, {:.4g} and {:.4g} {}, which fix each law there only: "
                            "between them the law is this assumption",
                            levels[0], levels[1], unit));

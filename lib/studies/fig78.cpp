@@ -25,7 +25,7 @@ std::vector<Table2Controller> ControllersOf(const std::string& condition) {
 
 namespace {
 
-const BodeCurve* Named(const std::vector<BodeCurve>& curves, const std::string& prefix, const std::string& not_containing = "") {
+const BodeCurve* CurveNamed(const std::vector<BodeCurve>& curves, const std::string& prefix, const std::string& not_containing = "") {
   for (const auto& c : curves) {
     if (c.name.rfind(prefix, 0) == 0 && (not_containing.empty() || c.name.find(not_containing) == std::string::npos)) return &c;
   }
@@ -39,9 +39,9 @@ std::vector<Claim> CheckE2(const std::vector<BodeCurve>& curves, const std::stri
   for (const auto& c : curves) {
     if (c.name == ff_name) ff = &c;
   }
-  const BodeCurve* lp = Named(curves, ff_name + " + LP");
-  const BodeCurve* poly = Named(curves, "3rd Poly");
-  const BodeCurve* lead = Named(curves, "Lead Comp");
+  const BodeCurve* lp = CurveNamed(curves, ff_name + " + LP");
+  const BodeCurve* poly = CurveNamed(curves, "3rd Poly");
+  const BodeCurve* lead = CurveNamed(curves, "Lead Comp");
   if (ff) {
     double mag = 0.0, lag = 0.0;
     ForEachIn(*ff, 0.5, 30.0, [&](std::size_t i) {

@@ -126,7 +126,7 @@ void MeasureExtendedRows(std::vector<Table2ExtendedRow>* rows, int jobs) {
 
 namespace {
 
-std::string Pct(double v) { return std::isfinite(v) ? fmt::format("{:#.3g}", v) : "-"; }
+std::string PctOrDash(double v) { return std::isfinite(v) ? fmt::format("{:#.3g}", v) : "-"; }
 
 const Table2ExtendedRow* FindExt(const std::vector<Table2ExtendedRow>& rows, const std::string& cond,
                                  const std::string& band, const std::string& name) {
@@ -241,9 +241,9 @@ void WriteErrors(std::ostream& md, const std::vector<Table2ExtendedRow>& rows) {
         if (r->stopped != "no") stop += fmt::format("{}{} Hz at {} of {} steps: {}", stop.empty() ? "" : "; ", r->band,
                                                     r->steps, r->steps_planned, r->stopped);
       }
-      md << fmt::format("| {} | {} | {} | {} | {} | {} | {} | {} | {} |\n", c, n, Pct(a->ours_pct),
-                        Pct(a->second_half_pct), Pct(a->peak_error_mm), Pct(b->ours_pct), Pct(b->second_half_pct),
-                        Pct(b->peak_error_mm), stop.empty() ? "no" : stop);
+      md << fmt::format("| {} | {} | {} | {} | {} | {} | {} | {} | {} |\n", c, n, PctOrDash(a->ours_pct),
+                        PctOrDash(a->second_half_pct), PctOrDash(a->peak_error_mm), PctOrDash(b->ours_pct), PctOrDash(b->second_half_pct),
+                        PctOrDash(b->peak_error_mm), stop.empty() ? "no" : stop);
     }
   }
 }
@@ -263,7 +263,7 @@ void WriteOrder(std::ostream& md, const std::vector<Table2ExtendedRow>& rows) {
         return sx != sy ? sy : (!sx && x->ours_pct < y->ours_pct);
       });
       std::string order;
-      for (auto* r : sel) order += fmt::format("{}{} {}", order.empty() ? "" : " < ", r->controller, Pct(r->ours_pct));
+      for (auto* r : sel) order += fmt::format("{}{} {}", order.empty() ? "" : " < ", r->controller, PctOrDash(r->ours_pct));
       md << fmt::format("| {} | {} Hz | {} |\n", c, band, order);
     }
   }
