@@ -75,7 +75,7 @@ cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DCMAKE_UNITY_BUILD=ON
 if ((tests)); then
   cmake --build build -j"$(nproc)"
   # The libFuzzer targets (docs/fuzzing.md), with clang in a tree of their own; ctest runs them.
-  cmake -S fuzz -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+  cmake -S fuzz -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_UNITY_BUILD=ON \
     -DCMAKE_CXX_COMPILER=clang++-14 -DCMAKE_C_COMPILER=clang-14
   cmake --build build-fuzz -j"$(nproc)"
 else
