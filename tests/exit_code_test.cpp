@@ -2,24 +2,14 @@
 // every code documented where users read them (README, docs/lockstep.md, `rths --help`).
 #include <doctest/doctest.h>
 
-#include <fstream>
 #include <set>
-#include <sstream>
 #include <string>
 
 #include "core/exit_code.h"
 #include "ident/fit_status.h"
+#include "test_support.h"
 
-namespace {
-
-std::string Slurp(const std::string& path) {
-  std::ifstream in(path);
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-}  // namespace
+using rths_test::Slurp;
 
 TEST_CASE("exit codes: one table, every value distinct, every name distinct") {
   std::set<int> codes;
