@@ -56,7 +56,7 @@ trap 'rm -rf "$stage"' EXIT
 root="$stage/$name"
 mkdir -p "$root/build/bin" "$root/build/libexec" "$root/build/lib"
 
-# Programs, without their debug information (RelWithDebInfo), and every library ldd resolves for
+# Programs, without debug information (strip: a RelWithDebInfo build has it), and every library ldd resolves for
 # them, copied under its soname; the loader goes beside the wrappers (see the top).
 loader=""
 declare -A libs=()
