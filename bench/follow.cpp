@@ -19,7 +19,7 @@
 #include <CLI/CLI.hpp>
 #include <fmt/core.h>
 
-#include "../tests/follow_replay.h"
+#include "../tests/support/follow_replay.h"
 
 namespace fs = std::filesystem;
 

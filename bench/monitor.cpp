@@ -26,7 +26,7 @@
 #include <fmt/core.h>
 #include <nlohmann/json.hpp>
 
-#include "../tests/chromium_pipe.h"
+#include "../tests/support/chromium_pipe.h"
 #include "signal/stats.h"
 
 namespace fs = std::filesystem;

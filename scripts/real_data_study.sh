@@ -28,7 +28,7 @@ log() { echo; echo "=== $*"; }
 
 log "actuator: chirp_0A, two halves"
 "$rths" utfsm-convert "$data/actuator/chirp_0A.txt" --out chirp_0A.csv
-# 51.216 s: the first half [0, 25.608) s, the second [25.608, end) (tests/identify_test.cpp's split).
+# 51.216 s: the first half [0, 25.608) s, the second [25.608, end) (tests/ident/identify_test.cpp's split).
 "$rths" utfsm-convert chirp_0A.csv --to-s 25.608 --out chirp_first.csv
 "$rths" utfsm-convert chirp_0A.csv --from-s 25.608 --out chirp_second.csv
 "$rths" identify chirp_first.csv --out act_first.toml

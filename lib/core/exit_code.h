@@ -2,7 +2,7 @@
 /// @file Every exit code of every rths program, in one table (docs/lockstep.md "Exit codes", the
 /// README and `rths --help`; each tool's --help footer says which of them it uses). A number means
 /// one thing whichever program returns it; the numbers are part of the interface: scripts and
-/// tests rely on them (tests/exit_code_test.cpp checks that they are distinct).
+/// tests rely on them (tests/programs/exit_code_test.cpp checks that they are distinct).
 namespace rths {
 
 /// The exit codes. Meanings shared by several programs are said once here (1: the diff/grep

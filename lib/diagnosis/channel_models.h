@@ -31,7 +31,7 @@
 ///      Jacobian, (beta + gamma) n |z|^(n-1) max(|v_k|, |v_{k+1}|) + A alpha / (c0 + c1) +
 ///      k0 / (c0 + c1) (so h lambda <= 0.4, inside RK4's stability interval [-2.78, 0]; at 0.8
 ///      the saturating Bouc-Wen phase near peak velocity left 0.01-0.02 kN at 80 Hz and 2.5 A;
-///      checked against the ARKODE damper at 1e-8 in tests/diagnosis_test.cpp). Where x' - y' changes sign
+///      checked against the ARKODE damper at 1e-8 in tests/diagnosis/diagnosis_test.cpp). Where x' - y' changes sign
 ///      over the step (a reversal; its value at the end taken with the damper state at the
 ///      start), Eq. 33's right-hand side has a kink (its |x' - y'|) and RK4's error there is
 ///      about A alpha |x''| h^2 / 8 in the force, not bounded by h lambda: the step then takes

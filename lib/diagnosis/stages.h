@@ -1,6 +1,6 @@
 #pragma once
 /// @file The stages of Diagnose (diagnosis.h), over one channel's state: internal to
-/// lib/diagnosis, exposed so that each stage can be tested alone (tests/diagnosis_stages_test.cpp).
+/// lib/diagnosis, exposed so that each stage can be tested alone (tests/diagnosis/diagnosis_stages_test.cpp).
 ///
 /// Per channel (y, then f), in this order:
 ///   ScoreNominal      nominal residuals, gap, noise floor, floor ratios, whiteness;

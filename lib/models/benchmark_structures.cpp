@@ -82,7 +82,7 @@ namespace {
 const char* kSource =
     "RTHS benchmark problem: Silva, Gomez, Maghareh, Dyke & Spencer, Mech. Syst. Signal Process. 2020\n"
     "(docs/benchmark.md). Written by models::WriteSilva3StructureFiles (lib/models/benchmark_structures.cpp);\n"
-    "tests/benchmark_structures_test.cpp checks this file against it (RTHS_WRITE_DATA=1 rewrites it).\n";
+    "tests/models/benchmark_structures_test.cpp checks this file against it (RTHS_WRITE_DATA=1 rewrites it).\n";
 
 std::string CaseText(const BenchmarkCase& c) {
   return fmt::format("case {}: floor mass {:g} kg, {:g} % damping in every mode", c.number, c.floor_mass_kg,

@@ -80,7 +80,7 @@ void WriteSilva3NumericalFile(const std::string& path, const BenchmarkCase& c, c
 
 /// Writes `dir`/silva3_reference_caseN.txt and `dir`/silva3_numerical_caseN.txt, N = 1 .. 4, from
 /// Silva3Structures() (the repository's copies are in data/buildings/;
-/// tests/benchmark_structures_test.cpp checks them against this function).
+/// tests/models/benchmark_structures_test.cpp checks them against this function).
 /// Throws rths::Error if a file cannot be written.
 void WriteSilva3StructureFiles(const std::string& dir);
 

@@ -2,7 +2,7 @@
 /// @file The measured accuracy of the structural integrators (docs/structures.md, "Measured
 /// accuracy"): each integrator at the RTHS step dt and at dt/2, dt/4 against the CVODE reference
 /// (structure_reference.h) of the same building and record, with the order of convergence the
-/// errors give. Used by tests/integrator_accuracy_test.cpp and bench-nonlinear_structure.
+/// errors give. Used by tests/models/integrator_accuracy_test.cpp and bench-nonlinear_structure.
 #include <functional>
 #include <string>
 #include <vector>

@@ -9,7 +9,7 @@
 ///    and servo eigenvalues give |h lambda| below 1.5, inside DP5's stability region, and a
 ///    one-step method restarts for free, whereas BDF restarts at order 1 on every step. For the
 ///    MR damper it is about ten times cheaper than kBdf at the same rtol, and more accurate
-///    (tests/damper_accuracy_test.cpp, bench/memq.cpp).
+///    (tests/models/damper_accuracy_test.cpp, bench/memq.cpp).
 ///  - kBdf: CVODE's variable-order BDF with Newton iterations on a dense Jacobian, for stiff
 ///    systems. The Jacobian comes from difference quotients computed here, with CVODE's own
 ///    increments (cvLsDenseDQJac) but into preallocated storage: CVODE's built-in version

@@ -15,7 +15,7 @@
 /// [x, xv, xv'] = [x, xv, w - b xv - c x]) when |xv| stays below kLinearStepMargin vmax at both
 /// ends; else classical RK4 with kFlowLimitSubsteps substeps, u held over the step (ZOH). Without
 /// the limit the RK4 steps agree with the exact ZOH to 2e-8 mm on a 7 mm motion at 2 kHz
-/// (tests/rig_effects_test.cpp).
+/// (tests/models/rig_effects_test.cpp).
 #include "models/servo_linear.h"
 
 namespace rths::models {

@@ -28,7 +28,7 @@
 /// Bouc-Wen over a drift increment du = u - u_c (u_c the committed drift): (z, E_h) integrated in u
 /// by classical RK4 with m = ceil(|du| / (x_y / kBoucWenStepsPerYield)) equal sub-steps (at least
 /// 1, at most kBoucWenMaxSubsteps): a deterministic function of (committed state, u). Error
-/// against the closed form above (tests/nonlinear_structure_test.cpp): 5e-10 x_y in z and 3e-9
+/// against the closed form above (tests/models/nonlinear_structure_test.cpp): 5e-10 x_y in z and 3e-9
 /// of E_h for one increment of 3 x_y (120 sub-steps); 2e-12 mm after 600 increments of x_y/200
 /// (one sub-step each, the size of a 2 kHz step's drift). The tangent returned is the end-point slope
 /// dF/du = k (r + (1 - r) dz/du), not the derivative of the RK4 map; the two differ by O(|du|/x_y).

@@ -27,7 +27,7 @@
 ///    target, the reference filter's output, the error and the command each rounded to a multiple
 ///    of quantise_m metres (2^-18 m in the reference code; 0: off).
 /// With substructure = reference = "cd", d = 0 and no quantisation the loop is the lockstep run's,
-/// step for step (tests/benchmark_loop_test.cpp checks J1-J9 against a memq run of the scenario).
+/// step for step (tests/studies/benchmark_loop_test.cpp checks J1-J9 against a memq run of the scenario).
 #include <string>
 
 #include "scenario/scenario.h"

@@ -1,6 +1,6 @@
 #pragma once
 /// @file The diagnosis's validation harness (docs/diagnosis.md "Validation harness"; bench/diagnosis.cpp and
-/// tests/diagnosis_harness_test.cpp): records with known effects, diagnosed without the truth,
+/// tests/diagnosis/diagnosis_harness_test.cpp): records with known effects, diagnosed without the truth,
 /// scored as a confusion table and held-out shrink.
 ///
 /// Each case: a truth (one effect, two effects, none = sensor noise only, or a disturbance

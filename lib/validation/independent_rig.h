@@ -2,7 +2,7 @@
 /// @file A second rig-record generator, written independently of the rig mode and of the effect
 /// blocks (models/rig_effects.h, models/effect_rig.h, validation/synthetic.h), for validating the
 /// diagnosis on records it was not built alongside (docs/diagnosis.md "Validation harness",
-/// tests/diagnosis_independent_test.cpp). It uses only the model equations of docs/models.md
+/// tests/diagnosis/diagnosis_independent_test.cpp). It uses only the model equations of docs/models.md
 /// (sections 1, 6, 13) and docs/rig_mode.md, the parameter structs (ServoModel3 "avg",
 /// MrDamperParams::Table3), and none of lib/models' simulation code. Units: mm, kN, A, s.
 ///

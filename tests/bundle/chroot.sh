@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The bundle of scripts/bundle.sh in a chroot that holds nothing but the bundle and Debian's
 # busybox-static (/bin/busybox and links to its applets): no library of this Debian can be loaded
-# there, so what runs, runs on the bundle's own glibc and libraries. Driven by tests/bundle_test.cpp.
+# there, so what runs, runs on the bundle's own glibc and libraries. Driven by tests/programs/bundle_test.cpp.
 #
 #   tests/bundle/chroot.sh TARBALL ROOT
 #
@@ -16,7 +16,7 @@
 #   tasks     rths sweep spec.toml --executor slurm --dry-run: the job script of the 2 array tasks,
 #             which (task0, task1) then run as Slurm would run them (rths-sweep --task --chunk c),
 #             and `rths sweep --resume` (resume) writes the table from their rows
-# Exit 0 when every step exited 0 (tests/bundle_test.cpp checks what they wrote); 1 when a step
+# Exit 0 when every step exited 0 (tests/programs/bundle_test.cpp checks what they wrote); 1 when a step
 # failed (its output is printed); 3 when this machine cannot run the test (the message says why).
 # Needs root, unshare and mount (util-linux), chroot (coreutils), busybox-static.
 set -euo pipefail
