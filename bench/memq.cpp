@@ -32,6 +32,8 @@
 #include "control/feedforward.h"
 #include "control/tracking_controller.h"
 #include "io/event_log.h"
+#include "io/mapped_log_file.h"
+#include "io/signals_row.h"
 #include "lockstep/participant.h"
 #include "lockstep/run_loop.h"
 #include "lockstep/step_table.h"
@@ -262,12 +264,15 @@ double TimeTransport(std::size_t steps, bool lcm_memq) {
   return Seconds(t0) / steps * 1e6;
 }
 
-// What the logger does per step: the four events in one pwrite to log.lcm, and the CSV row
-// buffered and written Logger::kCsvFlushBytes at a time (lib/participants/logger.cpp). `old`: the
-// former pattern, the row written with the step (a second pwrite).
-double TimeLogging(const std::vector<Row>& rows, const fs::path& dir, bool old) {
-  const int log = ::open((dir / "bench_log.lcm").c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+// What the logger does per step (lib/participants/logger.cpp): the four events appended to log.lcm
+// through its shared mapping (io::MappedLogFile) and the CSV row formatted by io::FormatSignalsRow,
+// buffered and written Logger::kCsvFlushBytes at a time. `former`: the logger before issue 46, the
+// events in one pwrite per step and the row formatted by snprintf.
+double TimeLogging(const std::vector<Row>& rows, const fs::path& dir, bool former) {
+  const fs::path log_path = dir / "bench_log.lcm";
+  const int log = ::open(log_path.c_str(), O_RDWR | O_CREAT | O_TRUNC, 0644);
   const int csv = ::open((dir / "bench_signals.csv").c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  rths::io::MappedLogFile mapped(::dup(log), log_path.string());
   std::vector<std::uint8_t> step, payload(80, 0x33);
   step.reserve(4096);
   std::string buf;
@@ -279,23 +284,28 @@ double TimeLogging(const std::vector<Row>& rows, const fs::path& dir, bool old) 
     for (const char* ch : {rths::lockstep::kChDesired, rths::lockstep::kChCommand, rths::lockstep::kChMeasured,
                            rths::lockstep::kChCurrent})
       rths::io::AppendEvent(&step, event++, static_cast<std::int64_t>(k) * 500, ch, payload.data(), payload.size());
-    log_end += ::pwrite(log, step.data(), step.size(), log_end);
     char row[400];
     const Row& r = rows[k];
-    const int n = std::snprintf(row, sizeof row,
-                                "%zu,%.6f,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n", k,
-                                k * 0.0005, r.r, r.u, r.u, 0.0, r.y, r.r - r.y, r.f, r.i_cmd, r.i_eff, r.ground);
-    if (old) {
-      csv_end += ::pwrite(csv, row, n, csv_end);
+    const double t = static_cast<double>(k) * 0.0005;
+    std::size_t n = 0;
+    if (former) {
+      log_end += ::pwrite(log, step.data(), step.size(), log_end);
+      n = static_cast<std::size_t>(std::snprintf(row, sizeof row,
+                                                 "%zu,%.6f,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n",
+                                                 k, t, r.r, r.u, r.u, 0.0, r.y, r.r - r.y, r.f, r.i_cmd, r.i_eff, r.ground));
     } else {
-      buf.append(row, n);
-      if (buf.size() >= rths::participants::Logger::kCsvFlushBytes) {
-        csv_end += ::pwrite(csv, buf.data(), buf.size(), csv_end);
-        buf.clear();
-      }
+      mapped.Append(step.data(), step.size());
+      n = rths::io::FormatSignalsRow(row, static_cast<std::int64_t>(k), t,
+                                     {r.r, r.u, r.u, 0.0, r.y, r.r - r.y, r.f, r.i_cmd, r.i_eff, r.ground});
+    }
+    buf.append(row, n);
+    if (buf.size() >= rths::participants::Logger::kCsvFlushBytes) {
+      csv_end += ::pwrite(csv, buf.data(), buf.size(), csv_end);
+      buf.clear();
     }
   }
-  const double us = Seconds(t0) / rows.size() * 1e6;
+  const double us = Seconds(t0) / static_cast<double>(rows.size()) * 1e6;
+  mapped.Close();
   ::close(log);
   ::close(csv);
   return us;
@@ -421,10 +431,14 @@ int main(int argc, char** argv) {
   line("model: plant (servo + damper)", p.plant);
   line("encode/decode (5 messages, 14 dec)", p.codec);
   line("transport (in-process queue)", p.transport);
-  line("logging (1 pwrite + buffered CSV)", p.logging);
+  line("logging (mapped log + to_chars CSV)", p.logging);
   line("other (lockstep bookkeeping)", std::max(0.0, step_us - p.Sum()));
-  std::printf("  logging, former pattern (2 pwrite)  %7.2f us  = %.2fx the current one\n", Median(logging_old),
+  std::printf("  logging, former (pwrite + snprintf)  %7.2f us  = %.2fx the current one\n", Median(logging_old),
               Median(logging_old) / p.logging);
+  const double model_us = p.integrator + p.controller + p.plant;
+  std::printf("model-only bound 1 / (%.2f us) = %.0f steps/s; memq run / bound = %.2f (issue 46 goal >= 0.7: %s)\n",
+              model_us, 1e6 / model_us, Median(rate) * model_us * 1e-6,
+              Median(rate) * model_us * 1e-6 >= 0.7 ? "met" : "NOT met");
   std::printf("  transport on LCM's memq:// (former)  %7.2f us  = %.2fx the current one\n", Median(transport_lcm),
               Median(transport_lcm) / p.transport);
   std::printf("MR damper step alone, the run's motion and current, rtol %g:\n", s.plant.ode_rtol);

@@ -82,7 +82,6 @@ std::pair<double, double> Parabola(const std::vector<std::pair<double, double>>&
 /// parabola's vertex, refitted, replaces the alternation's end if its cost is lower.
 void ProfileMeasurement(const std::vector<io::RigRecord>& records, const DamperFitOptions& o,
                         const MeasurementOptions& m, DamperModelFit* fit) {
-  const double dt_ms = 1e3 * records.front().dt_s;
   if (m.skew == MeasurementMode::kAuto) {
     // The step: the finest record's sample (the skew's resolution), at least kProfileSkewStepMs and
     // three conditional standard errors, at most kProfileSkewMaxStepMs; the points kept in the search

@@ -82,6 +82,13 @@ bool EventLogReader::Next(LogEvent* ev) {
   const std::size_t got = Read(h, std::min<std::uint64_t>(left, kEventHeaderBytes));
   std::uint8_t sync[4];
   detail::PutBigEndian(kEventSync, 4, sync);
+  constexpr std::uint8_t kZero[4] = {0, 0, 0, 0};
+  if (at > 0 && std::memcmp(h, kZero, std::min<std::size_t>(got, 4)) == 0) {  // reserved, never written
+    zero_tail_ = true;
+    zero_tail_at_ = at;
+    ended_ = true;
+    return false;
+  }
   if (std::memcmp(h, sync, std::min<std::size_t>(got, 4)) != 0) {
     ended_ = true;
     Fail(at, at == 0 ? "no event sync word (not an LCM event log)"

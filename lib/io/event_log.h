@@ -68,7 +68,9 @@ struct LogEvent {
 /// N the offset of the offending event). A file that ends in the middle of an event (a header,
 /// channel or payload cut short, e.g. a run killed while writing) is not an error: Next() returns
 /// false and truncated() tells, with the offset where the incomplete event starts; the events
-/// before it are complete and usable.
+/// before it are complete and usable. Nor is a zero word where an event's sync word should be:
+/// space a logger reserved ahead (MappedLogFile) and could not cut back because it was killed,
+/// or an event it had not finished storing; Next() returns false and zero_tail() tells.
 class EventLogReader {
  public:
   /// Opens `path`. Throws rths::Error (where = path) if it cannot be opened or is empty
@@ -90,6 +92,10 @@ class EventLogReader {
   bool truncated() const { return truncated_; }
   /// Where the incomplete last event starts [byte offset] (meaningful if truncated()).
   std::uint64_t truncated_at_byte() const { return truncated_at_; }
+  /// True once Next() met a zero word where an event should start (the log ends there).
+  bool zero_tail() const { return zero_tail_; }
+  /// Where that zero word is [byte offset] (meaningful if zero_tail()).
+  std::uint64_t zero_tail_at_byte() const { return zero_tail_at_; }
   /// The file's (or buffer's) size [bytes], taken when it was opened.
   std::uint64_t size_bytes() const { return size_; }
   /// Complete events read so far.
@@ -106,9 +112,9 @@ class EventLogReader {
   std::string name_;
   std::FILE* file_ = nullptr;
   const std::uint8_t* mem_ = nullptr;
-  std::uint64_t size_ = 0, offset_ = 0, truncated_at_ = 0;
+  std::uint64_t size_ = 0, offset_ = 0, truncated_at_ = 0, zero_tail_at_ = 0;
   std::int64_t events_ = 0;
-  bool truncated_ = false, ended_ = false;
+  bool truncated_ = false, ended_ = false, zero_tail_ = false;
 };
 
 }  // namespace rths::io

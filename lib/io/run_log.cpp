@@ -197,6 +197,8 @@ RunLog Read(EventLogReader& reader) {
   log.events = reader.events();
   log.truncated_tail = reader.truncated();
   log.truncated_at_byte = reader.truncated_at_byte();
+  log.zero_tail = reader.zero_tail();
+  log.zero_tail_at_byte = reader.zero_tail_at_byte();
 
   // Every k must be able to belong to this log: below the planned steps and below the number of
   // events (a step has a message on each channel). This also bounds the vectors below.

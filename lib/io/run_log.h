@@ -55,6 +55,10 @@ struct RunLog {
   /// truncated_at_byte and is ignored, everything before it is read.
   bool truncated_tail = false;
   std::uint64_t truncated_at_byte = 0;
+  /// True if the file ends in space the logger reserved and did not cut back (it was killed,
+  /// io::MappedLogFile): the log ends at zero_tail_at_byte, everything before it is whole.
+  bool zero_tail = false;
+  std::uint64_t zero_tail_at_byte = 0;
 
   /// Steps 0..n-1 for which every per-step channel has its message.
   std::int64_t CompleteSteps() const;

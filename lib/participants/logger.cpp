@@ -3,10 +3,10 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <array>
 #include <cerrno>
 #include <chrono>
 #include <cmath>
-#include <cinttypes>
 #include <cstdio>
 #include <cstring>
 
@@ -14,17 +14,16 @@
 
 #include "core/error.h"
 #include "io/event_log.h"
+#include "io/signals_row.h"
 
 namespace rths::participants {
 
 namespace {
-constexpr const char* kCsvHeader =
-    "k,t_s,r_mm,u_mm,u_ff_mm,u_fb_mm,y_mm,e_mm,f_kN,i_cmd_A,i_eff_A,ground_acc_mm_s2\n";
-/// A row: k, t and ten numbers printed with %.17g (at most 24 characters each).
-constexpr std::size_t kCsvRowMaxBytes = 20 + 1 + 24 + 10 * (1 + 24) + 1;
+constexpr const char* kCsvHeader = io::kSignalsCsvHeader;
+constexpr std::size_t kCsvRowMaxBytes = io::kSignalsRowMaxBytes;
 
-int CreateFile(const std::string& path, const char* what) {
-  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+int CreateFile(const std::string& path, const char* what, int flags = O_WRONLY) {
+  const int fd = ::open(path.c_str(), flags | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   if (fd < 0) throw Error(path, fmt::format("cannot create the {}: {}", what, std::strerror(errno)));
   return fd;
 }
@@ -51,18 +50,12 @@ Logger::Logger(lockstep::RunIdentity id, lockstep::LockstepConfig config, lcm::L
       csv_path_(csv_path),
       csv_every_(csv_every) {
   if (csv_every_ < 0) throw Error(csv_path_, fmt::format("csv_every = {}: must be >= 0", csv_every_));
-  log_fd_ = CreateFile(log_path_, "event log");
-  try {
-    if (csv_every_ > 0) csv_fd_ = CreateFile(csv_path_, "signals CSV");
-  } catch (...) {
-    ::close(log_fd_);
-    throw;
-  }
+  log_ = std::make_unique<io::MappedLogFile>(CreateFile(log_path_, "event log", O_RDWR), log_path_);
+  if (csv_every_ > 0) csv_fd_ = CreateFile(csv_path_, "signals CSV");
   if (const std::string why = csv_fd_ < 0 ? std::string()
                                           : Append(csv_fd_, csv_path_, reinterpret_cast<const std::uint8_t*>(kCsvHeader),
                                                    std::strlen(kCsvHeader), &csv_end_);
       !why.empty()) {
-    ::close(log_fd_);
     ::close(csv_fd_);
     throw Error(csv_path_, why);
   }
@@ -71,7 +64,6 @@ Logger::Logger(lockstep::RunIdentity id, lockstep::LockstepConfig config, lcm::L
     csv_buf_.reserve(kCsvFlushBytes + kCsvRowMaxBytes);
     csv_reserved_end_ = csv_end_;
     if (const std::string why = FlushCsv(); !why.empty()) {  // reserves the first stretch
-      ::close(log_fd_);
       ::close(csv_fd_);
       throw Error(csv_path_, why);
     }
@@ -80,9 +72,10 @@ Logger::Logger(lockstep::RunIdentity id, lockstep::LockstepConfig config, lcm::L
 
 Logger::~Logger() {
   if (csv_fd_ >= 0) CloseCsv();  // after a stop without OnStop (an exception): keep the rows
-  if (log_fd_ >= 0) ::close(log_fd_);
   if (csv_fd_ >= 0) ::close(csv_fd_);
-}
+}  // log_ cuts log.lcm back to its last event
+
+std::int64_t Logger::write_calls() const { return write_calls_ + log_->system_calls(); }
 
 std::string Logger::Append(int fd, const std::string& path, const std::uint8_t* data, std::size_t size,
                            std::int64_t* good_end) {
@@ -110,7 +103,8 @@ std::string Logger::Append(int fd, const std::string& path, const std::uint8_t* 
 void Logger::FailWrite(const std::string& why, std::int64_t k) {
   // log.lcm ends on the last written step (it may hold part of step k); the buffered rows are
   // all of written steps: write them (a failed write cuts signals.csv to a whole row).
-  const bool cut_log = ::ftruncate(log_fd_, static_cast<off_t>(log_acked_)) == 0;
+  log_->CutBack(log_acked_);
+  const bool cut_log = log_->Close().empty();
   const bool csv_ok = csv_fd_ < 0 || CloseCsv().empty();
   std::string reason = fmt::format("{} (at step {}; the log and signals.csv end on step {}, the last "
                                    "complete one{})",
@@ -159,7 +153,9 @@ std::string Logger::CloseCsv() {
   return why;
 }
 
-std::string Logger::OnDone() { return CloseCsv(); }  // every step is in log.lcm before its ack
+// Every step is in log.lcm before its ack; the log stays open for the handshake's last messages
+// and is cut back to its last event when the logger is destroyed.
+std::string Logger::OnDone() { return CloseCsv(); }
 
 void Logger::OnStop() { CloseCsv(); }
 
@@ -181,13 +177,12 @@ void Logger::OnHandshakeSeen(const lcm::ReceiveBuffer* rbuf, const rths::handsha
   const std::int64_t utime = start_utime_ < 0 ? rbuf->recv_utime : StepUtime(next_step());
   io::AppendEvent(&step_bytes_, event_number_, utime, lockstep::kChHandshake, rbuf->data,
                   rbuf->data_size);
-  if (const std::string why = Append(log_fd_, log_path_, step_bytes_.data(), step_bytes_.size(), &log_end_);
-      !why.empty()) {
+  if (const std::string why = log_->Append(step_bytes_.data(), step_bytes_.size()); !why.empty()) {
     FailWrite(why, msg.k);
     return;
   }
   ++event_number_;
-  log_acked_ = log_end_;  // a whole event between steps: keep it if a later write fails
+  log_acked_ = log_->size();  // a whole event between steps: keep it if a later write fails
 }
 
 void Logger::OnGo() {
@@ -219,31 +214,25 @@ bool Logger::WriteStep(std::int64_t k, const lockstep::StepInputs& in) {
     const lockstep::Bytes& r = (*ring)[slot];
     io::AppendEvent(&step_bytes_, event_number_++, StepUtime(k), ch, r.data(), r.size());
   }
-  if (const std::string why = Append(log_fd_, log_path_, step_bytes_.data(), step_bytes_.size(), &log_end_);
-      !why.empty()) {
+  if (const std::string why = log_->Append(step_bytes_.data(), step_bytes_.size()); !why.empty()) {
     FailWrite(why, k);
     return false;
   }
   if (csv_fd_ < 0 || csv_closed_ || k % csv_every_ != 0) {  // this step has no row of signals.csv
-    log_acked_ = log_end_;
+    log_acked_ = log_->size();
     ++written_;
     return true;
   }
   char row[kCsvRowMaxBytes + 1];
-  const int n = std::snprintf(row, sizeof row,
-                              "%" PRId64 ",%.6f,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n",
-                              k, static_cast<double>(k) * id_.dt_s, d->r_mm, c->u_mm, c->u_ff_mm, c->u_fb_mm,
-                              m->y_mm, d->r_mm - m->y_mm, m->f_kN, i->i_cmd_A, m->current_A,
-                              d->ground_acc_mm_s2);
-  if (n < 0 || static_cast<std::size_t>(n) >= sizeof row) {
-    FailWrite(fmt::format("formatting row {} of {} failed", k, csv_path_), k);
-    return false;
-  }
-  if (const std::string why = AddCsvRow(row, static_cast<std::size_t>(n)); !why.empty()) {
+  const std::size_t n =
+      io::FormatSignalsRow(row, k, static_cast<double>(k) * id_.dt_s,
+                {d->r_mm, c->u_mm, c->u_ff_mm, c->u_fb_mm, m->y_mm, d->r_mm - m->y_mm, m->f_kN, i->i_cmd_A,
+                 m->current_A, d->ground_acc_mm_s2});
+  if (const std::string why = AddCsvRow(row, n); !why.empty()) {
     FailWrite(why, k);
     return false;
   }
-  log_acked_ = log_end_;
+  log_acked_ = log_->size();
   ++written_;
   return true;
 }

@@ -6,7 +6,9 @@
 ///   desired_t k, command_t k, measured_t k, current_t k (+ measured_t k+1)  ->  ack_t k
 /// The first copy of every (channel, k) is kept; re-sent duplicates are ignored. Once all four
 /// messages of step k are in, they are appended to log.lcm (a standard LCM event log, readable by
-/// lcm-logplayer and lcm-spy) in channel order with one pwrite(2), and only then, and once the
+/// lcm-logplayer and lcm-spy) in channel order, copied into the file's shared mapping
+/// (io::MappedLogFile: in the kernel's page cache, as after a write(2), without a system call; a
+/// killed logger leaves every acknowledged step in the file), and only then, and once the
 /// rest of the barrier of step k is in too (measured_t k+1 where the plant answers command_t k: the
 /// logger's row of the step table, lockstep/step_table.h), is ack_t k published: the clock cannot advance past a step the logger has not handed to the kernel. The
 /// handshake is logged on its own channel as it arrives (first copy per participant and phase).
@@ -18,7 +20,9 @@
 /// run stops (ABORT, an interrupt, a write error) and when the logger is destroyed: signals.csv
 /// then ends on the last written step, like log.lcm. Only if the logger process itself is
 /// killed (SIGKILL) may signals.csv end earlier, on a whole row; log.lcm is complete regardless.
-/// One write system call per step, instead of two (bench/memq.cpp counts them).
+/// No write system call per step: one per 64 kB of rows and one per reserved stretch of the log
+/// (bench/memq.cpp counts them). Rows are formatted with std::to_chars, to the same bytes as
+/// printf's %.17g and %.6f.
 ///
 /// Event timestamps are simulated time: the wall-clock time at which the logger started stepping
 /// (GO) plus k dt for the events of step k, so `lcm-logplayer --speed 1` replays a run at the pace
@@ -30,10 +34,12 @@
 /// signals.csv (cut back to its last whole row if that fails too), ABORT is broadcast naming the
 /// file and the error, and the logger exits with kExitOutput.
 #include <cstdint>
+#include <memory>
 #include <set>
 #include <string>
 #include <utility>
 
+#include "io/mapped_log_file.h"
 #include "lockstep/step_participant.h"
 #include "rths/ack_t.hpp"
 #include "rths/handshake_t.hpp"
@@ -67,8 +73,8 @@ class Logger : public lockstep::StepAnswerer<rths::ack_t> {
   /// Steps written so far (every step acknowledged, and at most one more whose acknowledgement
   /// waits for measured_t k+1).
   std::int64_t steps_written() const { return written_; }
-  /// Write system calls (pwrite, ftruncate, fallocate) made so far, handshake included.
-  std::int64_t write_calls() const { return write_calls_; }
+  /// File system calls (pwrite, ftruncate, fallocate, mmap) made so far, handshake included.
+  std::int64_t write_calls() const;
 
  protected:
   std::string OnDone() override;  // writes the buffered rows of signals.csv
@@ -106,8 +112,9 @@ class Logger : public lockstep::StepAnswerer<rths::ack_t> {
 
   std::string log_path_, csv_path_;
   int csv_every_ = 1;  ///< signals.csv row every this many steps; 0: no signals.csv
-  int log_fd_ = -1, csv_fd_ = -1;
-  std::int64_t log_end_ = 0, csv_end_ = 0;      ///< bytes written, each ending on a whole event / row
+  std::unique_ptr<io::MappedLogFile> log_;    ///< log.lcm
+  int csv_fd_ = -1;
+  std::int64_t csv_end_ = 0;                    ///< bytes written, ending on a whole row
   std::int64_t log_acked_ = 0;                  ///< log bytes at the end of the last written step
   std::string csv_buf_;                         ///< rows of acknowledged steps not yet written
   bool csv_buffered_ = false;                   ///< space is reserved ahead: rows are buffered

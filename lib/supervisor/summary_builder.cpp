@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include "core/exit_code.h"
+#include "io/mapped_log_file.h"
 #include "supervisor/realtime_figures.h"
 
 namespace rths::supervisor {
@@ -25,6 +26,13 @@ RunSummary SummaryHead(const RunRequest& request, const RunPlan& plan) {
 RunSummary BuildSummary(const RunRequest& request, const RunPlan& plan, const GroupEnd& end) {
   RunSummary sum = SummaryHead(request, plan);
   sum.wall_s = end.wall_s;
+  // A logger killed before it could cut log.lcm back leaves the space it reserved as zero bytes:
+  // cut them off, so the file ends on its last whole step (a log it cannot read stays as it is,
+  // for ReadLog to report).
+  try {
+    io::TrimZeroTail((plan.out / "log.lcm").string());
+  } catch (const std::exception&) {
+  }
   ReadLog((plan.out / "log.lcm").string(), plan.scenario, &sum);  // + J1-J9 with a reference_file
   SetOutcomes(end.outcomes, &sum);
   SetVerdict(participants::Judge(end.outcomes), end.interrupted, &sum);

@@ -1,0 +1,148 @@
+#include "io/mapped_log_file.h"
+
+#include <fcntl.h>
+#include <sys/mman.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cerrno>
+#include <cstring>
+#include <filesystem>
+
+#include <fmt/core.h>
+
+#include "core/error.h"
+#include "io/event_log.h"
+
+namespace rths::io {
+
+namespace {
+std::int64_t PageBytes() {
+  static const std::int64_t page = ::sysconf(_SC_PAGESIZE);
+  return page;
+}
+}  // namespace
+
+MappedLogFile::MappedLogFile(int fd, std::string path, std::int64_t size_bytes)
+    : fd_(fd), path_(std::move(path)), size_(size_bytes), reserved_end_(size_bytes) {}
+
+MappedLogFile::~MappedLogFile() {
+  Close();
+  if (fd_ >= 0) ::close(fd_);
+}
+
+void MappedLogFile::Unmap() {
+  if (!map_) return;
+  ++calls_;
+  ::munmap(map_, static_cast<std::size_t>(reserved_end_ - map_start_));
+  map_ = nullptr;
+}
+
+bool MappedLogFile::Reserve(std::int64_t end) {
+  const std::int64_t grow = std::clamp(reserved_end_, kFirstChunkBytes, kChunkBytes);
+  const std::int64_t page = PageBytes();
+  const std::int64_t new_end = (std::max(end, reserved_end_ + grow) + page - 1) / page * page;
+  ++calls_;
+  if (::fallocate(fd_, 0, static_cast<off_t>(reserved_end_), static_cast<off_t>(new_end - reserved_end_)) != 0) {
+    return false;  // unsupported here, or no room (ENOSPC, EFBIG): write instead
+  }
+  Unmap();
+  reserved_end_ = new_end;  // after Unmap, which unmaps up to the former end
+  map_start_ = size_ / page * page;
+  ++calls_;
+  void* p = ::mmap(nullptr, static_cast<std::size_t>(reserved_end_ - map_start_), PROT_READ | PROT_WRITE, MAP_SHARED,
+                   fd_, static_cast<off_t>(map_start_));
+  if (p == MAP_FAILED) return false;
+  map_ = static_cast<std::uint8_t*>(p);
+  return true;
+}
+
+std::string MappedLogFile::WriteAll(const void* data, std::size_t size) {
+  const auto* bytes = static_cast<const std::uint8_t*>(data);
+  std::size_t done = 0;
+  while (done < size) {
+    ++calls_;
+    const ssize_t n = ::pwrite(fd_, bytes + done, size - done, static_cast<off_t>(size_ + done));
+    if (n > 0) {
+      done += static_cast<std::size_t>(n);
+      continue;
+    }
+    if (n < 0 && errno == EINTR) continue;
+    const std::string err = n < 0 ? std::strerror(errno) : "no progress (device full?)";
+    // Nothing of a half-written append may stay behind.
+    ++calls_;
+    if (::ftruncate(fd_, static_cast<off_t>(size_)) != 0) {
+      return fmt::format("writing {} failed: {}; cutting it back to {} bytes failed too: {}", path_, err, size_,
+                         std::strerror(errno));
+    }
+    reserved_end_ = size_;
+    return fmt::format("writing {} failed: {}", path_, err);
+  }
+  return {};
+}
+
+std::string MappedLogFile::Append(const void* data, std::size_t size) {
+  if (mode_ == Mode::kClosed) return fmt::format("writing {} failed: the file is closed", path_);
+  const std::int64_t end = size_ + static_cast<std::int64_t>(size);
+  if (mode_ == Mode::kMapped && end > reserved_end_ && !Reserve(end)) {
+    Unmap();
+    mode_ = Mode::kWrite;
+  }
+  if (mode_ == Mode::kWrite) {
+    if (std::string why = WriteAll(data, size); !why.empty()) return why;
+    size_ = end;
+    reserved_end_ = std::max(reserved_end_, size_);
+    return {};
+  }
+  std::uint8_t* at = map_ + (size_ - map_start_);
+  const auto* bytes = static_cast<const std::uint8_t*>(data);
+  const std::size_t head = std::min<std::size_t>(4, size);
+  std::memcpy(at + head, bytes + head, size - head);
+  std::atomic_thread_fence(std::memory_order_release);  // the sync word last: it commits the rest
+  std::memcpy(at, bytes, head);
+  size_ = end;
+  return {};
+}
+
+void MappedLogFile::CutBack(std::int64_t size_bytes) {
+  if (size_bytes >= size_) return;
+  if (map_) std::memset(map_ + (size_bytes - map_start_), 0, static_cast<std::size_t>(std::min<std::int64_t>(4, size_ - size_bytes)));
+  size_ = size_bytes;
+  if (mode_ == Mode::kWrite) {
+    ++calls_;
+    if (::ftruncate(fd_, static_cast<off_t>(size_)) == 0) reserved_end_ = size_;
+  }
+}
+
+std::string MappedLogFile::Close() {
+  if (mode_ == Mode::kClosed) return {};
+  mode_ = Mode::kClosed;
+  Unmap();
+  if (reserved_end_ == size_) return {};
+  ++calls_;
+  if (::ftruncate(fd_, static_cast<off_t>(size_)) != 0) {
+    return fmt::format("cutting {} back to {} bytes failed: {}", path_, size_, std::strerror(errno));
+  }
+  reserved_end_ = size_;
+  return {};
+}
+
+std::int64_t TrimZeroTail(const std::string& path) {
+  std::int64_t end = -1;
+  {
+    EventLogReader reader(path);
+    LogEvent ev;
+    while (reader.Next(&ev)) {
+    }
+    if (!reader.zero_tail()) return 0;
+    end = static_cast<std::int64_t>(reader.zero_tail_at_byte());
+  }
+  const std::int64_t size = static_cast<std::int64_t>(std::filesystem::file_size(path));
+  if (::truncate(path.c_str(), static_cast<off_t>(end)) != 0) {
+    throw Error(path, fmt::format("cannot cut the reserved space past byte {}: {}", end, std::strerror(errno)));
+  }
+  return size - end;
+}
+
+}  // namespace rths::io

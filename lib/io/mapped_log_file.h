@@ -1,0 +1,79 @@
+#pragma once
+/// @file An append-only file written through a shared memory mapping (the logger's log.lcm).
+///
+/// Bytes appended are copied into a MAP_SHARED mapping of the file: they are then in the kernel's
+/// page cache, as after a write(2), and stay there if the process dies (SIGKILL included), but
+/// appending costs a memcpy, not a system call. Space is reserved ahead with fallocate(2) (the
+/// file's size grown with it), in pieces that double from kFirstChunkBytes to kChunkBytes, so a
+/// store to the mapping never meets a hole (SIGBUS on a full disk). Where a reservation is refused
+/// (disk full, file size limit), appends go on as pwrite(2) calls from there, so the file fills up
+/// to the last whole append that fits and the failing Append is reported, as with write(2).
+///
+/// Crash safety: an Append copies its bytes but the first four (an event's sync word) first and
+/// stores those four last; a process killed during the copy leaves a zero word where that event's
+/// sync word goes. Readers take a zero word at an event's start as the end of the log.
+///
+/// Close() cuts the file back to the bytes appended. A process killed before Close() leaves the
+/// reserved space past them as zero bytes: EventLogReader reads such a log to its last whole
+/// event and reports the zero tail (io::TrimZeroTail cuts it off); lcm-logplayer skips it.
+///
+/// Where the file system cannot reserve space (fallocate unsupported), every Append is one
+/// pwrite(2), as before this file existed.
+#include <cstddef>
+#include <cstdint>
+#include <string>
+
+namespace rths::io {
+
+class MappedLogFile {
+ public:
+  /// Bytes reserved (and mapped) at a time: the first reservation, and the largest.
+  static constexpr std::int64_t kFirstChunkBytes = std::int64_t{64} << 10;
+  static constexpr std::int64_t kChunkBytes = std::int64_t{4} << 20;
+
+  /// Takes `fd` (open for reading and writing, empty or at `size_bytes`); `path` names it in
+  /// messages. Nothing is reserved until the first Append.
+  MappedLogFile(int fd, std::string path, std::int64_t size_bytes = 0);
+  /// Close() if not closed; the descriptor is closed.
+  ~MappedLogFile();
+  MappedLogFile(const MappedLogFile&) = delete;
+  MappedLogFile& operator=(const MappedLogFile&) = delete;
+
+  /// Appends `size` bytes: all of them, or none ("" or the error, naming the file).
+  std::string Append(const void* data, std::size_t size);
+  /// Forgets every byte past `size_bytes` (<= size()); Close() cuts the file there.
+  void CutBack(std::int64_t size_bytes);
+  /// Unmaps and cuts the file to size(); "" or the error. Appends after it fail.
+  std::string Close();
+
+  /// Bytes appended (and not cut back) so far.
+  std::int64_t size() const { return size_; }
+  /// System calls made so far (fallocate, mmap, munmap, pwrite, ftruncate).
+  std::int64_t system_calls() const { return calls_; }
+  /// False once the file system refused to reserve space: appends are pwrite(2) calls.
+  bool mapped() const { return mode_ == Mode::kMapped; }
+
+ private:
+  enum class Mode { kMapped, kWrite, kClosed };
+  /// Reserves the file up to at least `end` (and a chunk more), then maps from the page holding
+  /// size() to the new end. False if the file system refused (then appends are written).
+  bool Reserve(std::int64_t end);
+  void Unmap();
+  std::string WriteAll(const void* data, std::size_t size);
+
+  int fd_ = -1;
+  std::string path_;
+  Mode mode_ = Mode::kMapped;
+  std::int64_t size_ = 0;            ///< bytes appended
+  std::int64_t reserved_end_ = 0;    ///< the file's size: the end of the reserved space
+  std::uint8_t* map_ = nullptr;      ///< the mapped chunk
+  std::int64_t map_start_ = 0;       ///< file offset of map_[0]
+  std::int64_t calls_ = 0;
+};
+
+/// If the log at `path` ends in a zero word where an event should start (a logger killed before it
+/// cut back its reserved space), cuts the file there. Returns how many bytes it cut; throws
+/// rths::Error if the file cannot be read or cut, or holds garbage before that point.
+std::int64_t TrimZeroTail(const std::string& path);
+
+}  // namespace rths::io
