@@ -1,8 +1,8 @@
 #include "lockstep/bridge.h"
 
-#include <poll.h>
-
 #include <algorithm>
+#include <cstring>
+#include <optional>
 
 #include <fmt/core.h>
 
@@ -20,11 +20,13 @@ BridgedChannels::BridgedChannels(const std::string& udpm_url, const std::vector<
                          udpm_url);
     return;
   }
-  outer_ = std::make_unique<lcm::LCM>(udpm_url);
-  if (!outer_->good()) {
-    error_ = fmt::format("cannot open LCM on {} (is there a multicast route? {})", udpm_url, CheckMulticastRoute());
+  std::string why;
+  const std::optional<UdpmUrl> url = UdpmUrl::Parse(udpm_url, &why);
+  if (!url) {
+    error_ = why;
     return;
   }
+  outer_ = std::make_unique<UdpmChannels>(*url);
   out_[PortOffset(kChHandshake)] = in_[PortOffset(kChHandshake)] = true;
   out_[PortOffset(kChRepair)] = in_[PortOffset(kChRepair)] = true;
   for (const std::string& role : external_roles) {
@@ -35,7 +37,16 @@ BridgedChannels::BridgedChannels(const std::string& udpm_url, const std::vector<
     in_[PortOffset(ChannelName(r.row->answer))] = true;
   }
   for (std::size_t i = 0; i < kPortChannels.size(); ++i) {
-    if (in_[i]) outer_->subscribe(kPortChannels[i], &BridgedChannels::OnOuter, this);
+    if (!in_[i] || !outer_->good()) continue;
+    inlets_[i] = {this, static_cast<int>(i)};
+    outer_->Subscribe(kPortChannels[i], [](void* context, const lcm::ReceiveBuffer* rbuf) {
+      const auto* inlet = static_cast<const Inlet*>(context);
+      inlet->bridge->OnOuter(inlet->channel, rbuf);
+    }, &inlets_[i]);
+  }
+  if (!outer_->good()) {
+    error_ = fmt::format("cannot open {}: {} (is there a multicast route? {})", udpm_url, outer_->error(),
+                         CheckMulticastRoute());
   }
 }
 
@@ -55,15 +66,17 @@ int BridgedChannels::Publish(const char* channel, const void* data, unsigned siz
   if (inner_.Publish(channel, data, size) != 0) return -1;
   if (!out_[i]) return 0;
   ++sent_out_;
-  return outer_->publish(channel, data, size);
+  return outer_->Publish(channel, data, size);
 }
 
-void BridgedChannels::OnOuter(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
+void BridgedChannels::OnOuter(int channel, const lcm::ReceiveBuffer* rbuf) {
+  const char* name = kPortChannels[static_cast<std::size_t>(channel)];
   // Handshake and repair messages travel both ways: take in only those of an external role (our
-  // own come back to us by multicast loopback).
-  if (channel == kChHandshake || channel == kChRepair) {
+  // own come back to us by multicast loopback). They are few per run: decoding them may allocate.
+  const bool handshake = std::strcmp(name, kChHandshake) == 0;
+  if (handshake || std::strcmp(name, kChRepair) == 0) {
     std::string sender;
-    if (channel == kChHandshake) {
+    if (handshake) {
       rths::handshake_t h;
       if (h.decode(rbuf->data, 0, rbuf->data_size) < 0) return;
       sender = h.participant;
@@ -75,24 +88,11 @@ void BridgedChannels::OnOuter(const lcm::ReceiveBuffer* rbuf, const std::string&
     if (std::find(external_.begin(), external_.end(), sender) == external_.end()) return;
   }
   ++taken_in_;
-  inner_.Publish(channel.c_str(), rbuf->data, rbuf->data_size);
-}
-
-int BridgedChannels::DrainOuter(int timeout_ms) {
-  pollfd fd{outer_->getFileno(), POLLIN, 0};
-  int n = 0;
-  for (int wait = timeout_ms; n < 64; wait = 0) {
-    const int ready = ::poll(&fd, 1, wait);
-    if (ready < 0) return -1;  // errno set (EINTR: a signal)
-    if (ready == 0) break;
-    if (outer_->handle() != 0) return -1;
-    ++n;
-  }
-  return n;
+  inner_.Publish(name, rbuf->data, rbuf->data_size);
 }
 
 int BridgedChannels::HandleTimeout(int timeout_ms) {
-  if (DrainOuter(inner_.queued() > 0 ? 0 : timeout_ms) < 0) return -1;
+  if (outer_->HandleTimeout(inner_.queued() > 0 ? 0 : timeout_ms) < 0) return -1;
   return inner_.HandleTimeout(0);
 }
 

@@ -12,12 +12,13 @@
 ///     `participant` is an external role. Our own messages, looped back by multicast, are dropped
 ///     by the same rule (they carry a built-in role's name).
 /// Payloads are LCM's: the external participant cannot tell a mixed run from an all-udpm one.
+/// The udpm side is UdpmChannels on the run's one port, read in this thread between the queue's
+/// messages (no LCM receive thread and notify pipe: one wake-up per datagram, not three, and
+/// nothing allocated per message).
 #include <array>
 #include <memory>
 #include <string>
 #include <vector>
-
-#include <lcm/lcm-cpp.hpp>
 
 #include "lockstep/transport.h"
 #include "lockstep/wiring.h"
@@ -26,7 +27,7 @@ namespace rths::lockstep {
 
 class BridgedChannels final : public Channels {
  public:
-  /// Opens the LCM instance on `udpm_url` (a plain udpm:// URL: port_per_channel is refused) for
+  /// Opens the sockets of `udpm_url` (a plain udpm:// URL: port_per_channel is refused) for
   /// `external_roles` of `wiring`. Check good() afterwards.
   BridgedChannels(const std::string& udpm_url, const std::vector<std::string>& external_roles, const Wiring& wiring);
   ~BridgedChannels() override;
@@ -46,12 +47,16 @@ class BridgedChannels final : public Channels {
   std::int64_t taken_in() const { return taken_in_; }
 
  private:
-  void OnOuter(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
-  /// Takes in every datagram waiting on the udpm socket (up to 64); how many.
-  int DrainOuter(int timeout_ms);
+  /// A message of channel kPortChannels[channel] from the udpm side.
+  void OnOuter(int channel, const lcm::ReceiveBuffer* rbuf);
+  struct Inlet {  ///< the context of one channel's subscription on the udpm side
+    BridgedChannels* bridge = nullptr;
+    int channel = 0;
+  };
 
   InprocChannels inner_;
-  std::unique_ptr<lcm::LCM> outer_;
+  std::unique_ptr<UdpmChannels> outer_;
+  std::array<Inlet, kPortChannels.size()> inlets_{};
   std::array<bool, kPortChannels.size()> out_{};  ///< by PortOffset: sent out
   std::array<bool, kPortChannels.size()> in_{};   ///< by PortOffset: taken in
   std::vector<std::string> external_;

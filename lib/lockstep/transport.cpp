@@ -128,13 +128,9 @@ bool IsPortPerChannel(const std::string& url) {
 }
 
 UdpmChannels::UdpmChannels(const UdpmUrl& url) : url_(url), buffers_(kBatch * kBufferBytes) {
-  for (std::size_t i = 0; i < kPortChannels.size(); ++i) sockets_[i].channel = kPortChannels[i];
+  for (std::size_t i = 0; i < kPortChannels.size(); ++i) sockets_[i].channel = static_cast<int>(i);
   to_.sin_family = AF_INET;
   ::inet_pton(AF_INET, url_.group.c_str(), &to_.sin_addr);  // checked by UdpmUrl::Parse
-  if (!url_.port_per_channel) {
-    error_ = "UdpmChannels needs a URL with port_per_channel=1";
-    return;
-  }
   send_fd_ = ::socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC, 0);
   if (send_fd_ < 0) {
     error_ = fmt::format("cannot create a UDP socket: {}", std::strerror(errno));
@@ -154,50 +150,54 @@ UdpmChannels::~UdpmChannels() {
   }
 }
 
+int UdpmChannels::OpenReceiveSocket(int port, const char* channel) {
+  const int fd = ::socket(AF_INET, SOCK_DGRAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
+  if (fd < 0) {
+    error_ = fmt::format("cannot create a UDP socket: {}", std::strerror(errno));
+    return -1;
+  }
+  const int one = 1;
+  sockaddr_in a{};
+  a.sin_family = AF_INET;
+  a.sin_addr.s_addr = htonl(INADDR_ANY);
+  a.sin_port = htons(static_cast<std::uint16_t>(port));
+  ip_mreq m{};
+  ::inet_pton(AF_INET, url_.group.c_str(), &m.imr_multiaddr);
+  m.imr_interface.s_addr = htonl(INADDR_ANY);
+  std::string why;
+  // As LCM does: SO_REUSEADDR, so every process of the run (and lcm-spy) binds the same port.
+  if (::setsockopt(fd, SOL_SOCKET, SO_REUSEADDR, &one, sizeof one) != 0) {
+    why = "SO_REUSEADDR";
+  } else if (url_.recv_buf_size > 0 &&
+             ::setsockopt(fd, SOL_SOCKET, SO_RCVBUF, &url_.recv_buf_size, sizeof url_.recv_buf_size) != 0) {
+    why = "SO_RCVBUF";
+  } else if (::bind(fd, reinterpret_cast<const sockaddr*>(&a), sizeof a) != 0) {
+    why = fmt::format("bind to port {}", port);
+  } else if (::setsockopt(fd, IPPROTO_IP, IP_ADD_MEMBERSHIP, &m, sizeof m) != 0) {
+    why = fmt::format("join {}", url_.group);
+  }
+  if (!why.empty()) {
+    error_ = fmt::format("{} ({}): {}", why, channel, std::strerror(errno));
+    ::close(fd);
+    return -1;
+  }
+  return fd;
+}
+
 bool UdpmChannels::Subscribe(const char* channel, Callback callback, void* context, Wake wake) {
   const int i = PortOffset(channel);
   if (i < 0) {
     error_ = fmt::format("channel {} has no port of its own (not a run channel)", channel);
     return false;
   }
-  Socket& s = sockets_[i];
+  Socket& s = sockets_[url_.port_per_channel ? i : 0];
   if (s.fd < 0) {
-    const int port = url_.port + i;
-    const int fd = ::socket(AF_INET, SOCK_DGRAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
-    if (fd < 0) {
-      error_ = fmt::format("cannot create a UDP socket: {}", std::strerror(errno));
-      return false;
-    }
-    const int one = 1;
-    sockaddr_in a{};
-    a.sin_family = AF_INET;
-    a.sin_addr.s_addr = htonl(INADDR_ANY);
-    a.sin_port = htons(static_cast<std::uint16_t>(port));
-    ip_mreq m{};
-    ::inet_pton(AF_INET, url_.group.c_str(), &m.imr_multiaddr);
-    m.imr_interface.s_addr = htonl(INADDR_ANY);
-    std::string why;
-    // As LCM does: SO_REUSEADDR, so every process of the run (and lcm-spy) binds the same port.
-    if (::setsockopt(fd, SOL_SOCKET, SO_REUSEADDR, &one, sizeof one) != 0) {
-      why = "SO_REUSEADDR";
-    } else if (url_.recv_buf_size > 0 &&
-               ::setsockopt(fd, SOL_SOCKET, SO_RCVBUF, &url_.recv_buf_size, sizeof url_.recv_buf_size) != 0) {
-      why = "SO_RCVBUF";
-    } else if (::bind(fd, reinterpret_cast<const sockaddr*>(&a), sizeof a) != 0) {
-      why = fmt::format("bind to port {}", port);
-    } else if (::setsockopt(fd, IPPROTO_IP, IP_ADD_MEMBERSHIP, &m, sizeof m) != 0) {
-      why = fmt::format("join {}", url_.group);
-    }
-    if (!why.empty()) {
-      error_ = fmt::format("{} ({}): {}", why, channel, std::strerror(errno));
-      ::close(fd);
-      return false;
-    }
-    s.fd = fd;
-    poll_order_.push_back(i);
+    s.fd = OpenReceiveSocket(url_.port + (url_.port_per_channel ? i : 0), channel);
+    if (s.fd < 0) return false;
+    poll_order_.push_back(s.channel);
   }
-  s.wakes = s.wakes || wake == Wake::kOnArrival;
-  s.callbacks.emplace_back(callback, context);
+  s.wakes = s.wakes || wake == Wake::kOnArrival || !url_.port_per_channel;
+  callbacks_[i].emplace_back(callback, context);
   return true;
 }
 
@@ -206,6 +206,7 @@ int UdpmChannels::Publish(const char* channel, const void* data, unsigned size) 
   // listens there, and the participants' sockets drop another channel's datagrams.
   const int i = std::strcmp(channel, kChMonitor) == 0 ? 0 : PortOffset(channel);
   if (i < 0 || send_fd_ < 0) return -1;
+  const int port = url_.port + (url_.port_per_channel ? i : 0);
   const std::size_t channel_len = std::strlen(channel) + 1;
   if (8 + channel_len + size > kMaxShortDatagram) return -1;  // LCM would fragment: not needed here
   const std::uint32_t header[2] = {htonl(kShortMagic), htonl(seqno_++)};
@@ -213,7 +214,7 @@ int UdpmChannels::Publish(const char* channel, const void* data, unsigned size) 
                   {const_cast<char*>(channel), channel_len},
                   {const_cast<void*>(data), size}};
   sockaddr_in to = to_;
-  to.sin_port = htons(static_cast<std::uint16_t>(url_.port + i));
+  to.sin_port = htons(static_cast<std::uint16_t>(port));
   msghdr msg{};
   msg.msg_name = &to;
   msg.msg_namelen = sizeof to;
@@ -232,10 +233,13 @@ void UdpmChannels::Deliver(Socket* s, std::uint8_t* datagram, std::size_t size) 
   if (ntohl(magic) != kShortMagic) return;  // a fragment of a large message: none of ours
   const auto* channel = reinterpret_cast<const char*>(datagram + 8);
   const auto* end = static_cast<const char*>(std::memchr(channel, '\0', size - 8));
-  if (!end || std::strcmp(channel, s->channel) != 0) return;  // another channel on our port
+  if (!end) return;
+  const int i = PortOffset(std::string_view(channel, static_cast<std::size_t>(end - channel)));
+  // Not a run channel (the clock's live records), or per channel another channel on our port.
+  if (i < 0 || (url_.port_per_channel && i != s->channel)) return;
   const std::size_t header = 8 + static_cast<std::size_t>(end - channel) + 1;
   lcm::ReceiveBuffer rb{datagram + header, static_cast<std::uint32_t>(size - header), WallUtime()};
-  for (const auto& [callback, context] : s->callbacks) callback(context, &rb);
+  for (const auto& [callback, context] : callbacks_[i]) callback(context, &rb);
 }
 
 bool UdpmChannels::Dispatch(Socket* s) {
@@ -267,6 +271,13 @@ int UdpmChannels::Drain(Socket* s) {
 }
 
 int UdpmChannels::HandleTimeout(int timeout_ms) {
+  if (!url_.port_per_channel) {  // one FIFO: everything in arrival order
+    Socket& s = sockets_[0];
+    if (s.fd < 0) return ::poll(nullptr, 0, timeout_ms);
+    pollfd fd{s.fd, POLLIN, 0};
+    const int r = ::poll(&fd, 1, timeout_ms);
+    return r <= 0 ? r : Drain(&s);
+  }
   std::array<pollfd, kPortChannels.size()> fds{};
   std::array<Socket*, kPortChannels.size()> socks{};
   std::size_t n = 0;
@@ -287,7 +298,7 @@ int UdpmChannels::HandleTimeout(int timeout_ms) {
   for (std::size_t j = 0; j < n; ++j) {
     if (!(fds[j].revents & POLLIN)) continue;
     Socket* s = socks[j];
-    if (s->channel == kPortChannels[0]) {
+    if (s->channel == 0) {
       handshake = s;
     } else if (Dispatch(s)) {
       ++handled;

@@ -86,25 +86,29 @@ class Channels {
   std::string error_;
 };
 
-/// Sockets of one process on a per-channel run: one receive socket per subscribed channel (bound
-/// to its port, member of the group) and one send socket. Read by HandleTimeout in the caller's
-/// thread. Nothing is allocated per message: one receive buffer, headers sent with sendmsg.
+/// Sockets of one process on a udpm run, read by HandleTimeout in the caller's thread: per channel
+/// (`port_per_channel=1`), one receive socket per subscribed channel, bound to its port; on one
+/// port (a plain LCM URL: the bridge of a mixed run, BridgedChannels), one receive socket for
+/// every channel, read in arrival order, as LCM's own one-port transport hands messages over but
+/// without its receive thread. Either way one send socket, and nothing allocated per message: the
+/// receive buffers are made once, headers sent with sendmsg.
 class UdpmChannels final : public Channels {
  public:
-  /// Opens the send socket. `url.port_per_channel` must be set. Check good() afterwards (false if
-  /// a socket could not be opened, bound or joined to the group; error() says which).
+  /// Opens the send socket. Check good() afterwards (false if a socket could not be opened, bound
+  /// or joined to the group; error() says which).
   explicit UdpmChannels(const UdpmUrl& url);
   ~UdpmChannels() override;
   UdpmChannels(const UdpmChannels&) = delete;
   UdpmChannels& operator=(const UdpmChannels&) = delete;
 
-  /// Opens the channel's receive socket on first use. A socket wakes HandleTimeout if any of its
-  /// subscriptions is Wake::kOnArrival.
+  /// Opens the channel's receive socket on first use (on one port: the one socket). A socket wakes
+  /// HandleTimeout if any of its subscriptions is Wake::kOnArrival; on one port every message wakes.
   bool Subscribe(const char* channel, Callback callback, void* context, Wake wake = Wake::kOnArrival) override;
   /// One LCM datagram; -1 for an unknown channel, a message too large for one datagram, a send
   /// error.
   int Publish(const char* channel, const void* data, unsigned size) override;
-  /// Waits for a message on a channel that wakes (Wake::kOnArrival); then first hands over every
+  /// On one port: waits for a datagram, then hands over every one waiting, in arrival order.
+  /// Per channel: waits for a message on a channel that wakes (Wake::kOnArrival); then first hands over every
   /// message waiting on the channels that do not wake (sent before the one that woke it, or
   /// found at the timeout), then at most one waiting message per waking channel; before a
   /// handshake message (an ABORT, DONE) it hands over every message waiting on the other
@@ -118,16 +122,19 @@ class UdpmChannels final : public Channels {
  private:
   struct Socket {
     int fd = -1;
-    const char* channel = nullptr;
+    int channel = 0;     ///< index in kPortChannels of the channel it carries (per channel)
     bool wakes = false;  ///< in the poll set: some subscription is Wake::kOnArrival
-    std::vector<std::pair<Callback, void*>> callbacks;
   };
+  /// Opens, binds and joins the receive socket of `port`; -1 (and error_ says why, naming
+  /// `channel`) if it cannot.
+  int OpenReceiveSocket(int port, const char* channel);
   /// Receives one datagram from `s` and hands it over; false if none was waiting.
   bool Dispatch(Socket* s);
   /// Receives every datagram waiting on `s` (recvmmsg, kBatch at a time, at most 256) and hands
   /// them over; how many.
   int Drain(Socket* s);
-  /// Hands one received datagram to the socket's callbacks (if it is an LCM message of its channel).
+  /// Hands one received datagram to its channel's callbacks (if it is an LCM message of a run
+  /// channel, and per channel, of the socket's own channel).
   void Deliver(Socket* s, std::uint8_t* datagram, std::size_t size);
 
   /// Datagrams received per recvmmsg call, and the size of each receive buffer (the largest datagram).
@@ -138,7 +145,8 @@ class UdpmChannels final : public Channels {
   sockaddr_in to_{};  ///< the group at the base port (a channel's port is set per send)
   int send_fd_ = -1;
   std::uint32_t seqno_ = 0;
-  std::array<Socket, kPortChannels.size()> sockets_{};
+  std::array<Socket, kPortChannels.size()> sockets_{};  ///< per channel; on one port sockets_[0] only
+  std::array<std::vector<std::pair<Callback, void*>>, kPortChannels.size()> callbacks_{};  ///< per channel
   std::vector<int> poll_order_;  ///< indices of open receive sockets, in opening order
   std::vector<std::uint8_t> buffers_;  ///< kBatch receive buffers of 64 KiB, one after another
   std::int64_t received_ = 0, sent_ = 0;
