@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <string>
 
 #include <CLI/CLI.hpp>
@@ -244,8 +245,8 @@ std::string MulticastRouteAdvice() {
 
 namespace {
 
-/// Builds the participant on the transport of `a.url` (one LCM instance, or a port per channel:
-/// this process then receives only its channels) and runs it.
+/// Builds the participant on the transport of `a.url` (our udpm sockets: a port per channel, then
+/// this process receives only its channels, or the run's one port; else one LCM instance) and runs it.
 void RunOnTransport(std::string_view role, const scenario::Scenario& s, const RoleArgs& a, Outcome* o) {
   auto more = [] {  // how to fix the host, if that is the reason
     const std::string hint = MulticastRouteAdvice();
@@ -259,8 +260,12 @@ void RunOnTransport(std::string_view role, const scenario::Scenario& s, const Ro
     if (auto* clock = dynamic_cast<lockstep::ClockParticipant*>(p.get())) clock->PublishLive();
     return p;
   };
-  if (lockstep::IsPortPerChannel(a.url)) {
-    lockstep::UdpmChannels channels(*lockstep::UdpmUrl::Parse(a.url));
+  // A udpm URL is read with our own sockets (a port per channel, or the run's one port), in this
+  // thread; LCM's instance (its receive thread and notify pipe) only for other URLs, a follower's
+  // and URLs with options only LCM knows.
+  const std::optional<lockstep::UdpmUrl> udpm = lockstep::UdpmUrl::Parse(a.url);
+  if (udpm && !a.follow && udpm->other_options.empty()) {
+    lockstep::UdpmChannels channels(*udpm);
     auto p = make(nullptr);
     std::string why = channels.error();
     if (why.empty()) {
