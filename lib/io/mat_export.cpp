@@ -17,6 +17,7 @@
 
 #include "core/error.h"
 #include "io/csv.h"
+#include "io/matio_handles.h"
 
 #ifndef RTHS_VERSION_STRING
 #define RTHS_VERSION_STRING "unknown"
@@ -65,11 +66,7 @@ std::string MatioSaid() {
   return " (matio: " + m + ")";
 }
 
-/// A matio variable, freed with Mat_VarFree.
-struct VarFree {
-  void operator()(matvar_t* v) const { Mat_VarFree(v); }
-};
-using Var = std::unique_ptr<matvar_t, VarFree>;
+using Var = matio::Var;
 
 // --- outputs: written under a temporary name, checked, then put in place -----------------------
 /// An output file. A new or regular file is written beside the target under a temporary name and

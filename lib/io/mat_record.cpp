@@ -12,19 +12,14 @@
 
 #include "core/error.h"
 #include "io/column_record.h"
+#include "io/matio_handles.h"
 
 namespace rths::io {
 
 namespace {
 
-struct MatClose {
-  void operator()(mat_t* m) const { Mat_Close(m); }
-};
-struct VarFree {
-  void operator()(matvar_t* v) const { Mat_VarFree(v); }
-};
-using MatFile = std::unique_ptr<mat_t, MatClose>;
-using MatVar = std::unique_ptr<matvar_t, VarFree>;
+using MatFile = matio::File;
+using MatVar = matio::Var;
 
 MatFile Open(const std::string& path) {
   MatFile m(Mat_Open(path.c_str(), MAT_ACC_RDONLY));
