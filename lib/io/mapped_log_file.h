@@ -73,7 +73,8 @@ class MappedLogFile {
 
 /// If the log at `path` ends in a zero word where an event should start (a logger killed before it
 /// cut back its reserved space), cuts the file there. Returns how many bytes it cut; throws
-/// rths::Error if the file cannot be read or cut, or holds garbage before that point.
+/// rths::Error if the file cannot be read or cut, or holds garbage before that point. A file whose
+/// last four bytes are not all zero has no reserved tail and is not read further (returns 0).
 std::int64_t TrimZeroTail(const std::string& path);
 
 }  // namespace rths::io
