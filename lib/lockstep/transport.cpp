@@ -99,7 +99,7 @@ std::optional<UdpmUrl> UdpmUrl::Parse(const std::string& url, std::string* error
       u.other_options += (u.other_options.empty() ? "" : "&") + opt;
     }
   }
-  const int last = u.port + (u.port_per_channel ? static_cast<int>(kPortChannels.size()) - 1 : 0);
+  const int last = u.PortOf(static_cast<int>(kPortChannels.size()) - 1);
   if (u.port < 1 || last > 65535) {
     return fail(u.port_per_channel ? "ports PORT .. PORT+6 must be in [1, 65535]" : "port must be in [1, 65535]");
   }
@@ -107,8 +107,7 @@ std::optional<UdpmUrl> UdpmUrl::Parse(const std::string& url, std::string* error
 }
 
 std::string UdpmUrl::ChannelUrl(std::string_view channel) const {
-  const int offset = port_per_channel ? std::max(0, PortOffset(channel)) : 0;
-  std::string s = fmt::format("udpm://{}:{}?ttl={}", group, port + offset, ttl);
+  std::string s = fmt::format("udpm://{}:{}?ttl={}", group, PortOf(std::max(0, PortOffset(channel))), ttl);
   if (recv_buf_size > 0) s += fmt::format("&recv_buf_size={}", recv_buf_size);
   if (!other_options.empty()) s += "&" + other_options;
   return s;
@@ -190,9 +189,9 @@ bool UdpmChannels::Subscribe(const char* channel, Callback callback, void* conte
     error_ = fmt::format("channel {} has no port of its own (not a run channel)", channel);
     return false;
   }
-  Socket& s = sockets_[url_.port_per_channel ? i : 0];
+  Socket& s = sockets_[url_.PortOf(i) - url_.port];  // on one port, sockets_[0] for every channel
   if (s.fd < 0) {
-    s.fd = OpenReceiveSocket(url_.port + (url_.port_per_channel ? i : 0), channel);
+    s.fd = OpenReceiveSocket(url_.PortOf(i), channel);
     if (s.fd < 0) return false;
     poll_order_.push_back(s.channel);
   }
@@ -206,7 +205,6 @@ int UdpmChannels::Publish(const char* channel, const void* data, unsigned size) 
   // listens there, and the participants' sockets drop another channel's datagrams.
   const int i = std::strcmp(channel, kChMonitor) == 0 ? 0 : PortOffset(channel);
   if (i < 0 || send_fd_ < 0) return -1;
-  const int port = url_.port + (url_.port_per_channel ? i : 0);
   const std::size_t channel_len = std::strlen(channel) + 1;
   if (8 + channel_len + size > kMaxShortDatagram) return -1;  // LCM would fragment: not needed here
   const std::uint32_t header[2] = {htonl(kShortMagic), htonl(seqno_++)};
@@ -214,7 +212,7 @@ int UdpmChannels::Publish(const char* channel, const void* data, unsigned size) 
                   {const_cast<char*>(channel), channel_len},
                   {const_cast<void*>(data), size}};
   sockaddr_in to = to_;
-  to.sin_port = htons(static_cast<std::uint16_t>(port));
+  to.sin_port = htons(static_cast<std::uint16_t>(url_.PortOf(i)));
   msghdr msg{};
   msg.msg_name = &to;
   msg.msg_namelen = sizeof to;

@@ -48,6 +48,9 @@ struct UdpmUrl {
 
   /// Parses `url`; nullopt (and `*error` says why) if it is not a udpm:// URL of this form.
   static std::optional<UdpmUrl> Parse(const std::string& url, std::string* error = nullptr);
+  /// The UDP port of the run channel with index `channel` in kPortChannels: PORT + index per
+  /// channel, PORT on one port.
+  int PortOf(int channel) const { return port + (port_per_channel ? channel : 0); }
   /// The plain LCM URL that carries `channel` (per channel: its own port; else the run's port),
   /// e.g. for `lcm-spy --lcm-url` or a supervisor's one-off ABORT.
   std::string ChannelUrl(std::string_view channel) const;
