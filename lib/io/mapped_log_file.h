@@ -15,7 +15,8 @@
 ///
 /// Close() cuts the file back to the bytes appended. A process killed before Close() leaves the
 /// reserved space past them as zero bytes: EventLogReader reads such a log to its last whole
-/// event and reports the zero tail (io::TrimZeroTail cuts it off); lcm-logplayer skips it.
+/// event and reports the zero tail (io::TrimZeroTail cuts it off); lcm-logplayer plays the events
+/// before it and ends there with "Invalid header after log data".
 ///
 /// Where the file system cannot reserve space (fallocate unsupported), every Append is one
 /// pwrite(2), as before this file existed.
