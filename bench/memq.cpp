@@ -11,6 +11,7 @@
 // (OdeMethod::kErk, the default) against CVODE's BDF (kBdf, the former default), both at the
 // scenario's rtol, and its force error against CVODE at rtol 1e-12.
 #include <fcntl.h>
+#include <time.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -33,6 +34,7 @@
 #include "control/tracking_controller.h"
 #include "io/event_log.h"
 #include "io/mapped_log_file.h"
+#include "io/signals_csv_writer.h"
 #include "io/signals_row.h"
 #include "lockstep/participant.h"
 #include "lockstep/run_loop.h"
@@ -264,50 +266,77 @@ double TimeTransport(std::size_t steps, bool lcm_memq) {
   return Seconds(t0) / steps * 1e6;
 }
 
-// What the logger does per step (lib/participants/logger.cpp): the four events appended to log.lcm
-// through its shared mapping (io::MappedLogFile) and the CSV row formatted by io::FormatSignalsRow,
-// buffered and written Logger::kCsvFlushBytes at a time. `former`: the logger before issue 46, the
-// events in one pwrite per step and the row formatted by snprintf.
-double TimeLogging(const std::vector<Row>& rows, const fs::path& dir, bool former) {
+// What the logger does per step (lib/participants/logger.cpp), timed on this thread:
+//   kQueued: the four events appended to log.lcm through its shared mapping (io::MappedLogFile) and
+//            the row's numbers handed to io::SignalsCsvWriter's queue (its thread formats and
+//            writes them); `cpu_us`: CPU time of both threads per step;
+//   kInline: the same log, the row formatted by io::FormatSignalsRow on this thread, buffered and
+//            written 64 kB at a time (the logger earlier in issue 46);
+//   kFormer: the logger before issue 46: the events in one pwrite per step, the row by snprintf.
+enum class Logging { kQueued, kInline, kFormer };
+double CpuSeconds() {
+  timespec ts{};
+  ::clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
+double TimeLogging(const std::vector<Row>& rows, const fs::path& dir, Logging how, double* cpu_us = nullptr,
+                   std::int64_t* stalls = nullptr) {
   const fs::path log_path = dir / "bench_log.lcm";
   const int log = ::open(log_path.c_str(), O_RDWR | O_CREAT | O_TRUNC, 0644);
-  const int csv = ::open((dir / "bench_signals.csv").c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
   rths::io::MappedLogFile mapped(::dup(log), log_path.string());
+  const fs::path csv_path = dir / "bench_signals.csv";
+  std::unique_ptr<rths::io::SignalsCsvWriter> queued;
+  if (how == Logging::kQueued) {
+    queued = std::make_unique<rths::io::SignalsCsvWriter>(csv_path.string());
+    mapped.PrefaultInBackground();
+  }
+  const int csv = how == Logging::kQueued ? -1 : ::open(csv_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
   std::vector<std::uint8_t> step, payload(80, 0x33);
   step.reserve(4096);
   std::string buf;
-  buf.reserve(rths::participants::Logger::kCsvFlushBytes + 512);
+  buf.reserve(rths::io::SignalsCsvWriter::kFlushBytes + 512);
   std::int64_t log_end = 0, csv_end = 0, event = 0;
+  const double cpu0 = CpuSeconds();
   const auto t0 = Clock::now();
   for (std::size_t k = 0; k < rows.size(); ++k) {
     step.clear();
     for (const char* ch : {rths::lockstep::kChDesired, rths::lockstep::kChCommand, rths::lockstep::kChMeasured,
                            rths::lockstep::kChCurrent})
       rths::io::AppendEvent(&step, event++, static_cast<std::int64_t>(k) * 500, ch, payload.data(), payload.size());
-    char row[400];
     const Row& r = rows[k];
     const double t = static_cast<double>(k) * 0.0005;
+    const std::array<double, 10> values{r.r, r.u, r.u, 0.0, r.y, r.r - r.y, r.f, r.i_cmd, r.i_eff, r.ground};
+    if (how == Logging::kQueued) {
+      mapped.Append(step.data(), step.size());
+      queued->Add({static_cast<std::int64_t>(k), t, values});
+      continue;
+    }
+    char row[400];
     std::size_t n = 0;
-    if (former) {
+    if (how == Logging::kFormer) {
       log_end += ::pwrite(log, step.data(), step.size(), log_end);
       n = static_cast<std::size_t>(std::snprintf(row, sizeof row,
                                                  "%zu,%.6f,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n",
                                                  k, t, r.r, r.u, r.u, 0.0, r.y, r.r - r.y, r.f, r.i_cmd, r.i_eff, r.ground));
     } else {
       mapped.Append(step.data(), step.size());
-      n = rths::io::FormatSignalsRow(row, static_cast<std::int64_t>(k), t,
-                                     {r.r, r.u, r.u, 0.0, r.y, r.r - r.y, r.f, r.i_cmd, r.i_eff, r.ground});
+      n = rths::io::FormatSignalsRow(row, static_cast<std::int64_t>(k), t, values);
     }
     buf.append(row, n);
-    if (buf.size() >= rths::participants::Logger::kCsvFlushBytes) {
+    if (buf.size() >= rths::io::SignalsCsvWriter::kFlushBytes) {
       csv_end += ::pwrite(csv, buf.data(), buf.size(), csv_end);
       buf.clear();
     }
   }
   const double us = Seconds(t0) / static_cast<double>(rows.size()) * 1e6;
+  if (queued) {
+    queued->Close();  // the writer's remaining rows count in the CPU time
+    if (stalls) *stalls = queued->stalls();
+  }
+  if (cpu_us) *cpu_us = (CpuSeconds() - cpu0) / static_cast<double>(rows.size()) * 1e6;
   mapped.Close();
   ::close(log);
-  ::close(csv);
+  if (csv >= 0) ::close(csv);
   return us;
 }
 
@@ -386,7 +415,9 @@ int main(int argc, char** argv) {
   const fs::path tmp = fs::temp_directory_path() / fmt::format("rths_bench_memq_{}", ::getpid());
   fs::create_directories(tmp);
 
-  std::vector<double> rate, wall, writes, reads, integ, ctrl, plant, codec, transport, logging, logging_old;
+  std::vector<double> rate, wall, writes, reads, integ, ctrl, plant, codec, transport, logging, logging_cpu,
+      logging_inline, logging_old;
+  std::int64_t csv_stalls = 0;
   std::vector<double> rate_lcm, transport_lcm, ratio;
   std::vector<double> erk_us, bdf_us;
   DamperFigures damper;
@@ -406,8 +437,13 @@ int main(int argc, char** argv) {
     codec.push_back(TimeCodec(rows));
     transport.push_back(TimeTransport(rows.size(), false));
     transport_lcm.push_back(TimeTransport(rows.size(), true));
-    logging.push_back(TimeLogging(rows, tmp, false));
-    logging_old.push_back(TimeLogging(rows, tmp, true));
+    double cpu_us = 0;
+    std::int64_t stalls = 0;
+    logging.push_back(TimeLogging(rows, tmp, Logging::kQueued, &cpu_us, &stalls));
+    logging_cpu.push_back(cpu_us);
+    csv_stalls += stalls;
+    logging_inline.push_back(TimeLogging(rows, tmp, Logging::kInline));
+    logging_old.push_back(TimeLogging(rows, tmp, Logging::kFormer));
     damper = TimeDamper(s, rows);
     erk_us.push_back(damper.erk_us);
     bdf_us.push_back(damper.bdf_us);
@@ -431,8 +467,13 @@ int main(int argc, char** argv) {
   line("model: plant (servo + damper)", p.plant);
   line("encode/decode (5 messages, 14 dec)", p.codec);
   line("transport (in-process queue)", p.transport);
-  line("logging (mapped log + to_chars CSV)", p.logging);
+  line("logging (mapped log + CSV queue)", p.logging);
   line("other (lockstep bookkeeping)", std::max(0.0, step_us - p.Sum()));
+  std::printf("  logging, CPU of both threads         %7.2f us  (the writer thread formats the rows: %lld stalls "
+              "on a full queue)\n",
+              Median(logging_cpu), static_cast<long long>(csv_stalls));
+  std::printf("  logging, row formatted on the step   %7.2f us  = %.2fx the current one\n", Median(logging_inline),
+              Median(logging_inline) / p.logging);
   std::printf("  logging, former (pwrite + snprintf)  %7.2f us  = %.2fx the current one\n", Median(logging_old),
               Median(logging_old) / p.logging);
   const double model_us = p.integrator + p.controller + p.plant;

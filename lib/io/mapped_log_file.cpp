@@ -14,6 +14,7 @@
 #include <fmt/core.h>
 
 #include "core/error.h"
+#include "io/background_thread.h"
 #include "io/event_log.h"
 
 namespace rths::io {
@@ -30,6 +31,7 @@ MappedLogFile::MappedLogFile(int fd, std::string path, std::int64_t size_bytes)
 
 MappedLogFile::~MappedLogFile() {
   Close();
+  StopPrefault();
   if (fd_ >= 0) ::close(fd_);
 }
 
@@ -48,15 +50,62 @@ bool MappedLogFile::Reserve(std::int64_t end) {
   if (::fallocate(fd_, 0, static_cast<off_t>(reserved_end_), static_cast<off_t>(new_end - reserved_end_)) != 0) {
     return false;  // unsupported here, or no room (ENOSPC, EFBIG): write instead
   }
+  std::lock_guard<std::mutex> lock(map_mutex_);
   Unmap();
   reserved_end_ = new_end;  // after Unmap, which unmaps up to the former end
   map_start_ = size_ / page * page;
+  prefaulted_end_ = map_start_;
   ++calls_;
   void* p = ::mmap(nullptr, static_cast<std::size_t>(reserved_end_ - map_start_), PROT_READ | PROT_WRITE, MAP_SHARED,
                    fd_, static_cast<off_t>(map_start_));
   if (p == MAP_FAILED) return false;
   map_ = static_cast<std::uint8_t*>(p);
   return true;
+}
+
+void MappedLogFile::PrefaultInBackground() {
+  if (prefaulting_ || mode_ != Mode::kMapped) return;
+  stop_prefault_.store(false);
+  prefaulting_ = StartBackgroundThread(&prefault_thread_, &MappedLogFile::PrefaultMain, this);
+}
+
+void* MappedLogFile::PrefaultMain(void* self) {
+  auto* f = static_cast<MappedLogFile*>(self);
+  constexpr long kIdleMicros = 1000;
+  while (!f->stop_prefault_.load(std::memory_order_acquire)) {
+    if (!f->PrefaultSome()) SleepMicros(kIdleMicros);
+  }
+  return nullptr;
+}
+
+bool MappedLogFile::PrefaultSome() {
+#ifdef MADV_POPULATE_WRITE
+  constexpr std::int64_t kPieceBytes = std::int64_t{64} << 10;  // the most the mutex is held for
+  std::lock_guard<std::mutex> lock(map_mutex_);
+  if (!map_) return false;
+  const std::int64_t page = PageBytes();
+  const std::int64_t at = appended_.load(std::memory_order_relaxed) / page * page;
+  const std::int64_t from = std::max({prefaulted_end_, at, map_start_});
+  const std::int64_t to = std::min({reserved_end_, at + kPrefaultAheadBytes, from + kPieceBytes});
+  if (to <= from) return false;
+  if (::madvise(map_ + (from - map_start_), static_cast<std::size_t>(to - from), MADV_POPULATE_WRITE) != 0 &&
+      errno == EINVAL) {
+    stop_prefault_.store(true);  // this kernel has no MADV_POPULATE_WRITE: Append faults as before
+    return false;
+  }
+  prefaulted_end_ = to;
+  return true;
+#else
+  stop_prefault_.store(true);
+  return false;
+#endif
+}
+
+void MappedLogFile::StopPrefault() {
+  if (!prefaulting_) return;
+  stop_prefault_.store(true, std::memory_order_release);
+  ::pthread_join(prefault_thread_, nullptr);
+  prefaulting_ = false;
 }
 
 std::string MappedLogFile::WriteAll(const void* data, std::size_t size) {
@@ -87,6 +136,7 @@ std::string MappedLogFile::Append(const void* data, std::size_t size) {
   if (mode_ == Mode::kClosed) return fmt::format("writing {} failed: the file is closed", path_);
   const std::int64_t end = size_ + static_cast<std::int64_t>(size);
   if (mode_ == Mode::kMapped && end > reserved_end_ && !Reserve(end)) {
+    std::lock_guard<std::mutex> lock(map_mutex_);
     Unmap();
     mode_ = Mode::kWrite;
   }
@@ -103,6 +153,7 @@ std::string MappedLogFile::Append(const void* data, std::size_t size) {
   std::atomic_thread_fence(std::memory_order_release);  // the sync word last: it commits the rest
   std::memcpy(at, bytes, head);
   size_ = end;
+  appended_.store(end, std::memory_order_relaxed);
   return {};
 }
 
@@ -121,6 +172,7 @@ void MappedLogFile::CutBack(std::int64_t size_bytes) {
 
 std::string MappedLogFile::Close() {
   if (mode_ == Mode::kClosed) return {};
+  StopPrefault();
   mode_ = Mode::kClosed;
   Unmap();
   if (reserved_end_ == size_) return {};

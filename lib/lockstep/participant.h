@@ -252,6 +252,7 @@ class Participant {
   std::int64_t fail_step_ = -1;
   SteadyClock::time_point created_;
   SteadyClock::time_point last_clock_;
+  bool heard_clock_ = false;  ///< a step message from the clock since the last Tick (it sets last_clock_)
   bool said_hello_ = false;
   SteadyClock::time_point last_beat_;  ///< our last HEARTBEAT (or HELLO)
   std::int64_t last_clock_step_ = -1;  ///< the latest step the clock requested, as seen here

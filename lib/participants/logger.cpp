@@ -14,22 +14,22 @@
 
 #include "core/error.h"
 #include "io/event_log.h"
-#include "io/signals_row.h"
+#include "io/signals_csv_writer.h"
 
 namespace rths::participants {
 
 namespace {
-constexpr const char* kCsvHeader = io::kSignalsCsvHeader;
-constexpr std::size_t kCsvRowMaxBytes = io::kSignalsRowMaxBytes;
-
-int CreateFile(const std::string& path, const char* what, int flags = O_WRONLY) {
-  const int fd = ::open(path.c_str(), flags | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-  if (fd < 0) throw Error(path, fmt::format("cannot create the {}: {}", what, std::strerror(errno)));
+/// Creates the event log (for reading and writing: it is mapped); throws rths::Error.
+int CreateLog(const std::string& path) {
+  const int fd = ::open(path.c_str(), O_RDWR | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0) throw Error(path, fmt::format("cannot create the event log: {}", std::strerror(errno)));
   return fd;
 }
 }  // namespace
 
-std::int64_t StoredBytesPerStep(int n_dof) { return LogBytesPerStep(n_dof) + static_cast<std::int64_t>(kCsvRowMaxBytes); }
+std::int64_t StoredBytesPerStep(int n_dof) {
+  return LogBytesPerStep(n_dof) + static_cast<std::int64_t>(io::kSignalsRowMaxBytes);
+}
 
 std::int64_t LogBytesPerStep(int n_dof) {
   // desired_t: 8 hash + 2x8 (run_id, k) + 7x8 doubles + 4 (n_dof) + 2 n_dof x8; the others are
@@ -50,62 +50,24 @@ Logger::Logger(lockstep::RunIdentity id, lockstep::LockstepConfig config, lcm::L
       csv_path_(csv_path),
       csv_every_(csv_every) {
   if (csv_every_ < 0) throw Error(csv_path_, fmt::format("csv_every = {}: must be >= 0", csv_every_));
-  log_ = std::make_unique<io::MappedLogFile>(CreateFile(log_path_, "event log", O_RDWR), log_path_);
-  if (csv_every_ > 0) csv_fd_ = CreateFile(csv_path_, "signals CSV");
-  if (const std::string why = csv_fd_ < 0 ? std::string()
-                                          : Append(csv_fd_, csv_path_, reinterpret_cast<const std::uint8_t*>(kCsvHeader),
-                                                   std::strlen(kCsvHeader), &csv_end_);
-      !why.empty()) {
-    ::close(csv_fd_);
-    throw Error(csv_path_, why);
-  }
+  log_ = std::make_unique<io::MappedLogFile>(CreateLog(log_path_), log_path_);
+  log_->PrefaultInBackground();
+  if (csv_every_ > 0) csv_ = std::make_unique<io::SignalsCsvWriter>(csv_path_);
   step_bytes_.reserve(4096);
-  if (csv_fd_ >= 0) {
-    csv_buf_.reserve(kCsvFlushBytes + kCsvRowMaxBytes);
-    csv_reserved_end_ = csv_end_;
-    if (const std::string why = FlushCsv(); !why.empty()) {  // reserves the first stretch
-      ::close(csv_fd_);
-      throw Error(csv_path_, why);
-    }
-  }
 }
 
-Logger::~Logger() {
-  if (csv_fd_ >= 0) CloseCsv();  // after a stop without OnStop (an exception): keep the rows
-  if (csv_fd_ >= 0) ::close(csv_fd_);
-}  // log_ cuts log.lcm back to its last event
+Logger::~Logger() = default;  // signals.csv gets every row added; log_ cuts log.lcm back to its last event
 
-std::int64_t Logger::write_calls() const { return write_calls_ + log_->system_calls(); }
+std::int64_t Logger::write_calls() const { return (csv_ ? csv_->system_calls() : 0) + log_->system_calls(); }
 
-std::string Logger::Append(int fd, const std::string& path, const std::uint8_t* data, std::size_t size,
-                           std::int64_t* good_end) {
-  std::size_t done = 0;
-  while (done < size) {
-    ++write_calls_;
-    const ssize_t n = ::pwrite(fd, data + done, size - done, static_cast<off_t>(*good_end + done));
-    if (n > 0) {
-      done += static_cast<std::size_t>(n);
-      continue;
-    }
-    if (n < 0 && errno == EINTR) continue;
-    const std::string err = n < 0 ? std::strerror(errno) : "no progress (device full?)";
-    // Nothing of a half-written event or row may stay behind.
-    if (::ftruncate(fd, static_cast<off_t>(*good_end)) != 0) {
-      return fmt::format("writing {} failed: {}; cutting it back to {} bytes failed too: {}", path, err,
-                         *good_end, std::strerror(errno));
-    }
-    return fmt::format("writing {} failed: {}", path, err);
-  }
-  *good_end += static_cast<std::int64_t>(size);
-  return {};
-}
+std::int64_t Logger::csv_stalls() const { return csv_ ? csv_->stalls() : 0; }
 
 void Logger::FailWrite(const std::string& why, std::int64_t k) {
-  // log.lcm ends on the last written step (it may hold part of step k); the buffered rows are
-  // all of written steps: write them (a failed write cuts signals.csv to a whole row).
+  // log.lcm ends on the last written step (it may hold part of step k); the rows added are all of
+  // written steps: write them (a failed write cuts signals.csv to a whole row).
   log_->CutBack(log_acked_);
   const bool cut_log = log_->Close().empty();
-  const bool csv_ok = csv_fd_ < 0 || CloseCsv().empty();
+  const bool csv_ok = CloseCsv().empty();
   std::string reason = fmt::format("{} (at step {}; the log and signals.csv end on step {}, the last "
                                    "complete one{})",
                                    why, k, written_ - 1,
@@ -115,42 +77,10 @@ void Logger::FailWrite(const std::string& why, std::int64_t k) {
   Fail(rths::kExitOutput, "logger: " + reason, true, k);
 }
 
-std::string Logger::AddCsvRow(const char* row, std::size_t size) {
-  if (!csv_buffered_) return Append(csv_fd_, csv_path_, reinterpret_cast<const std::uint8_t*>(row), size, &csv_end_);
-  csv_buf_.append(row, size);
-  return csv_buf_.size() >= kCsvFlushBytes ? FlushCsv() : std::string();
-}
-
-std::string Logger::FlushCsv() {
-  if (!csv_buf_.empty()) {
-    const std::string why = Append(csv_fd_, csv_path_, reinterpret_cast<const std::uint8_t*>(csv_buf_.data()),
-                                   csv_buf_.size(), &csv_end_);
-    csv_buf_.clear();
-    if (!why.empty()) return why;
-  }
-  // Reserve what the next flush writes (it may exceed kCsvFlushBytes by one row), so that a full
-  // disk fails the log's write, never a flush of rows already acknowledged.
-  if (csv_reserved_end_ < csv_end_ + static_cast<std::int64_t>(kCsvFlushBytes + kCsvRowMaxBytes)) {
-    ++write_calls_;
-    const off_t len = static_cast<off_t>(2 * kCsvFlushBytes);
-    csv_buffered_ = ::fallocate(csv_fd_, FALLOC_FL_KEEP_SIZE, static_cast<off_t>(csv_end_), len) == 0;
-    csv_reserved_end_ = csv_buffered_ ? csv_end_ + len : csv_end_;
-  }
-  return {};
-}
-
 std::string Logger::CloseCsv() {
-  if (csv_closed_ || csv_fd_ < 0) return {};
+  if (!csv_ || csv_closed_) return {};
   csv_closed_ = true;
-  std::string why = FlushCsv();
-  csv_buffered_ = false;
-  if (csv_reserved_end_ > csv_end_) {  // give back the reserved blocks past the last row
-    ++write_calls_;
-    ::fallocate(csv_fd_, FALLOC_FL_PUNCH_HOLE | FALLOC_FL_KEEP_SIZE, static_cast<off_t>(csv_end_),
-                static_cast<off_t>(csv_reserved_end_ - csv_end_));
-    csv_reserved_end_ = csv_end_;
-  }
-  return why;
+  return csv_->Close();
 }
 
 // Every step is in log.lcm before its ack; the log stays open for the handshake's last messages
@@ -218,17 +148,15 @@ bool Logger::WriteStep(std::int64_t k, const lockstep::StepInputs& in) {
     FailWrite(why, k);
     return false;
   }
-  if (csv_fd_ < 0 || csv_closed_ || k % csv_every_ != 0) {  // this step has no row of signals.csv
+  if (!csv_ || csv_closed_ || k % csv_every_ != 0) {  // this step has no row of signals.csv
     log_acked_ = log_->size();
     ++written_;
     return true;
   }
-  char row[kCsvRowMaxBytes + 1];
-  const std::size_t n =
-      io::FormatSignalsRow(row, k, static_cast<double>(k) * id_.dt_s,
-                {d->r_mm, c->u_mm, c->u_ff_mm, c->u_fb_mm, m->y_mm, d->r_mm - m->y_mm, m->f_kN, i->i_cmd_A,
-                 m->current_A, d->ground_acc_mm_s2});
-  if (const std::string why = AddCsvRow(row, n); !why.empty()) {
+  const io::SignalsCsvWriter::Row row{k, static_cast<double>(k) * id_.dt_s,
+                                      {d->r_mm, c->u_mm, c->u_ff_mm, c->u_fb_mm, m->y_mm, d->r_mm - m->y_mm, m->f_kN,
+                                       i->i_cmd_A, m->current_A, d->ground_acc_mm_s2}};
+  if (const std::string why = csv_->Add(row); !why.empty()) {
     FailWrite(why, k);
     return false;
   }

@@ -13,16 +13,17 @@
 /// logger's row of the step table, lockstep/step_table.h), is ack_t k published: the clock cannot advance past a step the logger has not handed to the kernel. The
 /// handshake is logged on its own channel as it arrives (first copy per participant and phase).
 ///
-/// signals.csv is a derived copy of the log (every column comes from the four messages), so its
-/// rows are buffered and written kCsvFlushBytes at a time, into space reserved ahead with
-/// fallocate(2) (so a full disk cannot fail a flush); where the file system cannot reserve space,
-/// each row is written with the step as before. The buffer is flushed when DONE arrives, when the
-/// run stops (ABORT, an interrupt, a write error) and when the logger is destroyed: signals.csv
-/// then ends on the last written step, like log.lcm. Only if the logger process itself is
-/// killed (SIGKILL) may signals.csv end earlier, on a whole row; log.lcm is complete regardless.
-/// No write system call per step: one per 64 kB of rows and one per reserved stretch of the log
-/// (bench/memq.cpp counts them). Rows are formatted with std::to_chars, to the same bytes as
-/// printf's %.17g and %.6f.
+/// signals.csv is a derived copy of the log (every column comes from the four messages): the step
+/// hands the row's numbers to io::SignalsCsvWriter's queue (a copy of twelve numbers) and its
+/// writer thread formats the rows and writes them 64 kB at a time, into space reserved ahead with
+/// fallocate(2) (so a full disk cannot fail the write of a row already handed over); where the file
+/// system cannot reserve space, each row is formatted and written with the step, as before. Every
+/// row handed over is written when DONE arrives, when the run stops (ABORT, an interrupt, a write
+/// error) and when the logger is destroyed: signals.csv then ends on the last written step, like
+/// log.lcm. Only if the logger process itself is killed (SIGKILL) may signals.csv end earlier, on
+/// a whole row; log.lcm is complete regardless. No write system call per step: the log's
+/// reservations and one per 64 kB of rows (bench/memq.cpp counts them). Rows are formatted with
+/// std::to_chars, to the same bytes as printf's %.17g and %.6f.
 ///
 /// Event timestamps are simulated time: the wall-clock time at which the logger started stepping
 /// (GO) plus k dt for the events of step k, so `lcm-logplayer --speed 1` replays a run at the pace
@@ -40,6 +41,7 @@
 #include <utility>
 
 #include "io/mapped_log_file.h"
+#include "io/signals_csv_writer.h"
 #include "lockstep/step_participant.h"
 #include "rths/ack_t.hpp"
 #include "rths/handshake_t.hpp"
@@ -67,17 +69,16 @@ class Logger : public lockstep::StepAnswerer<rths::ack_t> {
          const std::string& log_path, const std::string& csv_path, lockstep::Faults faults = {}, int csv_every = 1);
   ~Logger() override;
 
-  /// Bytes of signals.csv rows buffered before one write (and reserved ahead on disk).
-  static constexpr std::size_t kCsvFlushBytes = 64 * 1024;
-
   /// Steps written so far (every step acknowledged, and at most one more whose acknowledgement
   /// waits for measured_t k+1).
   std::int64_t steps_written() const { return written_; }
   /// File system calls (pwrite, ftruncate, fallocate, mmap) made so far, handshake included.
   std::int64_t write_calls() const;
+  /// Steps whose signals.csv row waited for the writer thread (its queue was full).
+  std::int64_t csv_stalls() const;
 
  protected:
-  std::string OnDone() override;  // writes the buffered rows of signals.csv
+  std::string OnDone() override;  // writes every row of signals.csv
   void OnStop() override;         // the same, on an abnormal stop
   void OnGo() override;
   /// Writes step k (log.lcm and its signals.csv row); the ack follows once the barrier is in.
@@ -95,32 +96,17 @@ class Logger : public lockstep::StepAnswerer<rths::ack_t> {
   /// Writes step k (log.lcm and its signals.csv row) from its four messages; false if the write
   /// failed (the run is then stopped).
   bool WriteStep(std::int64_t k, const lockstep::StepInputs& in);
-  /// Appends `bytes` to the file `fd` (every byte, or none: on failure the file is cut back to
-  /// `*good_end`); advances `*good_end`. Returns "" or the error, naming the file.
-  std::string Append(int fd, const std::string& path, const std::uint8_t* data, std::size_t size,
-                     std::int64_t* good_end);
   /// Cuts both files back to the last written step and stops the run (kExitOutput).
   void FailWrite(const std::string& why, std::int64_t k);
-  /// Adds a row to signals.csv: to the buffer (written once it holds kCsvFlushBytes) or, where no
-  /// space can be reserved, straight to the file. Returns "" or the error.
-  std::string AddCsvRow(const char* row, std::size_t size);
-  /// Writes the buffered rows, then reserves the next 2 kCsvFlushBytes (fallocate, keeping the
-  /// size); if that fails, rows are written one by one from then on. Returns "" or the error.
-  std::string FlushCsv();
-  /// FlushCsv() once at the end of the run, then frees the reserved space past the last row.
+  /// Writes every row of signals.csv and closes it (once; later calls return ""): "" or the error.
   std::string CloseCsv();
 
   std::string log_path_, csv_path_;
   int csv_every_ = 1;  ///< signals.csv row every this many steps; 0: no signals.csv
   std::unique_ptr<io::MappedLogFile> log_;    ///< log.lcm
-  int csv_fd_ = -1;
-  std::int64_t csv_end_ = 0;                    ///< bytes written, ending on a whole row
+  std::unique_ptr<io::SignalsCsvWriter> csv_;  ///< signals.csv; null when csv_every = 0
   std::int64_t log_acked_ = 0;                  ///< log bytes at the end of the last written step
-  std::string csv_buf_;                         ///< rows of acknowledged steps not yet written
-  bool csv_buffered_ = false;                   ///< space is reserved ahead: rows are buffered
-  bool csv_closed_ = false;                     ///< final flush done (or failed): no more rows
-  std::int64_t csv_reserved_end_ = 0;           ///< end of the space reserved with fallocate
-  std::int64_t write_calls_ = 0;
+  bool csv_closed_ = false;                     ///< signals.csv closed: no more rows
   std::int64_t event_number_ = 0;
   std::int64_t start_utime_ = -1;  ///< wall-clock time of GO [us since the epoch]; -1 before
   std::int64_t written_ = 0;  ///< steps written: the next to acknowledge, or one more
