@@ -8,6 +8,10 @@
 //
 //   build/bin/bench-compare --other DIR [--repeat N] [--seconds S] [--studies fig9,table2] [--out DIR]
 //
+// --studies also takes NAME:quick (`rths reproduce NAME --quick`, e.g. benchmark:quick) and `sweep`
+// (`rths sweep` of chunk 0 of 40 of scenarios/sweeps/benchmark_mc.toml: 80 runs spread over the four
+// cases and eight controllers; its table compared with the timing columns masked).
+//
 // --outputs: is the behaviour unchanged? The same commands run in both checkouts, into OUT/this and
 // OUT/other (cwd), and EVERY file they wrote is compared (bench/compare_outputs.h):
 //   - rths reproduce fig5 fig6 fig7 fig8 table2 fig9 fig11 benchmark, and table2 --extended
@@ -95,7 +99,9 @@ struct Sample {
 
 double Measure(const fs::path& tree, const Kind& k, const fs::path& out) {
   fs::remove_all(out);
-  const std::string cmd = fmt::format("{} {} --out {}", Quote((tree / "rths").string()), k.args, Quote(out.string()));
+  std::string args = k.args;  // "{tree}" stands for the checkout's own folder
+  for (std::size_t at; (at = args.find("{tree}")) != std::string::npos;) args.replace(at, 6, tree.string());
+  const std::string cmd = fmt::format("{} {} --out {}", Quote((tree / "rths").string()), args, Quote(out.string()));
   const double wall = Timed(cmd, out.string() + ".log");
   if (wall < 0) return -1.0;
   if (!k.run) return wall;
@@ -122,8 +128,18 @@ std::vector<std::vector<std::string>> Cells(const fs::path& p) {
 /// "identical", or how the two tables differ.
 std::string CompareTables(const fs::path& a, const fs::path& b) {
   if (!fs::exists(a) || !fs::exists(b)) return "missing";
-  const auto ra = Cells(a), rb = Cells(b);
-  if (ra == rb) return "identical, cell for cell";
+  auto ra = Cells(a), rb = Cells(b);
+  // A sweep's timing columns differ from run to run: masked.
+  int masked = 0;
+  for (std::size_t j = 0; !ra.empty() && j < ra[0].size(); ++j) {
+    if (ra[0][j].find("steps_per_s") == std::string::npos && ra[0][j].find("wall_s") == std::string::npos) continue;
+    ++masked;
+    for (auto* t : {&ra, &rb})
+      for (auto& row : *t)
+        if (j < row.size() && &row != &t->front()) row[j] = "";
+  }
+  const std::string note = masked ? fmt::format(" ({} timing column(s) masked)", masked) : "";
+  if (ra == rb) return "identical, cell for cell" + note;
   if (ra.size() != rb.size()) return fmt::format("different shapes: {} rows against {}", ra.size(), rb.size());
   int text = 0, numeric = 0;
   double max_abs = 0, max_rel = 0;
@@ -158,7 +174,10 @@ int main(int argc, char** argv) {
   app.add_option("--other", other_dir, "the other checkout (built: its ./rths and build/bin)")->required();
   app.add_option("--repeat", repeat, "pairs of each measurement (medians printed)")->capture_default_str();
   app.add_option("--seconds", seconds, "simulated seconds of the default runs")->capture_default_str();
-  app.add_option("--studies", studies, "reproductions to time, comma-separated ('' for none)")->capture_default_str();
+  app.add_option("--studies", studies,
+                 "reproductions to time, comma-separated ('' for none); NAME:quick for `reproduce NAME --quick`; "
+                 "'sweep' for a fortieth of scenarios/sweeps/benchmark_mc.toml (80 runs)")
+      ->capture_default_str();
   app.add_option("--out", out_dir, "where the runs go (default: a temporary folder, removed)");
   bool outputs_mode = false;
   outputs::Options oo;
@@ -193,7 +212,15 @@ int main(int argc, char** argv) {
                              {"memq", "run --transport memq " + set, true, ""}};
   std::stringstream ss(studies);
   for (std::string name; std::getline(ss, name, ',');) {
-    if (!name.empty()) kinds.push_back({"reproduce " + name, "reproduce " + name, false, name + ".csv"});
+    if (name.empty()) continue;
+    if (name == "sweep") {  // a fortieth of the benchmark Monte Carlo SPEC: 80 runs over cases and controllers
+      kinds.push_back({"sweep benchmark_mc 1/40", "sweep {tree}/scenarios/sweeps/benchmark_mc.toml --chunk 0 --chunks 40",
+                       false, "table.csv"});
+      continue;
+    }
+    const bool quick = name.size() > 6 && name.compare(name.size() - 6, 6, ":quick") == 0;
+    const std::string study = quick ? name.substr(0, name.size() - 6) : name;
+    kinds.push_back({"reproduce " + name, "reproduce " + study + (quick ? " --quick" : ""), false, study + ".csv"});
   }
   std::printf("bench-compare: %s (this) against %s (other), %d pairs each, alternating which runs first\n",
               mine.c_str(), other.c_str(), repeat);
