@@ -44,6 +44,8 @@
 // DIR is a built checkout (its ./rths and build/bin), e.g.
 //   git worktree add --detach /tmp/old COMMIT && cmake -S /tmp/old -B /tmp/old/build -G Ninja
 //     -DCMAKE_BUILD_TYPE=RelWithDebInfo && cmake --build /tmp/old/build   (one command)
+#include <sys/wait.h>
+
 #include <unistd.h>
 
 #include <algorithm>
@@ -77,12 +79,13 @@ std::string Quote(const std::string& s) {
   return q + "'";
 }
 
-/// Runs `cmd` (output to `log`); its wall time [s], or a negative value if it failed.
-double Timed(const std::string& cmd, const fs::path& log) {
+/// Runs `cmd` (output to `log`); its wall time [s], or a negative value if it exited with a code
+/// above `max_ok_exit` (or was killed).
+double Timed(const std::string& cmd, const fs::path& log, int max_ok_exit = 0) {
   const auto t0 = Clock::now();
-  const int rc = std::system((cmd + " > " + Quote(log.string()) + " 2>&1").c_str());
+  const int status = std::system((cmd + " > " + Quote(log.string()) + " 2>&1").c_str());
   const double s = std::chrono::duration<double>(Clock::now() - t0).count();
-  return rc == 0 ? s : -1.0;
+  return WIFEXITED(status) && WEXITSTATUS(status) <= max_ok_exit ? s : -1.0;
 }
 
 /// One measurement kind: a command per checkout and what to read from it.
@@ -91,6 +94,7 @@ struct Kind {
   std::string args;  ///< after `rths`
   bool run = true;   ///< a `rths run` (steps/s from summary.json); else a study (wall time)
   std::string table; ///< study: the table file to compare
+  int max_ok_exit = 0;  ///< a sweep exits 1 when some of its runs stopped (the table is written)
 };
 
 struct Sample {
@@ -102,7 +106,7 @@ double Measure(const fs::path& tree, const Kind& k, const fs::path& out) {
   std::string args = k.args;  // "{tree}" stands for the checkout's own folder
   for (std::size_t at; (at = args.find("{tree}")) != std::string::npos;) args.replace(at, 6, tree.string());
   const std::string cmd = fmt::format("{} {} --out {}", Quote((tree / "rths").string()), args, Quote(out.string()));
-  const double wall = Timed(cmd, out.string() + ".log");
+  const double wall = Timed(cmd, out.string() + ".log", k.max_ok_exit);
   if (wall < 0) return -1.0;
   if (!k.run) return wall;
   std::ifstream in(out / "summary.json");
@@ -129,16 +133,20 @@ std::vector<std::vector<std::string>> Cells(const fs::path& p) {
 std::string CompareTables(const fs::path& a, const fs::path& b) {
   if (!fs::exists(a) || !fs::exists(b)) return "missing";
   auto ra = Cells(a), rb = Cells(b);
-  // A sweep's timing columns differ from run to run: masked.
+  // A sweep's timing columns differ from run to run, and its scenario_sha256 from checkout to
+  // checkout (each run's scenario names the data files under its own checkout): masked.
   int masked = 0;
   for (std::size_t j = 0; !ra.empty() && j < ra[0].size(); ++j) {
-    if (ra[0][j].find("steps_per_s") == std::string::npos && ra[0][j].find("wall_s") == std::string::npos) continue;
+    const std::string& name = ra[0][j];
+    if (name.find("steps_per_s") == std::string::npos && name.find("wall_s") == std::string::npos &&
+        name != "scenario_sha256")
+      continue;
     ++masked;
     for (auto* t : {&ra, &rb})
       for (auto& row : *t)
         if (j < row.size() && &row != &t->front()) row[j] = "";
   }
-  const std::string note = masked ? fmt::format(" ({} timing column(s) masked)", masked) : "";
+  const std::string note = masked ? fmt::format(" ({} timing or hash column(s) masked)", masked) : "";
   if (ra == rb) return "identical, cell for cell" + note;
   if (ra.size() != rb.size()) return fmt::format("different shapes: {} rows against {}", ra.size(), rb.size());
   int text = 0, numeric = 0;
@@ -215,7 +223,7 @@ int main(int argc, char** argv) {
     if (name.empty()) continue;
     if (name == "sweep") {  // a fortieth of the benchmark Monte Carlo SPEC: 80 runs over cases and controllers
       kinds.push_back({"sweep benchmark_mc 1/40", "sweep {tree}/scenarios/sweeps/benchmark_mc.toml --chunk 0 --chunks 40",
-                       false, "table.csv"});
+                       false, "table.csv", 1});
       continue;
     }
     const bool quick = name.size() > 6 && name.compare(name.size() - 6, 6, ":quick") == 0;

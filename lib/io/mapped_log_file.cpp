@@ -26,8 +26,12 @@ std::int64_t PageBytes() {
 }
 }  // namespace
 
-MappedLogFile::MappedLogFile(int fd, std::string path, std::int64_t size_bytes)
-    : fd_(fd), path_(std::move(path)), size_(size_bytes), reserved_end_(size_bytes) {}
+MappedLogFile::MappedLogFile(int fd, std::string path, std::int64_t size_bytes, std::int64_t max_chunk_bytes)
+    : fd_(fd),
+      path_(std::move(path)),
+      size_(size_bytes),
+      reserved_end_(size_bytes),
+      max_chunk_bytes_(std::clamp(max_chunk_bytes, kFirstChunkBytes, kChunkBytes)) {}
 
 MappedLogFile::~MappedLogFile() {
   Close();
@@ -43,7 +47,7 @@ void MappedLogFile::Unmap() {
 }
 
 bool MappedLogFile::Reserve(std::int64_t end) {
-  const std::int64_t grow = std::clamp(reserved_end_, kFirstChunkBytes, kChunkBytes);
+  const std::int64_t grow = std::clamp(reserved_end_, kFirstChunkBytes, max_chunk_bytes_);
   const std::int64_t page = PageBytes();
   const std::int64_t new_end = (std::max(end, reserved_end_ + grow) + page - 1) / page * page;
   ++calls_;

@@ -77,7 +77,7 @@ std::unique_ptr<lockstep::Participant> MakeParticipant(std::string_view role, co
   if (role == "semiactive") return std::make_unique<Semiactive>(s, id, lcm, wiring, std::move(faults));
   if (role == "logger") {
     return std::make_unique<Logger>(id, LockstepOf(s), lcm, wiring, out_dir + "/log.lcm", out_dir + "/signals.csv",
-                                    std::move(faults), s.run.csv_every);
+                                    std::move(faults), s.run.csv_every, s.realtime.enabled);
   }
   throw Error("", fmt::format("unknown participant role '{}'", role));
 }

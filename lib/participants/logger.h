@@ -64,9 +64,12 @@ class Logger : public lockstep::StepAnswerer<rths::ack_t> {
   /// soon as its four messages are in, and acknowledged once everything else the barrier of step k
   /// waits for is in as well (measured_t k+1 where the plant answers command_t k): the clock then
   /// sends desired_t k+1 after measured_t k+1 in every run, so the controller and the semiactive
-  /// law wake once per step, for desired_t (docs/lockstep.md, "Wake-ups").
+  /// law wake once per step, for desired_t (docs/lockstep.md, "Wake-ups"). `paced`: a real-time
+  /// run (scenario [realtime] enabled): log.lcm reserved in 64 KiB pieces, no pre-fault helper
+  /// (io::MappedLogFile).
   Logger(lockstep::RunIdentity id, lockstep::LockstepConfig config, lcm::LCM* lcm, const lockstep::Wiring& wiring,
-         const std::string& log_path, const std::string& csv_path, lockstep::Faults faults = {}, int csv_every = 1);
+         const std::string& log_path, const std::string& csv_path, lockstep::Faults faults = {}, int csv_every = 1,
+         bool paced = false);
   ~Logger() override;
 
   /// Steps written so far (every step acknowledged, and at most one more whose acknowledgement

@@ -9,6 +9,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <filesystem>
 #include <string>
@@ -69,6 +70,35 @@ TEST_CASE("appends, across reservations, give exactly the bytes appended; Close 
   // Its last payload ends in zero bytes: read through, nothing to cut.
   CHECK(rths::io::TrimZeroTail(p.string()) == 0);
   CHECK(Slurp(p) == expected);
+}
+
+TEST_CASE("pre-faulted from a helper thread, or in small pieces (a paced run): the same bytes; the reserve stays "
+          "within one small piece") {
+  const auto dir = TempDir("mapped_variants");
+  for (const bool paced : {false, true}) {
+    CAPTURE(paced);
+    const fs::path p = dir / (paced ? "paced.lcm" : "prefaulted.lcm");
+    std::string expected;
+    {
+      MappedLogFile f(OpenRw(p), p.string(), 0, paced ? MappedLogFile::kFirstChunkBytes : MappedLogFile::kChunkBytes);
+      if (!paced) f.PrefaultInBackground();
+      std::uintmax_t largest_reserve = 0;
+      for (std::int64_t k = 0; k < 20000; ++k) {  // ~4.5 MB
+        const auto e = Event(k);
+        REQUIRE(f.Append(e.data(), e.size()).empty());
+        expected.append(e.begin(), e.end());
+        if (k % 97 == 0) largest_reserve = std::max(largest_reserve, fs::file_size(p) - expected.size());
+      }
+      if (paced) {
+        CHECK(largest_reserve <= static_cast<std::uintmax_t>(MappedLogFile::kFirstChunkBytes) + 4096);
+      } else {
+        CHECK(largest_reserve > static_cast<std::uintmax_t>(MappedLogFile::kFirstChunkBytes) + 4096);
+      }
+      CHECK(f.Close().empty());
+    }
+    CHECK(Slurp(p) == expected);
+    CHECK(EventsIn(p) == 20000);
+  }
 }
 
 TEST_CASE("a writer killed without closing: every append is in the file, then zeros; TrimZeroTail cuts them") {
