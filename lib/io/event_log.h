@@ -8,6 +8,7 @@
 ///   uint32 sync word 0xEDA1DA01 | int64 event number | int64 timestamp [us]
 ///   | int32 channel length | int32 payload length | channel bytes | payload bytes
 #include <cstdint>
+#include <cstring>
 #include <cstdio>
 #include <string>
 #include <string_view>
@@ -43,9 +44,8 @@ inline void AppendEvent(std::vector<std::uint8_t>* out, std::int64_t event_numbe
   detail::PutBigEndian(channel.size(), 4, p + 20);
   detail::PutBigEndian(payload_bytes, 4, p + 24);
   p += kEventHeaderBytes;
-  for (char c : channel) *p++ = static_cast<std::uint8_t>(c);
-  const auto* src = static_cast<const std::uint8_t*>(payload);
-  for (std::size_t i = 0; i < payload_bytes; ++i) p[i] = src[i];
+  std::memcpy(p, channel.data(), channel.size());
+  if (payload_bytes > 0) std::memcpy(p + channel.size(), payload, payload_bytes);
 }
 
 /// Largest payload EventLogReader accepts [bytes]. Our largest message is a few hundred bytes

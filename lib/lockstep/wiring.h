@@ -49,7 +49,12 @@ class Wiring {
   static Wiring Resolve(const std::vector<RoleVariant>& variants = {});
 
   const ResolvedRole& Of(std::string_view role) const;  ///< throws rths::Error for an unknown role
-  const ResolvedRole& Clock() const { return Of(kClockRole); }
+  /// The clock's row (its index is known at compile time: no lookup on the step's path).
+  const ResolvedRole& Clock() const {
+    constexpr int kClock = RosterIndex(kClockRole);
+    static_assert(kClock >= 0, "the roster has a clock");
+    return roles_[kClock];
+  }
   const std::array<ResolvedRole, kRosterSize>& roles() const { return roles_; }
   /// The roster's non-clock roles in the order of the step (by how many messages of the step
   /// their answer follows from; ties in roster order): whom a stalled step blames first.
