@@ -95,6 +95,9 @@ class Participant {
   void Follow(const FollowOptions& o);
   /// Follow mode only: what it did with every step (nullptr otherwise, and for the clock).
   virtual const FollowLedger* follow_ledger() const { return nullptr; }
+  /// The logger only: steps whose signals.csv row waited for its writer thread (a full queue);
+  /// -1 for the others.
+  virtual std::int64_t output_stalls() const { return -1; }
 
   /// Moves every subscription, and every publication from now on, to `channels` (a per-channel
   /// udpm run, or the in-process queue of a memq run). For a participant built with

@@ -146,6 +146,7 @@ Outcome OutcomeOf(const lockstep::Participant& p, Outcome o) {
   o.stats = p.stats();
   o.stats_known = true;
   o.stepping_s = p.stepping_s();
+  o.output_stalls = p.output_stalls();
   if (const auto* rt = p.realtime()) o.realtime = *rt;
   if (const auto* ledger = p.follow_ledger()) o.follow = FollowToJson(*ledger);
   if (const auto* peers = p.peers()) {
@@ -168,6 +169,7 @@ nlohmann::json OutcomeToJson(const Outcome& o) {
                       {"killed_by_supervisor", o.killed_by_supervisor},
                       {"was_stopped", o.was_stopped}};
   if (o.stepping_s > 0) j["stepping_s"] = o.stepping_s;
+  if (o.output_stalls >= 0) j["output_stalls"] = o.output_stalls;
   if (o.external) {
     j["external"] = true;
     j["observed"] = o.observed;
@@ -201,6 +203,7 @@ Outcome OutcomeFromJson(const nlohmann::json& j) {
   o.killed_by_supervisor = j.value("killed_by_supervisor", false);
   o.was_stopped = j.value("was_stopped", false);
   o.stepping_s = j.value("stepping_s", 0.0);
+  o.output_stalls = j.value("output_stalls", std::int64_t{-1});
   o.external = j.value("external", false);
   o.observed = j.value("observed", std::string());
   if (j.contains("peers")) {

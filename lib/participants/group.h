@@ -40,6 +40,8 @@ struct Outcome {
   bool stats_known = false;
   lockstep::LinkStats stats;
   double stepping_s = 0;  ///< the clock: wall-clock time from GO to the last committed step [s]
+  /// The logger: steps whose signals.csv row waited for its writer thread (-1: not a logger).
+  std::int64_t output_stalls = -1;
   bool external = false;  ///< run by the user (`rths run --external`): not started by us
   /// External: how its end was observed by the clock: "finished" (said BYE), "aborted" (sent ABORT
   /// with `message` as reason), "killed" (its process died by `signal`), "exited" (its process

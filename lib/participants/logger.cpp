@@ -65,7 +65,7 @@ Logger::~Logger() = default;  // signals.csv gets every row added; log_ cuts log
 
 std::int64_t Logger::write_calls() const { return (csv_ ? csv_->system_calls() : 0) + log_->system_calls(); }
 
-std::int64_t Logger::csv_stalls() const { return csv_ ? csv_->stalls() : 0; }
+std::int64_t Logger::output_stalls() const { return csv_ ? csv_->stalls() : 0; }
 
 void Logger::FailWrite(const std::string& why, std::int64_t k) {
   // log.lcm ends on the last written step (it may hold part of step k); the rows added are all of

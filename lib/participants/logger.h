@@ -77,8 +77,9 @@ class Logger : public lockstep::StepAnswerer<rths::ack_t> {
   std::int64_t steps_written() const { return written_; }
   /// File system calls (pwrite, ftruncate, fallocate, mmap) made so far, handshake included.
   std::int64_t write_calls() const;
-  /// Steps whose signals.csv row waited for the writer thread (its queue was full).
-  std::int64_t csv_stalls() const;
+  /// Steps whose signals.csv row waited for the writer thread (its queue was full); in
+  /// summary.json as participants.logger.output_stalls.
+  std::int64_t output_stalls() const override;
 
  protected:
   std::string OnDone() override;  // writes every row of signals.csv

@@ -178,6 +178,7 @@ Outcome WithSelfReport(Outcome o, const fs::path& out) {
       o.stats = self.stats;
       o.stats_known = self.stats_known;
       o.stepping_s = self.stepping_s;
+      o.output_stalls = self.output_stalls;
       o.realtime_setup = self.realtime_setup;
       o.realtime_json = self.realtime_json;
       o.peers = self.peers;

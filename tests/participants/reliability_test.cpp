@@ -203,6 +203,9 @@ TEST_CASE("5 % of every kind of fault on every channel: bit-identical, with the 
       CHECK(l.contains("resent"));
     }
     CHECK(output.find("re-requests") != std::string::npos);
+    // The logger reports how often a signals.csv row waited for its writer thread; only it.
+    CHECK(j["participants"]["logger"]["output_stalls"].get<int>() >= 0);
+    CHECK_FALSE(j["participants"]["plant"].contains("output_stalls"));
   }
 }
 
