@@ -126,6 +126,12 @@ std::string RunSummary::Report(double dt_s) const {
   if (link.rerequests > 0) {
     o += fmt::format("  link               {} re-requests, {} messages repaired\n", link.rerequests, link.repaired);
   }
+  for (const Outcome& p : participants) {
+    if (p.output_stalls <= 0) continue;
+    o += fmt::format("  output             {} step(s) waited for signals.csv's writer thread (its queue was full: a "
+                     "slow disk under --out?)\n",
+                     p.output_stalls);
+  }
   return o;
 }
 

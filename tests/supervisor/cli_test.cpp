@@ -285,6 +285,14 @@ TEST_CASE("small frictions: the folder to give, the role meant, the --set meant,
   const std::string report = never.Report(0.0005);
   CHECK(report.find("0.000 %") == std::string::npos);
   CHECK(report.find("tracking error     - (no step completed)") != std::string::npos);
+  CHECK(report.find("signals.csv's writer") == std::string::npos);
+  // A logger that had to wait for its CSV writer says so (summary.json: output_stalls).
+  rths::participants::Outcome logger;
+  logger.role = "logger";
+  logger.output_stalls = 3;
+  never.participants.push_back(logger);
+  CHECK(never.Report(0.0005).find("  output             3 step(s) waited for signals.csv's writer thread") !=
+        std::string::npos);
 }
 
 TEST_CASE("design of an identified model file: at the record's step, on the file's own actuator") {
