@@ -16,6 +16,7 @@
 #include "core/error.h"
 #include "io/background_thread.h"
 #include "io/event_log.h"
+#include "io/reserved_file.h"
 
 namespace rths::io {
 
@@ -113,27 +114,10 @@ void MappedLogFile::StopPrefault() {
 }
 
 std::string MappedLogFile::WriteAll(const void* data, std::size_t size) {
-  const auto* bytes = static_cast<const std::uint8_t*>(data);
-  std::size_t done = 0;
-  while (done < size) {
-    ++calls_;
-    const ssize_t n = ::pwrite(fd_, bytes + done, size - done, static_cast<off_t>(size_ + done));
-    if (n > 0) {
-      done += static_cast<std::size_t>(n);
-      continue;
-    }
-    if (n < 0 && errno == EINTR) continue;
-    const std::string err = n < 0 ? std::strerror(errno) : "no progress (device full?)";
-    // Nothing of a half-written append may stay behind.
-    ++calls_;
-    if (::ftruncate(fd_, static_cast<off_t>(size_)) != 0) {
-      return fmt::format("writing {} failed: {}; cutting it back to {} bytes failed too: {}", path_, err, size_,
-                         std::strerror(errno));
-    }
-    reserved_end_ = size_;
-    return fmt::format("writing {} failed: {}", path_, err);
-  }
-  return {};
+  bool cut_back = false;
+  std::string why = AppendWhole(fd_, path_, size_, data, size, &calls_, &cut_back);
+  if (cut_back) reserved_end_ = size_;
+  return why;
 }
 
 std::string MappedLogFile::Append(const void* data, std::size_t size) {

@@ -4,6 +4,9 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <cstring>
+
+#include <fmt/core.h>
 
 namespace rths::io {
 
@@ -35,6 +38,31 @@ bool OverwriteFile(const std::string& path, const std::string& text) {
   bool ok = WriteAll(fd, text.data(), text.size());
   ok = ok && ::ftruncate(fd, static_cast<off_t>(text.size())) == 0;
   return (::close(fd) == 0) && ok;
+}
+
+std::string AppendWhole(int fd, const std::string& path, std::int64_t end, const void* data, std::size_t size,
+                        std::int64_t* system_calls, bool* cut_back) {
+  const auto* bytes = static_cast<const std::uint8_t*>(data);
+  std::size_t done = 0;
+  if (cut_back) *cut_back = false;
+  while (done < size) {
+    ++*system_calls;
+    const ssize_t n = ::pwrite(fd, bytes + done, size - done, static_cast<off_t>(end + static_cast<std::int64_t>(done)));
+    if (n > 0) {
+      done += static_cast<std::size_t>(n);
+      continue;
+    }
+    if (n < 0 && errno == EINTR) continue;
+    const std::string err = n < 0 ? std::strerror(errno) : "no progress (device full?)";
+    ++*system_calls;
+    if (::ftruncate(fd, static_cast<off_t>(end)) != 0) {
+      return fmt::format("writing {} failed: {}; cutting it back to {} bytes failed too: {}", path, err, end,
+                         std::strerror(errno));
+    }
+    if (cut_back) *cut_back = true;
+    return fmt::format("writing {} failed: {}", path, err);
+  }
+  return {};
 }
 
 }  // namespace rths::io

@@ -10,6 +10,7 @@
 
 #include "core/error.h"
 #include "io/background_thread.h"
+#include "io/reserved_file.h"
 
 namespace rths::io {
 
@@ -129,26 +130,11 @@ std::string SignalsCsvWriter::Close() {
 }
 
 std::string SignalsCsvWriter::WriteAll(const char* data, std::size_t size) {
-  std::size_t done = 0;
-  while (done < size) {
-    calls_.fetch_add(1, std::memory_order_relaxed);
-    const ssize_t n = ::pwrite(fd_, data + done, size - done, static_cast<off_t>(end_ + static_cast<std::int64_t>(done)));
-    if (n > 0) {
-      done += static_cast<std::size_t>(n);
-      continue;
-    }
-    if (n < 0 && errno == EINTR) continue;
-    const std::string err = n < 0 ? std::strerror(errno) : "no progress (device full?)";
-    // Nothing of a half-written row may stay behind.
-    calls_.fetch_add(1, std::memory_order_relaxed);
-    if (::ftruncate(fd_, static_cast<off_t>(end_)) != 0) {
-      return fmt::format("writing {} failed: {}; cutting it back to {} bytes failed too: {}", path_, err, end_,
-                         std::strerror(errno));
-    }
-    return fmt::format("writing {} failed: {}", path_, err);
-  }
-  end_ += static_cast<std::int64_t>(size);
-  return {};
+  std::int64_t calls = 0;
+  std::string why = AppendWhole(fd_, path_, end_, data, size, &calls);
+  calls_.fetch_add(calls, std::memory_order_relaxed);
+  if (why.empty()) end_ += static_cast<std::int64_t>(size);
+  return why;
 }
 
 std::string SignalsCsvWriter::Flush() {
