@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 
 #include "core/error.h"
+#include "signal/stats.h"
 
 namespace rths::signal {
 
@@ -21,25 +22,6 @@ double Mean(std::span<const double> a) {
   double s = 0.0;
   for (double v : a) s += v;
   return s / static_cast<double>(a.size());
-}
-
-/// Sample standard deviation of a - b (b empty: of a), two-pass.
-double StdOfDifference(std::span<const double> a, std::span<const double> b) {
-  const std::size_t n = a.size();
-  auto at = [&](std::size_t i) { return b.empty() ? a[i] : a[i] - b[i]; };
-  double mean = 0.0;
-  for (std::size_t i = 0; i < n; ++i) mean += at(i);
-  mean /= static_cast<double>(n);
-  double ss = 0.0;
-  for (std::size_t i = 0; i < n; ++i) ss += (at(i) - mean) * (at(i) - mean);
-  return std::sqrt(ss / static_cast<double>(n - 1));
-}
-
-/// max |a - b| (b empty: max |a|).
-double MaxAbsOfDifference(std::span<const double> a, std::span<const double> b) {
-  double m = 0.0;
-  for (std::size_t i = 0; i < a.size(); ++i) m = std::max(m, std::abs(b.empty() ? a[i] : a[i] - b[i]));
-  return m;
 }
 
 void CheckRecord(const std::string& name, const std::vector<double>& x, std::size_t n) {

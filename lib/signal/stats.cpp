@@ -24,6 +24,23 @@ Spread SpreadOf(std::span<const double> v) {
   return s;
 }
 
+double StdOfDifference(std::span<const double> a, std::span<const double> b) {
+  const std::size_t n = a.size();
+  auto at = [&](std::size_t i) { return b.empty() ? a[i] : a[i] - b[i]; };
+  double mean = 0.0;
+  for (std::size_t i = 0; i < n; ++i) mean += at(i);
+  mean /= static_cast<double>(n);
+  double ss = 0.0;
+  for (std::size_t i = 0; i < n; ++i) ss += (at(i) - mean) * (at(i) - mean);
+  return std::sqrt(ss / static_cast<double>(n - 1));
+}
+
+double MaxAbsOfDifference(std::span<const double> a, std::span<const double> b) {
+  double m = 0.0;
+  for (std::size_t i = 0; i < a.size(); ++i) m = std::max(m, std::abs(b.empty() ? a[i] : a[i] - b[i]));
+  return m;
+}
+
 double Median(std::vector<double> v) {
   if (v.empty()) return std::numeric_limits<double>::quiet_NaN();
   std::sort(v.begin(), v.end());

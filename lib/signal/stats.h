@@ -16,6 +16,13 @@ struct Spread {
 /// min and max; every field NaN (n = 0) for no values.
 Spread SpreadOf(std::span<const double> v);
 
+/// Sample standard deviation (n - 1, two passes) of a - b, or of a when b is empty; a and b of
+/// equal length >= 2 (not checked).
+double StdOfDifference(std::span<const double> a, std::span<const double> b);
+
+/// max |a - b|, or max |a| when b is empty (0 for no values).
+double MaxAbsOfDifference(std::span<const double> a, std::span<const double> b);
+
 /// The median of v: its middle value after sorting, the mean of the two middle ones for an even
 /// count; NaN for no values.
 double Median(std::vector<double> v);

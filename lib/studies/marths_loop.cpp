@@ -1,0 +1,120 @@
+#include "studies/marths_loop.h"
+
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "core/error.h"
+#include "models/marths_frame.h"
+#include "models/marths_structure.h"
+#include "models/newmark_linear.h"
+#include "signal/random.h"
+
+namespace rths::studies {
+
+namespace mm = models::marths;
+
+namespace {
+
+/// The S5_Evaluation.m records, reserved for n samples.
+signal::MarthsSignals ReservedSignals(std::size_t n, double dt_s) {
+  signal::MarthsSignals s;
+  s.dt_s = dt_s;
+  for (auto* v : {&s.xa1_t, &s.xa2_t, &s.xa1_m, &s.xa2_m, &s.x_hat, &s.r_hat, &s.x_num, &s.r_num,
+                  &s.x_ref, &s.r_ref, &s.x2_num, &s.r2_num, &s.x3_num, &s.r3_num, &s.x2_ref, &s.r2_ref,
+                  &s.x3_ref, &s.r3_ref}) {
+    v->reserve(n);
+  }
+  return s;
+}
+
+double Volts(const MarthsLoopConfig& c, int i, double u_mm) {
+  return u_mm / c.correction[i] / c.v2d_gain[i] + (-c.v2d_offset[i] / c.v2d_gain[i]);
+}
+
+double U(const models::NewmarkLinearState& s, int dof) { return s.U(mm::Index(dof)); }
+
+}  // namespace
+
+MarthsLoopResult RunMarthsLoop(const MarthsLoopConfig& c) {
+  const std::size_t n = c.ag_m_s2.size();
+  if (n < 2) throw Error("maRTHS loop", "the ground motion has fewer than 2 samples");
+  const mm::Structures st = mm::BuildStructures(c.K_ref, c.M_ref, c.ideal_density_kg_m3);
+  const models::NewmarkLinear num = models::MakeNewmarkLinear(st.numerical.M, st.numerical.C, st.numerical.K,
+                                                              st.numerical.l, c.dt_s);
+  const models::NewmarkLinear ref = models::MakeNewmarkLinear(st.reference.M, st.reference.C, st.reference.K,
+                                                              st.reference.l, c.dt_s);
+  const mm::FeedbackFrame frame = mm::MakeFeedbackFrame(c.dt_s);
+  const mm::MarthsPlant plant = mm::MakeMarthsPlant(c.plant, c.dt_s);
+  const mm::CouplerGeometry geometry;
+
+  models::NewmarkLinearState num_s = models::NewmarkLinearAtRest(num);
+  models::NewmarkLinearState ref_s = models::NewmarkLinearAtRest(ref);
+  mm::FeedbackFrameState frame_s;
+  mm::MarthsPlantState plant_s;
+  signal::GaussianState noise = signal::MakeGaussian(c.noise_seed);
+  control::RodeacState rodeac_s[2];
+  if (c.compensator == MarthsCompensator::kRodeac) {
+    for (int i = 0; i < 2; ++i) rodeac_s[i] = control::RodeacAtRest(c.rodeac[i]);
+  }
+
+  MarthsLoopResult r;
+  r.signals = ReservedSignals(n, c.dt_s);
+  signal::MarthsSignals& g = r.signals;
+  for (std::size_t k = 0; k < n; ++k) {
+    const double ag = c.ag_m_s2[k];
+    // Measured strokes at t_k.
+    Eigen::Vector2d y = mm::PlantOutput(plant, plant_s);
+    if (c.noise_mm > 0.0) {
+      const double n1 = c.noise_mm * signal::NextGaussian(&noise);
+      const double n2 = c.identical_noise ? n1 : c.noise_mm * signal::NextGaussian(&noise);
+      y += Eigen::Vector2d(n1, n2);
+    }
+    // Interface motion estimated from them, and the frame's force.
+    const mm::InterfaceMotion est = mm::Inverse(geometry, {y(0), y(1)}, c.inverse);
+    const mm::InterfaceForces f = mm::FeedbackForce(frame, &frame_s, est.x_m, est.theta_rad);
+    // Numerical substructure under a_g(t_k) and F_k; its targets.
+    num_s.F(mm::Index(mm::kDofX)) = f.F27_N;
+    num_s.F(mm::Index(mm::kDofTheta)) = f.M21_N_m;
+    num_s.F(mm::Index(mm::kDofTheta2)) = f.M29_N_m;
+    models::NewmarkLinearStep(num, &num_s, ag);
+    const mm::InterfaceMotion target_motion{U(num_s, mm::kDofX), -U(num_s, mm::kDofTheta)};
+    const mm::ActuatorPair t = mm::Forward(geometry, target_motion);
+    // Commands.
+    Eigen::Vector2d u(t.a1_mm, t.a2_mm);
+    if (c.compensator == MarthsCompensator::kRodeac) {
+      u(0) = control::RodeacStep(c.rodeac[0], &rodeac_s[0], t.a1_mm, y(0));
+      u(1) = control::RodeacStep(c.rodeac[1], &rodeac_s[1], t.a2_mm, y(1));
+    }
+    if (!u.allFinite() || !y.allFinite()) {
+      throw Error("maRTHS loop", fmt::format("diverged at sample {} (t = {:.4f} s)", k, k * c.dt_s));
+    }
+    mm::PlantStep(plant, &plant_s, u);
+    models::NewmarkLinearStep(ref, &ref_s, ag);
+    for (int i = 0; i < 2; ++i) r.max_volts[i] = std::max(r.max_volts[i], std::abs(Volts(c, i, u(i))));
+
+    g.xa1_t.push_back(t.a1_mm);
+    g.xa2_t.push_back(t.a2_mm);
+    g.xa1_m.push_back(y(0));
+    g.xa2_m.push_back(y(1));
+    g.x_hat.push_back(1000.0 * est.x_m);
+    g.r_hat.push_back(est.theta_rad);
+    g.x_num.push_back(1000.0 * U(num_s, mm::kDofX));
+    g.r_num.push_back(-U(num_s, mm::kDofTheta));
+    g.x_ref.push_back(1000.0 * U(ref_s, mm::kDofX));
+    g.r_ref.push_back(-U(ref_s, mm::kDofTheta));
+    g.x2_num.push_back(U(num_s, mm::kDofX2));
+    g.r2_num.push_back(U(num_s, mm::kDofTheta2nd));
+    g.x3_num.push_back(U(num_s, mm::kDofX3));
+    g.r3_num.push_back(U(num_s, mm::kDofTheta3rd));
+    g.x2_ref.push_back(U(ref_s, mm::kDofX2));
+    g.r2_ref.push_back(U(ref_s, mm::kDofTheta2nd));
+    g.x3_ref.push_back(U(ref_s, mm::kDofX3));
+    g.r3_ref.push_back(U(ref_s, mm::kDofTheta3rd));
+  }
+  r.saturated = r.max_volts[0] > 3.8 && r.max_volts[1] > 3.8;
+  r.j = signal::MarthsCriteriaFrom(g);
+  return r;
+}
+
+}  // namespace rths::studies

@@ -1,0 +1,51 @@
+// The maRTHS benchmark's loop as its reference code closes it (lib/studies/marths_loop.h).
+#include <string>
+
+#include <doctest/doctest.h>
+#include <fmt/format.h>
+
+#include "io/marths_files.h"
+#include "signal/history.h"
+#include "studies/marths_loop.h"
+
+namespace mm = rths::models::marths;
+using rths::studies::MarthsCompensator;
+using rths::studies::MarthsLoopConfig;
+
+namespace {
+
+const std::string kData = std::string(RTHS_SOURCE_DIR) + "/data/marths/";
+
+MarthsLoopConfig Base(MarthsCompensator c, bool noise) {
+  MarthsLoopConfig cfg;
+  cfg.K_ref = rths::io::ReadMatrixCsv(kData + "reference_K_N_per_m.csv");
+  cfg.M_ref = rths::io::ReadMatrixCsv(kData + "reference_M_kg.csv");
+  const auto rec = rths::signal::ReadHistoryFile(kData + "elcentro_m_s2.txt", 0.0);
+  const std::size_t n = static_cast<std::size_t>(41.18 / cfg.dt_s + 1e-9) + 1;
+  cfg.ag_m_s2 = rths::signal::ResampleHistory(rec, 0.0, 0.4, cfg.dt_s, n, 0.0);
+  cfg.noise_mm = noise ? mm::SensorNoiseMm(cfg.dt_s) : 0.0;
+  cfg.compensator = c;
+  const auto p = rths::io::ReadRodeacParameters(kData + "rodeac_initial_parameters.txt");
+  for (int i = 0; i < 2; ++i) cfg.rodeac[i] = rths::control::MakeRodeacDesign(p.theta0[i], p.P0[i], 1.0 / cfg.dt_s);
+  return cfg;
+}
+
+std::string Row(const rths::studies::MarthsLoopResult& r) {
+  std::string s;
+  for (const auto& [k, v] : r.j.Items()) s += fmt::format("{} {:.3f}  ", k, v);
+  return s + fmt::format("V {:.3f} {:.3f}", r.max_volts[0], r.max_volts[1]);
+}
+
+}  // namespace
+
+TEST_CASE("El Centro x 0.4, nominal plant: none and RoDeAC, noise off and on") {
+  for (bool noise : {false, true}) {
+    const auto none = rths::studies::RunMarthsLoop(Base(MarthsCompensator::kNone, noise));
+    const auto rodeac = rths::studies::RunMarthsLoop(Base(MarthsCompensator::kRodeac, noise));
+    MESSAGE("noise " << noise << " none:   " << Row(none));
+    MESSAGE("noise " << noise << " rodeac: " << Row(rodeac));
+    CHECK(none.signals.xa1_t.size() == 42169);
+    CHECK(rodeac.j.J2_1_pct < none.j.J2_1_pct);
+    CHECK(rodeac.j.J2_2_pct < none.j.J2_2_pct);
+  }
+}
