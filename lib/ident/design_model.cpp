@@ -20,17 +20,24 @@ bool UsesModel(const control::ControllerConfig& c) {
 
 /// Third-order fit of the benchmark plant's Gp from a noise-free BLWN record through it.
 FitSummary FitBenchmarkGp(const models::BenchmarkPlantParams& p, double dt_s) {
+  const models::BenchmarkPlant plant = models::BenchmarkPlant::Make(p, dt_s);
+  models::BenchmarkPlantState st;
+  return FitDesignModel([&](double u_mm) {
+    const double y_mm = 1e3 * models::Output(plant, st);  // y_k from u_0 .. u_{k-1}
+    models::StepMm(plant, &st, u_mm);
+    return y_mm;
+  }, dt_s);
+}
+
+}  // namespace
+
+FitSummary FitDesignModel(const std::function<double(double u_mm)>& plant, double dt_s) {
   constexpr double kDurationS = 20.0, kBandHz = 30.0, kFitHiHz = 25.0, kRmsMm = 1.0;
   constexpr std::uint64_t kSeed = 11;
   const auto n = static_cast<std::size_t>(std::llround(kDurationS / dt_s));
   const std::vector<double> u = signal::Blwn(std::min(kBandHz, 0.4 / dt_s), kRmsMm, dt_s, n, kSeed, 2.0);
-  const models::BenchmarkPlant plant = models::BenchmarkPlant::Make(p, dt_s);
-  models::BenchmarkPlantState st;
   std::vector<double> y(n);
-  for (std::size_t k = 0; k < n; ++k) {
-    y[k] = 1e3 * models::Output(plant, st);  // y_k from u_0 .. u_{k-1} [mm]
-    models::StepMm(plant, &st, u[k]);
-  }
+  for (std::size_t k = 0; k < n; ++k) y[k] = plant(u[k]);
   IdentifyOptions o;
   o.fit.poles = 3;
   o.fit.band_lo_hz = 0.5;
@@ -38,8 +45,6 @@ FitSummary FitBenchmarkGp(const models::BenchmarkPlantParams& p, double dt_s) {
   o.fit.zoh_dt_s = 0.0;  // a design model: the hold's half-sample lag in the fit, as the study's
   return Identify(u, y, dt_s, o).fit;
 }
-
-}  // namespace
 
 std::string ResolveDesignModel(scenario::Scenario* s) {
   control::ControllerConfig& c = s->controller;

@@ -2,11 +2,20 @@
 /// @file The model a model-based tracking controller is designed on, made to follow the plant the
 /// scenario drives (issue 43: a benchmark scenario with controller.kind = "ff_lqg" was designed on
 /// the paper's damper-rig servo model, 9 ms of lag, where the benchmark plant has 25 ms).
+#include <functional>
 #include <string>
 
+#include "ident/identify.h"
 #include "scenario/scenario.h"
 
 namespace rths::ident {
+
+/// The third-order design fit of a plant rths can simulate, as `rths reproduce benchmark`
+/// identifies one: ident::Identify (3 poles over 0.5-25 Hz, the hold's half-sample lag in the
+/// fit) on a noise-free 20 s BLWN command (0-30 Hz, 1 mm RMS, seed 11) through the plant.
+/// `plant(u_k)` returns y_k [mm] (the reading before u_k is applied) and then holds u_k [mm]
+/// over the next step. Deterministic.
+FitSummary FitDesignModel(const std::function<double(double u_mm)>& plant, double dt_s);
 
 /// Sets the design model of a model-based controller (ff, ff_lp, ff_lqg, ambc started from the
 /// model) to the plant's own where the scenario leaves it at the default, and says which model the

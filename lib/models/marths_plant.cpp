@@ -25,16 +25,9 @@ Cd PlantElement(const PlantZpk& p, int row, int col, Cd s) {
   return k * (s - z) / ((s - p.h2p1) * (s - p.h2p2) * frame);
 }
 
-/// Monic quartic (s - a)(s - b)(s - f)(s - conj f): coefficients c0..c3 of s^0..s^3.
-std::array<double, 4> ColumnDenominator(double a, double b, Cd f) {
-  const double f1 = -2.0 * f.real(), f0 = std::norm(f);  // s^2 + f1 s + f0
-  const double r1 = -(a + b), r0 = a * b;                 // s^2 + r1 s + r0
-  return {r0 * f0, r0 * f1 + r1 * f0, r0 + r1 * f1 + f0, r1 + f1};
-}
-
 /// One column's 4 states in the scaled controllable canonical basis (the file comment of the
 /// header): writes A's block at (o, o), B at (o, col), and C's entries for numerators n[row][0..3].
-void RealiseColumn(const std::array<double, 4>& c, const double n[2][4], int o, int col,
+void RealiseColumn(const std::array<double, 5>& c, const double n[2][4], int o, int col,
                    MarthsPlant* m) {
   const double w = std::pow(c[0], 0.25);
   for (int i = 0; i < 3; ++i) m->A(o + i, o + i + 1) = w;
@@ -50,6 +43,13 @@ double Draw(double value, double rel_std, signal::GaussianState* g) {
 }
 
 }  // namespace
+
+std::array<double, 5> ColumnDenominator(const PlantZpk& p, int j) {
+  const double a = j == 0 ? p.h1p1 : p.h2p1, b = j == 0 ? p.h1p2 : p.h2p2;
+  const double f1 = -2.0 * p.frame_pole.real(), f0 = std::norm(p.frame_pole);  // s^2 + f1 s + f0
+  const double r1 = -(a + b), r0 = a * b;                                       // s^2 + r1 s + r0
+  return {r0 * f0, r0 * f1 + r1 * f0, r0 + r1 * f1 + f0, r1 + f1, 1.0};
+}
 
 PlantZpk NominalPlantZpk() {
   PlantZpk p;
@@ -113,8 +113,8 @@ MarthsPlant MakeMarthsPlant(const PlantZpk& p, double dt_s) {
   const double n1[2][4] = {{p.k11 * p.h1z1 * p.h1z2, -p.k11 * (p.h1z1 + p.h1z2), p.k11, 0.0},
                            {p.k21 * p.h1z1 * p.h1z2, -p.k21 * (p.h1z1 + p.h1z2), p.k21, 0.0}};
   const double n2[2][4] = {{-p.k12 * p.h12z1, p.k12, 0.0, 0.0}, {-p.k22 * p.h22z1, p.k22, 0.0, 0.0}};
-  RealiseColumn(ColumnDenominator(p.h1p1, p.h1p2, p.frame_pole), n1, 0, 0, &m);
-  RealiseColumn(ColumnDenominator(p.h2p1, p.h2p2, p.frame_pole), n2, 4, 1, &m);
+  RealiseColumn(ColumnDenominator(p, 0), n1, 0, 0, &m);
+  RealiseColumn(ColumnDenominator(p, 1), n2, 4, 1, &m);
   using Mat8 = Eigen::Matrix<double, 8, 8>;
   const Mat8 X = dt_s * m.A, I = Mat8::Identity();
   const Mat8 X2 = X * X, X3 = X2 * X, X4 = X3 * X;

@@ -50,6 +50,10 @@ struct PlantZpk {
 /// The nominal plant (fcn_build_uncert_plant.m's nominal model).
 PlantZpk NominalPlantZpk();
 
+/// Column j's common denominator (s - p_a)(s - p_b)(s - p_f)(s - conj p_f), monic: its
+/// coefficients of s^0 .. s^4 (the last is 1). j = 0, 1.
+std::array<double, 5> ColumnDenominator(const PlantZpk& p, int j);
+
 /// DC gain matrix [[H11, H12], [H21, H22]] (mm/mm).
 Eigen::Matrix2d DcGain(const PlantZpk& p);
 

@@ -1,10 +1,15 @@
 #include "studies/marths_loop.h"
 
 #include <cmath>
+#include <memory>
+#include <optional>
 
 #include <fmt/format.h>
 
+#include "control/mimo_feedforward.h"
+#include "control/tracking_controller.h"
 #include "core/error.h"
+#include "ident/design_model.h"
 #include "models/marths_frame.h"
 #include "models/marths_structure.h"
 #include "models/newmark_linear.h"
@@ -36,6 +41,22 @@ double U(const models::NewmarkLinearState& s, int dof) { return s.U(mm::Index(do
 
 }  // namespace
 
+std::array<models::ServoModel3, 2> MarthsDesignModels(const mm::PlantZpk& p, double dt_s) {
+  const mm::MarthsPlant plant = mm::MakeMarthsPlant(p, dt_s);
+  std::array<models::ServoModel3, 2> out;
+  for (int i = 0; i < 2; ++i) {
+    mm::MarthsPlantState st;
+    const ident::FitSummary fit = ident::FitDesignModel([&](double u_mm) {
+      const double y_mm = mm::PlantOutput(plant, st)(i);
+      mm::PlantStep(plant, &st, i == 0 ? Eigen::Vector2d(u_mm, 0.0) : Eigen::Vector2d(0.0, u_mm));
+      return y_mm;
+    }, dt_s);
+    out[i] = fit.model.ToServoModel3();
+    out[i].name = "custom";
+  }
+  return out;
+}
+
 MarthsLoopResult RunMarthsLoop(const MarthsLoopConfig& c) {
   const std::size_t n = c.ag_m_s2.size();
   if (n < 2) throw Error("maRTHS loop", "the ground motion has fewer than 2 samples");
@@ -57,6 +78,15 @@ MarthsLoopResult RunMarthsLoop(const MarthsLoopConfig& c) {
   if (c.compensator == MarthsCompensator::kRodeac) {
     for (int i = 0; i < 2; ++i) rodeac_s[i] = control::RodeacAtRest(c.rodeac[i]);
   }
+  const bool per_actuator = c.compensator == MarthsCompensator::kFf || c.compensator == MarthsCompensator::kFfLqg;
+  std::unique_ptr<control::TrackingController> law[2];
+  control::ExtrapolationState extrapolation[2];
+  if (per_actuator) {
+    for (int i = 0; i < 2; ++i) law[i] = control::MakeTrackingController(c.per_actuator[i], c.dt_s);
+  }
+  std::optional<control::MimoFeedforward> mimo;
+  control::MimoFeedforwardState mimo_s;
+  if (c.compensator == MarthsCompensator::kMimoFf) mimo = control::MakeMimoFeedforward(c.design_plant, c.dt_s);
 
   MarthsLoopResult r;
   r.signals = ReservedSignals(n, c.dt_s);
@@ -85,6 +115,14 @@ MarthsLoopResult RunMarthsLoop(const MarthsLoopConfig& c) {
     if (c.compensator == MarthsCompensator::kRodeac) {
       u(0) = control::RodeacStep(c.rodeac[0], &rodeac_s[0], t.a1_mm, y(0));
       u(1) = control::RodeacStep(c.rodeac[1], &rodeac_s[1], t.a2_mm, y(1));
+    } else if (per_actuator) {
+      const double target[2] = {t.a1_mm, t.a2_mm};
+      for (int i = 0; i < 2; ++i) {
+        const control::Derivatives d = control::StepDerivatives(&extrapolation[i], target[i], c.dt_s);
+        u(i) = law[i]->Step(d, {y(i), 0.0, 0.0}).u_mm;
+      }
+    } else if (mimo) {
+      u = control::MimoFeedforwardStep(*mimo, &mimo_s, t.a1_mm, t.a2_mm);
     }
     if (!u.allFinite() || !y.allFinite()) {
       throw Error("maRTHS loop", fmt::format("diverged at sample {} (t = {:.4f} s)", k, k * c.dt_s));

@@ -17,12 +17,14 @@
 /// a_g(t_k) is the record linearly interpolated at t_k (Simulink's From File) times the scale
 /// (0.4 in the benchmark). The signals recorded at every sample are those of S5_Evaluation.m, and
 /// the run is scored by signal::MarthsCriteriaFrom.
+#include <array>
 #include <cstdint>
 #include <string>
 #include <vector>
 
 #include <Eigen/Core>
 
+#include "control/controller_config.h"
 #include "control/rodeac.h"
 #include "models/marths_coupler.h"
 #include "models/marths_plant.h"
@@ -34,6 +36,9 @@ namespace rths::studies {
 enum class MarthsCompensator {
   kNone,    ///< u = x_t
   kRodeac,  ///< control::RodeacStep per actuator
+  kFf,      ///< the paper's feedforward per actuator, designed on H_ii (MarthsDesignModels)
+  kFfLqg,   ///< the paper's FF + LQG per actuator, designed on H_ii
+  kMimoFf,  ///< control::MimoFeedforward: the inverse of the 2 x 2 plant
 };
 
 /// One run's inputs (read at the edge: no file is opened here).
@@ -49,6 +54,11 @@ struct MarthsLoopConfig {
   models::marths::InverseForm inverse = models::marths::InverseForm::kAsWired;
   MarthsCompensator compensator = MarthsCompensator::kNone;
   control::RodeacDesign rodeac[2];      ///< kRodeac: actuator 1, 2
+  /// kFf, kFfLqg: each actuator's controller (kind and design model: MarthsDesignModels);
+  /// kMimoFf: `design_plant` is inverted.
+  control::ControllerConfig per_actuator[2];
+  /// The plant the compensators are designed on (the nominal plant, also for perturbed runs).
+  models::marths::PlantZpk design_plant = models::marths::NominalPlantZpk();
   /// The reference code's voltage conversion of each command (S1_Input_Data.m): volts =
   /// (u / correction - offset) / gain; the "realizable" limit is |V| <= 3.8 on both actuators.
   double v2d_gain[2] = {7.4921, 7.3907};
@@ -64,6 +74,10 @@ struct MarthsLoopResult {
   /// Both actuators' largest |V| exceed 3.8 V: the reference code's saturation flag for a run.
   bool saturated = false;
 };
+
+/// The third-order design models of the diagonal elements H_11, H_22 of `p` at step dt_s
+/// (ident::FitDesignModel on the plant driven through one actuator, the other held at 0).
+std::array<models::ServoModel3, 2> MarthsDesignModels(const models::marths::PlantZpk& p, double dt_s);
 
 /// Runs `c` for c.ag_m_s2.size() samples and scores it. Throws rths::Error for inputs the models
 /// refuse or if the loop diverges (a value that is not finite).

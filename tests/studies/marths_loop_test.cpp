@@ -38,14 +38,28 @@ std::string Row(const rths::studies::MarthsLoopResult& r) {
 
 }  // namespace
 
-TEST_CASE("El Centro x 0.4, nominal plant: none and RoDeAC, noise off and on") {
+TEST_CASE("El Centro x 0.4, nominal plant: every compensator, noise off and on") {
+  const auto models = rths::studies::MarthsDesignModels(mm::NominalPlantZpk(), 1.0 / 1024);
+  for (int i = 0; i < 2; ++i) {
+    MESSAGE("design model " << i + 1 << ": K " << models[i].K << " p " << models[i].p << " b " << models[i].b
+                            << " c " << models[i].c << " DC " << models[i].K / (models[i].p * models[i].c));
+  }
   for (bool noise : {false, true}) {
     const auto none = rths::studies::RunMarthsLoop(Base(MarthsCompensator::kNone, noise));
-    const auto rodeac = rths::studies::RunMarthsLoop(Base(MarthsCompensator::kRodeac, noise));
     MESSAGE("noise " << noise << " none:   " << Row(none));
-    MESSAGE("noise " << noise << " rodeac: " << Row(rodeac));
     CHECK(none.signals.xa1_t.size() == 42169);
-    CHECK(rodeac.j.J2_1_pct < none.j.J2_1_pct);
-    CHECK(rodeac.j.J2_2_pct < none.j.J2_2_pct);
+    for (auto kind : {MarthsCompensator::kRodeac, MarthsCompensator::kFf, MarthsCompensator::kFfLqg,
+                      MarthsCompensator::kMimoFf}) {
+      auto cfg = Base(kind, noise);
+      for (int i = 0; i < 2; ++i) {
+        cfg.per_actuator[i].kind = kind == MarthsCompensator::kFfLqg ? rths::control::ControllerKind::kFfLqg
+                                                                     : rths::control::ControllerKind::kFf;
+        cfg.per_actuator[i].model = models[i];
+      }
+      const auto r = rths::studies::RunMarthsLoop(cfg);
+      MESSAGE("noise " << noise << " kind " << static_cast<int>(kind) << ": " << Row(r));
+      CHECK(r.j.J2_1_pct < none.j.J2_1_pct);
+      CHECK(r.j.J2_2_pct < none.j.J2_2_pct);
+    }
   }
 }
