@@ -102,9 +102,9 @@ int CheckOptions(Options* o) {
     std::fprintf(stderr, "rths reproduce fig5: --set/--compact: fig5 runs the damper model alone, no scenario\n");
     return rths::kExitUsage;
   }
-  if ((!o->sets.empty() || o->executor == "slurm") && o->name == "nonlinear") {
-    std::fprintf(stderr, "rths reproduce nonlinear: --set/--compact/--executor slurm: nonlinear runs its loops in this "
-                         "process, no lockstep runs\n");
+  if ((!o->sets.empty() || o->executor == "slurm") && (o->name == "nonlinear" || o->name == "marths")) {
+    std::fprintf(stderr, "rths reproduce %s: --set/--compact/--executor slurm: %s runs its loops in this "
+                         "process, no lockstep runs\n", o->name.c_str(), o->name.c_str());
     return rths::kExitUsage;
   }
   if (o->resume && o->out.empty()) {

@@ -1,11 +1,16 @@
 // The maRTHS benchmark's loop as its reference code closes it (lib/studies/marths_loop.h).
+#include <filesystem>
+#include <fstream>
 #include <string>
+
+#include <unistd.h>
 
 #include <doctest/doctest.h>
 #include <fmt/format.h>
 
 #include "io/marths_files.h"
 #include "signal/history.h"
+#include "studies/marths.h"
 #include "studies/marths_loop.h"
 
 namespace mm = rths::models::marths;
@@ -62,4 +67,23 @@ TEST_CASE("El Centro x 0.4, nominal plant: every compensator, noise off and on")
       CHECK(r.j.J2_2_pct < none.j.J2_2_pct);
     }
   }
+}
+
+TEST_CASE("rths reproduce marths --quick: 15 runs, the tables, the figure, and its claims") {
+  rths::studies::ReproduceOptions o;
+  o.quick = true;
+  o.out_dir = std::filesystem::temp_directory_path() / ("rths_test_marths_" + std::to_string(::getpid()));
+  o.source_dir = RTHS_SOURCE_DIR;
+  const auto s = rths::studies::ReproduceMarths(o);
+  CHECK(s.rows.size() == 15);
+  CHECK(s.perturbed == 2);
+  for (const char* f : {"marths.csv", "marths_summary.csv", "marths.md", "marths.png", "marths.dat"}) {
+    CHECK(std::filesystem::exists(o.out_dir / f));
+  }
+  for (const auto& c : s.claims) CHECK_MESSAGE(c.holds, c.text << ": " << c.detail);
+  // The perturbed runs differ from the nominal one, and the study repeats itself exactly.
+  CHECK(s.rows[1].j.J2_1_pct != s.rows[0].j.J2_1_pct);
+  const auto again = rths::studies::ReproduceMarths(o);
+  for (std::size_t i = 0; i < s.rows.size(); ++i) CHECK(again.rows[i].j.J2_2_pct == s.rows[i].j.J2_2_pct);
+  std::filesystem::remove_all(o.out_dir);
 }

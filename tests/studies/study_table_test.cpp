@@ -23,7 +23,7 @@ TEST_CASE("study table: every study once, each with a reproduction and a standin
     }
   }
   CHECK(st::StudyNames() == std::vector<std::string>{"fig5", "fig6", "fig7", "fig8", "fig9", "fig11", "table2",
-                                                      "benchmark", "nonlinear"});
+                                                      "benchmark", "marths", "nonlinear"});
   CHECK(&st::StudyNamed("table2") == &st::Studies()[6]);
   CHECK_THROWS_WITH_AS(st::StudyNamed("fig10"), doctest::Contains("one of fig5, fig6"), rths::Error);
 }

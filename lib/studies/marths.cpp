@@ -1,0 +1,271 @@
+#include "studies/marths.h"
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <fstream>
+#include <thread>
+
+#include <fmt/format.h>
+
+#include "core/error.h"
+#include "core/interrupt.h"
+#include "io/csv.h"
+#include "io/marths_files.h"
+#include "io/plot.h"
+#include "io/source_tree.h"
+#include "signal/history.h"
+#include "signal/stats.h"
+#include "studies/marths_loop.h"
+
+namespace rths::studies {
+
+namespace mm = models::marths;
+
+namespace {
+
+constexpr std::uint64_t kPlantSeed = 47;     // the perturbed plants' draws, in order
+constexpr std::uint64_t kNominalNoise = 123;  // the reference code's nominal seed; perturbed i: 123 + i
+
+MarthsCompensator KindOf(const std::string& name) {
+  if (name == "rodeac") return MarthsCompensator::kRodeac;
+  if (name == "ff") return MarthsCompensator::kFf;
+  if (name == "ff_lqg") return MarthsCompensator::kFfLqg;
+  if (name == "mimo_ff") return MarthsCompensator::kMimoFf;
+  return MarthsCompensator::kNone;
+}
+
+/// The configuration every run shares (data read once).
+MarthsLoopConfig SharedConfig(const ReproduceOptions& opts) {
+  auto data = [&](const char* file) { return io::FindSourceFile(std::string("data/marths/") + file, opts.source_dir).string(); };
+  MarthsLoopConfig c;
+  c.K_ref = io::ReadMatrixCsv(data("reference_K_N_per_m.csv"));
+  c.M_ref = io::ReadMatrixCsv(data("reference_M_kg.csv"));
+  const signal::HistoryRecord rec = signal::ReadHistoryFile(data("elcentro_m_s2.txt"), 0.0);
+  const double end_s = rec.t.back();
+  const auto n = static_cast<std::size_t>(std::floor(end_s / c.dt_s + 1e-9)) + 1;
+  c.ag_m_s2 = signal::ResampleHistory(rec, 0.0, 0.4, c.dt_s, n, 0.0);
+  c.noise_mm = mm::SensorNoiseMm(c.dt_s);
+  const io::RodeacInitialParameters p = io::ReadRodeacParameters(data("rodeac_initial_parameters.txt"));
+  const auto models = MarthsDesignModels(c.design_plant, c.dt_s);
+  for (int i = 0; i < 2; ++i) {
+    c.rodeac[i] = control::MakeRodeacDesign(p.theta0[i], p.P0[i], 1.0 / c.dt_s);
+    c.per_actuator[i].model = models[i];
+  }
+  return c;
+}
+
+void WriteRows(const std::filesystem::path& file, const std::vector<MarthsRow>& rows) {
+  std::vector<std::string> header = {"compensator", "run"};
+  for (const auto& [k, v] : rows.front().j.Items()) header.push_back(k);
+  for (const char* h : {"max_V_1", "max_V_2", "saturated"}) header.push_back(h);
+  io::CsvWriter csv(file, header);
+  for (const MarthsRow& r : rows) {
+    std::vector<std::string> f = {r.compensator, r.run};
+    for (const auto& [k, v] : r.j.Items()) f.push_back(fmt::format("{:.6g}", v));
+    f.push_back(fmt::format("{:.4f}", r.max_volts[0]));
+    f.push_back(fmt::format("{:.4f}", r.max_volts[1]));
+    f.push_back(r.saturated ? "yes" : "no");
+    csv.Row(f);
+  }
+  csv.Close();
+}
+
+/// The perturbed runs' spread of criterion `key` for `comp`.
+signal::Spread PerturbedSpread(const std::vector<MarthsRow>& rows, const std::string& comp, const std::string& key) {
+  std::vector<double> v;
+  for (const MarthsRow& r : rows) {
+    if (r.compensator != comp || r.run == "nominal") continue;
+    for (const auto& [k, x] : r.j.Items()) {
+      if (k == key) v.push_back(x);
+    }
+  }
+  return signal::SpreadOf(v);
+}
+
+double NominalValue(const std::vector<MarthsRow>& rows, const std::string& comp, const std::string& key) {
+  for (const MarthsRow& r : rows) {
+    if (r.compensator != comp || r.run != "nominal") continue;
+    for (const auto& [k, x] : r.j.Items()) {
+      if (k == key) return x;
+    }
+  }
+  return std::nan("");
+}
+
+void WriteSummary(const ReproduceOptions& opts, const MarthsStudy& s) {
+  const auto keys = s.rows.front().j.Items();
+  io::CsvWriter csv(opts.out_dir / "marths_summary.csv", {"compensator", "criterion", "nominal", "perturbed_mean",
+                                                          "perturbed_std", "perturbed_n"});
+  std::ofstream md(opts.out_dir / "marths.md");
+  md << "# maRTHS benchmark, El Centro x 0.4, 1024 Hz, sensor noise on (rths reproduce marths)\n\n"
+     << fmt::format("Nominal plant, and the mean (sample std) over {} perturbed plants. J1 in ms, the rest in %. "
+                    "docs/marths.md explains every column.\n\n",
+                    s.perturbed);
+  md << "| criterion |";
+  for (const auto& c : MarthsCompensatorNames()) md << " " << c << " |";
+  md << "\n|---|";
+  for (std::size_t i = 0; i < MarthsCompensatorNames().size(); ++i) md << "---|";
+  md << "\n";
+  for (const auto& [key, unused] : keys) {
+    md << "| " << key << " |";
+    for (const auto& c : MarthsCompensatorNames()) {
+      const double nom = NominalValue(s.rows, c, key);
+      const signal::Spread sp = PerturbedSpread(s.rows, c, key);
+      csv.Row({c, key, fmt::format("{:.6g}", nom), fmt::format("{:.6g}", sp.mean), fmt::format("{:.6g}", sp.std),
+               std::to_string(sp.n)});
+      md << fmt::format(" {:.2f}; {:.2f} ({:.2f}) |", nom, sp.mean, sp.std);
+    }
+    md << "\n";
+  }
+  csv.Close();
+  md << "\nLargest command [V] (nominal run) and whether any run's commands exceeded 3.8 V on both actuators:\n\n";
+  for (const auto& c : MarthsCompensatorNames()) {
+    bool any = false;
+    double v1 = 0, v2 = 0;
+    for (const MarthsRow& r : s.rows) {
+      if (r.compensator != c) continue;
+      any = any || r.saturated;
+      if (r.run == "nominal") v1 = r.max_volts[0], v2 = r.max_volts[1];
+    }
+    md << fmt::format("- {}: {:.3f} V, {:.3f} V; {}\n", c, v1, v2, any ? "NOT realizable" : "realizable");
+  }
+  md << "\n";
+  for (const Claim& c : s.claims) md << ClaimMarkdown(c);
+}
+
+void WriteFigure(const ReproduceOptions& opts, const MarthsStudy& s) {
+  const auto& names = MarthsCompensatorNames();
+  auto series = [&](const std::string& title, const std::string& key, bool nominal, const std::string& color) {
+    io::Series x = io::MakeSeries(title, color);
+    for (const auto& c : names) x.y.push_back(nominal ? NominalValue(s.rows, c, key) : PerturbedSpread(s.rows, c, key).mean);
+    return x;
+  };
+  const auto& col = io::ReadableColors();
+  io::Figure f;
+  f.name = "marths";
+  f.title = fmt::format("maRTHS, El Centro x 0.4: nominal plant and mean of {} perturbed plants", s.perturbed);
+  f.gnuplot = opts.gnuplot;
+  f.columns = 1;
+  f.panels.push_back(io::MakeBarPanel("Tracking: J2 (std of x_m - x_t over std of x_t)", "J2 [%]", names,
+                                      {series("actuator 1, nominal", "J2_1_pct", true, col[0]),
+                                       series("actuator 1, perturbed mean", "J2_1_pct", false, col[5]),
+                                       series("actuator 2, nominal", "J2_2_pct", true, col[1]),
+                                       series("actuator 2, perturbed mean", "J2_2_pct", false, col[3])}));
+  f.panels.push_back(io::MakeBarPanel("Interface against the reference structure: J7", "J7 [%]", names,
+                                      {series("translation, nominal", "J7_X_pct", true, col[0]),
+                                       series("translation, perturbed mean", "J7_X_pct", false, col[5]),
+                                       series("rotation, nominal", "J7_TH_pct", true, col[1]),
+                                       series("rotation, perturbed mean", "J7_TH_pct", false, col[3])}));
+  for (auto& p : f.panels) {
+    p.log_y = true;
+    p.key = "outside right top";
+    p.right_margin_chars = io::KeyMarginChars({&p});
+  }
+  io::Plot(f, opts.out_dir);
+}
+
+std::vector<Claim> MarthsClaims(const MarthsStudy& s) {
+  std::vector<Claim> claims;
+  auto j2 = [&](const std::string& c, const std::string& run, int a) {
+    for (const MarthsRow& r : s.rows)
+      if (r.compensator == c && r.run == run) return a == 1 ? r.j.J2_1_pct : r.j.J2_2_pct;
+    return std::nan("");
+  };
+  {
+    Claim c{"every compensator tracks both actuators better than none (J2, nominal plant)", true, ""};
+    for (const auto& name : MarthsCompensatorNames()) {
+      if (name == "none") continue;
+      for (int a = 1; a <= 2; ++a) c.holds = c.holds && j2(name, "nominal", a) < j2("none", "nominal", a);
+      c.detail += fmt::format("{} {:.2f} / {:.2f} %; ", name, j2(name, "nominal", 1), j2(name, "nominal", 2));
+    }
+    c.detail += fmt::format("none {:.2f} / {:.2f} %", j2("none", "nominal", 1), j2("none", "nominal", 2));
+    claims.push_back(c);
+  }
+  {
+    Claim c{"inverting the coupled 2 x 2 plant (mimo_ff) tracks better than the paper's feedforward per actuator (ff) "
+            "on every plant: the actuators' coupling is what a decentralised inverse misses",
+            true, ""};
+    int better = 0, n = 0;
+    for (const MarthsRow& r : s.rows) {
+      if (r.compensator != "mimo_ff") continue;
+      ++n;
+      const bool b = r.j.J2_1_pct < j2("ff", r.run, 1) && r.j.J2_2_pct < j2("ff", r.run, 2);
+      better += b;
+      c.holds = c.holds && b;
+    }
+    c.detail = fmt::format("{} of {} plants", better, n);
+    claims.push_back(c);
+  }
+  return claims;
+}
+
+}  // namespace
+
+const std::vector<std::string>& MarthsCompensatorNames() {
+  static const std::vector<std::string> names = {"none", "rodeac", "ff", "ff_lqg", "mimo_ff"};
+  return names;
+}
+
+MarthsStudy ReproduceMarths(const ReproduceOptions& opts) {
+  const auto t0 = std::chrono::steady_clock::now();
+  MarthsStudy s;
+  s.perturbed = opts.quick ? 2 : 20;
+  const MarthsLoopConfig shared = SharedConfig(opts);
+  std::vector<mm::PlantZpk> plants = {shared.design_plant};
+  signal::GaussianState g = signal::MakeGaussian(kPlantSeed);
+  for (int i = 0; i < s.perturbed; ++i) plants.push_back(mm::PerturbedPlantZpk(shared.design_plant, &g));
+  for (const auto& comp : MarthsCompensatorNames()) {
+    for (std::size_t p = 0; p < plants.size(); ++p) {
+      MarthsRow r;
+      r.compensator = comp;
+      r.run = p == 0 ? "nominal" : fmt::format("perturbed_{}", p);
+      s.rows.push_back(r);
+    }
+  }
+  std::atomic<std::size_t> next{0};
+  std::atomic<bool> failed{false};
+  std::string failure;
+  auto work = [&] {
+    for (std::size_t i; !failed && (i = next++) < s.rows.size();) {
+      if (InterruptRequested()) {
+        failed = true;
+        return;
+      }
+      MarthsRow& r = s.rows[i];
+      MarthsLoopConfig c = shared;
+      const std::size_t p = i % plants.size();
+      c.plant = plants[p];
+      c.noise_seed = kNominalNoise + p;
+      c.compensator = KindOf(r.compensator);
+      for (int a = 0; a < 2; ++a) {
+        c.per_actuator[a].kind = r.compensator == "ff_lqg" ? control::ControllerKind::kFfLqg : control::ControllerKind::kFf;
+      }
+      try {
+        const MarthsLoopResult res = RunMarthsLoop(c);
+        r.j = res.j;
+        r.max_volts[0] = res.max_volts[0];
+        r.max_volts[1] = res.max_volts[1];
+        r.saturated = res.saturated;
+      } catch (const std::exception& e) {
+        failure = fmt::format("{} {}: {}", r.compensator, r.run, e.what());
+        failed = true;
+      }
+      if (opts.log) opts.log(fmt::format("marths: {} {} done", r.compensator, r.run));
+    }
+  };
+  std::vector<std::thread> threads;
+  for (int t = 0; t < std::max(1, opts.jobs); ++t) threads.emplace_back(work);
+  for (auto& t : threads) t.join();
+  if (InterruptRequested()) throw Interrupted("reproduce marths", "interrupted");
+  if (failed) throw Error("reproduce marths", failure);
+  s.claims = MarthsClaims(s);
+  std::filesystem::create_directories(opts.out_dir);
+  WriteRows(opts.out_dir / "marths.csv", s.rows);
+  WriteSummary(opts, s);
+  WriteFigure(opts, s);
+  s.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return s;
+}
+
+}  // namespace rths::studies

@@ -1,0 +1,40 @@
+#pragma once
+/// @file `rths reproduce marths` (docs/marths.md): the maRTHS benchmark's criteria J1-J10 for every
+/// compensator (none, RoDeAC, the paper's ff and ff_lqg per actuator, the MIMO feedforward) on the
+/// nominal plant and on perturbed plants (20; --quick: 2), El Centro x 0.4 at 1024 Hz, sensor
+/// noise on, each run closed as the reference code closes its loop (studies/marths_loop.h).
+///
+/// Files: marths.csv (a row per run), marths_summary.csv (per compensator: the nominal run, and
+/// the perturbed runs' mean and sample standard deviation of every criterion), marths.md (the
+/// tables), marths.png (J2 per actuator, J5 and J7 per interface DOF, nominal and perturbed mean).
+#include <string>
+#include <vector>
+
+#include "signal/marths_criteria.h"
+#include "studies/study.h"
+
+namespace rths::studies {
+
+/// One run of the study.
+struct MarthsRow {
+  std::string compensator;  ///< "none", "rodeac", "ff", "ff_lqg", "mimo_ff"
+  std::string run;          ///< "nominal" or "perturbed_<i>" (i = 1 ..)
+  signal::MarthsCriteria j;
+  double max_volts[2] = {0.0, 0.0};
+  bool saturated = false;
+};
+
+struct MarthsStudy {
+  std::vector<MarthsRow> rows;
+  std::vector<Claim> claims;
+  int perturbed = 0;  ///< perturbed plants per compensator
+  double wall_s = 0.0;
+};
+
+/// The compensators, in the tables' order.
+const std::vector<std::string>& MarthsCompensatorNames();
+
+/// Runs the study into opts.out_dir. Reads data/marths/ (io::FindSourceFile with opts.source_dir).
+MarthsStudy ReproduceMarths(const ReproduceOptions& opts);
+
+}  // namespace rths::studies
