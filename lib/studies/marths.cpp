@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <fstream>
+#include <mutex>
 #include <thread>
 
 #include <fmt/format.h>
@@ -200,6 +201,89 @@ std::vector<Claim> MarthsClaims(const MarthsStudy& s) {
   return claims;
 }
 
+void Configure(const std::string& compensator, MarthsLoopConfig* c) {
+  c->compensator = KindOf(compensator);
+  for (int a = 0; a < 2; ++a) {
+    c->per_actuator[a].kind = compensator == "ff_lqg" ? control::ControllerKind::kFfLqg : control::ControllerKind::kFf;
+  }
+}
+
+/// The decisions table's runs (rows appended to `rows`, configs returned in the same order).
+std::vector<MarthsLoopConfig> DecisionConfigs(const MarthsLoopConfig& shared, std::vector<MarthsDecisionRow>* rows) {
+  std::vector<MarthsLoopConfig> out;
+  for (const char* comp : {"none", "rodeac", "mimo_ff"}) {
+    for (const char* variant : {"as coded", "exact inverse", "independent noise", "force one sample late",
+                                "derivatives from rest", "no noise"}) {
+      MarthsLoopConfig c = shared;
+      c.noise_seed = kNominalNoise;
+      Configure(comp, &c);
+      const std::string v = variant;
+      if (v == "exact inverse") c.inverse = mm::InverseForm::kExact;
+      if (v == "independent noise") c.identical_noise = false;
+      if (v == "force one sample late") c.force_delay_steps = 1;
+      if (v == "derivatives from rest") c.derivatives_from_rest = true;
+      if (v == "no noise") c.noise_mm = 0.0;
+      rows->push_back({comp, v, {}});
+      out.push_back(std::move(c));
+    }
+  }
+  return out;
+}
+
+/// Runs every config, opts.jobs at a time. Throws rths::Interrupted on Ctrl-C, rths::Error naming
+/// the first run that failed.
+std::vector<MarthsLoopResult> RunAll(const std::vector<MarthsLoopConfig>& configs, const ReproduceOptions& opts) {
+  std::vector<MarthsLoopResult> results(configs.size());
+  std::atomic<std::size_t> next{0};
+  std::atomic<bool> stop{false};
+  std::string failure;
+  std::mutex failure_mutex;
+  auto work = [&] {
+    for (std::size_t i; !stop && (i = next++) < configs.size();) {
+      if (InterruptRequested()) {
+        stop = true;
+        return;
+      }
+      try {
+        results[i] = RunMarthsLoop(configs[i]);
+        results[i].signals = {};  // scored: the records are not kept (6 MB a run)
+      } catch (const std::exception& e) {
+        const std::lock_guard<std::mutex> lock(failure_mutex);
+        if (failure.empty()) failure = fmt::format("run {}: {}", i + 1, e.what());
+        stop = true;
+      }
+      if (opts.log && (i + 1) % 20 == 0) opts.log(fmt::format("marths: {} of {} runs started", i + 1, configs.size()));
+    }
+  };
+  std::vector<std::thread> threads;
+  for (int t = 0; t < std::max(1, opts.jobs); ++t) threads.emplace_back(work);
+  for (auto& t : threads) t.join();
+  if (InterruptRequested()) throw Interrupted("reproduce marths", "interrupted");
+  if (!failure.empty()) throw Error("reproduce marths", failure);
+  return results;
+}
+
+void WriteDecisions(const ReproduceOptions& opts, const MarthsStudy& s) {
+  std::vector<std::string> header = {"compensator", "variant"};
+  for (const auto& [k, v] : s.decisions.front().j.Items()) header.push_back(k);
+  io::CsvWriter csv(opts.out_dir / "marths_decisions.csv", header);
+  std::ofstream md(opts.out_dir / "marths_decisions.md");
+  md << "# maRTHS: what each of the reference code's ambiguous choices changes (nominal plant, El Centro x 0.4)\n\n"
+     << "Each row switches one choice of docs/marths.md \"Decisions\" away from the reference code's (\"as coded\"). "
+        "J1 in ms, the rest in %.\n\n"
+     << "| compensator | variant | J1,1 | J2,1 | J2,2 | J5,X | J5,TH | J7,X | J7,TH | J8,X2 | J10,X3 |\n"
+     << "|---|---|---|---|---|---|---|---|---|---|---|\n";
+  for (const MarthsDecisionRow& r : s.decisions) {
+    std::vector<std::string> f = {r.compensator, r.variant};
+    for (const auto& [k, v] : r.j.Items()) f.push_back(fmt::format("{:.6g}", v));
+    csv.Row(f);
+    md << fmt::format("| {} | {} | {:.2f} | {:.3f} | {:.3f} | {:.3f} | {:.3f} | {:.3f} | {:.3f} | {:.3f} | {:.3f} |\n",
+                      r.compensator, r.variant, r.j.J1_1_ms, r.j.J2_1_pct, r.j.J2_2_pct, r.j.J5_X_pct, r.j.J5_TH_pct,
+                      r.j.J7_X_pct, r.j.J7_TH_pct, r.j.J8_X2_pct, r.j.J10_X3_pct);
+  }
+  csv.Close();
+}
+
 }  // namespace
 
 const std::vector<std::string>& MarthsCompensatorNames() {
@@ -223,47 +307,31 @@ MarthsStudy ReproduceMarths(const ReproduceOptions& opts) {
       s.rows.push_back(r);
     }
   }
-  std::atomic<std::size_t> next{0};
-  std::atomic<bool> failed{false};
-  std::string failure;
-  auto work = [&] {
-    for (std::size_t i; !failed && (i = next++) < s.rows.size();) {
-      if (InterruptRequested()) {
-        failed = true;
-        return;
-      }
-      MarthsRow& r = s.rows[i];
-      MarthsLoopConfig c = shared;
-      const std::size_t p = i % plants.size();
-      c.plant = plants[p];
-      c.noise_seed = kNominalNoise + p;
-      c.compensator = KindOf(r.compensator);
-      for (int a = 0; a < 2; ++a) {
-        c.per_actuator[a].kind = r.compensator == "ff_lqg" ? control::ControllerKind::kFfLqg : control::ControllerKind::kFf;
-      }
-      try {
-        const MarthsLoopResult res = RunMarthsLoop(c);
-        r.j = res.j;
-        r.max_volts[0] = res.max_volts[0];
-        r.max_volts[1] = res.max_volts[1];
-        r.saturated = res.saturated;
-      } catch (const std::exception& e) {
-        failure = fmt::format("{} {}: {}", r.compensator, r.run, e.what());
-        failed = true;
-      }
-      if (opts.log) opts.log(fmt::format("marths: {} {} done", r.compensator, r.run));
-    }
-  };
-  std::vector<std::thread> threads;
-  for (int t = 0; t < std::max(1, opts.jobs); ++t) threads.emplace_back(work);
-  for (auto& t : threads) t.join();
-  if (InterruptRequested()) throw Interrupted("reproduce marths", "interrupted");
-  if (failed) throw Error("reproduce marths", failure);
+  std::vector<MarthsLoopConfig> configs;
+  for (std::size_t i = 0; i < s.rows.size(); ++i) {
+    MarthsLoopConfig c = shared;
+    const std::size_t p = i % plants.size();
+    c.plant = plants[p];
+    c.noise_seed = kNominalNoise + p;
+    Configure(s.rows[i].compensator, &c);
+    configs.push_back(std::move(c));
+  }
+  const auto decision_configs = DecisionConfigs(shared, &s.decisions);
+  configs.insert(configs.end(), decision_configs.begin(), decision_configs.end());
+  const std::vector<MarthsLoopResult> results = RunAll(configs, opts);
+  for (std::size_t i = 0; i < s.rows.size(); ++i) {
+    s.rows[i].j = results[i].j;
+    s.rows[i].max_volts[0] = results[i].max_volts[0];
+    s.rows[i].max_volts[1] = results[i].max_volts[1];
+    s.rows[i].saturated = results[i].saturated;
+  }
+  for (std::size_t i = 0; i < s.decisions.size(); ++i) s.decisions[i].j = results[s.rows.size() + i].j;
   s.claims = MarthsClaims(s);
   std::filesystem::create_directories(opts.out_dir);
   WriteRows(opts.out_dir / "marths.csv", s.rows);
   WriteSummary(opts, s);
   WriteFigure(opts, s);
+  WriteDecisions(opts, s);
   s.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return s;
 }

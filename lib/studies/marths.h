@@ -6,7 +6,9 @@
 ///
 /// Files: marths.csv (a row per run), marths_summary.csv (per compensator: the nominal run, and
 /// the perturbed runs' mean and sample standard deviation of every criterion), marths.md (the
-/// tables), marths.png (J2 per actuator, J5 and J7 per interface DOF, nominal and perturbed mean).
+/// tables), marths.png (J2 per actuator, J5 and J7 per interface DOF, nominal and perturbed mean),
+/// marths_decisions.csv and .md (none, rodeac and mimo_ff on the nominal plant with each of the
+/// reference code's ambiguous choices switched alone).
 #include <string>
 #include <vector>
 
@@ -24,8 +26,18 @@ struct MarthsRow {
   bool saturated = false;
 };
 
+/// One run of the decisions table: a compensator on the nominal plant with one of the reference
+/// code's ambiguous choices switched (docs/marths.md "Decisions").
+struct MarthsDecisionRow {
+  std::string compensator;
+  std::string variant;  ///< "as coded", "exact inverse", "independent noise", "force one sample late",
+                        ///< "derivatives from rest", "no noise"
+  signal::MarthsCriteria j;
+};
+
 struct MarthsStudy {
   std::vector<MarthsRow> rows;
+  std::vector<MarthsDecisionRow> decisions;
   std::vector<Claim> claims;
   int perturbed = 0;  ///< perturbed plants per compensator
   double wall_s = 0.0;

@@ -60,6 +60,7 @@ std::array<models::ServoModel3, 2> MarthsDesignModels(const mm::PlantZpk& p, dou
 MarthsLoopResult RunMarthsLoop(const MarthsLoopConfig& c) {
   const std::size_t n = c.ag_m_s2.size();
   if (n < 2) throw Error("maRTHS loop", "the ground motion has fewer than 2 samples");
+  if (c.force_delay_steps != 0 && c.force_delay_steps != 1) throw Error("maRTHS loop", "force_delay_steps must be 0 or 1");
   const mm::Structures st = mm::BuildStructures(c.K_ref, c.M_ref, c.ideal_density_kg_m3);
   const models::NewmarkLinear num = models::MakeNewmarkLinear(st.numerical.M, st.numerical.C, st.numerical.K,
                                                               st.numerical.l, c.dt_s);
@@ -72,6 +73,8 @@ MarthsLoopResult RunMarthsLoop(const MarthsLoopConfig& c) {
   models::NewmarkLinearState num_s = models::NewmarkLinearAtRest(num);
   models::NewmarkLinearState ref_s = models::NewmarkLinearAtRest(ref);
   mm::FeedbackFrameState frame_s;
+  frame_s.started = c.derivatives_from_rest;  // q_{-1} = 0, q'_{-1} = 0: the first differences from rest
+  mm::InterfaceForces held{};                  // force_delay_steps = 1: the previous sample's
   mm::MarthsPlantState plant_s;
   signal::GaussianState noise = signal::MakeGaussian(c.noise_seed);
   control::RodeacState rodeac_s[2];
@@ -102,7 +105,9 @@ MarthsLoopResult RunMarthsLoop(const MarthsLoopConfig& c) {
     }
     // Interface motion estimated from them, and the frame's force.
     const mm::InterfaceMotion est = mm::Inverse(geometry, {y(0), y(1)}, c.inverse);
-    const mm::InterfaceForces f = mm::FeedbackForce(frame, &frame_s, est.x_m, est.theta_rad);
+    const mm::InterfaceForces estimated = mm::FeedbackForce(frame, &frame_s, est.x_m, est.theta_rad);
+    const mm::InterfaceForces f = c.force_delay_steps == 1 ? held : estimated;
+    held = estimated;
     // Numerical substructure under a_g(t_k) and F_k; its targets.
     num_s.F(mm::Index(mm::kDofX)) = f.F27_N;
     num_s.F(mm::Index(mm::kDofTheta)) = f.M21_N_m;

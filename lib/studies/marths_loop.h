@@ -52,6 +52,12 @@ struct MarthsLoopConfig {
   bool identical_noise = true;          ///< the same noise sample on both channels (as coded)
   std::uint64_t noise_seed = 123;
   models::marths::InverseForm inverse = models::marths::InverseForm::kAsWired;
+  /// The force that enters the Newmark step ending at t_k: the one estimated at t_k (0, the
+  /// reference code's signal flow) or at t_{k-1} (1: as if a unit delay held it).
+  int force_delay_steps = 0;
+  /// The feedback frame's derivatives at the first sample: 0 (Simulink's Derivative block) or the
+  /// backward difference from rest (q_{-1} = 0).
+  bool derivatives_from_rest = false;
   MarthsCompensator compensator = MarthsCompensator::kNone;
   control::RodeacDesign rodeac[2];      ///< kRodeac: actuator 1, 2
   /// kFf, kFfLqg: each actuator's controller (kind and design model: MarthsDesignModels);

@@ -76,6 +76,8 @@ TEST_CASE("rths reproduce marths --quick: 15 runs, the tables, the figure, and i
   o.source_dir = RTHS_SOURCE_DIR;
   const auto s = rths::studies::ReproduceMarths(o);
   CHECK(s.rows.size() == 15);
+  CHECK(s.decisions.size() == 18);
+  CHECK(std::filesystem::exists(o.out_dir / "marths_decisions.md"));
   CHECK(s.perturbed == 2);
   for (const char* f : {"marths.csv", "marths_summary.csv", "marths.md", "marths.png", "marths.dat"}) {
     CHECK(std::filesystem::exists(o.out_dir / f));
