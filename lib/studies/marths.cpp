@@ -36,16 +36,29 @@ MarthsCompensator KindOf(const std::string& name) {
   return MarthsCompensator::kNone;
 }
 
+std::string MarthsData(const ReproduceOptions& opts, const std::string& file) {
+  return io::FindSourceFile("data/marths/" + file, opts.source_dir).string();
+}
+
+/// A benchmark record x 0.4 at t_k = k dt for every t_k up to its last time (as Simulink's From
+/// File and the model's stop time give it).
+std::vector<double> MarthsGround(const ReproduceOptions& opts, const std::string& file, double dt_s) {
+  const signal::HistoryRecord rec = signal::ReadHistoryFile(MarthsData(opts, file), 0.0);
+  const auto n = static_cast<std::size_t>(std::floor(rec.t.back() / dt_s + 1e-9)) + 1;
+  return signal::ResampleHistory(rec, 0.0, 0.4, dt_s, n, 0.0);
+}
+
+/// The benchmark's records: name and file.
+const std::pair<const char*, const char*> kMarthsRecords[3] = {
+    {"El Centro", "elcentro_m_s2.txt"}, {"Kobe", "kobe_m_s2.txt"}, {"Morgan Hill", "morgan_hill_m_s2.txt"}};
+
 /// The configuration every run shares (data read once).
 MarthsLoopConfig SharedConfig(const ReproduceOptions& opts) {
-  auto data = [&](const char* file) { return io::FindSourceFile(std::string("data/marths/") + file, opts.source_dir).string(); };
+  auto data = [&](const char* file) { return MarthsData(opts, file); };
   MarthsLoopConfig c;
   c.K_ref = io::ReadMatrixCsv(data("reference_K_N_per_m.csv"));
   c.M_ref = io::ReadMatrixCsv(data("reference_M_kg.csv"));
-  const signal::HistoryRecord rec = signal::ReadHistoryFile(data("elcentro_m_s2.txt"), 0.0);
-  const double end_s = rec.t.back();
-  const auto n = static_cast<std::size_t>(std::floor(end_s / c.dt_s + 1e-9)) + 1;
-  c.ag_m_s2 = signal::ResampleHistory(rec, 0.0, 0.4, c.dt_s, n, 0.0);
+  c.ag_m_s2 = MarthsGround(opts, kMarthsRecords[0].second, c.dt_s);
   c.noise_mm = mm::SensorNoiseMm(c.dt_s);
   const io::RodeacInitialParameters p = io::ReadRodeacParameters(data("rodeac_initial_parameters.txt"));
   const auto models = MarthsDesignModels(c.design_plant, c.dt_s);
@@ -263,17 +276,17 @@ std::vector<MarthsLoopResult> RunAll(const std::vector<MarthsLoopConfig>& config
   return results;
 }
 
-void WriteDecisions(const ReproduceOptions& opts, const MarthsStudy& s) {
+/// `stem`.csv (every criterion) and `stem`.md (a selection) of variant runs.
+void WriteVariants(const std::filesystem::path& stem, const std::vector<MarthsDecisionRow>& rows,
+                   const std::string& title, const std::string& intro) {
   std::vector<std::string> header = {"compensator", "variant"};
-  for (const auto& [k, v] : s.decisions.front().j.Items()) header.push_back(k);
-  io::CsvWriter csv(opts.out_dir / "marths_decisions.csv", header);
-  std::ofstream md(opts.out_dir / "marths_decisions.md");
-  md << "# maRTHS: what each of the reference code's ambiguous choices changes (nominal plant, El Centro x 0.4)\n\n"
-     << "Each row switches one choice of docs/marths.md \"Decisions\" away from the reference code's (\"as coded\"). "
-        "J1 in ms, the rest in %.\n\n"
+  for (const auto& [k, v] : rows.front().j.Items()) header.push_back(k);
+  io::CsvWriter csv(stem.string() + ".csv", header);
+  std::ofstream md(stem.string() + ".md");
+  md << "# maRTHS: " << title << "\n\n" << intro << " J1 in ms, the rest in %.\n\n"
      << "| compensator | variant | J1,1 | J2,1 | J2,2 | J5,X | J5,TH | J7,X | J7,TH | J8,X2 | J10,X3 |\n"
      << "|---|---|---|---|---|---|---|---|---|---|---|\n";
-  for (const MarthsDecisionRow& r : s.decisions) {
+  for (const MarthsDecisionRow& r : rows) {
     std::vector<std::string> f = {r.compensator, r.variant};
     for (const auto& [k, v] : r.j.Items()) f.push_back(fmt::format("{:.6g}", v));
     csv.Row(f);
@@ -318,6 +331,17 @@ MarthsStudy ReproduceMarths(const ReproduceOptions& opts) {
   }
   const auto decision_configs = DecisionConfigs(shared, &s.decisions);
   configs.insert(configs.end(), decision_configs.begin(), decision_configs.end());
+  for (const auto& [record, file] : kMarthsRecords) {
+    const std::vector<double> ag = MarthsGround(opts, file, shared.dt_s);
+    for (const auto& comp : MarthsCompensatorNames()) {
+      MarthsLoopConfig c = shared;
+      c.ag_m_s2 = ag;
+      c.noise_seed = kNominalNoise;
+      Configure(comp, &c);
+      s.records.push_back({comp, record, {}});
+      configs.push_back(std::move(c));
+    }
+  }
   const std::vector<MarthsLoopResult> results = RunAll(configs, opts);
   for (std::size_t i = 0; i < s.rows.size(); ++i) {
     s.rows[i].j = results[i].j;
@@ -326,12 +350,20 @@ MarthsStudy ReproduceMarths(const ReproduceOptions& opts) {
     s.rows[i].saturated = results[i].saturated;
   }
   for (std::size_t i = 0; i < s.decisions.size(); ++i) s.decisions[i].j = results[s.rows.size() + i].j;
+  for (std::size_t i = 0; i < s.records.size(); ++i) {
+    s.records[i].j = results[s.rows.size() + s.decisions.size() + i].j;
+  }
   s.claims = MarthsClaims(s);
   std::filesystem::create_directories(opts.out_dir);
   WriteRows(opts.out_dir / "marths.csv", s.rows);
   WriteSummary(opts, s);
   WriteFigure(opts, s);
-  WriteDecisions(opts, s);
+  WriteVariants(opts.out_dir / "marths_decisions", s.decisions,
+                "what each of the reference code's ambiguous choices changes (nominal plant, El Centro x 0.4)",
+                "Each row switches one choice of docs/marths.md \"Decisions\" away from the reference code's "
+                "(\"as coded\").");
+  WriteVariants(opts.out_dir / "marths_records", s.records, "the benchmark's three records x 0.4 (nominal plant)",
+                "Every compensator under El Centro, Kobe and Morgan Hill, each scaled by 0.4, sensor noise on.");
   s.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return s;
 }

@@ -8,7 +8,8 @@
 /// the perturbed runs' mean and sample standard deviation of every criterion), marths.md (the
 /// tables), marths.png (J2 per actuator, J5 and J7 per interface DOF, nominal and perturbed mean),
 /// marths_decisions.csv and .md (none, rodeac and mimo_ff on the nominal plant with each of the
-/// reference code's ambiguous choices switched alone).
+/// reference code's ambiguous choices switched alone), marths_records.csv and .md (every
+/// compensator on the nominal plant under El Centro, Kobe and Morgan Hill, each x 0.4).
 #include <string>
 #include <vector>
 
@@ -38,6 +39,9 @@ struct MarthsDecisionRow {
 struct MarthsStudy {
   std::vector<MarthsRow> rows;
   std::vector<MarthsDecisionRow> decisions;
+  /// Every compensator on the nominal plant under each of the benchmark's three records x 0.4
+  /// (variant: "El Centro", "Kobe", "Morgan Hill").
+  std::vector<MarthsDecisionRow> records;
   std::vector<Claim> claims;
   int perturbed = 0;  ///< perturbed plants per compensator
   double wall_s = 0.0;

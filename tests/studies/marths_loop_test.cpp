@@ -77,6 +77,8 @@ TEST_CASE("rths reproduce marths --quick: 15 runs, the tables, the figure, and i
   const auto s = rths::studies::ReproduceMarths(o);
   CHECK(s.rows.size() == 15);
   CHECK(s.decisions.size() == 18);
+  CHECK(s.records.size() == 15);
+  CHECK(std::filesystem::exists(o.out_dir / "marths_records.md"));
   CHECK(std::filesystem::exists(o.out_dir / "marths_decisions.md"));
   CHECK(s.perturbed == 2);
   for (const char* f : {"marths.csv", "marths_summary.csv", "marths.md", "marths.png", "marths.dat"}) {
