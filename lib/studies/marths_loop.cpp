@@ -10,10 +10,9 @@
 #include "control/tracking_controller.h"
 #include "core/error.h"
 #include "ident/design_model.h"
-#include "models/marths_frame.h"
+#include "models/marths_rig.h"
 #include "models/marths_structure.h"
 #include "models/newmark_linear.h"
-#include "signal/random.h"
 
 namespace rths::studies {
 
@@ -60,23 +59,24 @@ std::array<models::ServoModel3, 2> MarthsDesignModels(const mm::PlantZpk& p, dou
 MarthsLoopResult RunMarthsLoop(const MarthsLoopConfig& c) {
   const std::size_t n = c.ag_m_s2.size();
   if (n < 2) throw Error("maRTHS loop", "the ground motion has fewer than 2 samples");
-  if (c.force_delay_steps != 0 && c.force_delay_steps != 1) throw Error("maRTHS loop", "force_delay_steps must be 0 or 1");
   const mm::Structures st = mm::BuildStructures(c.K_ref, c.M_ref, c.ideal_density_kg_m3);
-  const models::NewmarkLinear num = models::MakeNewmarkLinear(st.numerical.M, st.numerical.C, st.numerical.K,
-                                                              st.numerical.l, c.dt_s);
+  const mm::MarthsSubstructure sub{models::MakeNewmarkLinear(st.numerical.M, st.numerical.C, st.numerical.K,
+                                                             st.numerical.l, c.dt_s),
+                                   mm::CouplerGeometry{}};
   const models::NewmarkLinear ref = models::MakeNewmarkLinear(st.reference.M, st.reference.C, st.reference.K,
                                                               st.reference.l, c.dt_s);
-  const mm::FeedbackFrame frame = mm::MakeFeedbackFrame(c.dt_s);
-  const mm::MarthsPlant plant = mm::MakeMarthsPlant(c.plant, c.dt_s);
-  const mm::CouplerGeometry geometry;
+  mm::RigOptions ro;
+  ro.noise_mm = c.noise_mm;
+  ro.identical_noise = c.identical_noise;
+  ro.noise_seed = c.noise_seed;
+  ro.inverse = c.inverse;
+  ro.force_delay_steps = c.force_delay_steps;
+  ro.derivatives_from_rest = c.derivatives_from_rest;
+  const mm::MarthsRig rig = mm::MakeMarthsRig(c.plant, c.dt_s, ro);
 
-  models::NewmarkLinearState num_s = models::NewmarkLinearAtRest(num);
+  models::NewmarkLinearState num_s = models::NewmarkLinearAtRest(sub.numerical);
   models::NewmarkLinearState ref_s = models::NewmarkLinearAtRest(ref);
-  mm::FeedbackFrameState frame_s;
-  frame_s.started = c.derivatives_from_rest;  // q_{-1} = 0, q'_{-1} = 0: the first differences from rest
-  mm::InterfaceForces held{};                  // force_delay_steps = 1: the previous sample's
-  mm::MarthsPlantState plant_s;
-  signal::GaussianState noise = signal::MakeGaussian(c.noise_seed);
+  mm::MarthsRigState rig_s = mm::MarthsRigAtRest(rig);
   control::RodeacState rodeac_s[2];
   if (c.compensator == MarthsCompensator::kRodeac) {
     for (int i = 0; i < 2; ++i) rodeac_s[i] = control::RodeacAtRest(c.rodeac[i]);
@@ -96,25 +96,11 @@ MarthsLoopResult RunMarthsLoop(const MarthsLoopConfig& c) {
   signal::MarthsSignals& g = r.signals;
   for (std::size_t k = 0; k < n; ++k) {
     const double ag = c.ag_m_s2[k];
-    // Measured strokes at t_k.
-    Eigen::Vector2d y = mm::PlantOutput(plant, plant_s);
-    if (c.noise_mm > 0.0) {
-      const double n1 = c.noise_mm * signal::NextGaussian(&noise);
-      const double n2 = c.identical_noise ? n1 : c.noise_mm * signal::NextGaussian(&noise);
-      y += Eigen::Vector2d(n1, n2);
-    }
-    // Interface motion estimated from them, and the frame's force.
-    const mm::InterfaceMotion est = mm::Inverse(geometry, {y(0), y(1)}, c.inverse);
-    const mm::InterfaceForces estimated = mm::FeedbackForce(frame, &frame_s, est.x_m, est.theta_rad);
-    const mm::InterfaceForces f = c.force_delay_steps == 1 ? held : estimated;
-    held = estimated;
-    // Numerical substructure under a_g(t_k) and F_k; its targets.
-    num_s.F(mm::Index(mm::kDofX)) = f.F27_N;
-    num_s.F(mm::Index(mm::kDofTheta)) = f.M21_N_m;
-    num_s.F(mm::Index(mm::kDofTheta2)) = f.M29_N_m;
-    models::NewmarkLinearStep(num, &num_s, ag);
-    const mm::InterfaceMotion target_motion{U(num_s, mm::kDofX), -U(num_s, mm::kDofTheta)};
-    const mm::ActuatorPair t = mm::Forward(geometry, target_motion);
+    const mm::RigReading reading = mm::RigRead(rig, &rig_s);   // strokes and forces at t_k
+    const Eigen::Vector2d& y = reading.y_mm;
+    const mm::InterfaceMotion& est = reading.estimate;
+    const mm::SubstructureOutput out = mm::SubstructureStep(sub, &num_s, ag, reading.forces);
+    const mm::ActuatorPair& t = out.targets;
     // Commands.
     Eigen::Vector2d u(t.a1_mm, t.a2_mm);
     if (c.compensator == MarthsCompensator::kRodeac) {
@@ -132,7 +118,7 @@ MarthsLoopResult RunMarthsLoop(const MarthsLoopConfig& c) {
     if (!u.allFinite() || !y.allFinite()) {
       throw Error("maRTHS loop", fmt::format("diverged at sample {} (t = {:.4f} s)", k, k * c.dt_s));
     }
-    mm::PlantStep(plant, &plant_s, u);
+    mm::RigStep(rig, &rig_s, u);
     models::NewmarkLinearStep(ref, &ref_s, ag);
     for (int i = 0; i < 2; ++i) r.max_volts[i] = std::max(r.max_volts[i], std::abs(Volts(c, i, u(i))));
 

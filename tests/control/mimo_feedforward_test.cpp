@@ -5,7 +5,9 @@
 
 #include <doctest/doctest.h>
 
+#include "alloc_counter.h"
 #include "control/mimo_feedforward.h"
+#include "control/rodeac.h"
 
 namespace mm = rths::models::marths;
 
@@ -59,4 +61,21 @@ TEST_CASE("through the plant, the feedforward tracks a coupled 1 Hz motion withi
   MESSAGE("relative tracking error: mimo_ff " << rel << ", none " << rel_none);
   CHECK(rel < 0.1 * rel_none);
   CHECK(rel < 0.03);
+}
+
+TEST_CASE("the MIMO feedforward's and RoDeAC's steps allocate nothing") {
+  const double dt = 1.0 / 1024;
+  const rths::control::MimoFeedforward f = rths::control::MakeMimoFeedforward(mm::NominalPlantZpk(), dt);
+  rths::control::MimoFeedforwardState s;
+  const auto d = rths::control::MakeRodeacDesign(Eigen::Vector4d(1.0, 0.1, 0.0, 0.0), 10.0 * Eigen::Matrix4d::Identity(), 1024.0);
+  rths::control::RodeacState r = rths::control::RodeacAtRest(d);
+  const long before = rths_test::AllocationCount();
+  double sum = 0.0;
+  for (int k = 0; k < 2000; ++k) {
+    const double x = std::sin(0.01 * k);
+    sum += rths::control::MimoFeedforwardStep(f, &s, x, -x).sum();
+    sum += rths::control::RodeacStep(d, &r, x, 0.9 * x);
+  }
+  CHECK(rths_test::AllocationCount() == before);
+  CHECK(std::isfinite(sum));
 }

@@ -12,9 +12,11 @@
 #include <doctest/doctest.h>
 #include <unsupported/Eigen/MatrixFunctions>
 
+#include "alloc_counter.h"
 #include "models/marths_coupler.h"
 #include "models/marths_frame.h"
 #include "models/marths_plant.h"
+#include "models/marths_rig.h"
 #include "models/marths_structure.h"
 #include "models/newmark_linear.h"
 
@@ -214,4 +216,29 @@ TEST_CASE("perturbed plants keep the DC gains, move the poles by their stated sp
     CHECK(std::arg(a.frame_pole) == doctest::Approx(std::arg(nominal.frame_pole)).epsilon(1e-12));
   }
   CHECK(std::sqrt(sum_sq / n) == doctest::Approx(0.06).epsilon(0.15));
+}
+
+TEST_CASE("the rig's and the substructure's steps allocate nothing") {
+  const Eigen::MatrixXd K = ReadCsv(kData + "reference_K_N_per_m.csv");
+  const Eigen::MatrixXd M = ReadCsv(kData + "reference_M_kg.csv");
+  const double dt = 1.0 / 1024;
+  const mm::Structures st = mm::BuildStructures(K, M);
+  const mm::MarthsSubstructure sub{rths::models::MakeNewmarkLinear(st.numerical.M, st.numerical.C, st.numerical.K,
+                                                                   st.numerical.l, dt),
+                                   mm::CouplerGeometry{}};
+  mm::RigOptions o;
+  o.noise_mm = 0.0124;
+  const mm::MarthsRig rig = mm::MakeMarthsRig(mm::NominalPlantZpk(), dt, o);
+  rths::models::NewmarkLinearState ns = rths::models::NewmarkLinearAtRest(sub.numerical);
+  mm::MarthsRigState rs = mm::MarthsRigAtRest(rig);
+  const long before = rths_test::AllocationCount();
+  double peak = 0.0;
+  for (int k = 0; k < 2000; ++k) {
+    const mm::RigReading r = mm::RigRead(rig, &rs);
+    const mm::SubstructureOutput out = mm::SubstructureStep(sub, &ns, 0.5 * std::sin(0.01 * k), r.forces);
+    mm::RigStep(rig, &rs, Eigen::Vector2d(out.targets.a1_mm, out.targets.a2_mm));
+    peak = std::max(peak, std::abs(out.targets.a1_mm));
+  }
+  CHECK(rths_test::AllocationCount() == before);
+  CHECK(peak > 0.0);
 }
