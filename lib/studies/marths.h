@@ -1,7 +1,8 @@
 #pragma once
 /// @file `rths reproduce marths` (docs/marths.md): the maRTHS benchmark's criteria J1-J10 for every
 /// compensator (none, RoDeAC, the paper's ff and ff_lqg per actuator, the MIMO feedforward) on the
-/// nominal plant and on perturbed plants (20; --quick: 2), El Centro x 0.4 at 1024 Hz, sensor
+/// nominal plant and on perturbed plants (20; --quick: 2, and the records' first 20 s), El Centro
+/// x 0.4 at 1024 Hz, sensor
 /// noise on, each run closed as the reference code closes its loop (studies/marths_loop.h).
 ///
 /// Files: marths.csv (a row per run), marths_summary.csv (per compensator: the nominal run, and

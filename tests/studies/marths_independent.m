@@ -1,4 +1,4 @@
-function marths_independent(data_dir, record, compensator)
+function marths_independent(data_dir, record, compensator, seconds)
 % An independent implementation of the maRTHS benchmark's loop, noise off, in GNU Octave, written
 % from the equations of docs/marths.md without any of rths's code, for tests/studies/marths_octave_test.cpp
 % to compare J1-J10 with (lib/studies/marths_loop.h). Where rths takes one formulation, this takes
@@ -8,7 +8,8 @@ function marths_independent(data_dir, record, compensator)
 % its own phase-variable realisation, stepped by explicit RK4 stages; RoDeAC's algebraic loop by
 % fixed-point iteration; finddelay through an FFT cross-correlation. Prints "key value" lines.
 %
-%   octave-cli marths_independent.m DATA_DIR RECORD COMPENSATOR   (COMPENSATOR: none | rodeac)
+%   marths_independent(DATA_DIR, RECORD, COMPENSATOR, SECONDS)   (COMPENSATOR: none | rodeac; the
+%   record's first SECONDS, Inf for all of it)
   dt = 1 / 1024;
   K = csvread(fullfile(data_dir, 'reference_K_N_per_m.csv'));
   M = csvread(fullfile(data_dir, 'reference_M_kg.csv'));
@@ -66,7 +67,7 @@ function marths_independent(data_dir, record, compensator)
   end
   % The record x 0.4, linear interpolation at t_k, zero after its end.
   g = dlmread(fullfile(data_dir, record), ' ', 1, 0);
-  N = floor(g(end, 1) / dt + 1e-9) + 1;
+  N = floor(min(seconds, g(end, 1)) / dt + 1e-9) + 1;
   ag = 0.4 * interp1(g(:, 1), g(:, 2), (0:N - 1)' * dt, 'linear', 0);
   % Newmark, average acceleration, effective-stiffness form.
   Kh = Kn + 4 / dt^2 * Mn + 2 / dt * Cn;
