@@ -63,7 +63,7 @@ MarthsLoopConfig SharedConfig(const ReproduceOptions& opts) {
   c.K_ref = io::ReadMatrixCsv(data("reference_K_N_per_m.csv"));
   c.M_ref = io::ReadMatrixCsv(data("reference_M_kg.csv"));
   c.ag_m_s2 = MarthsGround(opts, kMarthsRecords[0].second, c.dt_s);
-  c.noise_mm = mm::SensorNoiseMm(c.dt_s);
+  c.rig.noise_mm = mm::SensorNoiseMm(c.dt_s);
   const io::RodeacInitialParameters p = io::ReadRodeacParameters(data("rodeac_initial_parameters.txt"));
   const auto models = MarthsDesignModels(c.design_plant, c.dt_s);
   for (int i = 0; i < 2; ++i) {
@@ -89,28 +89,6 @@ void WriteRows(const std::filesystem::path& file, const std::vector<MarthsRow>& 
   csv.Close();
 }
 
-/// The perturbed runs' spread of criterion `key` for `comp`.
-signal::Spread PerturbedSpread(const std::vector<MarthsRow>& rows, const std::string& comp, const std::string& key) {
-  std::vector<double> v;
-  for (const MarthsRow& r : rows) {
-    if (r.compensator != comp || r.run == "nominal") continue;
-    for (const auto& [k, x] : r.j.Items()) {
-      if (k == key) v.push_back(x);
-    }
-  }
-  return signal::SpreadOf(v);
-}
-
-double NominalValue(const std::vector<MarthsRow>& rows, const std::string& comp, const std::string& key) {
-  for (const MarthsRow& r : rows) {
-    if (r.compensator != comp || r.run != "nominal") continue;
-    for (const auto& [k, x] : r.j.Items()) {
-      if (k == key) return x;
-    }
-  }
-  return std::nan("");
-}
-
 void WriteSummary(const ReproduceOptions& opts, const MarthsStudy& s) {
   const auto keys = s.rows.front().j.Items();
   io::CsvWriter csv(opts.out_dir / "marths_summary.csv", {"compensator", "criterion", "nominal", "perturbed_mean",
@@ -128,8 +106,8 @@ void WriteSummary(const ReproduceOptions& opts, const MarthsStudy& s) {
   for (const auto& [key, unused] : keys) {
     md << "| " << key << " |";
     for (const auto& c : MarthsCompensatorNames()) {
-      const double nom = NominalValue(s.rows, c, key);
-      const signal::Spread sp = PerturbedSpread(s.rows, c, key);
+      const double nom = MarthsNominalValue(s.rows, c, key);
+      const signal::Spread sp = MarthsPerturbedSpread(s.rows, c, key);
       csv.Row({c, key, fmt::format("{:.6g}", nom), fmt::format("{:.6g}", sp.mean), fmt::format("{:.6g}", sp.std),
                std::to_string(sp.n)});
       md << fmt::format(" {:.2f}; {:.2f} ({:.2f}) |", nom, sp.mean, sp.std);
@@ -156,7 +134,7 @@ void WriteFigure(const ReproduceOptions& opts, const MarthsStudy& s) {
   const auto& names = MarthsCompensatorNames();
   auto series = [&](const std::string& title, const std::string& key, bool nominal, const std::string& color) {
     io::Series x = io::MakeSeries(title, color);
-    for (const auto& c : names) x.y.push_back(nominal ? NominalValue(s.rows, c, key) : PerturbedSpread(s.rows, c, key).mean);
+    for (const auto& c : names) x.y.push_back(nominal ? MarthsNominalValue(s.rows, c, key) : MarthsPerturbedSpread(s.rows, c, key).mean);
     return x;
   };
   const auto& col = io::ReadableColors();
@@ -232,14 +210,14 @@ std::vector<MarthsLoopConfig> DecisionConfigs(const MarthsLoopConfig& shared, st
     for (const char* variant : {"as coded", "exact inverse", "independent noise", "force one sample late",
                                 "derivatives from rest", "no noise"}) {
       MarthsLoopConfig c = shared;
-      c.noise_seed = kNominalNoise;
+      c.rig.noise_seed = kNominalNoise;
       Configure(comp, &c);
       const std::string v = variant;
-      if (v == "exact inverse") c.inverse = mm::InverseForm::kExact;
-      if (v == "independent noise") c.identical_noise = false;
-      if (v == "force one sample late") c.force_delay_steps = 1;
-      if (v == "derivatives from rest") c.derivatives_from_rest = true;
-      if (v == "no noise") c.noise_mm = 0.0;
+      if (v == "exact inverse") c.rig.inverse = mm::InverseForm::kExact;
+      if (v == "independent noise") c.rig.identical_noise = false;
+      if (v == "force one sample late") c.rig.force_delay_steps = 1;
+      if (v == "derivatives from rest") c.rig.derivatives_from_rest = true;
+      if (v == "no noise") c.rig.noise_mm = 0.0;
       rows->push_back({comp, v, {}});
       out.push_back(std::move(c));
     }
@@ -308,6 +286,27 @@ const std::vector<std::string>& MarthsCompensatorNames() {
   return names;
 }
 
+signal::Spread MarthsPerturbedSpread(const std::vector<MarthsRow>& rows, const std::string& comp, const std::string& key) {
+  std::vector<double> v;
+  for (const MarthsRow& r : rows) {
+    if (r.compensator != comp || r.run == "nominal") continue;
+    for (const auto& [k, x] : r.j.Items()) {
+      if (k == key) v.push_back(x);
+    }
+  }
+  return signal::SpreadOf(v);
+}
+
+double MarthsNominalValue(const std::vector<MarthsRow>& rows, const std::string& comp, const std::string& key) {
+  for (const MarthsRow& r : rows) {
+    if (r.compensator != comp || r.run != "nominal") continue;
+    for (const auto& [k, x] : r.j.Items()) {
+      if (k == key) return x;
+    }
+  }
+  return std::nan("");
+}
+
 MarthsStudy ReproduceMarths(const ReproduceOptions& opts) {
   const auto t0 = std::chrono::steady_clock::now();
   MarthsStudy s;
@@ -329,7 +328,7 @@ MarthsStudy ReproduceMarths(const ReproduceOptions& opts) {
     MarthsLoopConfig c = shared;
     const std::size_t p = i % plants.size();
     c.plant = plants[p];
-    c.noise_seed = kNominalNoise + p;
+    c.rig.noise_seed = kNominalNoise + p;
     Configure(s.rows[i].compensator, &c);
     configs.push_back(std::move(c));
   }
@@ -340,7 +339,7 @@ MarthsStudy ReproduceMarths(const ReproduceOptions& opts) {
     for (const auto& comp : MarthsCompensatorNames()) {
       MarthsLoopConfig c = shared;
       c.ag_m_s2 = ag;
-      c.noise_seed = kNominalNoise;
+      c.rig.noise_seed = kNominalNoise;
       Configure(comp, &c);
       s.records.push_back({comp, record, {}});
       configs.push_back(std::move(c));

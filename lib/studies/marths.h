@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "signal/marths_criteria.h"
+#include "signal/stats.h"
 #include "studies/study.h"
 
 namespace rths::studies {
@@ -50,6 +51,14 @@ struct MarthsStudy {
 
 /// The compensators, in the tables' order.
 const std::vector<std::string>& MarthsCompensatorNames();
+
+/// The nominal run's value of criterion `key` (a MarthsCriteria::Items key) for `compensator`;
+/// NaN if there is none.
+double MarthsNominalValue(const std::vector<MarthsRow>& rows, const std::string& compensator, const std::string& key);
+
+/// The spread of criterion `key` over `compensator`'s perturbed runs.
+signal::Spread MarthsPerturbedSpread(const std::vector<MarthsRow>& rows, const std::string& compensator,
+                                     const std::string& key);
 
 /// Runs the study into opts.out_dir. Reads data/marths/ (io::FindSourceFile with opts.source_dir).
 MarthsStudy ReproduceMarths(const ReproduceOptions& opts);

@@ -65,14 +65,7 @@ MarthsLoopResult RunMarthsLoop(const MarthsLoopConfig& c) {
                                    mm::CouplerGeometry{}};
   const models::NewmarkLinear ref = models::MakeNewmarkLinear(st.reference.M, st.reference.C, st.reference.K,
                                                               st.reference.l, c.dt_s);
-  mm::RigOptions ro;
-  ro.noise_mm = c.noise_mm;
-  ro.identical_noise = c.identical_noise;
-  ro.noise_seed = c.noise_seed;
-  ro.inverse = c.inverse;
-  ro.force_delay_steps = c.force_delay_steps;
-  ro.derivatives_from_rest = c.derivatives_from_rest;
-  const mm::MarthsRig rig = mm::MakeMarthsRig(c.plant, c.dt_s, ro);
+  const mm::MarthsRig rig = mm::MakeMarthsRig(c.plant, c.dt_s, c.rig);
 
   models::NewmarkLinearState num_s = models::NewmarkLinearAtRest(sub.numerical);
   models::NewmarkLinearState ref_s = models::NewmarkLinearAtRest(ref);

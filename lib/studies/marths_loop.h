@@ -28,6 +28,7 @@
 #include "control/rodeac.h"
 #include "models/marths_coupler.h"
 #include "models/marths_plant.h"
+#include "models/marths_rig.h"
 #include "signal/marths_criteria.h"
 
 namespace rths::studies {
@@ -48,16 +49,9 @@ struct MarthsLoopConfig {
   Eigen::MatrixXd K_ref, M_ref;         ///< the SAP2000 reference matrices (29 x 29, SI)
   double ideal_density_kg_m3 = 785e3;   ///< the ideal physical substructure's density (as coded)
   models::marths::PlantZpk plant = models::marths::NominalPlantZpk();
-  double noise_mm = 0.0;                ///< sensor noise standard deviation [mm] (0: off)
-  bool identical_noise = true;          ///< the same noise sample on both channels (as coded)
-  std::uint64_t noise_seed = 123;
-  models::marths::InverseForm inverse = models::marths::InverseForm::kAsWired;
-  /// The force that enters the Newmark step ending at t_k: the one estimated at t_k (0, the
-  /// reference code's signal flow) or at t_{k-1} (1: as if a unit delay held it).
-  int force_delay_steps = 0;
-  /// The feedback frame's derivatives at the first sample: 0 (Simulink's Derivative block) or the
-  /// backward difference from rest (q_{-1} = 0).
-  bool derivatives_from_rest = false;
+  /// The rig's sensor noise (off by default here), its seed, and the reference code's ambiguous
+  /// choices (models::marths::RigOptions; docs/marths.md "Decisions").
+  models::marths::RigOptions rig{};
   MarthsCompensator compensator = MarthsCompensator::kNone;
   control::RodeacDesign rodeac[2];      ///< kRodeac: actuator 1, 2
   /// kFf, kFfLqg: each actuator's controller (kind and design model: MarthsDesignModels);

@@ -165,17 +165,7 @@ StudyReport Marths(const ReproduceOptions& opts) {
   for (const auto& c : MarthsCompensatorNames()) {
     Appendf(&s, "%-9s", c.c_str());
     for (const char* key : {"J2_1_pct", "J2_2_pct", "J5_X_pct", "J5_TH_pct", "J7_X_pct", "J7_TH_pct"}) {
-      double nominal = 0.0, sum = 0.0;
-      int n = 0;
-      for (const auto& row : r.rows) {
-        if (row.compensator != c) continue;
-        for (const auto& [k, v] : row.j.Items()) {
-          if (k != key) continue;
-          if (row.run == "nominal") nominal = v;
-          else sum += v, ++n;
-        }
-      }
-      Appendf(&s, " %6.2f [%6.2f]", nominal, n ? sum / n : 0.0);
+      Appendf(&s, " %6.2f [%6.2f]", MarthsNominalValue(r.rows, c, key), MarthsPerturbedSpread(r.rows, c, key).mean);
     }
     s += "\n";
   }

@@ -28,7 +28,7 @@ MarthsLoopConfig Base(MarthsCompensator c, bool noise) {
   const auto rec = rths::signal::ReadHistoryFile(kData + "elcentro_m_s2.txt", 0.0);
   const std::size_t n = static_cast<std::size_t>(41.18 / cfg.dt_s + 1e-9) + 1;
   cfg.ag_m_s2 = rths::signal::ResampleHistory(rec, 0.0, 0.4, cfg.dt_s, n, 0.0);
-  cfg.noise_mm = noise ? mm::SensorNoiseMm(cfg.dt_s) : 0.0;
+  cfg.rig.noise_mm = noise ? mm::SensorNoiseMm(cfg.dt_s) : 0.0;
   cfg.compensator = c;
   const auto p = rths::io::ReadRodeacParameters(kData + "rodeac_initial_parameters.txt");
   for (int i = 0; i < 2; ++i) cfg.rodeac[i] = rths::control::MakeRodeacDesign(p.theta0[i], p.P0[i], 1.0 / cfg.dt_s);

@@ -49,7 +49,7 @@ rths::studies::MarthsLoopResult Ours(rths::studies::MarthsCompensator kind) {
   const auto rec = rths::signal::ReadHistoryFile(kData + "elcentro_m_s2.txt", 0.0);
   const std::size_t n = static_cast<std::size_t>(kSeconds / c.dt_s + 1e-9) + 1;
   c.ag_m_s2 = rths::signal::ResampleHistory(rec, 0.0, 0.4, c.dt_s, n, 0.0);
-  c.noise_mm = 0.0;
+  c.rig.noise_mm = 0.0;
   c.compensator = kind;
   const auto p = rths::io::ReadRodeacParameters(kData + "rodeac_initial_parameters.txt");
   for (int i = 0; i < 2; ++i) c.rodeac[i] = rths::control::MakeRodeacDesign(p.theta0[i], p.P0[i], 1.0 / c.dt_s);
