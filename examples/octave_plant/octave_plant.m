@@ -322,13 +322,14 @@ end
 function bytes = encode_measured(head, k, y_mm, current_A)
 % The 'octave' codec: measured_t's wire format written directly (lcmtypes/measured_t.lcm): head =
 % fingerprint and run_id (16 bytes, taken from a Java encoding), then k (int64), y_mm, f_kN = 0,
-% current_A (doubles), each big-endian. Checked against msg.encode() at start (codec_matches).
+% current_A (doubles), each big-endian, then n_act = 0 and n_iface = 0 (int32: one actuator, no
+% arrays). Checked against msg.encode() at start (codec_matches).
   % (x86/ARM hosts are little-endian: reversing the bytes of typecast() gives big-endian; reversing
   % the 24 bytes of [current_A, f, y_mm] gives y_mm, f, current_A each big-endian. swapbytes() would
   % do the same, but costs 60 us a call in Octave.)
   kb = typecast(int64(k), 'int8');
   vb = typecast([current_A, 0, y_mm], 'int8');
-  bytes = [head, kb(8:-1:1), vb(24:-1:1)];
+  bytes = [head, kb(8:-1:1), vb(24:-1:1), zeros(1, 8, 'int8')];
 end
 
 function ok = codec_matches(P)
@@ -337,7 +338,7 @@ function ok = codec_matches(P)
   P.meas.k = int64(123456789);  P.meas.y_mm = pi;  P.meas.current_A = 0.5;
   ok = isequal(encode(P, P.meas)', encode_measured(P.meas_head, 123456789, pi, 0.5));
   c = javaObject('rths.command_t');
-  c.run_id = P.run_id;  c.k = int64(987654321);  c.u_mm = -exp(1);  c.n_adapt = int32(0);
+  c.run_id = P.run_id;  c.k = int64(987654321);  c.u_mm = -exp(1);  c.n_adapt = int32(0);  c.n_act = int32(0);
   b = encode(P, c);
   ok = ok && all(b(1:8) == P.fp_command) && typecast(b(24:-1:17), 'int64') == 987654321 && ...
        typecast(b(32:-1:25), 'double') == -exp(1);

@@ -46,7 +46,46 @@ FitSummary FitDesignModel(const std::function<double(double u_mm)>& plant, doubl
   return Identify(u, y, dt_s, o).fit;
 }
 
+std::array<models::ServoModel3, 2> MarthsDesignModels(const models::marths::PlantZpk& p, double dt_s) {
+  namespace mm = models::marths;
+  const mm::MarthsPlant plant = mm::MakeMarthsPlant(p, dt_s);
+  std::array<models::ServoModel3, 2> out;
+  for (int i = 0; i < 2; ++i) {
+    mm::MarthsPlantState st;
+    const FitSummary fit = FitDesignModel([&](double u_mm) {
+      const double y_mm = mm::PlantOutput(plant, st)(i);
+      mm::PlantStep(plant, &st, i == 0 ? Eigen::Vector2d(u_mm, 0.0) : Eigen::Vector2d(0.0, u_mm));
+      return y_mm;
+    }, dt_s);
+    out[i] = fit.model.ToServoModel3();
+    out[i].name = "custom";
+  }
+  return out;
+}
+
+namespace {
+/// ResolveDesignModel for marths.enabled.
+std::string ResolveMarthsDesign(control::MarthsConfig* m, double dt_s) {
+  using control::MarthsCompensator;
+  if (m->compensator != MarthsCompensator::kFf && m->compensator != MarthsCompensator::kFfLqg) return "";
+  std::array<models::ServoModel3*, 2> model = {&m->model_1, &m->model_2};
+  if (model[0]->name != "avg" && model[1]->name != "avg") {
+    return "controller: each actuator designed on marths.model_1 and marths.model_2";
+  }
+  const auto fits = MarthsDesignModels(models::marths::NominalPlantZpk(), dt_s);
+  std::string note = "controller: each actuator designed on a third-order fit of the nominal plant's diagonal";
+  for (int i = 0; i < 2; ++i) {
+    if (model[i]->name != "avg") continue;
+    *model[i] = fits[i];
+    note += fmt::format("; H_{}{}: K = {:.5g}, p = {:.5g}, b = {:.5g}, c = {:.5g}", i + 1, i + 1, fits[i].K,
+                        fits[i].p, fits[i].b, fits[i].c);
+  }
+  return note;
+}
+}  // namespace
+
 std::string ResolveDesignModel(scenario::Scenario* s) {
+  if (s->marths.enabled) return ResolveMarthsDesign(&s->marths, s->run.dt_s);
   control::ControllerConfig& c = s->controller;
   if (!UsesModel(c)) return "";
   const bool benchmark = s->plant.kind == models::PlantKind::kBenchmark;

@@ -2,10 +2,12 @@
 /// @file The model a model-based tracking controller is designed on, made to follow the plant the
 /// scenario drives (issue 43: a benchmark scenario with controller.kind = "ff_lqg" was designed on
 /// the paper's damper-rig servo model, 9 ms of lag, where the benchmark plant has 25 ms).
+#include <array>
 #include <functional>
 #include <string>
 
 #include "ident/identify.h"
+#include "models/marths_plant.h"
 #include "scenario/scenario.h"
 
 namespace rths::ident {
@@ -33,6 +35,13 @@ FitSummary FitDesignModel(const std::function<double(double u_mm)>& plant, doubl
 ///   - otherwise (the damper rig's presets, a custom model): kept.
 /// Returns the line to print ("controller: designed on ..."); empty for a controller that uses no
 /// model. Deterministic: the same scenario gives the same model, bit for bit.
+///
+/// With marths.enabled (docs/marths.md): for ff and ff_lqg, marths.model_1 and model_2 left at "avg"
+/// become MarthsDesignModels of the nominal plant (the design plant also of a perturbed run).
 std::string ResolveDesignModel(scenario::Scenario* s);
+
+/// The third-order design models of the diagonal elements H_11, H_22 of the maRTHS plant `p` at
+/// step dt_s: FitDesignModel on the plant driven through one actuator, the other held at 0.
+std::array<models::ServoModel3, 2> MarthsDesignModels(const models::marths::PlantZpk& p, double dt_s);
 
 }  // namespace rths::ident

@@ -93,10 +93,10 @@ using enum Wire;
 const std::vector<Wire> kHandshakeLayout = {kI64, kI8,    kString,      kString,      kI64, kF64,
                                                       kI64, kCount, kStringArray, kStringArray, kString,
                                                       kI32, kF64};
-const std::vector<Wire> kDesiredLayout = {kI64, kI64, kF64, kF64, kF64,      kF64,
-                                                    kF64, kF64, kF64, kCount, kF64Array, kF64Array};
-const std::vector<Wire> kCommandLayout = {kI64, kI64, kF64, kF64, kF64, kCount, kF64Array};
-const std::vector<Wire> kMeasuredLayout = {kI64, kI64, kF64, kF64, kF64};
+const std::vector<Wire> kDesiredLayout = {kI64, kI64, kF64,      kF64,      kF64,   kF64,     kF64, kF64,
+                                          kF64, kCount, kF64Array, kF64Array, kCount, kF64Array};
+const std::vector<Wire> kCommandLayout = {kI64, kI64, kF64, kF64, kF64, kCount, kF64Array, kCount, kF64Array};
+const std::vector<Wire> kMeasuredLayout = {kI64, kI64, kF64, kF64, kF64, kCount, kF64Array, kCount, kF64Array};
 const std::vector<Wire> kCurrentLayout = {kI64, kI64, kF64, kF64};
 
 /// Decodes `ev` as a Msg after checking its shape; throws "<source>: byte N: ..." if it is not one.

@@ -128,6 +128,39 @@ void AddAdaptColumns(const RunLog& log, std::size_t n, RunSignals* s) {
   }
 }
 
+/// Several actuators (desired_t.n_act > 0 at step 0: the maRTHS benchmark): each actuator's target,
+/// command and stroke, and the interface forces, one column each, at the end; NaN at a step that
+/// carries fewer.
+void AddActuatorColumns(const RunLog& log, std::size_t n, RunSignals* s) {
+  if (n == 0) return;
+  const auto at = [](const std::vector<double>& v, std::int32_t count, int q) {
+    return q < count && q < static_cast<int>(v.size()) ? v[static_cast<std::size_t>(q)] : std::nan("");
+  };
+  for (int q = 0; q < log.desired[0].n_act; ++q) {
+    const std::size_t r = AddColumn(s, fmt::format("r_act{}_mm", q + 1), "mm",
+                                    fmt::format("actuator {}'s target r_k (desired_t.r_act_mm)", q + 1), n);
+    const std::size_t u = AddColumn(s, fmt::format("u_act{}_mm", q + 1), "mm",
+                                    fmt::format("actuator {}'s command u_k (command_t.u_act_mm)", q + 1), n);
+    const std::size_t y = AddColumn(s, fmt::format("y_act{}_mm", q + 1), "mm",
+                                    fmt::format("actuator {}'s measured stroke y_k (measured_t.y_act_mm)", q + 1), n);
+    for (std::size_t j = 0; j < n; ++j) {
+      s->columns[r].values.push_back(at(log.desired[j].r_act_mm, log.desired[j].n_act, q));
+      s->columns[u].values.push_back(at(log.command[j].u_act_mm, log.command[j].n_act, q));
+      s->columns[y].values.push_back(at(log.measured[j].y_act_mm, log.measured[j].n_act, q));
+    }
+  }
+  for (int q = 0; q < log.measured[0].n_iface; ++q) {
+    const std::size_t f = AddColumn(s, fmt::format("f_iface{}", q + 1), "N or N m",
+                                    fmt::format("the specimen's force on interface DOF {} of the numerical "
+                                                "substructure (measured_t.f_iface; maRTHS: DOFs 27, 21, 29)",
+                                                q + 1),
+                                    n);
+    for (std::size_t j = 0; j < n; ++j) {
+      s->columns[f].values.push_back(at(log.measured[j].f_iface, log.measured[j].n_iface, q));
+    }
+  }
+}
+
 }  // namespace
 
 RunSignals SignalsFromRunLog(const RunLog& log, double dt_s) {
@@ -141,6 +174,7 @@ RunSignals SignalsFromRunLog(const RunLog& log, double dt_s) {
   const Layout layout = AddColumns(&s, n_dof, n);
   for (std::size_t j = 0; j < n; ++j) AppendStep(log, j, n_dof, layout, &s);
   AddAdaptColumns(log, n, &s);
+  AddActuatorColumns(log, n, &s);
   return s;
 }
 

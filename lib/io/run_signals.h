@@ -29,7 +29,8 @@ struct RunSignals {
   /// acc_prev_mm_s2, vel_prev_mm_s, ground_acc_mm_s2, x1_mm..xN_mm, abs_acc1_mm_s2..abs_accN_mm_s2),
   /// the command_t fields (u_mm, u_ff_mm, u_fb_mm), the measured_t fields (y_mm, then
   /// e_mm = r - y, f_kN, i_eff_A), the current_t fields (i_cmd_A, f_desired_kN) and, for an
-  /// adaptive controller, its coefficients (a0, a1_s, a2_s2, a3_s3 from command_t.adapt).
+  /// adaptive controller, its coefficients (a0, a1_s, a2_s2, a3_s3 from command_t.adapt); with
+  /// several actuators, r_act<i>_mm, u_act<i>_mm, y_act<i>_mm per actuator and f_iface<i>.
   std::vector<SignalColumn> columns;
   /// Number of steps (rows): the length of every column (0 if there are no columns).
   std::size_t steps() const;

@@ -52,10 +52,16 @@ ClockParticipant::ClockParticipant(std::string name, RunIdentity id, LockstepCon
   rt_.period_s = timing_.pacing.period_s;
   if (rt_.paced) rt_.SizeWindows(id_.n_steps, rt_.period_s);
   SetAnswerChannel(kDesired, &desired_cache_);
+  const RoleRow& row = *wiring_.Clock().row;
+  for (int i = 0; i < row.n_inputs(); ++i) {
+    if (row.inputs[i].channel == kMeasured) measured_offset_ = row.inputs[i].offset;
+  }
+  if (measured_offset_ > 0) throw std::runtime_error(name_ + ": the clock cannot wait for a later measured_t");
   // The barrier of step k is the clock's inputs of step k+1 (wiring.h); only the last of them to
   // be sent (ack_t: the logger acknowledges step k once it holds the rest) wakes the clock.
   SubscribeInputs(wiring_.Clock(), &boxes_, [this](Channel channel, std::int64_t k, const lcm::ReceiveBuffer*) {
     if (k_ >= 0 && wiring_.Clock().Waits(channel, k, k_ + 1)) CheckBarrier();
+    if (awaiting_first_ && channel == kMeasured && k == 0) IssueFirst();
   });
 }
 
@@ -161,11 +167,47 @@ void ClockParticipant::SendGo() {
   live_.Start(id_.run_id, id_.n_steps, id_.dt_s, rt_.paced, live_limits_);
   live_.Phase(kLiveRunning, live_sink_);
   OnGo();
+  if (measured_offset_ == 0 && !boxes_.measured.Get(0)) {
+    awaiting_first_ = true;
+    last_send_ = go_at_;
+    return;
+  }
+  IssueFirst();
+}
+
+void ClockParticipant::IssueFirst() {
+  awaiting_first_ = false;
+  rerequests_ = 0;
+  go_at_ = SteadyClock::now();
   try {
     IssueStep(0);
   } catch (const std::exception& e) {
     Fail(kExitInternal, fmt::format("{}: step 0: {}", name_, e.what()), true, 0);
   }
+}
+
+void ClockParticipant::PollFirst(SteadyClock::time_point now, bool idle) {
+  if (boxes_.measured.Get(0)) {
+    IssueFirst();
+    return;
+  }
+  const int plant = owner_[kMeasured];
+  const std::string who = plant >= 0 ? std::string(kRoster[plant]) : std::string("plant");
+  if (idle && Seconds(go_at_, now) > timing_.stall_budget_s) {
+    Fail(kExitLockstep,
+         fmt::format("before step 0: {} stopped answering: no measured_t 0 after {:.3g} s and {} re-requests", who,
+                     Seconds(go_at_, now), rerequests_),
+         true, -1, who);
+    return;
+  }
+  if (Seconds(last_send_, now) < timing_.RerequestAfterS(rerequests_ + 1, typical_step_s_)) return;
+  if (rerequests_ == 0) ++stats_.steps_rerequested;
+  ++rerequests_;
+  last_send_ = now;
+  if (plant >= 0) ++peers_[plant].rerequests;
+  WantList wants;
+  wants.Add(kMeasured, 0);
+  SendRepair(0, wants);
 }
 
 SteadyClock::time_point ClockParticipant::ReleaseOf(std::int64_t k) const {
@@ -206,8 +248,9 @@ bool ClockParticipant::AccountStep(SteadyClock::time_point now) {
 
 void ClockParticipant::IssueStep(std::int64_t k) {
   MaybeFault(k);
-  const rths::measured_t* prev = k > 0 ? boxes_.measured.Get(k - 1) : nullptr;
-  ComputeDesired(k, prev, &desired_);
+  const std::int64_t j = k + measured_offset_;
+  const rths::measured_t* measured = j >= 0 ? boxes_.measured.Get(j) : nullptr;
+  ComputeDesired(k, measured, &desired_);
   desired_.run_id = id_.run_id;
   desired_.k = k;
   k_ = k;
@@ -319,7 +362,7 @@ void ClockParticipant::FailStalled(SteadyClock::time_point now) {
 
 SteadyClock::time_point ClockParticipant::PollDeadline() const {
   if (release_ != SteadyClock::time_point::max()) return release_;
-  if (k_ < 0 || Stalled(k_)) return SteadyClock::time_point::max();
+  if (!awaiting_first_ && (k_ < 0 || Stalled(k_))) return SteadyClock::time_point::max();
   return last_send_ + std::chrono::duration_cast<SteadyClock::duration>(std::chrono::duration<double>(
                           timing_.RerequestAfterS(rerequests_ + 1, typical_step_s_)));
 }
@@ -357,6 +400,10 @@ void ClockParticipant::Poll(SteadyClock::time_point now, bool idle) {
         return;
       }
     }
+  }
+  if (awaiting_first_) {
+    PollFirst(now, idle);
+    return;
   }
   if (k_ < 0) {
     PollHandshake(now, idle);

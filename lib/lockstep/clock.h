@@ -63,9 +63,10 @@ class ClockParticipant : public Participant {
   }
 
  protected:
-  /// Computes desired_t k into `*out`. `measured_prev` is measured_t k-1 (nullptr for k = 0).
+  /// Computes desired_t k into `*out`. `measured` is the clock row's input: measured_t k-1 for the
+  /// ordinary row (nullptr for k = 0), measured_t k for "same_sample" (step_table.h; never null).
   /// Must not allocate once warmed up (reuse `out`).
-  virtual void ComputeDesired(std::int64_t k, const rths::measured_t* measured_prev,
+  virtual void ComputeDesired(std::int64_t k, const rths::measured_t* measured,
                               rths::desired_t* out) = 0;
 
   /// Called once per step when its barrier is complete (every message of step k is logged),
@@ -86,6 +87,12 @@ class ClockParticipant : public Participant {
  private:
   void CheckBarrier();
   void IssueStep(std::int64_t k);
+  /// Issues step 0: at GO, or ("same_sample") once measured_t 0 is in. Step 0's release is then, and
+  /// every later (paced) release counts from it.
+  void IssueFirst();
+  /// After GO, before step 0 ("same_sample"): re-requests measured_t 0 as the step's re-requests do;
+  /// the stall budget stops the run naming the plant.
+  void PollFirst(SteadyClock::time_point now, bool idle);
   /// Issues step k_ + 1; an exception from its computation fails the run.
   void IssueNext();
   void SendGo();
@@ -128,6 +135,9 @@ class ClockParticipant : public Participant {
   /// Who sent a repair_t for the current step (alive, but lacking inputs).
   std::array<bool, kRosterSize> reported_{};
   std::int64_t k_ = -1;
+  /// Offset of the clock row's measured_t input (-1: measured_t k-1; 0: "same_sample").
+  int measured_offset_ = -1;
+  bool awaiting_first_ = false;  ///< GO sent, step 0 waits for measured_t 0
   int rerequests_ = 0;  ///< re-requests of the current step (or DONEs after the first)
   double typical_step_s_ = 0;  ///< moving average of the steps that needed no re-request [s]
   bool done_ = false;

@@ -23,13 +23,15 @@ struct StepInput {
 /// The variants of a row (RoleRow::variant).
 inline constexpr std::string_view kIdealVariant = "ideal";
 inline constexpr std::string_view kRecordedVariant = "recorded";
+inline constexpr std::string_view kSameSampleVariant = "same_sample";
 
 /// One row of the step-index table.
 struct RoleRow {
   std::string_view role;
   /// "" for the role's ordinary row; otherwise the variant a run selects instead (Wiring::Resolve):
   /// "ideal" (plant.kind = "ideal": the plant answers desired_t k), "recorded" (a stand-in that
-  /// answers step k with a recorded message once desired_t k requests it: `rths replay`).
+  /// answers step k with a recorded message once desired_t k requests it: `rths replay`),
+  /// "same_sample" (the integrator answers desired_t k from measured_t k: the maRTHS benchmark).
   std::string_view variant;
   Channel answer = kNoChannel;
   /// What its answer of step k is computed from (in this order), handed to its step function.
@@ -54,9 +56,13 @@ struct RoleRow {
 };
 
 /// docs/lockstep.md, "Time and indices" (rows in roster order; variants after their role).
-inline constexpr std::array<RoleRow, 9> kStepTable{{
+inline constexpr std::array<RoleRow, 10> kStepTable{{
     // desired_t k from measured_t k-1 (f_{k-1}); issued when the barrier of step k-1 is complete.
     {"integrator", "", kDesired, {{{kMeasured, -1}}}, {}, 0, false, true, 4},
+    // "same_sample": desired_t k from measured_t k (the forces of t_k, as the maRTHS reference code's
+    // signal flow: docs/marths.md); measured_t k is in the barrier of step k-1; step 0 waits for
+    // measured_t 0 (the plant's state at rest, sent at GO).
+    {"integrator", kSameSampleVariant, kDesired, {{{kMeasured, 0}}}, {}, 0, false, true, 4},
     // command_t k (u_k) from desired_t k (r_k) and measured_t k (y_k).
     {"controller", "", kCommand, {{{kDesired, 0}, {kMeasured, 0}}}, {0}, 1, false, false, 2},
     {"controller", kRecordedVariant, kCommand, {{{kDesired, 0}}}, {0}, 1, false, false, 2},

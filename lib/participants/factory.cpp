@@ -20,6 +20,7 @@
 #include "participants/group.h"
 #include "participants/integrator.h"
 #include "participants/logger.h"
+#include "participants/marths_participants.h"
 #include "participants/plant.h"
 #include "participants/semiactive.h"
 
@@ -38,6 +39,7 @@ lockstep::LockstepConfig LockstepOf(const scenario::Scenario& s) {
 }
 
 lockstep::Wiring WiringOf(const scenario::Scenario& s) {
+  if (s.marths.enabled) return lockstep::Wiring::Resolve({{"integrator", lockstep::kSameSampleVariant}});
   if (s.plant.kind == models::PlantKind::kIdeal) return lockstep::Wiring::Resolve({{"plant", lockstep::kIdealVariant}});
   return lockstep::Wiring::Resolve();
 }
@@ -54,13 +56,28 @@ lockstep::Faults FaultsOf(const scenario::Scenario& s, std::string_view role) {
   return f;
 }
 
+namespace {
+/// The sizes of the per-step messages' arrays in a run of `s`: DOFs, actuators, interface forces.
+struct ArraySizes {
+  int n_dof = 1, n_act = 0, n_iface = 0;
+};
+ArraySizes ArraySizesOf(const scenario::Scenario& s) {
+  if (s.marths.enabled) return {static_cast<int>(s.marths.files.K_ref.rows()), 2, 3};
+  if (s.structure.mode == models::StructureMode::kPredefined) return {};
+  return {static_cast<int>(models::StructureFromScenario(s.structure).M.rows()), 0, 0};
+}
+}  // namespace
+
+std::int64_t LogBytesPerStepOf(const scenario::Scenario& s) {
+  const ArraySizes a = ArraySizesOf(s);
+  return LogBytesPerStep(a.n_dof, a.n_act, a.n_iface);
+}
+
 OutputBytes EstimateOutputBytes(const scenario::Scenario& s) {
-  const int n_dof = s.structure.mode == models::StructureMode::kPredefined
-                        ? 1
-                        : static_cast<int>(models::StructureFromScenario(s.structure).M.rows());
+  const ArraySizes a = ArraySizesOf(s);
   const double steps = static_cast<double>(s.steps());
-  const double log_step = static_cast<double>(LogBytesPerStep(n_dof));
-  const double row = static_cast<double>(StoredBytesPerStep(n_dof)) - log_step;
+  const double log_step = static_cast<double>(LogBytesPerStep(a.n_dof, a.n_act, a.n_iface));
+  const double row = static_cast<double>(StoredBytesPerStep(a.n_dof, a.n_act, a.n_iface)) - log_step;
   OutputBytes b;
   b.log = steps * log_step;
   b.csv = s.run.csv_every > 0 ? std::ceil(steps / s.run.csv_every) * row : 0.0;
@@ -71,6 +88,11 @@ std::unique_ptr<lockstep::Participant> MakeParticipant(std::string_view role, co
                                                        const lockstep::RunIdentity& id, lcm::LCM* lcm,
                                                        const std::string& out_dir, lockstep::Faults faults,
                                                        const lockstep::Wiring& wiring) {
+  if (s.marths.enabled) {  // the benchmark's two-actuator loop (participants/marths_participants.h)
+    if (role == "integrator") return std::make_unique<MarthsIntegrator>(s, id, lcm, wiring, std::move(faults));
+    if (role == "controller") return std::make_unique<MarthsController>(s, id, lcm, wiring, std::move(faults));
+    if (role == "plant") return std::make_unique<MarthsPlant>(s, id, lcm, wiring, std::move(faults));
+  }
   if (role == "integrator") return std::make_unique<Integrator>(s, id, lcm, wiring, std::move(faults));
   if (role == "controller") return std::make_unique<Controller>(s, id, lcm, wiring, std::move(faults));
   if (role == "plant") return std::make_unique<Plant>(s, id, lcm, wiring, std::move(faults));

@@ -56,6 +56,8 @@ struct OutputBytes {
   double total() const { return log + csv; }
 };
 OutputBytes EstimateOutputBytes(const scenario::Scenario& s);
+/// Bytes of log.lcm per step of a run of `s` (LogBytesPerStep with its message sizes).
+std::int64_t LogBytesPerStepOf(const scenario::Scenario& s);
 
 /// main() of procs/<role>: `--scenario FILE --lcm-url URL --run-id N [--out DIR]`.
 /// Exit codes: ExitCode (core/exit_code.h). At exit it writes `DIR/logs/<role>.json` (its outcome and

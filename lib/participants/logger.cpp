@@ -27,15 +27,18 @@ int CreateLog(const std::string& path) {
 }
 }  // namespace
 
-std::int64_t StoredBytesPerStep(int n_dof) {
-  return LogBytesPerStep(n_dof) + static_cast<std::int64_t>(io::kSignalsRowMaxBytes);
+std::int64_t StoredBytesPerStep(int n_dof, int n_act, int n_iface) {
+  return LogBytesPerStep(n_dof, n_act, n_iface) + static_cast<std::int64_t>(io::kSignalsRowMaxBytes);
 }
 
-std::int64_t LogBytesPerStep(int n_dof) {
-  // desired_t: 8 hash + 2x8 (run_id, k) + 7x8 doubles + 4 (n_dof) + 2 n_dof x8; the others are
-  // fixed (hash, run_id, k and their doubles); ack_t is not logged.
-  const std::int64_t desired = 8 + 16 + 7 * 8 + 4 + 16 * static_cast<std::int64_t>(n_dof);
-  const std::int64_t command = 8 + 16 + 3 * 8, measured = 8 + 16 + 3 * 8, current = 8 + 16 + 2 * 8;
+std::int64_t LogBytesPerStep(int n_dof, int n_act, int n_iface) {
+  // Each: 8 hash + 2x8 (run_id, k), its doubles, and 4 bytes per array length with 8 per element
+  // (lcmtypes/*.lcm); ack_t is not logged.
+  const std::int64_t act = 4 + 8 * static_cast<std::int64_t>(n_act);
+  const std::int64_t desired = 8 + 16 + 7 * 8 + 4 + 16 * static_cast<std::int64_t>(n_dof) + act;
+  const std::int64_t command = 8 + 16 + 3 * 8 + 4 + act;
+  const std::int64_t measured = 8 + 16 + 3 * 8 + act + 4 + 8 * static_cast<std::int64_t>(n_iface);
+  const std::int64_t current = 8 + 16 + 2 * 8;
   const std::int64_t events = static_cast<std::int64_t>(
       io::EventBytes(lockstep::kChDesired, desired) + io::EventBytes(lockstep::kChCommand, command) +
       io::EventBytes(lockstep::kChMeasured, measured) + io::EventBytes(lockstep::kChCurrent, current));

@@ -48,13 +48,14 @@
 
 namespace rths::participants {
 
-/// Bytes of the stored output per step for a structure with `n_dof` degrees of freedom: the four
+/// Bytes of the stored output per step for a structure with `n_dof` degrees of freedom, `n_act`
+/// actuators' arrays (0: one actuator, the scalars only) and `n_iface` interface forces: the four
 /// events of log.lcm and the signals.csv row (an upper bound for the row). The supervisor uses
 /// it to check the free disk space before a run.
-std::int64_t StoredBytesPerStep(int n_dof);
-/// Bytes of log.lcm per step (its four events) for `n_dof` degrees of freedom: the log's size
-/// divided by this is about the steps written (progress displays).
-std::int64_t LogBytesPerStep(int n_dof);
+std::int64_t StoredBytesPerStep(int n_dof, int n_act = 0, int n_iface = 0);
+/// Bytes of log.lcm per step (its four events; an adaptive controller's coefficients aside): the
+/// log's size divided by this is about the steps written (progress displays).
+std::int64_t LogBytesPerStep(int n_dof, int n_act = 0, int n_iface = 0);
 
 class Logger : public lockstep::StepAnswerer<rths::ack_t> {
  public:

@@ -13,6 +13,7 @@
 /// Ranges may depend on other fields and on dt (given by the Context); checks that need files
 /// or several keys at once are in validate.cpp, after the walk.
 #include "scenario/fields_controller.h"
+#include "scenario/fields_marths.h"
 #include "scenario/fields_plant.h"
 #include "scenario/fields_run.h"
 #include "scenario/fields_structure.h"
@@ -32,6 +33,8 @@ void ScenarioFields(V& v, Scenario& s) {
   v.Table("lockstep", [&](V& t) { LockstepFields(t, s.lockstep, cx); });
   v.Table("realtime", [&](V& t) { RealtimeFields(t, s.realtime, cx); });
   v.Table("faults", [&](V& t) { FaultFields(t, s.faults, cx); });
+  // Written only when set (a scenario without it keeps its text, and its hash, as before [marths]).
+  v.Table("marths", [&](V& t) { MarthsFields(t, s.marths, cx); }, !(s.marths == control::MarthsConfig{}));
 }
 
 }  // namespace rths::scenario::detail

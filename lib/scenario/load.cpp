@@ -101,6 +101,12 @@ Scenario ScenarioFromToml(const toml::table& root, const std::string& path) {
   if (!s.structure.file.empty()) s.structure.file = ResolveFile(path, s.structure.file).string();
   if (!s.structure.reference_file.empty())
     s.structure.reference_file = ResolveFile(path, s.structure.reference_file).string();
+  if (s.marths.enabled) {  // (a scenario without [marths] keeps the defaults as written: its ToToml has none)
+    for (std::string* f : {&s.marths.reference_k_file, &s.marths.reference_m_file, &s.marths.rodeac_file,
+                           &s.marths.ground_file}) {
+      if (!f->empty()) *f = ResolveFile(path, *f).string();
+    }
+  }
   return s;
 }
 

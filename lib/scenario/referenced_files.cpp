@@ -7,6 +7,7 @@
 
 #include "core/names.h"
 #include "models/benchmark_structures.h"
+#include "models/marths_files.h"
 #include "scenario/walk.h"
 
 namespace rths::scenario {
@@ -59,11 +60,32 @@ void ReadStructureFiles(const std::string& path, const detail::Check& check, con
   }
 }
 
+/// [marths] (when enabled): the matrices, RoDeAC's parameters and the ground record; each reader's
+/// errors name the file and line.
+void ReadMarthsFiles(const std::string& path, const detail::Check& check, control::MarthsConfig* m) {
+  m->files = {};
+  m->ground = {};
+  if (!m->enabled) return;
+  auto file = [&](const std::string& f) { return detail::ResolveFile(path, f).string(); };
+  m->files.K_ref = models::marths::ReadMatrixCsv(file(m->reference_k_file));
+  m->files.M_ref = models::marths::ReadMatrixCsv(file(m->reference_m_file));
+  m->files.rodeac = models::marths::ReadRodeacParameters(file(m->rodeac_file));
+  m->ground = signal::ReadHistoryFile(file(m->ground_file), 0.0);
+  const auto n = m->files.K_ref.rows();
+  if (m->files.K_ref.cols() != n || m->files.M_ref.rows() != n || m->files.M_ref.cols() != n || n != 29) {
+    check.Fail("marths.reference_m_file",
+               fmt::format("the reference matrices must be 29 x 29 (the benchmark's frame): K is {} x {}, M is {} x {}",
+                           m->files.K_ref.rows(), m->files.K_ref.cols(), m->files.M_ref.rows(),
+                           m->files.M_ref.cols()));
+  }
+}
+
 }  // namespace
 
 void ReadReferencedFiles(Scenario* s) {
   const detail::Check check(detail::DisplayName(s->path));
   ReadStructureFiles(s->path, check, s->plant, &s->structure);
+  ReadMarthsFiles(s->path, check, &s->marths);
   for (signal::SignalSpec* signal : {&s->structure.ground, &s->structure.desired}) {
     signal->record = {};
     if (signal->kind != signal::SignalKind::kFile) continue;

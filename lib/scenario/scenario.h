@@ -13,6 +13,7 @@
 
 #include "control/clipped_optimal.h"
 #include "control/controller_config.h"
+#include "control/marths_config.h"
 #include "lockstep/config.h"
 #include "lockstep/faults.h"
 #include "lockstep/realtime.h"
@@ -52,6 +53,8 @@ struct Scenario {
   lockstep::RealtimeConfig realtime;
   safety::SafetyConfig safety;
   lockstep::FaultConfig faults;
+  /// The maRTHS benchmark's two-actuator loop instead of the tables above (docs/marths.md).
+  control::MarthsConfig marths;
 
   /// Number of lockstep steps: round(duration_s / dt_s).
   std::int64_t steps() const;

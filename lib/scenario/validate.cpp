@@ -164,6 +164,31 @@ void ValidateFaults(const lockstep::FaultConfig& f, const Check& check) {
   }
 }
 
+/// [marths]: its files given and present, and nothing set that its loop would not run.
+void ValidateMarths(const Scenario& s, const Check& check) {
+  const control::MarthsConfig& m = s.marths;
+  if (!m.enabled) return;
+  for (const auto& [key, file] : {std::pair{"marths.reference_k_file", &m.reference_k_file},
+                                  {"marths.reference_m_file", &m.reference_m_file},
+                                  {"marths.rodeac_file", &m.rodeac_file},
+                                  {"marths.ground_file", &m.ground_file}}) {
+    if (file->empty()) {
+      check.Fail(key, "is required with marths.enabled (the benchmark's files: data/marths/, docs/marths.md)");
+    } else {
+      CheckFileExists(check, key, s.path, *file);
+    }
+  }
+  if (s.semiactive.mode == control::SemiactiveMode::kClippedOptimal) {
+    check.Fail("semiactive.mode", "\"clipped_optimal\" controls the one-actuator structure; the maRTHS loop "
+                                  "(marths.enabled) has no damper");
+  }
+  if (s.plant.kind == models::PlantKind::kIdeal) {
+    check.Fail("plant.kind", "\"ideal\" answers desired_t k, but the maRTHS loop's integrator answers "
+                             "desired_t k from measured_t k (a cycle); leave plant.kind at its default "
+                             "(marths.enabled runs the benchmark's own plant)");
+  }
+}
+
 }  // namespace
 }  // namespace detail
 
@@ -187,6 +212,7 @@ void ValidateScenario(const Scenario& s) {
                                               "(the specimen is [plant.benchmark]'s)");
   }
   ValidateFaults(s.faults, check);
+  ValidateMarths(s, check);
 }
 
 }  // namespace rths::scenario

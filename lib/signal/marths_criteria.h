@@ -52,6 +52,18 @@ struct MarthsCriteria {
   std::vector<std::pair<std::string, double>> Items() const;
 };
 
+/// The reference code's conversion of an actuator command to the servo-valve voltage
+/// (S1_Input_Data.m: volts = u / correction / gain - offset / gain) and S5_Evaluation.m's
+/// "realizable" check: a run saturates when both actuators' largest |V| exceed kMarthsVoltLimit.
+struct MarthsVoltage {
+  double gain[2] = {7.4921, 7.3907};
+  double offset[2] = {0.0092, -0.0059};
+  double correction[2] = {1.053, 1.055};
+  /// Actuator i's (0, 1) command u_mm [mm] in volts [V].
+  double Volts(int i, double u_mm) const { return u_mm / correction[i] / gain[i] + (-offset[i] / gain[i]); }
+};
+inline constexpr double kMarthsVoltLimit = 3.8;  ///< [V]
+
 /// The criteria of `s`. Throws rths::Error if lengths differ, fewer than 2 samples, dt_s is not
 /// > 0, or a denominator is zero.
 MarthsCriteria MarthsCriteriaFrom(const MarthsSignals& s);

@@ -11,12 +11,14 @@
 
 #include "core/error.h"
 #include "core/interrupt.h"
+#include "ident/design_model.h"
 #include "io/csv.h"
-#include "io/marths_files.h"
 #include "io/plot.h"
 #include "io/source_tree.h"
+#include "models/marths_files.h"
 #include "signal/history.h"
 #include "signal/stats.h"
+#include "studies/marths_lockstep.h"
 #include "studies/marths_loop.h"
 
 namespace rths::studies {
@@ -29,11 +31,7 @@ constexpr std::uint64_t kPlantSeed = 47;     // the perturbed plants' draws, in 
 constexpr std::uint64_t kNominalNoise = 123;  // the reference code's nominal seed; perturbed i: 123 + i
 
 MarthsCompensator KindOf(const std::string& name) {
-  if (name == "rodeac") return MarthsCompensator::kRodeac;
-  if (name == "ff") return MarthsCompensator::kFf;
-  if (name == "ff_lqg") return MarthsCompensator::kFfLqg;
-  if (name == "mimo_ff") return MarthsCompensator::kMimoFf;
-  return MarthsCompensator::kNone;
+  return ValueOf(control::kMarthsCompensatorNames, name).value_or(MarthsCompensator::kNone);
 }
 
 std::string MarthsData(const ReproduceOptions& opts, const std::string& file) {
@@ -60,15 +58,15 @@ const std::pair<const char*, const char*> kMarthsRecords[3] = {
 MarthsLoopConfig SharedConfig(const ReproduceOptions& opts) {
   auto data = [&](const char* file) { return MarthsData(opts, file); };
   MarthsLoopConfig c;
-  c.K_ref = io::ReadMatrixCsv(data("reference_K_N_per_m.csv"));
-  c.M_ref = io::ReadMatrixCsv(data("reference_M_kg.csv"));
+  c.K_ref = mm::ReadMatrixCsv(data("reference_K_N_per_m.csv"));
+  c.M_ref = mm::ReadMatrixCsv(data("reference_M_kg.csv"));
   c.ag_m_s2 = MarthsGround(opts, kMarthsRecords[0].second, c.dt_s);
   c.rig.noise_mm = mm::SensorNoiseMm(c.dt_s);
-  const io::RodeacInitialParameters p = io::ReadRodeacParameters(data("rodeac_initial_parameters.txt"));
-  const auto models = MarthsDesignModels(c.design_plant, c.dt_s);
+  const mm::RodeacInitialParameters p = mm::ReadRodeacParameters(data("rodeac_initial_parameters.txt"));
+  const auto models = ident::MarthsDesignModels(c.compensators.design_plant, c.dt_s);
   for (int i = 0; i < 2; ++i) {
-    c.rodeac[i] = control::MakeRodeacDesign(p.theta0[i], p.P0[i], 1.0 / c.dt_s);
-    c.per_actuator[i].model = models[i];
+    c.compensators.rodeac[i] = control::MakeRodeacDesign(p.theta0[i], p.P0[i], 1.0 / c.dt_s);
+    c.compensators.per_actuator[i].model = models[i];
   }
   return c;
 }
@@ -161,6 +159,59 @@ void WriteFigure(const ReproduceOptions& opts, const MarthsStudy& s) {
   io::Plot(f, opts.out_dir);
 }
 
+/// marths_history.png: the nominal El Centro run of none, rodeac, ff_lqg and mimo_ff in time: each
+/// actuator's target and tracking error, and the interface rotation against the reference
+/// structure's (every 2nd sample drawn).
+void WriteHistory(const ReproduceOptions& opts, const std::vector<MarthsRow>& rows,
+                  const std::vector<MarthsLoopResult>& results) {
+  const auto& col = io::ReadableColors();
+  const std::vector<std::string> shown = {"none", "rodeac", "ff_lqg", "mimo_ff"};
+  auto nominal = [&](const std::string& c) -> const signal::MarthsSignals& {
+    for (std::size_t i = 0; i < rows.size(); ++i)
+      if (rows[i].compensator == c && rows[i].run == "nominal") return results[i].signals;
+    throw Error("rths reproduce marths", "no nominal run of " + c);
+  };
+  auto line = [&](const std::string& title, const std::string& color, const std::vector<double>& a,
+                  const std::vector<double>* minus, double dt_s) {
+    io::Series x = io::MakeSeries(title, color);
+    for (std::size_t k = 0; k < a.size(); k += 2) {
+      x.x.push_back(static_cast<double>(k) * dt_s);
+      x.y.push_back(minus ? a[k] - (*minus)[k] : a[k]);
+    }
+    return x;
+  };
+  io::Figure f;
+  f.name = "marths_history";
+  f.title = "maRTHS, El Centro x 0.4, nominal plant, sensor noise on";
+  f.gnuplot = opts.gnuplot;
+  f.columns = 1;
+  const signal::MarthsSignals& ref = nominal("none");
+  for (int a = 0; a < 2; ++a) {
+    io::Panel t = io::MakePanel(fmt::format("Actuator {}: target x_t", a + 1), "t [s]", "x_t [mm]");
+    t.series.push_back(line("target (none)", col[0], a == 0 ? ref.xa1_t : ref.xa2_t, nullptr, ref.dt_s));
+    t.key = "outside right top";
+    f.panels.push_back(t);
+    io::Panel e = io::MakePanel(fmt::format("Actuator {}: tracking error x_m - x_t", a + 1), "t [s]", "error [mm]");
+    for (std::size_t i = 0; i < shown.size(); ++i) {
+      const signal::MarthsSignals& g = nominal(shown[i]);
+      e.series.push_back(line(shown[i], col[i], a == 0 ? g.xa1_m : g.xa2_m, a == 0 ? &g.xa1_t : &g.xa2_t, g.dt_s));
+    }
+    e.key = "outside right top";
+    f.panels.push_back(e);
+  }
+  io::Panel r = io::MakePanel("Interface rotation: estimated from the strokes (mimo_ff) and the reference structure's",
+                              "t [s]", "rotation [rad]");
+  r.series.push_back(line("reference", col[0], ref.r_ref, nullptr, ref.dt_s));
+  r.series.push_back(line("estimated, mimo_ff", col[3], nominal("mimo_ff").r_hat, nullptr, ref.dt_s));
+  r.key = "outside right top";
+  f.panels.push_back(r);
+  std::vector<const io::Panel*> all;
+  for (const auto& p : f.panels) all.push_back(&p);
+  const int margin = io::KeyMarginChars(all);
+  for (auto& p : f.panels) p.right_margin_chars = margin;
+  io::Plot(f, opts.out_dir);
+}
+
 std::vector<Claim> MarthsClaims(const MarthsStudy& s) {
   std::vector<Claim> claims;
   auto j2 = [&](const std::string& c, const std::string& run, int a) {
@@ -196,12 +247,7 @@ std::vector<Claim> MarthsClaims(const MarthsStudy& s) {
   return claims;
 }
 
-void Configure(const std::string& compensator, MarthsLoopConfig* c) {
-  c->compensator = KindOf(compensator);
-  for (int a = 0; a < 2; ++a) {
-    c->per_actuator[a].kind = compensator == "ff_lqg" ? control::ControllerKind::kFfLqg : control::ControllerKind::kFf;
-  }
-}
+void Configure(const std::string& compensator, MarthsLoopConfig* c) { c->compensators.kind = KindOf(compensator); }
 
 /// The decisions table's runs (rows appended to `rows`, configs returned in the same order).
 std::vector<MarthsLoopConfig> DecisionConfigs(const MarthsLoopConfig& shared, std::vector<MarthsDecisionRow>* rows) {
@@ -225,9 +271,11 @@ std::vector<MarthsLoopConfig> DecisionConfigs(const MarthsLoopConfig& shared, st
   return out;
 }
 
-/// Runs every config, opts.jobs at a time. Throws rths::Interrupted on Ctrl-C, rths::Error naming
-/// the first run that failed.
-std::vector<MarthsLoopResult> RunAll(const std::vector<MarthsLoopConfig>& configs, const ReproduceOptions& opts) {
+/// Runs every config, opts.jobs at a time; a run's records are kept only where keep_signals says
+/// (6 MB a run), the others scored and dropped. Throws rths::Interrupted on Ctrl-C, rths::Error
+/// naming the first run that failed.
+std::vector<MarthsLoopResult> RunAll(const std::vector<MarthsLoopConfig>& configs, const ReproduceOptions& opts,
+                                     const std::vector<bool>& keep_signals) {
   std::vector<MarthsLoopResult> results(configs.size());
   std::atomic<std::size_t> next{0};
   std::atomic<bool> stop{false};
@@ -241,7 +289,7 @@ std::vector<MarthsLoopResult> RunAll(const std::vector<MarthsLoopConfig>& config
       }
       try {
         results[i] = RunMarthsLoop(configs[i]);
-        results[i].signals = {};  // scored: the records are not kept (6 MB a run)
+        if (!keep_signals[i]) results[i].signals = {};
       } catch (const std::exception& e) {
         const std::lock_guard<std::mutex> lock(failure_mutex);
         if (failure.empty()) failure = fmt::format("run {}: {}", i + 1, e.what());
@@ -282,7 +330,11 @@ void WriteVariants(const std::filesystem::path& stem, const std::vector<MarthsDe
 }  // namespace
 
 const std::vector<std::string>& MarthsCompensatorNames() {
-  static const std::vector<std::string> names = {"none", "rodeac", "ff", "ff_lqg", "mimo_ff"};
+  static const std::vector<std::string> names = [] {
+    std::vector<std::string> out;
+    for (const auto& n : control::kMarthsCompensatorNames) out.emplace_back(n.name);
+    return out;
+  }();
   return names;
 }
 
@@ -307,14 +359,63 @@ double MarthsNominalValue(const std::vector<MarthsRow>& rows, const std::string&
   return std::nan("");
 }
 
+namespace {
+
+/// marths_lockstep.csv and .md: the shipped scenarios through the lockstep beside the loop.
+void WriteLockstep(const std::filesystem::path& stem, const std::vector<MarthsLockstepRow>& rows) {
+  std::vector<std::string> header = {"compensator", "source", "steps"};
+  for (const auto& [k, v] : rows.front().lockstep.Items()) header.push_back(k);
+  for (const char* h : {"max_V_1", "max_V_2", "realizable", "max_rel_diff", "wall_s"}) header.push_back(h);
+  io::CsvWriter csv(stem.string() + ".csv", header);
+  std::ofstream md(stem.string() + ".md");
+  md << "# maRTHS: the shipped scenarios through the lockstep (rths reproduce marths)\n\n"
+     << "scenarios/marths/elcentro_<compensator>.toml run by the five participants in this process (memq), "
+        "scored from their logs, beside the in-process loop's nominal run (docs/marths.md \"Through the "
+        "lockstep\"). J in % (J1 in ms).\n\n"
+     << "| compensator | steps | J2,1 lockstep | J2,1 loop | J2,2 lockstep | J2,2 loop | J5,TH lockstep | J5,TH loop | "
+        "largest rel. difference, J1-J10 | largest V | wall [s] |\n|---|---|---|---|---|---|---|---|---|---|---|\n";
+  for (const MarthsLockstepRow& r : rows) {
+    for (int source = 0; source < 2; ++source) {
+      const signal::MarthsCriteria& j = source == 0 ? r.lockstep : r.loop;
+      std::vector<std::string> f = {r.compensator, source == 0 ? "lockstep" : "loop", std::to_string(r.steps)};
+      for (const auto& [k, v] : j.Items()) f.push_back(fmt::format("{:.9g}", v));
+      f.push_back(source == 0 ? fmt::format("{:.4f}", r.max_volts[0]) : "");
+      f.push_back(source == 0 ? fmt::format("{:.4f}", r.max_volts[1]) : "");
+      f.push_back(source == 0 ? (r.realizable ? "yes" : "no") : "");
+      f.push_back(source == 0 ? fmt::format("{:.3g}", r.max_rel_diff) : "");
+      f.push_back(source == 0 ? fmt::format("{:.2f}", r.wall_s) : "");
+      csv.Row(f);
+    }
+    md << fmt::format("| {} | {} | {:.4f} | {:.4f} | {:.4f} | {:.4f} | {:.4f} | {:.4f} | {:.2g} | {:.3f} / {:.3f} | {:.1f} |\n",
+                      r.compensator, r.steps, r.lockstep.J2_1_pct, r.loop.J2_1_pct, r.lockstep.J2_2_pct,
+                      r.loop.J2_2_pct, r.lockstep.J5_TH_pct, r.loop.J5_TH_pct, r.max_rel_diff, r.max_volts[0],
+                      r.max_volts[1], r.wall_s);
+  }
+  csv.Close();
+}
+
+Claim LockstepClaim(const std::vector<MarthsLockstepRow>& rows) {
+  Claim c{"the shipped scenarios through the lockstep give the loop's J1-J10 (relative difference below 1e-9)", true,
+          ""};
+  double worst = 0.0;
+  for (const MarthsLockstepRow& r : rows) {
+    worst = std::max(worst, r.max_rel_diff);
+    c.holds = c.holds && r.max_rel_diff < 1e-9;
+  }
+  c.detail = fmt::format("{} scenarios, largest relative difference {:.2g}", rows.size(), worst);
+  return c;
+}
+
+}  // namespace
+
 MarthsStudy ReproduceMarths(const ReproduceOptions& opts) {
   const auto t0 = std::chrono::steady_clock::now();
   MarthsStudy s;
   s.perturbed = opts.quick ? 2 : 20;
   const MarthsLoopConfig shared = SharedConfig(opts);
-  std::vector<mm::PlantZpk> plants = {shared.design_plant};
+  std::vector<mm::PlantZpk> plants = {shared.compensators.design_plant};
   signal::GaussianState g = signal::MakeGaussian(kPlantSeed);
-  for (int i = 0; i < s.perturbed; ++i) plants.push_back(mm::PerturbedPlantZpk(shared.design_plant, &g));
+  for (int i = 0; i < s.perturbed; ++i) plants.push_back(mm::PerturbedPlantZpk(shared.compensators.design_plant, &g));
   for (const auto& comp : MarthsCompensatorNames()) {
     for (std::size_t p = 0; p < plants.size(); ++p) {
       MarthsRow r;
@@ -345,7 +446,9 @@ MarthsStudy ReproduceMarths(const ReproduceOptions& opts) {
       configs.push_back(std::move(c));
     }
   }
-  const std::vector<MarthsLoopResult> results = RunAll(configs, opts);
+  std::vector<bool> keep(configs.size(), false);  // the nominal runs: marths_history.png
+  for (std::size_t i = 0; i < s.rows.size(); ++i) keep[i] = s.rows[i].run == "nominal";
+  const std::vector<MarthsLoopResult> results = RunAll(configs, opts, keep);
   for (std::size_t i = 0; i < s.rows.size(); ++i) {
     s.rows[i].j = results[i].j;
     s.rows[i].max_volts[0] = results[i].max_volts[0];
@@ -358,9 +461,13 @@ MarthsStudy ReproduceMarths(const ReproduceOptions& opts) {
   }
   s.claims = MarthsClaims(s);
   std::filesystem::create_directories(opts.out_dir);
+  const std::vector<MarthsLockstepRow> lockstep = RunMarthsScenarios(opts, s.rows, shared.ag_m_s2.size(), shared.dt_s);
+  WriteLockstep(opts.out_dir / "marths_lockstep", lockstep);
+  s.claims.push_back(LockstepClaim(lockstep));
   WriteRows(opts.out_dir / "marths.csv", s.rows);
   WriteSummary(opts, s);
   WriteFigure(opts, s);
+  WriteHistory(opts, s.rows, results);
   WriteVariants(opts.out_dir / "marths_decisions", s.decisions,
                 "what each of the reference code's ambiguous choices changes (nominal plant, El Centro x 0.4)",
                 "Each row switches one choice of docs/marths.md \"Decisions\" away from the reference code's "

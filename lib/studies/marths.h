@@ -8,9 +8,12 @@
 /// Files: marths.csv (a row per run), marths_summary.csv (per compensator: the nominal run, and
 /// the perturbed runs' mean and sample standard deviation of every criterion), marths.md (the
 /// tables), marths.png (J2 per actuator, J5 and J7 per interface DOF, nominal and perturbed mean),
+/// marths_history.png (the nominal runs in time: targets, tracking errors, the interface rotation),
 /// marths_decisions.csv and .md (none, rodeac and mimo_ff on the nominal plant with each of the
 /// reference code's ambiguous choices switched alone), marths_records.csv and .md (every
-/// compensator on the nominal plant under El Centro, Kobe and Morgan Hill, each x 0.4).
+/// compensator on the nominal plant under El Centro, Kobe and Morgan Hill, each x 0.4),
+/// marths_lockstep.csv and .md (the shipped scenarios scenarios/marths/elcentro_*.toml run through
+/// the lockstep beside the loop's nominal runs: studies/marths_lockstep.h).
 #include <string>
 #include <vector>
 

@@ -9,7 +9,6 @@
 #include "control/mimo_feedforward.h"
 #include "control/tracking_controller.h"
 #include "core/error.h"
-#include "ident/design_model.h"
 #include "models/marths_rig.h"
 #include "models/marths_structure.h"
 #include "models/newmark_linear.h"
@@ -32,29 +31,9 @@ signal::MarthsSignals ReservedSignals(std::size_t n, double dt_s) {
   return s;
 }
 
-double Volts(const MarthsLoopConfig& c, int i, double u_mm) {
-  return u_mm / c.correction[i] / c.v2d_gain[i] + (-c.v2d_offset[i] / c.v2d_gain[i]);
-}
-
 double U(const models::NewmarkLinearState& s, int dof) { return s.U(mm::Index(dof)); }
 
 }  // namespace
-
-std::array<models::ServoModel3, 2> MarthsDesignModels(const mm::PlantZpk& p, double dt_s) {
-  const mm::MarthsPlant plant = mm::MakeMarthsPlant(p, dt_s);
-  std::array<models::ServoModel3, 2> out;
-  for (int i = 0; i < 2; ++i) {
-    mm::MarthsPlantState st;
-    const ident::FitSummary fit = ident::FitDesignModel([&](double u_mm) {
-      const double y_mm = mm::PlantOutput(plant, st)(i);
-      mm::PlantStep(plant, &st, i == 0 ? Eigen::Vector2d(u_mm, 0.0) : Eigen::Vector2d(0.0, u_mm));
-      return y_mm;
-    }, dt_s);
-    out[i] = fit.model.ToServoModel3();
-    out[i].name = "custom";
-  }
-  return out;
-}
 
 MarthsLoopResult RunMarthsLoop(const MarthsLoopConfig& c) {
   const std::size_t n = c.ag_m_s2.size();
@@ -70,19 +49,7 @@ MarthsLoopResult RunMarthsLoop(const MarthsLoopConfig& c) {
   models::NewmarkLinearState num_s = models::NewmarkLinearAtRest(sub.numerical);
   models::NewmarkLinearState ref_s = models::NewmarkLinearAtRest(ref);
   mm::MarthsRigState rig_s = mm::MarthsRigAtRest(rig);
-  control::RodeacState rodeac_s[2];
-  if (c.compensator == MarthsCompensator::kRodeac) {
-    for (int i = 0; i < 2; ++i) rodeac_s[i] = control::RodeacAtRest(c.rodeac[i]);
-  }
-  const bool per_actuator = c.compensator == MarthsCompensator::kFf || c.compensator == MarthsCompensator::kFfLqg;
-  std::unique_ptr<control::TrackingController> law[2];
-  control::ExtrapolationState extrapolation[2];
-  if (per_actuator) {
-    for (int i = 0; i < 2; ++i) law[i] = control::MakeTrackingController(c.per_actuator[i], c.dt_s);
-  }
-  std::optional<control::MimoFeedforward> mimo;
-  control::MimoFeedforwardState mimo_s;
-  if (c.compensator == MarthsCompensator::kMimoFf) mimo = control::MakeMimoFeedforward(c.design_plant, c.dt_s);
+  control::MarthsCompensators compensators(c.compensators, c.dt_s);
 
   MarthsLoopResult r;
   r.signals = ReservedSignals(n, c.dt_s);
@@ -94,26 +61,13 @@ MarthsLoopResult RunMarthsLoop(const MarthsLoopConfig& c) {
     const mm::InterfaceMotion& est = reading.estimate;
     const mm::SubstructureOutput out = mm::SubstructureStep(sub, &num_s, ag, reading.forces);
     const mm::ActuatorPair& t = out.targets;
-    // Commands.
-    Eigen::Vector2d u(t.a1_mm, t.a2_mm);
-    if (c.compensator == MarthsCompensator::kRodeac) {
-      u(0) = control::RodeacStep(c.rodeac[0], &rodeac_s[0], t.a1_mm, y(0));
-      u(1) = control::RodeacStep(c.rodeac[1], &rodeac_s[1], t.a2_mm, y(1));
-    } else if (per_actuator) {
-      const double target[2] = {t.a1_mm, t.a2_mm};
-      for (int i = 0; i < 2; ++i) {
-        const control::Derivatives d = control::StepDerivatives(&extrapolation[i], target[i], c.dt_s);
-        u(i) = law[i]->Step(d, {y(i), 0.0, 0.0}).u_mm;
-      }
-    } else if (mimo) {
-      u = control::MimoFeedforwardStep(*mimo, &mimo_s, t.a1_mm, t.a2_mm);
-    }
+    const Eigen::Vector2d u = compensators.Step(Eigen::Vector2d(t.a1_mm, t.a2_mm), y);
     if (!u.allFinite() || !y.allFinite()) {
       throw Error("maRTHS loop", fmt::format("diverged at sample {} (t = {:.4f} s)", k, k * c.dt_s));
     }
     mm::RigStep(rig, &rig_s, u);
     models::NewmarkLinearStep(ref, &ref_s, ag);
-    for (int i = 0; i < 2; ++i) r.max_volts[i] = std::max(r.max_volts[i], std::abs(Volts(c, i, u(i))));
+    for (int i = 0; i < 2; ++i) r.max_volts[i] = std::max(r.max_volts[i], std::abs(c.volts.Volts(i, u(i))));
 
     g.xa1_t.push_back(t.a1_mm);
     g.xa2_t.push_back(t.a2_mm);
@@ -134,7 +88,7 @@ MarthsLoopResult RunMarthsLoop(const MarthsLoopConfig& c) {
     g.x3_ref.push_back(U(ref_s, mm::kDofX3));
     g.r3_ref.push_back(U(ref_s, mm::kDofTheta3rd));
   }
-  r.saturated = r.max_volts[0] > 3.8 && r.max_volts[1] > 3.8;
+  r.saturated = r.max_volts[0] > signal::kMarthsVoltLimit && r.max_volts[1] > signal::kMarthsVoltLimit;
   r.j = signal::MarthsCriteriaFrom(g);
   return r;
 }

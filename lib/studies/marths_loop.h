@@ -25,6 +25,8 @@
 #include <Eigen/Core>
 
 #include "control/controller_config.h"
+#include "control/marths_compensator.h"
+#include "control/marths_config.h"
 #include "control/rodeac.h"
 #include "models/marths_coupler.h"
 #include "models/marths_plant.h"
@@ -33,14 +35,8 @@
 
 namespace rths::studies {
 
-/// The compensators the loop runs, one per actuator.
-enum class MarthsCompensator {
-  kNone,    ///< u = x_t
-  kRodeac,  ///< control::RodeacStep per actuator
-  kFf,      ///< the paper's feedforward per actuator, designed on H_ii (MarthsDesignModels)
-  kFfLqg,   ///< the paper's FF + LQG per actuator, designed on H_ii
-  kMimoFf,  ///< control::MimoFeedforward: the inverse of the 2 x 2 plant
-};
+/// The compensators the loop runs (control/marths_config.h).
+using control::MarthsCompensator;
 
 /// One run's inputs (read at the edge: no file is opened here).
 struct MarthsLoopConfig {
@@ -52,18 +48,11 @@ struct MarthsLoopConfig {
   /// The rig's sensor noise (off by default here), its seed, and the reference code's ambiguous
   /// choices (models::marths::RigOptions; docs/marths.md "Decisions").
   models::marths::RigOptions rig{};
-  MarthsCompensator compensator = MarthsCompensator::kNone;
-  control::RodeacDesign rodeac[2];      ///< kRodeac: actuator 1, 2
-  /// kFf, kFfLqg: each actuator's controller (kind and design model: MarthsDesignModels);
-  /// kMimoFf: `design_plant` is inverted.
-  control::ControllerConfig per_actuator[2];
-  /// The plant the compensators are designed on (the nominal plant, also for perturbed runs).
-  models::marths::PlantZpk design_plant = models::marths::NominalPlantZpk();
-  /// The reference code's voltage conversion of each command (S1_Input_Data.m): volts =
-  /// (u / correction - offset) / gain; the "realizable" limit is |V| <= 3.8 on both actuators.
-  double v2d_gain[2] = {7.4921, 7.3907};
-  double v2d_offset[2] = {0.0092, -0.0059};
-  double correction[2] = {1.053, 1.055};
+  /// The compensators (kind, RoDeAC's designs, each actuator's controller for ff and ff_lqg,
+  /// and the plant they are designed on: the nominal one, also for perturbed runs).
+  control::MarthsCompensatorSpec compensators{};
+  /// The reference code's voltage conversion of each command (signal::MarthsVoltage).
+  signal::MarthsVoltage volts{};
 };
 
 /// The run's outcome.
@@ -71,13 +60,9 @@ struct MarthsLoopResult {
   signal::MarthsCriteria j;
   signal::MarthsSignals signals;
   double max_volts[2] = {0.0, 0.0};  ///< largest |command| per actuator [V]
-  /// Both actuators' largest |V| exceed 3.8 V: the reference code's saturation flag for a run.
+  /// Both actuators' largest |V| exceed signal::kMarthsVoltLimit: the reference code's saturation flag.
   bool saturated = false;
 };
-
-/// The third-order design models of the diagonal elements H_11, H_22 of `p` at step dt_s
-/// (ident::FitDesignModel on the plant driven through one actuator, the other held at 0).
-std::array<models::ServoModel3, 2> MarthsDesignModels(const models::marths::PlantZpk& p, double dt_s);
 
 /// Runs `c` for c.ag_m_s2.size() samples and scores it. Throws rths::Error for inputs the models
 /// refuse or if the loop diverges (a value that is not finite).

@@ -5,7 +5,6 @@
 
 #include <fmt/format.h>
 
-#include "models/structure_file.h"
 #include "participants/factory.h"
 #include "participants/logger.h"
 
@@ -13,18 +12,9 @@ namespace rths::supervisor {
 
 namespace fs = std::filesystem;
 
-namespace {
-
-int DegreesOfFreedom(const scenario::Scenario& s) {
-  if (s.structure.mode == models::StructureMode::kPredefined) return 1;
-  return static_cast<int>(models::StructureFromScenario(s.structure).M.rows());
-}
-
-}  // namespace
-
 RunProgress::RunProgress(const fs::path& log, const scenario::Scenario& s, bool enabled) : line_("rths run", enabled) {
   if (!line_.enabled() || s.steps() <= 0) return;
-  const std::int64_t bytes_per_step = participants::LogBytesPerStep(DegreesOfFreedom(s));
+  const std::int64_t bytes_per_step = participants::LogBytesPerStepOf(s);
   thread_ = std::thread([this, log, steps = s.steps(), bytes_per_step] { Draw(log, steps, bytes_per_step); });
 }
 

@@ -51,6 +51,15 @@ nlohmann::json RunSummary::ToJson() const {
     j["benchmark_criteria"] = b;
   }
   if (!benchmark_error.empty()) j["benchmark_criteria_error"] = benchmark_error;
+  if (marths) {
+    nlohmann::json m = nlohmann::json::object();
+    for (const auto& [key, value] : marths->j.Items()) m[key] = value;
+    j["marths_criteria"] = m;
+    j["marths_realizable"] = {{"realizable", marths->realizable},
+                              {"max_volts", {marths->max_volts[0], marths->max_volts[1]}},
+                              {"limit_volts", signal::kMarthsVoltLimit}};
+  }
+  if (!marths_error.empty()) j["marths_criteria_error"] = marths_error;
   if (structure_response) {
     const participants::StructureResponse& r = *structure_response;
     j["structure_peak_displacement_mm"] = r.peak_displacement_mm;
@@ -95,6 +104,14 @@ std::string RunSummary::Report(double dt_s) const {
   }
   if (benchmark_criteria) o += "  benchmark          " + benchmark_criteria->Format() + "\n";
   if (!benchmark_error.empty()) o += "  benchmark          no J1-J9: " + benchmark_error + "\n";
+  if (marths) {
+    const signal::MarthsCriteria& c = marths->j;
+    o += fmt::format("  maRTHS             J2 {:.3g} / {:.3g} %, J5 X {:.3g} %, TH {:.3g} %, J7 X {:.3g} %, TH {:.3g} % "
+                     "(docs/marths.md); largest commands {:.3f} / {:.3f} V: {}\n",
+                     c.J2_1_pct, c.J2_2_pct, c.J5_X_pct, c.J5_TH_pct, c.J7_X_pct, c.J7_TH_pct, marths->max_volts[0],
+                     marths->max_volts[1], marths->realizable ? "realizable" : "NOT realizable (both above 3.8 V)");
+  }
+  if (!marths_error.empty()) o += "  maRTHS             no J1-J10: " + marths_error + "\n";
   if (structure_response) {
     const participants::StructureResponse& r = *structure_response;
     o += fmt::format("  structure          floor {}: peak {:.4g} mm, residual {:.4g} mm; story {}: peak drift {:.4g} mm "
@@ -162,26 +179,32 @@ void ReadLog(const std::string& log_path, const scenario::Scenario& scenario, Ru
   s->benchmark_error.clear();
   s->structure_response.reset();
   s->structure_error.clear();
-  if (scenario.structure.reference_file.empty() && !scenario.structure.Stepped()) {
+  s->marths.reset();
+  s->marths_error.clear();
+  const bool benchmark = !scenario.structure.reference_file.empty() && !scenario.marths.enabled;
+  const bool stepped = scenario.structure.Stepped() && !scenario.marths.enabled;
+  if (!benchmark && !stepped && !scenario.marths.enabled) {
     ReadLog(log_path, s);
     return;
   }
+  // Each score's own failure is said beside it (never thrown); a log that cannot be read is log_error.
+  auto score = [](auto compute, auto* value, std::string* error) {
+    try {
+      *value = compute();
+    } catch (const std::exception& e) {
+      *error = e.what();
+    }
+  };
   try {
     const io::RunLog log = io::ReadRunLog(log_path);
     ReadLog(log, s);
-    if (!scenario.structure.reference_file.empty()) {
-      try {
-        s->benchmark_criteria = BenchmarkCriteriaOfRun(log, scenario);
-      } catch (const std::exception& e) {
-        s->benchmark_error = e.what();
-      }
+    if (benchmark) score([&] { return BenchmarkCriteriaOfRun(log, scenario); }, &s->benchmark_criteria, &s->benchmark_error);
+    if (stepped) {
+      score([&] { return participants::StructureResponseOfRun(log, scenario); }, &s->structure_response,
+            &s->structure_error);
     }
-    if (scenario.structure.Stepped()) {
-      try {
-        s->structure_response = participants::StructureResponseOfRun(log, scenario);
-      } catch (const std::exception& e) {
-        s->structure_error = e.what();
-      }
+    if (scenario.marths.enabled) {
+      score([&] { return participants::MarthsScoreOfRun(log, scenario); }, &s->marths, &s->marths_error);
     }
   } catch (const std::exception& e) {
     s->steps = 0;

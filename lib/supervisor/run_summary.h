@@ -13,6 +13,7 @@
 #include "core/exit_code.h"
 #include "lockstep/link_stats.h"
 #include "participants/group.h"
+#include "participants/marths_run.h"
 #include "scenario/scenario.h"
 #include "participants/structure_response.h"
 #include "signal/benchmark_criteria.h"
@@ -42,6 +43,10 @@ struct RunSummary {
   /// structure.reference_file (ReadLog with the scenario; participants/benchmark_run.h).
   std::optional<signal::BenchmarkCriteria> benchmark_criteria;
   std::string benchmark_error;    ///< why they could not be computed ("" if they were or were not asked for)
+  /// The maRTHS benchmark's J1-J10 and realizable verdict over the logged steps, when the scenario has
+  /// marths.enabled (participants/marths_run.h); marths_error says why not.
+  std::optional<participants::MarthsRunScore> marths;
+  std::string marths_error;
   /// A stepped (yielding) structure's response (participants/structure_response.h), or why not.
   std::optional<participants::StructureResponse> structure_response;
   std::string structure_error;

@@ -342,7 +342,8 @@ TEST_CASE("payloads: step indices bounded, negative k, wrong types, hostile arra
   for (std::uint32_t n_dof : {0x7FFFFFFFu, 0xFFFFFFFFu, 3u}) {
     bad = evs;
     Bytes& p = bad[1].payload;
-    const std::size_t n_at = p.size() - 4 - 2 * 2 * 8;  // n_dof precedes two arrays of 2 doubles
+    // n_dof precedes two arrays of 2 doubles, then n_act = 0 (one actuator: no array) ends the message
+    const std::size_t n_at = p.size() - 4 - 2 * 2 * 8 - 4;
     PutBigEndian32(&p, n_at, n_dof);
     e = ErrorOf(LogBytes(bad));
     CHECK(Contains(e, "the payload is not a desired_t"));

@@ -64,3 +64,20 @@ TEST_CASE("the wiring is checked before a run") {
   CHECK_THROWS_AS(Wiring::Resolve({{"nobody", ""}}), rths::Error);
   CHECK_THROWS_AS(Wiring::Resolve().Of("nobody"), rths::Error);
 }
+
+TEST_CASE("the \"same_sample\" integrator (maRTHS) answers desired_t k from measured_t k; with the ideal plant it "
+          "is a cycle") {
+  // Its input, measured_t k, is already in the barrier of step k-1 (the plant's measured_t k+1):
+  // the waits are those of the ordinary row, the row's input is step k's.
+  const Wiring w = Wiring::Resolve({{"integrator", "same_sample"}});
+  CHECK(std::string(w.Clock().row->variant) == "same_sample");
+  CHECK(w.Clock().row->inputs[0].channel == rths::lockstep::kMeasured);
+  CHECK(w.Clock().row->inputs[0].offset == 0);
+  std::string ordinary = Wiring::Resolve().Describe();
+  ordinary.replace(0, ordinary.find('\n'),
+                   "integrator: desired_t k <- measured_t k, command_t k-1, measured_t k-1, current_t k-1, ack_t k-1; "
+                   "wakes for ack_t k-1; barrier -");
+  CHECK(w.Describe() == ordinary);
+  // desired_t k <- measured_t k <- desired_t k (the ideal plant answers desired_t k).
+  CHECK_THROWS_AS(Wiring::Resolve({{"integrator", "same_sample"}, {"plant", "ideal"}}), rths::Error);
+}

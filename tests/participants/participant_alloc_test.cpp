@@ -174,3 +174,21 @@ reference = {{ num = [50.8, 8570.0], den = [1.0, 8570.0] }}
 )", kind));
   }
 }
+
+TEST_CASE("no allocation per step: the maRTHS loop's participants (two actuators), each compensator") {
+  const std::string data = std::string(RTHS_SOURCE_DIR) + "/data/marths/";
+  for (const char* compensator : {"rodeac", "ff_lqg", "mimo_ff"}) {
+    CAPTURE(compensator);
+    CheckNoAllocationPerStep(std::string("marths, ") + compensator, fmt::format(R"(
+[plant]
+noise_y_mm_rms = 0.0124
+[marths]
+enabled = true
+reference_k_file = "{0}reference_K_N_per_m.csv"
+reference_m_file = "{0}reference_M_kg.csv"
+rodeac_file = "{0}rodeac_initial_parameters.txt"
+ground_file = "{0}elcentro_m_s2.txt"
+compensator = "{1}"
+)", data, compensator));
+  }
+}

@@ -645,3 +645,38 @@ TEST_CASE("plant.cvode_rtol: the old name of plant.ode_rtol keeps working; both 
   CHECK(text.find("cvode_rtol") == std::string::npos);
   CHECK(ParseScenario(text, "old.toml").plant.ode_rtol == 1e-7);
 }
+
+TEST_CASE("[marths]: the shipped scenarios load their files, round-trip through ToToml, and bad input is refused") {
+  for (const char* name : {"none", "rodeac", "ff", "ff_lqg"}) {
+    CAPTURE(name);
+    const fs::path file = kSourceDir / "scenarios" / "marths" / (std::string("elcentro_") + name + ".toml");
+    const Scenario s = LoadScenario(file.string());
+    CHECK(s.marths.enabled);
+    CHECK(rths::NameOf(rths::control::kMarthsCompensatorNames, s.marths.compensator) == name);
+    CHECK(s.marths.files.K_ref.rows() == 29);
+    CHECK(s.marths.files.M_ref.cols() == 29);
+    CHECK(s.marths.files.rodeac.theta0[0].norm() > 0.0);
+    CHECK(s.marths.ground.t.back() == doctest::Approx(41.18));
+    CHECK(s.steps() == 42169);
+    const std::string text = rths::scenario::ToToml(s);
+    CHECK(text.find("[marths]") != std::string::npos);
+    const Scenario back = rths::scenario::ParseScenario(text, file.string());
+    CHECK(back.marths == s.marths);
+    CHECK(rths::scenario::ToToml(back) == text);
+  }
+  // A scenario without [marths] writes none (its text and hash stay as they were).
+  CHECK(rths::scenario::ToToml(ParseScenario("[run]\nname = \"x\"\n", "x.toml")).find("marths") == std::string::npos);
+  const std::string base = (kSourceDir / "scenarios" / "marths" / "elcentro_none.toml").string();
+  auto refused = [&](const std::string& set, const std::string& key) {
+    CAPTURE(set);
+    CHECK_THROWS_WITH_AS(LoadScenario(base, {set}), doctest::Contains(key.c_str()), rths::Error);
+  };
+  refused("marths.compensator=pid", "marths.compensator");
+  refused("marths.perturbed_plant=-1", "marths.perturbed_plant");
+  refused("marths.force_delay_steps=2", "marths.force_delay_steps");
+  refused("marths.ground_scale=0", "marths.ground_scale");
+  refused("marths.inverse=asin", "marths.inverse");
+  refused("marths.ground_file=nowhere.txt", "marths.ground_file");
+  refused("semiactive.mode=clipped_optimal", "semiactive.mode");
+  refused("plant.kind=ideal", "plant.kind");
+}

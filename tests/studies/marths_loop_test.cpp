@@ -8,7 +8,8 @@
 #include <doctest/doctest.h>
 #include <fmt/format.h>
 
-#include "io/marths_files.h"
+#include "ident/design_model.h"
+#include "models/marths_files.h"
 #include "signal/history.h"
 #include "studies/marths.h"
 #include "studies/marths_loop.h"
@@ -23,15 +24,15 @@ const std::string kData = std::string(RTHS_SOURCE_DIR) + "/data/marths/";
 
 MarthsLoopConfig Base(MarthsCompensator c, bool noise) {
   MarthsLoopConfig cfg;
-  cfg.K_ref = rths::io::ReadMatrixCsv(kData + "reference_K_N_per_m.csv");
-  cfg.M_ref = rths::io::ReadMatrixCsv(kData + "reference_M_kg.csv");
+  cfg.K_ref = rths::models::marths::ReadMatrixCsv(kData + "reference_K_N_per_m.csv");
+  cfg.M_ref = rths::models::marths::ReadMatrixCsv(kData + "reference_M_kg.csv");
   const auto rec = rths::signal::ReadHistoryFile(kData + "elcentro_m_s2.txt", 0.0);
   const std::size_t n = static_cast<std::size_t>(41.18 / cfg.dt_s + 1e-9) + 1;
   cfg.ag_m_s2 = rths::signal::ResampleHistory(rec, 0.0, 0.4, cfg.dt_s, n, 0.0);
   cfg.rig.noise_mm = noise ? mm::SensorNoiseMm(cfg.dt_s) : 0.0;
-  cfg.compensator = c;
-  const auto p = rths::io::ReadRodeacParameters(kData + "rodeac_initial_parameters.txt");
-  for (int i = 0; i < 2; ++i) cfg.rodeac[i] = rths::control::MakeRodeacDesign(p.theta0[i], p.P0[i], 1.0 / cfg.dt_s);
+  cfg.compensators.kind = c;
+  const auto p = rths::models::marths::ReadRodeacParameters(kData + "rodeac_initial_parameters.txt");
+  for (int i = 0; i < 2; ++i) cfg.compensators.rodeac[i] = rths::control::MakeRodeacDesign(p.theta0[i], p.P0[i], 1.0 / cfg.dt_s);
   return cfg;
 }
 
@@ -44,7 +45,7 @@ std::string Row(const rths::studies::MarthsLoopResult& r) {
 }  // namespace
 
 TEST_CASE("El Centro x 0.4, nominal plant: every compensator, noise off and on") {
-  const auto models = rths::studies::MarthsDesignModels(mm::NominalPlantZpk(), 1.0 / 1024);
+  const auto models = rths::ident::MarthsDesignModels(mm::NominalPlantZpk(), 1.0 / 1024);
   for (int i = 0; i < 2; ++i) {
     MESSAGE("design model " << i + 1 << ": K " << models[i].K << " p " << models[i].p << " b " << models[i].b
                             << " c " << models[i].c << " DC " << models[i].K / (models[i].p * models[i].c));
@@ -56,11 +57,7 @@ TEST_CASE("El Centro x 0.4, nominal plant: every compensator, noise off and on")
     for (auto kind : {MarthsCompensator::kRodeac, MarthsCompensator::kFf, MarthsCompensator::kFfLqg,
                       MarthsCompensator::kMimoFf}) {
       auto cfg = Base(kind, noise);
-      for (int i = 0; i < 2; ++i) {
-        cfg.per_actuator[i].kind = kind == MarthsCompensator::kFfLqg ? rths::control::ControllerKind::kFfLqg
-                                                                     : rths::control::ControllerKind::kFf;
-        cfg.per_actuator[i].model = models[i];
-      }
+      for (int i = 0; i < 2; ++i) cfg.compensators.per_actuator[i].model = models[i];
       const auto r = rths::studies::RunMarthsLoop(cfg);
       MESSAGE("noise " << noise << " kind " << static_cast<int>(kind) << ": " << Row(r));
       CHECK(r.j.J2_1_pct < none.j.J2_1_pct);
@@ -80,8 +77,11 @@ TEST_CASE("rths reproduce marths --quick: 15 runs, the tables, the figure, and i
   CHECK(s.records.size() == 15);
   CHECK(std::filesystem::exists(o.out_dir / "marths_records.md"));
   CHECK(std::filesystem::exists(o.out_dir / "marths_decisions.md"));
+  CHECK(std::filesystem::exists(o.out_dir / "marths_lockstep.md"));  // the shipped scenarios through the lockstep
+  CHECK(std::filesystem::exists(o.out_dir / "marths_lockstep.csv"));
+  CHECK(s.claims.size() == 3);
   CHECK(s.perturbed == 2);
-  for (const char* f : {"marths.csv", "marths_summary.csv", "marths.md", "marths.png", "marths.dat"}) {
+  for (const char* f : {"marths.csv", "marths_summary.csv", "marths.md", "marths.png", "marths.dat", "marths_history.png"}) {
     CHECK(std::filesystem::exists(o.out_dir / f));
   }
   for (const auto& c : s.claims) CHECK_MESSAGE(c.holds, c.text << ": " << c.detail);

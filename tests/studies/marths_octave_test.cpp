@@ -11,7 +11,7 @@
 
 #include <doctest/doctest.h>
 
-#include "io/marths_files.h"
+#include "models/marths_files.h"
 #include "signal/history.h"
 #include "studies/marths_loop.h"
 #include "test_support.h"
@@ -44,15 +44,15 @@ std::map<std::string, double> Octave(const std::string& compensator) {
 
 rths::studies::MarthsLoopResult Ours(rths::studies::MarthsCompensator kind) {
   rths::studies::MarthsLoopConfig c;
-  c.K_ref = rths::io::ReadMatrixCsv(kData + "reference_K_N_per_m.csv");
-  c.M_ref = rths::io::ReadMatrixCsv(kData + "reference_M_kg.csv");
+  c.K_ref = rths::models::marths::ReadMatrixCsv(kData + "reference_K_N_per_m.csv");
+  c.M_ref = rths::models::marths::ReadMatrixCsv(kData + "reference_M_kg.csv");
   const auto rec = rths::signal::ReadHistoryFile(kData + "elcentro_m_s2.txt", 0.0);
   const std::size_t n = static_cast<std::size_t>(kSeconds / c.dt_s + 1e-9) + 1;
   c.ag_m_s2 = rths::signal::ResampleHistory(rec, 0.0, 0.4, c.dt_s, n, 0.0);
   c.rig.noise_mm = 0.0;
-  c.compensator = kind;
-  const auto p = rths::io::ReadRodeacParameters(kData + "rodeac_initial_parameters.txt");
-  for (int i = 0; i < 2; ++i) c.rodeac[i] = rths::control::MakeRodeacDesign(p.theta0[i], p.P0[i], 1.0 / c.dt_s);
+  c.compensators.kind = kind;
+  const auto p = rths::models::marths::ReadRodeacParameters(kData + "rodeac_initial_parameters.txt");
+  for (int i = 0; i < 2; ++i) c.compensators.rodeac[i] = rths::control::MakeRodeacDesign(p.theta0[i], p.P0[i], 1.0 / c.dt_s);
   return rths::studies::RunMarthsLoop(c);
 }
 

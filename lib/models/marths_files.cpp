@@ -1,4 +1,4 @@
-#include "io/marths_files.h"
+#include "models/marths_files.h"
 
 #include <cmath>
 #include <fstream>
@@ -8,9 +8,8 @@
 #include <fmt/format.h>
 
 #include "core/error.h"
-#include "io/csv.h"
 
-namespace rths::io {
+namespace rths::models::marths {
 
 namespace {
 
@@ -31,11 +30,27 @@ double MarthsNumber(const std::string& text, const std::string& where) {
 }  // namespace
 
 Eigen::MatrixXd ReadMatrixCsv(const std::string& path) {
-  const auto rows = ReadCsvFile(path);
+  std::ifstream in(path);
+  if (!in) throw Error(path, "cannot be read");
+  std::vector<std::vector<std::string>> rows;
+  std::vector<int> line_of;
+  int line_no = 0;
+  for (std::string line; std::getline(in, line);) {
+    ++line_no;
+    if (line.find_first_not_of(" \t\r") == std::string::npos) continue;  // a blank line (the last, say)
+    std::vector<std::string> fields;
+    std::size_t at = 0;
+    for (std::size_t comma; (comma = line.find(',', at)) != std::string::npos; at = comma + 1) {
+      fields.push_back(line.substr(at, comma - at));
+    }
+    fields.push_back(line.substr(at));
+    rows.push_back(std::move(fields));
+    line_of.push_back(line_no);
+  }
   if (rows.empty() || rows[0].empty()) throw Error(path, "no rows");
   Eigen::MatrixXd m(rows.size(), rows[0].size());
   for (std::size_t i = 0; i < rows.size(); ++i) {
-    const std::string where = fmt::format("{}:{}", path, i + 1);
+    const std::string where = fmt::format("{}:{}", path, line_of[i]);
     if (rows[i].size() != rows[0].size()) {
       throw Error(where, fmt::format("{} fields where the first row has {}", rows[i].size(), rows[0].size()));
     }
@@ -79,4 +94,14 @@ RodeacInitialParameters ReadRodeacParameters(const std::string& path) {
   return p;
 }
 
-}  // namespace rths::io
+bool MarthsFiles::operator==(const MarthsFiles& o) const {
+  auto same = [](const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
+    return a.rows() == b.rows() && a.cols() == b.cols() && a == b;
+  };
+  for (int i = 0; i < 2; ++i) {
+    if (rodeac.theta0[i] != o.rodeac.theta0[i] || rodeac.P0[i] != o.rodeac.P0[i]) return false;
+  }
+  return same(K_ref, o.K_ref) && same(M_ref, o.M_ref);
+}
+
+}  // namespace rths::models::marths

@@ -1,0 +1,173 @@
+// The maRTHS benchmark through the lockstep (marths.enabled; participants/marths_participants.h): two
+// actuators' targets, commands and strokes in the per-step messages, the integrator answering
+// desired_t k from measured_t k. Every number is held to the in-process loop of studies/marths_loop.h,
+// configured here from the data files directly (not through the participants' helpers), and udpm runs
+// (a process per participant) log the memq run's payloads bit for bit, also with lost datagrams repaired.
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include <doctest/doctest.h>
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "ident/design_model.h"
+#include "io/run_log.h"
+#include "models/marths_files.h"
+#include "participants/marths_run.h"
+#include "scenario/scenario.h"
+#include "signal/history.h"
+#include "signal/random.h"
+#include "studies/marths_loop.h"
+
+#include "run_support.h"
+#include "udpm_support.h"
+
+namespace fs = std::filesystem;
+namespace mm = rths::models::marths;
+using rths::studies::MarthsCompensator;
+using rths_test::RunCli;
+using rths_test::RunMemq;
+using rths_test::TempDir;
+
+namespace {
+
+const std::string kData = std::string(RTHS_SOURCE_DIR) + "/data/marths/";
+const std::string kScenario = std::string(RTHS_SOURCE_DIR) + "/scenarios/marths/elcentro_none.toml";
+constexpr double kSeconds = 6.0;  // the strong motion begins within the record's first seconds
+
+/// The shipped scenario, shortened, with `sets`; model_1/2 resolved as `rths run` does.
+rths::scenario::Scenario Scenario(std::vector<std::string> sets) {
+  sets.push_back(fmt::format("run.duration_s={}", kSeconds));
+  rths::scenario::Scenario s = rths::scenario::LoadScenario(kScenario, sets);
+  rths::ident::ResolveDesignModel(&s);
+  return s;
+}
+
+/// The same run as the in-process loop, its configuration made from the data files here.
+rths::studies::MarthsLoopResult Loop(MarthsCompensator kind, std::size_t n, const mm::PlantZpk& plant,
+                                     std::uint64_t noise_seed, bool identical_noise) {
+  rths::studies::MarthsLoopConfig c;
+  c.K_ref = mm::ReadMatrixCsv(kData + "reference_K_N_per_m.csv");
+  c.M_ref = mm::ReadMatrixCsv(kData + "reference_M_kg.csv");
+  const auto rec = rths::signal::ReadHistoryFile(kData + "elcentro_m_s2.txt", 0.0);
+  c.ag_m_s2 = rths::signal::ResampleHistory(rec, 0.0, 0.4, c.dt_s, n, 0.0);
+  c.plant = plant;
+  c.rig.noise_mm = mm::SensorNoiseMm(c.dt_s);
+  c.rig.noise_seed = noise_seed;
+  c.rig.identical_noise = identical_noise;
+  c.compensators.kind = kind;
+  const auto p = mm::ReadRodeacParameters(kData + "rodeac_initial_parameters.txt");
+  const auto models = rths::ident::MarthsDesignModels(mm::NominalPlantZpk(), c.dt_s);
+  for (int i = 0; i < 2; ++i) {
+    c.compensators.rodeac[i] = rths::control::MakeRodeacDesign(p.theta0[i], p.P0[i], 1.0 / c.dt_s);
+    c.compensators.per_actuator[i].model = models[i];
+  }
+  return rths::studies::RunMarthsLoop(c);
+}
+
+/// The lockstep run's log equals the loop's signals sample for sample (targets and strokes bit for
+/// bit), and its score the loop's.
+void CheckSame(const rths::io::RunLog& log, const rths::scenario::Scenario& s,
+               const rths::studies::MarthsLoopResult& loop) {
+  const std::int64_t n = log.CompleteSteps();
+  REQUIRE(n == static_cast<std::int64_t>(loop.signals.xa1_t.size()));
+  std::int64_t differ = 0;
+  for (std::int64_t k = 0; k < n; ++k) {
+    const auto i = static_cast<std::size_t>(k);
+    const auto& d = log.desired[i];
+    const auto& m = log.measured[i];
+    REQUIRE(d.n_act == 2);
+    REQUIRE(m.n_act == 2);
+    REQUIRE(m.n_iface == 3);
+    differ += d.r_act_mm[0] != loop.signals.xa1_t[i] || d.r_act_mm[1] != loop.signals.xa2_t[i] ||
+              m.y_act_mm[0] != loop.signals.xa1_m[i] || m.y_act_mm[1] != loop.signals.xa2_m[i];
+  }
+  CHECK(differ == 0);
+  const auto score = rths::participants::MarthsScoreOfRun(log, s);
+  const auto a = score.j.Items(), b = loop.j.Items();
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    CAPTURE(a[i].first);
+    CHECK(a[i].second == doctest::Approx(b[i].second).epsilon(1e-9));
+  }
+  CHECK(score.max_volts[0] == loop.max_volts[0]);
+  CHECK(score.max_volts[1] == loop.max_volts[1]);
+  CHECK(score.realizable == !loop.saturated);
+}
+
+}  // namespace
+
+TEST_CASE("maRTHS through the lockstep (memq) = the in-process loop, every compensator, noise on") {
+  for (MarthsCompensator kind : {MarthsCompensator::kNone, MarthsCompensator::kRodeac, MarthsCompensator::kFf,
+                                 MarthsCompensator::kFfLqg, MarthsCompensator::kMimoFf}) {
+    const std::string name(NameOf(rths::control::kMarthsCompensatorNames, kind));
+    CAPTURE(name);
+    const auto s = Scenario({"marths.compensator=" + name});
+    const fs::path dir = TempDir("marths_" + name);
+    const auto r = RunMemq({s}, dir);
+    CAPTURE(r.errors.back());
+    REQUIRE(r.code == 0);
+    const auto log = rths::io::ReadRunLog((dir / "log.lcm").string());
+    REQUIRE(log.CompleteSteps() == s.steps());
+    CheckSame(log, s, Loop(kind, static_cast<std::size_t>(s.steps()), mm::NominalPlantZpk(), 123, true));
+  }
+}
+
+TEST_CASE("maRTHS lockstep: a perturbed plant and independent noise, as the study draws them") {
+  // rths reproduce marths's perturbed_3: the third plant drawn from seed 47, noise seed 123 + 3.
+  const auto s = Scenario({"marths.compensator=mimo_ff", "marths.perturbed_plant=3", "marths.noise_seed=126",
+                           "marths.identical_noise=false"});
+  const fs::path dir = TempDir("marths_perturbed");
+  REQUIRE(RunMemq({s}, dir).code == 0);
+  rths::signal::GaussianState g = rths::signal::MakeGaussian(47);
+  mm::PlantZpk plant;
+  for (int i = 0; i < 3; ++i) plant = mm::PerturbedPlantZpk(mm::NominalPlantZpk(), &g);
+  CheckSame(rths::io::ReadRunLog((dir / "log.lcm").string()), s,
+            Loop(MarthsCompensator::kMimoFf, static_cast<std::size_t>(s.steps()), plant, 126, false));
+}
+
+TEST_CASE("maRTHS lockstep: udpm gives memq's log bit for bit, one process per participant, also with 5 % of "
+          "datagrams lost; summary.json holds marths_criteria") {
+  if (!rths_test::UdpmAvailable()) FAIL("udpm cannot run on this host: " << rths::lockstep::CheckMulticastRoute());
+  const auto s = Scenario({"marths.compensator=rodeac"});
+  const fs::path memq = TempDir("marths_memq");
+  REQUIRE(RunMemq({s}, memq).code == 0);
+  const std::string digest = rths::io::PayloadDigest(rths::io::ReadRunLog((memq / "log.lcm").string()));
+  const std::string args = kScenario + fmt::format(" --set run.duration_s={} --set marths.compensator=rodeac", kSeconds);
+  for (const std::string extra : {" --transport udpm", " --transport udpm --set faults.drop=0.05"}) {
+    CAPTURE(extra);
+    const fs::path out = TempDir("marths_cli") / "run";
+    std::string output;
+    REQUIRE(RunCli(args + extra + " --out " + out.string(), &output) == 0);
+    CAPTURE(output);
+    CHECK(rths::io::PayloadDigest(rths::io::ReadRunLog((out / "log.lcm").string())) == digest);
+    CHECK(output.find("maRTHS") != std::string::npos);
+    const auto summary = nlohmann::json::parse(std::ifstream(out / "summary.json"));
+    REQUIRE(summary.contains("marths_criteria"));
+    CHECK(summary["marths_criteria"].size() == 22);
+    for (const char* key : {"J1_1_ms", "J2_1_pct", "J5_TH_pct", "J10_TH3_pct"}) {
+      CAPTURE(key);
+      CHECK(summary["marths_criteria"].contains(key));
+    }
+    CHECK(summary["marths_criteria"]["J2_1_pct"].get<double>() > 0.0);
+    CHECK(summary["marths_realizable"]["realizable"].get<bool>());
+    CHECK(summary["marths_realizable"]["max_volts"].size() == 2);
+    if (extra.find("drop") != std::string::npos) CHECK(summary["link"]["rerequests"].get<std::int64_t>() > 0);
+  }
+}
+
+TEST_CASE("maRTHS scenarios: bad input is refused naming the key") {
+  const fs::path dir = TempDir("marths_bad");
+  std::string output;
+  // The ideal plant answers desired_t k: a cycle with the integrator's same-sample row.
+  CHECK(RunCli(kScenario + " --set plant.kind=ideal --out " + (dir / "a").string(), &output) != 0);
+  CHECK(output.find("plant.kind") != std::string::npos);
+  CHECK(RunCli(kScenario + " --set marths.ground_file=nowhere.txt --out " + (dir / "b").string(), &output) != 0);
+  CHECK(output.find("marths.ground_file") != std::string::npos);
+  CHECK(RunCli(kScenario + " --set marths.compensator=pid --out " + (dir / "c").string(), &output) != 0);
+  CHECK(output.find("marths.compensator") != std::string::npos);
+  CHECK(output.find("mimo_ff") != std::string::npos);  // the allowed names
+  CHECK(!fs::exists(dir / "a" / "log.lcm"));
+}
