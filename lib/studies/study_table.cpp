@@ -169,7 +169,11 @@ StudyReport Marths(const ReproduceOptions& opts) {
     }
     s += "\n";
   }
-  Appendf(&s, "\n%zu runs in %.1f s; marths.csv, marths_summary.csv, marths.md, marths.png\n\n", r.rows.size(), r.wall_s);
+  Appendf(&s,
+          "\n%zu runs (and the decisions', the records' and 4 through the lockstep) in %.1f s; marths.csv, "
+          "marths_summary.csv, marths.md, marths.png, marths_history.png, marths_decisions.*, marths_records.*, "
+          "marths_lockstep.*\n\n",
+          r.rows.size(), r.wall_s);
   return {s, std::move(r.claims), ""};
 }
 
