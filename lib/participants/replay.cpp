@@ -93,13 +93,18 @@ std::vector<Outcome> RunReplay(const scenario::Scenario& s, const io::RunLog& re
   lockstep::RunIdentity id = IdentityOf(s, run_id);
   id.n_steps = steps;
   const lockstep::LockstepConfig config = LockstepOf(s);
-  // The roles not live answer from the record: their "recorded" rows (the integrator's is its own).
+  // The roles not live answer from the record: their "recorded" rows (answer step k once desired_t k
+  // requests it; the recorded clock runs the integrator's ordinary row). A live "same_sample"
+  // integrator (the maRTHS benchmark) answers desired_t k from measured_t k, so a recorded plant
+  // keeps its ordinary row there (measured_t k on command_t k-1, as the live plant would answer).
   lockstep::Wiring wiring = WiringOf(s);
+  const bool same_sample = IsLive(live, "integrator") && wiring.Clock().row->variant == lockstep::kSameSampleVariant;
   std::vector<lockstep::RoleVariant> variants;
   for (const lockstep::ResolvedRole& r : wiring.roles()) {
-    if (!IsLive(live, r.role()) && !r.row->clock) {
+    const bool live_role = IsLive(live, r.role());
+    if (!live_role && !r.row->clock && !(same_sample && r.role() == "plant")) {
       variants.push_back({r.role(), lockstep::kRecordedVariant});
-    } else if (!r.row->variant.empty()) {
+    } else if (!r.row->variant.empty() && (live_role || !r.row->clock)) {
       variants.push_back({r.role(), r.row->variant});
     }
   }
