@@ -7,6 +7,7 @@
 
 #include "core/error.h"
 #include "models/marths_coupler.h"
+#include "models/marths_records.h"
 #include "models/marths_structure.h"
 #include "models/newmark_linear.h"
 #include "participants/marths_participants.h"
@@ -56,20 +57,15 @@ MarthsRunScore MarthsScoreOfRun(const io::RunLog& log, const scenario::Scenario&
     g.r_hat.push_back(est.theta_rad);
     g.x_num.push_back(d.x_mm[static_cast<std::size_t>(mm::Index(mm::kDofX))]);
     g.r_num.push_back(-Num(d, mm::kDofTheta));
-    g.x_ref.push_back(1000.0 * ref_s.U(mm::Index(mm::kDofX)));
-    g.r_ref.push_back(-ref_s.U(mm::Index(mm::kDofTheta)));
     g.x2_num.push_back(Num(d, mm::kDofX2));
     g.r2_num.push_back(Num(d, mm::kDofTheta2nd));
     g.x3_num.push_back(Num(d, mm::kDofX3));
     g.r3_num.push_back(Num(d, mm::kDofTheta3rd));
-    g.x2_ref.push_back(ref_s.U(mm::Index(mm::kDofX2)));
-    g.r2_ref.push_back(ref_s.U(mm::Index(mm::kDofTheta2nd)));
-    g.x3_ref.push_back(ref_s.U(mm::Index(mm::kDofX3)));
-    g.r3_ref.push_back(ref_s.U(mm::Index(mm::kDofTheta3rd)));
+    mm::AppendReference(ref_s, &g);
     for (int a = 0; a < 2; ++a) out.max_volts[a] = std::max(out.max_volts[a], std::abs(volts.Volts(a, c.u_act_mm[a])));
   }
   out.j = signal::MarthsCriteriaFrom(g);
-  out.realizable = !(out.max_volts[0] > signal::kMarthsVoltLimit && out.max_volts[1] > signal::kMarthsVoltLimit);
+  out.realizable = !signal::MarthsSaturated(out.max_volts[0], out.max_volts[1]);
   return out;
 }
 

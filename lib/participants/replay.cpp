@@ -94,15 +94,23 @@ std::vector<Outcome> RunReplay(const scenario::Scenario& s, const io::RunLog& re
   id.n_steps = steps;
   const lockstep::LockstepConfig config = LockstepOf(s);
   // The roles not live answer from the record: their "recorded" rows (answer step k once desired_t k
-  // requests it; the recorded clock runs the integrator's ordinary row). A live "same_sample"
-  // integrator (the maRTHS benchmark) answers desired_t k from measured_t k, so a recorded plant
-  // keeps its ordinary row there (measured_t k on command_t k-1, as the live plant would answer).
+  // requests it; the recorded clock runs the integrator's ordinary row). A live clock that answers
+  // desired_t k from a message of step k itself ("same_sample": measured_t k) cannot have that
+  // message's recorded owner wait for desired_t k (a cycle): the owner keeps its ordinary row, whose
+  // inputs come before (the plant: command_t k-1), and answers from the record as the live one would.
   lockstep::Wiring wiring = WiringOf(s);
-  const bool same_sample = IsLive(live, "integrator") && wiring.Clock().row->variant == lockstep::kSameSampleVariant;
+  const lockstep::ResolvedRole& clock = wiring.Clock();
+  const bool live_clock = IsLive(live, clock.role());
+  auto clock_needs_at_k = [&](const lockstep::ResolvedRole& r) {
+    for (int i = 0; live_clock && i < clock.row->n_inputs(); ++i) {
+      if (clock.row->inputs[i].channel == r.row->answer && clock.row->inputs[i].offset == 0) return true;
+    }
+    return false;
+  };
   std::vector<lockstep::RoleVariant> variants;
   for (const lockstep::ResolvedRole& r : wiring.roles()) {
     const bool live_role = IsLive(live, r.role());
-    if (!live_role && !r.row->clock && !(same_sample && r.role() == "plant")) {
+    if (!live_role && !r.row->clock && !clock_needs_at_k(r)) {
       variants.push_back({r.role(), lockstep::kRecordedVariant});
     } else if (!r.row->variant.empty() && (live_role || !r.row->clock)) {
       variants.push_back({r.role(), r.row->variant});

@@ -63,6 +63,10 @@ struct MarthsVoltage {
   double Volts(int i, double u_mm) const { return u_mm / correction[i] / gain[i] + (-offset[i] / gain[i]); }
 };
 inline constexpr double kMarthsVoltLimit = 3.8;  ///< [V]
+/// S5_Evaluation.m's flag: both actuators' largest |V| [V] exceed kMarthsVoltLimit (not realizable).
+inline bool MarthsSaturated(double max_volts_1, double max_volts_2) {
+  return max_volts_1 > kMarthsVoltLimit && max_volts_2 > kMarthsVoltLimit;
+}
 
 /// The criteria of `s`. Throws rths::Error if lengths differ, fewer than 2 samples, dt_s is not
 /// > 0, or a denominator is zero.

@@ -9,6 +9,7 @@
 #include "control/mimo_feedforward.h"
 #include "control/tracking_controller.h"
 #include "core/error.h"
+#include "models/marths_records.h"
 #include "models/marths_rig.h"
 #include "models/marths_structure.h"
 #include "models/newmark_linear.h"
@@ -77,18 +78,13 @@ MarthsLoopResult RunMarthsLoop(const MarthsLoopConfig& c) {
     g.r_hat.push_back(est.theta_rad);
     g.x_num.push_back(1000.0 * U(num_s, mm::kDofX));
     g.r_num.push_back(-U(num_s, mm::kDofTheta));
-    g.x_ref.push_back(1000.0 * U(ref_s, mm::kDofX));
-    g.r_ref.push_back(-U(ref_s, mm::kDofTheta));
     g.x2_num.push_back(U(num_s, mm::kDofX2));
     g.r2_num.push_back(U(num_s, mm::kDofTheta2nd));
     g.x3_num.push_back(U(num_s, mm::kDofX3));
     g.r3_num.push_back(U(num_s, mm::kDofTheta3rd));
-    g.x2_ref.push_back(U(ref_s, mm::kDofX2));
-    g.r2_ref.push_back(U(ref_s, mm::kDofTheta2nd));
-    g.x3_ref.push_back(U(ref_s, mm::kDofX3));
-    g.r3_ref.push_back(U(ref_s, mm::kDofTheta3rd));
+    mm::AppendReference(ref_s, &g);
   }
-  r.saturated = r.max_volts[0] > signal::kMarthsVoltLimit && r.max_volts[1] > signal::kMarthsVoltLimit;
+  r.saturated = signal::MarthsSaturated(r.max_volts[0], r.max_volts[1]);
   r.j = signal::MarthsCriteriaFrom(g);
   return r;
 }
