@@ -55,6 +55,9 @@ struct MarthsConfig {
   std::int64_t plant_seed = 47;
   std::int64_t noise_seed = 123;  ///< the sensor noise's (the reference code's 123)
   bool identical_noise = true;    ///< the same noise sample on both strokes (docs/marths.md, Decisions)
+  /// The coupler's arms (fcn_coupler_geometry.m's by default; a lab's own two-actuator coupler:
+  /// models::marths::CouplerGeometry, checked by CouplerProblem).
+  models::marths::CouplerGeometry coupler;
   models::marths::InverseForm inverse = models::marths::InverseForm::kAsWired;
   int force_delay_steps = 0;      ///< the forces of t_k (0) or of t_{k-1} (1)
   bool derivatives_from_rest = false;

@@ -20,16 +20,41 @@
 /// Actuator to Frame") computes theta = asin(r) but puts r, not asin(r), inside the cosine of the
 /// translation: x = x_1 - d_1 (cos(alpha_1 + r) - cos(alpha_1)). Both are here (Inverse's `form`);
 /// the difference is of order d sin(alpha_1) r^3 / 6 (1e-12 m at the benchmark's 1e-3 rad).
+///
+/// **Any geometry** (a lab's own coupler; declared in [marths] as coupler_xv_m, coupler_yv_m,
+/// coupler_alpha_deg). With P = d_1 cos(alpha_1) - d_2 cos(alpha_2) and
+/// Q = d_1 sin(alpha_1) - d_2 sin(alpha_2) the stroke difference is
+///
+///     x_1 - x_2 = P (cos(theta) - 1) - Q sin(theta) = R sin(theta + phi) - P,
+///     R = hypot(P, Q),  phi = atan2(P, -Q),
+///
+/// so theta = asin((x_1 - x_2 + P) / R) - phi, or pi - asin(...) - phi: the exact inverse takes
+/// the branch nearer theta = 0 (the coupler's working range) and then x as above. For the
+/// benchmark's symmetric arms P = 0 and -Q = 2 d sin(alpha_2): the same floating-point operations
+/// as the benchmark's formula, so its numbers are unchanged bit for bit. R = 0 (arms whose ends
+/// move alike) leaves theta unobservable, and so, to first order, does Q = 0 (arm ends at one
+/// height: d(x_1 - x_2)/d theta = -Q at theta = 0): CouplerProblem refuses |Q| under 1 % of the
+/// longer arm. The as-wired form is the reference code's formula for symmetric arms only
+/// (CouplerProblem refuses it otherwise).
+#include <array>
+#include <string>
+
 namespace rths::models::marths {
 
-/// The coupler's arms (fcn_coupler_geometry.m). SI.
+/// The coupler's arms, actuator 1 then 2 (fcn_coupler_geometry.m's values by default): arm i
+/// ends at (xv_i, yv_i) [m] from the interface node, at the angle alpha_i [deg] (the reference
+/// code gives the angle to four decimals beside the arm; CouplerProblem checks they agree).
 struct CouplerGeometry {
-  double xv1_m = 0.26670, yv1_m = -0.127;
-  double xv2_m = 0.26670, yv2_m = 0.127;
-  double alpha1_rad = -25.4633 * 3.14159265358979323846 / 180.0;
-  double alpha2_rad = 25.4633 * 3.14159265358979323846 / 180.0;
-  double d1_m() const;  ///< sqrt(xv1^2 + yv1^2)
-  double d2_m() const;  ///< sqrt(xv2^2 + yv2^2)
+  std::array<double, 2> xv_m = {0.26670, 0.26670};
+  std::array<double, 2> yv_m = {-0.127, 0.127};
+  std::array<double, 2> alpha_deg = {-25.4633, 25.4633};
+  double d_m(int i) const;        ///< sqrt(xv_i^2 + yv_i^2), i = 0, 1
+  double alpha_rad(int i) const;  ///< alpha_i pi / 180
+  double d1_m() const { return d_m(0); }
+  double d2_m() const { return d_m(1); }
+  double alpha1_rad() const { return alpha_rad(0); }
+  double alpha2_rad() const { return alpha_rad(1); }
+  bool operator==(const CouplerGeometry&) const = default;
 };
 
 /// The two actuator strokes [mm].
@@ -46,11 +71,24 @@ struct InterfaceMotion {
 /// or exactly (asin r): the file comment.
 enum class InverseForm { kAsWired, kExact };
 
+/// The stroke difference's coefficients (the file comment): x_1 - x_2 = P (cos theta - 1) - Q sin theta.
+struct StrokeDifference {
+  double P_m = 0.0;  ///< d_1 cos(alpha_1) - d_2 cos(alpha_2)
+  double Q_m = 0.0;  ///< d_1 sin(alpha_1) - d_2 sin(alpha_2)
+};
+StrokeDifference StrokeDifferenceOf(const CouplerGeometry& g);
+
+/// What is wrong with `g` for the inverse `form`, or "" if nothing: an arm shorter than 1 mm, an
+/// angle more than 1e-3 deg from atan2(yv, xv), arms whose stroke difference does not see a small
+/// rotation (|Q| < 0.01 max(d_1, d_2): the file comment), or the as-wired form on arms that are not symmetric
+/// (d_1 = d_2, alpha_1 = -alpha_2).
+std::string CouplerProblem(const CouplerGeometry& g, InverseForm form);
+
 /// Forward kinematics (the file comment).
 ActuatorPair Forward(const CouplerGeometry& g, const InterfaceMotion& m);
 
-/// Inverse kinematics from the measured strokes. |r| > 1 (a stroke difference the coupler
-/// cannot make) gives theta NaN, as asin does.
+/// Inverse kinematics from the measured strokes (the file comment). A stroke difference the
+/// coupler cannot make (|sin| > 1) gives theta NaN, as asin does. Allocates nothing.
 InterfaceMotion Inverse(const CouplerGeometry& g, const ActuatorPair& a, InverseForm form);
 
 }  // namespace rths::models::marths

@@ -8,7 +8,8 @@ namespace rths::models::marths {
 MarthsRig MakeMarthsRig(const PlantZpk& p, double dt_s, const RigOptions& o) {
   if (o.force_delay_steps != 0 && o.force_delay_steps != 1) throw Error("maRTHS rig", "force_delay_steps must be 0 or 1");
   if (!(o.noise_mm >= 0.0)) throw Error("maRTHS rig", "noise_mm must be >= 0");
-  return {MakeMarthsPlant(p, dt_s), MakeFeedbackFrame(dt_s), CouplerGeometry{}, o};
+  if (const std::string why = CouplerProblem(o.geometry, o.inverse); !why.empty()) throw Error("maRTHS coupler", why);
+  return {MakeMarthsPlant(p, dt_s), MakeFeedbackFrame(dt_s), o};
 }
 
 MarthsRigState MarthsRigAtRest(const MarthsRig& r) {
@@ -27,7 +28,7 @@ RigReading RigRead(const MarthsRig& r, MarthsRigState* s) {
     const double n2 = o.identical_noise ? n1 : o.noise_mm * signal::NextGaussian(&s->noise);
     out.y_mm += Eigen::Vector2d(n1, n2);
   }
-  out.estimate = Inverse(r.geometry, {out.y_mm(0), out.y_mm(1)}, o.inverse);
+  out.estimate = Inverse(o.geometry, {out.y_mm(0), out.y_mm(1)}, o.inverse);
   const InterfaceForces estimated = FeedbackForce(r.frame, &s->frame, out.estimate.x_m, out.estimate.theta_rad);
   out.forces = o.force_delay_steps == 1 ? s->held : estimated;
   s->held = estimated;

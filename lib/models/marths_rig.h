@@ -24,6 +24,7 @@ namespace rths::models::marths {
 
 /// The rig's choices (docs/marths.md "Decisions").
 struct RigOptions {
+  CouplerGeometry geometry;        ///< the coupler's arms (the benchmark's by default)
   double noise_mm = 0.0;           ///< sensor noise standard deviation [mm] (0: off)
   bool identical_noise = true;     ///< the same sample on both channels (as the reference code's seeds)
   std::uint64_t noise_seed = 123;
@@ -38,11 +39,11 @@ struct RigOptions {
 struct MarthsRig {
   MarthsPlant plant;
   FeedbackFrame frame;
-  CouplerGeometry geometry;
   RigOptions options;
 };
 
-/// Builds it for `p` at dt_s. Throws rths::Error for a step or option out of range.
+/// Builds it for `p` at dt_s. Throws rths::Error for a step or option out of range (a coupler
+/// geometry CouplerProblem refuses for o.inverse).
 MarthsRig MakeMarthsRig(const PlantZpk& p, double dt_s, const RigOptions& o);
 
 /// Per-step state.

@@ -24,6 +24,7 @@ models::marths::RigOptions MarthsRigOptionsOf(const scenario::Scenario& s) {
   o.noise_mm = s.plant.noise_y_mm_rms;
   o.identical_noise = s.marths.identical_noise;
   o.noise_seed = static_cast<std::uint64_t>(s.marths.noise_seed);
+  o.geometry = s.marths.coupler;
   o.inverse = s.marths.inverse;
   o.force_delay_steps = s.marths.force_delay_steps;
   o.derivatives_from_rest = s.marths.derivatives_from_rest;
@@ -54,7 +55,7 @@ mm::MarthsSubstructure SubstructureOf(const scenario::Scenario& s) {
   const mm::Structures st = mm::BuildStructures(s.marths.files.K_ref, s.marths.files.M_ref,
                                                 s.marths.ideal_density_kg_m3);
   return {models::MakeNewmarkLinear(st.numerical.M, st.numerical.C, st.numerical.K, st.numerical.l, s.run.dt_s),
-          mm::CouplerGeometry{}};
+          s.marths.coupler};
 }
 
 /// Sizes a message's array once (the first step), so that later steps only write into it.
@@ -77,7 +78,7 @@ MarthsIntegrator::MarthsIntegrator(const scenario::Scenario& s, lockstep::RunIde
       sub_(SubstructureOf(s)),
       state_(models::NewmarkLinearAtRest(sub_.numerical)),
       ag_m_s2_(MarthsGroundOf(s, static_cast<std::size_t>(id.n_steps))),
-      safety_(s.safety, s.run.dt_s) {
+      safety_(s.safety, s.run.dt_s, 2) {
   if (wiring.Clock().row->variant != lockstep::kSameSampleVariant) {
     throw Error("integrator", "the maRTHS loop needs the integrator's \"same_sample\" row (desired_t k from measured_t k)");
   }
@@ -115,7 +116,11 @@ void MarthsIntegrator::ComputeDesired(std::int64_t k, const rths::measured_t* me
 
 std::string_view MarthsIntegrator::CheckCommitted(std::int64_t k, const rths::desired_t& desired,
                                                   const rths::measured_t& measured, const rths::command_t& command) {
-  return safety_.Check(k, desired.r_mm, command.u_mm, measured.y_mm, measured.f_kN);
+  RequireActuators("integrator", "desired_t", desired.n_act);
+  RequireActuators("integrator", "command_t", command.n_act);
+  RequireActuators("integrator", "measured_t", measured.n_act);
+  return safety_.CheckActuators(k, desired.r_act_mm.data(), command.u_act_mm.data(), measured.y_act_mm.data(),
+                                measured.f_kN);
 }
 
 MarthsPlant::MarthsPlant(const scenario::Scenario& s, lockstep::RunIdentity id, lcm::LCM* lcm,

@@ -13,8 +13,9 @@
 ///   controller  command_t k from desired_t k and measured_t k: control::MarthsCompensators
 ///               (u_act_mm [mm]).
 ///
-/// The scalars carry actuator 1 (r_mm, u_mm, y_mm; f_kN = 0), for signals.csv, the live monitor
-/// and the safety monitor, which watch actuator 1 only. Each step allocates nothing.
+/// The scalars carry actuator 1 (r_mm, u_mm, y_mm; f_kN = 0), for signals.csv and the live
+/// monitor, which show actuator 1 only; the safety monitor watches both actuators' arrays. Each
+/// step allocates nothing.
 #include <vector>
 
 #include "control/feedforward.h"

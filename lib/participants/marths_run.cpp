@@ -48,7 +48,7 @@ MarthsRunScore MarthsScoreOfRun(const io::RunLog& log, const scenario::Scenario&
     }
     models::NewmarkLinearStep(ref, &ref_s, ag[i]);
     const mm::InterfaceMotion est =
-        mm::Inverse(mm::CouplerGeometry{}, {m.y_act_mm[0], m.y_act_mm[1]}, s.marths.inverse);
+        mm::Inverse(s.marths.coupler, {m.y_act_mm[0], m.y_act_mm[1]}, s.marths.inverse);
     g.xa1_t.push_back(d.r_act_mm[0]);
     g.xa2_t.push_back(d.r_act_mm[1]);
     g.xa1_m.push_back(m.y_act_mm[0]);

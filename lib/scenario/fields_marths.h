@@ -20,6 +20,9 @@ void MarthsFields(V& v, control::MarthsConfig& m, const Context&) {
   v.Integer("plant_seed", m.plant_seed, Closed(0.0, 9007199254740992.0));
   v.Integer("noise_seed", m.noise_seed, Closed(0.0, 9007199254740992.0));
   v.Bool("identical_noise", m.identical_noise);
+  v.Numbers("coupler_xv_m", m.coupler.xv_m, Closed(-10.0, 10.0));  // the arms: ValidateMarths (CouplerProblem)
+  v.Numbers("coupler_yv_m", m.coupler.yv_m, Closed(-10.0, 10.0));
+  v.Numbers("coupler_alpha_deg", m.coupler.alpha_deg, Closed(-180.0, 180.0));
   v.Choice("inverse", m.inverse, control::kMarthsInverseNames);
   v.Integer("force_delay_steps", m.force_delay_steps, Closed(0, 1));
   v.Bool("derivatives_from_rest", m.derivatives_from_rest);

@@ -187,6 +187,9 @@ void ValidateMarths(const Scenario& s, const Check& check) {
                              "desired_t k from measured_t k (a cycle); leave plant.kind at its default "
                              "(marths.enabled runs the benchmark's own plant)");
   }
+  if (const std::string why = models::marths::CouplerProblem(m.coupler, m.inverse); !why.empty()) {
+    check.Fail("marths.coupler_xv_m", fmt::format("(with coupler_yv_m, coupler_alpha_deg, inverse): {}", why));
+  }
 }
 
 }  // namespace

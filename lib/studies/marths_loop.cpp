@@ -42,7 +42,7 @@ MarthsLoopResult RunMarthsLoop(const MarthsLoopConfig& c) {
   const mm::Structures st = mm::BuildStructures(c.K_ref, c.M_ref, c.ideal_density_kg_m3);
   const mm::MarthsSubstructure sub{models::MakeNewmarkLinear(st.numerical.M, st.numerical.C, st.numerical.K,
                                                              st.numerical.l, c.dt_s),
-                                   mm::CouplerGeometry{}};
+                                   c.rig.geometry};
   const models::NewmarkLinear ref = models::MakeNewmarkLinear(st.reference.M, st.reference.C, st.reference.K,
                                                               st.reference.l, c.dt_s);
   const mm::MarthsRig rig = mm::MakeMarthsRig(c.plant, c.dt_s, c.rig);

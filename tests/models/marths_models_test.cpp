@@ -3,6 +3,7 @@
 #include <cmath>
 #include <complex>
 #include <fstream>
+#include <random>
 #include <sstream>
 #include <string>
 
@@ -121,7 +122,7 @@ TEST_CASE("coupler: the forward map and the exact inverse round trip; the as-wir
       // x_wired - x = -d (cos(alpha_1 + r) - cos(alpha_1 + theta)), r = sin(theta): of order
       // d sin(alpha_1) theta^3 / 6.
       const double r = std::sin(th);
-      const double expect = -g.d1_m() * (std::cos(g.alpha1_rad + r) - std::cos(g.alpha1_rad + th));
+      const double expect = -g.d1_m() * (std::cos(g.alpha1_rad() + r) - std::cos(g.alpha1_rad() + th));
       CHECK(std::abs((w.x_m - x) - expect) < 1e-15);
       CHECK(std::abs(w.x_m - x) <= g.d1_m() * std::abs(th * th * th) / 6 * 1.01 + 1e-18);
     }
@@ -129,7 +130,80 @@ TEST_CASE("coupler: the forward map and the exact inverse round trip; the as-wir
   // A rotation alone moves the two actuators in opposite directions by equal amounts (first order).
   const mm::ActuatorPair a = mm::Forward(g, {0.0, 1e-4});
   CHECK(a.a1_mm == doctest::Approx(-a.a2_mm).epsilon(1e-4));
-  CHECK(a.a1_mm == doctest::Approx(1000 * g.d1_m() * std::sin(-g.alpha1_rad) * 1e-4).epsilon(1e-3));
+  CHECK(a.a1_mm == doctest::Approx(1000 * g.d1_m() * std::sin(-g.alpha1_rad()) * 1e-4).epsilon(1e-3));
+}
+
+TEST_CASE("coupler: any two-arm geometry round-trips exactly; the benchmark's arms keep their formula bit for bit") {
+  std::mt19937_64 gen(4711);
+  std::uniform_real_distribution<double> xv(0.05, 0.6), yv(-0.4, 0.4), x(-0.05, 0.05), th(-0.2, 0.2);
+  int geometries = 0, motions = 0;
+  double worst_x = 0.0, worst_th = 0.0;
+  while (geometries < 200) {
+    mm::CouplerGeometry g;
+    for (int i = 0; i < 2; ++i) {
+      g.xv_m[i] = xv(gen) * (i == 1 && geometries % 3 == 0 ? -1.0 : 1.0);  // some arms on the far side
+      g.yv_m[i] = yv(gen);
+      g.alpha_deg[i] = std::atan2(g.yv_m[i], g.xv_m[i]) * 180.0 / 3.14159265358979323846;
+    }
+    if (!mm::CouplerProblem(g, mm::InverseForm::kExact).empty()) continue;
+    ++geometries;
+    const auto [P, Q] = mm::StrokeDifferenceOf(g);
+    for (int j = 0; j < 20; ++j) {
+      const mm::InterfaceMotion m{x(gen), th(gen)};
+      // Near the fold (theta + phi = +-pi/2) the stroke difference is stationary in theta: no
+      // inverse is well conditioned there; the working range keeps away from it.
+      if (std::abs(std::cos(m.theta_rad + std::atan2(P, -Q))) < 0.2) continue;
+      const mm::InterfaceMotion e = mm::Inverse(g, mm::Forward(g, m), mm::InverseForm::kExact);
+      worst_x = std::max(worst_x, std::abs(e.x_m - m.x_m));
+      worst_th = std::max(worst_th, std::abs(e.theta_rad - m.theta_rad));
+      const mm::ActuatorPair a = mm::Forward(g, m), b = mm::Forward(g, e);
+      CHECK(std::abs(a.a1_mm - b.a1_mm) < 1e-9);
+      CHECK(std::abs(a.a2_mm - b.a2_mm) < 1e-9);
+      ++motions;
+    }
+  }
+  CHECK(motions > 2000);
+  CHECK(worst_x < 1e-12);
+  CHECK(worst_th < 1e-12);
+  MESSAGE("round trip over ", geometries, " geometries, ", motions, " motions: |dx| <= ", worst_x,
+          " m, |dtheta| <= ", worst_th, " rad");
+
+  // The benchmark's arms: the general inverse performs the benchmark formula's operations.
+  const mm::CouplerGeometry bmk;
+  for (double a1 : {-3.1, -0.2, 0.0, 0.05, 2.7}) {
+    for (double a2 : {-2.9, 0.0, 0.01, 3.3}) {
+      const double x1 = a1 / 1000.0, x2 = a2 / 1000.0;
+      const double theta = std::asin((x1 - x2) / (2.0 * bmk.d2_m() * std::sin(bmk.alpha2_rad())));
+      const mm::InterfaceMotion e = mm::Inverse(bmk, {a1, a2}, mm::InverseForm::kExact);
+      CHECK(e.theta_rad == theta);
+      CHECK(e.x_m == x1 - bmk.d1_m() * (std::cos(bmk.alpha1_rad() + theta) - std::cos(bmk.alpha1_rad())));
+    }
+  }
+}
+
+TEST_CASE("coupler: CouplerProblem names what is wrong with a geometry") {
+  mm::CouplerGeometry g;
+  CHECK(mm::CouplerProblem(g, mm::InverseForm::kAsWired).empty());
+  CHECK(mm::CouplerProblem(g, mm::InverseForm::kExact).empty());
+  mm::CouplerGeometry lopsided = g;  // a longer second arm: exact only
+  lopsided.xv_m[1] = 0.4;
+  lopsided.alpha_deg[1] = std::atan2(lopsided.yv_m[1], lopsided.xv_m[1]) * 180.0 / 3.14159265358979323846;
+  CHECK(mm::CouplerProblem(lopsided, mm::InverseForm::kExact).empty());
+  CHECK(mm::CouplerProblem(lopsided, mm::InverseForm::kAsWired).find("symmetric") != std::string::npos);
+  mm::CouplerGeometry level = g;  // both arm ends at one height: the rotation is not seen
+  level.yv_m[1] = -0.127;
+  level.alpha_deg[1] = -25.4633;
+  level.xv_m[1] = 0.3;
+  level.alpha_deg[1] = std::atan2(level.yv_m[1], level.xv_m[1]) * 180.0 / 3.14159265358979323846;
+  CHECK(mm::CouplerProblem(level, mm::InverseForm::kExact).find("rotation") != std::string::npos);
+  mm::CouplerGeometry wrong_angle = g;
+  wrong_angle.alpha_deg[0] = -30.0;
+  CHECK(mm::CouplerProblem(wrong_angle, mm::InverseForm::kExact).find("atan2") != std::string::npos);
+  mm::CouplerGeometry short_arm = g;
+  short_arm.xv_m[0] = 1e-4;
+  short_arm.yv_m[0] = 0.0;
+  short_arm.alpha_deg[0] = 0.0;
+  CHECK(mm::CouplerProblem(short_arm, mm::InverseForm::kExact).find("at least") != std::string::npos);
 }
 
 TEST_CASE("feedback frame: a held motion gives the statically condensed stiffness; its first mode is the script's") {

@@ -67,6 +67,52 @@ TEST_CASE("each limit trips on its own, naming the signal, the value and the key
   }
 }
 
+TEST_CASE("several actuators: every limit is checked on each actuator, and the reason names it") {
+  rths::safety::SafetyConfig cfg;
+  const double r[2] = {1.0, 1.0}, u[2] = {1.0, 1.0};
+  {
+    Monitor m(cfg, kDt, 2);
+    const double y[2] = {1.0, 1.0};
+    CHECK(m.CheckActuators(0, r, u, y, 0.0).empty());
+    const double y2[2] = {1.0, 160.0};  // only the second actuator leaves its stroke
+    const std::string why(m.CheckActuators(1, r, u, y2, 0.0));
+    CHECK(why.find("step 1") != std::string::npos);
+    CHECK(why.find("actuator 2: measured displacement |y| = 160.00 mm") != std::string::npos);
+  }
+  {
+    Monitor m(cfg, kDt, 2);
+    const double y[2] = {1.0, -29.0};
+    CHECK(std::string(m.CheckActuators(0, r, u, y, 0.0)).find("actuator 2: tracking error |r - y| = 30.00 mm") !=
+          std::string::npos);
+  }
+  {
+    Monitor m(cfg, kDt, 2);
+    const double y[2] = {std::numeric_limits<double>::infinity(), 1.0};
+    CHECK(std::string(m.CheckActuators(0, r, u, y, 0.0)).find("actuator 1: a signal is not finite") !=
+          std::string::npos);
+    const double y_ok[2] = {1.0, 1.0};
+    const std::string force(m.CheckActuators(1, r, u, y_ok, 600.0));  // the force is no actuator's
+    CHECK(force.find("|f| = 600.0 kN") != std::string::npos);
+    CHECK(force.find("actuator") == force.find("actuator's"));
+  }
+  {
+    // Divergence on the second actuator only: each actuator keeps its own windows.
+    Monitor m(cfg, kDt, 2);
+    std::string why;
+    for (int k = 0; k < 40000 && why.empty(); ++k) {
+      const double t = k * kDt;
+      const double y[2] = {1.0 - 0.3 * std::sin(2 * M_PI * 20.0 * t),
+                           1.0 - 0.1 * std::exp(3.0 * t) * std::sin(2 * M_PI * 20.0 * t)};
+      why = m.CheckActuators(k, r, u, y, 0.0);
+    }
+    CHECK(why.find("actuator 2: tracking error diverging") != std::string::npos);
+  }
+  CHECK_THROWS_AS(Monitor(cfg, kDt, 0), rths::Error);
+  // One actuator: the reasons read as they always did, without an actuator's number.
+  Monitor one(cfg, kDt);
+  CHECK(std::string(one.Check(0, 1.0, 1.0, 160.0, 0.0)).find("actuator 1") == std::string::npos);
+}
+
 TEST_CASE("divergence trips on exponential growth long before the hard limits") {
   rths::safety::SafetyConfig cfg;
   Monitor m(cfg, kDt);

@@ -679,4 +679,26 @@ TEST_CASE("[marths]: the shipped scenarios load their files, round-trip through 
   refused("marths.ground_file=nowhere.txt", "marths.ground_file");
   refused("semiactive.mode=clipped_optimal", "semiactive.mode");
   refused("plant.kind=ideal", "plant.kind");
+  // A lab's own coupler: the arms are checked together (models::marths::CouplerProblem).
+  auto refused_why = [&](const std::vector<std::string>& sets, const char* why) {
+    CAPTURE(sets.front());
+    try {
+      LoadScenario(base, sets);
+      FAIL("accepted");
+    } catch (const rths::Error& e) {
+      const std::string message = e.what();
+      CHECK(message.find("marths.coupler_xv_m") != std::string::npos);
+      CHECK(message.find(why) != std::string::npos);
+    }
+  };
+  refused_why({"marths.coupler_alpha_deg=[-30.0, 25.4633]"}, "atan2");
+  refused_why({"marths.coupler_yv_m=[-0.127, -0.127]", "marths.coupler_alpha_deg=[-25.4633, -25.4633]"}, "rotation");
+  const std::vector<std::string> longer_arm = {"marths.coupler_xv_m=[0.2667, 0.4]",
+                                               "marths.coupler_alpha_deg=[-25.4633, 17.614643300007042]"};
+  refused_why(longer_arm, "symmetric");  // the as-wired inverse is the symmetric arms' formula
+  std::vector<std::string> exact = longer_arm;
+  exact.push_back("marths.inverse=exact");
+  const Scenario lab = LoadScenario(base, exact);
+  CHECK(lab.marths.coupler.xv_m[1] == 0.4);
+  CHECK(rths::scenario::ParseScenario(rths::scenario::ToToml(lab), lab.path).marths == lab.marths);
 }

@@ -3,6 +3,7 @@
 // desired_t k from measured_t k. Every number is held to the in-process loop of studies/marths_loop.h,
 // configured here from the data files directly (not through the participants' helpers), and udpm runs
 // (a process per participant) log the memq run's payloads bit for bit, also with lost datagrams repaired.
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -13,6 +14,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "core/exit_code.h"
 #include "ident/design_model.h"
 #include "io/run_log.h"
 #include "models/marths_files.h"
@@ -157,6 +159,47 @@ TEST_CASE("maRTHS lockstep: udpm gives memq's log bit for bit, one process per p
     CHECK(summary["marths_realizable"]["max_volts"].size() == 2);
     if (extra.find("drop") != std::string::npos) CHECK(summary["link"]["rerequests"].get<std::int64_t>() > 0);
   }
+}
+
+TEST_CASE("maRTHS lockstep: the safety monitor watches both actuators and names the one that tripped") {
+  // Without compensation the second actuator's tracking error is the larger in the first 6 s
+  // (0.171 mm against 0.130 mm): a limit between the two is left by actuator 2 alone.
+  const auto free_run = Scenario({"marths.compensator=none"});
+  const fs::path free_dir = TempDir("marths_safety_free");
+  REQUIRE(RunMemq({free_run}, free_dir).code == 0);
+  const auto free_log = rths::io::ReadRunLog((free_dir / "log.lcm").string());
+  const double limit_mm = 0.15;
+  std::int64_t first = -1;
+  int which = 0;
+  double peak[2] = {0.0, 0.0};
+  for (std::int64_t k = 0; k < free_run.steps(); ++k) {
+    const auto i = static_cast<std::size_t>(k);
+    for (int a = 0; a < 2; ++a) {
+      const double e = std::abs(free_log.desired[i].r_act_mm[a] - free_log.measured[i].y_act_mm[a]);
+      peak[a] = std::max(peak[a], e);
+      if (e > limit_mm && first < 0) {
+        first = k;
+        which = a + 1;
+      }
+    }
+  }
+  CAPTURE(peak[0]);
+  CAPTURE(peak[1]);
+  REQUIRE(peak[0] < limit_mm);  // actuator 1 alone would never trip
+  REQUIRE(first >= 0);
+  CHECK(which == 2);
+
+  const auto s = Scenario({"marths.compensator=none", fmt::format("safety.max_error_mm={}", limit_mm)});
+  const fs::path dir = TempDir("marths_safety");
+  const auto r = RunMemq({s}, dir);
+  CHECK(r.code == rths::kExitSafety);
+  const std::string& why = r.errors.back();
+  CAPTURE(why);
+  CHECK(why.find(fmt::format("safety: step {} ", first)) == 0);
+  CHECK(why.find("actuator 2: tracking error |r - y|") != std::string::npos);
+  const auto log = rths::io::ReadRunLog((dir / "log.lcm").string());
+  CHECK(log.CompleteSteps() == first + 1);  // the log is whole up to the step that tripped
+  CHECK(log.AbortReason().find("actuator 2") != std::string::npos);
 }
 
 TEST_CASE("maRTHS scenarios: bad input is refused naming the key") {
