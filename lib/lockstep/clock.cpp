@@ -287,6 +287,9 @@ void ClockParticipant::CheckBarrier() {
     return;
   }
   if (live_sink_) {
+    if (const int n = std::min({desired_.n_act, c->n_act, m->n_act}); n > 0) {
+      live_.KeepActuatorPeaks(n, desired_.r_act_mm.data(), c->u_act_mm.data(), m->y_act_mm.data());
+    }
     live_.Add(k_, desired_.r_mm, c->u_mm, m->y_mm, m->f_kN, m->current_A, Seconds(step_since_, now), missed, rt_,
               live_sink_);
   }

@@ -63,6 +63,13 @@ void LiveFeed::Add(std::int64_t k, double r_mm, double u_mm, double y_mm, double
   if ((k + 1) % record_.bucket_steps == 0 || k + 1 == record_.n_steps) PushBucket(sink);
 }
 
+void LiveFeed::KeepActuatorPeaks(int n, const double* r_mm, const double* u_mm, const double* y_mm) {
+  for (int i = 0; i < n; ++i) {
+    record_.peak_disp_mm = std::max({record_.peak_disp_mm, std::abs(r_mm[i]), std::abs(u_mm[i]), std::abs(y_mm[i])});
+    record_.peak_error_mm = std::max(record_.peak_error_mm, std::abs(r_mm[i] - y_mm[i]));
+  }
+}
+
 void LiveFeed::PushBucket(LiveSink* sink) {
   if (in_bucket_ == 0) return;
   if (sink) sink->Push(record_);

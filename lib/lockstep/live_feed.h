@@ -53,6 +53,11 @@ class LiveFeed {
   /// the bucket to `sink` when step k closes it.
   void Add(std::int64_t k, double r_mm, double u_mm, double y_mm, double f_kN, double i_A, double latency_s,
            bool missed, const RealtimeStats& rt, LiveSink* sink);
+  /// Several actuators (n >= 1 values each, e.g. desired_t.r_act_mm): folds every actuator's
+  /// |r|, |u|, |y| and |r - y| of the step into the run's peaks against the safety limits, as the
+  /// safety monitor checks every actuator (the plotted signals stay the scalars: actuator 1).
+  /// Call with the step's Add. Allocates nothing.
+  void KeepActuatorPeaks(int n, const double* r_mm, const double* u_mm, const double* y_mm);
   /// Pushes what the open bucket holds, then a record of `phase` (the totals unchanged).
   void Phase(LivePhase phase, LiveSink* sink);
   std::int32_t bucket_steps() const { return record_.bucket_steps; }

@@ -14,8 +14,8 @@
 ///               (u_act_mm [mm]).
 ///
 /// The scalars carry actuator 1 (r_mm, u_mm, y_mm; f_kN = 0), for signals.csv and the live
-/// monitor, which show actuator 1 only; the safety monitor watches both actuators' arrays. Each
-/// step allocates nothing.
+/// monitor's plots; the safety monitor and the live monitor's peaks cover both actuators' arrays.
+/// Each step allocates nothing.
 #include <vector>
 
 #include "control/feedforward.h"

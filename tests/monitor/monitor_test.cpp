@@ -184,6 +184,32 @@ TEST_CASE("live feed and view: a bucket keeps each signal's peak, a lost record 
   CHECK(v.Status().phase == "aborted");
 }
 
+TEST_CASE("live feed: with several actuators the peaks against the limits are every actuator's") {
+  LiveView v;
+  ViewSink sink;
+  sink.view = &v;
+  rths::lockstep::LiveFeed feed;
+  rths::lockstep::RealtimeStats rt;
+  feed.Start(3, 100, 0.001, false, {152.4, 556.0, 25.0});
+  feed.Phase(rths::lockstep::kLiveRunning, &sink);
+  for (std::int64_t k = 0; k < 100; ++k) {
+    // Actuator 1 (the scalars, plotted) tracks within 0.1 mm; actuator 2 lags by 7 mm at step 40
+    // and its command reaches 60 mm at step 70.
+    const double r[2] = {1.0, 2.0};
+    const double u[2] = {1.0, k == 70 ? -60.0 : 2.0};
+    const double y[2] = {0.9, k == 40 ? -5.0 : 2.0};
+    feed.KeepActuatorPeaks(2, r, u, y);
+    ++rt.steps;
+    feed.Add(k, r[0], u[0], y[0], 0.0, 0.0, 1e-4, false, rt, &sink);
+  }
+  const auto s = v.Status();
+  CHECK(s.peak_error_mm == doctest::Approx(7.0));
+  CHECK(s.peak_disp_mm == doctest::Approx(60.0));
+  const auto j = v.Since(0);
+  REQUIRE(j["points"].size() == 10);
+  CHECK(j["points"][4][4].get<double>() == doctest::Approx(0.1));  // the plot: actuator 1's r - y
+}
+
 TEST_CASE("live feed and view: a paced run's latency and misses are the clock's own figures") {
   LiveView v;
   ViewSink sink;
