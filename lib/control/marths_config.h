@@ -14,6 +14,7 @@
 #include "core/names.h"
 #include "models/marths_coupler.h"
 #include "models/marths_files.h"
+#include "models/marths_structure.h"
 #include "models/servo_linear.h"
 #include "signal/history.h"
 
@@ -40,14 +41,17 @@ inline constexpr std::array<Named<models::marths::InverseForm>, 2> kMarthsInvers
 /// [marths]. Paths relative to the scenario file, or found under the source tree's data/marths/.
 struct MarthsConfig {
   bool enabled = false;
-  std::string reference_k_file = "data/marths/reference_K_N_per_m.csv";  ///< 29 x 29 [N/m]
-  std::string reference_m_file = "data/marths/reference_M_kg.csv";       ///< 29 x 29 [kg]
+  std::string reference_k_file = "data/marths/reference_K_N_per_m.csv";  ///< n x n [N/m] (29 x 29: the benchmark)
+  std::string reference_m_file = "data/marths/reference_M_kg.csv";       ///< n x n [kg]
   std::string rodeac_file = "data/marths/rodeac_initial_parameters.txt";
   /// The ground motion: two columns t [s], a_g [m/s^2]; linearly interpolated at t_k, times
   /// ground_scale (0.4 in the benchmark).
   std::string ground_file = "data/marths/elcentro_m_s2.txt";
   double ground_scale = 0.4;
   double ideal_density_kg_m3 = 785e3;  ///< the ideal physical bay's density, as coded
+  /// Where the interface, the stories and the ground load are among the reference matrices' DOFs
+  /// (the benchmark's numbering by default; a lab's own model of the frame declares its own).
+  models::marths::FrameDofs dofs;
   MarthsCompensator compensator = MarthsCompensator::kNone;
   /// 0: the nominal plant; i >= 1: the i-th plant drawn by the uncertainty model from plant_seed
   /// (models::marths::PerturbedPlantZpk), as `rths reproduce marths` draws its perturbed_i.

@@ -71,7 +71,8 @@ struct InterfaceMotion {
 /// or exactly (asin r): the file comment.
 enum class InverseForm { kAsWired, kExact };
 
-/// The stroke difference's coefficients (the file comment): x_1 - x_2 = P (cos theta - 1) - Q sin theta.
+/// The stroke difference's coefficients (the file comment):
+/// x_1 - x_2 = P (cos theta - 1) - Q sin theta [m].
 struct StrokeDifference {
   double P_m = 0.0;  ///< d_1 cos(alpha_1) - d_2 cos(alpha_2)
   double Q_m = 0.0;  ///< d_1 sin(alpha_1) - d_2 sin(alpha_2)
@@ -80,8 +81,8 @@ StrokeDifference StrokeDifferenceOf(const CouplerGeometry& g);
 
 /// What is wrong with `g` for the inverse `form`, or "" if nothing: an arm shorter than 1 mm, an
 /// angle more than 1e-3 deg from atan2(yv, xv), arms whose stroke difference does not see a small
-/// rotation (|Q| < 0.01 max(d_1, d_2): the file comment), or the as-wired form on arms that are not symmetric
-/// (d_1 = d_2, alpha_1 = -alpha_2).
+/// rotation (|Q| < 0.01 max(d_1, d_2): the file comment), or the as-wired form on arms that are
+/// not symmetric (d_1 = d_2, alpha_1 = -alpha_2).
 std::string CouplerProblem(const CouplerGeometry& g, InverseForm form);
 
 /// Forward kinematics (the file comment).

@@ -8,15 +8,16 @@
 
 namespace rths::models::marths {
 
-/// Appends x_ref = 1000 U_27 [mm], r_ref = -U_21 [rad] and the stories' x2_ref, r2_ref, x3_ref,
-/// r3_ref (U_26, U_22, U_13, U_3 [m, rad]) of `ref` to `g`.
-inline void AppendReference(const NewmarkLinearState& ref, signal::MarthsSignals* g) {
-  g->x_ref.push_back(1000.0 * ref.U(Index(kDofX)));
-  g->r_ref.push_back(-ref.U(Index(kDofTheta)));
-  g->x2_ref.push_back(ref.U(Index(kDofX2)));
-  g->r2_ref.push_back(ref.U(Index(kDofTheta2nd)));
-  g->x3_ref.push_back(ref.U(Index(kDofX3)));
-  g->r3_ref.push_back(ref.U(Index(kDofTheta3rd)));
+/// Appends x_ref = 1000 U_x [mm], r_ref = -U_theta [rad] and the stories' x2_ref, r2_ref, x3_ref,
+/// r3_ref (U_x2, U_theta2nd, U_x3, U_theta3rd [m, rad]; the benchmark's DOFs 27, 21, 26, 22, 13, 3)
+/// of `ref` to `g`.
+inline void AppendReference(const NewmarkLinearState& ref, const FrameDofs& d, signal::MarthsSignals* g) {
+  g->x_ref.push_back(1000.0 * ref.U(Index(d.x())));
+  g->r_ref.push_back(-ref.U(Index(d.theta())));
+  g->x2_ref.push_back(ref.U(Index(d.x2())));
+  g->r2_ref.push_back(ref.U(Index(d.theta_2nd())));
+  g->x3_ref.push_back(ref.U(Index(d.x3())));
+  g->r3_ref.push_back(ref.U(Index(d.theta_3rd())));
 }
 
 }  // namespace rths::models::marths

@@ -39,12 +39,12 @@ void RigStep(const MarthsRig& r, MarthsRigState* s, const Eigen::Vector2d& u_mm)
 
 SubstructureOutput SubstructureStep(const MarthsSubstructure& m, NewmarkLinearState* s, double ag_m_s2,
                                     const InterfaceForces& f) {
-  s->F(Index(kDofX)) = f.F27_N;
-  s->F(Index(kDofTheta)) = f.M21_N_m;
-  s->F(Index(kDofTheta2)) = f.M29_N_m;
+  s->F(Index(m.dofs.x())) = f.F27_N;
+  s->F(Index(m.dofs.theta())) = f.M21_N_m;
+  s->F(Index(m.dofs.theta2())) = f.M29_N_m;
   NewmarkLinearStep(m.numerical, s, ag_m_s2);
   SubstructureOutput out;
-  out.interface = {s->U(Index(kDofX)), -s->U(Index(kDofTheta))};
+  out.interface = {s->U(Index(m.dofs.x())), -s->U(Index(m.dofs.theta()))};
   out.targets = Forward(m.geometry, out.interface);
   return out;
 }

@@ -17,6 +17,7 @@
 #include "models/marths_coupler.h"
 #include "models/marths_frame.h"
 #include "models/marths_plant.h"
+#include "models/marths_structure.h"
 #include "models/newmark_linear.h"
 #include "signal/random.h"
 
@@ -75,11 +76,12 @@ void RigStep(const MarthsRig& r, MarthsRigState* s, const Eigen::Vector2d& u_mm)
 struct MarthsSubstructure {
   NewmarkLinear numerical;
   CouplerGeometry geometry;
+  FrameDofs dofs;  ///< where the interface is (Structures::dofs)
 };
 
 /// What the substructure computes at t_k.
 struct SubstructureOutput {
-  InterfaceMotion interface;  ///< x = U_27 [m], theta = -U_21 [rad] (the frame's sign)
+  InterfaceMotion interface;  ///< x = U_x [m], theta = -U_theta [rad] (the frame's sign; DOFs 27, 21)
   ActuatorPair targets;       ///< the coupler's forward map of `interface` [mm]
 };
 

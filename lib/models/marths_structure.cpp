@@ -12,10 +12,10 @@ namespace rths::models::marths {
 
 namespace {
 
-void CheckFrameMatrix(const Eigen::MatrixXd& A, const char* name) {
-  if (A.rows() != kDofs || A.cols() != kDofs) {
+void CheckFrameMatrix(const Eigen::MatrixXd& A, const char* name, Eigen::Index n) {
+  if (A.rows() != n || A.cols() != n) {
     throw Error(fmt::format("maRTHS structure: {}", name),
-                fmt::format("{} x {} matrix, expected {} x {}", A.rows(), A.cols(), kDofs, kDofs));
+                fmt::format("{} x {} matrix, expected {} x {} (square, K and M alike)", A.rows(), A.cols(), n, n));
   }
   if (!A.allFinite()) throw Error(fmt::format("maRTHS structure: {}", name), "a value is not finite");
   const double scale = A.cwiseAbs().maxCoeff();
@@ -25,6 +25,27 @@ void CheckFrameMatrix(const Eigen::MatrixXd& A, const char* name) {
 }
 
 }  // namespace
+
+std::string FrameDofsProblem(const FrameDofs& d, int n_dofs) {
+  const std::array<int, 7> named = {d.x(), d.theta(), d.theta2(), d.x2(), d.theta_2nd(), d.x3(), d.theta_3rd()};
+  for (int dof : named) {
+    if (dof < 1 || dof > n_dofs) return fmt::format("DOF {} is outside the model's 1..{}", dof, n_dofs);
+  }
+  for (int dof : d.ground) {
+    if (dof < 1 || dof > n_dofs) return fmt::format("ground DOF {} is outside the model's 1..{}", dof, n_dofs);
+  }
+  for (std::size_t i = 0; i < named.size(); ++i) {
+    for (std::size_t j = i + 1; j < named.size(); ++j) {
+      if (named[i] == named[j]) return fmt::format("DOF {} is named twice among the interface and story DOFs", named[i]);
+    }
+  }
+  for (std::size_t i = 0; i < d.ground.size(); ++i) {
+    for (std::size_t j = i + 1; j < d.ground.size(); ++j) {
+      if (d.ground[i] == d.ground[j]) return fmt::format("ground DOF {} is named twice", d.ground[i]);
+    }
+  }
+  return "";
+}
 
 Eigen::MatrixXd RayleighDamping(const Eigen::MatrixXd& M, const Eigen::MatrixXd& K, double w_i,
                                 double w_j, double zeta) {
@@ -56,25 +77,31 @@ IdealPhysical BuildIdealPhysical(double density_kg_m3) {
 }
 
 Structures BuildStructures(const Eigen::MatrixXd& K_ref, const Eigen::MatrixXd& M_ref,
-                           double ideal_density_kg_m3) {
-  CheckFrameMatrix(K_ref, "K (reference_K_N_per_m.csv)");
-  CheckFrameMatrix(M_ref, "M (reference_M_kg.csv)");
+                           double ideal_density_kg_m3, const FrameDofs& dofs) {
+  const Eigen::Index n = M_ref.rows();  // K is checked against M's size, then M against itself
+  CheckFrameMatrix(K_ref, "K (reference_K_N_per_m.csv)", n);
+  CheckFrameMatrix(M_ref, "M (reference_M_kg.csv)", n);
+  if (const std::string why = FrameDofsProblem(dofs, static_cast<int>(n)); !why.empty()) {
+    throw Error("maRTHS structure: DOFs", why);
+  }
   Structures s;
+  s.dofs = dofs;
   s.reference.K = K_ref;
   s.reference.M = M_ref;
   s.reference.C = RayleighDamping(M_ref, K_ref, 13.493, 165.125, 0.05);
-  s.reference.l = Eigen::VectorXd::Zero(kDofs);
-  for (int dof : kGroundDofs) s.reference.l(Index(dof)) = 1.0;
+  s.reference.l = Eigen::VectorXd::Zero(n);
+  for (int dof : dofs.ground) s.reference.l(Index(dof)) = 1.0;
   s.physical = BuildIdealPhysical(ideal_density_kg_m3);
   s.numerical = s.reference;
+  const std::array<int, 3> physical = dofs.physical();
   for (int i = 0; i < 3; ++i) {
     for (int j = 0; j < 3; ++j) {
-      const int a = Index(kPhysicalDofs[i]), b = Index(kPhysicalDofs[j]);
+      const int a = Index(physical[i]), b = Index(physical[j]);
       s.numerical.K(a, b) -= s.physical.K(i, j);
       s.numerical.C(a, b) -= s.physical.C(i, j);
     }
   }
-  s.numerical.M(Index(kDofX), Index(kDofX)) -= s.physical.M(0, 0);
+  s.numerical.M(Index(dofs.x()), Index(dofs.x())) -= s.physical.M(0, 0);
   return s;
 }
 

@@ -33,6 +33,7 @@
 /// Numerical (build_numerical.m): K_n = K_r - K_p and C_n = C_r - C_p on the DOFs (27, 29, 21);
 /// M_n = M_r - M_p(1,1) at DOF 27 only (the code zeroes the rotational masses before subtracting).
 #include <array>
+#include <string>
 
 #include <Eigen/Core>
 
@@ -50,18 +51,44 @@ inline constexpr int kDofX3 = 13;       ///< third story, translation [m]
 inline constexpr int kDofTheta3rd = 3;  ///< third story, rotation [rad]
 /// The DOFs the ground acceleration loads (influence 1).
 inline constexpr std::array<int, 3> kGroundDofs = {13, 26, 27};
-/// The physical substructure's DOFs, in K_p's order.
-inline constexpr std::array<int, 3> kPhysicalDofs = {kDofX, kDofTheta2, kDofTheta};
+
+/// Where the benchmark's quantities sit among a frame model's DOFs (1-based, as Joint_DOF.xlsx
+/// numbers them): the reference code's numbering by default. A lab's own model of the frame
+/// (another mesh or numbering; [marths] interface_dofs, story_dofs, ground_dofs) declares its own;
+/// the physical bay is subtracted at (x, theta2, theta) in K_p's order.
+struct FrameDofs {
+  /// The interface node's translation x, its driven rotation theta, the other top node's
+  /// rotation theta2 (not driven): where the feedback frame's F, M_theta, M_theta2 enter.
+  std::array<int, 3> interface = {kDofX, kDofTheta, kDofTheta2};
+  /// Second story translation and rotation, third story translation and rotation (J8-J10).
+  std::array<int, 4> stories = {kDofX2, kDofTheta2nd, kDofX3, kDofTheta3rd};
+  /// The DOFs the ground acceleration loads (influence 1).
+  std::array<int, 3> ground = kGroundDofs;
+  int x() const { return interface[0]; }
+  int theta() const { return interface[1]; }
+  int theta2() const { return interface[2]; }
+  int x2() const { return stories[0]; }
+  int theta_2nd() const { return stories[1]; }
+  int x3() const { return stories[2]; }
+  int theta_3rd() const { return stories[3]; }
+  /// The physical substructure's DOFs in K_p's order (x, theta2, theta).
+  std::array<int, 3> physical() const { return {x(), theta2(), theta()}; }
+  bool operator==(const FrameDofs&) const = default;
+};
+
+/// What is wrong with `d` for a model of `n_dofs` DOFs, or "": a DOF outside [1, n_dofs], the
+/// interface and story DOFs not seven distinct ones, the ground DOFs not distinct.
+std::string FrameDofsProblem(const FrameDofs& d, int n_dofs);
 
 /// Mass, damping and stiffness of a frame model, SI.
 struct FrameMatrices {
   Eigen::MatrixXd M;  ///< [kg, kg m^2]
   Eigen::MatrixXd C;  ///< [N s/m, N m s/rad]
   Eigen::MatrixXd K;  ///< [N/m, N m/rad]
-  Eigen::VectorXd l;  ///< ground influence [-]: 1 at kGroundDofs
+  Eigen::VectorXd l;  ///< ground influence [-]: 1 at the ground DOFs (FrameDofs::ground)
 };
 
-/// The ideal physical substructure (3 x 3, DOFs kPhysicalDofs).
+/// The ideal physical substructure (3 x 3, DOFs FrameDofs::physical()).
 struct IdealPhysical {
   Eigen::Matrix3d M, C, K;
 };
@@ -78,13 +105,15 @@ struct Structures {
   FrameMatrices reference;
   FrameMatrices numerical;
   IdealPhysical physical;
+  FrameDofs dofs;  ///< where the interface, the stories and the ground load are
 };
 
-/// From the SAP2000 matrices (29 x 29, SI): the reference with its Rayleigh damping and the
-/// numerical substructure (the file comment). Throws rths::Error if a matrix is not 29 x 29,
-/// not symmetric (relative 1e-9), or holds a value that is not finite.
+/// From the reference matrices (the SAP2000 export: 29 x 29, SI; a lab's own model: n x n with
+/// its `dofs`): the reference with its Rayleigh damping and the numerical substructure (the file
+/// comment). Throws rths::Error if a matrix is not square, K and M differ in size, one is not
+/// symmetric (relative 1e-9) or holds a value that is not finite, or FrameDofsProblem refuses `dofs`.
 Structures BuildStructures(const Eigen::MatrixXd& K_ref, const Eigen::MatrixXd& M_ref,
-                           double ideal_density_kg_m3 = 785e3);
+                           double ideal_density_kg_m3 = 785e3, const FrameDofs& dofs = {});
 
 /// The 0-based index of a 1-based DOF number.
 constexpr int Index(int dof) { return dof - 1; }

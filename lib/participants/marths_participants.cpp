@@ -53,9 +53,9 @@ namespace {
 /// The numerical substructure of the scenario's matrices, at run.dt_s.
 mm::MarthsSubstructure SubstructureOf(const scenario::Scenario& s) {
   const mm::Structures st = mm::BuildStructures(s.marths.files.K_ref, s.marths.files.M_ref,
-                                                s.marths.ideal_density_kg_m3);
+                                                s.marths.ideal_density_kg_m3, s.marths.dofs);
   return {models::MakeNewmarkLinear(st.numerical.M, st.numerical.C, st.numerical.K, st.numerical.l, s.run.dt_s),
-          s.marths.coupler};
+          s.marths.coupler, st.dofs};
 }
 
 /// Sizes a message's array once (the first step), so that later steps only write into it.

@@ -8,7 +8,7 @@
 ///               the strokes y_k,i (y_act_mm, with the sensor noise) and the forces on the numerical
 ///               DOFs 27, 21, 29 (f_iface [N, N m, N m]); measured_t 0 at rest, at GO.
 ///   integrator  desired_t k from measured_t k: the Newmark step to t_k under a_g(t_k) and those
-///               forces, the targets through the coupler (r_act_mm [mm]); x_mm holds the 29 DOFs'
+///               forces, the targets through the coupler (r_act_mm [mm]); x_mm holds the frame's DOFs'
 ///               displacements x 1000 (translations [mm], rotations [mrad]).
 ///   controller  command_t k from desired_t k and measured_t k: control::MarthsCompensators
 ///               (u_act_mm [mm]).

@@ -25,7 +25,9 @@ MarthsRunScore MarthsScoreOfRun(const io::RunLog& log, const scenario::Scenario&
   if (!s.marths.enabled) throw Error(s.path, "marths.enabled is false: not a maRTHS run");
   const std::int64_t n = log.CompleteSteps();
   const mm::Structures st = mm::BuildStructures(s.marths.files.K_ref, s.marths.files.M_ref,
-                                                s.marths.ideal_density_kg_m3);
+                                                s.marths.ideal_density_kg_m3, s.marths.dofs);
+  const mm::FrameDofs& dofs = st.dofs;
+  const auto n_dof = static_cast<std::int32_t>(st.reference.K.rows());
   const models::NewmarkLinear ref = models::MakeNewmarkLinear(st.reference.M, st.reference.C, st.reference.K,
                                                               st.reference.l, s.run.dt_s);
   models::NewmarkLinearState ref_s = models::NewmarkLinearAtRest(ref);
@@ -40,11 +42,11 @@ MarthsRunScore MarthsScoreOfRun(const io::RunLog& log, const scenario::Scenario&
     const rths::desired_t& d = log.desired[i];
     const rths::measured_t& m = log.measured[i];
     const rths::command_t& c = log.command[i];
-    if (d.n_act != 2 || m.n_act != 2 || c.n_act != 2 || d.n_dof != mm::kDofs) {
+    if (d.n_act != 2 || m.n_act != 2 || c.n_act != 2 || d.n_dof != n_dof) {
       throw Error(log.source, fmt::format("step {}: the messages do not carry the benchmark's 2 actuators and {} DOFs "
                                           "(desired_t n_act = {}, n_dof = {}; measured_t n_act = {}; command_t "
                                           "n_act = {})",
-                                          k, mm::kDofs, d.n_act, d.n_dof, m.n_act, c.n_act));
+                                          k, n_dof, d.n_act, d.n_dof, m.n_act, c.n_act));
     }
     models::NewmarkLinearStep(ref, &ref_s, ag[i]);
     const mm::InterfaceMotion est =
@@ -55,13 +57,13 @@ MarthsRunScore MarthsScoreOfRun(const io::RunLog& log, const scenario::Scenario&
     g.xa2_m.push_back(m.y_act_mm[1]);
     g.x_hat.push_back(1000.0 * est.x_m);
     g.r_hat.push_back(est.theta_rad);
-    g.x_num.push_back(d.x_mm[static_cast<std::size_t>(mm::Index(mm::kDofX))]);
-    g.r_num.push_back(-Num(d, mm::kDofTheta));
-    g.x2_num.push_back(Num(d, mm::kDofX2));
-    g.r2_num.push_back(Num(d, mm::kDofTheta2nd));
-    g.x3_num.push_back(Num(d, mm::kDofX3));
-    g.r3_num.push_back(Num(d, mm::kDofTheta3rd));
-    mm::AppendReference(ref_s, &g);
+    g.x_num.push_back(d.x_mm[static_cast<std::size_t>(mm::Index(dofs.x()))]);
+    g.r_num.push_back(-Num(d, dofs.theta()));
+    g.x2_num.push_back(Num(d, dofs.x2()));
+    g.r2_num.push_back(Num(d, dofs.theta_2nd()));
+    g.x3_num.push_back(Num(d, dofs.x3()));
+    g.r3_num.push_back(Num(d, dofs.theta_3rd()));
+    mm::AppendReference(ref_s, dofs, &g);
     for (int a = 0; a < 2; ++a) out.max_volts[a] = std::max(out.max_volts[a], std::abs(volts.Volts(a, c.u_act_mm[a])));
   }
   out.j = signal::MarthsCriteriaFrom(g);

@@ -40,8 +40,8 @@ class Checker {
   }
   void Servo(std::string_view key, models::ServoModel3& m) { ValidateServo(m, Dotted(key), *check_); }
   void Tf(std::string_view, control::TfCoefficients&) {}  // ValidateController: CheckTf and stability
-  template <std::size_t N>
-  void Numbers(std::string_view key, std::array<double, N>& v, const Range& r) {
+  template <typename T, std::size_t N>
+  void Numbers(std::string_view key, std::array<T, N>& v, const Range& r) {
     for (std::size_t i = 0; i < N; ++i) check_->InRange(fmt::format("{}[{}]", Dotted(key), i), v[i], r);
   }
   template <typename F>

@@ -15,6 +15,10 @@ void MarthsFields(V& v, control::MarthsConfig& m, const Context&) {
   v.String("ground_file", m.ground_file);
   v.Number("ground_scale", m.ground_scale, OpenClosed(0.0, 100.0));
   v.Number("ideal_density_kg_m3", m.ideal_density_kg_m3, OpenClosed(0.0, 1e9));
+  // The DOFs against the matrices' size and each other: ReadMarthsFiles (FrameDofsProblem).
+  v.Numbers("interface_dofs", m.dofs.interface, Closed(1.0, 1e6));
+  v.Numbers("story_dofs", m.dofs.stories, Closed(1.0, 1e6));
+  v.Numbers("ground_dofs", m.dofs.ground, Closed(1.0, 1e6));
   v.Choice("compensator", m.compensator, control::kMarthsCompensatorNames);
   v.Integer("perturbed_plant", m.perturbed_plant, Closed(0, 10000));
   v.Integer("plant_seed", m.plant_seed, Closed(0.0, 9007199254740992.0));

@@ -1,5 +1,6 @@
 /// @file The Reader: TOML -> structs (keys and types; ranges are the Checker's).
 #include <atomic>
+#include <cmath>
 #include <cstdio>
 #include <string>
 #include <string_view>
@@ -39,6 +40,19 @@ class Reader {
   void Tf(std::string_view key, control::TfCoefficients& tf) { section_->Tf(key, &tf); }
   template <std::size_t N>
   void Numbers(std::string_view key, std::array<double, N>& v, const Range&) { section_->Numbers(key, v.data(), N); }
+  /// Whole numbers: as Numbers, each an integer.
+  template <std::size_t N>
+  void Numbers(std::string_view key, std::array<int, N>& v, const Range&) {
+    std::array<double, N> read{};
+    for (std::size_t i = 0; i < N; ++i) read[i] = v[i];
+    section_->Numbers(key, read.data(), N);
+    for (std::size_t i = 0; i < N; ++i) {
+      if (!(std::abs(read[i]) < 1e9) || read[i] != std::floor(read[i])) {
+        section_->Fail(key, fmt::format("element {} is {}: expected an integer", i + 1, read[i]));
+      }
+      v[i] = static_cast<int>(read[i]);
+    }
+  }
   template <typename F>
   void Table(std::string_view key, F&& fields, bool /*present*/ = true) {
     Section sub = section_->Sub(key);

@@ -8,6 +8,7 @@
 #include "core/names.h"
 #include "models/benchmark_structures.h"
 #include "models/marths_files.h"
+#include "models/marths_structure.h"
 #include "scenario/walk.h"
 
 namespace rths::scenario {
@@ -72,11 +73,16 @@ void ReadMarthsFiles(const std::string& path, const detail::Check& check, contro
   m->files.rodeac = models::marths::ReadRodeacParameters(file(m->rodeac_file));
   m->ground = signal::ReadHistoryFile(file(m->ground_file), 0.0);
   const auto n = m->files.K_ref.rows();
-  if (m->files.K_ref.cols() != n || m->files.M_ref.rows() != n || m->files.M_ref.cols() != n || n != 29) {
+  if (m->files.K_ref.cols() != n || m->files.M_ref.rows() != n || m->files.M_ref.cols() != n) {
     check.Fail("marths.reference_m_file",
-               fmt::format("the reference matrices must be 29 x 29 (the benchmark's frame): K is {} x {}, M is {} x {}",
+               fmt::format("the reference matrices must be square and of one size (29 x 29 in the benchmark): K is "
+                           "{} x {}, M is {} x {}",
                            m->files.K_ref.rows(), m->files.K_ref.cols(), m->files.M_ref.rows(),
                            m->files.M_ref.cols()));
+  }
+  if (const std::string why = models::marths::FrameDofsProblem(m->dofs, static_cast<int>(n)); !why.empty()) {
+    check.Fail("marths.interface_dofs", fmt::format("(with story_dofs, ground_dofs; the matrices of {}): {}",
+                                                    m->reference_k_file, why));
   }
 }
 

@@ -64,6 +64,12 @@ class Writer {
     for (std::size_t i = 0; i < N; ++i) t += (i ? ", " : "") + TomlNumber(v[i]);
     Key(key, t + "]");
   }
+  template <std::size_t N>
+  void Numbers(std::string_view key, std::array<int, N>& v, const Range&) {
+    std::string t = "[";
+    for (std::size_t i = 0; i < N; ++i) t += fmt::format("{}{}", i ? ", " : "", v[i]);
+    Key(key, t + "]");
+  }
   void Tf(std::string_view key, control::TfCoefficients& tf) {
     if (tf.Empty()) return;  // the default, 1
     auto list = [](const std::vector<double>& v) {

@@ -39,10 +39,10 @@ double U(const models::NewmarkLinearState& s, int dof) { return s.U(mm::Index(do
 MarthsLoopResult RunMarthsLoop(const MarthsLoopConfig& c) {
   const std::size_t n = c.ag_m_s2.size();
   if (n < 2) throw Error("maRTHS loop", "the ground motion has fewer than 2 samples");
-  const mm::Structures st = mm::BuildStructures(c.K_ref, c.M_ref, c.ideal_density_kg_m3);
+  const mm::Structures st = mm::BuildStructures(c.K_ref, c.M_ref, c.ideal_density_kg_m3, c.dofs);
   const mm::MarthsSubstructure sub{models::MakeNewmarkLinear(st.numerical.M, st.numerical.C, st.numerical.K,
                                                              st.numerical.l, c.dt_s),
-                                   c.rig.geometry};
+                                   c.rig.geometry, st.dofs};
   const models::NewmarkLinear ref = models::MakeNewmarkLinear(st.reference.M, st.reference.C, st.reference.K,
                                                               st.reference.l, c.dt_s);
   const mm::MarthsRig rig = mm::MakeMarthsRig(c.plant, c.dt_s, c.rig);
@@ -76,13 +76,13 @@ MarthsLoopResult RunMarthsLoop(const MarthsLoopConfig& c) {
     g.xa2_m.push_back(y(1));
     g.x_hat.push_back(1000.0 * est.x_m);
     g.r_hat.push_back(est.theta_rad);
-    g.x_num.push_back(1000.0 * U(num_s, mm::kDofX));
-    g.r_num.push_back(-U(num_s, mm::kDofTheta));
-    g.x2_num.push_back(U(num_s, mm::kDofX2));
-    g.r2_num.push_back(U(num_s, mm::kDofTheta2nd));
-    g.x3_num.push_back(U(num_s, mm::kDofX3));
-    g.r3_num.push_back(U(num_s, mm::kDofTheta3rd));
-    mm::AppendReference(ref_s, &g);
+    g.x_num.push_back(1000.0 * U(num_s, st.dofs.x()));
+    g.r_num.push_back(-U(num_s, st.dofs.theta()));
+    g.x2_num.push_back(U(num_s, st.dofs.x2()));
+    g.r2_num.push_back(U(num_s, st.dofs.theta_2nd()));
+    g.x3_num.push_back(U(num_s, st.dofs.x3()));
+    g.r3_num.push_back(U(num_s, st.dofs.theta_3rd()));
+    mm::AppendReference(ref_s, st.dofs, &g);
   }
   r.saturated = signal::MarthsSaturated(r.max_volts[0], r.max_volts[1]);
   r.j = signal::MarthsCriteriaFrom(g);

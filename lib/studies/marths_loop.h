@@ -43,6 +43,7 @@ struct MarthsLoopConfig {
   double dt_s = 1.0 / 1024.0;
   std::vector<double> ag_m_s2;          ///< the scaled ground acceleration at t_k, one per sample
   Eigen::MatrixXd K_ref, M_ref;         ///< the SAP2000 reference matrices (29 x 29, SI)
+  models::marths::FrameDofs dofs;       ///< where the interface, stories and ground load are in them
   double ideal_density_kg_m3 = 785e3;   ///< the ideal physical substructure's density (as coded)
   models::marths::PlantZpk plant = models::marths::NominalPlantZpk();
   /// The rig's sensor noise (off by default here), its seed, and the reference code's ambiguous

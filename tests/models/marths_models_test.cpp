@@ -76,6 +76,16 @@ TEST_CASE("the reference and numerical structures: Rayleigh at 13.493 and 165.12
   CHECK(s.reference.l(mm::Index(26)) == 1.0);
   // A wrong size is refused, naming the matrix.
   CHECK_THROWS_WITH(mm::BuildStructures(K.topLeftCorner(28, 28), M), doctest::Contains("K (reference_K_N_per_m.csv)"));
+  // The DOFs: the benchmark's by default; out of the model or named twice is refused.
+  CHECK(mm::FrameDofsProblem(mm::FrameDofs{}, 29).empty());
+  CHECK(s.dofs == mm::FrameDofs{});
+  mm::FrameDofs twice;
+  twice.stories[3] = 21;
+  CHECK(mm::FrameDofsProblem(twice, 29).find("named twice") != std::string::npos);
+  mm::FrameDofs outside;
+  outside.ground[0] = 30;
+  CHECK(mm::FrameDofsProblem(outside, 29).find("outside the model's 1..29") != std::string::npos);
+  CHECK_THROWS_WITH(mm::BuildStructures(K, M, 785e3, outside), doctest::Contains("ground DOF 30"));
 }
 
 TEST_CASE("Newmark average acceleration is the trapezoidal rule on (x, x') with the loads at both ends of the step") {
@@ -299,7 +309,7 @@ TEST_CASE("the rig's and the substructure's steps allocate nothing") {
   const mm::Structures st = mm::BuildStructures(K, M);
   const mm::MarthsSubstructure sub{rths::models::MakeNewmarkLinear(st.numerical.M, st.numerical.C, st.numerical.K,
                                                                    st.numerical.l, dt),
-                                   mm::CouplerGeometry{}};
+                                   mm::CouplerGeometry{}, st.dofs};
   mm::RigOptions o;
   o.noise_mm = 0.0124;
   const mm::MarthsRig rig = mm::MakeMarthsRig(mm::NominalPlantZpk(), dt, o);

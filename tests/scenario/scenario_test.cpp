@@ -679,6 +679,11 @@ TEST_CASE("[marths]: the shipped scenarios load their files, round-trip through 
   refused("marths.ground_file=nowhere.txt", "marths.ground_file");
   refused("semiactive.mode=clipped_optimal", "semiactive.mode");
   refused("plant.kind=ideal", "plant.kind");
+  // A lab's own model of the frame: its DOFs against the matrices and each other.
+  refused("marths.interface_dofs=[27, 27, 29]", "named twice");
+  refused("marths.story_dofs=[26, 22, 13, 30]", "outside the model's 1..29");
+  refused("marths.ground_dofs=[13, 26, 27.5]", "expected an integer");
+  refused("marths.interface_dofs=[27, 21]", "marths.interface_dofs");
   // A lab's own coupler: the arms are checked together (models::marths::CouplerProblem).
   auto refused_why = [&](const std::vector<std::string>& sets, const char* why) {
     CAPTURE(sets.front());

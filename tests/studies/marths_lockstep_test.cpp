@@ -7,6 +7,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -18,6 +19,7 @@
 #include "ident/design_model.h"
 #include "io/run_log.h"
 #include "models/marths_files.h"
+#include "models/marths_structure.h"
 #include "participants/marths_run.h"
 #include "participants/replay.h"
 #include "scenario/scenario.h"
@@ -200,6 +202,74 @@ TEST_CASE("maRTHS lockstep: the safety monitor watches both actuators and names 
   const auto log = rths::io::ReadRunLog((dir / "log.lcm").string());
   CHECK(log.CompleteSteps() == first + 1);  // the log is whole up to the step that tripped
   CHECK(log.AbortReason().find("actuator 2") != std::string::npos);
+}
+
+TEST_CASE("maRTHS lockstep: a lab's own model of the frame (the benchmark's, its DOFs renumbered, from files) "
+          "gives the benchmark's run") {
+  // The reference matrices with their 29 DOFs in a random order, written as a lab would export
+  // them, and the interface, story and ground DOFs declared in that order.
+  const Eigen::MatrixXd K = mm::ReadMatrixCsv(kData + "reference_K_N_per_m.csv");
+  const Eigen::MatrixXd M = mm::ReadMatrixCsv(kData + "reference_M_kg.csv");
+  std::vector<int> to(29);
+  for (int i = 0; i < 29; ++i) to[static_cast<std::size_t>(i)] = i;
+  std::mt19937_64 gen(29);
+  std::shuffle(to.begin(), to.end(), gen);  // old DOF i (0-based) is new DOF to[i]
+  const fs::path dir = TempDir("marths_renumbered");
+  auto write = [&](const Eigen::MatrixXd& A, const fs::path& file) {
+    Eigen::MatrixXd B(29, 29);
+    for (int i = 0; i < 29; ++i) {
+      for (int j = 0; j < 29; ++j) B(to[static_cast<std::size_t>(i)], to[static_cast<std::size_t>(j)]) = A(i, j);
+    }
+    std::ofstream out(file);
+    for (int i = 0; i < 29; ++i) {
+      for (int j = 0; j < 29; ++j) out << fmt::format("{}{:.17g}", j ? "," : "", B(i, j));
+      out << "\n";
+    }
+  };
+  write(K, dir / "K.csv");
+  write(M, dir / "M.csv");
+  auto renumbered = [&](auto dofs) {
+    std::string list = "[";
+    for (std::size_t i = 0; i < dofs.size(); ++i) list += fmt::format("{}{}", i ? ", " : "", to[static_cast<std::size_t>(dofs[i] - 1)] + 1);
+    return list + "]";
+  };
+  const mm::FrameDofs bmk;
+  const auto s = Scenario({"marths.compensator=rodeac", "marths.reference_k_file=" + (dir / "K.csv").string(),
+                           "marths.reference_m_file=" + (dir / "M.csv").string(),
+                           "marths.interface_dofs=" + renumbered(bmk.interface),
+                           "marths.story_dofs=" + renumbered(bmk.stories),
+                           "marths.ground_dofs=" + renumbered(bmk.ground)});
+  CHECK(s.marths.dofs.x() == to[26] + 1);
+  const auto base = Scenario({"marths.compensator=rodeac"});
+  fs::create_directories(dir / "lab");
+  fs::create_directories(dir / "bmk");
+  REQUIRE(RunMemq({s}, dir / "lab").code == 0);
+  REQUIRE(RunMemq({base}, dir / "bmk").code == 0);
+  const auto lab = rths::io::ReadRunLog((dir / "lab" / "log.lcm").string());
+  const auto ref = rths::io::ReadRunLog((dir / "bmk" / "log.lcm").string());
+  REQUIRE(lab.CompleteSteps() == ref.CompleteSteps());
+  double worst_target = 0.0, worst_dof = 0.0, peak = 0.0;
+  for (std::size_t k = 0; k < static_cast<std::size_t>(lab.CompleteSteps()); ++k) {
+    for (int a = 0; a < 2; ++a) {
+      worst_target = std::max(worst_target, std::abs(lab.desired[k].r_act_mm[a] - ref.desired[k].r_act_mm[a]));
+      peak = std::max(peak, std::abs(ref.desired[k].r_act_mm[a]));
+    }
+    for (int i = 0; i < 29; ++i) {  // the lab's DOF to[i] is the benchmark's DOF i
+      worst_dof = std::max(worst_dof, std::abs(lab.desired[k].x_mm[to[static_cast<std::size_t>(i)]] -
+                                               ref.desired[k].x_mm[static_cast<std::size_t>(i)]));
+    }
+  }
+  MESSAGE("renumbered frame: targets within ", worst_target, " mm of the benchmark's (peak ", peak,
+          " mm), every DOF within ", worst_dof);
+  CHECK(peak > 0.1);
+  CHECK(worst_target < 1e-9 * peak);
+  CHECK(worst_dof < 1e-9);
+  const auto a = rths::participants::MarthsScoreOfRun(lab, s).j.Items();
+  const auto b = rths::participants::MarthsScoreOfRun(ref, base).j.Items();
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    CAPTURE(a[i].first);
+    CHECK(a[i].second == doctest::Approx(b[i].second).epsilon(1e-8));
+  }
 }
 
 TEST_CASE("maRTHS scenarios: bad input is refused naming the key") {
