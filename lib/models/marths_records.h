@@ -1,7 +1,8 @@
 #pragma once
-/// @file The reference structure's records of one sample as S5_Evaluation.m takes them (docs/marths.md
-/// "Criteria"), from its Newmark state: the one piece the in-process loop (studies/marths_loop.h)
-/// and the lockstep run's score (participants/marths_run.h) both append with.
+/// @file The structures' records of one sample as S5_Evaluation.m takes them (docs/marths.md
+/// "Criteria"): the reference's from its Newmark state and the numerical substructure's from its
+/// displacements, the pieces the in-process loop (studies/marths_loop.h) and the lockstep run's
+/// score (participants/marths_run.h) both append with.
 #include "models/marths_structure.h"
 #include "models/newmark_linear.h"
 #include "signal/marths_criteria.h"
@@ -18,6 +19,19 @@ inline void AppendReference(const NewmarkLinearState& ref, const FrameDofs& d, s
   g->r2_ref.push_back(ref.U(Index(d.theta_2nd())));
   g->x3_ref.push_back(ref.U(Index(d.x3())));
   g->r3_ref.push_back(ref.U(Index(d.theta_3rd())));
+}
+
+/// Appends the numerical substructure's x_num = x_mm [mm] (passed as the caller has it: the loop's
+/// 1000 U_x, the log's x_mm), r_num = -u(theta) [rad] and the stories' x2_num, r2_num, x3_num,
+/// r3_num = u(dof) [m, rad], where u(dof) is the displacement of a 1-based DOF in SI.
+template <typename U>
+void AppendNumerical(const FrameDofs& d, double x_mm, U&& u, signal::MarthsSignals* g) {
+  g->x_num.push_back(x_mm);
+  g->r_num.push_back(-u(d.theta()));
+  g->x2_num.push_back(u(d.x2()));
+  g->r2_num.push_back(u(d.theta_2nd()));
+  g->x3_num.push_back(u(d.x3()));
+  g->r3_num.push_back(u(d.theta_3rd()));
 }
 
 }  // namespace rths::models::marths

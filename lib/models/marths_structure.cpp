@@ -24,6 +24,17 @@ void CheckFrameMatrix(const Eigen::MatrixXd& A, const char* name, Eigen::Index n
   }
 }
 
+/// The first value that `a` holds twice, or 0 (DOFs are >= 1).
+template <std::size_t N>
+int Repeated(const std::array<int, N>& a) {
+  for (std::size_t i = 0; i < N; ++i) {
+    for (std::size_t j = i + 1; j < N; ++j) {
+      if (a[i] == a[j]) return a[i];
+    }
+  }
+  return 0;
+}
+
 }  // namespace
 
 std::string FrameDofsProblem(const FrameDofs& d, int n_dofs) {
@@ -34,16 +45,10 @@ std::string FrameDofsProblem(const FrameDofs& d, int n_dofs) {
   for (int dof : d.ground) {
     if (dof < 1 || dof > n_dofs) return fmt::format("ground DOF {} is outside the model's 1..{}", dof, n_dofs);
   }
-  for (std::size_t i = 0; i < named.size(); ++i) {
-    for (std::size_t j = i + 1; j < named.size(); ++j) {
-      if (named[i] == named[j]) return fmt::format("DOF {} is named twice among the interface and story DOFs", named[i]);
-    }
+  if (const int twice = Repeated(named)) {
+    return fmt::format("DOF {} is named twice among the interface and story DOFs", twice);
   }
-  for (std::size_t i = 0; i < d.ground.size(); ++i) {
-    for (std::size_t j = i + 1; j < d.ground.size(); ++j) {
-      if (d.ground[i] == d.ground[j]) return fmt::format("ground DOF {} is named twice", d.ground[i]);
-    }
-  }
+  if (const int twice = Repeated(d.ground)) return fmt::format("ground DOF {} is named twice", twice);
   return "";
 }
 

@@ -57,12 +57,8 @@ MarthsRunScore MarthsScoreOfRun(const io::RunLog& log, const scenario::Scenario&
     g.xa2_m.push_back(m.y_act_mm[1]);
     g.x_hat.push_back(1000.0 * est.x_m);
     g.r_hat.push_back(est.theta_rad);
-    g.x_num.push_back(d.x_mm[static_cast<std::size_t>(mm::Index(dofs.x()))]);
-    g.r_num.push_back(-Num(d, dofs.theta()));
-    g.x2_num.push_back(Num(d, dofs.x2()));
-    g.r2_num.push_back(Num(d, dofs.theta_2nd()));
-    g.x3_num.push_back(Num(d, dofs.x3()));
-    g.r3_num.push_back(Num(d, dofs.theta_3rd()));
+    mm::AppendNumerical(dofs, d.x_mm[static_cast<std::size_t>(mm::Index(dofs.x()))],
+                        [&](int dof) { return Num(d, dof); }, &g);
     mm::AppendReference(ref_s, dofs, &g);
     for (int a = 0; a < 2; ++a) out.max_volts[a] = std::max(out.max_volts[a], std::abs(volts.Volts(a, c.u_act_mm[a])));
   }

@@ -76,12 +76,7 @@ MarthsLoopResult RunMarthsLoop(const MarthsLoopConfig& c) {
     g.xa2_m.push_back(y(1));
     g.x_hat.push_back(1000.0 * est.x_m);
     g.r_hat.push_back(est.theta_rad);
-    g.x_num.push_back(1000.0 * U(num_s, st.dofs.x()));
-    g.r_num.push_back(-U(num_s, st.dofs.theta()));
-    g.x2_num.push_back(U(num_s, st.dofs.x2()));
-    g.r2_num.push_back(U(num_s, st.dofs.theta_2nd()));
-    g.x3_num.push_back(U(num_s, st.dofs.x3()));
-    g.r3_num.push_back(U(num_s, st.dofs.theta_3rd()));
+    mm::AppendNumerical(st.dofs, 1000.0 * U(num_s, st.dofs.x()), [&](int dof) { return U(num_s, dof); }, &g);
     mm::AppendReference(ref_s, st.dofs, &g);
   }
   r.saturated = signal::MarthsSaturated(r.max_volts[0], r.max_volts[1]);
